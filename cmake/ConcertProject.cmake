@@ -92,10 +92,24 @@ function(concert_check_core_libraries)
   endforeach()
 endfunction()
 
+# Tests that talk DDS each get their own domain id (CONCERT_DOMAIN_ID), so `ctest -j` never
+# mixes two tests' traffic. Ids 100..229 are handed out in configuration order.
+set_property(GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN 100)
+function(concert_next_test_domain out_var)
+  get_property(id GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN)
+  if(id GREATER 229)
+    message(FATAL_ERROR "More DDS tests than test domain ids (100..229)")
+  endif()
+  math(EXPR next "${id} + 1")
+  set_property(GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN ${next})
+  set(${out_var} ${id} PARENT_SCOPE)
+endfunction()
+
 # Unit/integration test from sources, linked with GoogleTest, registered with ctest.
-#   concert_add_test(NAME name SOURCES a.cpp ... LIBS lib ... [LABELS l ...] [TIMEOUT s])
+#   concert_add_test(NAME name SOURCES a.cpp ... LIBS lib ... [LABELS l ...] [TIMEOUT s] [DDS])
+# DDS: the test gets a private CONCERT_DOMAIN_ID and the label "dds".
 function(concert_add_test)
-  cmake_parse_arguments(T "" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(T "DDS" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
   concert_target_defaults(${T_NAME})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main Threads::Threads)
@@ -107,4 +121,9 @@ function(concert_add_test)
   endif()
   add_test(NAME ${T_NAME} COMMAND ${T_NAME})
   set_tests_properties(${T_NAME} PROPERTIES TIMEOUT ${T_TIMEOUT} LABELS "${T_LABELS}")
+  if(T_DDS)
+    concert_next_test_domain(domain)
+    set_tests_properties(${T_NAME} PROPERTIES
+      ENVIRONMENT "CONCERT_DOMAIN_ID=${domain}" LABELS "dds;${T_LABELS}")
+  endif()
 endfunction()
