@@ -23,6 +23,16 @@ struct EscIdentity {
 /// Kind of module, as the network can tell it from mod_type.
 enum class ModuleKind { kJoint, kHub, kEndEffector, kLink, kWheel, kBaseLink };
 
+/// Kind for an ESC's mod_type register (1 joint, 2 hub, 3 end-effector, 4 link, 5 wheel,
+/// 6 base link); empty for any other value.
+std::optional<ModuleKind> module_kind_from_mod_type(int32_t mod_type);
+
+/// Lower-case name of a kind: "joint", "hub", "end_effector", "link", "wheel", "base_link".
+std::string to_string(ModuleKind kind);
+
+/// "(mod_type 1, mod_id 6, mod_size 4, mod_rev 0)", for messages.
+std::string to_string(const EscIdentity& identity);
+
 /// One slave as reported by the EtherCAT master after a scan.
 struct EscSlave {
   int32_t position = 0;      ///< position in the ring, 1..n
