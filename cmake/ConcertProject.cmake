@@ -23,7 +23,8 @@ endif()
 
 add_library(concert_build_options INTERFACE)
 target_compile_options(concert_build_options INTERFACE
-  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wconversion -Wno-sign-conversion
+  -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion
+  $<$<COMPILE_LANGUAGE:CXX>:-Wnon-virtual-dtor>
   $<$<BOOL:${CONCERT_WERROR}>:-Werror>)
 if(CONCERT_SANITIZE)
   target_compile_options(concert_build_options INTERFACE -fsanitize=${CONCERT_SANITIZE} -fno-omit-frame-pointer)
