@@ -1,0 +1,270 @@
+#include "concert/kinematics/model.hpp"
+
+#include <kdl/jacobian.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/treefksolverpos_recursive.hpp>
+#include <kdl/treeidsolver_recursive_newton_euler.hpp>
+#include <kdl/treejnttojacsolver.hpp>
+#include <urdf_parser/urdf_parser.h>
+
+#include <algorithm>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <unordered_map>
+
+#include "urdf_to_kdl.hpp"
+
+namespace concert::kinematics {
+
+struct Model::Impl {
+  std::string name;
+  std::string urdf;
+  std::string root_link;
+  detail::KdlConversion kdl;
+  std::unordered_map<std::string, int> joint_index;
+  Eigen::Vector3d gravity;
+};
+
+struct Data::Impl {
+  explicit Impl(std::shared_ptr<const Model::Impl> m)
+      : model(std::move(m)),
+        fk(model->kdl.tree),
+        jac_solver(model->kdl.tree),
+        id(model->kdl.tree, KDL::Vector(model->gravity.x(), model->gravity.y(), model->gravity.z())),
+        q(model->kdl.tree.getNrOfJoints()),
+        qd(model->kdl.tree.getNrOfJoints()),
+        qdd(model->kdl.tree.getNrOfJoints()),
+        tau(model->kdl.tree.getNrOfJoints()),
+        jac(model->kdl.tree.getNrOfJoints()) {}
+  std::shared_ptr<const Model::Impl> model;
+  KDL::TreeFkSolverPos_recursive fk;
+  KDL::TreeJntToJacSolver jac_solver;
+  KDL::TreeIdSolver_RNE id;
+  KDL::JntArray q, qd, qdd, tau;
+  KDL::Jacobian jac;
+  KDL::WrenchMap wrenches;
+};
+
+namespace {
+
+void check_size(const Model::Impl& m, const Eigen::VectorXd& v, const char* what) {
+  if (v.size() != static_cast<Eigen::Index>(m.kdl.joint_names.size())) {
+    throw ModelError(std::string("model '") + m.name + "': " + what + " has size " + std::to_string(v.size()) +
+                     ", expected " + std::to_string(m.kdl.joint_names.size()));
+  }
+}
+
+void check_frame(const Model::Impl& m, std::string_view frame) {
+  if (m.kdl.tree.getSegments().find(std::string(frame)) == m.kdl.tree.getSegments().end()) {
+    throw ModelError("model '" + m.name + "': unknown frame '" + std::string(frame) + "'");
+  }
+}
+
+Eigen::Isometry3d to_eigen(const KDL::Frame& f) {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      out.linear()(r, c) = f.M(static_cast<unsigned>(r), static_cast<unsigned>(c));
+    }
+    out.translation()(r) = f.p(static_cast<unsigned>(r));
+  }
+  return out;
+}
+
+}  // namespace
+
+Model::Model(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
+
+Model Model::from_urdf_string(const std::string& urdf_xml, const ModelOptions& options) {
+  const urdf::ModelInterfaceSharedPtr parsed = urdf::parseURDF(urdf_xml);
+  if (!parsed) {
+    throw ModelError("URDF could not be parsed (malformed XML, missing links or joints; see urdfdom messages)");
+  }
+  auto impl = std::make_shared<Impl>();
+  impl->name = parsed->getName();
+  impl->urdf = urdf_xml;
+  impl->root_link = parsed->getRoot() ? parsed->getRoot()->name : std::string{};
+  impl->kdl = detail::urdf_to_kdl(*parsed, options);
+  impl->gravity = options.gravity;
+  for (std::size_t i = 0; i < impl->kdl.joint_names.size(); ++i) {
+    impl->joint_index.emplace(impl->kdl.joint_names[i], static_cast<int>(i));
+  }
+  // KDL numbers joints in insertion order; the converter inserts depth-first, as listed.
+  for (const auto& [name, element] : impl->kdl.tree.getSegments()) {
+    const auto& joint = GetTreeElementSegment(element).getJoint();
+    if (joint.getType() != KDL::Joint::None &&
+        impl->joint_index.at(joint.getName()) != static_cast<int>(GetTreeElementQNr(element))) {
+      throw ModelError("internal: KDL joint numbering differs for joint '" + joint.getName() + "'");
+    }
+  }
+  return Model(std::move(impl));
+}
+
+Model Model::from_urdf_file(const std::string& path, const ModelOptions& options) {
+  std::ifstream in(path);
+  if (!in) {
+    throw ModelError("cannot open URDF file '" + path + "'");
+  }
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  try {
+    return from_urdf_string(buffer.str(), options);
+  } catch (const ModelError& e) {
+    throw ModelError("URDF file '" + path + "': " + e.what());
+  }
+}
+
+const std::string& Model::name() const { return impl_->name; }
+int Model::dof() const { return static_cast<int>(impl_->kdl.joint_names.size()); }
+const std::vector<std::string>& Model::joint_names() const { return impl_->kdl.joint_names; }
+const std::vector<JointLimits>& Model::joint_limits() const { return impl_->kdl.joint_limits; }
+const std::vector<JointType>& Model::joint_types() const { return impl_->kdl.joint_types; }
+
+std::optional<int> Model::joint_index(std::string_view joint) const {
+  const auto it = impl_->joint_index.find(std::string(joint));
+  if (it == impl_->joint_index.end()) {
+    return std::nullopt;
+  }
+  return it->second;
+}
+
+int Model::joint_index_or_throw(std::string_view joint) const {
+  if (auto i = joint_index(joint)) {
+    return *i;
+  }
+  std::string known;
+  for (const auto& n : impl_->kdl.joint_names) {
+    known += (known.empty() ? "" : ", ") + n;
+  }
+  throw ModelError("model '" + impl_->name + "': unknown joint '" + std::string(joint) + "' (known: " + known + ")");
+}
+
+bool Model::is_virtual_joint(int index) const { return index >= 0 && index < impl_->kdl.num_virtual_joints; }
+int Model::num_virtual_joints() const { return impl_->kdl.num_virtual_joints; }
+const std::vector<std::string>& Model::frame_names() const { return impl_->kdl.frame_names; }
+bool Model::has_frame(std::string_view frame) const {
+  return impl_->kdl.tree.getSegments().count(std::string(frame)) > 0;
+}
+const std::string& Model::root_link() const { return impl_->root_link; }
+const std::string& Model::joint_parent_link(int index) const { return impl_->kdl.joint_parent_links.at(index); }
+const std::string& Model::joint_child_link(int index) const { return impl_->kdl.joint_child_links.at(index); }
+const Eigen::Vector3d& Model::joint_axis(int index) const { return impl_->kdl.joint_axes.at(index); }
+
+std::vector<std::string> Model::subtree_links(int index) const {
+  std::vector<std::string> out;
+  const auto& segments = impl_->kdl.tree.getSegments();
+  std::function<void(KDL::SegmentMap::const_iterator)> visit = [&](KDL::SegmentMap::const_iterator it) {
+    out.push_back(it->first);
+    for (const auto& child : GetTreeElementChildren(it->second)) {
+      visit(child);
+    }
+  };
+  visit(segments.find(joint_child_link(index)));
+  return out;
+}
+
+std::vector<int> Model::descendant_joints(int index) const {
+  std::vector<int> out;
+  const auto& segments = impl_->kdl.tree.getSegments();
+  for (const auto& link : subtree_links(index)) {
+    const auto& element = segments.find(link)->second;
+    if (GetTreeElementSegment(element).getJoint().getType() != KDL::Joint::None) {
+      const int q = static_cast<int>(GetTreeElementQNr(element));
+      if (q != index) {
+        out.push_back(q);
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+double Model::total_mass() const { return impl_->kdl.total_mass; }
+const Eigen::Vector3d& Model::gravity() const { return impl_->gravity; }
+const std::string& Model::urdf() const { return impl_->urdf; }
+
+Data Model::make_data() const { return Data(impl_); }
+
+Eigen::Isometry3d Model::frame_pose(Data& data, const Eigen::VectorXd& q, std::string_view frame) const {
+  check_size(*impl_, q, "q");
+  check_frame(*impl_, frame);
+  auto& d = *data.impl_;
+  d.q.data = q;
+  KDL::Frame out;
+  if (d.fk.JntToCart(d.q, out, std::string(frame)) < 0) {
+    throw ModelError("model '" + impl_->name + "': forward kinematics failed for frame '" + std::string(frame) + "'");
+  }
+  return to_eigen(out);
+}
+
+Eigen::Isometry3d Model::relative_pose(Data& data, const Eigen::VectorXd& q, std::string_view reference,
+                                       std::string_view frame) const {
+  return frame_pose(data, q, reference).inverse() * frame_pose(data, q, frame);
+}
+
+Eigen::MatrixXd Model::frame_jacobian(Data& data, const Eigen::VectorXd& q, std::string_view frame) const {
+  check_size(*impl_, q, "q");
+  check_frame(*impl_, frame);
+  auto& d = *data.impl_;
+  d.q.data = q;
+  // KDL: reference point at the frame origin, expressed in the root ("world") frame.
+  if (d.jac_solver.JntToJac(d.q, d.jac, std::string(frame)) < 0) {
+    throw ModelError("model '" + impl_->name + "': Jacobian failed for frame '" + std::string(frame) + "'");
+  }
+  return d.jac.data;
+}
+
+Eigen::VectorXd Model::gravity_torques(Data& data, const Eigen::VectorXd& q) const {
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(dof());
+  return inverse_dynamics(data, q, zero, zero);
+}
+
+Eigen::VectorXd Model::inverse_dynamics(Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                                        const Eigen::VectorXd& qdd,
+                                        const std::map<std::string, Eigen::Matrix<double, 6, 1>>& external) const {
+  check_size(*impl_, q, "q");
+  check_size(*impl_, qd, "qd");
+  check_size(*impl_, qdd, "qdd");
+  auto& d = *data.impl_;
+  d.q.data = q;
+  d.qd.data = qd;
+  d.qdd.data = qdd;
+  d.wrenches.clear();
+  for (const auto& [frame, w] : external) {
+    check_frame(*impl_, frame);
+    if (frame == "world") {
+      continue;
+    }
+    KDL::Frame pose;
+    d.fk.JntToCart(d.q, pose, frame);
+    // KDL wants the wrench in the segment frame, reference point at the segment origin.
+    const KDL::Wrench world_aligned(KDL::Vector(w(0), w(1), w(2)), KDL::Vector(w(3), w(4), w(5)));
+    d.wrenches[frame] = pose.M.Inverse(world_aligned);
+  }
+  if (d.id.CartToJnt(d.q, d.qd, d.qdd, d.wrenches, d.tau) < 0) {
+    throw ModelError("model '" + impl_->name + "': inverse dynamics failed");
+  }
+  return d.tau.data;
+}
+
+Eigen::MatrixXd Model::mass_matrix(Data& data, const Eigen::VectorXd& q) const {
+  const int n = dof();
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd g = inverse_dynamics(data, q, zero, zero);
+  Eigen::MatrixXd m(n, n);
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+  for (int j = 0; j < n; ++j) {
+    e.setZero();
+    e(j) = 1.0;
+    m.col(j) = inverse_dynamics(data, q, zero, e) - g;
+  }
+  return m;
+}
+
+Data::Data(std::shared_ptr<const Model::Impl> model) : impl_(std::make_unique<Impl>(std::move(model))) {}
+Data::Data(Data&&) noexcept = default;
+Data& Data::operator=(Data&&) noexcept = default;
+Data::~Data() = default;
+
+}  // namespace concert::kinematics
