@@ -1,0 +1,22 @@
+#pragma once
+// Helpers shared by the two loaders (not installed).
+
+#include <filesystem>
+#include <string>
+
+#include "concert/module_db/module_description.hpp"
+
+namespace concert::module_db::detail {
+
+/// Throws ModuleDbError("<file name>: <field>: <what>").
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& field, const std::string& what);
+
+/// Checks the structure common to both formats (body/joint indices, one input, a tree of bodies,
+/// finite numbers, non-negative masses, limits ordered) and normalises end-effectors (their
+/// output connectors become TCP connectors). Throws ModuleDbError naming the file and field.
+void validate_and_normalise(ModuleDescription& module, const std::filesystem::path& file);
+
+/// Joint limit magnitude from which a revolute joint counts as unbounded (continuous), rad.
+inline constexpr double kUnboundedLimit = 1e6;
+
+}  // namespace concert::module_db::detail

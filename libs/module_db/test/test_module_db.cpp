@@ -1,0 +1,183 @@
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "concert/module_db/module_db.hpp"
+
+namespace fs = std::filesystem;
+using namespace concert::module_db;
+
+namespace {
+
+const fs::path kPublic = fs::path(CONCERT_SHARED_DATA) / "concert_resources";
+const fs::path kOwn = fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db";
+
+/// A fresh scratch folder per test.
+fs::path scratch(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("concert_module_db_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ModuleDbError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST(PublicDatabase, LoadsEveryModuleAndAddon) {
+  const ModuleDatabase db = load_module_database(kPublic);
+  EXPECT_EQ(db.size(), 28u);
+  EXPECT_EQ(db.addon_keys().size(), 8u);
+  const ModuleDescription& elbow = db.at("module_joint_elbow_A_concert");
+  EXPECT_EQ(elbow.type, ModuleType::kJoint);
+  ASSERT_EQ(elbow.bodies.size(), 2u);
+  ASSERT_EQ(elbow.joints.size(), 1u);
+  EXPECT_DOUBLE_EQ(elbow.joints[0].limits.velocity, 2.14);
+  EXPECT_DOUBLE_EQ(elbow.joints[0].limits.peak_torque, 460.0);
+  EXPECT_DOUBLE_EQ(elbow.joints[0].gear_ratio, 160.0);
+  EXPECT_EQ(elbow.joints[0].control.mode, "impedance");
+  ASSERT_TRUE(elbow.esc.has_value());
+  EXPECT_EQ(*elbow.esc, (concert::topology::EscIdentity{1, 6, 4, 0}));
+  EXPECT_EQ(db.find_by_identity({1, 6, 4, 0}), &elbow);
+  EXPECT_NEAR(elbow.mass(), 3.6144181 + 1.1481338, 1e-12);
+  EXPECT_EQ(elbow.output_connectors().size(), 1u);
+  EXPECT_EQ(elbow.root_body(), 0);
+}
+
+TEST(PublicDatabase, MobileBaseConnectorsFollowTheNumberingContract) {
+  const ModuleDatabase db = load_module_database(kPublic);
+  const ModuleDescription& base = db.at("mobile_platform_concert");
+  EXPECT_EQ(base.type, ModuleType::kMobileBase);
+  const std::vector<int> outs = base.output_connectors();
+  ASSERT_EQ(outs.size(), 5u);
+  for (size_t n = 0; n < outs.size(); ++n) {
+    EXPECT_EQ(base.connectors[static_cast<size_t>(outs[n])].name, "2300_connector_" + std::to_string(n + 1));
+  }
+  // Leg 1 is front-left (+x, +y), leg 4 rear-right.
+  EXPECT_GT(base.connectors[static_cast<size_t>(outs[0])].pose.translation().x(), 0.0);
+  EXPECT_GT(base.connectors[static_cast<size_t>(outs[0])].pose.translation().y(), 0.0);
+  EXPECT_LT(base.connectors[static_cast<size_t>(outs[3])].pose.translation().x(), 0.0);
+  EXPECT_LT(base.connectors[static_cast<size_t>(outs[3])].pose.translation().y(), 0.0);
+  EXPECT_EQ(base.input_connector(), -1);
+  EXPECT_FALSE(db.port_routes().empty());
+}
+
+TEST(PublicDatabase, TypesFromHeaderAndIndex) {
+  const ModuleDatabase db = load_module_database(kPublic);
+  EXPECT_EQ(db.at("module_base_link_600_concert").type, ModuleType::kBaseLink);
+  EXPECT_EQ(db.at("module_link_straight_400_concert").type, ModuleType::kLink);
+  EXPECT_EQ(db.at("module_Y_torso_concert").type, ModuleType::kHub);
+  EXPECT_EQ(db.at("module_Y_torso_concert").output_connectors().size(), 2u);
+  const ModuleDescription& wheel = db.at("module_wheel_concert");
+  EXPECT_EQ(wheel.type, ModuleType::kWheel);
+  EXPECT_EQ(wheel.joints[0].type, JointType::kContinuous);
+  EXPECT_EQ(wheel.joints[0].control.mode, "velocity");
+  EXPECT_TRUE(wheel.output_connectors().empty());
+  EXPECT_EQ(wheel.tcp_connectors().size(), 1u);
+  const ModuleDescription& drill = db.at("module_drill_concert");
+  EXPECT_EQ(drill.type, ModuleType::kEndEffector);
+  EXPECT_EQ(drill.tcp_connectors().size(), 1u);
+  EXPECT_EQ(drill.addon_types, (std::vector<std::string>{"drillbit", "handle"}));
+  // The Timor planar base uses Python's Infinity: loaded as unbounded.
+  const ModuleDescription& planar = db.at("mobile_platform_concert_timor_planar");
+  EXPECT_EQ(planar.joints.size(), 3u);
+  EXPECT_EQ(planar.joints[2].type, JointType::kContinuous);
+}
+
+TEST(PublicDatabase, AddonsCarryMassAndTcpOffset) {
+  const ModuleDatabase db = load_module_database(kPublic);
+  const AddonDescription* bit = db.find_addon("drillbit_16_SDSplus");
+  ASSERT_NE(bit, nullptr);
+  EXPECT_EQ(bit->type, "drillbit");
+  EXPECT_DOUBLE_EQ(bit->mass, 0.8);
+  EXPECT_DOUBLE_EQ(bit->tcp_offset, 0.336);
+  const AddonDescription* handle = db.find_addon("drill_handle");
+  ASSERT_NE(handle, nullptr);
+  EXPECT_DOUBLE_EQ(handle->com.y(), 0.25);
+}
+
+TEST(JsonErrors, NameFileAndField) {
+  const fs::path dir = scratch("json");
+  nlohmann::json doc;
+  {
+    std::ifstream in(kPublic / "json/concert/module_joint_elbow_A_concert.json");
+    in >> doc;
+  }
+  auto write = [&](const nlohmann::json& d) {
+    std::ofstream(dir / "module_joint_elbow_A_concert.json") << d.dump(2);
+    return dir / "module_joint_elbow_A_concert.json";
+  };
+  nlohmann::json no_velocity = doc;
+  no_velocity["joints"][0]["limits"].erase("velocity");
+  EXPECT_EQ(error_of([&] { load_json_module(write(no_velocity)); }),
+            "module_joint_elbow_A_concert.json: joints[0].limits.velocity: missing");
+  nlohmann::json bad_mass = doc;
+  bad_mass["bodies"][1]["mass"] = "heavy";
+  EXPECT_EQ(error_of([&] { load_json_module(write(bad_mass)); }),
+            "module_joint_elbow_A_concert.json: bodies[1].mass: not a number");
+  nlohmann::json bad_child = doc;
+  bad_child["joints"][0]["child"] = "nowhere";
+  EXPECT_EQ(error_of([&] { load_json_module(write(bad_child)); }),
+            "module_joint_elbow_A_concert.json: joints[0].child: no body 'nowhere'");
+  nlohmann::json bad_pose = doc;
+  bad_pose["joints"][0]["pose_parent"][0][0] = 2.0;
+  EXPECT_EQ(error_of([&] { load_json_module(write(bad_pose)); }),
+            "module_joint_elbow_A_concert.json: joints[0].pose_parent: rotation part is not a rotation matrix");
+  nlohmann::json bad_type = doc;
+  bad_type["header"]["type"] = "teleporter";
+  EXPECT_EQ(error_of([&] { load_json_module(write(bad_type)); }),
+            "module_joint_elbow_A_concert.json: header.type: unknown module type 'teleporter'");
+  std::ofstream(dir / "broken.json") << "{ \"header\": ";
+  EXPECT_NE(error_of([&] { load_json_module(dir / "broken.json"); }).find("broken.json: (document): invalid JSON"),
+            std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(YamlErrors, NameFileAndField) {
+  const fs::path dir = scratch("yaml");
+  const std::string good = R"(type: link
+bodies:
+  - {name: link, mass: 1.0, com: [0, 0, 0.1], inertia: [0.01, 0.01, 0.01, 0, 0, 0]}
+connectors:
+  - {name: input, role: input, body: link, size: large}
+  - {name: output, role: output, body: link, size: large, pose: {xyz: [0, 0, 0.2]}}
+)";
+  std::ofstream(dir / "good_link.yaml") << good;
+  const ModuleDescription m = load_yaml_module(dir / "good_link.yaml");
+  EXPECT_EQ(m.key, "good_link");
+  EXPECT_DOUBLE_EQ(m.connectors[1].pose.translation().z(), 0.2);
+
+  std::string no_mass = good;
+  no_mass.replace(no_mass.find("mass: 1.0, "), 11, "");
+  std::ofstream(dir / "no_mass.yaml") << no_mass;
+  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "no_mass.yaml"); }).rfind("no_mass.yaml: bodies[0].mass: missing", 0), 0u);
+
+  std::string bad_role = good;
+  bad_role.replace(bad_role.find("role: output"), 12, "role: sideways");
+  std::ofstream(dir / "bad_role.yaml") << bad_role;
+  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "bad_role.yaml"); }),
+            "bad_role.yaml: connectors[1].role: unknown role 'sideways' (expected input, output, tcp, base)");
+
+  std::string bad_body = good;
+  bad_body.replace(bad_body.find("body: link, size: large, pose"), 10, "body: lnk,");
+  std::ofstream(dir / "bad_body.yaml") << bad_body;
+  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "bad_body.yaml"); }), "bad_body.yaml: connectors[1].body: no body 'lnk'");
+  fs::remove_all(dir);
+}
+
+TEST(Database, DuplicateKeysAndUnknownKeysAreErrors) {
+  ModuleDatabase a = load_module_database(kPublic);
+  EXPECT_NE(error_of([&] { a.merge(load_module_database(kPublic)); }).find("already defined by"), std::string::npos);
+  EXPECT_EQ(error_of([&] { (void)a.at("no_such_module"); }), "unknown module key 'no_such_module'");
+  EXPECT_EQ(error_of([&] { load_module_database(kPublic / "models"); }).find("not a module database"),
+            (kPublic / "models").string().size() + 2);
+}
