@@ -23,7 +23,7 @@ endif()
 
 add_library(concert_build_options INTERFACE)
 target_compile_options(concert_build_options INTERFACE
-  -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion
+  -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion -Wno-missing-field-initializers
   $<$<COMPILE_LANGUAGE:CXX>:-Wnon-virtual-dtor>
   $<$<BOOL:${CONCERT_WERROR}>:-Werror>)
 if(CONCERT_SANITIZE)

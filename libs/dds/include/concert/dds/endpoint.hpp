@@ -1,0 +1,134 @@
+#pragma once
+// Typed writer and reader over a catalogue topic, with the catalogue's QoS.
+
+#include <chrono>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+
+#include "concert/dds/participant.hpp"
+#include "concert/dds/topics.hpp"
+
+namespace concert::dds {
+
+namespace detail {
+/// Checks `name` against the catalogue (exists, type name matches) and creates the writer.
+eprosima::fastdds::dds::DataWriter* create_writer(Participant& participant, std::string_view name,
+                                                  eprosima::fastdds::dds::TypeSupport type);
+eprosima::fastdds::dds::DataReader* create_reader(Participant& participant, std::string_view name,
+                                                  eprosima::fastdds::dds::TypeSupport type,
+                                                  eprosima::fastdds::dds::DataReaderListener* listener);
+void delete_writer(Participant& participant, eprosima::fastdds::dds::DataWriter* writer);
+void delete_reader(Participant& participant, eprosima::fastdds::dds::DataReader* reader);
+bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout);
+}  // namespace detail
+
+template <class T> class Writer {
+ public:
+  Writer(Participant& participant, TopicHandle<T> topic)
+      : participant_(participant),
+        writer_(detail::create_writer(participant, topic.name,
+                                      eprosima::fastdds::dds::TypeSupport(new typename PubSubOf<T>::type()))) {}
+  ~Writer() { detail::delete_writer(participant_, writer_); }
+  Writer(const Writer&) = delete;
+  Writer& operator=(const Writer&) = delete;
+
+  /// Publishes a sample. Returns false if DDS refused it (e.g. while shutting down).
+  bool write(const T& sample) { return writer_->write(const_cast<T*>(&sample)); }
+
+  /// Disposes the instance `sample` names (keyed topics only).
+  bool dispose(const T& sample) {
+    return writer_->dispose(const_cast<T*>(&sample), eprosima::fastdds::dds::HANDLE_NIL) ==
+           eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
+  }
+
+  int32_t matched_readers() const {
+    eprosima::fastdds::dds::PublicationMatchedStatus status;
+    writer_->get_publication_matched_status(status);
+    return status.current_count;
+  }
+
+  /// Waits until at least `count` readers matched; false on timeout.
+  bool wait_for_readers(int32_t count, std::chrono::milliseconds timeout) const {
+    return detail::wait_until([&] { return matched_readers() >= count; }, timeout);
+  }
+
+  eprosima::fastdds::dds::DataWriter* get() const { return writer_; }
+
+ private:
+  Participant& participant_;
+  eprosima::fastdds::dds::DataWriter* writer_;
+};
+
+/// Reads a catalogue topic. With a callback, every valid sample is handed to it on the DDS
+/// listener thread (keep it short; never throw out of it). Without, poll with take()/wait().
+template <class T> class Reader : private eprosima::fastdds::dds::DataReaderListener {
+ public:
+  using Callback = std::function<void(const T&, const eprosima::fastdds::dds::SampleInfo&)>;
+
+  Reader(Participant& participant, TopicHandle<T> topic, Callback callback = {})
+      : participant_(participant), callback_(std::move(callback)) {
+    reader_ = detail::create_reader(participant, topic.name,
+                                    eprosima::fastdds::dds::TypeSupport(new typename PubSubOf<T>::type()),
+                                    callback_ ? this : nullptr);
+  }
+  ~Reader() override { detail::delete_reader(participant_, reader_); }
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+
+  /// The next unread valid sample, if any.
+  std::optional<T> take() {
+    T sample;
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader_->take_next_sample(&sample, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data) return sample;
+    }
+    return std::nullopt;
+  }
+
+  /// Waits up to `timeout` for the next valid sample.
+  std::optional<T> wait(std::chrono::milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (true) {
+      if (auto s = take()) return s;
+      const auto left = deadline - std::chrono::steady_clock::now();
+      if (left <= std::chrono::nanoseconds::zero()) return std::nullopt;
+      const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(left).count();
+      reader_->wait_for_unread_message(eprosima::fastrtps::Duration_t(
+          static_cast<int32_t>(ns / 1'000'000'000), static_cast<uint32_t>(ns % 1'000'000'000)));
+    }
+  }
+
+  int32_t matched_writers() const {
+    eprosima::fastdds::dds::SubscriptionMatchedStatus status;
+    reader_->get_subscription_matched_status(status);
+    return status.current_count;
+  }
+
+  bool wait_for_writers(int32_t count, std::chrono::milliseconds timeout) const {
+    return detail::wait_until([&] { return matched_writers() >= count; }, timeout);
+  }
+
+  eprosima::fastdds::dds::DataReader* get() const { return reader_; }
+
+ private:
+  void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
+    T sample;
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader->take_next_sample(&sample, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data) callback_(sample, info);
+    }
+  }
+
+  Participant& participant_;
+  Callback callback_;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+};
+
+}  // namespace concert::dds

@@ -1,0 +1,55 @@
+#pragma once
+// A Fast DDS domain participant with one publisher and one subscriber, configured from the
+// environment (CONCERT_DOMAIN_ID) and optionally an XML profile (deploy/dds/).
+
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "concert/dds/catalogue.hpp"
+
+namespace concert::dds {
+
+struct ParticipantOptions {
+  std::string name = "concert";   ///< participant name, shown by DDS tools
+  int32_t domain_id = -1;         ///< -1: CONCERT_DOMAIN_ID (default 0)
+  /// Fast DDS XML profiles file; empty: CONCERT_DDS_PROFILES if set, else built-in defaults.
+  std::string profiles_file;
+  std::string profile_name = "concert_participant";  ///< participant profile in that file
+};
+
+/// Owns a DomainParticipant. Writers and readers made from it must be destroyed before it.
+class Participant {
+ public:
+  /// Throws std::runtime_error (or std::invalid_argument for a bad domain id) with the reason.
+  explicit Participant(ParticipantOptions options = {});
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
+  int32_t domain_id() const { return domain_id_; }
+  const std::string& name() const { return name_; }
+  eprosima::fastdds::dds::DomainParticipant* get() const { return participant_; }
+  eprosima::fastdds::dds::Publisher* publisher() const { return publisher_; }
+  eprosima::fastdds::dds::Subscriber* subscriber() const { return subscriber_; }
+
+  /// The topic `name` with type `type` (registered on first use). Throws if the topic exists
+  /// with another type.
+  eprosima::fastdds::dds::Topic* topic(const std::string& name, eprosima::fastdds::dds::TypeSupport type);
+
+ private:
+  std::string name_;
+  int32_t domain_id_ = 0;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::mutex mutex_;
+};
+
+}  // namespace concert::dds

@@ -1,0 +1,18 @@
+#pragma once
+// Fast DDS QoS of each catalogue class. The only place where QoS values are set.
+
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+
+#include "concert/dds/catalogue.hpp"
+
+namespace concert::dds {
+
+/// Reliable writers announce heartbeats every 100 ms (Fast DDS's default of 3 s delays the
+/// data a late-joining reader is owed by up to 3 s).
+inline constexpr int32_t kHeartbeatPeriodMs = 100;
+
+eprosima::fastdds::dds::DataWriterQos writer_qos(QosClass qos);
+eprosima::fastdds::dds::DataReaderQos reader_qos(QosClass qos);
+
+}  // namespace concert::dds

@@ -1,0 +1,58 @@
+#pragma once
+// Typed handles of the catalogue's topics for Fast DDS code: topics::robot_model is the
+// RobotModel topic, with the generated type bound at compile time. Writer/Reader check each
+// handle against the catalogue when they are made (name, type name).
+
+#include <string_view>
+
+#include "ethercatPubSubTypes.h"
+#include "modelPubSubTypes.h"
+#include "robotPubSubTypes.h"
+#include "systemPubSubTypes.h"
+#include "topologyPubSubTypes.h"
+
+namespace concert::dds {
+
+/// The generated Fast DDS TopicDataType of a message type.
+template <class T> struct PubSubOf;
+
+#define CONCERT_BIND_PUBSUB(Type) \
+  template <> struct PubSubOf<::concert::msg::Type> { using type = ::concert::msg::Type##PubSubType; }
+CONCERT_BIND_PUBSUB(EscScan);
+CONCERT_BIND_PUBSUB(ModuleTree);
+CONCERT_BIND_PUBSUB(RobotModel);
+CONCERT_BIND_PUBSUB(ModelCustomisation);
+CONCERT_BIND_PUBSUB(JointState);
+CONCERT_BIND_PUBSUB(JointCommand);
+CONCERT_BIND_PUBSUB(CartesianImpedanceCommand);
+CONCERT_BIND_PUBSUB(BaseVelocityCommand);
+CONCERT_BIND_PUBSUB(Odometry);
+CONCERT_BIND_PUBSUB(EndEffectorWrench);
+CONCERT_BIND_PUBSUB(ServiceStatus);
+CONCERT_BIND_PUBSUB(EStopInput);
+CONCERT_BIND_PUBSUB(SafetyState);
+#undef CONCERT_BIND_PUBSUB
+
+/// A catalogue topic carrying T.
+template <class T> struct TopicHandle {
+  using Type = T;
+  std::string_view name;
+};
+
+namespace topics {
+inline constexpr TopicHandle<msg::EscScan> esc_scan{"concert/ethercat/scan"};
+inline constexpr TopicHandle<msg::ModuleTree> module_tree{"concert/topology/module_tree"};
+inline constexpr TopicHandle<msg::RobotModel> robot_model{"concert/model/robot_model"};
+inline constexpr TopicHandle<msg::ModelCustomisation> customisation{"concert/model/customisation"};
+inline constexpr TopicHandle<msg::JointState> joint_state{"concert/robot/joint_state"};
+inline constexpr TopicHandle<msg::JointCommand> joint_command{"concert/robot/joint_command"};
+inline constexpr TopicHandle<msg::CartesianImpedanceCommand> cartesian_command{"concert/robot/cartesian_command"};
+inline constexpr TopicHandle<msg::BaseVelocityCommand> base_velocity{"concert/robot/base_velocity"};
+inline constexpr TopicHandle<msg::Odometry> odometry{"concert/robot/odometry"};
+inline constexpr TopicHandle<msg::EndEffectorWrench> ee_wrench{"concert/robot/ee_wrench"};
+inline constexpr TopicHandle<msg::ServiceStatus> status{"concert/system/status"};
+inline constexpr TopicHandle<msg::EStopInput> estop{"concert/safety/estop"};
+inline constexpr TopicHandle<msg::SafetyState> safety_state{"concert/safety/state"};
+}  // namespace topics
+
+}  // namespace concert::dds

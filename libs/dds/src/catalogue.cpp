@@ -1,0 +1,99 @@
+#include "concert/dds/catalogue.hpp"
+
+#include <array>
+#include <charconv>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace concert::dds {
+namespace {
+
+constexpr std::array kTopics = {
+    TopicInfo{"concert/ethercat/scan", "concert::msg::EscScan", QosClass::kLatched,
+              "robot: raw EtherCAT scan, one sample per (re)scan of the ring"},
+    TopicInfo{"concert/topology/module_tree", "concert::msg::ModuleTree", QosClass::kLatched,
+              "discovery: module tree rebuilt from the last good scan"},
+    TopicInfo{"concert/model/robot_model", "concert::msg::RobotModel", QosClass::kLatched,
+              "modelgen: versioned URDF/SRDF/config every service reconfigures from"},
+    TopicInfo{"concert/model/customisation", "concert::msg::ModelCustomisation", QosClass::kCommand,
+              "users/tools: homing posture and add-ons for the next model version"},
+    TopicInfo{"concert/robot/joint_state", "concert::msg::JointState", QosClass::kStream,
+              "robot: measured joint state, every control cycle (1 kHz)"},
+    TopicInfo{"concert/robot/joint_command", "concert::msg::JointCommand", QosClass::kCommand,
+              "tasks: joint position/velocity/effort/impedance command"},
+    TopicInfo{"concert/robot/cartesian_command", "concert::msg::CartesianImpedanceCommand", QosClass::kCommand,
+              "tasks: Cartesian impedance/admittance of an end-effector"},
+    TopicInfo{"concert/robot/base_velocity", "concert::msg::BaseVelocityCommand", QosClass::kCommand,
+              "nav/collab: mobile base velocity command"},
+    TopicInfo{"concert/robot/odometry", "concert::msg::Odometry", QosClass::kStream,
+              "robot: wheel odometry of the mobile base"},
+    TopicInfo{"concert/robot/ee_wrench", "concert::msg::EndEffectorWrench", QosClass::kStream,
+              "robot: external end-effector wrench estimated from joint torques"},
+    TopicInfo{"concert/system/status", "concert::msg::ServiceStatus", QosClass::kLatched,
+              "every service: state, model version and last error (one instance per service)"},
+    TopicInfo{"concert/safety/estop", "concert::msg::EStopInput", QosClass::kLatched,
+              "buttons, wireless receiver, software: e-stop inputs (one instance per source)"},
+    TopicInfo{"concert/safety/state", "concert::msg::SafetyState", QosClass::kLatched,
+              "safety: running or stopped, and why"},
+};
+
+}  // namespace
+
+QosSpec qos_spec(QosClass qos) {
+  switch (qos) {
+    case QosClass::kLatched: return {true, true, 1};
+    case QosClass::kStream: return {false, false, 1};
+    case QosClass::kCommand: return {true, false, 8};
+  }
+  throw std::logic_error("unknown QosClass");
+}
+
+std::string_view to_string(QosClass qos) {
+  switch (qos) {
+    case QosClass::kLatched: return "latched (reliable, transient-local, keep-last 1)";
+    case QosClass::kStream: return "stream (best-effort, volatile, keep-last 1)";
+    case QosClass::kCommand: return "command (reliable, volatile, keep-last 8)";
+  }
+  return "?";
+}
+
+std::span<const TopicInfo> catalogue() { return kTopics; }
+
+std::optional<TopicInfo> find_topic(std::string_view name) {
+  for (const auto& t : kTopics) {
+    if (t.name == name) return t;
+  }
+  return std::nullopt;
+}
+
+int32_t parse_domain_id(std::string_view text, std::string_view what) {
+  int32_t id = -1;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), id);
+  if (ec != std::errc() || ptr != text.data() + text.size() || id < 0 || id > 232) {
+    throw std::invalid_argument(std::string(what) + ": '" + std::string(text) +
+                                "' is not a DDS domain id (an integer from 0 to 232)");
+  }
+  return id;
+}
+
+int32_t domain_id_from_env() {
+  const char* env = std::getenv("CONCERT_DOMAIN_ID");
+  if (env == nullptr || *env == '\0') return 0;
+  return parse_domain_id(env, "CONCERT_DOMAIN_ID");
+}
+
+uint32_t status_instance_id(std::string_view service, std::string_view host) {
+  uint32_t h = 2166136261u;
+  auto mix = [&h](std::string_view s) {
+    for (unsigned char c : s) {
+      h ^= c;
+      h *= 16777619u;
+    }
+  };
+  mix(service);
+  mix("@");
+  mix(host);
+  return h;
+}
+
+}  // namespace concert::dds

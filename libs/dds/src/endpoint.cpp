@@ -1,0 +1,62 @@
+#include "concert/dds/endpoint.hpp"
+
+#include <stdexcept>
+#include <thread>
+
+#include "concert/dds/qos.hpp"
+
+namespace concert::dds::detail {
+
+using namespace eprosima::fastdds::dds;
+
+namespace {
+TopicInfo checked(std::string_view name, const TypeSupport& type) {
+  const auto info = find_topic(name);
+  if (!info) throw std::invalid_argument("topic '" + std::string(name) + "' is not in the topic catalogue");
+  if (info->type_name != type.get_type_name()) {
+    throw std::invalid_argument("topic '" + std::string(name) + "' carries '" + std::string(info->type_name) +
+                                "' in the catalogue, not '" + type.get_type_name() + "'");
+  }
+  return *info;
+}
+}  // namespace
+
+DataWriter* create_writer(Participant& participant, std::string_view name, TypeSupport type) {
+  const TopicInfo info = checked(name, type);
+  Topic* topic = participant.topic(std::string(name), type);
+  DataWriter* writer = participant.publisher()->create_datawriter(topic, writer_qos(info.qos));
+  if (writer == nullptr) throw std::runtime_error("cannot create a DDS writer on '" + std::string(name) + "'");
+  return writer;
+}
+
+DataReader* create_reader(Participant& participant, std::string_view name, TypeSupport type,
+                          DataReaderListener* listener) {
+  const TopicInfo info = checked(name, type);
+  Topic* topic = participant.topic(std::string(name), type);
+  DataReader* reader = participant.subscriber()->create_datareader(
+      topic, reader_qos(info.qos), listener, listener ? StatusMask::data_available() : StatusMask::none());
+  if (reader == nullptr) throw std::runtime_error("cannot create a DDS reader on '" + std::string(name) + "'");
+  return reader;
+}
+
+void delete_writer(Participant& participant, DataWriter* writer) {
+  if (writer != nullptr) participant.publisher()->delete_datawriter(writer);
+}
+
+void delete_reader(Participant& participant, DataReader* reader) {
+  if (reader != nullptr) {
+    reader->set_listener(nullptr);
+    participant.subscriber()->delete_datareader(reader);
+  }
+}
+
+bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+}  // namespace concert::dds::detail

@@ -1,0 +1,75 @@
+#include "concert/dds/participant.hpp"
+
+#include <cstdlib>
+#include <stdexcept>
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+
+namespace concert::dds {
+
+using namespace eprosima::fastdds::dds;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+Participant::Participant(ParticipantOptions options) : name_(options.name) {
+  domain_id_ = options.domain_id >= 0 ? options.domain_id : domain_id_from_env();
+  auto* factory = DomainParticipantFactory::get_instance();
+
+  std::string profiles = options.profiles_file;
+  if (profiles.empty()) {
+    if (const char* env = std::getenv("CONCERT_DDS_PROFILES")) profiles = env;
+  }
+  if (!profiles.empty()) {
+    if (factory->load_XML_profiles_file(profiles) != ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error("DDS profiles file '" + profiles + "' cannot be loaded (missing or invalid XML)");
+    }
+    DomainParticipantQos qos;
+    if (factory->get_participant_qos_from_profile(options.profile_name, qos) != ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error("DDS profiles file '" + profiles + "' has no participant profile '" +
+                               options.profile_name + "'");
+    }
+    qos.name(options.name);
+    participant_ = factory->create_participant(domain_id_, qos);
+  } else {
+    DomainParticipantQos qos = PARTICIPANT_QOS_DEFAULT;
+    qos.name(options.name);
+    participant_ = factory->create_participant(domain_id_, qos);
+  }
+  if (participant_ == nullptr) {
+    throw std::runtime_error("cannot create a DDS participant on domain " + std::to_string(domain_id_));
+  }
+  publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  if (publisher_ == nullptr || subscriber_ == nullptr) {
+    factory->delete_participant(participant_);
+    throw std::runtime_error("cannot create the DDS publisher/subscriber");
+  }
+}
+
+Participant::~Participant() {
+  participant_->delete_contained_entities();
+  DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+Topic* Participant::topic(const std::string& name, TypeSupport type) {
+  std::lock_guard lock(mutex_);
+  const std::string type_name = type.get_type_name();
+  TypeSupport registered = participant_->find_type(type_name);
+  if (registered.empty()) {
+    if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error("cannot register DDS type '" + type_name + "'");
+    }
+  }
+  if (auto* existing = participant_->lookup_topicdescription(name)) {
+    if (existing->get_type_name() != type_name) {
+      throw std::runtime_error("topic '" + name + "' already exists with type '" + existing->get_type_name() +
+                               "', not '" + type_name + "'");
+    }
+    return static_cast<Topic*>(existing);
+  }
+  Topic* topic = participant_->create_topic(name, type_name, TOPIC_QOS_DEFAULT);
+  if (topic == nullptr) throw std::runtime_error("cannot create DDS topic '" + name + "'");
+  return topic;
+}
+
+}  // namespace concert::dds

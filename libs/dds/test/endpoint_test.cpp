@@ -1,0 +1,115 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/qos.hpp"
+#include "concert/dds/status_reporter.hpp"
+
+namespace concert::dds {
+namespace {
+
+using namespace std::chrono_literals;
+
+msg::RobotModel model(uint32_t version) {
+  msg::RobotModel m;
+  m.version(version);
+  m.content_hash("h" + std::to_string(version));
+  m.urdf(std::string(100'000, 'u'));  // larger than one UDP datagram
+  m.modules({"a", "b"});
+  return m;
+}
+
+TEST(Endpoint, SampleArrivesEqualBetweenParticipants) {
+  Participant a({.name = "a"}), b({.name = "b"});
+  Writer<msg::RobotModel> writer(a, topics::robot_model);
+  Reader<msg::RobotModel> reader(b, topics::robot_model);
+  ASSERT_TRUE(writer.wait_for_readers(1, 5s));
+  ASSERT_TRUE(writer.write(model(3)));
+  auto got = reader.wait(5s);
+  ASSERT_TRUE(got.has_value());
+  EXPECT_EQ(*got, model(3));
+}
+
+TEST(Endpoint, LateJoinerGetsTheLastLatchedSampleOnly) {
+  Participant a({.name = "a"});
+  Writer<msg::RobotModel> writer(a, topics::robot_model);
+  writer.write(model(1));
+  writer.write(model(2));
+  Participant b({.name = "late"});
+  const auto start = std::chrono::steady_clock::now();
+  Reader<msg::RobotModel> reader(b, topics::robot_model);
+  auto got = reader.wait(5s);
+  ASSERT_TRUE(got.has_value());
+  EXPECT_EQ(got->version(), 2u);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 2s) << "late joiner waited too long for the latched value";
+  EXPECT_FALSE(reader.wait(300ms).has_value()) << "KEEP_LAST 1: only the last value is owed";
+}
+
+TEST(Endpoint, CallbackReaderAndQosFromTheCatalogue) {
+  Participant p({.name = "p"});
+  std::atomic<int> received{0};
+  Reader<msg::JointState> reader(p, topics::joint_state, [&](const msg::JointState& s, const auto&) {
+    if (s.name().size() == 2) ++received;
+  });
+  Writer<msg::JointState> writer(p, topics::joint_state);
+  ASSERT_TRUE(writer.wait_for_readers(1, 5s));
+  msg::JointState s;
+  s.name({"j1", "j2"});
+  for (int i = 0; i < 10 && received == 0; ++i) {
+    writer.write(s);
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_GT(received.load(), 0);
+  eprosima::fastdds::dds::DataWriterQos q;
+  writer.get()->get_qos(q);
+  EXPECT_EQ(q.reliability().kind, eprosima::fastdds::dds::BEST_EFFORT_RELIABILITY_QOS);
+  EXPECT_EQ(q.history().depth, 1);
+}
+
+TEST(Endpoint, TopicsOutsideTheCatalogueAreRefused) {
+  Participant p({.name = "p"});
+  try {
+    Writer<msg::RobotModel> w(p, TopicHandle<msg::RobotModel>{"concert/model/typo"});
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("concert/model/typo"), std::string::npos);
+  }
+  EXPECT_THROW((Writer<msg::RobotModel>(p, TopicHandle<msg::RobotModel>{"concert/robot/joint_state"})),
+               std::invalid_argument);
+}
+
+TEST(Endpoint, BadProfilesFileIsNamed) {
+  try {
+    Participant p({.name = "p", .profiles_file = "/nonexistent/profiles.xml"});
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/profiles.xml"), std::string::npos);
+  }
+}
+
+TEST(Endpoint, StatusReporterPublishesStateChanges) {
+  Participant p({.name = "p"});
+  Reader<msg::ServiceStatus> reader(p, topics::status);
+  {
+    StatusReporter status(p, "unit_test", "host1");
+    status.report(msg::SERVICE_READY, 7, "ok");
+    bool ready = false;
+    for (int i = 0; i < 50 && !ready; ++i) {
+      if (auto s = reader.wait(100ms)) {
+        EXPECT_EQ(s->service(), "unit_test");
+        EXPECT_EQ(s->id(), status_instance_id("unit_test", "host1"));
+        ready = s->state() == msg::SERVICE_READY && s->model_version() == 7;
+      }
+    }
+    EXPECT_TRUE(ready);
+  }
+  bool stopped = false;
+  for (int i = 0; i < 50 && !stopped; ++i) {
+    if (auto s = reader.wait(100ms)) stopped = s->state() == msg::SERVICE_STOPPED;
+  }
+  EXPECT_TRUE(stopped);
+}
+
+}  // namespace
+}  // namespace concert::dds
