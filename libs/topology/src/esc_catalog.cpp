@@ -56,7 +56,12 @@ int32_t parse_leads_to(const YAML::Node& row, const std::string& context) {
   const YAML::Node node = row["leads_to"];
   if (!node) throw CatalogError(context + ": missing field 'leads_to'" + where(row));
   if (node.IsScalar() && node.Scalar() == kHubBoard) return 0;
-  const auto connector = opt_int32<CatalogError>(row, "leads_to", context);
+  std::optional<int32_t> connector;
+  try {
+    connector = opt_int32<CatalogError>(row, "leads_to", context);
+  } catch (const CatalogError&) {
+    connector.reset();
+  }
   if (!connector || *connector < 1) {
     throw CatalogError(context + ".leads_to: expected a connector number >= 1 or '" + kHubBoard +
                        "'" + where(node));
