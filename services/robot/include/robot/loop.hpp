@@ -1,0 +1,49 @@
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace concert::robot {
+
+/// Parameters of the control loop.
+struct LoopParams {
+  double period{0.001};   ///< [s] (1 kHz)
+  bool real_time{true};   ///< false: as fast as possible (simulated time only, for tests)
+  bool record_periods{false};  ///< keep every measured wall-clock period (benchmarks)
+};
+
+/// Wall-clock period statistics of a loop run [s].
+struct LoopStats {
+  std::uint64_t cycles{0};
+  std::uint64_t overruns{0};   ///< cycles whose tick took longer than the period
+  double mean_period{0.0};
+  double max_period{0.0};
+  double p99_period{0.0};      ///< only with record_periods
+  double mean_jitter{0.0};     ///< mean |period - nominal| (only with record_periods)
+  double p99_jitter{0.0};      ///< (only with record_periods)
+  double wall_time{0.0};       ///< wall-clock duration of the run
+};
+
+/// Fixed-rate loop: calls `tick` every period, on deadlines period apart (absolute, so
+/// no drift) in real-time mode, or back-to-back otherwise. The tick advances simulated time.
+class Loop {
+ public:
+  Loop(LoopParams params, std::function<void()> tick);
+
+  /// Runs `cycles` ticks (or until stop()). Returns the statistics of this run.
+  LoopStats run(std::uint64_t cycles);
+  /// Runs until stop() is called from another thread or a signal handler.
+  LoopStats run_forever();
+  /// Asks a running loop to return after the current tick.
+  void stop() { stop_.store(true); }
+
+ private:
+  LoopParams params_;
+  std::function<void()> tick_;
+  std::atomic<bool> stop_{false};
+};
+
+}  // namespace concert::robot

@@ -1,0 +1,83 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "robot/hardware.hpp"
+#include "robot/world.hpp"
+
+namespace concert::robot {
+
+/// Parameters of the simulated robot (MuJoCo).
+struct SimParams {
+  double timestep{0.001};            ///< physics step [s]; step(dt) runs round(dt / timestep) steps
+  double position_stiffness{3000.0}; ///< drive gains in position mode [Nm/rad]
+  double position_damping{100.0};    ///< [Nm s/rad]
+  double velocity_gain{60.0};        ///< drive gain in velocity mode [Nm s/rad]
+  double armature{0.1};              ///< reflected rotor inertia added to every actuated joint [kg m^2]
+  double friction_scale{1.0};        ///< multiplies URDF <dynamics friction> (Coulomb, [Nm])
+  double damping_scale{1.0};         ///< multiplies URDF <dynamics damping> (viscous, [Nm s/rad])
+  double wheel_friction{1.0};        ///< sliding friction of wheel geoms [-]
+  double robot_friction{0.5};        ///< sliding friction of other robot geoms [-]
+  /// Floating (free) base: default true iff the model has steering+wheel legs.
+  std::optional<bool> floating_base;
+  Eigen::Vector3d base_position{0.0, 0.0, 0.0};  ///< [m]; z is computed for a floating base on the floor
+  double base_yaw{0.0};                           ///< [rad]
+  std::map<std::string, double> initial_positions;  ///< joint -> [rad]/[m]; others start at 0
+  double position_noise{0.0};        ///< std-dev of the encoder noise [rad]
+  double effort_noise{0.0};          ///< std-dev of the torque-sensor noise [Nm]
+  unsigned seed{1};                  ///< noise seed
+};
+
+/// MJCF text for a URDF placed in a world (exposed for tests and for debugging in MuJoCo's
+/// viewer). Throws HardwareError naming the URDF element that cannot be simulated.
+std::string urdf_to_mjcf(const std::string& urdf, const World& world, const SimParams& params);
+
+/// Cylinder collision radius per link (first cylinder collision of each link) [m].
+std::map<std::string, double> collision_cylinder_radii(const std::string& urdf);
+
+/// The `sim` backend: the robot in MuJoCo. The drives' inner loops (impedance with torque
+/// saturation at the URDF effort limit) run at the physics rate, as real drives do.
+class SimHardware final : public Hardware {
+ public:
+  SimHardware(const std::string& urdf, World world, SimParams params = {});
+  ~SimHardware() override;
+  SimHardware(const SimHardware&) = delete;
+  SimHardware& operator=(const SimHardware&) = delete;
+
+  [[nodiscard]] std::string backend() const override { return "sim"; }
+  [[nodiscard]] const std::vector<std::string>& joint_names() const override;
+  [[nodiscard]] std::uint64_t generation() const override;
+  void read(HardwareState& state) override;
+  void write(const std::vector<DriveCommand>& commands) override;
+  void step(double dt) override;
+
+  /// Hot swap: the robot becomes `urdf` (the base pose and joints with the same name keep
+  /// their state, every drive holds position); generation() increases.
+  void swap_model(const std::string& urdf);
+  /// Replaces the world (keeps the robot state).
+  void set_world(const World& world);
+
+  // Ground truth, for tests and benchmarks.
+  [[nodiscard]] double time() const;
+  [[nodiscard]] Eigen::Isometry3d link_pose(const std::string& link) const;
+  /// Pose of the root link in the world.
+  [[nodiscard]] Eigen::Isometry3d base_pose() const;
+  /// Total contact force the world exerts on `links` [N], world frame.
+  [[nodiscard]] Eigen::Vector3d contact_force_on(const std::vector<std::string>& links) const;
+  [[nodiscard]] const std::string& mjcf() const;
+  [[nodiscard]] const std::string& urdf() const;
+  [[nodiscard]] bool floating_base() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace concert::robot

@@ -1,0 +1,160 @@
+#include "robot/base_kinematics.hpp"
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace concert::robot {
+namespace {
+
+double wrap(double a) {
+  a = std::fmod(a + M_PI, 2.0 * M_PI);
+  if (a < 0.0) {
+    a += 2.0 * M_PI;
+  }
+  return a - M_PI;
+}
+
+}  // namespace
+
+std::vector<Leg> detect_legs(const kinematics::Model& model, const std::map<std::string, double>& wheel_radii,
+                             double default_wheel_radius) {
+  std::vector<Leg> legs;
+  kinematics::Data data = model.make_data();
+  const Eigen::VectorXd q0 = Eigen::VectorXd::Zero(model.dof());
+  const Eigen::Isometry3d base = model.frame_pose(data, q0, model.root_link());
+  std::vector<bool> has_movable_ancestor(static_cast<std::size_t>(model.dof()), false);
+  for (int j = 0; j < model.dof(); ++j) {
+    for (int d : model.descendant_joints(j)) {
+      has_movable_ancestor[static_cast<std::size_t>(d)] = true;
+    }
+  }
+  auto axis_in_base = [&](int j) -> Eigen::Vector3d {
+    const Eigen::Isometry3d child = base.inverse() * model.frame_pose(data, q0, model.joint_child_link(j));
+    return child.linear() * model.joint_axis(j);
+  };
+  for (int s = 0; s < model.dof(); ++s) {
+    if (model.is_virtual_joint(s) || has_movable_ancestor[static_cast<std::size_t>(s)]) {
+      continue;
+    }
+    const Eigen::Vector3d steer_axis = axis_in_base(s);
+    const auto below = model.descendant_joints(s);
+    if (std::abs(steer_axis.z()) < 0.9 || below.size() != 1) {
+      continue;
+    }
+    const int w = below.front();
+    const Eigen::Vector3d wheel_axis = axis_in_base(w);
+    if (std::abs(wheel_axis.z()) > 0.1 || model.joint_types()[static_cast<std::size_t>(w)] ==
+                                              kinematics::JointType::kPrismatic) {
+      continue;
+    }
+    Leg leg;
+    leg.steering_joint = model.joint_names()[static_cast<std::size_t>(s)];
+    leg.wheel_joint = model.joint_names()[static_cast<std::size_t>(w)];
+    leg.steering_index = s;
+    leg.wheel_index = w;
+    const Eigen::Isometry3d steer_frame = base.inverse() * model.frame_pose(data, q0, model.joint_child_link(s));
+    leg.position = steer_frame.translation().head<2>();
+    const Eigen::Isometry3d wheel_frame = base.inverse() * model.frame_pose(data, q0, model.joint_child_link(w));
+    leg.wheel_center_height = wheel_frame.translation().z();
+    const auto radius = wheel_radii.find(model.joint_child_link(w));
+    leg.wheel_radius = radius != wheel_radii.end() ? radius->second : default_wheel_radius;
+    leg.steering_sign = steer_axis.z() > 0.0 ? 1.0 : -1.0;
+    const Eigen::Vector3d rolling = wheel_axis.cross(Eigen::Vector3d::UnitZ());
+    leg.heading_offset = std::atan2(rolling.y(), rolling.x());
+    const auto& limits = model.joint_limits()[static_cast<std::size_t>(s)];
+    if (limits.has_position_limits) {
+      leg.steering_lower = limits.lower;
+      leg.steering_upper = limits.upper;
+    }
+    legs.push_back(leg);
+  }
+  return legs;
+}
+
+BaseKinematics::BaseKinematics(std::vector<Leg> legs) : legs_(std::move(legs)) {
+  if (legs_.size() < 2) {
+    throw std::invalid_argument("a steerable base needs at least 2 steering+wheel legs, found " +
+                                std::to_string(legs_.size()));
+  }
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  for (const auto& leg : legs_) {
+    Eigen::Matrix<double, 2, 3> a;
+    a << 1.0, 0.0, -leg.position.y(), 0.0, 1.0, leg.position.x();
+    ata += a.transpose() * a;
+  }
+  normal_inverse_ = ata.inverse();
+}
+
+std::vector<LegSetpoint> BaseKinematics::leg_setpoints(const Eigen::Vector3d& twist,
+                                                       const std::vector<double>& current_steering) const {
+  if (current_steering.size() != legs_.size()) {
+    throw std::invalid_argument("leg_setpoints: " + std::to_string(current_steering.size()) +
+                                " steering angles for " + std::to_string(legs_.size()) + " legs");
+  }
+  std::vector<LegSetpoint> out(legs_.size());
+  for (std::size_t i = 0; i < legs_.size(); ++i) {
+    const Leg& leg = legs_[i];
+    const double current = current_steering[i];
+    const Eigen::Vector2d v(twist.x() - twist.z() * leg.position.y(), twist.y() + twist.z() * leg.position.x());
+    const double speed = v.norm();
+    if (speed < 1e-6) {
+      out[i] = {current, 0.0};
+      continue;
+    }
+    const double heading = std::atan2(v.y(), v.x());
+    double angle = current + wrap(leg.steering_sign * (heading - leg.heading_offset) - current);
+    double direction = 1.0;
+    if (std::abs(angle - current) > M_PI / 2.0) {
+      angle -= std::copysign(M_PI, angle - current);
+      direction = -1.0;
+    }
+    // Keep inside the steering limits: shift by a full turn, or flip once more.
+    for (const double shift : {2.0 * M_PI, -2.0 * M_PI}) {
+      if (angle < leg.steering_lower || angle > leg.steering_upper) {
+        if (angle + shift >= leg.steering_lower && angle + shift <= leg.steering_upper) {
+          angle += shift;
+        }
+      }
+    }
+    if (angle < leg.steering_lower || angle > leg.steering_upper) {
+      const double flipped = angle - std::copysign(M_PI, angle - 0.5 * (leg.steering_lower + leg.steering_upper));
+      angle = flipped;
+      direction = -direction;
+    }
+    out[i] = {angle, direction * speed / leg.wheel_radius};
+  }
+  return out;
+}
+
+Eigen::Vector3d BaseKinematics::twist_from_legs(const std::vector<double>& steering,
+                                                const std::vector<double>& wheel_velocity) const {
+  if (steering.size() != legs_.size() || wheel_velocity.size() != legs_.size()) {
+    throw std::invalid_argument("twist_from_legs: expected " + std::to_string(legs_.size()) + " legs");
+  }
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < legs_.size(); ++i) {
+    const Leg& leg = legs_[i];
+    const double heading = leg.heading_offset + leg.steering_sign * steering[i];
+    const Eigen::Vector2d v = wheel_velocity[i] * leg.wheel_radius * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+    Eigen::Matrix<double, 2, 3> a;
+    a << 1.0, 0.0, -leg.position.y(), 0.0, 1.0, leg.position.x();
+    atb += a.transpose() * v;
+  }
+  return normal_inverse_ * atb;
+}
+
+void BaseKinematics::integrate(Odometry& odometry, const std::vector<double>& steering,
+                               const std::vector<double>& wheel_velocity, double dt) const {
+  const Eigen::Vector3d twist = twist_from_legs(steering, wheel_velocity);
+  const double mid_yaw = odometry.yaw + 0.5 * twist.z() * dt;
+  odometry.x += (std::cos(mid_yaw) * twist.x() - std::sin(mid_yaw) * twist.y()) * dt;
+  odometry.y += (std::sin(mid_yaw) * twist.x() + std::cos(mid_yaw) * twist.y()) * dt;
+  odometry.yaw = wrap(odometry.yaw + twist.z() * dt);
+  odometry.vx = twist.x();
+  odometry.vy = twist.y();
+  odometry.wz = twist.z();
+}
+
+}  // namespace concert::robot

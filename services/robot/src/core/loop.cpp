@@ -1,0 +1,75 @@
+#include "robot/loop.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <thread>
+
+namespace concert::robot {
+
+Loop::Loop(LoopParams params, std::function<void()> tick) : params_(params), tick_(std::move(tick)) {
+  if (params_.period <= 0.0) {
+    throw std::invalid_argument("loop period must be positive");
+  }
+}
+
+LoopStats Loop::run_forever() { return run(std::numeric_limits<std::uint64_t>::max()); }
+
+LoopStats Loop::run(std::uint64_t cycles) {
+  using Clock = std::chrono::steady_clock;
+  stop_.store(false);
+  LoopStats stats;
+  std::vector<double> periods;
+  if (params_.record_periods && cycles < (1u << 26)) {
+    periods.reserve(static_cast<std::size_t>(cycles));
+  }
+  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(params_.period));
+  const auto start = Clock::now();
+  auto deadline = start;
+  auto last = start;
+  double sum = 0.0;
+  for (std::uint64_t k = 0; k < cycles && !stop_.load(std::memory_order_relaxed); ++k) {
+    if (params_.real_time) {
+      std::this_thread::sleep_until(deadline);
+    }
+    const auto now = Clock::now();
+    if (k > 0) {
+      const double p = std::chrono::duration<double>(now - last).count();
+      sum += p;
+      stats.max_period = std::max(stats.max_period, p);
+      if (params_.record_periods) {
+        periods.push_back(p);
+      }
+    }
+    last = now;
+    tick_();
+    ++stats.cycles;
+    deadline += period;
+    if (params_.real_time && Clock::now() > deadline) {
+      ++stats.overruns;
+      deadline = Clock::now();  // do not try to catch up with a burst of ticks
+    }
+  }
+  stats.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
+  if (stats.cycles > 1) {
+    stats.mean_period = sum / static_cast<double>(stats.cycles - 1);
+  }
+  if (!periods.empty()) {
+    std::vector<double> jitter(periods.size());
+    double jsum = 0.0;
+    for (std::size_t i = 0; i < periods.size(); ++i) {
+      jitter[i] = std::abs(periods[i] - params_.period);
+      jsum += jitter[i];
+    }
+    stats.mean_jitter = jsum / static_cast<double>(jitter.size());
+    const auto idx = static_cast<std::size_t>(0.99 * static_cast<double>(periods.size() - 1));
+    std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(idx), periods.end());
+    stats.p99_period = periods[idx];
+    std::nth_element(jitter.begin(), jitter.begin() + static_cast<std::ptrdiff_t>(idx), jitter.end());
+    stats.p99_jitter = jitter[idx];
+  }
+  return stats;
+}
+
+}  // namespace concert::robot

@@ -1,0 +1,468 @@
+#include "robot/sim_hardware.hpp"
+
+#include <mujoco/mujoco.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <iomanip>
+#include <random>
+#include <sstream>
+
+#include "robot/base_kinematics.hpp"
+
+namespace concert::robot {
+namespace {
+
+urdf::ModelInterfaceSharedPtr parse(const std::string& urdf) {
+  auto model = urdf::parseURDF(urdf);
+  if (!model) {
+    throw HardwareError("sim: the robot URDF could not be parsed");
+  }
+  return model;
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << std::setprecision(12) << v;
+  return s.str();
+}
+
+std::string vec(double a, double b, double c) { return num(a) + " " + num(b) + " " + num(c); }
+
+std::string pos_quat(const urdf::Pose& p) {
+  return "pos=\"" + vec(p.position.x, p.position.y, p.position.z) + "\" quat=\"" + num(p.rotation.w) + " " +
+         vec(p.rotation.x, p.rotation.y, p.rotation.z) + "\"";
+}
+
+Eigen::Matrix3d rotation(const urdf::Rotation& r) { return Eigen::Quaterniond(r.w, r.x, r.y, r.z).toRotationMatrix(); }
+
+struct MjcfWriter {
+  const SimParams& params;
+  const std::map<std::string, double>& wheel_radii;
+  std::ostringstream xml;
+  std::vector<std::string> actuated;  // joint names in depth-first order
+  std::vector<double> efforts;
+
+  void geoms(const urdf::Link& link, bool is_wheel) {
+    int k = 0;
+    for (const auto& c : link.collision_array) {
+      if (!c || !c->geometry) {
+        continue;
+      }
+      const std::string name = "\"" + link.name + "_collision_" + std::to_string(k++) + "\"";
+      const std::string common = " name=" + name + " " + pos_quat(c->origin) + " contype=\"1\" conaffinity=\"0\"" +
+                                 " friction=\"" + num(is_wheel ? params.wheel_friction : params.robot_friction) +
+                                 " 0.005 0.0001\"";
+      switch (c->geometry->type) {
+        case urdf::Geometry::BOX: {
+          const auto& b = dynamic_cast<const urdf::Box&>(*c->geometry);
+          xml << "<geom type=\"box\" size=\"" << vec(b.dim.x / 2, b.dim.y / 2, b.dim.z / 2) << "\"" << common
+              << "/>\n";
+          break;
+        }
+        case urdf::Geometry::CYLINDER: {
+          const auto& cy = dynamic_cast<const urdf::Cylinder&>(*c->geometry);
+          xml << "<geom type=\"cylinder\" size=\"" << num(cy.radius) << " " << num(cy.length / 2) << "\"" << common
+              << "/>\n";
+          break;
+        }
+        case urdf::Geometry::SPHERE: {
+          const auto& s = dynamic_cast<const urdf::Sphere&>(*c->geometry);
+          xml << "<geom type=\"sphere\" size=\"" << num(s.radius) << "\"" << common << "/>\n";
+          break;
+        }
+        case urdf::Geometry::MESH:
+        default:
+          // Meshes are not loaded (package:// resolution and convex hulls cost start-up time);
+          // see README: collision meshes are replaced by their modules' primitive shapes.
+          break;
+      }
+    }
+  }
+
+  void inertial(const urdf::Link& link) {
+    if (!link.inertial || link.inertial->mass <= 0.0) {
+      return;
+    }
+    const auto& in = *link.inertial;
+    Eigen::Matrix3d i;
+    i << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    const Eigen::Matrix3d r = rotation(in.origin.rotation);
+    const Eigen::Matrix3d il = r * i * r.transpose();
+    xml << "<inertial pos=\"" << vec(in.origin.position.x, in.origin.position.y, in.origin.position.z)
+        << "\" mass=\"" << num(in.mass) << "\" fullinertia=\"" << vec(il(0, 0), il(1, 1), il(2, 2)) << " "
+        << vec(il(0, 1), il(0, 2), il(1, 2)) << "\"/>\n";
+  }
+
+  void joint(const urdf::Joint& j) {
+    if (j.type == urdf::Joint::FIXED) {
+      return;
+    }
+    if (j.type != urdf::Joint::REVOLUTE && j.type != urdf::Joint::CONTINUOUS && j.type != urdf::Joint::PRISMATIC) {
+      throw HardwareError("sim: URDF joint '" + j.name + "' has a type MuJoCo cannot take here (floating/planar)");
+    }
+    const bool slide = j.type == urdf::Joint::PRISMATIC;
+    xml << "<joint name=\"" << j.name << "\" type=\"" << (slide ? "slide" : "hinge") << "\" axis=\""
+        << vec(j.axis.x, j.axis.y, j.axis.z) << "\" armature=\"" << num(params.armature) << "\"";
+    if (j.type != urdf::Joint::CONTINUOUS && j.limits && j.limits->upper > j.limits->lower) {
+      xml << " limited=\"true\" range=\"" << num(j.limits->lower) << " " << num(j.limits->upper) << "\"";
+    } else {
+      xml << " limited=\"false\"";
+    }
+    if (j.dynamics) {
+      xml << " damping=\"" << num(j.dynamics->damping * params.damping_scale) << "\" frictionloss=\""
+          << num(j.dynamics->friction * params.friction_scale) << "\"";
+    }
+    xml << "/>\n";
+    actuated.push_back(j.name);
+    efforts.push_back(j.limits ? j.limits->effort : 0.0);
+  }
+
+  void body(const urdf::Link& link) {
+    for (const auto& child : link.child_links) {
+      const urdf::Joint& j = *child->parent_joint;
+      xml << "<body name=\"" << child->name << "\" " << pos_quat(j.parent_to_joint_origin_transform) << ">\n";
+      inertial(*child);
+      joint(j);
+      geoms(*child, wheel_radii.count(child->name) > 0 && j.type != urdf::Joint::FIXED);
+      body(*child);
+      xml << "</body>\n";
+    }
+  }
+};
+
+void world_geoms(std::ostringstream& xml, const World& world) {
+  if (world.floor) {
+    xml << "<geom name=\"floor\" type=\"plane\" size=\"100 100 0.1\" pos=\"0 0 " << num(world.floor_height)
+        << "\" contype=\"0\" conaffinity=\"1\" friction=\"" << num(world.floor_friction) << " 0.005 0.0001\"/>\n";
+  }
+  auto shape = [&](const WorldShape& s) {
+    const std::string where = "pos=\"" + vec(s.position.x(), s.position.y(), s.position.z()) + "\" euler=\"0 0 " +
+                              num(s.yaw) + "\" contype=\"0\" conaffinity=\"1\" friction=\"" + num(s.friction) +
+                              " 0.005 0.0001\"";
+    if (s.type == WorldShape::Type::kBox) {
+      xml << "<geom name=\"" << s.name << "\" type=\"box\" size=\"" << vec(s.size.x() / 2, s.size.y() / 2, s.size.z() / 2)
+          << "\" " << where << "/>\n";
+    } else {
+      xml << "<geom name=\"" << s.name << "\" type=\"cylinder\" size=\"" << num(s.size.x()) << " "
+          << num(s.size.z() / 2) << "\" " << where << "/>\n";
+    }
+  };
+  for (const auto& w : world.walls) {
+    shape(w);
+  }
+  for (const auto& o : world.obstacles) {
+    shape(o);
+  }
+}
+
+struct Built {
+  std::string mjcf;
+  std::vector<std::string> joints;
+  bool floating{false};
+};
+
+Built build_mjcf(const std::string& urdf, const World& world, const SimParams& params) {
+  const auto parsed = parse(urdf);
+  const auto radii = collision_cylinder_radii(urdf);
+  const kinematics::Model model = kinematics::Model::from_urdf_string(urdf);
+  std::vector<Leg> legs = detect_legs(model, radii);
+  std::map<std::string, double> wheel_links;
+  for (const auto& leg : legs) {
+    wheel_links[model.joint_child_link(model.joint_index_or_throw(leg.wheel_joint))] = leg.wheel_radius;
+  }
+  Built out;
+  out.floating = params.floating_base.value_or(!legs.empty());
+  double z = params.base_position.z();
+  if (out.floating && !legs.empty()) {
+    z = world.floor_height;
+    double lift = 0.0;
+    for (const auto& leg : legs) {
+      lift = std::max(lift, leg.wheel_radius - leg.wheel_center_height);
+    }
+    z += lift + 0.002;
+  }
+  MjcfWriter w{params, wheel_links, {}, {}, {}};
+  const urdf::Link& root = *parsed->getRoot();
+  w.xml << "<mujoco model=\"" << parsed->getName() << "\">\n"
+        << "<compiler angle=\"radian\" inertiafromgeom=\"false\" boundmass=\"0.0001\" boundinertia=\"0.00000001\" "
+           "balanceinertia=\"true\"/>\n"
+        << "<option timestep=\"" << num(params.timestep) << "\" integrator=\"implicit\" gravity=\"0 0 -9.81\"/>\n"
+        << "<worldbody>\n";
+  world_geoms(w.xml, world);
+  w.xml << "<body name=\"" << root.name << "\" pos=\"" << vec(params.base_position.x(), params.base_position.y(), z)
+        << "\" euler=\"0 0 " << num(params.base_yaw) << "\">\n";
+  if (out.floating) {
+    w.xml << "<freejoint name=\"__floating_base\"/>\n";
+  }
+  w.inertial(root);
+  w.geoms(root, false);
+  w.body(root);
+  w.xml << "</body>\n</worldbody>\n<actuator>\n";
+  for (std::size_t i = 0; i < w.actuated.size(); ++i) {
+    w.xml << "<general name=\"" << w.actuated[i] << "\" joint=\"" << w.actuated[i]
+          << "\" gaintype=\"fixed\" gainprm=\"1\" biastype=\"affine\" biasprm=\"0 0 0\" ctrllimited=\"false\"";
+    if (w.efforts[i] > 0.0) {
+      w.xml << " forcelimited=\"true\" forcerange=\"" << num(-w.efforts[i]) << " " << num(w.efforts[i]) << "\"";
+    }
+    w.xml << "/>\n";
+  }
+  w.xml << "</actuator>\n</mujoco>\n";
+  out.mjcf = w.xml.str();
+  out.joints = w.actuated;
+  return out;
+}
+
+}  // namespace
+
+std::map<std::string, double> collision_cylinder_radii(const std::string& urdf) {
+  const auto parsed = parse(urdf);
+  std::vector<urdf::LinkSharedPtr> links;
+  parsed->getLinks(links);
+  std::map<std::string, double> out;
+  for (const auto& link : links) {
+    for (const auto& c : link->collision_array) {
+      if (c && c->geometry && c->geometry->type == urdf::Geometry::CYLINDER) {
+        out[link->name] = dynamic_cast<const urdf::Cylinder&>(*c->geometry).radius;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+std::string urdf_to_mjcf(const std::string& urdf, const World& world, const SimParams& params) {
+  return build_mjcf(urdf, world, params).mjcf;
+}
+
+struct SimHardware::Impl {
+  SimParams params;
+  World world;
+  std::string urdf;
+  Built built;
+  mjModel* m{nullptr};
+  mjData* d{nullptr};
+  std::vector<int> qpos_adr, dof_adr;
+  std::vector<double> effort_limit;
+  std::vector<DriveCommand> commands;
+  std::uint64_t generation{0};
+  std::mt19937 rng;
+
+  ~Impl() { release(); }
+  void release() {
+    if (d != nullptr) {
+      mj_deleteData(d);
+      d = nullptr;
+    }
+    if (m != nullptr) {
+      mj_deleteModel(m);
+      m = nullptr;
+    }
+  }
+
+  void load(const std::string& new_urdf) {
+    Built b = build_mjcf(new_urdf, world, params);
+    mjVFS vfs;
+    mj_defaultVFS(&vfs);
+    const char* file = "robot.xml";
+    if (mj_makeEmptyFileVFS(&vfs, file, static_cast<int>(b.mjcf.size())) != 0) {
+      throw HardwareError("sim: could not allocate the MuJoCo virtual file");
+    }
+    std::memcpy(vfs.filedata[0], b.mjcf.data(), b.mjcf.size());
+    char error[1000] = "";
+    mjModel* nm = mj_loadXML(file, &vfs, error, sizeof(error));
+    mj_deleteVFS(&vfs);
+    if (nm == nullptr) {
+      throw HardwareError(std::string("sim: MuJoCo rejected the model built from the URDF: ") + error);
+    }
+    mjData* nd = mj_makeData(nm);
+    // Carry the state over (hot swap): base pose and same-named joints.
+    std::map<std::string, std::pair<double, double>> carried;
+    std::vector<double> base_qpos;
+    if (m != nullptr) {
+      for (std::size_t i = 0; i < built.joints.size(); ++i) {
+        carried[built.joints[i]] = {d->qpos[qpos_adr[i]], d->qvel[dof_adr[i]]};
+      }
+      if (built.floating && b.floating) {
+        base_qpos.assign(d->qpos, d->qpos + 7);
+      }
+      nd->time = d->time;
+    }
+    release();
+    m = nm;
+    d = nd;
+    built = std::move(b);
+    urdf = new_urdf;
+    qpos_adr.clear();
+    dof_adr.clear();
+    effort_limit.clear();
+    commands.assign(built.joints.size(), DriveCommand{});
+    for (std::size_t i = 0; i < built.joints.size(); ++i) {
+      const int jid = mj_name2id(m, mjOBJ_JOINT, built.joints[i].c_str());
+      qpos_adr.push_back(m->jnt_qposadr[jid]);
+      dof_adr.push_back(m->jnt_dofadr[jid]);
+      effort_limit.push_back(m->actuator_forcelimited[i] ? m->actuator_forcerange[2 * i + 1] : 0.0);
+      double q = 0.0;
+      if (auto it = carried.find(built.joints[i]); it != carried.end()) {
+        q = it->second.first;
+      } else if (auto p = params.initial_positions.find(built.joints[i]); p != params.initial_positions.end()) {
+        q = p->second;
+      }
+      d->qpos[qpos_adr[i]] = q;
+      commands[i].mode = DriveMode::kPosition;
+      commands[i].position = q;
+    }
+    if (!base_qpos.empty()) {
+      std::copy(base_qpos.begin(), base_qpos.end(), d->qpos);
+    }
+    mj_forward(m, d);
+    ++generation;
+  }
+
+  void apply_drives() {
+    for (std::size_t i = 0; i < commands.size(); ++i) {
+      const DriveCommand& c = commands[i];
+      double kp = 0.0, kd = 0.0;
+      switch (c.mode) {
+        case DriveMode::kPosition:
+          kp = params.position_stiffness;
+          kd = params.position_damping;
+          break;
+        case DriveMode::kVelocity:
+          kd = params.velocity_gain;
+          break;
+        case DriveMode::kEffort:
+          break;
+        case DriveMode::kImpedance:
+          kp = std::max(0.0, c.stiffness);
+          kd = std::max(0.0, c.damping);
+          break;
+      }
+      const double ff = c.mode == DriveMode::kVelocity ? 0.0 : c.effort;
+      const double pos_term = c.mode == DriveMode::kVelocity ? 0.0 : kp * c.position;
+      // General actuator: force = ctrl + biasprm[1] q + biasprm[2] qd, saturated at forcerange.
+      // The velocity-dependent part stays inside MuJoCo so the implicit integrator damps it stably.
+      m->actuator_biasprm[i * mjNBIAS + 1] = -kp;
+      m->actuator_biasprm[i * mjNBIAS + 2] = -kd;
+      d->ctrl[i] = pos_term + kd * c.velocity + ff;
+    }
+  }
+};
+
+SimHardware::SimHardware(const std::string& urdf, World world, SimParams params) : impl_(std::make_unique<Impl>()) {
+  impl_->params = std::move(params);
+  impl_->world = std::move(world);
+  impl_->rng.seed(impl_->params.seed);
+  if (impl_->params.timestep <= 0.0) {
+    throw HardwareError("sim: timestep must be positive");
+  }
+  impl_->load(urdf);
+}
+
+SimHardware::~SimHardware() = default;
+
+const std::vector<std::string>& SimHardware::joint_names() const { return impl_->built.joints; }
+std::uint64_t SimHardware::generation() const { return impl_->generation; }
+
+void SimHardware::read(HardwareState& state) {
+  const auto n = impl_->built.joints.size();
+  state.time = impl_->d->time;
+  state.position.resize(n);
+  state.velocity.resize(n);
+  state.effort.resize(n);
+  std::normal_distribution<double> pos_noise(0.0, 1.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    state.position[i] = impl_->d->qpos[impl_->qpos_adr[i]];
+    state.velocity[i] = impl_->d->qvel[impl_->dof_adr[i]];
+    state.effort[i] = impl_->d->actuator_force[i];
+    if (impl_->params.position_noise > 0.0) {
+      state.position[i] += impl_->params.position_noise * pos_noise(impl_->rng);
+    }
+    if (impl_->params.effort_noise > 0.0) {
+      state.effort[i] += impl_->params.effort_noise * pos_noise(impl_->rng);
+    }
+  }
+}
+
+void SimHardware::write(const std::vector<DriveCommand>& commands) {
+  if (commands.size() != impl_->built.joints.size()) {
+    throw HardwareError("sim: " + std::to_string(commands.size()) + " drive commands for " +
+                        std::to_string(impl_->built.joints.size()) + " joints");
+  }
+  impl_->commands = commands;
+}
+
+void SimHardware::step(double dt) {
+  const int n = std::max(1, static_cast<int>(std::lround(dt / impl_->params.timestep)));
+  for (int k = 0; k < n; ++k) {
+    impl_->apply_drives();
+    mj_step(impl_->m, impl_->d);
+  }
+  // As on real drives, measured efforts and contacts lag the positions by one physics step
+  // (mj_step computes forces before integrating); a second mj_forward would double the cost.
+}
+
+void SimHardware::swap_model(const std::string& urdf) { impl_->load(urdf); }
+
+void SimHardware::set_world(const World& world) {
+  impl_->world = world;
+  impl_->load(impl_->urdf);
+}
+
+double SimHardware::time() const { return impl_->d->time; }
+
+Eigen::Isometry3d SimHardware::link_pose(const std::string& link) const {
+  const int id = mj_name2id(impl_->m, mjOBJ_BODY, link.c_str());
+  if (id < 0) {
+    throw HardwareError("sim: unknown link '" + link + "'");
+  }
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    pose.translation()(r) = impl_->d->xpos[3 * id + r];
+    for (int c = 0; c < 3; ++c) {
+      pose.linear()(r, c) = impl_->d->xmat[9 * id + 3 * r + c];
+    }
+  }
+  return pose;
+}
+
+Eigen::Isometry3d SimHardware::base_pose() const { return link_pose(mj_id2name(impl_->m, mjOBJ_BODY, 1)); }
+
+Eigen::Vector3d SimHardware::contact_force_on(const std::vector<std::string>& links) const {
+  std::vector<int> bodies;
+  for (const auto& l : links) {
+    const int id = mj_name2id(impl_->m, mjOBJ_BODY, l.c_str());
+    if (id < 0) {
+      throw HardwareError("sim: unknown link '" + l + "'");
+    }
+    bodies.push_back(id);
+  }
+  auto on_robot = [&](int geom) {
+    return std::find(bodies.begin(), bodies.end(), impl_->m->geom_bodyid[geom]) != bodies.end();
+  };
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  for (int i = 0; i < impl_->d->ncon; ++i) {
+    const mjContact& c = impl_->d->contact[i];
+    const bool g1 = on_robot(c.geom1), g2 = on_robot(c.geom2);
+    if (g1 == g2) {
+      continue;
+    }
+    mjtNum f[6];
+    mj_contactForce(impl_->m, impl_->d, i, f);
+    // Contact frame rows: normal (from geom1 to geom2), then tangents; the force acts on geom2.
+    Eigen::Vector3d world = Eigen::Vector3d::Zero();
+    for (int r = 0; r < 3; ++r) {
+      world += f[r] * Eigen::Vector3d(c.frame[3 * r], c.frame[3 * r + 1], c.frame[3 * r + 2]);
+    }
+    total += g2 ? world : Eigen::Vector3d(-world);
+  }
+  return total;
+}
+
+const std::string& SimHardware::mjcf() const { return impl_->built.mjcf; }
+const std::string& SimHardware::urdf() const { return impl_->urdf; }
+bool SimHardware::floating_base() const { return impl_->built.floating; }
+
+}  // namespace concert::robot

@@ -1,0 +1,115 @@
+#include "robot/base_kinematics.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "robot/sim_hardware.hpp"
+
+namespace concert::robot {
+namespace {
+
+std::string fixture(const std::string& name) { return std::string(ROBOT_FIXTURES) + "/" + name; }
+
+std::vector<Leg> legs_of(const std::string& file) {
+  const auto model = kinematics::Model::from_urdf_file(fixture(file));
+  return detect_legs(model, collision_cylinder_radii(model.urdf()));
+}
+
+TEST(BaseKinematics, DetectsFourLegsOfTheMobileBase) {
+  const auto legs = legs_of("mobile_drill.urdf");
+  ASSERT_EQ(legs.size(), 4u);
+  EXPECT_EQ(legs[0].steering_joint, "J_steer_fl");
+  EXPECT_EQ(legs[0].wheel_joint, "J_wheel_fl");
+  EXPECT_TRUE(legs[0].position.isApprox(Eigen::Vector2d(0.35, 0.3)));
+  EXPECT_DOUBLE_EQ(legs[0].wheel_radius, 0.16);
+  EXPECT_DOUBLE_EQ(legs[0].steering_sign, 1.0);
+  EXPECT_NEAR(legs[0].heading_offset, 0.0, 1e-12);  // wheel axis +y rolls towards +x
+  EXPECT_NEAR(legs[0].wheel_center_height, -0.3, 1e-12);
+  EXPECT_EQ(legs_of("mobile_three_legs.urdf").size(), 3u);
+  EXPECT_TRUE(legs_of("arm_drill.urdf").empty());  // arm joints are not legs
+}
+
+TEST(BaseKinematics, NeedsTwoLegs) {
+  auto legs = legs_of("mobile_drill.urdf");
+  legs.resize(1);
+  EXPECT_THROW(BaseKinematics{legs}, std::invalid_argument);
+}
+
+TEST(BaseKinematics, PureTranslationsAndRotation) {
+  const BaseKinematics base(legs_of("mobile_drill.urdf"));
+  const std::vector<double> zero(4, 0.0);
+  // Forward: every wheel straight, speed v / r.
+  auto sp = base.leg_setpoints({0.5, 0.0, 0.0}, zero);
+  for (const auto& s : sp) {
+    EXPECT_NEAR(s.steering_angle, 0.0, 1e-12);
+    EXPECT_NEAR(s.wheel_velocity, 0.5 / 0.16, 1e-12);
+  }
+  // Sideways: +90 degrees.
+  sp = base.leg_setpoints({0.0, 0.3, 0.0}, zero);
+  for (const auto& s : sp) {
+    EXPECT_NEAR(s.steering_angle, M_PI / 2, 1e-12);
+    EXPECT_NEAR(s.wheel_velocity, 0.3 / 0.16, 1e-12);
+  }
+  // Turning in place: wheel directions tangent to the circle through the leg.
+  sp = base.leg_setpoints({0.0, 0.0, 1.0}, zero);
+  const auto& legs = base.legs();
+  for (std::size_t i = 0; i < legs.size(); ++i) {
+    const Eigen::Vector2d p = legs[i].position;
+    const Eigen::Vector2d dir(std::cos(sp[i].steering_angle), std::sin(sp[i].steering_angle));
+    EXPECT_NEAR(dir.dot(p), 0.0, 1e-12);
+    EXPECT_NEAR(std::abs(sp[i].wheel_velocity), p.norm() / 0.16, 1e-12);
+    EXPECT_LE(std::abs(sp[i].steering_angle), M_PI / 2 + 1e-12);
+  }
+}
+
+TEST(BaseKinematics, SteeringFlipsInsteadOfTurningMoreThanNinetyDegrees) {
+  const BaseKinematics base(legs_of("mobile_drill.urdf"));
+  const std::vector<double> zero(4, 0.0);
+  // Backwards from straight: keep the angle, roll backwards (no half turn).
+  auto sp = base.leg_setpoints({-0.4, 0.0, 0.0}, zero);
+  for (const auto& s : sp) {
+    EXPECT_NEAR(s.steering_angle, 0.0, 1e-12);
+    EXPECT_NEAR(s.wheel_velocity, -0.4 / 0.16, 1e-12);
+  }
+  // Heading 135 degrees from 0: turn to -45 degrees and roll backwards.
+  sp = base.leg_setpoints({-0.3, 0.3, 0.0}, zero);
+  for (const auto& s : sp) {
+    EXPECT_NEAR(s.steering_angle, -M_PI / 4, 1e-12);
+    EXPECT_LT(s.wheel_velocity, 0.0);
+  }
+}
+
+TEST(BaseKinematics, OdometryRecoversTheCommandedTwist) {
+  const BaseKinematics base(legs_of("mobile_drill.urdf"));
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 50; ++k) {
+    const Eigen::Vector3d twist(u(rng), u(rng), u(rng));
+    const auto sp = base.leg_setpoints(twist, std::vector<double>(4, u(rng)));
+    std::vector<double> steer, wheel;
+    for (const auto& s : sp) {
+      steer.push_back(s.steering_angle);
+      wheel.push_back(s.wheel_velocity);
+    }
+    EXPECT_TRUE(base.twist_from_legs(steer, wheel).isApprox(twist, 1e-9));
+  }
+  // Integration: a quarter circle of radius 1 m (vx = 0.5 m/s, wz = 0.5 rad/s for pi s) ends at (1, 1).
+  Odometry odom;
+  const auto sp = base.leg_setpoints({0.5, 0.0, 0.5}, std::vector<double>(4, 0.0));
+  std::vector<double> steer, wheel;
+  for (const auto& s : sp) {
+    steer.push_back(s.steering_angle);
+    wheel.push_back(s.wheel_velocity);
+  }
+  for (int i = 0; i < 3142; ++i) {
+    base.integrate(odom, steer, wheel, 0.001);
+  }
+  EXPECT_NEAR(odom.x, 1.0, 2e-3);
+  EXPECT_NEAR(odom.y, 1.0, 2e-3);
+  EXPECT_NEAR(odom.yaw, M_PI / 2, 2e-3);
+}
+
+}  // namespace
+}  // namespace concert::robot

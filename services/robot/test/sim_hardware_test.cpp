@@ -1,0 +1,102 @@
+#include "robot/sim_hardware.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "test_helpers.hpp"
+
+namespace concert::robot {
+namespace {
+
+using test::read_fixture;
+
+std::size_t index_of(const std::vector<std::string>& names, const std::string& n) {
+  return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin());
+}
+
+TEST(SimHardware, MjcfHasActuatorLimitsFrictionWorldAndFreeBase) {
+  World world = load_world_file(test::fixture_path("world_wall.yaml"));
+  const std::string mjcf = urdf_to_mjcf(read_fixture("mobile_drill.urdf"), world, {});
+  EXPECT_NE(mjcf.find("<freejoint"), std::string::npos);
+  EXPECT_NE(mjcf.find("name=\"floor\""), std::string::npos);
+  EXPECT_NE(mjcf.find("name=\"wall_front\""), std::string::npos);
+  EXPECT_NE(mjcf.find("name=\"pillar\" type=\"cylinder\""), std::string::npos);
+  EXPECT_NE(mjcf.find("joint=\"J1_A\" gaintype=\"fixed\""), std::string::npos);
+  EXPECT_NE(mjcf.find("forcerange=\"-150 150\""), std::string::npos);
+  EXPECT_NE(mjcf.find("frictionloss=\"0.1\""), std::string::npos);
+  // A fixed-base arm has no free joint.
+  EXPECT_EQ(urdf_to_mjcf(read_fixture("arm_drill.urdf"), world, {}).find("<freejoint"), std::string::npos);
+}
+
+TEST(SimHardware, MobileBaseRestsOnTheFloorOnItsWheels) {
+  SimHardware sim(read_fixture("mobile_drill.urdf"), World{}, {});
+  EXPECT_TRUE(sim.floating_base());
+  EXPECT_EQ(sim.joint_names().size(), 14u);
+  HardwareState s;
+  for (int i = 0; i < 1000; ++i) {
+    sim.step(0.001);
+  }
+  sim.read(s);
+  EXPECT_NEAR(s.time, 1.0, 1e-9);
+  // Wheel centre 0.3 m below the base frame, wheel radius 0.16 m.
+  EXPECT_NEAR(sim.base_pose().translation().z(), 0.46, 0.01);
+  EXPECT_NEAR(sim.base_pose().translation().x(), 0.0, 0.01);
+  const Eigen::Vector3d support = sim.contact_force_on({"wheel_fl", "wheel_fr", "wheel_rl", "wheel_rr"});
+  const double weight = 9.81 * (80.0 + 4 * 7.0 + 2.0 + 3.6 + 3.0 + 2.5 + 1.5 + 1.2 + 0.8 + 2.0);
+  EXPECT_NEAR(support.z(), weight, 0.02 * weight);
+  // Arm holds its position under gravity (position-mode drives).
+  const auto j2 = index_of(sim.joint_names(), "J2_A");
+  EXPECT_NEAR(s.position[j2], 0.0, 0.01);
+}
+
+TEST(SimHardware, TorqueSaturatesAtTheUrdfEffortLimit) {
+  SimHardware sim(read_fixture("arm_drill.urdf"), World{}, {});
+  const auto j1 = index_of(sim.joint_names(), "J1_A");
+  std::vector<DriveCommand> cmd(sim.joint_names().size());
+  HardwareState s;
+  sim.read(s);
+  for (std::size_t i = 0; i < cmd.size(); ++i) {
+    cmd[i].position = s.position[i];
+  }
+  cmd[j1].mode = DriveMode::kEffort;
+  cmd[j1].effort = 1000.0;  // limit is 150 Nm
+  sim.write(cmd);
+  sim.step(0.001);
+  sim.step(0.001);
+  sim.read(s);
+  EXPECT_NEAR(s.effort[j1], 150.0, 1e-9);
+  EXPECT_GT(s.velocity[j1], 0.0);
+  cmd.pop_back();
+  EXPECT_THROW(sim.write(cmd), HardwareError);
+}
+
+TEST(SimHardware, HotSwapKeepsStateAndBumpsGeneration) {
+  SimParams params;
+  params.initial_positions = {{"J2_A", 0.2}};
+  SimHardware sim(read_fixture("mobile_drill.urdf"), World{}, params);
+  for (int i = 0; i < 200; ++i) {
+    sim.step(0.001);
+  }
+  const auto gen = sim.generation();
+  const double z = sim.base_pose().translation().z();
+  sim.swap_model(read_fixture("mobile_sander.urdf"));
+  EXPECT_EQ(sim.generation(), gen + 1);
+  EXPECT_NEAR(sim.time(), 0.2, 1e-9);
+  HardwareState s;
+  sim.read(s);
+  EXPECT_NEAR(s.position[index_of(sim.joint_names(), "J2_A")], 0.2, 0.01);
+  EXPECT_NEAR(sim.base_pose().translation().z(), z, 1e-6);
+  EXPECT_NO_THROW((void)sim.link_pose("sander"));
+  EXPECT_THROW((void)sim.link_pose("drill"), HardwareError);
+  sim.swap_model(read_fixture("mobile_three_legs.urdf"));
+  EXPECT_EQ(sim.joint_names().size(), 12u);
+  EXPECT_EQ(index_of(sim.joint_names(), "J_wheel_rr"), sim.joint_names().size());
+}
+
+TEST(SimHardware, BadUrdfIsAClearError) {
+  EXPECT_THROW(SimHardware("<robot name='x'>", World{}, {}), std::exception);
+}
+
+}  // namespace
+}  // namespace concert::robot
