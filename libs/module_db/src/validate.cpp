@@ -1,4 +1,6 @@
 #include <cmath>
+
+#include <Eigen/SVD>
 #include <set>
 
 #include "concert/module_db/module_db.hpp"
@@ -14,12 +16,18 @@ namespace {
 
 bool finite(const Pose& p) { return p.matrix().allFinite(); }
 
-void check_rotation(const Pose& p, const std::filesystem::path& file, const std::string& field) {
+/// Checks that the rotation part is a rotation (to 1e-3) and replaces it by the nearest exact
+/// rotation: the public files round entries to 6 digits (0.707107), and every consumer (URDF rpy,
+/// FK) must see the same orthonormal matrix.
+void check_rotation(Pose& p, const std::filesystem::path& file, const std::string& field) {
   if (!finite(p)) fail(file, field, "not finite");
   const Eigen::Matrix3d r = p.linear();
-  if (!(r.transpose() * r).isIdentity(1e-3) || std::abs(r.determinant() - 1.0) > 1e-3) {
+  if (!(r.transpose() * r).isIdentity(1e-3) || std::abs(r.determinant() - 1.0) > 1e-3 ||
+      std::abs(p.matrix()(3, 3) - 1.0) > 1e-12 || !p.matrix().row(3).head<3>().isZero(0.0)) {
     fail(file, field, "rotation part is not a rotation matrix");
   }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  p.linear() = svd.matrixU() * svd.matrixV().transpose();
 }
 
 }  // namespace
@@ -56,7 +64,7 @@ void validate_and_normalise(ModuleDescription& m, const std::filesystem::path& f
   if (inputs == 0 && !m.is_hub()) fail(file, "connectors", "no input connector");
   std::set<int> children;
   for (size_t i = 0; i < m.joints.size(); ++i) {
-    const JointDescription& j = m.joints[i];
+    JointDescription& j = m.joints[i];
     const std::string f = "joints[" + std::to_string(i) + "]";
     if (j.parent_body < 0 || j.parent_body >= nb) fail(file, f + ".parent", "no such body");
     if (j.child_body < 0 || j.child_body >= nb) fail(file, f + ".child", "no such body");

@@ -1,0 +1,141 @@
+#pragma once
+// The robot model generated from a module tree (paper section 4.3.3): the physical tree phi,
+// URDF/SRDF/controller-configuration texts and the joint/chain/end-effector lists carried by the
+// RobotModel message. Plain C++/Eigen; no DDS.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "concert/module_db/module_description.hpp"
+
+namespace concert::modelgen {
+
+using module_db::Pose;
+
+/// A tree that cannot be modelled (unknown module, connector mismatch, bad customisation...).
+/// what() names the module (index, key) and what is wrong.
+class ModelError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A body (node) of the physical tree phi = one URDF link.
+struct PhysicalBody {
+  std::string name;                ///< URDF link name (section 4.3.3 naming)
+  int module = -1;                 ///< index into the module tree; -1 for none
+  int module_body = -1;            ///< body index in the module description; -1 for frames
+  std::string chain;               ///< chain tag ("A", "B", ...); empty for the root hub
+  bool massless = false;           ///< TCP/wheel/camera frames carry no inertia
+  module_db::Inertial inertial;    ///< in the link frame (CoM and inertia axes rotated into it)
+  std::vector<module_db::Shape> visuals;     ///< poses in the link frame
+  std::vector<module_db::Shape> collisions;  ///< poses in the link frame
+};
+
+/// An edge of phi = one URDF joint. Moving joints carry the module's limits and control data.
+struct PhysicalJoint {
+  std::string name;
+  module_db::JointType type = module_db::JointType::kFixed;
+  int parent = 0;                  ///< index into PhysicalTree::bodies
+  int child = 0;                   ///< index into PhysicalTree::bodies
+  Pose origin = Pose::Identity();  ///< parent_link_T_child_link at q = 0
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< in the child link frame
+  int module = -1;
+  std::string chain;
+  bool connection = false;         ///< true: static joint made by two mating connectors (eq. 1)
+  const module_db::JointDescription* description = nullptr;  ///< moving joints: the module's joint
+};
+
+/// The physical tree phi. bodies[0] is the root; joints are ordered parents first.
+struct PhysicalTree {
+  std::vector<PhysicalBody> bodies;
+  std::vector<PhysicalJoint> joints;
+  /// Index of the body called `name`, or -1.
+  int body_index(const std::string& name) const;
+  /// Sum of body masses, kg.
+  double mass() const;
+};
+
+/// A moving joint as listed in the model (RobotModel.joints).
+struct JointInfo {
+  std::string name;
+  std::string chain;
+  int module = -1;
+  std::string module_key;
+  module_db::JointType type = module_db::JointType::kRevolute;
+  double lower = 0.0;              ///< rad (m)
+  double upper = 0.0;              ///< rad (m)
+  double velocity = 0.0;           ///< rad/s (m/s)
+  double peak_torque = 0.0;        ///< N m (N)
+  double continuous_torque = 0.0;  ///< N m; the peak torque where the database gives none
+  double gear_ratio = 1.0;
+  std::string control_mode;        ///< "position", "velocity" or "impedance"
+  module_db::ControlParams gains;
+  double home = 0.0;               ///< homing position, rad (m)
+};
+
+/// A kinematic chain (RobotModel.chains).
+struct ChainInfo {
+  std::string name;                ///< tag "A", "B", ...
+  std::string role;                ///< "arm", "leg" or "other"
+  std::string base_link;
+  std::string tip_link;
+  std::vector<std::string> joints; ///< moving joints, root to tip
+  std::vector<int> modules;        ///< module indices in the chain, root to tip
+};
+
+/// An end-effector (RobotModel.end_effectors); wheels count as end-effectors of legs.
+struct EndEffectorInfo {
+  std::string name;                ///< e.g. "drill_E"
+  std::string chain;
+  std::string frame;               ///< TCP or wheel-centre link
+  std::string module_key;
+  int module = -1;
+  std::vector<std::string> addons; ///< add-on keys mounted on it
+};
+
+/// One add-on choice of a customisation (section 4.4).
+struct AddonChoice {
+  std::string module_name;         ///< end-effector name ("drill_E") or URDF body name
+  std::string addon;               ///< add-on key, e.g. "drillbit_12_SDSmax"
+  bool operator==(const AddonChoice&) const = default;
+};
+
+/// What the network cannot discover: homing posture and add-ons.
+struct Customisation {
+  std::map<std::string, double> home;  ///< joint name -> homing position, rad (m)
+  std::vector<AddonChoice> addons;
+  bool operator==(const Customisation&) const = default;
+};
+
+/// A generated model. Texts contain no version or time, so equal content gives an equal hash.
+struct RobotModel {
+  uint64_t version = 0;            ///< assigned by ModelVersioner; 0 = not published
+  uint64_t tree_version = 0;       ///< version of the module tree it was built from
+  std::string content_hash;        ///< "sha256:<hex>" of urdf + '\0' + srdf + '\0' + config_yaml
+  std::string urdf;
+  std::string srdf;
+  std::string config_yaml;
+  std::vector<std::string> modules;  ///< module keys in tree order
+  std::vector<JointInfo> joints;
+  std::vector<ChainInfo> chains;
+  std::vector<EndEffectorInfo> end_effectors;
+  Customisation customisation;     ///< the customisation applied
+  PhysicalTree tree;               ///< phi
+};
+
+/// Options of the generator.
+struct Params {
+  std::string robot_name = "concert";
+  /// Gains used when the database gives none for a joint of that control mode.
+  double default_stiffness = 1000.0;  ///< N m/rad
+  double default_damping = 20.0;      ///< N m s/rad
+  double default_kp = 500.0;
+  double default_kd = 10.0;
+  double default_velocity_kp = 5.0;
+};
+
+}  // namespace concert::modelgen

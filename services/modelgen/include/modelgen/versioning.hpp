@@ -1,0 +1,37 @@
+#pragma once
+// Versioning of published models: versions strictly increase, unchanged content (same hash)
+// gives no new version, and a failed generation never replaces the current model.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "modelgen/model.hpp"
+
+namespace concert::modelgen {
+
+class ModelVersioner {
+ public:
+  /// Outcome of offering a newly generated model.
+  struct Update {
+    bool published = false;  ///< true: the model became current with a new version
+    uint64_t version = 0;    ///< version of the current model after the call
+  };
+
+  /// `first_version` is the version given to the first model (e.g. one more than the last version
+  /// read back from a bundle on disk, so versions keep increasing across restarts).
+  explicit ModelVersioner(uint64_t first_version = 1) : next_version_(first_version == 0 ? 1 : first_version) {}
+
+  /// Makes `model` current with the next version unless its content hash equals the current
+  /// model's (then only tree_version is refreshed and nothing is published).
+  Update offer(RobotModel model);
+
+  /// The current model, if any.
+  const std::optional<RobotModel>& current() const { return current_; }
+
+ private:
+  uint64_t next_version_;
+  std::optional<RobotModel> current_;
+};
+
+}  // namespace concert::modelgen
