@@ -1,0 +1,160 @@
+// Module tree from the network graph: group the ESCs of multi-ESC modules, name each module
+// from the catalogue and find the output connector each module hangs on.
+#include "discovery/discovery.hpp"
+
+#include <utility>
+
+namespace concert::discovery {
+namespace {
+
+using topology::EscScan;
+using topology::ModuleLayout;
+using topology::ModuleNode;
+using topology::ModuleTree;
+using topology::SlaveNode;
+
+std::string module_name(const ModuleNode& m) {
+  return "module #" + std::to_string(m.index) + " " + m.key + " (" + to_string(m.kind) + ")";
+}
+
+std::string connectors_text(const ModuleLayout& layout) {
+  if (layout.connectors.empty()) return "no output connector";
+  std::string text = std::to_string(layout.outputs()) + " output connector" +
+                     (layout.outputs() == 1 ? "" : "s") + " (";
+  for (std::size_t i = 0; i < layout.connectors.size(); ++i) {
+    const auto& c = layout.connectors[i];
+    if (i > 0) text += ", ";
+    text += std::to_string(c.connector) + " on port " + std::to_string(c.port);
+    if (layout.escs.size() > 1) text += " of ESC " + std::to_string(c.esc + 1);
+  }
+  return text + ")";
+}
+
+}  // namespace
+
+Discovery::Discovery(topology::EscCatalog catalog, Params params)
+    : catalog_(std::move(catalog)), params_(params) {
+  for (const auto& entry : catalog_.entries()) {
+    layouts_.emplace(entry.identity, catalog_.layout(entry.identity, params_.port_order));
+  }
+}
+
+ModuleTree Discovery::run(const EscScan& raw_scan) const {
+  const EscScan scan = checked_scan(raw_scan);
+  const std::vector<SlaveLink> links = reconstruct_network(scan, params_.port_order);
+  const std::size_t n = scan.slaves.size();
+
+  std::vector<int32_t> child_count(n, 0);
+  for (const auto& link : links) {
+    if (link.parent_position > 0) ++child_count[static_cast<std::size_t>(link.parent_position - 1)];
+  }
+
+  ModuleTree tree;
+  tree.slaves.resize(n);
+  std::vector<const ModuleLayout*> module_layouts;
+  std::vector<int32_t> esc_in_module(n, 0);  // index of the slave's ESC in its module layout
+
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& slave = scan.slaves[i];
+    const SlaveLink& link = links[i];
+    SlaveNode& node = tree.slaves[i];
+    node.slave = slave;
+    node.parent_position = link.parent_position;
+    node.parent_port = link.parent_port;
+
+    int32_t parent_module = -1;
+    int32_t parent_connector = -1;
+    if (link.parent_position > 0) {
+      const auto p = static_cast<std::size_t>(link.parent_position - 1);
+      const int32_t port = *link.parent_port;
+      parent_module = tree.slaves[p].module_index;
+      const ModuleLayout& layout = *module_layouts[static_cast<std::size_t>(parent_module)];
+      ModuleNode& owner = tree.modules[static_cast<std::size_t>(parent_module)];
+      if (const auto esc = layout.esc_at(esc_in_module[p], port)) {
+        // Another ESC of the parent's own module (e.g. the Mobile Base Hub's hub board).
+        const auto& expected = layout.escs[static_cast<std::size_t>(*esc)].identity;
+        if (slave.identity != expected) {
+          throw DiscoveryError(slave.position,
+                               "hangs on port " + std::to_string(port) + " of slave " +
+                                   std::to_string(link.parent_position) + ", where " +
+                                   module_name(owner) + " has its ESC " + to_string(expected) +
+                                   ", but reports " + to_string(slave.identity));
+        }
+        node.module_index = parent_module;
+        esc_in_module[i] = *esc;
+        owner.slave_positions.push_back(slave.position);
+        continue;
+      }
+      const auto connector = layout.connector_at(esc_in_module[p], port);
+      if (!connector) {
+        int32_t children = 0;
+        for (int32_t pos : owner.slave_positions) {
+          children += child_count[static_cast<std::size_t>(pos - 1)];
+        }
+        children -= static_cast<int32_t>(layout.escs.size()) - 1;
+        if (children > layout.outputs()) {
+          throw DiscoveryError(
+              owner.slave_positions.front(),
+              module_name(owner) + " has " + std::to_string(children) + " child module" +
+                  (children == 1 ? "" : "s") + " but " + owner.key + " has " +
+                  connectors_text(layout) + "; slave " +
+                  std::to_string(slave.position) + " hangs on port " + std::to_string(port) +
+                  " of slave " + std::to_string(link.parent_position));
+        }
+        throw DiscoveryError(slave.position,
+                             "hangs on port " + std::to_string(port) + " of slave " +
+                                 std::to_string(link.parent_position) + ", which is not an output "
+                                 "connector of " + module_name(owner) + ": it has " +
+                                 connectors_text(layout));
+      }
+      parent_connector = *connector;
+    }
+
+    const auto found = layouts_.find(slave.identity);
+    if (found == layouts_.end()) {
+      throw DiscoveryError(slave.position, "unknown module identity " + to_string(slave.identity) +
+                                               ": not in the ESC catalogue");
+    }
+    const ModuleLayout& layout = found->second;
+    ModuleNode module;
+    module.index = static_cast<int32_t>(tree.modules.size());
+    module.key = layout.key;
+    module.kind = layout.kind;
+    module.identity = slave.identity;
+    module.slave_positions.push_back(slave.position);
+    module.parent_module = parent_module;
+    module.parent_connector = parent_connector;
+    module.robot_id = slave.robot_id;
+    node.module_index = module.index;
+    esc_in_module[i] = 0;
+    tree.modules.push_back(std::move(module));
+    module_layouts.push_back(&layout);
+  }
+
+  for (std::size_t m = 0; m < tree.modules.size(); ++m) {
+    const ModuleLayout& layout = *module_layouts[m];
+    const ModuleNode& module = tree.modules[m];
+    if (module.slave_positions.size() == layout.escs.size()) continue;
+    // The first ESC of the layout that no slave filled.
+    std::vector<bool> present(layout.escs.size(), false);
+    for (int32_t pos : module.slave_positions) {
+      present[static_cast<std::size_t>(esc_in_module[static_cast<std::size_t>(pos - 1)])] = true;
+    }
+    for (std::size_t e = 1; e < layout.escs.size(); ++e) {
+      if (present[e]) continue;
+      const auto& placement = layout.escs[e];
+      throw DiscoveryError(module.slave_positions.front(),
+                           module_name(module) + " lacks its ESC " + to_string(placement.identity) +
+                               " on port " + std::to_string(placement.parent_port) + " of its ESC " +
+                               std::to_string(placement.parent_esc + 1));
+    }
+  }
+  return tree;
+}
+
+ModuleTree discover(const EscScan& scan, const topology::EscCatalog& catalog,
+                    const Params& params) {
+  return Discovery(catalog, params).run(scan);
+}
+
+}  // namespace concert::discovery

@@ -1,0 +1,137 @@
+#include "discovery/cli.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "concert/simbus/assembly.hpp"
+#include "concert/topology/esc_catalog.hpp"
+#include "concert/topology/scan_io.hpp"
+
+namespace concert::discovery {
+namespace {
+
+const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
+const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("concert_discovery_cli_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    const auto catalog = topology::EscCatalog::load(kPublicDb);
+    const auto assembly = simbus::load_assembly(kExamples + "/concert_paper_robot.yaml");
+    const auto scan = simbus::simulate_scan(assembly, catalog);
+    std::ofstream(dir_ / "robot.yaml") << topology::scan_to_yaml(scan);
+    std::ofstream(dir_ / "robot.json") << topology::scan_to_json(scan).dump();
+    std::ofstream(dir_ / "robot_0123.yaml") << topology::scan_to_yaml(
+        simbus::simulate_scan(assembly, catalog, topology::PortOrder::kNumeric0123));
+    auto bad = scan;
+    bad.slaves[2].topology = 4;
+    std::ofstream(dir_ / "bad.yaml") << topology::scan_to_yaml(bad);
+    std::ofstream(dir_ / "broken.yaml") << "slaves:\n  - {position: 1, active_ports: 1}\n";
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  int run(std::vector<std::string> args) {
+    out_.str("");
+    err_.str("");
+    return cli_main(args, out_, err_);
+  }
+  std::string file(const char* name) const { return (dir_ / name).string(); }
+
+  std::filesystem::path dir_;
+  std::ostringstream out_, err_;
+};
+
+TEST_F(Cli, JsonOutputHasEverySlaveAndModule) {
+  for (const char* name : {"robot.yaml", "robot.json"}) {
+    ASSERT_EQ(run({"--scan", file(name), "--module-db", kPublicDb, "--json"}), 0) << err_.str();
+    const auto j = nlohmann::json::parse(out_.str());
+    ASSERT_EQ(j["slaves"].size(), 19u);
+    ASSERT_EQ(j["modules"].size(), 18u);
+    const auto& first = j["slaves"][0];
+    EXPECT_EQ(first["position"], 1);
+    EXPECT_EQ(first["parent_position"], 0);
+    EXPECT_TRUE(first["parent_port"].is_null());
+    EXPECT_EQ(first["active_ports"], 15);
+    EXPECT_EQ(first["mod_type"], 2);
+    EXPECT_EQ(first["mod_id"], 3);
+    EXPECT_EQ(first["mod_size"], 0);
+    EXPECT_EQ(first["mod_rev"], 0);
+    EXPECT_EQ(first["robot_id"], 100);
+    EXPECT_EQ(first["module"], 0);
+    EXPECT_EQ(j["slaves"][1]["parent_port"], 3);
+    EXPECT_EQ(j["slaves"][1]["module"], 0);
+    EXPECT_EQ(j["slaves"][10]["parent_port"], 2);
+    EXPECT_EQ(j["slaves"][10]["module_key"], "module_joint_yaw_A_concert");
+    EXPECT_EQ(j["modules"][9]["parent_connector"], 5);
+  }
+}
+
+TEST_F(Cli, TextOutputAndPortOrder) {
+  ASSERT_EQ(run({"--scan", file("robot.yaml"), "--module-db", kPublicDb}), 0) << err_.str();
+  EXPECT_NE(out_.str().find("#0 mobile_platform_concert (hub) slaves 1,2 robot_id 100"),
+            std::string::npos)
+      << out_.str();
+  EXPECT_NE(out_.str().find("[5] #9 module_joint_yaw_A_concert (joint) slave 11"),
+            std::string::npos)
+      << out_.str();
+  ASSERT_EQ(run({"--scan", file("robot_0123.yaml"), "--port-order", "0123", "--module-db",
+                 kPublicDb, "--json"}),
+            0)
+      << err_.str();
+  const auto j = nlohmann::json::parse(out_.str());
+  EXPECT_EQ(j["slaves"][1]["parent_port"], 1);
+}
+
+TEST_F(Cli, BadInputGivesOneLineAndNonZero) {
+  EXPECT_EQ(run({"--module-db", kPublicDb}), 2);
+  EXPECT_NE(err_.str().find("missing --scan FILE"), std::string::npos);
+  EXPECT_EQ(run({"--scan"}), 2);
+  EXPECT_NE(err_.str().find("option --scan needs a value"), std::string::npos);
+  EXPECT_EQ(run({"--scan", file("robot.yaml"), "--port-order", "0321"}), 2);
+  EXPECT_NE(err_.str().find("--port-order '0321': expected 0312 or 0123"), std::string::npos);
+  EXPECT_EQ(run({"--scan", file("robot.yaml"), "--frobnicate"}), 2);
+  EXPECT_NE(err_.str().find("unknown argument '--frobnicate'"), std::string::npos);
+
+  EXPECT_EQ(run({"--scan", file("bad.yaml"), "--module-db", kPublicDb}), 1);
+  EXPECT_EQ(err_.str(), "concert discover: " + file("bad.yaml") +
+                            ": slave 3: active_ports 0b1001 has 2 open ports but topology says 4\n");
+  EXPECT_EQ(run({"--scan", file("broken.yaml"), "--module-db", kPublicDb}), 1);
+  EXPECT_NE(err_.str().find(file("broken.yaml") + ": slaves[0]: missing field 'mod_type'"),
+            std::string::npos)
+      << err_.str();
+  EXPECT_EQ(run({"--scan", file("missing.yaml"), "--module-db", kPublicDb}), 1);
+  EXPECT_NE(err_.str().find("missing.yaml: cannot open the scan file"), std::string::npos);
+  EXPECT_EQ(run({"--scan", file("robot.yaml"), "--module-db", file("nodb")}), 1);
+  EXPECT_NE(err_.str().find("nodb: module database folder not found"), std::string::npos);
+  EXPECT_TRUE(out_.str().empty());
+  // A database without the base: unknown identity at slave 1.
+  std::filesystem::create_directories(dir_ / "db");
+  std::ofstream(dir_ / "db" / "esc_index.yaml")
+      << "modules:\n  - {mod_type: 1, mod_id: 4, mod_size: 4, mod_rev: 0, key: yaw}\n";
+  EXPECT_EQ(run({"--scan", file("robot.yaml"), "--module-db", file("db")}), 1);
+  EXPECT_NE(err_.str().find("slave 1: unknown module identity (mod_type 2, mod_id 3"),
+            std::string::npos)
+      << err_.str();
+}
+
+TEST_F(Cli, SeveralDatabasesMerge) {
+  std::filesystem::create_directories(dir_ / "db");
+  std::ofstream(dir_ / "db" / "esc_index.yaml")
+      << "modules:\n  - {mod_type: 3, mod_id: 3, mod_size: 4, mod_rev: 0, key: my_drill}\n";
+  ASSERT_EQ(run({"--scan", file("robot.yaml"), "--module-db", kPublicDb, "--module-db",
+                 file("db"), "--json"}),
+            0)
+      << err_.str();
+  EXPECT_EQ(nlohmann::json::parse(out_.str())["modules"][17]["key"], "my_drill");
+}
+
+}  // namespace
+}  // namespace concert::discovery
