@@ -1,0 +1,171 @@
+#include "robot/robot_core.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "test_helpers.hpp"
+
+namespace concert::robot {
+namespace {
+
+using test::hw_index;
+using test::read_fixture;
+using test::run_cycles;
+
+std::string message_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+class RobotCoreTest : public ::testing::Test {
+ protected:
+  RobotCoreTest() : sim_(read_fixture("mobile_drill.urdf"), World{}, {}), core_(sim_) {}
+  SimHardware sim_;
+  RobotCore core_;
+};
+
+TEST_F(RobotCoreTest, NotReadyWithoutAModelAndHoldsTheHardware) {
+  EXPECT_FALSE(core_.ready());
+  EXPECT_NE(message_of([&] { core_.command_base({0, 0.1, 0, 0}); }).find("not ready"), std::string::npos);
+  run_cycles(core_, 300);
+  const RobotState s = core_.state();
+  EXPECT_NEAR(s.time, 0.299, 1e-9);  // state is read before the cycle's step
+  EXPECT_NEAR(s.position[hw_index(s, "J2_A")], 0.0, 0.01);
+}
+
+TEST_F(RobotCoreTest, AcceptsAMatchingModelAndFindsArmAndLegs) {
+  core_.set_model(read_fixture("mobile_drill.urdf"), 1);
+  EXPECT_TRUE(core_.ready());
+  EXPECT_EQ(core_.model_version(), 1u);
+  EXPECT_EQ(core_.arm_joints(), (std::vector<std::string>{"J1_A", "J2_A", "J3_A", "J4_B", "J5_B", "J6_B"}));
+  EXPECT_EQ(core_.legs().size(), 4u);
+  run_cycles(core_, 10);
+  const RobotState s = core_.state();
+  EXPECT_EQ(s.end_effector_frame, "tcp");
+  EXPECT_TRUE(s.has_base);
+  EXPECT_EQ(s.message, "ready at model version 1");
+}
+
+TEST_F(RobotCoreTest, RefusesModelsThatDoNotMatchTheMountedHardware) {
+  core_.set_model(read_fixture("mobile_drill.urdf"), 1);
+  const std::string msg = message_of([&] { core_.set_model(read_fixture("mobile_three_legs.urdf"), 2); });
+  EXPECT_NE(msg.find("does not match the mounted hardware"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("J_steer_rr"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("J_wheel_rr"), std::string::npos) << msg;
+  EXPECT_EQ(core_.model_version(), 1u);  // the last good model stays
+  EXPECT_TRUE(core_.ready());
+  EXPECT_NE(message_of([&] { core_.set_model("<robot", 3); }).find("model version 3 refused"), std::string::npos);
+  EXPECT_NE(message_of([&] { core_.set_model(read_fixture("mobile_drill.urdf"), 0); }).find("older"),
+            std::string::npos);
+}
+
+TEST_F(RobotCoreTest, RefusesUnknownJointsStaleVersionsAndBadValues) {
+  core_.set_model(read_fixture("mobile_drill.urdf"), 4);
+  JointCommandSet cmd{4, {{"J9_X", DriveMode::kPosition, 0.1, 0, 0, 0, 0}}};
+  std::string msg = message_of([&] { core_.command_joints(cmd); });
+  EXPECT_NE(msg.find("unknown joint 'J9_X'"), std::string::npos) << msg;
+  cmd.joints[0].joint = "J1_A";
+  cmd.model_version = 3;
+  msg = message_of([&] { core_.command_joints(cmd); });
+  EXPECT_NE(msg.find("model version 3 refused: current model version is 4"), std::string::npos) << msg;
+  cmd.model_version = 4;
+  cmd.joints[0].position = std::nan("");
+  EXPECT_NE(message_of([&] { core_.command_joints(cmd); }).find("non-finite"), std::string::npos);
+  cmd.joints[0].position = 0.1;
+  cmd.joints.push_back(cmd.joints[0]);
+  EXPECT_NE(message_of([&] { core_.command_joints(cmd); }).find("twice"), std::string::npos);
+  CartesianCommand cart;
+  cart.model_version = 4;
+  cart.frame = "wheel_fl";
+  EXPECT_NE(message_of([&] { core_.command_cartesian(cart); }).find("not the end-effector frame"), std::string::npos);
+}
+
+TEST_F(RobotCoreTest, PositionAndVelocityLimitsAreEnforced) {
+  core_.set_model(read_fixture("mobile_drill.urdf"), 1);
+  // J2_A: position limits [-2, 2] rad, velocity limit 1.5 rad/s. Ask for 2.5 rad.
+  core_.command_joints({1, {{"J1_A", DriveMode::kPosition, 2.5, 0, 0, 0, 0}}});
+  double max_speed = 0.0;
+  for (int i = 0; i < 3000; ++i) {
+    core_.cycle();
+    const RobotState s = core_.state();
+    max_speed = std::max(max_speed, std::abs(s.velocity[hw_index(s, "J1_A")]));
+  }
+  const RobotState s = core_.state();
+  EXPECT_LE(s.position[hw_index(s, "J1_A")], 2.9 + 0.01);  // J1_A upper limit 2.9 rad
+  EXPECT_NEAR(s.position[hw_index(s, "J1_A")], 2.5, 0.01);
+  EXPECT_LE(max_speed, 1.5 * 1.05);
+  EXPECT_GE(max_speed, 1.5 * 0.8);
+  // Beyond the position limit: clamped to it.
+  core_.command_joints({1, {{"J2_A", DriveMode::kPosition, 2.5, 0, 0, 0, 0}}});
+  run_cycles(core_, 3000);
+  const RobotState s2 = core_.state();
+  EXPECT_NEAR(s2.position[hw_index(s2, "J2_A")], 2.0, 0.03);
+  // Velocity mode: clamped at 2.5 rad/s for J4_B.
+  core_.command_joints({1, {{"J4_B", DriveMode::kVelocity, 0, 10.0, 0, 0, 0}}});
+  run_cycles(core_, 500);
+  const RobotState s3 = core_.state();
+  EXPECT_NEAR(s3.velocity[hw_index(s3, "J4_B")], 2.5, 0.1);
+}
+
+TEST_F(RobotCoreTest, EffortCommandsSaturateAtTheTorqueLimit) {
+  core_.set_model(read_fixture("mobile_drill.urdf"), 1);
+  core_.command_joints({1, {{"J4_B", DriveMode::kEffort, 0, 0, 500.0, 0, 0}}});
+  run_cycles(core_, 3);
+  const RobotState s = core_.state();
+  EXPECT_NEAR(s.effort[hw_index(s, "J4_B")], 40.0, 1e-6);
+}
+
+TEST_F(RobotCoreTest, GravityCompensationFloatsTheArm) {
+  SimParams params;
+  params.initial_positions = {{"J2_A", 0.5}, {"J3_A", 0.6}};
+  SimHardware sim(read_fixture("arm_drill.urdf"), World{}, params);
+  RobotCore core(sim);
+  core.set_model(read_fixture("arm_drill.urdf"), 1);
+  run_cycles(core, 200);
+  // Position hold has gravity feed-forward: no sag (g / kp would be ~0.02 rad here).
+  const RobotState held = core.state();
+  EXPECT_NEAR(held.position[hw_index(held, "J2_A")], 0.5, 2e-3);
+  core.command_gravity_compensation(1);
+  run_cycles(core, 1000);
+  const RobotState s = core.state();
+  EXPECT_EQ(s.owners[hw_index(s, "J2_A")], JointOwner::kGravityCompensation);
+  EXPECT_NEAR(s.position[hw_index(s, "J2_A")], 0.5, 5e-3);
+  EXPECT_NEAR(s.position[hw_index(s, "J3_A")], 0.6, 5e-3);
+  // Torques are the model's gravity torques (not position-control torques).
+  EXPECT_GT(std::abs(s.effort[hw_index(s, "J2_A")]), 5.0);
+}
+
+TEST_F(RobotCoreTest, HotSwapThenReconfigureToTheNewModel) {
+  core_.set_model(read_fixture("mobile_drill.urdf"), 1);
+  run_cycles(core_, 100);
+  // Replace the drill by the sanding tool: same joints, new links.
+  sim_.swap_model(read_fixture("mobile_sander.urdf"));
+  run_cycles(core_, 10);
+  EXPECT_FALSE(core_.ready());
+  EXPECT_NE(core_.state().message.find("hardware changed"), std::string::npos);
+  EXPECT_NE(message_of([&] { core_.command_base({1, 0.1, 0, 0}); }).find("not ready"), std::string::npos);
+  core_.set_model(read_fixture("mobile_sander.urdf"), 2);
+  EXPECT_TRUE(core_.ready());
+  run_cycles(core_, 10);
+  EXPECT_EQ(core_.state().model_version, 2u);
+  // Remove a leg: the old model no longer matches, the new one does.
+  sim_.swap_model(read_fixture("mobile_three_legs.urdf"));
+  run_cycles(core_, 10);
+  EXPECT_FALSE(core_.ready());
+  EXPECT_THROW(core_.set_model(read_fixture("mobile_sander.urdf"), 3), ModelMismatchError);
+  core_.set_model(read_fixture("mobile_three_legs.urdf"), 3);
+  EXPECT_TRUE(core_.ready());
+  EXPECT_EQ(core_.legs().size(), 3u);
+  run_cycles(core_, 500);
+  // The robot held still through both swaps.
+  const RobotState s = core_.state();
+  EXPECT_NEAR(s.position[hw_index(s, "J2_A")], 0.0, 0.02);
+}
+
+}  // namespace
+}  // namespace concert::robot

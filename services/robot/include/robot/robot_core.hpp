@@ -37,7 +37,7 @@ struct JointCommand {
   DriveMode mode{DriveMode::kPosition};
   double position{0.0};   ///< [rad] or [m]
   double velocity{0.0};   ///< [rad/s] or [m/s]
-  double effort{0.0};     ///< feed-forward [Nm] or [N]
+  double effort{0.0};     ///< feed-forward [Nm] or [N] (position mode adds it to the model gravity torque)
   double stiffness{0.0};  ///< impedance mode [Nm/rad]
   double damping{0.0};    ///< impedance mode [Nm s/rad]
 };

@@ -417,6 +417,7 @@ void RobotCore::cycle() {
           case JointOwner::kHold:
             d.mode = DriveMode::kPosition;
             d.position = ramp(c.hold_position[iu]);
+            d.effort = gravity(i);
             break;
           case JointOwner::kJoint: {
             const JointCommand& jc = c.joint_cmd[iu];
@@ -424,6 +425,7 @@ void RobotCore::cycle() {
             switch (jc.mode) {
               case DriveMode::kPosition:
                 d.position = ramp(jc.position);
+                d.effort = gravity(i) + jc.effort;
                 break;
               case DriveMode::kVelocity:
                 d.velocity = clamp_abs(jc.velocity, vmax);
@@ -466,6 +468,7 @@ void RobotCore::cycle() {
             if (steering) {
               d.mode = DriveMode::kPosition;
               d.position = ramp(sp.steering_angle);
+              d.effort = gravity(i);
             } else {
               d.mode = DriveMode::kVelocity;
               d.velocity = clamp_abs(sp.wheel_velocity, vmax);
