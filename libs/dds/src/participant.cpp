@@ -5,11 +5,41 @@
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
 
 namespace concert::dds {
 
 using namespace eprosima::fastdds::dds;
 using eprosima::fastrtps::types::ReturnCode_t;
+
+namespace {
+
+// Participants on this machine find each other by unicast to 127.0.0.1 (the well-known RTPS
+// ports of the first kMaxLocalParticipants participant ids); no multicast, no other interface.
+constexpr uint32_t kMaxLocalParticipants = 48;
+
+void use_localhost_only(DomainParticipantQos& qos) {
+  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  udp->interfaceWhiteList.emplace_back("127.0.0.1");
+  udp->maxInitialPeersRange = kMaxLocalParticipants;
+  qos.transport().use_builtin_transports = false;
+  qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  qos.transport().user_transports.push_back(udp);
+
+  eprosima::fastrtps::rtps::Locator_t local;
+  local.kind = LOCATOR_KIND_UDPv4;
+  eprosima::fastrtps::rtps::IPLocator::setIPv4(local, 127, 0, 0, 1);
+  auto& builtin = qos.wire_protocol().builtin;
+  builtin.initialPeersList.push_back(local);
+  // A user-given metatraffic unicast locator keeps Fast DDS from adding its multicast one.
+  builtin.metatrafficUnicastLocatorList.push_back(local);
+  builtin.metatrafficMulticastLocatorList.clear();
+  qos.wire_protocol().default_unicast_locator_list.push_back(local);
+}
+
+}  // namespace
 
 Participant::Participant(ParticipantOptions options) : name_(options.name) {
   domain_id_ = options.domain_id >= 0 ? options.domain_id : domain_id_from_env();
@@ -31,8 +61,18 @@ Participant::Participant(ParticipantOptions options) : name_(options.name) {
     qos.name(options.name);
     participant_ = factory->create_participant(domain_id_, qos);
   } else {
+    std::string network = options.network;
+    if (network.empty()) {
+      const char* env = std::getenv("CONCERT_DDS_NETWORK");
+      network = env != nullptr && *env != '\0' ? env : "localhost";
+    }
     DomainParticipantQos qos = PARTICIPANT_QOS_DEFAULT;
     qos.name(options.name);
+    if (network == "localhost") {
+      use_localhost_only(qos);
+    } else if (network != "system") {
+      throw std::invalid_argument("CONCERT_DDS_NETWORK: '" + network + "' is not 'localhost' or 'system'");
+    }
     participant_ = factory->create_participant(domain_id_, qos);
   }
   if (participant_ == nullptr) {

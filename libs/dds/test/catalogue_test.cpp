@@ -15,12 +15,8 @@ template <class T> std::pair<std::string, std::string> bound(TopicHandle<T> h) {
 }
 
 TEST(Catalogue, EveryTopicHasATypedHandleWithTheSameType) {
-  const std::vector<std::pair<std::string, std::string>> handles = {
-      bound(topics::esc_scan),       bound(topics::module_tree),       bound(topics::robot_model),
-      bound(topics::customisation),  bound(topics::joint_state),       bound(topics::joint_command),
-      bound(topics::cartesian_command), bound(topics::base_velocity),  bound(topics::odometry),
-      bound(topics::ee_wrench),      bound(topics::status),            bound(topics::estop),
-      bound(topics::safety_state)};
+  std::vector<std::pair<std::string, std::string>> handles;
+  for_each_topic([&](auto handle) { handles.push_back(bound(handle)); });
   ASSERT_EQ(handles.size(), catalogue().size());
   for (const auto& [name, type] : handles) {
     const auto info = find_topic(name);

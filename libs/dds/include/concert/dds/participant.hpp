@@ -22,6 +22,10 @@ struct ParticipantOptions {
   /// Fast DDS XML profiles file; empty: CONCERT_DDS_PROFILES if set, else built-in defaults.
   std::string profiles_file;
   std::string profile_name = "concert_participant";  ///< participant profile in that file
+  /// Without a profile: "localhost" (default; UDP on 127.0.0.1 + shared memory, unicast
+  /// discovery, nothing leaves the machine) or "system" (Fast DDS defaults: every interface,
+  /// multicast discovery). Empty: CONCERT_DDS_NETWORK if set, else "localhost".
+  std::string network;
 };
 
 /// Owns a DomainParticipant. Writers and readers made from it must be destroyed before it.

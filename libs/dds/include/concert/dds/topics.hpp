@@ -55,4 +55,21 @@ inline constexpr TopicHandle<msg::EStopInput> estop{"concert/safety/estop"};
 inline constexpr TopicHandle<msg::SafetyState> safety_state{"concert/safety/state"};
 }  // namespace topics
 
+/// Calls f(handle) for every typed topic handle (e.g. to dispatch on a topic name).
+template <class F> void for_each_topic(F&& f) {
+  f(topics::esc_scan);
+  f(topics::module_tree);
+  f(topics::robot_model);
+  f(topics::customisation);
+  f(topics::joint_state);
+  f(topics::joint_command);
+  f(topics::cartesian_command);
+  f(topics::base_velocity);
+  f(topics::odometry);
+  f(topics::ee_wrench);
+  f(topics::status);
+  f(topics::estop);
+  f(topics::safety_state);
+}
+
 }  // namespace concert::dds

@@ -1,0 +1,250 @@
+#include "cyclone_ops.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <dds/dds.h>
+#include <dds/ddsi/ddsi_serdata.h>
+
+#include "ethercat.h"
+#include "model.h"
+#include "robot.h"
+#include "system.h"
+#include "topology.h"
+
+static const struct {
+  const char* name;
+  const dds_topic_descriptor_t* desc;
+} k_types[] = {
+    {"concert::msg::EscScan", &concert_msg_EscScan_desc},
+    {"concert::msg::ModuleTree", &concert_msg_ModuleTree_desc},
+    {"concert::msg::RobotModel", &concert_msg_RobotModel_desc},
+    {"concert::msg::ModelCustomisation", &concert_msg_ModelCustomisation_desc},
+    {"concert::msg::JointState", &concert_msg_JointState_desc},
+    {"concert::msg::JointCommand", &concert_msg_JointCommand_desc},
+    {"concert::msg::CartesianImpedanceCommand", &concert_msg_CartesianImpedanceCommand_desc},
+    {"concert::msg::BaseVelocityCommand", &concert_msg_BaseVelocityCommand_desc},
+    {"concert::msg::Odometry", &concert_msg_Odometry_desc},
+    {"concert::msg::EndEffectorWrench", &concert_msg_EndEffectorWrench_desc},
+    {"concert::msg::ServiceStatus", &concert_msg_ServiceStatus_desc},
+    {"concert::msg::EStopInput", &concert_msg_EStopInput_desc},
+    {"concert::msg::SafetyState", &concert_msg_SafetyState_desc},
+};
+
+#define MAX_ENDPOINTS 64
+static struct {
+  dds_entity_t entity;
+  const dds_topic_descriptor_t* desc;
+  int is_writer;
+  struct ddsi_serdata* type_holder; /* keeps the sertype alive (writers) */
+} g_ep[MAX_ENDPOINTS];
+static int g_n = 0;
+static dds_entity_t g_pp = 0;
+
+static const dds_topic_descriptor_t* find_desc(const char* type_name) {
+  for (size_t i = 0; i < sizeof k_types / sizeof k_types[0]; ++i) {
+    if (strcmp(k_types[i].name, type_name) == 0) return k_types[i].desc;
+  }
+  fprintf(stderr, "cyclone peer: no Cyclone type for '%s' (add it to cyclone_ops.c)\n", type_name);
+  return NULL;
+}
+
+static dds_qos_t* make_qos(cy_qos q, int writer) {
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, q.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT, DDS_MSECS(100));
+  dds_qset_durability(qos, q.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, q.depth);
+  if (writer) {
+    /* Fast DDS 2.9 readers cannot decode XCDR2: write plain XCDR1. */
+    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+    dds_qset_data_representation(qos, 1, &xcdr1);
+  }
+  return qos;
+}
+
+/* Same rule as the Fast DDS participants (libs/dds): loopback only, unicast discovery. */
+static const char* k_localhost_config =
+    "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/></Interfaces>"
+    "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
+    "<MaxAutoParticipantIndex>48</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
+    "</Discovery></Domain></CycloneDDS>";
+
+int cy_open(int domain_id) {
+  const char* uri = getenv("CYCLONEDDS_URI");
+  if (uri == NULL || *uri == '\0') {
+    dds_entity_t dom = dds_create_domain((dds_domainid_t)domain_id, k_localhost_config);
+    if (dom < 0) {
+      fprintf(stderr, "cyclone peer: cannot create domain: %s\n", dds_strretcode(dom));
+      return -1;
+    }
+  }
+  g_pp = dds_create_participant((dds_domainid_t)domain_id, NULL, NULL);
+  if (g_pp < 0) {
+    fprintf(stderr, "cyclone peer: cannot create participant: %s\n", dds_strretcode(g_pp));
+    return -1;
+  }
+  return 0;
+}
+
+void cy_close(void) {
+  for (int i = 0; i < g_n; ++i) {
+    if (g_ep[i].type_holder) ddsi_serdata_unref(g_ep[i].type_holder);
+  }
+  dds_delete(g_pp);
+}
+
+static int add(dds_entity_t e, const dds_topic_descriptor_t* desc, int writer, struct ddsi_serdata* holder) {
+  if (g_n == MAX_ENDPOINTS) return -1;
+  g_ep[g_n].entity = e;
+  g_ep[g_n].desc = desc;
+  g_ep[g_n].is_writer = writer;
+  g_ep[g_n].type_holder = holder;
+  return g_n++;
+}
+
+int cy_create_reader(const char* topic, const char* type_name, cy_qos q) {
+  const dds_topic_descriptor_t* desc = find_desc(type_name);
+  if (!desc) return -1;
+  dds_entity_t t = dds_create_topic(g_pp, desc, topic, NULL, NULL);
+  if (t < 0) {
+    fprintf(stderr, "cyclone peer: topic %s: %s\n", topic, dds_strretcode(t));
+    return -1;
+  }
+  dds_qos_t* qos = make_qos(q, 0);
+  dds_entity_t r = dds_create_reader(g_pp, t, qos, NULL);
+  dds_delete_qos(qos);
+  if (r < 0) {
+    fprintf(stderr, "cyclone peer: reader %s: %s\n", topic, dds_strretcode(r));
+    return -1;
+  }
+  return add(r, desc, 0, NULL);
+}
+
+/* Cyclone 0.10's C API offers no way to get a topic's sertype (dds_get_entity_sertype came in
+ * a later release), and a serdata can only be built from bytes with one. So: write an empty
+ * sample of the type to a private probe topic with a local reader, and take it back as serdata;
+ * its sertype is the type's (Cyclone shares one sertype per type in a domain). */
+static struct ddsi_serdata* sertype_probe(const char* topic, const dds_topic_descriptor_t* desc) {
+  char name[256];
+  snprintf(name, sizeof name, "concert_contract_probe/%s", topic);
+  dds_entity_t t = dds_create_topic(g_pp, desc, name, NULL, NULL);
+  dds_qos_t* qos = make_qos((cy_qos){1, 0, 1}, 0);
+  dds_entity_t r = dds_create_reader(g_pp, t, qos, NULL);
+  dds_entity_t w = dds_create_writer(g_pp, t, qos, NULL);
+  dds_delete_qos(qos);
+  void* empty = dds_alloc(desc->m_size);
+  memset(empty, 0, desc->m_size);
+  dds_write(w, empty);
+  dds_sample_free(empty, desc, DDS_FREE_ALL);
+  struct ddsi_serdata* sd = NULL;
+  dds_sample_info_t info;
+  for (int i = 0; i < 200; ++i) {
+    if (dds_takecdr(r, &sd, 1, &info, DDS_ANY_STATE) == 1) break;
+    dds_sleepfor(DDS_MSECS(5));
+  }
+  dds_delete(w);
+  dds_delete(r);
+  if (!sd) fprintf(stderr, "cyclone peer: sertype probe for %s got nothing\n", topic);
+  return sd;
+}
+
+int cy_create_writer(const char* topic, const char* type_name, cy_qos q) {
+  const dds_topic_descriptor_t* desc = find_desc(type_name);
+  if (!desc) return -1;
+  struct ddsi_serdata* holder = sertype_probe(topic, desc);
+  if (!holder) return -1;
+  dds_entity_t t = dds_create_topic(g_pp, desc, topic, NULL, NULL);
+  if (t < 0) {
+    fprintf(stderr, "cyclone peer: topic %s: %s\n", topic, dds_strretcode(t));
+    return -1;
+  }
+  dds_qos_t* qos = make_qos(q, 1);
+  dds_entity_t w = dds_create_writer(g_pp, t, qos, NULL);
+  dds_delete_qos(qos);
+  if (w < 0) {
+    fprintf(stderr, "cyclone peer: writer %s: %s\n", topic, dds_strretcode(w));
+    return -1;
+  }
+  return add(w, desc, 1, holder);
+}
+
+static uint8_t* to_bytes(const struct ddsi_serdata* sd, size_t* len) {
+  *len = ddsi_serdata_size(sd);
+  uint8_t* buf = malloc(*len);
+  ddsi_serdata_to_ser(sd, 0, *len, buf);
+  return buf;
+}
+
+int cy_take(int reader, uint8_t** wire, size_t* wire_len, uint8_t** reser, size_t* reser_len) {
+  struct ddsi_serdata* sd = NULL;
+  dds_sample_info_t info;
+  while (dds_takecdr(g_ep[reader].entity, &sd, 1, &info, DDS_ANY_STATE) == 1) {
+    if (!info.valid_data) {
+      ddsi_serdata_unref(sd);
+      continue;
+    }
+    const dds_topic_descriptor_t* desc = g_ep[reader].desc;
+    void* sample = dds_alloc(desc->m_size);
+    memset(sample, 0, desc->m_size);
+    int ok = ddsi_serdata_to_sample(sd, sample, NULL, NULL);
+    *wire = to_bytes(sd, wire_len);
+    struct ddsi_serdata* again = ok ? ddsi_serdata_from_sample(sd->type, SDK_DATA, sample) : NULL;
+    dds_sample_free(sample, desc, DDS_FREE_ALL);
+    ddsi_serdata_unref(sd);
+    if (!again) {
+      fprintf(stderr, "cyclone peer: Cyclone could not decode a received sample\n");
+      return -1;
+    }
+    *reser = to_bytes(again, reser_len);
+    ddsi_serdata_unref(again);
+    return 1;
+  }
+  return 0;
+}
+
+int cy_write(int writer, const uint8_t* bytes, size_t len) {
+  const struct ddsi_sertype* type = g_ep[writer].type_holder->type;
+  ddsrt_iovec_t iov;
+  iov.iov_base = (void*)bytes;
+  iov.iov_len = (ddsrt_iov_len_t)len;
+  struct ddsi_serdata* sd = ddsi_serdata_from_ser_iov(type, SDK_DATA, 1, &iov, len);
+  if (!sd) {
+    fprintf(stderr, "cyclone peer: Cyclone rejected the serialized sample\n");
+    return -1;
+  }
+  const dds_topic_descriptor_t* desc = g_ep[writer].desc;
+  void* sample = dds_alloc(desc->m_size);
+  memset(sample, 0, desc->m_size);
+  int ok = ddsi_serdata_to_sample(sd, sample, NULL, NULL);
+  ddsi_serdata_unref(sd);
+  dds_return_t rc = ok ? dds_write(g_ep[writer].entity, sample) : -1;
+  dds_sample_free(sample, desc, DDS_FREE_ALL);
+  if (rc < 0) {
+    fprintf(stderr, "cyclone peer: write failed\n");
+    return -1;
+  }
+  return 0;
+}
+
+int cy_matched(int endpoint, cy_qos* remote) {
+  dds_instance_handle_t handles[8];
+  const int writer = g_ep[endpoint].is_writer;
+  dds_entity_t e = g_ep[endpoint].entity;
+  int n = writer ? dds_get_matched_subscriptions(e, handles, 8) : dds_get_matched_publications(e, handles, 8);
+  if (n <= 0) return n < 0 ? -1 : 0;
+  dds_builtintopic_endpoint_t* data =
+      writer ? dds_get_matched_subscription_data(e, handles[0]) : dds_get_matched_publication_data(e, handles[0]);
+  if (data && remote) {
+    dds_reliability_kind_t rk = DDS_RELIABILITY_BEST_EFFORT;
+    dds_duration_t block;
+    dds_durability_kind_t dk = DDS_DURABILITY_VOLATILE;
+    dds_qget_reliability(data->qos, &rk, &block);
+    dds_qget_durability(data->qos, &dk);
+    remote->reliable = rk == DDS_RELIABILITY_RELIABLE;
+    remote->transient_local = dk == DDS_DURABILITY_TRANSIENT_LOCAL;
+    remote->depth = -1; /* history is not announced in discovery */
+  }
+  if (data) dds_builtintopic_free_endpoint(data);
+  return n;
+}

@@ -1,0 +1,96 @@
+#pragma once
+// Command line and output shared by the Fast DDS and Cyclone contract peers.
+//   peer write|read [--topics all|latched|NAME[,NAME...]] [--seed N] [--timeout-ms T]
+//                   [--linger-ms L] [--wait-readers] [--repeat-ms R] [--stale-first]
+// Output: one JSON object per line (event "written", "received", "missing").
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "concert/dds/catalogue.hpp"
+#include "concert/idl_schema/cdr.hpp"
+
+namespace concert::contract {
+
+struct PeerArgs {
+  bool write = false;
+  std::vector<dds::TopicInfo> topics;
+  uint32_t seed = 1;
+  int timeout_ms = 20000;
+  int linger_ms = 0;
+  bool wait_readers = false;
+  int repeat_ms = 0;         ///< writers: write again every repeat_ms while lingering (0 = once)
+  bool stale_first = false;  ///< writers: first write an older sample, then the expected one
+};
+
+/// The sample a peer writes on topic `t`: the same on every peer for the same seed.
+inline idl::Json expected_sample(const dds::TopicInfo& t, uint32_t seed) {
+  uint32_t index = 0;
+  for (const auto& c : dds::catalogue()) {
+    if (c.name == t.name) break;
+    ++index;
+  }
+  return idl::sample_with_every_field_set(idl::Schema::builtin(), t.type_name, seed * 100 + index);
+}
+
+/// An older sample of the same instance (same key fields) as expected_sample.
+inline idl::Json stale_sample(const dds::TopicInfo& t, uint32_t seed) {
+  idl::Json stale = expected_sample(t, seed + 1000);
+  const idl::Json expected = expected_sample(t, seed);
+  for (const auto& f : idl::Schema::builtin().at(t.type_name).fields) {
+    if (f.key) stale[f.name] = expected[f.name];
+  }
+  return stale;
+}
+
+inline PeerArgs parse_peer_args(int argc, char** argv) {
+  PeerArgs a;
+  if (argc < 2) throw std::invalid_argument("usage: peer write|read [options]");
+  const std::string mode = argv[1];
+  if (mode != "write" && mode != "read") throw std::invalid_argument("first argument must be write or read");
+  a.write = mode == "write";
+  std::string topics = "all";
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
+      return argv[++i];
+    };
+    if (arg == "--topics") topics = next();
+    else if (arg == "--seed") a.seed = static_cast<uint32_t>(std::stoul(next()));
+    else if (arg == "--timeout-ms") a.timeout_ms = std::stoi(next());
+    else if (arg == "--linger-ms") a.linger_ms = std::stoi(next());
+    else if (arg == "--wait-readers") a.wait_readers = true;
+    else if (arg == "--repeat-ms") a.repeat_ms = std::stoi(next());
+    else if (arg == "--stale-first") a.stale_first = true;
+    else throw std::invalid_argument("unknown option " + arg);
+  }
+  for (const auto& t : dds::catalogue()) {
+    const bool all = topics == "all";
+    const bool latched = topics == "latched" && t.qos == dds::QosClass::kLatched;
+    const bool named = ("," + topics + ",").find("," + std::string(t.name) + ",") != std::string::npos;
+    if (all || latched || named) a.topics.push_back(t);
+  }
+  if (a.topics.empty()) throw std::invalid_argument("no topic matches --topics " + topics);
+  return a;
+}
+
+inline idl::Json qos_json(bool reliable, bool transient_local, int depth) {
+  idl::Json j = {{"reliable", reliable}, {"transient_local", transient_local}};
+  if (depth >= 0) j["depth"] = depth;
+  return j;
+}
+
+inline void emit(const idl::Json& j) {
+  std::cout << j.dump() << std::endl;
+}
+
+inline bool past(std::chrono::steady_clock::time_point start, int ms) {
+  return std::chrono::steady_clock::now() - start > std::chrono::milliseconds(ms);
+}
+
+}  // namespace concert::contract

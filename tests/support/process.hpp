@@ -1,0 +1,45 @@
+#pragma once
+// Test helper: run a program as a child process with its output in a file, wait with a time
+// bound, and kill it if it overstays. Shared by contract, integration and system tests.
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <sys/types.h>
+
+namespace concert::testing {
+
+class Process {
+ public:
+  /// Starts argv[0] with the arguments; stdout and stderr go to files in a fresh temp folder.
+  /// `env` entries ("NAME=value") are added to the environment.
+  explicit Process(std::vector<std::string> argv, std::vector<std::string> env = {});
+  /// Kills the process (SIGKILL) if still running.
+  ~Process();
+  Process(const Process&) = delete;
+  Process& operator=(const Process&) = delete;
+
+  /// Exit code, or nullopt if it did not end within `timeout` (it is then still running).
+  std::optional<int> wait(std::chrono::milliseconds timeout);
+  /// Sends SIGINT and waits up to `timeout`; SIGKILL after that. Returns the exit code, or -signal.
+  int stop(std::chrono::milliseconds timeout);
+  bool running();
+
+  std::string out() const;  ///< stdout so far
+  std::string err() const;  ///< stderr so far
+  /// Waits until stdout contains `text` (or the process ends); true if found.
+  bool wait_for_output(const std::string& text, std::chrono::milliseconds timeout);
+  pid_t pid() const { return pid_; }
+
+ private:
+  pid_t pid_ = -1;
+  std::optional<int> status_;
+  std::string dir_;
+};
+
+/// Lines of `text`.
+std::vector<std::string> lines(const std::string& text);
+
+}  // namespace concert::testing
