@@ -178,6 +178,12 @@ ModuleDescription load_yaml_module(const fs::path& file) {
   }
   m.tags = string_list(doc["tags"], file, "tags");
   m.addon_types = string_list(doc["addon_types"], file, "addon_types");
+  if (doc["actuator"]) {
+    ModuleDescription::Actuator a;
+    a.name = req_str(doc["actuator"], "name", file, "actuator.");
+    a.mass = req_num(doc["actuator"], "mass", file, "actuator.");
+    m.actuator = a;
+  }
   const YAML::Node bodies = req(doc, "bodies", file, "");
   if (!bodies.IsSequence() || bodies.size() == 0) fail(file, "bodies", "expected a non-empty list");
   std::map<std::string, int> body_index;

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "concert/module_db/module_db.hpp"
+#include "concert/topology/esc_catalog.hpp"
 
 namespace fs = std::filesystem;
 using namespace concert::module_db;
@@ -180,4 +181,95 @@ TEST(Database, DuplicateKeysAndUnknownKeysAreErrors) {
   EXPECT_EQ(error_of([&] { (void)a.at("no_such_module"); }), "unknown module key 'no_such_module'");
   EXPECT_EQ(error_of([&] { load_module_database(kPublic / "models"); }).find("not a module database"),
             (kPublic / "models").string().size() + 2);
+}
+
+TEST(OwnDatabase, DescribesEveryModuleOfThePaper) {
+  const ModuleDatabase db = load_module_database(kOwn);
+  const std::vector<std::string> keys{"concert_mobile_base_hub", "concert_steering_fl_rr", "concert_steering_fr_rl", "concert_wheel",
+                                      "concert_elbow_a", "concert_elbow_b", "concert_straight_a", "concert_straight_b",
+                                      "concert_link_300", "concert_link_400", "concert_link_elbow_45", "concert_link_elbow_90",
+                                      "concert_base_link_600", "concert_torso_hub", "concert_drill", "concert_spraying_tool",
+                                      "concert_sanding_tool", "concert_active_gripper_panel", "concert_active_gripper_tube",
+                                      "concert_passive_gripper_panel", "concert_passive_gripper_tube"};
+  EXPECT_EQ(db.module_keys().size(), keys.size());
+  for (const std::string& k : keys) EXPECT_NE(db.find(k), nullptr) << k;
+  const ModuleDescription& base = db.at("concert_mobile_base_hub");
+  EXPECT_EQ(base.type, ModuleType::kMobileBase);
+  EXPECT_EQ(base.output_connectors().size(), 5u);
+  EXPECT_EQ(base.connectors[static_cast<size_t>(base.output_connectors()[4])].name, "arm");
+  EXPECT_EQ(db.at("concert_torso_hub").output_connectors().size(), 2u);
+  EXPECT_EQ(db.at("concert_base_link_600").type, ModuleType::kBaseLink);
+  EXPECT_NEAR(db.at("concert_base_link_600").connectors[1].pose.translation().z(), 0.6, 1e-12);
+  const ModuleDescription& drill = db.at("concert_drill");
+  ASSERT_EQ(drill.frames.size(), 1u);
+  EXPECT_EQ(drill.frames[0].kind, FrameKind::kCamera);
+  EXPECT_FALSE(db.at("concert_passive_gripper_panel").esc.has_value());
+  EXPECT_FALSE(db.at("concert_passive_gripper_panel").actuated());
+  EXPECT_TRUE(db.at("concert_active_gripper_panel").actuated());
+  EXPECT_EQ(db.addon_keys().size(), 4u);
+  ASSERT_NE(db.find_addon("sanding_force_sensor"), nullptr);
+  EXPECT_TRUE(db.find_addon("sanding_force_sensor")->frame.has_value());
+}
+
+TEST(OwnDatabase, ActuatorLimitsAreTable1) {
+  const ModuleDatabase db = load_module_database(kOwn);
+  struct Row {
+    const char* key;
+    const char* actuator;
+    double gear, velocity, peak, continuous, mass;
+  };
+  const Row rows[] = {{"concert_elbow_a", "Large A", 160, 2.14, 460, 160, 2.5},       {"concert_straight_a", "Large A", 160, 2.14, 460, 160, 2.5},
+                      {"concert_elbow_b", "Large B", 120, 2.85, 314, 120, 2.0},       {"concert_straight_b", "Large B", 120, 2.85, 314, 120, 2.0},
+                      {"concert_steering_fl_rr", "Medium", 120, 8.1, 127, 34, 1.3},   {"concert_active_gripper_tube", "Small A", 100, 11.7, 55, 17, 1.0},
+                      {"concert_wheel", "Small B", 29, 13.7, 24, 17.5, 2.7}};
+  for (const Row& r : rows) {
+    const ModuleDescription& m = db.at(r.key);
+    ASSERT_EQ(m.joints.size(), 1u) << r.key;
+    const JointDescription& j = m.joints[0];
+    EXPECT_DOUBLE_EQ(j.gear_ratio, r.gear) << r.key;
+    EXPECT_DOUBLE_EQ(j.limits.velocity, r.velocity) << r.key;
+    EXPECT_DOUBLE_EQ(j.limits.peak_torque, r.peak) << r.key;
+    ASSERT_TRUE(j.limits.continuous_torque.has_value()) << r.key;
+    EXPECT_DOUBLE_EQ(*j.limits.continuous_torque, r.continuous) << r.key;
+    ASSERT_TRUE(m.actuator.has_value()) << r.key;
+    EXPECT_EQ(m.actuator->name, r.actuator);
+    EXPECT_DOUBLE_EQ(m.actuator->mass, r.mass) << r.key;
+  }
+  EXPECT_EQ(db.at("concert_wheel").joints[0].type, JointType::kContinuous);
+}
+
+TEST(OwnDatabase, EscIndexReusesPublicIdentities) {
+  const ModuleDatabase own = load_module_database(kOwn);
+  const ModuleDatabase pub = load_module_database(kPublic);
+  const std::pair<const char*, const char*> same[] = {
+      {"concert_elbow_a", "module_joint_elbow_A_concert"},   {"concert_elbow_b", "module_joint_elbow_B_concert"},
+      {"concert_straight_a", "module_joint_yaw_A_concert"},  {"concert_straight_b", "module_joint_yaw_B_concert"},
+      {"concert_steering_fl_rr", "module_steering_concert_fl_rr"}, {"concert_wheel", "module_wheel_concert"},
+      {"concert_mobile_base_hub", "mobile_platform_concert"}, {"concert_torso_hub", "module_Y_torso_concert"},
+      {"concert_drill", "module_drill_concert"},             {"concert_base_link_600", "module_base_link_600_concert"},
+      {"concert_link_400", "module_link_straight_400_concert"}};
+  for (const auto& [mine, theirs] : same) {
+    ASSERT_TRUE(own.at(mine).esc.has_value()) << mine;
+    EXPECT_EQ(*own.at(mine).esc, *pub.at(theirs).esc) << mine;
+  }
+  EXPECT_EQ(own.find_by_identity({2, 4, 0, 0}), &own.at("concert_mobile_base_hub"));
+  const EscIndex index = load_esc_index(kOwn / "esc_index.yaml");
+  int project_assigned = 0;
+  for (const EscIndexEntry& e : index.modules) project_assigned += e.project_assigned ? 1 : 0;
+  EXPECT_EQ(project_assigned, 4);
+  EXPECT_EQ(index.ports.size(), 6u);
+}
+
+TEST(OwnDatabase, DiscoveryCatalogueReadsOurEscIndex) {
+  // The discovery engineer's loader reads the same file: its connector layout must agree with
+  // our connector numbering contract.
+  const auto catalog = concert::topology::EscCatalog::load(kOwn);
+  const ModuleDatabase db = load_module_database(kOwn);
+  for (const auto& entry : catalog.entries()) {
+    const ModuleDescription* m = db.find(entry.key);
+    ASSERT_NE(m, nullptr) << entry.key;
+    if (entry.identity == concert::topology::EscIdentity{2, 4, 0, 0}) continue;  // hub board: secondary ESC
+    const auto layout = catalog.layout(entry.identity);
+    EXPECT_EQ(static_cast<size_t>(layout.outputs()), m->output_connectors().size()) << entry.key;
+  }
 }

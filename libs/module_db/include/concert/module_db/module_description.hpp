@@ -140,6 +140,12 @@ struct ModuleDescription {
   std::vector<Frame> frames;        ///< extra frames (camera, ...); connectors/joints not repeated
   std::vector<std::string> tags;    ///< semantic tags ("arm", "gripper", "drill", ...)
   std::vector<std::string> addon_types;  ///< add-on types this module accepts ("drillbit", ...)
+  /// Actuator family (paper Table 1) and its mass in kg, where the database names it.
+  struct Actuator {
+    std::string name;
+    double mass = 0.0;
+  };
+  std::optional<Actuator> actuator;
 
   /// Index of the body that carries the input (or base) connector: the module's root body.
   int root_body() const;
