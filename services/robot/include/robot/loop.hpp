@@ -13,6 +13,11 @@ struct LoopParams {
   double period{0.001};   ///< [s] (1 kHz)
   bool real_time{true};   ///< false: as fast as possible (simulated time only, for tests)
   bool record_periods{false};  ///< keep every measured wall-clock period (benchmarks)
+  /// Real-time mode: sleep until this long before each deadline, then spin [s] (trades a
+  /// little CPU for much lower wake-up jitter on a non-RT kernel).
+  double spin_time{0.0002};
+  /// SCHED_FIFO priority for the thread calling run() (1..99); 0 leaves the scheduler alone.
+  int fifo_priority{0};
 };
 
 /// Wall-clock period statistics of a loop run [s].
@@ -37,6 +42,8 @@ class Loop {
   LoopStats run(std::uint64_t cycles);
   /// Runs until stop() is called from another thread or a signal handler.
   LoopStats run_forever();
+  /// True if the last run() got the requested SCHED_FIFO priority.
+  [[nodiscard]] bool fifo_applied() const { return fifo_applied_; }
   /// Asks a running loop to return after the current tick.
   void stop() { stop_.store(true); }
 
@@ -44,6 +51,7 @@ class Loop {
   LoopParams params_;
   std::function<void()> tick_;
   std::atomic<bool> stop_{false};
+  bool fifo_applied_{false};
 };
 
 }  // namespace concert::robot

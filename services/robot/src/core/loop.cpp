@@ -6,6 +6,9 @@
 #include <stdexcept>
 #include <thread>
 
+#include <pthread.h>
+#include <sched.h>
+
 namespace concert::robot {
 
 Loop::Loop(LoopParams params, std::function<void()> tick) : params_(params), tick_(std::move(tick)) {
@@ -19,6 +22,16 @@ LoopStats Loop::run_forever() { return run(std::numeric_limits<std::uint64_t>::m
 LoopStats Loop::run(std::uint64_t cycles) {
   using Clock = std::chrono::steady_clock;
   stop_.store(false);
+  fifo_applied_ = false;
+  int old_policy = SCHED_OTHER;
+  sched_param old_param{};
+  pthread_getschedparam(pthread_self(), &old_policy, &old_param);
+  if (params_.real_time && params_.fifo_priority > 0) {
+    sched_param sp{};
+    sp.sched_priority = params_.fifo_priority;
+    fifo_applied_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
+  }
+  const auto spin = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(params_.spin_time));
   LoopStats stats;
   std::vector<double> periods;
   if (params_.record_periods && cycles < (1u << 26)) {
@@ -31,7 +44,9 @@ LoopStats Loop::run(std::uint64_t cycles) {
   double sum = 0.0;
   for (std::uint64_t k = 0; k < cycles && !stop_.load(std::memory_order_relaxed); ++k) {
     if (params_.real_time) {
-      std::this_thread::sleep_until(deadline);
+      std::this_thread::sleep_until(deadline - spin);
+      while (Clock::now() < deadline) {
+      }
     }
     const auto now = Clock::now();
     if (k > 0) {
@@ -52,6 +67,9 @@ LoopStats Loop::run(std::uint64_t cycles) {
     }
   }
   stats.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
+  if (fifo_applied_) {
+    pthread_setschedparam(pthread_self(), old_policy, &old_param);
+  }
   if (stats.cycles > 1) {
     stats.mean_period = sum / static_cast<double>(stats.cycles - 1);
   }
