@@ -59,7 +59,7 @@ Participant::Participant(ParticipantOptions options) : name_(options.name) {
                                options.profile_name + "'");
     }
     qos.name(options.name);
-    participant_ = factory->create_participant(domain_id_, qos);
+    participant_ = factory->create_participant(domain_id_, qos, options.listener, StatusMask::none());
   } else {
     std::string network = options.network;
     if (network.empty()) {
@@ -73,7 +73,7 @@ Participant::Participant(ParticipantOptions options) : name_(options.name) {
     } else if (network != "system") {
       throw std::invalid_argument("CONCERT_DDS_NETWORK: '" + network + "' is not 'localhost' or 'system'");
     }
-    participant_ = factory->create_participant(domain_id_, qos);
+    participant_ = factory->create_participant(domain_id_, qos, options.listener, StatusMask::none());
   }
   if (participant_ == nullptr) {
     throw std::runtime_error("cannot create a DDS participant on domain " + std::to_string(domain_id_));

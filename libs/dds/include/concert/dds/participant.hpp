@@ -7,6 +7,7 @@
 #include <string>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
@@ -26,6 +27,8 @@ struct ParticipantOptions {
   /// discovery, nothing leaves the machine) or "system" (Fast DDS defaults: every interface,
   /// multicast discovery). Empty: CONCERT_DDS_NETWORK if set, else "localhost".
   std::string network;
+  /// Optional listener for discovery events (participants, writers, readers on the domain).
+  eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr;
 };
 
 /// Owns a DomainParticipant. Writers and readers made from it must be destroyed before it.

@@ -1,0 +1,134 @@
+// `concert topic` verbs against real running writers: a Fast DDS peer publishing every
+// catalogue topic at 100 Hz, and Cyclone's ddsperf as a program that is not ours.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <thread>
+
+#include "peer_common.hpp"
+#include "process.hpp"
+
+namespace concert {
+namespace {
+
+using namespace std::chrono_literals;
+using testing::Process;
+
+constexpr uint32_t kSeed = 5;
+const char* kCycloneLocalhost =
+    "CYCLONEDDS_URI=<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/>"
+    "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
+    "<MaxAutoParticipantIndex>48</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery>"
+    "</Domain></CycloneDDS>";
+
+std::string domain() {
+  const char* d = std::getenv("CONCERT_DOMAIN_ID");
+  return d ? d : "0";
+}
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+Result concert(std::vector<std::string> args) {
+  args.insert(args.begin(), CONCERT_BIN);
+  Process p(args);
+  const auto code = p.wait(60s);
+  EXPECT_TRUE(code.has_value()) << "concert did not terminate";
+  return {code.value_or(-1), p.out(), p.err()};
+}
+
+class TopicCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    writer_ = new Process({CONTRACT_PEER_FAST, "write", "--seed", std::to_string(kSeed), "--repeat-ms", "10",
+                           "--linger-ms", "120000"});
+    foreign_ = new Process({"/usr/bin/ddsperf", "-i", domain(), "-D", "120", "pub", "50Hz"}, {kCycloneLocalhost});
+    ASSERT_TRUE(writer_->wait_for_output("concert/safety/state", 20s)) << writer_->err();
+  }
+  static void TearDownTestSuite() {
+    delete writer_;
+    delete foreign_;
+  }
+  static Process* writer_;
+  static Process* foreign_;
+};
+Process* TopicCli::writer_ = nullptr;
+Process* TopicCli::foreign_ = nullptr;
+
+TEST_F(TopicCli, ListShowsEveryTopicOursAndOthers) {
+  const auto r = concert({"topic", "list", "--json", "--wait-ms", "2500"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto rows = idl::Json::parse(r.out);
+  std::map<std::string, idl::Json> by_topic;
+  for (const auto& row : rows) by_topic[row.at("topic").get<std::string>()] = row;
+  for (const auto& t : dds::catalogue()) {
+    const std::string name(t.name);
+    ASSERT_TRUE(by_topic.count(name)) << name << " missing in " << r.out;
+    EXPECT_EQ(by_topic[name].at("type"), t.type_name);
+    EXPECT_GE(by_topic[name].at("writers").get<int>(), 1);
+    EXPECT_TRUE(by_topic[name].at("catalogue").get<bool>());
+  }
+  bool foreign = false;
+  for (const auto& [name, row] : by_topic) {
+    if (name.find("DDSPerf") != std::string::npos && !row.at("catalogue").get<bool>()) foreign = true;
+  }
+  EXPECT_TRUE(foreign) << "ddsperf's topics not listed: " << r.out;
+}
+
+TEST_F(TopicCli, InfoShowsTypeQosEndpointsAndShape) {
+  const auto r = concert({"topic", "info", "concert/robot/joint_state", "--wait-ms", "2000"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("concert::msg::JointState"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("writer"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("best-effort volatile"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("sequence<double> position"), std::string::npos) << r.out;
+}
+
+TEST_F(TopicCli, EchoPrintsSamplesWithFieldNames) {
+  const auto r = concert({"topic", "echo", "concert/robot/cartesian_command", "--count", "3", "--timeout-ms", "15000"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto lines = testing::lines(r.out);
+  ASSERT_EQ(lines.size(), 3u) << r.out;
+  const auto expected = contract::expected_sample(*dds::find_topic("concert/robot/cartesian_command"), kSeed);
+  for (const auto& line : lines) EXPECT_EQ(idl::Json::parse(line), expected);
+}
+
+TEST_F(TopicCli, HzMeasuresTheRateOfAnyTopic) {
+  auto r = concert({"topic", "hz", "concert/robot/odometry", "--count", "30", "--timeout-ms", "15000", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = idl::Json::parse(r.out);
+  EXPECT_EQ(j.at("samples"), 30);
+  EXPECT_GT(j.at("rate_hz").get<double>(), 0.0);
+  EXPECT_LE(j.at("period_ms").at("min").get<double>(), j.at("period_ms").at("max").get<double>());
+  // A topic of a program that is not ours: its type is unknown, but it can be timed.
+  r = concert({"topic", "hz", "DDSPerfRDataKS", "--count", "5", "--timeout-ms", "15000", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(idl::Json::parse(r.out).at("samples"), 5);
+}
+
+TEST_F(TopicCli, ClearErrors) {
+  auto r = concert({"topic", "echo", "no/such_topic", "--wait-ms", "500", "--count", "1"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("no/such_topic"), std::string::npos) << r.err;
+  r = concert({"topic", "echo", "DDSPerfRDataKS", "--count", "1", "--timeout-ms", "5000"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("not in the project's IDL"), std::string::npos) << r.err;
+  r = concert({"topic", "frob"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("frob"), std::string::npos);
+  r = concert({"topic", "list", "--domain", "999"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--domain"), std::string::npos);
+  r = concert({"topic", "echo", "concert/robot/odometry", "--count", "x"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--count"), std::string::npos);
+  // A topic without writers times out with a count of what arrived.
+  r = concert({"topic", "echo", "concert/robot/ee_wrench", "--domain", "231", "--count", "1", "--timeout-ms", "500"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("received 0 of 1"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace concert
