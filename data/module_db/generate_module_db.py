@@ -287,10 +287,10 @@ for variant, tcp_z, mass in (("panel", 0.1, 1.08), ("tube", 0.1, 1.13)):
 
 # --- Add-ons ----------------------------------------------------------------------------------
 ADDONS = {
-    "drillbit_8_sdsplus": "type: drillbit\nlabel: Drill bit 8 mm SDS-plus\nmass: 0.35  # estimated\ntcp_offset: 0.25  # estimated, m along the TCP z axis\ncom: [0, 0, 0.125]\n",
-    "drillbit_12_sdsmax": "type: drillbit\nlabel: Drill bit 12 mm SDS-max\nmass: 0.6  # estimated\ntcp_offset: 0.34  # estimated\ncom: [0, 0, 0.17]\n",
-    "drill_handle": "type: handle\nlabel: Drill handle for hand guiding\nmass: 0.33  # estimated\ncom: [0, 0.25, -0.18]  # estimated, in the TCP frame\n",
-    "sanding_force_sensor": "type: sensor\nlabel: Force/torque sensor for the sanding tool\nmass: 0.25  # estimated\ntcp_offset: 0.03  # estimated\ncom: [0, 0, 0.015]\nframe: {name: ft_sensor, kind: other, pose: {xyz: [0, 0, -0.015]}}\n",
+    "concert_drillbit_8_sdsplus": "type: drillbit\nlabel: Drill bit 8 mm SDS-plus\nmass: 0.35  # estimated\ntcp_offset: 0.25  # estimated, m along the TCP z axis\ncom: [0, 0, 0.125]\n",
+    "concert_drillbit_12_sdsmax": "type: drillbit\nlabel: Drill bit 12 mm SDS-max\nmass: 0.6  # estimated\ntcp_offset: 0.34  # estimated\ncom: [0, 0, 0.17]\n",
+    "concert_drill_handle": "type: handle\nlabel: Drill handle for hand guiding\nmass: 0.33  # estimated\ncom: [0, 0.25, -0.18]  # estimated, in the TCP frame\n",
+    "concert_sanding_force_sensor": "type: sensor\nlabel: Force/torque sensor for the sanding tool\nmass: 0.25  # estimated\ntcp_offset: 0.03  # estimated\ncom: [0, 0, 0.015]\nframe: {name: ft_sensor, kind: other, pose: {xyz: [0, 0, -0.015]}}\n",
 }
 
 

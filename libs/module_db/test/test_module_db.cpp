@@ -207,8 +207,8 @@ TEST(OwnDatabase, DescribesEveryModuleOfThePaper) {
   EXPECT_FALSE(db.at("concert_passive_gripper_panel").actuated());
   EXPECT_TRUE(db.at("concert_active_gripper_panel").actuated());
   EXPECT_EQ(db.addon_keys().size(), 4u);
-  ASSERT_NE(db.find_addon("sanding_force_sensor"), nullptr);
-  EXPECT_TRUE(db.find_addon("sanding_force_sensor")->frame.has_value());
+  ASSERT_NE(db.find_addon("concert_sanding_force_sensor"), nullptr);
+  EXPECT_TRUE(db.find_addon("concert_sanding_force_sensor")->frame.has_value());
 }
 
 TEST(OwnDatabase, ActuatorLimitsAreTable1) {

@@ -129,7 +129,7 @@ TEST(OwnDatabase, MorphologyCAndTwoArmTorso) {
   rows.emplace_back("concert_sanding_tool", static_cast<int>(rows.size()) - 1, 1);
   const topology::ModuleTree tree = make_tree(rows, &own_db());
   Customisation custom;
-  custom.addons.push_back({"sanding_tool_G", "sanding_force_sensor"});
+  custom.addons.push_back({"sanding_tool_G", "concert_sanding_force_sensor"});
   const RobotModel model = gen.generate(tree, custom);
   check_model(tree, gen.generate(tree), 9u);
   ASSERT_EQ(model.chains.size(), 7u);

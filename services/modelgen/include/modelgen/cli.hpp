@@ -1,0 +1,27 @@
+#pragma once
+// `concert model ...` verbs (wired into the `concert` tool by its owner).
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "concert/topology/types.hpp"
+
+namespace concert::modelgen {
+
+/// Runs `concert model <args>` (args[0] is the verb):
+///   generate (--scan FILE | --tree FILE | --assembly FILE) --module-db DIR [--module-db DIR ...]
+///            --out DIR [--port-order 0312|0123] [--home JOINT=RAD ...] [--addon EE=ADDON ...]
+/// --module-db accepts either database format; several are merged in order. --assembly goes
+/// through the simulated bus and discovery, as the real pipeline does. The bundle's version is
+/// one more than the version already in DIR, or unchanged when the content hash is the same.
+/// Returns 0, or non-zero with a one-line message on `err`.
+int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+/// Reads a module tree in the `concert discover --json` shape (topology::tree_to_json).
+/// Throws std::runtime_error naming `source` and the field.
+topology::ModuleTree tree_from_json(const nlohmann::json& doc, const std::string& source);
+
+}  // namespace concert::modelgen
