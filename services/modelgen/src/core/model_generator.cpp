@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <set>
 
 namespace concert::modelgen {
@@ -144,10 +145,8 @@ class Builder {
     phi.joints.push_back(std::move(j));
   }
   ChainRecord* chain(const std::string& tag) {
-    for (ChainRecord& c : chains) {
-      if (c.info.name == tag) return &c;
-    }
-    return nullptr;
+    const auto it = chain_index_.find(tag);
+    return it == chain_index_.end() ? nullptr : &chains[it->second];
   }
 
   int make_body(int m, const ModuleDescription& d, int b, const Pose& offset, const std::string& name, const std::string& tag) {
@@ -203,6 +202,7 @@ class Builder {
       ChainRecord c;
       c.info.name = s.tag;
       c.info.base_link = is_root ? "base_link" : phi.bodies[static_cast<size_t>(attach_body)].name;
+      chain_index_[s.tag] = chains.size();
       chains.push_back(std::move(c));
     }
     ChainRecord* ch = chain(s.tag);
@@ -346,6 +346,7 @@ class Builder {
   std::vector<std::vector<int>> children_;
   std::vector<bool> visited_;
   std::set<std::string> names_;
+  std::map<std::string, size_t> chain_index_;
   int next_tag_ = 0;
 };
 
