@@ -63,12 +63,9 @@ static dds_qos_t* make_qos(cy_qos q, int writer) {
   return qos;
 }
 
-/* Same rule as the Fast DDS participants (libs/dds): loopback only, unicast discovery. */
-static const char* k_localhost_config =
-    "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/></Interfaces>"
-    "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
-    "<MaxAutoParticipantIndex>48</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
-    "</Discovery></Domain></CycloneDDS>";
+/* Same rule as the Fast DDS participants (libs/dds): loopback only, unicast discovery.
+ * CONCERT_CYCLONE_CONFIG is deploy/dds/cyclonedds_localhost.xml, as a file:// URI. */
+static const char* k_localhost_config = CONCERT_CYCLONE_CONFIG;
 
 int cy_open(int domain_id) {
   const char* uri = getenv("CYCLONEDDS_URI");

@@ -6,6 +6,9 @@
 #include "concert/dds/qos.hpp"
 #include "concert/dds/status_reporter.hpp"
 
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+
 namespace concert::dds {
 namespace {
 
@@ -86,6 +89,20 @@ TEST(Endpoint, BadProfilesFileIsNamed) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/profiles.xml"), std::string::npos);
   }
+}
+
+// The three-PC deployment profile loads and says what the README promises. (No participant is
+// made from it: its peers are the robot's addresses, not this machine's.)
+TEST(Endpoint, DeploymentProfileParses) {
+  auto* factory = eprosima::fastdds::dds::DomainParticipantFactory::get_instance();
+  ASSERT_EQ(factory->load_XML_profiles_file(CONCERT_SOURCE_DIR "/deploy/dds/fastdds_profiles.xml"),
+            eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK);
+  eprosima::fastdds::dds::DomainParticipantQos qos;
+  ASSERT_EQ(factory->get_participant_qos_from_profile("concert_participant", qos),
+            eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK);
+  EXPECT_EQ(qos.wire_protocol().builtin.initialPeersList.size(), 3u);
+  EXPECT_FALSE(qos.transport().use_builtin_transports);
+  EXPECT_EQ(qos.transport().user_transports.size(), 2u);
 }
 
 TEST(Endpoint, StatusReporterPublishesStateChanges) {

@@ -15,11 +15,8 @@ using namespace std::chrono_literals;
 using testing::Process;
 
 constexpr uint32_t kSeed = 5;
-const char* kCycloneLocalhost =
-    "CYCLONEDDS_URI=<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/>"
-    "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
-    "<MaxAutoParticipantIndex>48</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery>"
-    "</Domain></CycloneDDS>";
+const std::string kCycloneLocalhost =
+    "CYCLONEDDS_URI=file://" CONCERT_SOURCE_DIR "/deploy/dds/cyclonedds_localhost.xml";
 
 std::string domain() {
   const char* d = std::getenv("CONCERT_DOMAIN_ID");
