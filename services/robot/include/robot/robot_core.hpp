@@ -87,7 +87,9 @@ enum class JointOwner : std::uint8_t { kHold, kJoint, kCartesian, kGravityCompen
 /// Parameters of the robot core (loaded from YAML by the adapter).
 struct RobotParams {
   double period{0.001};                  ///< control period [s] (1 kHz)
-  std::string end_effector_frame;        ///< empty: "tcp" if the model has it, else the deepest link
+  /// Empty: the deepest frame named "tcp" or "tcp_<chain>" (modelgen's naming), else the
+  /// deepest leaf link (most movable joints above it).
+  std::string end_effector_frame;
   double default_wheel_radius{0.16};     ///< for wheel links without a collision cylinder [m]
   double wrench_filter_time_constant{0.02};  ///< low-pass of the wrench estimate [s]
   double base_command_timeout{0.5};      ///< base stops if no base command for this long [s]
@@ -127,7 +129,9 @@ class RobotCore {
   /// Accepts a new model (URDF text) at `version`: holds every joint, rebuilds
   /// controllers/limits/legs, reports ready. Throws ModelMismatchError (old model kept) if it
   /// cannot be parsed, its joints differ from the mounted hardware, or the version is older.
-  void set_model(const std::string& urdf, std::uint64_t version);
+  /// `end_effector_frame` (e.g. from the model's end-effector list) overrides
+  /// RobotParams::end_effector_frame when not empty.
+  void set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame = "");
 
   void command_joints(const JointCommandSet& command);
   void command_cartesian(const CartesianCommand& command);

@@ -29,6 +29,34 @@ Eigen::Vector3d rotation_error(const Eigen::Matrix3d& target, const Eigen::Matri
   return aa.angle() * aa.axis();
 }
 
+// The deepest "tcp"/"tcp_<tag>" frame, else the last deepest link ("" for a model without
+// movable joints). Depth = number of movable joints above the frame.
+std::string default_end_effector(const kinematics::Model& model) {
+  std::map<std::string, int> depth;
+  for (int j = 0; j < model.dof(); ++j) {
+    for (const auto& link : model.subtree_links(j)) {
+      ++depth[link];
+    }
+  }
+  std::string best_tcp, best_leaf;
+  int tcp_depth = 0, leaf_depth = 0;
+  // frame_names() is depth-first: with >=, the last frame of the deepest chain wins.
+  for (const auto& frame : model.frame_names()) {
+    const auto it = depth.find(frame);
+    const int d = it == depth.end() ? 0 : it->second;
+    const bool is_tcp = frame == "tcp" || frame.rfind("tcp_", 0) == 0;
+    if (is_tcp && d > tcp_depth) {
+      best_tcp = frame;
+      tcp_depth = d;
+    }
+    if (d > 0 && d >= leaf_depth) {
+      best_leaf = frame;
+      leaf_depth = d;
+    }
+  }
+  return best_tcp.empty() ? best_leaf : best_tcp;
+}
+
 }  // namespace
 
 struct RobotCore::Controllers {
@@ -70,7 +98,7 @@ RobotCore::RobotCore(Hardware& hardware, RobotParams params) : hw_(hardware), pa
 
 RobotCore::~RobotCore() = default;
 
-void RobotCore::set_model(const std::string& urdf, std::uint64_t version) {
+void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame) {
   std::shared_ptr<const kinematics::Model> model;
   try {
     model = std::make_shared<const kinematics::Model>(kinematics::Model::from_urdf_string(urdf));
@@ -109,25 +137,9 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version) {
   ctl->owner.assign(static_cast<std::size_t>(n), JointOwner::kHold);
   ctl->joint_cmd.assign(static_cast<std::size_t>(n), JointCommand{});
   // End-effector frame and its chain.
-  ctl->ee_frame = params_.end_effector_frame;
+  ctl->ee_frame = end_effector_frame.empty() ? params_.end_effector_frame : end_effector_frame;
   if (ctl->ee_frame.empty()) {
-    if (model->has_frame("tcp")) {
-      ctl->ee_frame = "tcp";
-    } else {
-      // The deepest leaf: the link with the most movable joints above it.
-      std::size_t best = 0;
-      for (const auto& f : model->frame_names()) {
-        std::size_t count = 0;
-        for (int j = 0; j < n; ++j) {
-          const auto sub = model->subtree_links(j);
-          count += static_cast<std::size_t>(std::find(sub.begin(), sub.end(), f) != sub.end());
-        }
-        if (count > best) {
-          best = count;
-          ctl->ee_frame = f;
-        }
-      }
-    }
+    ctl->ee_frame = default_end_effector(*model);
   } else if (!model->has_frame(ctl->ee_frame)) {
     throw ModelMismatchError("model version " + std::to_string(version) + ": end-effector frame '" + ctl->ee_frame +
                              "' is not a link of the model");
