@@ -22,6 +22,10 @@ class ModelVersioner {
   /// read back from a bundle on disk, so versions keep increasing across restarts).
   explicit ModelVersioner(uint64_t first_version = 1) : next_version_(first_version == 0 ? 1 : first_version) {}
 
+  /// Resumes after a restart from the last published version and hash (e.g. a bundle manifest):
+  /// the next different model gets `version + 1`; a first model with hash `hash` keeps `version`.
+  static ModelVersioner resume(uint64_t version, std::string hash);
+
   /// Makes `model` current with the next version unless its content hash equals the current
   /// model's (then only tree_version is refreshed and nothing is published).
   Update offer(RobotModel model);
@@ -31,6 +35,8 @@ class ModelVersioner {
 
  private:
   uint64_t next_version_;
+  uint64_t resumed_version_ = 0;
+  std::string resumed_hash_;
   std::optional<RobotModel> current_;
 };
 
