@@ -3,6 +3,8 @@
 #include <mujoco/mujoco.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -91,9 +93,18 @@ struct MjcfWriter {
     i << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
     const Eigen::Matrix3d r = rotation(in.origin.rotation);
     const Eigen::Matrix3d il = r * i * r.transpose();
+    // Principal axes; module databases contain rank-deficient inertias (e.g. point-mass
+    // tools), which MuJoCo refuses: clamp the principal moments to a small positive value.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(il);
+    Eigen::Matrix3d axes = eig.eigenvectors();
+    if (axes.determinant() < 0.0) {
+      axes.col(2) = -axes.col(2);
+    }
+    const Eigen::Vector3d moments = eig.eigenvalues().cwiseMax(1e-6 * std::max(in.mass, 1e-3));
+    const Eigen::Quaterniond q(axes);
     xml << "<inertial pos=\"" << vec(in.origin.position.x, in.origin.position.y, in.origin.position.z)
-        << "\" mass=\"" << num(in.mass) << "\" fullinertia=\"" << vec(il(0, 0), il(1, 1), il(2, 2)) << " "
-        << vec(il(0, 1), il(0, 2), il(1, 2)) << "\"/>\n";
+        << "\" quat=\"" << num(q.w()) << " " << vec(q.x(), q.y(), q.z()) << "\" mass=\"" << num(in.mass)
+        << "\" diaginertia=\"" << vec(moments.x(), moments.y(), moments.z()) << "\"/>\n";
   }
 
   void joint(const urdf::Joint& j) {

@@ -1,0 +1,41 @@
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "concert/topology/types.hpp"
+
+namespace concert::robot {
+
+/// What the simulator needs to stand in for an assembled robot.
+struct SimulatedRobot {
+  std::string urdf;             ///< physics model of the assembly (modelgen's URDF)
+  topology::EscScan scan;       ///< the scan the EtherCAT master would report (faults applied)
+  topology::ModuleTree tree;    ///< the tree the assembly describes
+  std::string source;           ///< assembly file
+};
+
+/// Turns an assembly file (libs/simbus format) into the simulated robot, with the module
+/// databases given (EscCatalog + module descriptions). Immutable; build() is const.
+class AssemblyBuilder {
+ public:
+  /// Loads the databases; throws std::runtime_error naming the folder on failure.
+  explicit AssemblyBuilder(const std::vector<std::filesystem::path>& module_db_dirs);
+  ~AssemblyBuilder();
+  AssemblyBuilder(AssemblyBuilder&&) noexcept;
+  AssemblyBuilder& operator=(AssemblyBuilder&&) noexcept;
+
+  /// Throws std::runtime_error naming the file and module on any problem.
+  [[nodiscard]] SimulatedRobot build(const std::filesystem::path& assembly_file) const;
+  /// Same from YAML text; `source` names it in messages.
+  [[nodiscard]] SimulatedRobot build_from_text(const std::string& yaml, const std::string& source) const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace concert::robot

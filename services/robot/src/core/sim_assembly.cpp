@@ -1,0 +1,62 @@
+#include "robot/sim_assembly.hpp"
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "concert/module_db/module_db.hpp"
+#include "concert/simbus/assembly.hpp"
+#include "concert/topology/esc_catalog.hpp"
+#include "modelgen/model_generator.hpp"
+
+namespace concert::robot {
+
+struct AssemblyBuilder::Impl {
+  module_db::ModuleDatabase db;
+  topology::EscCatalog catalog;
+  std::unique_ptr<modelgen::ModelGenerator> generator;  // points into db: Impl never moves
+};
+
+AssemblyBuilder::AssemblyBuilder(const std::vector<std::filesystem::path>& module_db_dirs)
+    : impl_(std::make_unique<Impl>()) {
+  if (module_db_dirs.empty()) {
+    throw std::runtime_error("sim assembly: no module database folder given");
+  }
+  impl_->db = module_db::load_module_databases(module_db_dirs);
+  impl_->catalog = topology::EscCatalog::load(module_db_dirs.front());
+  for (std::size_t i = 1; i < module_db_dirs.size(); ++i) {
+    impl_->catalog.merge(topology::EscCatalog::load(module_db_dirs[i]));
+  }
+  impl_->generator = std::make_unique<modelgen::ModelGenerator>(impl_->db);
+}
+
+AssemblyBuilder::~AssemblyBuilder() = default;
+AssemblyBuilder::AssemblyBuilder(AssemblyBuilder&&) noexcept = default;
+AssemblyBuilder& AssemblyBuilder::operator=(AssemblyBuilder&&) noexcept = default;
+
+SimulatedRobot AssemblyBuilder::build(const std::filesystem::path& assembly_file) const {
+  std::ifstream in(assembly_file);
+  if (!in) {
+    throw std::runtime_error("cannot open assembly file '" + assembly_file.string() + "'");
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  return build_from_text(text.str(), assembly_file.string());
+}
+
+SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const std::string& source) const {
+  const simbus::Assembly assembly = simbus::parse_assembly(yaml, source);
+  simbus::validate(assembly, impl_->catalog);
+  SimulatedRobot out;
+  out.source = source;
+  out.scan = simbus::simulate_scan(assembly, impl_->catalog);
+  out.tree = simbus::tree_from_assembly(assembly, impl_->catalog);
+  try {
+    out.urdf = impl_->generator->generate(out.tree).urdf;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("assembly '" + source + "': model generation failed: " + e.what());
+  }
+  return out;
+}
+
+}  // namespace concert::robot
