@@ -100,22 +100,25 @@ static int add(dds_entity_t e, const dds_topic_descriptor_t* desc, int writer, s
   return g_n++;
 }
 
-int cy_create_reader(const char* topic, const char* type_name, cy_qos q) {
-  const dds_topic_descriptor_t* desc = find_desc(type_name);
-  if (!desc) return -1;
+/* Topic plus reader or writer with the catalogue QoS; a negative entity on failure. */
+static dds_entity_t make_endpoint(const char* topic, const dds_topic_descriptor_t* desc, cy_qos q, int writer) {
   dds_entity_t t = dds_create_topic(g_pp, desc, topic, NULL, NULL);
   if (t < 0) {
     fprintf(stderr, "cyclone peer: topic %s: %s\n", topic, dds_strretcode(t));
-    return -1;
+    return t;
   }
-  dds_qos_t* qos = make_qos(q, 0);
-  dds_entity_t r = dds_create_reader(g_pp, t, qos, NULL);
+  dds_qos_t* qos = make_qos(q, writer);
+  dds_entity_t e = writer ? dds_create_writer(g_pp, t, qos, NULL) : dds_create_reader(g_pp, t, qos, NULL);
   dds_delete_qos(qos);
-  if (r < 0) {
-    fprintf(stderr, "cyclone peer: reader %s: %s\n", topic, dds_strretcode(r));
-    return -1;
-  }
-  return add(r, desc, 0, NULL);
+  if (e < 0) fprintf(stderr, "cyclone peer: %s %s: %s\n", writer ? "writer" : "reader", topic, dds_strretcode(e));
+  return e;
+}
+
+int cy_create_reader(const char* topic, const char* type_name, cy_qos q) {
+  const dds_topic_descriptor_t* desc = find_desc(type_name);
+  if (!desc) return -1;
+  dds_entity_t r = make_endpoint(topic, desc, q, 0);
+  return r < 0 ? -1 : add(r, desc, 0, NULL);
 }
 
 /* Cyclone 0.10's C API offers no way to get a topic's sertype (dds_get_entity_sertype came in
@@ -151,16 +154,9 @@ int cy_create_writer(const char* topic, const char* type_name, cy_qos q) {
   if (!desc) return -1;
   struct ddsi_serdata* holder = sertype_probe(topic, desc);
   if (!holder) return -1;
-  dds_entity_t t = dds_create_topic(g_pp, desc, topic, NULL, NULL);
-  if (t < 0) {
-    fprintf(stderr, "cyclone peer: topic %s: %s\n", topic, dds_strretcode(t));
-    return -1;
-  }
-  dds_qos_t* qos = make_qos(q, 1);
-  dds_entity_t w = dds_create_writer(g_pp, t, qos, NULL);
-  dds_delete_qos(qos);
+  dds_entity_t w = make_endpoint(topic, desc, q, 1);
   if (w < 0) {
-    fprintf(stderr, "cyclone peer: writer %s: %s\n", topic, dds_strretcode(w));
+    ddsi_serdata_unref(holder);
     return -1;
   }
   return add(w, desc, 1, holder);

@@ -89,6 +89,17 @@ inline void emit(const idl::Json& j) {
   std::cout << j.dump() << std::endl;
 }
 
+/// Reports the topics that never delivered a sample; returns the peer's exit code.
+template <class Endpoints> int report_missing(const Endpoints& endpoints) {
+  idl::Json missing = idl::Json::array();
+  for (const auto& ep : endpoints) {
+    if (!ep.done) missing.push_back(ep.info.name);
+  }
+  if (missing.empty()) return 0;
+  emit({{"event", "missing"}, {"topics", missing}});
+  return 1;
+}
+
 inline bool past(std::chrono::steady_clock::time_point start, int ms) {
   return std::chrono::steady_clock::now() - start > std::chrono::milliseconds(ms);
 }

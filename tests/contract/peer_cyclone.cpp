@@ -94,13 +94,7 @@ int main(int argc, char** argv) try {
     std::this_thread::sleep_for(5ms);
   }
   cy_close();
-  if (remaining == 0) return 0;
-  idl::Json missing = idl::Json::array();
-  for (const auto& ep : endpoints) {
-    if (!ep.done) missing.push_back(ep.info.name);
-  }
-  contract::emit({{"event", "missing"}, {"topics", missing}});
-  return 1;
+  return contract::report_missing(endpoints);
 } catch (const std::exception& e) {
   std::cerr << "contract_peer_cyclone: " << e.what() << std::endl;
   return 2;

@@ -192,11 +192,25 @@ int info(Args& a, std::ostream& out, int32_t domain) {
   return 0;
 }
 
+/// Options shared by echo and hz: which topic, and when to stop.
+struct Follow {
+  std::string topic;
+  long count;
+  long timeout_ms;
+  long wait_ms;
+};
+
+Follow follow_options(Args& a) {
+  Follow f;
+  f.topic = a.positional("topic name");
+  f.count = a.integer("--count", 0, 0, 1'000'000'000);
+  f.timeout_ms = a.integer("--timeout-ms", 0, 0, 86'400'000);
+  f.wait_ms = a.integer("--wait-ms", 2000, 0, 600000);
+  return f;
+}
+
 int echo(Args& a, std::ostream& out, std::ostream& err, int32_t domain) {
-  const std::string topic = a.positional("topic name");
-  const long count = a.integer("--count", 0, 0, 1'000'000'000);
-  const long timeout_ms = a.integer("--timeout-ms", 0, 0, 86'400'000);
-  const long wait_ms = a.integer("--wait-ms", 2000, 0, 600000);
+  const auto [topic, count, timeout_ms, wait_ms] = follow_options(a);
   a.finish();
   DomainGraph graph(domain, "concert-topic-echo");
   const Resolved r = resolve(graph, topic, static_cast<int>(wait_ms), domain);
@@ -229,10 +243,7 @@ int echo(Args& a, std::ostream& out, std::ostream& err, int32_t domain) {
 }
 
 int hz(Args& a, std::ostream& out, std::ostream& err, int32_t domain) {
-  const std::string topic = a.positional("topic name");
-  const long count = a.integer("--count", 0, 0, 1'000'000'000);
-  const long timeout_ms = a.integer("--timeout-ms", 0, 0, 86'400'000);
-  const long wait_ms = a.integer("--wait-ms", 2000, 0, 600000);
+  const auto [topic, count, timeout_ms, wait_ms] = follow_options(a);
   const bool json = a.flag("--json");
   a.finish();
   if (count == 0 && timeout_ms == 0) err << "concert topic hz: measuring until Ctrl-C\n";
