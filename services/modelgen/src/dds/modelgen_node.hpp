@@ -1,0 +1,42 @@
+#pragma once
+// DDS adapter of the modelgen service: module tree and customisation requests in, RobotModel
+// (transient-local, latched) and service status out. Errors keep the current model; they go to
+// the status message and the log.
+
+#include <atomic>
+#include <chrono>
+#include <ostream>
+
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/status_reporter.hpp"
+#include "modelgen/service.hpp"
+
+namespace concert::modelgen::dds {
+
+class ModelgenNode {
+ public:
+  /// `participant` and `service` must outlive the node. Reports READY (model version 0) at once.
+  ModelgenNode(concert::dds::Participant& participant, ModelgenService& service, std::ostream& log);
+
+  /// Handles one tree sample: generate, publish a new version or report the error.
+  Outcome handle(const msg::ModuleTree& tree);
+  /// Handles one customisation request.
+  Outcome handle(const msg::ModelCustomisation& request);
+
+  /// Waits up to `timeout` for input and handles everything that arrived; returns how many.
+  int spin_once(std::chrono::milliseconds timeout);
+  /// Handles input until `stop` becomes true (checked every `poll`).
+  void spin(const std::atomic<bool>& stop, std::chrono::milliseconds poll = std::chrono::milliseconds(50));
+
+ private:
+  void report(const Outcome& outcome, const std::string& what);
+
+  ModelgenService& service_;
+  concert::dds::Reader<msg::ModuleTree> trees_;
+  concert::dds::Reader<msg::ModelCustomisation> requests_;
+  concert::dds::Writer<msg::RobotModel> models_;
+  concert::dds::StatusReporter status_;
+  std::ostream& log_;
+};
+
+}  // namespace concert::modelgen::dds

@@ -1,0 +1,122 @@
+// The modelgen node over real DDS (private domain): tree in -> latched RobotModel out, same
+// tree -> no new version, bad tree -> model kept, customisation -> new version, late joiners.
+
+#include <chrono>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include "concert/dds/participant.hpp"
+#include "dds/conversions.hpp"
+#include "dds/modelgen_node.hpp"
+#include "test_support.hpp"
+
+namespace fs = std::filesystem;
+using namespace concert;
+using namespace std::chrono_literals;
+
+namespace {
+
+msg::ModuleTree tree_msg(const topology::ModuleTree& tree, uint32_t version) {
+  msg::ModuleTree m;
+  m.version(version);
+  for (const topology::ModuleNode& n : tree.modules) {
+    msg::ModuleNode w;
+    w.index(n.index);
+    w.key(n.key);
+    w.mod_type(n.identity.mod_type);
+    w.mod_id(n.identity.mod_id);
+    w.mod_size(n.identity.mod_size);
+    w.mod_rev(n.identity.mod_rev);
+    w.slave_positions(n.slave_positions);
+    w.parent_module(n.parent_module);
+    w.parent_connector(n.parent_connector);
+    w.robot_id(n.robot_id);
+    m.modules().push_back(w);
+  }
+  return m;
+}
+
+/// Spins the node until `reader` has a sample or 5 s pass.
+std::optional<msg::RobotModel> spin_for_model(modelgen::dds::ModelgenNode& node, concert::dds::Reader<msg::RobotModel>& reader,
+                                              std::chrono::milliseconds limit = 5000ms) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (std::chrono::steady_clock::now() < deadline) {
+    node.spin_once(50ms);
+    if (auto m = reader.take()) return m;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+TEST(ModelgenNode, PublishesVersionedModelsOverDds) {
+  const module_db::ModuleDatabase db = module_db::load_module_database(fs::path(CONCERT_SHARED_DATA) / "concert_resources");
+  modelgen::ModelgenService service(db);
+  concert::dds::Participant node_participant({.name = "modelgen_under_test"});
+  concert::dds::Participant test_participant({.name = "modelgen_test"});
+  std::ostringstream log;
+  modelgen::dds::ModelgenNode node(node_participant, service, log);
+  concert::dds::Writer<msg::ModuleTree> trees(test_participant, concert::dds::topics::module_tree);
+  concert::dds::Writer<msg::ModelCustomisation> requests(test_participant, concert::dds::topics::customisation);
+  concert::dds::Reader<msg::RobotModel> models(test_participant, concert::dds::topics::robot_model);
+  ASSERT_TRUE(trees.wait_for_readers(1, 5000ms));
+  ASSERT_TRUE(requests.wait_for_readers(1, 5000ms));
+  ASSERT_TRUE(models.wait_for_writers(1, 5000ms));
+
+  const topology::ModuleTree big = modelgen::test::make_tree(modelgen::test::public_eighteen_module_robot(), &db);
+  ASSERT_TRUE(trees.write(tree_msg(big, 1)));
+  const auto m1 = spin_for_model(node, models);
+  ASSERT_TRUE(m1.has_value()) << log.str();
+  EXPECT_EQ(m1->version(), 1u);
+  EXPECT_EQ(m1->tree_version(), 1u);
+  EXPECT_EQ(m1->modules().size(), 18u);
+  EXPECT_EQ(m1->joints().size(), 14u);
+  EXPECT_EQ(m1->chains().size(), 5u);
+  EXPECT_EQ(m1->end_effectors().size(), 5u);
+  EXPECT_EQ(m1->content_hash(), service.current()->content_hash);
+  EXPECT_TRUE(urdf::parseURDF(m1->urdf()));
+  EXPECT_EQ(m1->joints()[1].upper(), 1e300);  // continuous wheel joint
+
+  // Same tree again: no new version on the wire.
+  ASSERT_TRUE(trees.write(tree_msg(big, 2)));
+  EXPECT_FALSE(spin_for_model(node, models, 600ms).has_value());
+  EXPECT_NE(log.str().find("not republished"), std::string::npos) << log.str();
+
+  // A tree that cannot be modelled: error in the log, model kept.
+  ASSERT_TRUE(trees.write(tree_msg(modelgen::test::make_tree({{"mobile_platform_concert", -1, -1}, {"nope", 0, 5}}), 3)));
+  EXPECT_FALSE(spin_for_model(node, models, 600ms).has_value());
+  EXPECT_NE(log.str().find("tree 3: module 1 ('nope')"), std::string::npos) << log.str();
+  EXPECT_EQ(service.current()->version, 1u);
+
+  // Customisation: refused as a whole when one add-on does not fit (the panel gripper takes
+  // none), then accepted: a new version with the homing posture.
+  msg::ModelCustomisation request;
+  request.request_id(5);
+  request.base_version(1);
+  request.homing_joints({"J2_E"});
+  request.homing_positions({0.4});
+  msg::AddonChoice addon;
+  addon.module_name("ee_E");
+  addon.addon("drillbit_6_SDSplus");
+  request.addons().push_back(addon);
+  ASSERT_TRUE(requests.write(request));
+  EXPECT_FALSE(spin_for_model(node, models, 600ms).has_value());
+  EXPECT_NE(log.str().find("customisation request 5: customisation addons[0]: module 'passive_end_effector_panel' accepts no add-ons"),
+            std::string::npos)
+      << log.str();
+  request.request_id(6);
+  request.addons().clear();
+  ASSERT_TRUE(requests.write(request));
+  const auto m2 = spin_for_model(node, models);
+  ASSERT_TRUE(m2.has_value()) << log.str();
+  EXPECT_EQ(m2->version(), 2u);
+  EXPECT_NE(m2->srdf().find("<joint name=\"J2_E\" value=\"0.4\"/>"), std::string::npos);
+
+  // A late joiner gets the current model at once (transient-local).
+  concert::dds::Reader<msg::RobotModel> late(test_participant, concert::dds::topics::robot_model);
+  const auto latched = late.wait(5000ms);
+  ASSERT_TRUE(latched.has_value());
+  EXPECT_EQ(latched->version(), m2->version());
+}
