@@ -129,6 +129,7 @@ class RobotCore {
   /// Accepts a new model (URDF text) at `version`: holds every joint, rebuilds
   /// controllers/limits/legs, reports ready. Throws ModelMismatchError (old model kept) if it
   /// cannot be parsed, its joints differ from the mounted hardware, or the version is older.
+  /// The mounted hardware is what the last cycle() saw (a hot swap is noticed at the next cycle).
   /// `end_effector_frame` (e.g. from the model's end-effector list) overrides
   /// RobotParams::end_effector_frame when not empty.
   void set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame = "");
@@ -165,7 +166,9 @@ class RobotCore {
   RobotState state_;
   HardwareState hw_state_;
   std::vector<DriveCommand> drive_;
-  std::uint64_t known_generation_{0};
+  std::vector<std::string> hw_joints_;   // as of the last cycle (the loop thread owns hw_)
+  std::uint64_t hw_generation_{0};       // as of the last cycle
+  std::uint64_t known_generation_{0};    // generation the current model was accepted for
   bool holding_hw_{false};
 };
 

@@ -92,7 +92,9 @@ RobotCore::RobotCore(Hardware& hardware, RobotParams params) : hw_(hardware), pa
     throw std::invalid_argument("robot: period must be positive");
   }
   hw_.read(hw_state_);
-  known_generation_ = hw_.generation();
+  hw_joints_ = hw_.joint_names();
+  hw_generation_ = hw_.generation();
+  known_generation_ = hw_generation_;
   state_.message = "waiting for a robot model";
 }
 
@@ -110,7 +112,8 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
     throw ModelMismatchError("model version " + std::to_string(version) + " refused: older than the current version " +
                              std::to_string(ctl_->version));
   }
-  const auto& hw_joints = hw_.joint_names();
+  // The hardware belongs to the loop thread: use what the last cycle read.
+  const auto& hw_joints = hw_joints_;
   const std::set<std::string> mounted(hw_joints.begin(), hw_joints.end());
   const std::set<std::string> modelled(model->joint_names().begin(), model->joint_names().end());
   std::vector<std::string> missing, extra;
@@ -128,7 +131,6 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
     ctl->hw_to_model.push_back(model->joint_index_or_throw(name));
   }
   // Hold: every joint keeps the position it has now.
-  hw_.read(hw_state_);
   ctl->hold_position.assign(static_cast<std::size_t>(n), 0.0);
   for (std::size_t h = 0; h < hw_joints.size(); ++h) {
     ctl->hold_position[static_cast<std::size_t>(ctl->hw_to_model[h])] = hw_state_.position[h];
@@ -166,7 +168,7 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
     ctl->odometry = ctl_->odometry;
   }
   ctl_ = std::move(ctl);
-  known_generation_ = hw_.generation();
+  known_generation_ = hw_generation_;
   holding_hw_ = false;
   state_.ready = true;
   state_.model_version = version;
@@ -302,9 +304,13 @@ void RobotCore::cycle() {
   {
     std::lock_guard lock(mutex_);
     hw_.read(hw_state_);
+    if (hw_.generation() != hw_generation_) {
+      hw_generation_ = hw_.generation();
+      hw_joints_ = hw_.joint_names();
+    }
     const std::size_t nh = hw_state_.position.size();
     const double dt = params_.period;
-    if (hw_.generation() != known_generation_ || !ctl_) {
+    if (hw_generation_ != known_generation_ || !ctl_) {
       // Mounted hardware changed (hot swap) or no model yet: hold every drive where it is
       // until a matching model arrives.
       if (ctl_ && state_.ready) {
@@ -508,7 +514,7 @@ void RobotCore::cycle() {
       }
     }
     state_.time = hw_state_.time;
-    state_.joint_names = hw_.joint_names();
+    state_.joint_names = hw_joints_;
     state_.position = hw_state_.position;
     state_.velocity = hw_state_.velocity;
     state_.effort = hw_state_.effort;
