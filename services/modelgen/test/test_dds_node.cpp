@@ -10,6 +10,7 @@
 #include "concert/dds/participant.hpp"
 #include "dds/conversions.hpp"
 #include "dds/modelgen_node.hpp"
+#include "modelgen/cli.hpp"
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -119,4 +120,20 @@ TEST(ModelgenNode, PublishesVersionedModelsOverDds) {
   const auto latched = late.wait(5000ms);
   ASSERT_TRUE(latched.has_value());
   EXPECT_EQ(latched->version(), m2->version());
+
+  // `concert model show` prints the live model.
+  std::ostringstream out;
+  std::ostringstream err;
+  ASSERT_EQ(modelgen::cli_main({"show", "--timeout", "5"}, out, err), 0) << err.str();
+  EXPECT_NE(out.str().find("robot model version 2 (" + service.current()->content_hash + ")"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("  E (arm) base_link -> tcp_E: J1_E J2_E J3_E J4_E J5_E J6_E"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("  ee_E chain E frame tcp_E module passive_end_effector_panel"), std::string::npos) << out.str();
+}
+
+TEST(ModelShow, NoModelIsAClearError) {
+  std::ostringstream out;
+  std::ostringstream err;
+  EXPECT_EQ(modelgen::cli_main({"show", "--timeout", "0.3"}, out, err), 1);
+  EXPECT_NE(err.str().find("no robot model received within 0.3 s"), std::string::npos) << err.str();
+  EXPECT_EQ(modelgen::cli_main({"show", "--timeout", "-1"}, out, err), 2);
 }

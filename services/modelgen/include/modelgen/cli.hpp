@@ -18,7 +18,12 @@ namespace concert::modelgen {
 /// through the simulated bus and discovery, as the real pipeline does. The bundle's version is
 /// one more than the version already in DIR, or unchanged when the content hash is the same.
 /// Returns 0, or non-zero with a one-line message on `err`.
+///   show [--timeout S]   prints the live model (version, modules, chains, joints,
+///                        end-effectors) read from the latched RobotModel topic (CONCERT_DOMAIN_ID).
 int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+/// `concert model show` (args[0] == "show").
+int show_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 /// Reads a module tree in the `concert discover --json` shape (topology::tree_to_json).
 /// Throws std::runtime_error naming `source` and the field.

@@ -139,8 +139,9 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
     (args.empty() ? err : out) << kUsage << "\n";
     return args.empty() ? 2 : 0;
   }
+  if (args[0] == "show") return show_main(args, out, err);
   if (args[0] != "generate") {
-    err << "concert model: unknown verb '" << args[0] << "' (expected generate)\n";
+    err << "concert model: unknown verb '" << args[0] << "' (expected generate or show)\n";
     return 2;
   }
   Options o;
