@@ -76,6 +76,23 @@ std::vector<int> ModuleDescription::tcp_connectors() const {
   return out;
 }
 
+std::vector<Frame> ModuleDescription::named_frames() const {
+  std::vector<Frame> out;
+  auto add = [&](ConnectorRole role, FrameKind kind) {
+    for (const Connector& c : connectors) {
+      if (c.role == role) out.push_back({c.name, kind, c.body, c.pose});
+    }
+  };
+  add(ConnectorRole::kInput, FrameKind::kInput);
+  for (const JointDescription& j : joints) {
+    if (j.actuated()) out.push_back({j.name, FrameKind::kJoint, j.parent_body, j.pose_parent});
+  }
+  add(ConnectorRole::kOutput, FrameKind::kOutput);
+  add(ConnectorRole::kTcp, type == ModuleType::kWheel ? FrameKind::kWheel : FrameKind::kTcp);
+  out.insert(out.end(), frames.begin(), frames.end());
+  return out;
+}
+
 double ModuleDescription::mass() const {
   double m = 0.0;
   for (const Body& b : bodies) m += b.inertial.mass;

@@ -203,6 +203,15 @@ TEST(OwnDatabase, DescribesEveryModuleOfThePaper) {
   const ModuleDescription& drill = db.at("concert_drill");
   ASSERT_EQ(drill.frames.size(), 1u);
   EXPECT_EQ(drill.frames[0].kind, FrameKind::kCamera);
+  std::vector<FrameKind> kinds;
+  for (const Frame& f : drill.named_frames()) kinds.push_back(f.kind);
+  EXPECT_EQ(kinds, (std::vector<FrameKind>{FrameKind::kInput, FrameKind::kTcp, FrameKind::kCamera}));
+  kinds.clear();
+  for (const Frame& f : db.at("concert_wheel").named_frames()) kinds.push_back(f.kind);
+  EXPECT_EQ(kinds, (std::vector<FrameKind>{FrameKind::kInput, FrameKind::kJoint, FrameKind::kWheel}));
+  kinds.clear();
+  for (const Frame& f : db.at("concert_elbow_a").named_frames()) kinds.push_back(f.kind);
+  EXPECT_EQ(kinds, (std::vector<FrameKind>{FrameKind::kInput, FrameKind::kJoint, FrameKind::kOutput}));
   EXPECT_FALSE(db.at("concert_passive_gripper_panel").esc.has_value());
   EXPECT_FALSE(db.at("concert_passive_gripper_panel").actuated());
   EXPECT_TRUE(db.at("concert_active_gripper_panel").actuated());

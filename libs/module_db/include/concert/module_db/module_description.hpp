@@ -156,6 +156,9 @@ struct ModuleDescription {
   std::vector<int> output_connectors() const;
   /// Indices into connectors of TCP connectors (tool centre points, wheel centres).
   std::vector<int> tcp_connectors() const;
+  /// Every frame of the module (paper section 4.3.2), each on its body: input, joint (on the
+  /// parent body, at pose_parent), outputs, TCP or wheel centre, then the extra frames.
+  std::vector<Frame> named_frames() const;
   /// Sum of body masses, kg.
   double mass() const;
   /// True if any joint moves.
