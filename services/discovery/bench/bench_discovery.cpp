@@ -101,6 +101,42 @@ BENCHMARK(BM_Network<false>)->Name("BM_NetworkLinear")
 BENCHMARK(BM_Network<true>)->Name("BM_NetworkPaperReference")
     ->Arg(18)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond)->Complexity();
 
+/// The paper algorithm's worst case: a chain of split points, each with a leaf on its second
+/// port; every leaf comes after the whole rest of the chain in the ring, so Algorithm 1 walks
+/// back over it. n = 2k + 1 slaves.
+EscScan comb_scan(int64_t slaves) {
+  const int64_t k = slaves / 2;
+  EscScan scan;
+  for (int64_t i = 0; i < 2 * k + 1; ++i) {
+    concert::topology::EscSlave s;
+    s.position = static_cast<int32_t>(i + 1);
+    s.active_ports = i < k ? 0b1011 : 0b0001;
+    s.topology = i < k ? 3 : 1;
+    scan.slaves.push_back(s);
+  }
+  return scan;
+}
+
+template <bool kReference>
+void BM_NetworkComb(benchmark::State& state) {
+  const EscScan scan = comb_scan(state.range(0));
+  for (auto _ : state) {
+    if constexpr (kReference) {
+      benchmark::DoNotOptimize(
+          concert::discovery::reconstruct_network_reference(scan, PortOrder::kReal0312));
+    } else {
+      benchmark::DoNotOptimize(
+          concert::discovery::reconstruct_network(scan, PortOrder::kReal0312));
+    }
+  }
+  state.counters["slaves"] = static_cast<double>(scan.slaves.size());
+  state.SetComplexityN(static_cast<int64_t>(scan.slaves.size()));
+}
+BENCHMARK(BM_NetworkComb<false>)->Name("BM_NetworkCombLinear")
+    ->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond)->Complexity();
+BENCHMARK(BM_NetworkComb<true>)->Name("BM_NetworkCombPaperReference")
+    ->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond)->Complexity();
+
 }  // namespace
 
 BENCHMARK_MAIN();

@@ -135,3 +135,17 @@ TEST_F(Cli, SeveralDatabasesMerge) {
 
 }  // namespace
 }  // namespace concert::discovery
+
+namespace concert::discovery {
+namespace {
+
+TEST_F(Cli, DefaultIsTheProjectDatabase) {
+  // Without --module-db: <source>/data/module_db (the project database, with its own keys).
+  ASSERT_EQ(run({"--scan", file("robot.yaml"), "--json"}), 0) << err_.str();
+  const auto j = nlohmann::json::parse(out_.str());
+  EXPECT_EQ(j["modules"][0]["key"], "concert_mobile_base_hub");
+  EXPECT_EQ(j["modules"].size(), 18u);
+}
+
+}  // namespace
+}  // namespace concert::discovery

@@ -1,0 +1,132 @@
+#include "conversions.hpp"
+
+namespace concert::discovery::dds {
+namespace {
+
+topology::EscSlave slave_to_core(const msg::EscSlave& m) {
+  topology::EscSlave s;
+  s.position = m.position();
+  s.active_ports = m.active_ports();
+  s.topology = m.topology();
+  s.esc_type = m.esc_type();
+  s.identity = topology::EscIdentity{m.mod_type(), m.mod_id(), m.mod_size(), m.mod_rev()};
+  s.robot_id = m.robot_id();
+  return s;
+}
+
+msg::EscSlave slave_to_msg(const topology::EscSlave& s) {
+  msg::EscSlave m;
+  m.position(s.position);
+  m.active_ports(s.active_ports);
+  m.topology(s.topology);
+  m.esc_type(s.esc_type);
+  m.mod_type(s.identity.mod_type);
+  m.mod_id(s.identity.mod_id);
+  m.mod_size(s.identity.mod_size);
+  m.mod_rev(s.identity.mod_rev);
+  m.robot_id(s.robot_id);
+  return m;
+}
+
+msg::ModuleKind kind_to_msg(topology::ModuleKind kind) {
+  switch (kind) {
+    case topology::ModuleKind::kJoint: return msg::MODULE_JOINT;
+    case topology::ModuleKind::kHub: return msg::MODULE_HUB;
+    case topology::ModuleKind::kEndEffector: return msg::MODULE_END_EFFECTOR;
+    case topology::ModuleKind::kLink: return msg::MODULE_LINK;
+    case topology::ModuleKind::kWheel: return msg::MODULE_WHEEL;
+    case topology::ModuleKind::kBaseLink: return msg::MODULE_BASE_LINK;
+  }
+  return msg::MODULE_LINK;
+}
+
+topology::ModuleKind kind_to_core(msg::ModuleKind kind) {
+  switch (kind) {
+    case msg::MODULE_JOINT: return topology::ModuleKind::kJoint;
+    case msg::MODULE_HUB: return topology::ModuleKind::kHub;
+    case msg::MODULE_END_EFFECTOR: return topology::ModuleKind::kEndEffector;
+    case msg::MODULE_LINK: return topology::ModuleKind::kLink;
+    case msg::MODULE_WHEEL: return topology::ModuleKind::kWheel;
+    case msg::MODULE_BASE_LINK: return topology::ModuleKind::kBaseLink;
+  }
+  return topology::ModuleKind::kLink;
+}
+
+}  // namespace
+
+topology::EscScan to_core(const msg::EscScan& scan) {
+  topology::EscScan out;
+  out.slaves.reserve(scan.slaves().size());
+  for (const auto& s : scan.slaves()) out.slaves.push_back(slave_to_core(s));
+  return out;
+}
+
+msg::EscScan to_msg(const topology::EscScan& scan, uint32_t scan_id, int64_t stamp_ns,
+                    const std::string& source) {
+  msg::EscScan out;
+  out.scan_id(scan_id);
+  out.stamp_ns(stamp_ns);
+  out.source(source);
+  out.slaves().reserve(scan.slaves.size());
+  for (const auto& s : scan.slaves) out.slaves().push_back(slave_to_msg(s));
+  return out;
+}
+
+topology::ModuleTree to_core(const msg::ModuleTree& tree) {
+  topology::ModuleTree out;
+  for (const auto& m : tree.slaves()) {
+    topology::SlaveNode node;
+    node.slave = slave_to_core(m.slave());
+    node.parent_position = m.parent_position();
+    if (m.parent_port() >= 0) node.parent_port = m.parent_port();
+    node.module_index = m.module_index();
+    out.slaves.push_back(node);
+  }
+  for (const auto& m : tree.modules()) {
+    topology::ModuleNode node;
+    node.index = m.index();
+    node.key = m.key();
+    node.kind = kind_to_core(m.kind());
+    node.identity = topology::EscIdentity{m.mod_type(), m.mod_id(), m.mod_size(), m.mod_rev()};
+    node.slave_positions = m.slave_positions();
+    node.parent_module = m.parent_module();
+    node.parent_connector = m.parent_connector();
+    node.robot_id = m.robot_id();
+    out.modules.push_back(std::move(node));
+  }
+  return out;
+}
+
+msg::ModuleTree to_msg(const topology::ModuleTree& tree, uint32_t version, uint32_t scan_id,
+                       int64_t stamp_ns) {
+  msg::ModuleTree out;
+  out.version(version);
+  out.scan_id(scan_id);
+  out.stamp_ns(stamp_ns);
+  for (const auto& s : tree.slaves) {
+    msg::SlaveNode node;
+    node.slave(slave_to_msg(s.slave));
+    node.parent_position(s.parent_position);
+    node.parent_port(s.parent_port.value_or(-1));
+    node.module_index(s.module_index);
+    out.slaves().push_back(node);
+  }
+  for (const auto& m : tree.modules) {
+    msg::ModuleNode node;
+    node.index(m.index);
+    node.key(m.key);
+    node.kind(kind_to_msg(m.kind));
+    node.mod_type(m.identity.mod_type);
+    node.mod_id(m.identity.mod_id);
+    node.mod_size(m.identity.mod_size);
+    node.mod_rev(m.identity.mod_rev);
+    node.slave_positions(m.slave_positions);
+    node.parent_module(m.parent_module);
+    node.parent_connector(m.parent_connector);
+    node.robot_id(m.robot_id);
+    out.modules().push_back(node);
+  }
+  return out;
+}
+
+}  // namespace concert::discovery::dds

@@ -1,0 +1,108 @@
+// The DDS adapter in one process: scans in, versioned latched trees and status out; a faulty
+// scan keeps the last good tree.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <sstream>
+
+#include "concert/simbus/assembly.hpp"
+#include "concert/topology/esc_catalog.hpp"
+#include "dds/conversions.hpp"
+#include "dds/discovery_node.hpp"
+
+namespace concert::discovery {
+namespace {
+
+using namespace std::chrono_literals;
+
+const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
+const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
+
+TEST(DdsConversions, RoundTrip) {
+  const auto catalog = topology::EscCatalog::load(kPublicDb);
+  const auto assembly = simbus::load_assembly(kExamples + "/concert_torso_two_arms.yaml");
+  const auto scan = simbus::simulate_scan(assembly, catalog);
+  const auto msg_scan = dds::to_msg(scan, 7, 123, "sim");
+  EXPECT_EQ(msg_scan.scan_id(), 7u);
+  EXPECT_EQ(msg_scan.source(), "sim");
+  EXPECT_EQ(dds::to_core(msg_scan), scan);
+  const auto tree = simbus::tree_from_assembly(assembly, catalog);
+  const auto msg_tree = dds::to_msg(tree, 3, 7, 456);
+  EXPECT_EQ(msg_tree.version(), 3u);
+  EXPECT_EQ(msg_tree.slaves()[0].parent_port(), -1);
+  EXPECT_EQ(msg_tree.modules()[10].kind(), msg::MODULE_HUB);
+  EXPECT_EQ(dds::to_core(msg_tree), tree);
+}
+
+/// Waits (bounded) for a status sample of the discovery service in `state`.
+std::optional<msg::ServiceStatus> wait_status(concert::dds::Reader<msg::ServiceStatus>& reader,
+                                              msg::ServiceState state) {
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (auto s = reader.wait(200ms); s && s->service() == "discovery" && s->state() == state) {
+      return s;
+    }
+  }
+  return std::nullopt;
+}
+
+TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
+  const auto catalog = topology::EscCatalog::load(kPublicDb);
+  const auto assembly = simbus::load_assembly(kExamples + "/concert_paper_robot.yaml");
+  const auto good = simbus::simulate_scan(assembly, catalog);
+  auto bad = good;
+  bad.slaves[4].topology = 3;
+
+  concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "discovery_test"});
+  concert::dds::Reader<msg::ServiceStatus> status(participant, concert::dds::topics::status);
+  std::ostringstream log;
+  dds::DiscoveryNode node(participant, DiscoveryService(Discovery(catalog)), log);
+  concert::dds::Writer<msg::EscScan> scans(participant, concert::dds::topics::esc_scan);
+  concert::dds::Reader<msg::ModuleTree> trees(participant, concert::dds::topics::module_tree);
+  ASSERT_TRUE(scans.wait_for_readers(1, 10s));
+  ASSERT_TRUE(trees.wait_for_writers(1, 10s));
+
+  ASSERT_TRUE(scans.write(dds::to_msg(good, 1, 0, "test")));
+  int handled = 0;
+  for (int i = 0; i < 50 && handled == 0; ++i) handled = node.spin_once(200ms);
+  ASSERT_EQ(handled, 1);
+  const auto first = trees.wait(10s);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->version(), 1u);
+  EXPECT_EQ(first->scan_id(), 1u);
+  EXPECT_EQ(dds::to_core(*first), simbus::tree_from_assembly(assembly, catalog));
+  ASSERT_TRUE(wait_status(status, msg::SERVICE_READY));
+
+  ASSERT_TRUE(scans.write(dds::to_msg(bad, 2, 0, "test")));
+  handled = 0;
+  for (int i = 0; i < 50 && handled == 0; ++i) handled = node.spin_once(200ms);
+  ASSERT_EQ(handled, 1);
+  const auto error = wait_status(status, msg::SERVICE_ERROR);
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->message(),
+            "scan 2 rejected: slave 5: active_ports 0b1001 has 2 open ports but topology says 3 "
+            "(keeping tree version 1)");
+  EXPECT_NE(log.str().find("scan 2 rejected: slave 5"), std::string::npos);
+  EXPECT_FALSE(trees.wait(300ms));
+  EXPECT_EQ(node.service().version(), 1u);
+
+  // A late joiner gets the last good tree at once (transient local).
+  concert::dds::Reader<msg::ModuleTree> late(participant, concert::dds::topics::module_tree);
+  const auto latched = late.wait(10s);
+  ASSERT_TRUE(latched);
+  EXPECT_EQ(latched->version(), 1u);
+
+  // A different robot: version 2.
+  auto changed = assembly;
+  changed.faults.push_back(simbus::Fault{simbus::FaultType::kBrokenLink, "drill", {}, {}});
+  ASSERT_TRUE(scans.write(dds::to_msg(simbus::simulate_scan(changed, catalog), 3, 0, "test")));
+  handled = 0;
+  for (int i = 0; i < 50 && handled == 0; ++i) handled = node.spin_once(200ms);
+  const auto second = trees.wait(10s);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->version(), 2u);
+  EXPECT_EQ(second->modules().size(), 17u);
+}
+
+}  // namespace
+}  // namespace concert::discovery
