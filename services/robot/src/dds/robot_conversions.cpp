@@ -1,0 +1,157 @@
+#include "robot_conversions.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace concert::robot::dds {
+namespace {
+
+std::string from(const std::string& source) { return source.empty() ? std::string("unnamed sender") : "'" + source + "'"; }
+
+void check_length(const msg::JointCommand& c, std::size_t size, const char* field, bool required) {
+  if ((required || size != 0) && size != c.name().size()) {
+    throw CommandError("joint command from " + from(c.source()) + ": " + std::to_string(c.name().size()) +
+                       " names but " + std::to_string(size) + " values in '" + field + "'" +
+                       (required ? " (required by the mode)" : " (give one per joint or none)"));
+  }
+}
+
+double at(const std::vector<double>& v, std::size_t i) { return v.empty() ? 0.0 : v[i]; }
+
+}  // namespace
+
+JointCommandSet to_core(const msg::JointCommand& c) {
+  JointCommandSet out;
+  out.model_version = c.model_version();
+  DriveMode mode = DriveMode::kPosition;
+  switch (c.mode()) {
+    case msg::JOINT_POSITION:
+      mode = DriveMode::kPosition;
+      check_length(c, c.position().size(), "position", true);
+      break;
+    case msg::JOINT_VELOCITY:
+      mode = DriveMode::kVelocity;
+      check_length(c, c.velocity().size(), "velocity", true);
+      break;
+    case msg::JOINT_EFFORT:
+      mode = DriveMode::kEffort;
+      check_length(c, c.effort().size(), "effort", true);
+      break;
+    case msg::JOINT_IMPEDANCE:
+      mode = DriveMode::kImpedance;
+      check_length(c, c.position().size(), "position", true);
+      check_length(c, c.stiffness().size(), "stiffness", true);
+      check_length(c, c.damping().size(), "damping", true);
+      break;
+    default:
+      throw CommandError("joint command from " + from(c.source()) + ": unknown mode " +
+                         std::to_string(static_cast<int>(c.mode())));
+  }
+  check_length(c, c.position().size(), "position", false);
+  check_length(c, c.velocity().size(), "velocity", false);
+  check_length(c, c.effort().size(), "effort", false);
+  check_length(c, c.stiffness().size(), "stiffness", false);
+  check_length(c, c.damping().size(), "damping", false);
+  for (std::size_t i = 0; i < c.name().size(); ++i) {
+    out.joints.push_back({c.name()[i], mode, at(c.position(), i), at(c.velocity(), i), at(c.effort(), i),
+                          at(c.stiffness(), i), at(c.damping(), i)});
+  }
+  return out;
+}
+
+CartesianCommand to_core(const msg::CartesianImpedanceCommand& c) {
+  CartesianCommand out;
+  out.model_version = c.model_version();
+  out.frame = c.end_effector();
+  const auto& p = c.target().position();
+  const auto& o = c.target().orientation();
+  const Eigen::Quaterniond q(o.w(), o.x(), o.y(), o.z());
+  if (std::abs(q.norm() - 1.0) > 1e-3) {
+    throw CommandError("Cartesian command from " + from(c.source()) + ": target.orientation is not a unit quaternion");
+  }
+  out.target_pose = Eigen::Isometry3d::Identity();
+  out.target_pose.linear() = q.normalized().toRotationMatrix();
+  out.target_pose.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
+  const auto& t = c.target_twist();
+  out.target_twist << t.linear().x(), t.linear().y(), t.linear().z(), t.angular().x(), t.angular().y(),
+      t.angular().z();
+  for (int i = 0; i < 6; ++i) {
+    out.stiffness(i) = c.stiffness()[static_cast<std::size_t>(i)];
+    out.damping(i) = c.damping()[static_cast<std::size_t>(i)];
+  }
+  const auto& f = c.feedforward();
+  out.feedforward_wrench << f.force().x(), f.force().y(), f.force().z(), f.torque().x(), f.torque().y(),
+      f.torque().z();
+  const uint8_t axis = c.admittance_axis();
+  if (axis != 255) {
+    if (axis > 2) {
+      throw CommandError("Cartesian command from " + from(c.source()) + ": admittance_axis " +
+                         std::to_string(axis) + " (rotational) is not supported; use 0..2 (x, y, z of the TCP) or 255");
+    }
+    if (!(c.admittance_gain() > 0.0)) {
+      throw CommandError("Cartesian command from " + from(c.source()) + ": admittance_gain must be > 0 [m/(N s)]");
+    }
+    out.admittance.enabled = true;
+    // The axis is given in the TCP frame: fixed in the world at the target orientation.
+    out.admittance.axis = out.target_pose.linear().col(axis);
+    out.admittance.force_setpoint = c.admittance_force();
+    // First-order admittance s' = gain (F_set - F): damping 1/gain, a 20 ms virtual-mass lag.
+    out.admittance.damping = 1.0 / c.admittance_gain();
+    out.admittance.mass = 0.02 * out.admittance.damping;
+  }
+  return out;
+}
+
+BaseCommand to_core(const msg::BaseVelocityCommand& c) { return {c.model_version(), c.vx(), c.vy(), c.wz()}; }
+
+int64_t to_stamp_ns(double time) { return static_cast<int64_t>(std::llround(time * 1e9)); }
+
+msg::JointState to_joint_state(const RobotState& s) {
+  msg::JointState out;
+  out.model_version(static_cast<uint32_t>(s.model_version));
+  out.stamp_ns(to_stamp_ns(s.time));
+  out.name(s.joint_names);
+  out.position(s.position);
+  out.velocity(s.velocity);
+  out.effort(s.effort);
+  return out;
+}
+
+msg::Odometry to_odometry(const RobotState& s, double distance) {
+  msg::Odometry out;
+  out.stamp_ns(to_stamp_ns(s.time));
+  out.x(s.odometry.x);
+  out.y(s.odometry.y);
+  out.yaw(s.odometry.yaw);
+  out.vx(s.odometry.vx);
+  out.vy(s.odometry.vy);
+  out.wz(s.odometry.wz);
+  // Wheel odometry drifts with distance: 2 % of it in x and y, 0.01 rad per metre in yaw (1 sigma).
+  std::array<double, 9> cov{};
+  cov[0] = cov[4] = std::pow(0.02 * distance, 2) + 1e-6;
+  cov[8] = std::pow(0.01 * distance, 2) + 1e-6;
+  out.covariance(cov);
+  return out;
+}
+
+msg::EndEffectorWrench to_wrench(const RobotState& s) {
+  msg::EndEffectorWrench out;
+  out.model_version(static_cast<uint32_t>(s.model_version));
+  out.stamp_ns(to_stamp_ns(s.time));
+  out.end_effector(s.end_effector_frame);
+  const auto& w = s.end_effector_wrench;
+  msg::Wrench wrench;
+  msg::Vector3 force, torque;
+  force.x(w(0));
+  force.y(w(1));
+  force.z(w(2));
+  torque.x(w(3));
+  torque.y(w(4));
+  torque.z(w(5));
+  wrench.force(force);
+  wrench.torque(torque);
+  out.wrench(wrench);
+  return out;
+}
+
+}  // namespace concert::robot::dds

@@ -1,0 +1,68 @@
+#pragma once
+// DDS face of the robot service: model in, commands in, state/odometry/wrench/scan/status out.
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/status_reporter.hpp"
+#include "concert/topology/types.hpp"
+#include "robot/robot_core.hpp"
+
+namespace concert::robot::dds {
+
+struct NodeParams {
+  std::string service_name{"robot"};
+  int odometry_decimation{10};  ///< odometry every N cycles (100 Hz at 1 kHz)
+  int wrench_decimation{10};    ///< end-effector wrench every N cycles
+};
+
+/// Readers call the core from the DDS listener threads (the core locks); publish() is called
+/// by the loop thread after every cycle. Refused commands and models are reported on the
+/// status topic with the core's message; the last good model stays.
+class RobotNode {
+ public:
+  RobotNode(concert::dds::Participant& participant, RobotCore& core, NodeParams params = {});
+  ~RobotNode();
+  RobotNode(const RobotNode&) = delete;
+  RobotNode& operator=(const RobotNode&) = delete;
+
+  /// Joint state every call (KEEP_LAST 1 stream), odometry and wrench decimated, status on change.
+  void publish(const RobotState& state);
+  /// Latched scan of the (simulated) bus; `scan_id` increases with each scan.
+  void publish_scan(const topology::EscScan& scan, const std::string& source);
+
+  /// Counters for tests and diagnostics.
+  [[nodiscard]] std::uint64_t refused_commands() const { return refused_.load(); }
+  [[nodiscard]] std::string last_error() const;
+
+ private:
+  void on_model(const msg::RobotModel& model);
+  template <class F> void guarded(const std::string& what, F&& f);
+
+  concert::dds::Participant& participant_;
+  RobotCore& core_;
+  NodeParams params_;
+  concert::dds::StatusReporter status_;
+  concert::dds::Writer<msg::JointState> joint_state_;
+  concert::dds::Writer<msg::Odometry> odometry_;
+  concert::dds::Writer<msg::EndEffectorWrench> wrench_;
+  concert::dds::Writer<msg::EscScan> scan_;
+  std::unique_ptr<concert::dds::Reader<msg::RobotModel>> model_reader_;
+  std::unique_ptr<concert::dds::Reader<msg::JointCommand>> joint_reader_;
+  std::unique_ptr<concert::dds::Reader<msg::CartesianImpedanceCommand>> cartesian_reader_;
+  std::unique_ptr<concert::dds::Reader<msg::BaseVelocityCommand>> base_reader_;
+  std::atomic<std::uint64_t> refused_{0};
+  mutable std::mutex mutex_;
+  std::string last_error_;
+  bool last_ready_{false};
+  std::uint64_t cycles_{0};
+  std::uint32_t scan_id_{0};
+  double distance_{0.0};
+  double last_x_{0.0}, last_y_{0.0};
+};
+
+}  // namespace concert::robot::dds

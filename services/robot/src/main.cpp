@@ -1,0 +1,221 @@
+// concert_robot: the robot service (XBot2's role). Simulated hardware by default.
+//   concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE]
+//                 [--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK]
+//                 [--standalone] [--fifo PRIORITY]
+// The assembly file is watched: edit it (or `concert sim swap` it) and the simulated bus
+// publishes the new scan. See services/robot/README.md.
+#include <sys/stat.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "concert/dds/participant.hpp"
+#include "robot_node.hpp"
+#include "robot/loop.hpp"
+#include "robot/robot_core.hpp"
+#include "robot/sim_assembly.hpp"
+#include "robot/sim_hardware.hpp"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE] "
+    "[--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK] [--standalone] [--fifo PRIORITY]";
+
+struct Options {
+  std::string backend{"sim"};
+  std::string assembly;
+  std::string urdf;
+  std::vector<std::filesystem::path> module_dbs;
+  std::string world;
+  bool fast{false};
+  double duration{0.0};
+  std::string ee_frame;
+  bool standalone{false};
+  int fifo{0};
+};
+
+std::atomic<concert::robot::Loop*> g_loop{nullptr};
+
+void on_signal(int) {
+  if (auto* loop = g_loop.load()) {
+    loop->stop();
+  }
+}
+
+[[noreturn]] void usage_error(const std::string& what) {
+  std::cerr << "concert_robot: " << what << "\n" << kUsage << "\n";
+  std::exit(2);
+}
+
+double parse_number(const std::string& flag, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used != text.size()) {
+      throw std::invalid_argument(text);
+    }
+    return v;
+  } catch (const std::exception&) {
+    usage_error(flag + ": expected a number, got '" + text + "'");
+  }
+}
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        usage_error(arg + " needs a value");
+      }
+      return argv[++i];
+    };
+    if (arg == "--backend") {
+      o.backend = value();
+    } else if (arg == "--assembly") {
+      o.assembly = value();
+    } else if (arg == "--urdf") {
+      o.urdf = value();
+    } else if (arg == "--module-db") {
+      o.module_dbs.emplace_back(value());
+    } else if (arg == "--world") {
+      o.world = value();
+    } else if (arg == "--fast") {
+      o.fast = true;
+    } else if (arg == "--duration") {
+      o.duration = parse_number(arg, value());
+    } else if (arg == "--ee-frame") {
+      o.ee_frame = value();
+    } else if (arg == "--standalone") {
+      o.standalone = true;
+    } else if (arg == "--fifo") {
+      o.fifo = static_cast<int>(parse_number(arg, value()));
+    } else if (arg == "--help" || arg == "-h") {
+      std::cout << kUsage << "\n";
+      std::exit(0);
+    } else {
+      usage_error("unknown argument '" + arg + "'");
+    }
+  }
+  if (o.backend == "ethercat") {
+    std::cerr << "concert_robot: backend 'ethercat' is not part of this build (no EtherCAT master here); "
+                 "see services/robot/README.md for what it must provide\n";
+    std::exit(2);
+  }
+  if (o.backend != "sim") {
+    usage_error("unknown backend '" + o.backend + "' (sim or ethercat)");
+  }
+  if (o.assembly.empty() == o.urdf.empty()) {
+    usage_error("give exactly one of --assembly FILE or --urdf FILE");
+  }
+  if (o.module_dbs.empty()) {
+    o.module_dbs.emplace_back(CONCERT_DEFAULT_MODULE_DB);
+  }
+  if (o.duration < 0.0) {
+    usage_error("--duration must not be negative");
+  }
+  return o;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error("cannot open '" + path + "'");
+  }
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::optional<std::filesystem::file_time_type> mtime(const std::string& path) {
+  std::error_code ec;
+  const auto t = std::filesystem::last_write_time(path, ec);
+  if (ec) {
+    return std::nullopt;
+  }
+  return t;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace concert;
+  const Options options = parse(argc, argv);
+  try {
+    std::optional<robot::AssemblyBuilder> builder;
+    robot::SimulatedRobot simulated;
+    if (!options.assembly.empty()) {
+      builder.emplace(options.module_dbs);
+      simulated = builder->build(options.assembly);
+    } else {
+      simulated.urdf = read_file(options.urdf);
+      simulated.source = options.urdf;
+    }
+    const robot::World world = options.world.empty() ? robot::World{} : robot::load_world_file(options.world);
+    robot::SimHardware sim(simulated.urdf, world, {});
+    robot::RobotParams params;
+    params.end_effector_frame = options.ee_frame;
+    robot::RobotCore core(sim, params);
+
+    concert::dds::Participant participant({.name = "robot"});
+    robot::dds::RobotNode node(participant, core);
+    if (!options.assembly.empty()) {
+      node.publish_scan(simulated.scan, "sim");
+    }
+    if (options.standalone) {
+      core.set_model(simulated.urdf, 1);
+    }
+
+    robot::LoopParams loop_params;
+    loop_params.real_time = !options.fast;
+    loop_params.fifo_priority = options.fifo;
+    auto watched = options.assembly.empty() ? std::nullopt : mtime(options.assembly);
+    std::uint64_t ticks = 0;
+    robot::Loop loop(loop_params, [&] {
+      // Hot swap: the assembly file changed (checked every 250 ms of loop time).
+      if (!options.assembly.empty() && ++ticks % 250 == 0) {
+        const auto now = mtime(options.assembly);
+        if (now && now != watched) {
+          watched = now;
+          try {
+            simulated = builder->build(options.assembly);
+            sim.swap_model(simulated.urdf);
+            core.cycle();  // the core notices the new hardware before anyone sees the scan
+            node.publish_scan(simulated.scan, "sim");
+            std::cerr << "concert_robot: hot swap from '" << options.assembly << "': " << simulated.scan.slaves.size()
+                      << " slaves\n";
+            if (options.standalone) {
+              core.set_model(simulated.urdf, core.model_version() + 1);
+            }
+          } catch (const std::exception& e) {
+            std::cerr << "concert_robot: hot swap refused, the robot keeps its modules: " << e.what() << "\n";
+          }
+        }
+      }
+      core.cycle();
+      node.publish(core.state());
+    });
+    g_loop = &loop;
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    const auto cycles = options.duration > 0.0 ? static_cast<std::uint64_t>(options.duration / params.period)
+                                                : std::numeric_limits<std::uint64_t>::max();
+    const robot::LoopStats stats = loop.run(cycles);
+    g_loop = nullptr;
+    std::cerr << "concert_robot: stopped after " << stats.cycles << " cycles (" << stats.overruns << " overruns)\n";
+  } catch (const std::exception& e) {
+    std::cerr << "concert_robot: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

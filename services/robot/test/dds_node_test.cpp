@@ -1,0 +1,181 @@
+// The robot service's DDS face: model in, commands in, state/odometry/wrench/status out.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "concert/dds/endpoint.hpp"
+#include "robot_conversions.hpp"
+#include "robot_node.hpp"
+#include "test_helpers.hpp"
+
+namespace concert::robot {
+namespace {
+
+using namespace std::chrono_literals;
+namespace cdds = concert::dds;
+
+// Runs cycles (publishing after each) until `done` or `max_cycles`.
+template <class F> bool run_until(RobotCore& core, dds::RobotNode& node, F done, int max_cycles = 5000) {
+  for (int i = 0; i < max_cycles; ++i) {
+    core.cycle();
+    node.publish(core.state());
+    if (i % 50 == 0) {
+      std::this_thread::sleep_for(1ms);  // let the DDS threads deliver
+    }
+    if (done()) {
+      return true;
+    }
+  }
+  return false;
+}
+
+msg::RobotModel model_msg(const std::string& urdf, uint32_t version) {
+  msg::RobotModel m;
+  m.version(version);
+  m.urdf(urdf);
+  return m;
+}
+
+TEST(RobotNode, ModelCommandsAndStateOverDds) {
+  SimHardware sim(test::read_fixture("mobile_drill.urdf"), World{}, {});
+  RobotCore core(sim);
+  cdds::Participant robot_side({.name = "robot"});
+  dds::RobotNode node(robot_side, core);
+
+  cdds::Participant client({.name = "client"});
+  cdds::Writer<msg::RobotModel> models(client, cdds::topics::robot_model);
+  cdds::Writer<msg::JointCommand> joints(client, cdds::topics::joint_command);
+  cdds::Writer<msg::BaseVelocityCommand> base(client, cdds::topics::base_velocity);
+  cdds::Reader<msg::JointState> states(client, cdds::topics::joint_state);
+  cdds::Reader<msg::Odometry> odometry(client, cdds::topics::odometry);
+  cdds::Reader<msg::ServiceStatus> status(client, cdds::topics::status);
+  ASSERT_TRUE(models.wait_for_readers(1, 10s));
+  ASSERT_TRUE(joints.wait_for_readers(1, 10s));
+  ASSERT_TRUE(base.wait_for_readers(1, 10s));
+
+  // The model arrives: the core reconfigures and reports ready at that version.
+  models.write(model_msg(test::read_fixture("mobile_drill.urdf"), 7));
+  ASSERT_TRUE(run_until(core, node, [&] { return core.ready(); }));
+  EXPECT_EQ(core.model_version(), 7u);
+  bool ready_seen = false;
+  for (int i = 0; i < 100 && !ready_seen; ++i) {
+    if (auto s = status.wait(100ms); s && s->service() == "robot" && s->state() == msg::SERVICE_READY) {
+      ready_seen = s->model_version() == 7u;
+    }
+  }
+  EXPECT_TRUE(ready_seen);
+
+  // Joint state stream carries every joint.
+  auto js = states.wait(5s);
+  for (int i = 0; i < 10 && (!js || js->model_version() != 7u); ++i) {
+    run_until(core, node, [] { return false; }, 10);
+    js = states.wait(1s);
+  }
+  ASSERT_TRUE(js.has_value());
+  EXPECT_EQ(js->name().size(), 14u);
+  EXPECT_EQ(js->model_version(), 7u);
+
+  // An unknown joint is refused with a clear error; a stale version too.
+  msg::JointCommand bad;
+  bad.model_version(7);
+  bad.source("test");
+  bad.mode(msg::JOINT_POSITION);
+  bad.name({"J9_X"});
+  bad.position({0.1});
+  joints.write(bad);
+  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() >= 1; }));
+  EXPECT_NE(node.last_error().find("unknown joint 'J9_X'"), std::string::npos) << node.last_error();
+  bad.name({"J1_A"});
+  bad.model_version(6);
+  joints.write(bad);
+  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() >= 2; }));
+  EXPECT_NE(node.last_error().find("current model version is 7"), std::string::npos) << node.last_error();
+
+  // A valid command moves the joint.
+  msg::JointCommand good = bad;
+  good.model_version(7);
+  good.position({0.4});
+  joints.write(good);
+  EXPECT_TRUE(run_until(core, node, [&] {
+    const auto s = core.state();
+    return std::abs(s.position[test::hw_index(s, "J1_A")] - 0.4) < 0.01;
+  }));
+
+  // Base velocity in, odometry out.
+  msg::BaseVelocityCommand drive;
+  drive.model_version(7);
+  drive.vx(0.2);
+  for (int k = 0; k < 20; ++k) {
+    base.write(drive);
+    run_until(core, node, [] { return false; }, 100);
+  }
+  std::optional<msg::Odometry> odom;
+  while (auto o = odometry.take()) {
+    odom = o;
+  }
+  ASSERT_TRUE(odom.has_value());
+  EXPECT_NEAR(odom->vx(), 0.2, 0.02);
+  EXPECT_GT(odom->x(), 0.2);
+  EXPECT_GT(odom->covariance()[0], 0.0);
+
+  // A model that does not match the mounted hardware: refused, the old one keeps running.
+  models.write(model_msg(test::read_fixture("mobile_three_legs.urdf"), 8));
+  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() >= 3; }));
+  EXPECT_NE(node.last_error().find("does not match the mounted hardware"), std::string::npos);
+  EXPECT_EQ(core.model_version(), 7u);
+  EXPECT_TRUE(core.ready());
+}
+
+TEST(RobotConversions, JointCommandLengthsAreChecked) {
+  msg::JointCommand c;
+  c.source("planner");
+  c.mode(msg::JOINT_IMPEDANCE);
+  c.name({"a", "b"});
+  c.position({0.1, 0.2});
+  c.stiffness({100.0});
+  c.damping({1.0, 1.0});
+  try {
+    (void)dds::to_core(c);
+    FAIL();
+  } catch (const CommandError& e) {
+    EXPECT_NE(std::string(e.what()).find("'planner'"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("'stiffness'"), std::string::npos);
+  }
+  c.stiffness({100.0, 200.0});
+  const JointCommandSet set = dds::to_core(c);
+  ASSERT_EQ(set.joints.size(), 2u);
+  EXPECT_EQ(set.joints[1].mode, DriveMode::kImpedance);
+  EXPECT_DOUBLE_EQ(set.joints[1].stiffness, 200.0);
+  EXPECT_DOUBLE_EQ(set.joints[1].velocity, 0.0);
+}
+
+TEST(RobotConversions, CartesianAdmittanceAxisIsTheTcpAxisInTheWorld) {
+  msg::CartesianImpedanceCommand c;
+  c.source("sanding");
+  msg::Pose pose;
+  msg::Quaternion q;  // 90 degrees about world y: the TCP z axis points along world +x
+  q.w(std::sqrt(0.5));
+  q.y(std::sqrt(0.5));
+  pose.orientation(q);
+  c.target(pose);
+  c.admittance_axis(2);
+  c.admittance_force(25.0);
+  c.admittance_gain(0.002);
+  const CartesianCommand out = dds::to_core(c);
+  ASSERT_TRUE(out.admittance.enabled);
+  EXPECT_TRUE(out.admittance.axis.isApprox(Eigen::Vector3d::UnitX(), 1e-9)) << out.admittance.axis.transpose();
+  EXPECT_DOUBLE_EQ(out.admittance.force_setpoint, 25.0);
+  EXPECT_DOUBLE_EQ(out.admittance.damping, 500.0);
+  c.admittance_axis(4);
+  EXPECT_THROW((void)dds::to_core(c), CommandError);
+  c.admittance_axis(255);
+  EXPECT_FALSE(dds::to_core(c).admittance.enabled);
+  q.w(2.0);
+  pose.orientation(q);
+  c.target(pose);
+  EXPECT_THROW((void)dds::to_core(c), CommandError);
+}
+
+}  // namespace
+}  // namespace concert::robot
