@@ -180,5 +180,43 @@ TEST(Network, LinearEqualsPaperReferenceOnRandomTrees) {
   }
 }
 
+/// On arbitrary open-port masks the linear pass and the paper's algorithms agree exactly:
+/// same links, or the same error for the same slave.
+TEST(Network, LinearAndReferenceAgreeOnArbitraryMasks) {
+  std::mt19937 rng(99);
+  int valid = 0;
+  for (int trial = 0; trial < 8000; ++trial) {
+    const int n = 1 + static_cast<int>(rng() % 12);
+    EscScan scan;
+    for (int i = 0; i < n; ++i) {
+      topology::EscSlave s;
+      s.position = i + 1;
+      // Leaves are more likely, so that some random scans are valid trees.
+      s.active_ports = static_cast<uint8_t>(rng() % 3 == 0 ? (1U | (rng() % 16)) : 1U);
+      s.topology = __builtin_popcount(s.active_ports);
+      scan.slaves.push_back(s);
+    }
+    for (PortOrder order : {PortOrder::kReal0312, PortOrder::kNumeric0123}) {
+      std::string linear_error, reference_error;
+      std::vector<SlaveLink> linear, reference;
+      try {
+        linear = reconstruct_network(scan, order);
+      } catch (const DiscoveryError& e) {
+        linear_error = e.what();
+      }
+      try {
+        reference = reconstruct_network_reference(scan, order);
+      } catch (const DiscoveryError& e) {
+        reference_error = e.what();
+      }
+      ASSERT_EQ(linear_error, reference_error) << "trial " << trial;
+      ASSERT_EQ(linear, reference) << "trial " << trial;
+      valid += linear_error.empty() ? 1 : 0;
+    }
+  }
+  EXPECT_GT(valid, 400);  // both outcomes are exercised
+  EXPECT_LT(valid, 15000);
+}
+
 }  // namespace
 }  // namespace concert::discovery

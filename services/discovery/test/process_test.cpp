@@ -1,0 +1,102 @@
+// The service as a real process: concert_discovery reads scans from DDS, publishes trees and
+// its status, reports faulty scans on stderr and stops cleanly on SIGTERM.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "concert/dds/endpoint.hpp"
+#include "concert/simbus/assembly.hpp"
+#include "concert/topology/esc_catalog.hpp"
+#include "dds/conversions.hpp"
+
+extern char** environ;
+
+namespace concert::discovery {
+namespace {
+
+using namespace std::chrono_literals;
+
+const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
+const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
+
+/// Waits (bounded) for the child to exit; returns its exit status or -1.
+int wait_exit(pid_t pid, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::this_thread::sleep_for(20ms);
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  return -1;
+}
+
+TEST(DiscoveryProcess, ScansInTreesAndStatusOutCleanStop) {
+  const auto log = std::filesystem::temp_directory_path() /
+                   ("concert_discovery_process_" + std::to_string(getpid()) + ".log");
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::string binary = DISCOVERY_BINARY, db_flag = "--module-db", db = kPublicDb;
+  char* argv[] = {binary.data(), db_flag.data(), db.data(), nullptr};
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), &actions, nullptr, argv, environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+
+  {
+    const auto catalog = topology::EscCatalog::load(kPublicDb);
+    const auto assembly = simbus::load_assembly(kExamples + "/concert_paper_robot.yaml");
+    const auto scan = simbus::simulate_scan(assembly, catalog);
+    auto bad = scan;
+    bad.slaves.pop_back();  // slave 18 (yaw) now has an open port with nothing behind it
+
+    concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "process_test"});
+    concert::dds::Writer<msg::EscScan> scans(participant, concert::dds::topics::esc_scan);
+    concert::dds::Reader<msg::ModuleTree> trees(participant, concert::dds::topics::module_tree);
+    concert::dds::Reader<msg::ServiceStatus> status(participant, concert::dds::topics::status);
+    ASSERT_TRUE(scans.wait_for_readers(1, 20s));
+    ASSERT_TRUE(scans.write(dds::to_msg(scan, 1, 0, "test")));
+    const auto tree = trees.wait(20s);
+    ASSERT_TRUE(tree);
+    EXPECT_EQ(tree->version(), 1u);
+    EXPECT_EQ(dds::to_core(*tree), simbus::tree_from_assembly(assembly, catalog));
+
+    ASSERT_TRUE(scans.write(dds::to_msg(bad, 2, 0, "test")));
+    bool error_seen = false;
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (!error_seen && std::chrono::steady_clock::now() < deadline) {
+      if (auto s = status.wait(200ms)) {
+        error_seen = s->service() == "discovery" && s->state() == msg::SERVICE_ERROR &&
+                     s->message().find("scan 2 rejected: slave 18") != std::string::npos;
+      }
+    }
+    EXPECT_TRUE(error_seen);
+    EXPECT_FALSE(trees.wait(300ms));
+  }
+  kill(pid, SIGTERM);
+  EXPECT_EQ(wait_exit(pid, 15s), 0);
+  std::ifstream in(log);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("discovery: scan 1: tree version 1 (18 modules, 19 slaves)"),
+            std::string::npos)
+      << text.str();
+  EXPECT_NE(text.str().find("scan 2 rejected: slave 18: port 3 is open but no slave hangs on it"),
+            std::string::npos)
+      << text.str();
+  std::filesystem::remove(log);
+}
+
+}  // namespace
+}  // namespace concert::discovery
