@@ -2,8 +2,8 @@
 //   concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE]
 //                 [--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK]
 //                 [--standalone] [--fifo PRIORITY]
-// The assembly file is watched: edit it (or `concert sim swap` it) and the simulated bus
-// publishes the new scan. See services/robot/README.md.
+// The assembly and world files are watched: edit them (hot swap, new walls) while it runs
+// and the simulated bus publishes the new scan. See services/robot/README.md.
 #include <sys/stat.h>
 
 #include <atomic>
@@ -173,17 +173,19 @@ int main(int argc, char** argv) {
       node.publish_scan(simulated.scan, "sim");
     }
     if (options.standalone) {
-      core.set_model(simulated.urdf, 1);
+      node.apply_model(simulated.urdf, 1, options.ee_frame);
     }
 
     robot::LoopParams loop_params;
     loop_params.real_time = !options.fast;
     loop_params.fifo_priority = options.fifo;
     auto watched = options.assembly.empty() ? std::nullopt : mtime(options.assembly);
+    auto world_watched = options.world.empty() ? std::nullopt : mtime(options.world);
     std::uint64_t ticks = 0;
     robot::Loop loop(loop_params, [&] {
       // Hot swap: the assembly file changed (checked every 250 ms of loop time).
-      if (!options.assembly.empty() && ++ticks % 250 == 0) {
+      ++ticks;
+      if (!options.assembly.empty() && ticks % 250 == 0) {
         const auto now = mtime(options.assembly);
         if (now && now != watched) {
           watched = now;
@@ -195,10 +197,23 @@ int main(int argc, char** argv) {
             std::cerr << "concert_robot: hot swap from '" << options.assembly << "': " << simulated.scan.slaves.size()
                       << " slaves\n";
             if (options.standalone) {
-              core.set_model(simulated.urdf, core.model_version() + 1);
+              node.apply_model(simulated.urdf, core.model_version() + 1, options.ee_frame);
             }
           } catch (const std::exception& e) {
             std::cerr << "concert_robot: hot swap refused, the robot keeps its modules: " << e.what() << "\n";
+          }
+        }
+      }
+      // World edits (walls, obstacles) are picked up the same way.
+      if (!options.world.empty() && ticks % 250 == 125) {
+        const auto now = mtime(options.world);
+        if (now && now != world_watched) {
+          world_watched = now;
+          try {
+            sim.set_world(robot::load_world_file(options.world));
+            std::cerr << "concert_robot: world reloaded from '" << options.world << "'\n";
+          } catch (const std::exception& e) {
+            std::cerr << "concert_robot: world change refused, the old world stays: " << e.what() << "\n";
           }
         }
       }

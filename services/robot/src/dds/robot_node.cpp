@@ -65,23 +65,25 @@ template <class F> void RobotNode::guarded(const std::string& what, F&& f) {
 
 void RobotNode::on_model(const msg::RobotModel& m) {
   const std::string ee = m.end_effectors().empty() ? std::string{} : m.end_effectors().front().frame();
+  apply_model(m.urdf(), m.version(), ee);
+}
+
+void RobotNode::apply_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame) {
   try {
     status_.report(msg::SERVICE_RECONFIGURING, status_.model_version(),
-                   "reconfiguring to model version " + std::to_string(m.version()));
-    core_.set_model(m.urdf(), m.version(), ee);
-    status_.report(msg::SERVICE_READY, m.version(), "ready at model version " + std::to_string(m.version()));
+                   "reconfiguring to model version " + std::to_string(version));
+    core_.set_model(urdf, version, end_effector_frame);
+    status_.report(msg::SERVICE_READY, static_cast<uint32_t>(version),
+                   "ready at model version " + std::to_string(version));
   } catch (const std::exception& e) {
     ++refused_;
     {
       std::lock_guard lock(mutex_);
       last_error_ = e.what();
     }
-    if (core_.ready()) {
-      // The last good model keeps running.
-      status_.report(msg::SERVICE_READY, static_cast<uint32_t>(core_.model_version()), e.what());
-    } else {
-      status_.report(msg::SERVICE_ERROR, static_cast<uint32_t>(core_.model_version()), e.what());
-    }
+    // The last good model keeps running if the hardware still matches it.
+    status_.report(core_.ready() ? msg::SERVICE_READY : msg::SERVICE_ERROR,
+                   static_cast<uint32_t>(core_.model_version()), e.what());
   }
 }
 

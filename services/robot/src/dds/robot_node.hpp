@@ -35,6 +35,10 @@ class RobotNode {
   /// Latched scan of the (simulated) bus; `scan_id` increases with each scan.
   void publish_scan(const topology::EscScan& scan, const std::string& source);
 
+  /// Reconfigures the core to a model (from the model topic, or the sim's own model in
+  /// standalone mode) and reports the outcome on the status topic. Never throws.
+  void apply_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame);
+
   /// Counters for tests and diagnostics.
   [[nodiscard]] std::uint64_t refused_commands() const { return refused_.load(); }
   [[nodiscard]] std::string last_error() const;
