@@ -94,6 +94,20 @@ TEST(SimHardware, HotSwapKeepsStateAndBumpsGeneration) {
   EXPECT_EQ(index_of(sim.joint_names(), "J_wheel_rr"), sim.joint_names().size());
 }
 
+TEST(SimHardware, WorldChangeKeepsTheRobot) {
+  SimHardware sim(read_fixture("arm_drill.urdf"), World{}, {});
+  const auto gen = sim.generation();
+  World world;
+  WorldShape box;
+  box.name = "crate";
+  box.size = {0.5, 0.5, 0.5};
+  box.position = {2.0, 0.0, 0.25};
+  world.obstacles.push_back(box);
+  sim.set_world(world);
+  EXPECT_EQ(sim.generation(), gen);
+  EXPECT_NE(sim.mjcf().find("name=\"crate\""), std::string::npos);
+}
+
 TEST(SimHardware, BadUrdfIsAClearError) {
   EXPECT_THROW(SimHardware("<robot name='x'>", World{}, {}), std::exception);
 }

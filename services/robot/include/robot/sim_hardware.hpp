@@ -61,7 +61,7 @@ class SimHardware final : public Hardware {
   /// Hot swap: the robot becomes `urdf` (the base pose and joints with the same name keep
   /// their state, every drive holds position); generation() increases.
   void swap_model(const std::string& urdf);
-  /// Replaces the world (keeps the robot state).
+  /// Replaces the world (keeps the robot state and the hardware generation).
   void set_world(const World& world);
 
   // Ground truth, for tests and benchmarks.

@@ -273,7 +273,7 @@ struct SimHardware::Impl {
     }
   }
 
-  void load(const std::string& new_urdf) {
+  void load(const std::string& new_urdf, bool new_hardware) {
     Built b = build_mjcf(new_urdf, world, params);
     mjVFS vfs;
     mj_defaultVFS(&vfs);
@@ -329,7 +329,9 @@ struct SimHardware::Impl {
       std::copy(base_qpos.begin(), base_qpos.end(), d->qpos);
     }
     mj_forward(m, d);
-    ++generation;
+    if (new_hardware) {
+      ++generation;
+    }
   }
 
   void apply_drives() {
@@ -369,7 +371,7 @@ SimHardware::SimHardware(const std::string& urdf, World world, SimParams params)
   if (impl_->params.timestep <= 0.0) {
     throw HardwareError("sim: timestep must be positive");
   }
-  impl_->load(urdf);
+  impl_->load(urdf, true);
 }
 
 SimHardware::~SimHardware() = default;
@@ -415,11 +417,11 @@ void SimHardware::step(double dt) {
   // (mj_step computes forces before integrating); a second mj_forward would double the cost.
 }
 
-void SimHardware::swap_model(const std::string& urdf) { impl_->load(urdf); }
+void SimHardware::swap_model(const std::string& urdf) { impl_->load(urdf, true); }
 
 void SimHardware::set_world(const World& world) {
   impl_->world = world;
-  impl_->load(impl_->urdf);
+  impl_->load(impl_->urdf, false);  // same robot: no new hardware generation
 }
 
 double SimHardware::time() const { return impl_->d->time; }
