@@ -273,3 +273,20 @@ TEST(Discovery, InconsistentCatalogueIsRefusedAtConstruction) {
 
 }  // namespace
 }  // namespace concert::discovery
+
+namespace concert::discovery {
+namespace {
+
+TEST(Discovery, ShippedExampleScansMatchTheirAssemblies) {
+  const EscCatalog catalog = EscCatalog::load(kPublicDb);
+  const std::string dir = std::string(CONCERT_SOURCE_DIR) + "/services/discovery/examples";
+  EXPECT_EQ(discover(topology::load_scan(dir + "/paper_robot_scan.yaml"), catalog),
+            simbus::tree_from_assembly(
+                simbus::load_assembly(kExamples + "/concert_paper_robot.yaml"), catalog));
+  EXPECT_EQ(discover(topology::load_scan(dir + "/torso_two_arms_scan.json"), catalog),
+            simbus::tree_from_assembly(
+                simbus::load_assembly(kExamples + "/concert_torso_two_arms.yaml"), catalog));
+}
+
+}  // namespace
+}  // namespace concert::discovery
