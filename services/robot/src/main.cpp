@@ -1,7 +1,7 @@
 // concert_robot: the robot service (XBot2's role). Simulated hardware by default.
 //   concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE]
 //                 [--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK]
-//                 [--standalone] [--fifo PRIORITY]
+//                 [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...]
 // The assembly and world files are watched: edit them (hot swap, new walls) while it runs
 // and the simulated bus publishes the new scan. See services/robot/README.md.
 #include <sys/stat.h>
@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -29,7 +30,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE] "
-    "[--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK] [--standalone] [--fifo PRIORITY]";
+    "[--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK] [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...]";
 
 struct Options {
   std::string backend{"sim"};
@@ -42,6 +43,7 @@ struct Options {
   std::string ee_frame;
   bool standalone{false};
   int fifo{0};
+  std::map<std::string, std::string> packages;
 };
 
 std::atomic<concert::robot::Loop*> g_loop{nullptr};
@@ -98,6 +100,13 @@ Options parse(int argc, char** argv) {
       o.ee_frame = value();
     } else if (arg == "--standalone") {
       o.standalone = true;
+    } else if (arg == "--package") {
+      const std::string v = value();
+      const auto eq = v.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        usage_error("--package: expected NAME=DIR, got '" + v + "'");
+      }
+      o.packages[v.substr(0, eq)] = v.substr(eq + 1);
     } else if (arg == "--fifo") {
       o.fifo = static_cast<int>(parse_number(arg, value()));
     } else if (arg == "--help" || arg == "-h") {
@@ -162,7 +171,16 @@ int main(int argc, char** argv) {
       simulated.source = options.urdf;
     }
     const robot::World world = options.world.empty() ? robot::World{} : robot::load_world_file(options.world);
-    robot::SimHardware sim(simulated.urdf, world, {});
+    robot::SimParams sim_params;
+    // Collision meshes: package://NAME/... resolves to a module-database folder named NAME.
+    for (const auto& db : options.module_dbs) {
+      sim_params.package_paths[std::filesystem::absolute(db).lexically_normal().filename().string()] =
+          std::filesystem::absolute(db).string();
+    }
+    for (const auto& [name, dir] : options.packages) {
+      sim_params.package_paths[name] = dir;
+    }
+    robot::SimHardware sim(simulated.urdf, world, sim_params);
     robot::RobotParams params;
     params.end_effector_frame = options.ee_frame;
     robot::RobotCore core(sim, params);

@@ -52,6 +52,23 @@ TEST(PaperRobot, GeneratedModelRunsInTheSimulator) {
   }
 }
 
+TEST(PaperRobot, CollisionMeshesFromTheModuleDatabase) {
+  const std::string urdf = paper_robot_urdf();
+  SimParams params;
+  params.package_paths = {{"concert_resources", kPublicDb.string()}};
+  SimHardware sim(urdf, World{}, params);
+  EXPECT_NE(sim.mjcf().find("type=\"mesh\""), std::string::npos);
+  EXPECT_EQ(sim.mjcf().find("concert_wheel.stl"), std::string::npos);  // wheels roll on cylinders
+  RobotCore core(sim);
+  core.set_model(urdf, 1);
+  test::run_cycles(core, 1000);
+  double expected_z = 0.0;
+  for (const auto& leg : core.legs()) {
+    expected_z = std::max(expected_z, leg.wheel_radius - leg.wheel_center_height);
+  }
+  EXPECT_NEAR(sim.base_pose().translation().z(), expected_z, 0.02);  // on its wheels, not on a hull
+}
+
 TEST(PaperRobot, BaseDrivesOnTheGeneratedLegs) {
   const std::string urdf = paper_robot_urdf();
   SimHardware sim(urdf, World{}, {});

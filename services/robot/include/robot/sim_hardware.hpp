@@ -33,6 +33,10 @@ struct SimParams {
   double position_noise{0.0};        ///< std-dev of the encoder noise [rad]
   double effort_noise{0.0};          ///< std-dev of the torque-sensor noise [Nm]
   unsigned seed{1};                  ///< noise seed
+  /// ROS-style package roots for collision meshes: "package://NAME/rest" -> DIR/rest
+  /// (e.g. {"concert_resources", "/work/shared/data/concert_resources"}). Meshes that do not
+  /// resolve to an existing file are skipped; wheel links keep only their primitive shapes.
+  std::map<std::string, std::string> package_paths;
 };
 
 /// MJCF text for a URDF placed in a world (exposed for tests and for debugging in MuJoCo's

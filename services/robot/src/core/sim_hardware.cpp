@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <iomanip>
 #include <random>
 #include <sstream>
@@ -46,6 +47,28 @@ struct MjcfWriter {
   std::ostringstream xml;
   std::vector<std::string> actuated;  // joint names in depth-first order
   std::vector<double> efforts;
+  std::vector<std::string> assets;    // <mesh> elements
+  int skipped_meshes{0};
+
+  // package://NAME/rest, file://PATH or an absolute path -> existing file, else "".
+  [[nodiscard]] std::string resolve(const std::string& uri) const {
+    std::string path;
+    if (uri.rfind("package://", 0) == 0) {
+      const std::string rest = uri.substr(10);
+      const auto slash = rest.find('/');
+      const auto root = params.package_paths.find(rest.substr(0, slash));
+      if (root == params.package_paths.end() || slash == std::string::npos) {
+        return "";
+      }
+      path = root->second + "/" + rest.substr(slash + 1);
+    } else if (uri.rfind("file://", 0) == 0) {
+      path = uri.substr(7);
+    } else if (!uri.empty() && uri.front() == '/') {
+      path = uri;
+    }
+    std::error_code ec;
+    return !path.empty() && std::filesystem::is_regular_file(path, ec) ? path : "";
+  }
 
   void geoms(const urdf::Link& link, bool is_wheel) {
     int k = 0;
@@ -75,10 +98,21 @@ struct MjcfWriter {
           xml << "<geom type=\"sphere\" size=\"" << num(s.radius) << "\"" << common << "/>\n";
           break;
         }
-        case urdf::Geometry::MESH:
+        case urdf::Geometry::MESH: {
+          // Wheels roll on their cylinder: a convex hull of the tyre mesh would not.
+          const auto& mesh = dynamic_cast<const urdf::Mesh&>(*c->geometry);
+          const std::string file = resolve(mesh.filename);
+          if (is_wheel || file.empty()) {
+            ++skipped_meshes;
+            break;
+          }
+          const std::string asset = "mesh_" + std::to_string(assets.size());
+          assets.push_back("<mesh name=\"" + asset + "\" file=\"" + file + "\" scale=\"" +
+                           vec(mesh.scale.x, mesh.scale.y, mesh.scale.z) + "\"/>");
+          xml << "<geom type=\"mesh\" mesh=\"" << asset << "\"" << common << "/>\n";
+          break;
+        }
         default:
-          // Meshes are not loaded (package:// resolution and convex hulls cost start-up time);
-          // see README: collision meshes are replaced by their modules' primitive shapes.
           break;
       }
     }
@@ -171,6 +205,7 @@ void world_geoms(std::ostringstream& xml, const World& world) {
 
 struct Built {
   std::string mjcf;
+  int meshes{0};
   std::vector<std::string> joints;
   bool floating{false};
 };
@@ -195,13 +230,9 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
     }
     z += lift + 0.002;
   }
-  MjcfWriter w{params, wheel_links, {}, {}, {}};
+  MjcfWriter w{params, wheel_links, {}, {}, {}, {}, 0};
   const urdf::Link& root = *parsed->getRoot();
-  w.xml << "<mujoco model=\"" << parsed->getName() << "\">\n"
-        << "<compiler angle=\"radian\" inertiafromgeom=\"false\" boundmass=\"0.0001\" boundinertia=\"0.00000001\" "
-           "balanceinertia=\"true\"/>\n"
-        << "<option timestep=\"" << num(params.timestep) << "\" integrator=\"implicit\" gravity=\"0 0 -9.81\"/>\n"
-        << "<worldbody>\n";
+  w.xml << "<worldbody>\n";
   world_geoms(w.xml, world);
   w.xml << "<body name=\"" << root.name << "\" pos=\"" << vec(params.base_position.x(), params.base_position.y(), z)
         << "\" euler=\"0 0 " << num(params.base_yaw) << "\">\n";
@@ -221,7 +252,20 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
     w.xml << "/>\n";
   }
   w.xml << "</actuator>\n</mujoco>\n";
-  out.mjcf = w.xml.str();
+  std::ostringstream head;
+  head << "<mujoco model=\"" << parsed->getName() << "\">\n"
+       << "<compiler angle=\"radian\" inertiafromgeom=\"false\" boundmass=\"0.0001\" boundinertia=\"0.00000001\" "
+          "balanceinertia=\"true\"/>\n"
+       << "<option timestep=\"" << num(params.timestep) << "\" integrator=\"implicit\" gravity=\"0 0 -9.81\"/>\n";
+  if (!w.assets.empty()) {
+    head << "<asset>\n";
+    for (const auto& a : w.assets) {
+      head << a << "\n";
+    }
+    head << "</asset>\n";
+  }
+  out.mjcf = head.str() + w.xml.str();
+  out.meshes = static_cast<int>(w.assets.size());
   out.joints = w.actuated;
   return out;
 }
