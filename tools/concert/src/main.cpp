@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "args.hpp"
+#include "scan_verbs.hpp"
 #include "topic_verbs.hpp"
 #ifdef CONCERT_HAVE_DISCOVERY_CLI
 #include "discovery/cli.hpp"
@@ -25,8 +26,13 @@ verbs:
                                                 arrival rate statistics
   discover --scan FILE [--port-order 0312|0123] [--module-db DIR ...] [--json]
                                                 rebuild the module tree from an EtherCAT scan file
+  scan show (--assembly F | --scan F) [--module-db DIR ...] [--json]
+                                                the scan an assembly gives on the simulated bus
+  scan publish (--assembly F | --scan F) [--module-db DIR ...] [--hold-ms MS]
+                                                publish a scan as an EtherCAT master would (latched)
   model generate (--scan F | --tree F | --assembly F) --module-db DIR [...] --out DIR
                                                 write URDF, SRDF, controller config and manifest
+  model show [--json]                           the live robot model: version, modules, chains, joints
   help                                          this text
 
 common options: --domain N (DDS domain id; default: CONCERT_DOMAIN_ID or 0)
@@ -45,6 +51,7 @@ int main(int argc, char** argv) {
   const std::vector<std::string> rest(args.begin() + 1, args.end());
   try {
     if (verb == "topic") return concert::cli::run_topic(rest, std::cout, std::cerr);
+    if (verb == "scan") return concert::cli::run_scan(rest, std::cout, std::cerr);
 #ifdef CONCERT_HAVE_DISCOVERY_CLI
     if (verb == "discover") return concert::discovery::cli_main(rest, std::cout, std::cerr);
 #endif
