@@ -1,7 +1,8 @@
 // concert_robot: the robot service (XBot2's role). Simulated hardware by default.
 //   concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE]
 //                 [--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK]
-//                 [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...]
+//                 [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...] [--params FILE]
+// --params: YAML with sections robot, sim, loop, node (config/robot.yaml); flags override it.
 // The assembly and world files are watched: edit them (hot swap, new walls) while it runs
 // and the simulated bus publishes the new scan. See services/robot/README.md.
 #include <sys/stat.h>
@@ -21,6 +22,7 @@
 
 #include "concert/dds/participant.hpp"
 #include "robot_node.hpp"
+#include "robot_params.hpp"
 #include "robot/loop.hpp"
 #include "robot/robot_core.hpp"
 #include "robot/sim_assembly.hpp"
@@ -30,7 +32,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE] "
-    "[--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK] [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...]";
+    "[--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK] [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...] [--params FILE]";
 
 struct Options {
   std::string backend{"sim"};
@@ -44,6 +46,7 @@ struct Options {
   bool standalone{false};
   int fifo{0};
   std::map<std::string, std::string> packages;
+  std::string params;
 };
 
 std::atomic<concert::robot::Loop*> g_loop{nullptr};
@@ -100,6 +103,8 @@ Options parse(int argc, char** argv) {
       o.ee_frame = value();
     } else if (arg == "--standalone") {
       o.standalone = true;
+    } else if (arg == "--params") {
+      o.params = value();
     } else if (arg == "--package") {
       const std::string v = value();
       const auto eq = v.find('=');
@@ -171,7 +176,9 @@ int main(int argc, char** argv) {
       simulated.source = options.urdf;
     }
     const robot::World world = options.world.empty() ? robot::World{} : robot::load_world_file(options.world);
-    robot::SimParams sim_params;
+    robot::dds::ServiceParams service = options.params.empty() ? robot::dds::ServiceParams{}
+                                                                : robot::dds::load_service_params(options.params);
+    robot::SimParams& sim_params = service.sim;
     // Collision meshes: package://NAME/... resolves to a module-database folder named NAME.
     for (const auto& db : options.module_dbs) {
       sim_params.package_paths[std::filesystem::absolute(db).lexically_normal().filename().string()] =
@@ -181,12 +188,14 @@ int main(int argc, char** argv) {
       sim_params.package_paths[name] = dir;
     }
     robot::SimHardware sim(simulated.urdf, world, sim_params);
-    robot::RobotParams params;
-    params.end_effector_frame = options.ee_frame;
+    robot::RobotParams& params = service.robot;
+    if (!options.ee_frame.empty()) {
+      params.end_effector_frame = options.ee_frame;
+    }
     robot::RobotCore core(sim, params);
 
     concert::dds::Participant participant({.name = "robot"});
-    robot::dds::RobotNode node(participant, core);
+    robot::dds::RobotNode node(participant, core, service.node);
     if (!options.assembly.empty()) {
       node.publish_scan(simulated.scan, "sim");
     }
@@ -194,9 +203,13 @@ int main(int argc, char** argv) {
       node.apply_model(simulated.urdf, 1, options.ee_frame);
     }
 
-    robot::LoopParams loop_params;
-    loop_params.real_time = !options.fast;
-    loop_params.fifo_priority = options.fifo;
+    robot::LoopParams& loop_params = service.loop;
+    if (options.fast) {
+      loop_params.real_time = false;
+    }
+    if (options.fifo > 0) {
+      loop_params.fifo_priority = options.fifo;
+    }
     auto watched = options.assembly.empty() ? std::nullopt : mtime(options.assembly);
     auto world_watched = options.world.empty() ? std::nullopt : mtime(options.world);
     std::uint64_t ticks = 0;

@@ -7,6 +7,7 @@
 #include "concert/dds/endpoint.hpp"
 #include "robot_conversions.hpp"
 #include "robot_node.hpp"
+#include "robot_params.hpp"
 #include "test_helpers.hpp"
 
 namespace concert::robot {
@@ -175,6 +176,46 @@ TEST(RobotConversions, CartesianAdmittanceAxisIsTheTcpAxisInTheWorld) {
   pose.orientation(q);
   c.target(pose);
   EXPECT_THROW((void)dds::to_core(c), CommandError);
+}
+
+TEST(RobotParamsYaml, ExampleConfigHasTheDefaults) {
+  const dds::ServiceParams p = dds::load_service_params(std::string(CONCERT_SOURCE_DIR) + "/services/robot/config/robot.yaml");
+  const dds::ServiceParams d;
+  EXPECT_DOUBLE_EQ(p.robot.period, d.robot.period);
+  EXPECT_DOUBLE_EQ(p.sim.position_stiffness, d.sim.position_stiffness);
+  EXPECT_DOUBLE_EQ(p.sim.armature, d.sim.armature);
+  EXPECT_EQ(p.loop.real_time, d.loop.real_time);
+  EXPECT_EQ(p.node.odometry_decimation, d.node.odometry_decimation);
+  EXPECT_TRUE(p.sim.base_position.isZero());
+}
+
+TEST(RobotParamsYaml, ValuesAndClearErrors) {
+  const dds::ServiceParams p = dds::parse_service_params(
+      "robot: {period: 0.002, end_effector_frame: tcp_E}\n"
+      "sim: {initial_positions: {J2_A: 0.3}, floating_base: false, base_position: [1, 2, 0.5]}\n"
+      "loop: {real_time: false}\n",
+      "p.yaml");
+  EXPECT_DOUBLE_EQ(p.robot.period, 0.002);
+  EXPECT_DOUBLE_EQ(p.loop.period, 0.002);
+  EXPECT_EQ(p.robot.end_effector_frame, "tcp_E");
+  EXPECT_DOUBLE_EQ(p.sim.initial_positions.at("J2_A"), 0.3);
+  EXPECT_EQ(p.sim.floating_base, std::optional<bool>(false));
+  EXPECT_TRUE(p.sim.base_position.isApprox(Eigen::Vector3d(1, 2, 0.5)));
+  EXPECT_FALSE(p.loop.real_time);
+  auto error_of = [](const std::string& yaml) {
+    try {
+      (void)dds::parse_service_params(yaml, "p.yaml");
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_of("robot: {perod: 1}").find("robot.perod: unknown key"), std::string::npos);
+  EXPECT_NE(error_of("sim: {armature: heavy}").find("sim.armature: wrong type"), std::string::npos);
+  EXPECT_NE(error_of("sim: {base_position: [1, 2]}").find("sim.base_position"), std::string::npos);
+  EXPECT_NE(error_of("drives: {}").find("unknown section 'drives'"), std::string::npos);
+  EXPECT_NE(error_of("robot: {period: 0}").find("positive"), std::string::npos);
+  EXPECT_NE(error_of("robot: [").find("p.yaml"), std::string::npos);
 }
 
 }  // namespace

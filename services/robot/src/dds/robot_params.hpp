@@ -1,0 +1,25 @@
+#pragma once
+// The service's parameters from one YAML file (sections robot, sim, loop, node); see README.
+
+#include <string>
+
+#include "robot/loop.hpp"
+#include "robot/robot_core.hpp"
+#include "robot/sim_hardware.hpp"
+#include "robot_node.hpp"
+
+namespace concert::robot::dds {
+
+struct ServiceParams {
+  RobotParams robot;
+  SimParams sim;
+  LoopParams loop;
+  NodeParams node;
+};
+
+/// Parses parameters YAML; unknown sections/keys and wrong types are errors naming `source`
+/// and the key (std::runtime_error). Missing keys keep their defaults.
+ServiceParams parse_service_params(const std::string& yaml_text, const std::string& source);
+ServiceParams load_service_params(const std::string& path);
+
+}  // namespace concert::robot::dds
