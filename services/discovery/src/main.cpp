@@ -37,16 +37,23 @@ void load_params(const std::string& file, Settings& settings) {
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(file + ": " + e.what());
   }
+  if (!root.IsMap()) throw std::runtime_error(file + ": expected a mapping");
   if (const auto dbs = root["module_db"]) {
     if (dbs.IsScalar()) {
       settings.module_dbs.push_back(dbs.Scalar());
     } else if (dbs.IsSequence()) {
-      for (const auto& db : dbs) settings.module_dbs.push_back(db.as<std::string>());
+      for (const auto& db : dbs) {
+        if (!db.IsScalar()) throw std::runtime_error(file + ": module_db: expected folder names");
+        settings.module_dbs.push_back(db.Scalar());
+      }
     } else {
       throw std::runtime_error(file + ": module_db: expected a folder or a list of folders");
     }
   }
-  if (const auto order = root["port_order"]) settings.port_order = order.as<std::string>();
+  if (const auto order = root["port_order"]) {
+    if (!order.IsScalar()) throw std::runtime_error(file + ": port_order: expected 0312 or 0123");
+    settings.port_order = order.Scalar();
+  }
 }
 
 }  // namespace

@@ -12,6 +12,8 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include <tuple>
+#include <vector>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/simbus/assembly.hpp"
@@ -96,6 +98,51 @@ TEST(DiscoveryProcess, ScansInTreesAndStatusOutCleanStop) {
             std::string::npos)
       << text.str();
   std::filesystem::remove(log);
+}
+
+/// Runs the binary with `args`; returns (exit status, stderr).
+std::pair<int, std::string> run_binary(std::vector<std::string> args) {
+  const auto log = std::filesystem::temp_directory_path() /
+                   ("concert_discovery_args_" + std::to_string(getpid()) + ".log");
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::string binary = DISCOVERY_BINARY;
+  std::vector<char*> argv{binary.data()};
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, binary.c_str(), &actions, nullptr, argv.data(), environ) != 0) return {-1, ""};
+  posix_spawn_file_actions_destroy(&actions);
+  const int status = wait_exit(pid, 15s);
+  std::ifstream in(log);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::filesystem::remove(log);
+  return {status, text.str()};
+}
+
+TEST(DiscoveryProcess, BadArgumentsExitNonZeroWithOneLine) {
+  auto [status, err] = run_binary({"--port-order", "9"});
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(err.find("concert_discovery: port order '9': expected 0312 or 0123"), std::string::npos)
+      << err;
+  std::tie(status, err) = run_binary({"--module-db", "/nonexistent/db"});
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(err.find("/nonexistent/db: module database folder not found"), std::string::npos)
+      << err;
+  const auto params = std::filesystem::temp_directory_path() /
+                      ("concert_discovery_params_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(params) << "port_order: [1]\n";
+  std::tie(status, err) = run_binary({"--params", params.string()});
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(err.find(params.string() + ": port_order: expected 0312 or 0123"), std::string::npos)
+      << err;
+  std::filesystem::remove(params);
+  std::tie(status, err) = run_binary({"--bogus"});
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(err.find("unknown argument '--bogus'"), std::string::npos) << err;
 }
 
 }  // namespace
