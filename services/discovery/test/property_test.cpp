@@ -61,6 +61,22 @@ TEST(Property, PublicCatalogue) {
                     1000, 30, 0.6);
 }
 
+TEST(Property, CatalogueBuiltEntryByEntry) {
+  // No YAML at all: a joint, a cross-point hub and a tool, added in code.
+  EscCatalog catalog;
+  const auto add = [&](topology::EscIdentity id, const char* key, topology::ModuleKind kind) {
+    topology::EscType t;
+    t.identity = id;
+    t.key = key;
+    t.kind = kind;
+    catalog.add(t);
+  };
+  add({1, 10, 0, 0}, "j", topology::ModuleKind::kJoint);
+  add({2, 10, 0, 0}, "h", topology::ModuleKind::kHub);
+  add({3, 10, 0, 0}, "t", topology::ModuleKind::kEndEffector);
+  check_round_trips(catalog, 6, 500, 60, 0.5);
+}
+
 TEST(Property, VeryLongChain) {
   // 5000 modules, almost a single chain: no recursion in bus, tree or discovery.
   const EscCatalog catalog = simbus::synthetic_catalog();
