@@ -221,6 +221,10 @@ TEST(Errors, TreesThatCannotBeModelled) {
   EXPECT_EQ(error_of([&] { gen.generate(unknown); }),
             "module 1 at slave 3: unknown ESC identity (mod_type 1, mod_id 99, mod_size 4, mod_rev 0)");
   EXPECT_EQ(error_of([&] { gen.generate(topology::ModuleTree{}); }), "module tree is empty");
+  // A key unknown here but an identity known: the identity names the module.
+  topology::ModuleTree foreign = make_tree({{"mobile_platform_concert", -1, -1}, {"their_elbow_a", 0, 5}});
+  foreign.modules[1].identity = {1, 6, 4, 0};
+  EXPECT_EQ(gen.generate(foreign).modules[1], "module_joint_elbow_A_concert");
 }
 
 TEST(Versioning, StrictlyIncreasingAndUnchangedContentIsNotRepublished) {

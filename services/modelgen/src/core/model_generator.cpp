@@ -429,6 +429,9 @@ const ModuleDescription& ModelGenerator::describe(const topology::ModuleNode& no
   const ModuleDescription* d = nullptr;
   if (!node.key.empty()) {
     d = db_.find(node.key);
+    // A key from another database's index (e.g. discovery ran on the public index): the ESC
+    // identity still names the module type.
+    if (d == nullptr && node.identity != topology::EscIdentity{}) d = db_.find_by_identity(node.identity);
     if (d == nullptr) {
       throw ModelError(module_label(node, node.index) + ": no module description with key '" + node.key + "' in the module database");
     }
