@@ -1,12 +1,15 @@
 // assembly -> simulated scan -> discovery -> model equals assembly -> model directly.
 
 #include <filesystem>
+#include <random>
 
 #include <gtest/gtest.h>
+#include <urdf_parser/urdf_parser.h>
 
 #include "concert/simbus/assembly.hpp"
 #include "discovery/discovery.hpp"
 #include "modelgen/model_generator.hpp"
+#include "test_support.hpp"
 
 namespace fs = std::filesystem;
 using namespace concert;
@@ -76,4 +79,53 @@ TEST(RoundTrip, ProjectDatabaseRobots) {
 )";
   expect_round_trip(d, simbus::parse_assembly(morphology_b, "morphology_b"), "morphology B");
   expect_round_trip(d, simbus::parse_assembly(torso, "torso"), "torso");
+}
+
+TEST(RoundTrip, RandomRobotsOfTheProjectDatabase) {
+  // Property: for seeded random robots built from every module with an ESC, the discovered tree
+  // gives the same model as the assembly, and every end-effector's URDF FK equals eq. (1)-(2).
+  const Db d(fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db");
+  std::vector<std::string> keys;
+  for (const auto& e : d.catalog.entries()) {
+    if (e.key != "concert_mobile_base_hub") keys.push_back(e.key);
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::mt19937 rng(20240611u);
+  for (int robot = 0; robot < 40; ++robot) {
+    simbus::Assembly a;
+    a.modules.push_back({"m0", "concert_mobile_base_hub", "", 0, {}});
+    std::vector<std::pair<std::string, int>> free{{"m0", 1}, {"m0", 2}, {"m0", 3}, {"m0", 4}, {"m0", 5}};
+    const int size = std::uniform_int_distribution<int>(2, 30)(rng);
+    while (static_cast<int>(a.modules.size()) < size && !free.empty()) {
+      const size_t slot = std::uniform_int_distribution<size_t>(0, free.size() - 1)(rng);
+      const auto [parent, connector] = free[slot];
+      free.erase(free.begin() + static_cast<long>(slot));
+      const std::string key = keys[std::uniform_int_distribution<size_t>(0, keys.size() - 1)(rng)];
+      const std::string name = "m" + std::to_string(a.modules.size());
+      a.modules.push_back({name, key, parent, connector, {}});
+      const size_t outputs = d.db.at(key).output_connectors().size();
+      for (size_t c = 1; c <= outputs; ++c) free.emplace_back(name, static_cast<int>(c));
+    }
+    const std::string what = "robot " + std::to_string(robot) + ":\n" + simbus::assembly_to_yaml(a);
+    expect_round_trip(d, a, what);
+    const topology::ModuleTree tree = simbus::tree_from_assembly(a, d.catalog);
+    const modelgen::RobotModel model = modelgen::ModelGenerator(d.db).generate(tree);
+    const auto u = urdf::parseURDF(model.urdf);
+    ASSERT_TRUE(u) << what;
+    std::map<std::string, double> qn;
+    std::map<int, std::map<int, double>> qm;
+    for (const modelgen::PhysicalJoint& j : model.tree.joints) {
+      if (j.description == nullptr) continue;
+      const double v = std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+      qn[j.name] = v;
+      qm[j.module][static_cast<int>(j.description - d.db.at(model.modules[static_cast<size_t>(j.module)]).joints.data())] = v;
+    }
+    for (const modelgen::EndEffectorInfo& e : model.end_effectors) {
+      const Eigen::Isometry3d x = modelgen::test::urdf_fk(*u, e.frame, qn);
+      const Eigen::Isometry3d y = modelgen::test::description_fk(d.db, tree, e.module, 0, qm);
+      ASSERT_LT((x.translation() - y.translation()).norm(), 1e-9) << e.frame << "\n" << what;
+      ASSERT_LT((x.linear() - y.linear()).norm(), 1e-9) << e.frame << "\n" << what;
+    }
+  }
 }
