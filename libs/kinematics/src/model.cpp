@@ -262,6 +262,68 @@ Eigen::MatrixXd Model::mass_matrix(Data& data, const Eigen::VectorXd& q) const {
   return m;
 }
 
+IkResult Model::inverse_kinematics(Data& data, std::string_view frame, const Eigen::Isometry3d& target,
+                                   const Eigen::VectorXd& seed, const IkOptions& options) const {
+  check_size(*impl_, seed, "seed");
+  check_frame(*impl_, frame);
+  std::vector<int> joints = options.joints;
+  if (joints.empty()) {
+    for (int j = 0; j < dof(); ++j) {
+      const auto sub = subtree_links(j);
+      if (std::find(sub.begin(), sub.end(), std::string(frame)) != sub.end()) {
+        joints.push_back(j);
+      }
+    }
+  }
+  for (int j : joints) {
+    if (j < 0 || j >= dof()) {
+      throw ModelError("model '" + impl_->name + "': IK joint index " + std::to_string(j) + " out of range");
+    }
+  }
+  const int rows = options.position_only ? 3 : 6;
+  const auto m = static_cast<Eigen::Index>(joints.size());
+  IkResult result;
+  result.q = seed;
+  for (result.iterations = 0; result.iterations <= options.max_iterations; ++result.iterations) {
+    const Eigen::Isometry3d pose = frame_pose(data, result.q, frame);
+    Eigen::Matrix<double, 6, 1> error;
+    error.head<3>() = target.translation() - pose.translation();
+    const Eigen::AngleAxisd rot(target.linear() * pose.linear().transpose());
+    error.tail<3>() = rot.angle() * rot.axis();
+    result.position_error = error.head<3>().norm();
+    result.orientation_error = options.position_only ? 0.0 : error.tail<3>().norm();
+    if (result.position_error <= options.position_tolerance &&
+        result.orientation_error <= options.orientation_tolerance) {
+      result.converged = true;
+      break;
+    }
+    if (result.iterations == options.max_iterations || m == 0) {
+      break;
+    }
+    const Eigen::MatrixXd full = frame_jacobian(data, result.q, frame);
+    Eigen::MatrixXd jac(rows, m);
+    for (Eigen::Index k = 0; k < m; ++k) {
+      jac.col(k) = full.col(joints[static_cast<std::size_t>(k)]).head(rows);
+    }
+    const Eigen::MatrixXd jjt = jac * jac.transpose() +
+                                options.damping * options.damping * Eigen::MatrixXd::Identity(rows, rows);
+    Eigen::VectorXd step = jac.transpose() * jjt.ldlt().solve(error.head(rows));
+    const double largest = step.cwiseAbs().maxCoeff();
+    if (largest > options.max_step) {
+      step *= options.max_step / largest;
+    }
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const int j = joints[static_cast<std::size_t>(k)];
+      const auto& lim = impl_->kdl.joint_limits[static_cast<std::size_t>(j)];
+      result.q(j) += step(k);
+      if (lim.has_position_limits) {
+        result.q(j) = std::clamp(result.q(j), lim.lower, lim.upper);
+      }
+    }
+  }
+  return result;
+}
+
 Data::Data(std::shared_ptr<const Model::Impl> model) : impl_(std::make_unique<Impl>(std::move(model))) {}
 Data::Data(Data&&) noexcept = default;
 Data& Data::operator=(Data&&) noexcept = default;

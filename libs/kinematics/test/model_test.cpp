@@ -230,6 +230,56 @@ TEST(KinematicsModel, DataPerThreadGivesSameResults) {
   EXPECT_EQ(mismatches[0] + mismatches[1], 0);
 }
 
+TEST(KinematicsModel, InverseKinematicsReachesPosesFromFk) {
+  const Model m = mobile_drill(false);
+  Data d = m.make_data();
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-0.8, 0.8);
+  IkOptions options;
+  for (const std::string j : {"J1_A", "J2_A", "J3_A", "J4_B", "J5_B", "J6_B"}) {
+    options.joints.push_back(m.joint_index_or_throw(j));
+  }
+  int converged = 0;
+  for (int k = 0; k < 20; ++k) {
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(m.dof());
+    for (int j : options.joints) {
+      q(j) = u(rng);
+    }
+    const Eigen::Isometry3d target = m.frame_pose(d, q, "tcp");
+    Eigen::VectorXd seed = q;
+    for (int j : options.joints) {
+      seed(j) += 0.3 * u(rng);
+    }
+    const IkResult r = m.inverse_kinematics(d, "tcp", target, seed, options);
+    if (r.converged) {
+      ++converged;
+      const Eigen::Isometry3d reached = m.frame_pose(d, r.q, "tcp");
+      EXPECT_LT((reached.translation() - target.translation()).norm(), 1e-6);
+      EXPECT_LT(rotation_difference(reached.linear(), target.linear()).norm(), 1e-6);
+      for (int j = 0; j < m.dof(); ++j) {
+        if (std::find(options.joints.begin(), options.joints.end(), j) == options.joints.end()) {
+          EXPECT_EQ(r.q(j), 0.0);  // legs untouched
+        }
+      }
+    }
+  }
+  EXPECT_GE(converged, 18);
+  // Out of reach: not converged, error reported.
+  Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
+  far.translation() << 5.0, 0.0, 1.0;
+  const IkResult r = m.inverse_kinematics(d, "tcp", far, Eigen::VectorXd::Zero(m.dof()), options);
+  EXPECT_FALSE(r.converged);
+  EXPECT_GT(r.position_error, 2.0);
+  // Default joint set: the chain moving the frame (arm joints, not the legs).
+  options.joints.clear();
+  options.position_only = true;
+  Eigen::Isometry3d near = m.frame_pose(d, Eigen::VectorXd::Zero(m.dof()), "tcp");
+  near.translation() += Eigen::Vector3d(0.1, 0.1, -0.2);
+  const IkResult p = m.inverse_kinematics(d, "tcp", near, Eigen::VectorXd::Zero(m.dof()), options);
+  EXPECT_TRUE(p.converged);
+  EXPECT_EQ(p.q(m.joint_index_or_throw("J_wheel_fl")), 0.0);
+}
+
 TEST(KinematicsModel, ClearErrors) {
   EXPECT_THROW(Model::from_urdf_string("<robot name='x'><link name='a'/>"), ModelError);
   try {

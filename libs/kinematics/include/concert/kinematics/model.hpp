@@ -45,6 +45,28 @@ struct ModelOptions {
 
 class Data;
 
+/// Options of Model::inverse_kinematics.
+struct IkOptions {
+  int max_iterations{200};
+  double position_tolerance{1e-6};     ///< [m]
+  double orientation_tolerance{1e-6};  ///< [rad]
+  double damping{1e-3};                ///< damped least squares lambda [-]
+  double max_step{0.2};                ///< largest joint change per iteration [rad] or [m]
+  bool position_only{false};           ///< ignore the orientation
+  /// Joints the solver may move (indices in q); empty: every joint moving the frame
+  /// (virtual planar-base joints included).
+  std::vector<int> joints;
+};
+
+/// Outcome of Model::inverse_kinematics.
+struct IkResult {
+  Eigen::VectorXd q;            ///< best joint positions found (within position limits)
+  bool converged{false};
+  int iterations{0};
+  double position_error{0.0};     ///< [m]
+  double orientation_error{0.0};  ///< [rad]
+};
+
 /// Immutable kinematic/dynamic model of a robot tree, built from URDF through orocos-kdl.
 ///
 /// Joint order: virtual base joints (if any), then the URDF's movable joints in depth-first
@@ -117,6 +139,11 @@ class Model {
   [[nodiscard]] Eigen::VectorXd inverse_dynamics(
       Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
       const std::map<std::string, Eigen::Matrix<double, 6, 1>>& external_wrenches = {}) const;
+  /// Pose of `frame` reaching `target` (world frame) from `seed`, by damped least squares on
+  /// the frame Jacobian with position limits respected. Never throws for unreachable
+  /// targets: check IkResult::converged.
+  [[nodiscard]] IkResult inverse_kinematics(Data& data, std::string_view frame, const Eigen::Isometry3d& target,
+                                            const Eigen::VectorXd& seed, const IkOptions& options = {}) const;
   /// Joint-space inertia matrix M(q) (dof x dof) [kg m^2], from dof RNE passes.
   [[nodiscard]] Eigen::MatrixXd mass_matrix(Data& data, const Eigen::VectorXd& q) const;
 
