@@ -41,6 +41,14 @@ TEST(RoundTrip, PublicDatabaseExampleAssemblies) {
   for (const char* file : {"concert_paper_robot.yaml", "concert_torso_two_arms.yaml"}) {
     expect_round_trip(d, simbus::load_assembly(fs::path(SIMBUS_EXAMPLES) / file), file);
   }
+  // The Mobile Base Hub's two ESCs are one module and one body.
+  const simbus::Assembly paper = simbus::load_assembly(fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml");
+  const topology::ModuleTree tree = discovery::discover(simbus::simulate_scan(paper, d.catalog), d.catalog);
+  ASSERT_EQ(tree.modules[0].slave_positions.size(), 2u);
+  const modelgen::RobotModel model = modelgen::ModelGenerator(d.db).generate(tree);
+  int base_bodies = 0;
+  for (const modelgen::PhysicalBody& b : model.tree.bodies) base_bodies += b.module == 0 ? 1 : 0;
+  EXPECT_EQ(base_bodies, 1);
 }
 
 TEST(RoundTrip, ProjectDatabaseRobots) {
