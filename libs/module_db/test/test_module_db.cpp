@@ -282,3 +282,30 @@ TEST(OwnDatabase, DiscoveryCatalogueReadsOurEscIndex) {
     EXPECT_EQ(static_cast<size_t>(layout.outputs()), m->output_connectors().size()) << entry.key;
   }
 }
+
+TEST(EscIndexFile, ProjectExtensionsAndErrors) {
+  const fs::path dir = scratch("esc_index");
+  std::ofstream(dir / "esc_index.yaml") << R"(modules:
+  - {mod_type: 2, mod_id: 9, mod_size: 4, mod_rev: 1, file: modules/hub3.yaml, key: my_hub, outputs: 3, project_assigned: true,
+     ports: [{port: 3, leads_to: 1}, {port: 1, leads_to: 2}, {port: 2, leads_to: 3}]}
+  - {mod_type: 1, mod_id: 6, mod_size: 4, mod_rev: 0, file: modules/elbow.yaml}
+module_ports:
+  - {mod_type: 2, mod_id: 9, port: 2, leads_to: hub_board}
+)";
+  const EscIndex index = load_esc_index(dir / "esc_index.yaml");
+  ASSERT_EQ(index.modules.size(), 2u);
+  EXPECT_EQ(index.modules[0].key, "my_hub");
+  EXPECT_EQ(index.modules[0].outputs, 3);
+  EXPECT_TRUE(index.modules[0].project_assigned);
+  EXPECT_EQ(index.modules[1].key, "elbow");
+  EXPECT_FALSE(index.modules[1].project_assigned);
+  ASSERT_EQ(index.ports.size(), 4u);
+  EXPECT_EQ(index.ports[0].port, 3);
+  EXPECT_EQ(index.ports[0].leads_to, "1");
+  EXPECT_EQ(index.ports[3].leads_to, "hub_board");
+  std::ofstream(dir / "bad_index.yaml") << "modules:\n  - {mod_type: 1, mod_size: 4, mod_rev: 0, file: x.yaml}\n";
+  EXPECT_EQ(error_of([&] { load_esc_index(dir / "bad_index.yaml"); }), "bad_index.yaml: modules[0].mod_id: missing");
+  std::ofstream(dir / "bad_port.yaml") << "modules: []\nmobile_base_ports:\n  - {mod_type: 2, mod_id: 3, port: 7, leads_to: 1}\n";
+  EXPECT_EQ(error_of([&] { load_esc_index(dir / "bad_port.yaml"); }), "bad_port.yaml: mobile_base_ports[0].port: must be 0..3");
+  fs::remove_all(dir);
+}
