@@ -315,3 +315,35 @@ TEST(Bundle, WritesFilesAndManifest) {
   EXPECT_TRUE(urdf::parseURDFFile((dir / "bundle" / "robot.urdf").string()));
   fs::remove_all(dir);
 }
+
+TEST(Customisation, PassiveGripperWithoutEscIsMountedByHand) {
+  // The network cannot see a passive gripper: the discovered tree lacks it, and the user adds
+  // it as a customisation. The result equals the model of the full 18-module tree.
+  const auto& db = public_db();
+  const ModelGenerator gen(db);
+  std::vector<Row> rows = test::public_eighteen_module_robot();
+  const RobotModel full = gen.generate(make_tree(rows, &db));
+  rows.pop_back();
+  const topology::ModuleTree seen = make_tree(rows, &db);
+  for (const char* where : {"E", "L_6_E"}) {
+    Customisation custom;
+    custom.addons.push_back({where, "passive_end_effector_panel"});
+    const RobotModel mounted = gen.generate(seen, custom);
+    EXPECT_EQ(mounted.urdf, full.urdf) << where;
+    EXPECT_EQ(mounted.srdf, full.srdf) << where;
+    EXPECT_EQ(mounted.content_hash, full.content_hash) << where;
+  }
+  Customisation busy;
+  busy.addons.push_back({"L_5_E", "passive_end_effector_panel"});
+  EXPECT_EQ(error_of([&] { gen.generate(seen, busy); }),
+            "customisation addons[0]: module 'module_joint_elbow_B_concert' (L_5_E) has no free output connector for "
+            "'passive_end_effector_panel'");
+  Customisation nowhere;
+  nowhere.addons.push_back({"Z", "passive_end_effector_panel"});
+  EXPECT_EQ(error_of([&] { gen.generate(seen, nowhere); }),
+            "customisation addons[0].module_name: no body or chain 'Z' to mount 'passive_end_effector_panel' on");
+  Customisation discovered;
+  discovered.addons.push_back({"E", "module_drill_concert"});
+  EXPECT_EQ(error_of([&] { gen.generate(seen, discovered); }),
+            "customisation addons[0]: module 'module_drill_concert' has an ESC and is discovered, not added by hand");
+}

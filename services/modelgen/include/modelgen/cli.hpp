@@ -17,6 +17,8 @@ namespace concert::modelgen {
 /// --module-db accepts either database format; several are merged in order. --assembly goes
 /// through the simulated bus and discovery, as the real pipeline does. The bundle's version is
 /// one more than the version already in DIR, or unchanged when the content hash is the same.
+/// --addon EE=ADDON mounts an add-on on end-effector (or body) EE; with the key of a module
+/// without ESC (passive gripper) it mounts that module on chain/body EE (see ModelGenerator).
 /// Returns 0, or non-zero with a one-line message on `err`.
 ///   show [--timeout S]   prints the live model (version, modules, chains, joints,
 ///                        end-effectors) read from the latched RobotModel topic (CONCERT_DOMAIN_ID).

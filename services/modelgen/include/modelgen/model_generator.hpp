@@ -33,7 +33,10 @@ class ModelGenerator {
   PhysicalTree build_tree(const topology::ModuleTree& tree, const Customisation& custom = {}) const;
 
   /// Builds the whole model (texts, lists, hash); version stays 0. Throws ModelError; the
-  /// caller's current model is not touched.
+  /// caller's current model is not touched. An add-on choice whose `addon` is the key of a
+  /// module without ESC (a passive gripper, which the network cannot see) mounts that module on
+  /// the first free output connector of the module owning body `module_name`, or of the last
+  /// module of chain `module_name` (e.g. "E").
   RobotModel generate(const topology::ModuleTree& tree, const Customisation& custom = {},
                       uint64_t tree_version = 0) const;
 
@@ -42,6 +45,9 @@ class ModelGenerator {
   const module_db::ModuleDescription& describe(const topology::ModuleNode& node) const;
 
   const Params& params() const { return params_; }
+
+  /// `tree` with the passive modules named in `custom.addons` mounted (see generate()).
+  topology::ModuleTree mount_passive_modules(const topology::ModuleTree& tree, const Customisation& custom) const;
 
  private:
   const module_db::ModuleDatabase& db_;

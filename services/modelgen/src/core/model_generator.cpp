@@ -450,10 +450,75 @@ PhysicalTree ModelGenerator::build_tree(const topology::ModuleTree& tree, const 
   return generate(tree, custom).tree;
 }
 
-RobotModel ModelGenerator::generate(const topology::ModuleTree& tree, const Customisation& custom, uint64_t tree_version) const {
+topology::ModuleTree ModelGenerator::mount_passive_modules(const topology::ModuleTree& tree, const Customisation& custom) const {
+  topology::ModuleTree out = tree;
+  bool any = false;
+  for (const AddonChoice& c : custom.addons) {
+    const ModuleDescription* d = db_.find_addon(c.addon) == nullptr ? db_.find(c.addon) : nullptr;
+    if (d != nullptr) any = true;
+  }
+  if (!any) return out;
+  // Names exist only once the tree is built: build it once to resolve module_name.
+  Builder first(*this, tree);
+  first.run();
+  for (size_t i = 0; i < custom.addons.size(); ++i) {
+    const AddonChoice& c = custom.addons[i];
+    if (db_.find_addon(c.addon) != nullptr) continue;
+    const ModuleDescription* d = db_.find(c.addon);
+    const std::string where = "customisation addons[" + std::to_string(i) + "]";
+    if (d == nullptr) continue;  // reported as an unknown add-on later
+    if (d->esc) throw ModelError(where + ": module '" + c.addon + "' has an ESC and is discovered, not added by hand");
+    int parent = -1;
+    const int b = first.phi.body_index(c.module_name);
+    if (b >= 0) {
+      parent = first.phi.bodies[static_cast<size_t>(b)].module;
+    } else {
+      for (const ChainRecord& ch : first.chains) {
+        if (ch.info.name == c.module_name && !ch.info.modules.empty()) parent = ch.info.modules.back();
+      }
+    }
+    if (parent < 0) throw ModelError(where + ".module_name: no body or chain '" + c.module_name + "' to mount '" + c.addon + "' on");
+    const ModuleDescription& pd = *first.desc_[static_cast<size_t>(parent)];
+    std::set<int> used;
+    for (const auto& n : out.modules) {
+      if (n.parent_module == parent) used.insert(n.parent_connector);
+    }
+    int connector = 0;
+    for (int k = 1; k <= static_cast<int>(pd.output_connectors().size()); ++k) {
+      if (!used.count(k)) {
+        connector = k;
+        break;
+      }
+    }
+    if (connector == 0) {
+      throw ModelError(where + ": module '" + pd.key + "' (" + c.module_name + ") has no free output connector for '" + c.addon + "'");
+    }
+    topology::ModuleNode n;
+    n.index = static_cast<int32_t>(out.modules.size());
+    n.key = d->key;
+    n.kind = topology::ModuleKind::kEndEffector;
+    n.parent_module = parent;
+    n.parent_connector = connector;
+    out.modules.push_back(std::move(n));
+  }
+  return out;
+}
+
+RobotModel ModelGenerator::generate(const topology::ModuleTree& input_tree, const Customisation& input_custom,
+                                    uint64_t tree_version) const {
+  // Passive modules without ESC (passive grippers) named in the add-ons are mounted first; the
+  // remaining add-ons are applied to the built tree.
+  const topology::ModuleTree tree = mount_passive_modules(input_tree, input_custom);
+  Customisation custom_addons = input_custom;
+  custom_addons.addons.clear();
+  for (const AddonChoice& c : input_custom.addons) {
+    const ModuleDescription* d = db_.find_addon(c.addon) == nullptr ? db_.find(c.addon) : nullptr;
+    if (d == nullptr) custom_addons.addons.push_back(c);
+  }
+  const Customisation& custom = input_custom;
   Builder b(*this, tree);
   b.run();
-  apply_addons(db_, custom, b.phi, b.ees, b.desc_);
+  apply_addons(db_, custom_addons, b.phi, b.ees, b.desc_);
   RobotModel model;
   model.tree_version = tree_version;
   model.customisation = custom;
