@@ -30,6 +30,7 @@ static const struct {
     {"concert::msg::ServiceStatus", &concert_msg_ServiceStatus_desc},
     {"concert::msg::EStopInput", &concert_msg_EStopInput_desc},
     {"concert::msg::SafetyState", &concert_msg_SafetyState_desc},
+    {"concert::msg::SafetyReset", &concert_msg_SafetyReset_desc},
 };
 
 #define MAX_ENDPOINTS 64

@@ -35,6 +35,8 @@ constexpr std::array kTopics = {
               "buttons, wireless receiver, software: e-stop inputs (one instance per source)"},
     TopicInfo{"concert/safety/state", "concert::msg::SafetyState", QosClass::kLatched,
               "safety: running or stopped, and why"},
+    TopicInfo{"concert/safety/reset", "concert::msg::SafetyReset", QosClass::kCommand,
+              "operator/tools: reset a latched safety stop once every e-stop input is released"},
 };
 
 }  // namespace

@@ -31,6 +31,7 @@ CONCERT_BIND_PUBSUB(EndEffectorWrench);
 CONCERT_BIND_PUBSUB(ServiceStatus);
 CONCERT_BIND_PUBSUB(EStopInput);
 CONCERT_BIND_PUBSUB(SafetyState);
+CONCERT_BIND_PUBSUB(SafetyReset);
 #undef CONCERT_BIND_PUBSUB
 
 /// A catalogue topic carrying T.
@@ -53,6 +54,7 @@ inline constexpr TopicHandle<msg::EndEffectorWrench> ee_wrench{"concert/robot/ee
 inline constexpr TopicHandle<msg::ServiceStatus> status{"concert/system/status"};
 inline constexpr TopicHandle<msg::EStopInput> estop{"concert/safety/estop"};
 inline constexpr TopicHandle<msg::SafetyState> safety_state{"concert/safety/state"};
+inline constexpr TopicHandle<msg::SafetyReset> safety_reset{"concert/safety/reset"};
 }  // namespace topics
 
 /// Calls f(handle) for every typed topic handle (e.g. to dispatch on a topic name).
@@ -70,6 +72,7 @@ template <class F> void for_each_topic(F&& f) {
   f(topics::status);
   f(topics::estop);
   f(topics::safety_state);
+  f(topics::safety_reset);
 }
 
 }  // namespace concert::dds
