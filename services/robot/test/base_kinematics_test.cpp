@@ -5,7 +5,6 @@
 #include <cmath>
 #include <random>
 
-#include "robot/sim_hardware.hpp"
 
 namespace concert::robot {
 namespace {

@@ -37,6 +37,10 @@ struct Odometry {
   double vx{0.0}, vy{0.0}, wz{0.0};    ///< twist in the base frame [m/s, m/s, rad/s]
 };
 
+/// Cylinder collision radius per link of a URDF (first cylinder collision of each link) [m]
+/// (wheel radii for detect_legs). Throws std::invalid_argument if the URDF cannot be parsed.
+std::map<std::string, double> collision_cylinder_radii(const std::string& urdf);
+
 /// Finds the legs of whatever mobile base the model has: a joint with a vertical axis
 /// (in the base frame at q = 0) and no movable ancestor, whose only movable descendant is a
 /// joint with a horizontal axis (the wheel). Wheel radii come from `wheel_radii`

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "robot/base_kinematics.hpp"
 #include "robot/hardware.hpp"
 #include "robot/world.hpp"
 
@@ -42,9 +43,6 @@ struct SimParams {
 /// MJCF text for a URDF placed in a world (exposed for tests and for debugging in MuJoCo's
 /// viewer). Throws HardwareError naming the URDF element that cannot be simulated.
 std::string urdf_to_mjcf(const std::string& urdf, const World& world, const SimParams& params);
-
-/// Cylinder collision radius per link (first cylinder collision of each link) [m].
-std::map<std::string, double> collision_cylinder_radii(const std::string& urdf);
 
 /// The `sim` backend: the robot in MuJoCo. The drives' inner loops (impedance with torque
 /// saturation at the URDF effort limit) run at the physics rate, as real drives do.

@@ -1,6 +1,7 @@
 #include "robot/base_kinematics.hpp"
 
 #include <Eigen/Dense>
+#include <urdf_parser/urdf_parser.h>
 
 #include <cmath>
 #include <stdexcept>
@@ -17,6 +18,25 @@ double wrap(double a) {
 }
 
 }  // namespace
+
+std::map<std::string, double> collision_cylinder_radii(const std::string& urdf) {
+  const auto parsed = urdf::parseURDF(urdf);
+  if (!parsed) {
+    throw std::invalid_argument("collision_cylinder_radii: the URDF could not be parsed");
+  }
+  std::vector<urdf::LinkSharedPtr> links;
+  parsed->getLinks(links);
+  std::map<std::string, double> out;
+  for (const auto& link : links) {
+    for (const auto& c : link->collision_array) {
+      if (c && c->geometry && c->geometry->type == urdf::Geometry::CYLINDER) {
+        out[link->name] = dynamic_cast<const urdf::Cylinder&>(*c->geometry).radius;
+        break;
+      }
+    }
+  }
+  return out;
+}
 
 std::vector<Leg> detect_legs(const kinematics::Model& model, const std::map<std::string, double>& wheel_radii,
                              double default_wheel_radius) {

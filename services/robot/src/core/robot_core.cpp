@@ -7,7 +7,6 @@
 #include <map>
 #include <set>
 
-#include "robot/sim_hardware.hpp"
 
 namespace concert::robot {
 namespace {

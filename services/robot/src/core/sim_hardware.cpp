@@ -272,22 +272,6 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
 
 }  // namespace
 
-std::map<std::string, double> collision_cylinder_radii(const std::string& urdf) {
-  const auto parsed = parse(urdf);
-  std::vector<urdf::LinkSharedPtr> links;
-  parsed->getLinks(links);
-  std::map<std::string, double> out;
-  for (const auto& link : links) {
-    for (const auto& c : link->collision_array) {
-      if (c && c->geometry && c->geometry->type == urdf::Geometry::CYLINDER) {
-        out[link->name] = dynamic_cast<const urdf::Cylinder&>(*c->geometry).radius;
-        break;
-      }
-    }
-  }
-  return out;
-}
-
 std::string urdf_to_mjcf(const std::string& urdf, const World& world, const SimParams& params) {
   return build_mjcf(urdf, world, params).mjcf;
 }
