@@ -1,0 +1,136 @@
+#pragma once
+// The safety layer's logic, free of any middleware: e-stop inputs, liveliness of the robot and
+// task services, and a joint limits watchdog. Any cause stops the robot; the stop is latched
+// until every e-stop input is released AND an explicit reset is accepted.
+//
+// Time is passed in by the caller (steady clock), so the logic is testable without waiting.
+
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "safety/params.hpp"
+
+namespace concert::safety {
+
+using Clock = std::chrono::steady_clock;
+using TimePoint = Clock::time_point;
+
+/// The six e-stop inputs of the CONCERT base (paper section 3): four corner buttons, the
+/// wireless receiver, and a software stop. Same order as msg::EStopSource.
+enum class EStopSource { kButtonFrontLeft, kButtonFrontRight, kButtonRearLeft, kButtonRearRight, kWireless, kSoftware };
+inline constexpr std::size_t kEStopSourceCount = 6;
+
+/// "button front left", ..., "wireless", "software".
+std::string_view to_string(EStopSource source);
+
+/// Limits of one joint from the robot model; infinite limits may be +-1e300 or +-inf.
+struct JointLimits {
+  std::string name;
+  double lower = 0.0;     ///< [rad] (or [m])
+  double upper = 0.0;     ///< [rad] (or [m])
+  double velocity = 0.0;  ///< [rad/s]
+  double effort = 0.0;    ///< [N m]
+};
+
+/// One measured joint state; vectors indexed like `name` (velocity/effort may be empty).
+struct JointSample {
+  uint32_t model_version = 0;
+  std::vector<std::string> name;
+  std::vector<double> position;  ///< [rad]
+  std::vector<double> velocity;  ///< [rad/s]
+  std::vector<double> effort;    ///< [N m]
+};
+
+enum class Mode { kRunning, kStopped };
+
+struct SafetyStatus {
+  Mode mode = Mode::kRunning;
+  /// True while stopped: the stop is latched and needs released inputs plus a reset.
+  bool reset_required = false;
+  /// Why the robot is stopped, oldest first; e.g. "estop: wireless engaged (operator)".
+  std::vector<std::string> causes;
+};
+
+struct ResetOutcome {
+  bool accepted = false;
+  std::string message;  ///< why refused, or what the reset cleared
+};
+
+/// What the limits watchdog did with one joint sample.
+enum class SampleOutcome { kChecked, kNoModel, kOtherModelVersion };
+
+class SafetyMonitor {
+ public:
+  /// `start` is the time the monitor starts watching (for Params::require_robot).
+  SafetyMonitor(Params params, TimePoint start);
+
+  /// An e-stop input changed (or was re-sent). Engaging one stops the robot.
+  void set_estop(EStopSource source, bool engaged, const std::string& reason);
+
+  /// A status/heartbeat of the instance `service`@`host`, received at `now`. `clean_stop`:
+  /// the service said it stops (SERVICE_STOPPED). Services other than the robot and the
+  /// task services are ignored. A task service that stops cleanly is no longer watched; the
+  /// robot service stopping is a stop cause (nothing holds the drives any more).
+  void on_heartbeat(const std::string& service, const std::string& host, bool clean_stop, TimePoint now);
+
+  /// Checks liveliness at `now`: a watched instance silent beyond the bound stops the robot,
+  /// with a cause naming it.
+  void check_liveliness(TimePoint now);
+
+  /// A new robot model: the joint limits the watchdog enforces from now on.
+  void set_model(uint32_t version, std::vector<JointLimits> joints);
+
+  /// Checks a joint sample against the model's limits. Samples of another model version (a
+  /// reconfiguration in flight) are not checked. A malformed sample (vector lengths differ
+  /// from `name`) stops the robot too.
+  SampleOutcome on_joint_state(const JointSample& sample);
+
+  /// Explicit reset of a latched stop. Refused while an e-stop input is engaged, or while the
+  /// robot service is silent. Accepting it forgets silent task services (the operator
+  /// acknowledges them gone; a new heartbeat watches them again) and clears the causes.
+  ResetOutcome reset(const std::string& source, TimePoint now);
+
+  const SafetyStatus& status() const { return status_; }
+  /// Increases every time status() changes.
+  uint64_t revision() const { return revision_; }
+  /// Names of the e-stop inputs engaged now.
+  std::vector<std::string> engaged_inputs() const;
+  /// "service@host" of the watched instances, and whether each is silent now.
+  std::vector<std::pair<std::string, bool>> watched() const;
+  uint32_t model_version() const { return model_version_; }
+  const Params& params() const { return params_; }
+
+ private:
+  struct Instance {
+    std::string service;
+    TimePoint last_seen;
+    bool silent = false;
+  };
+
+  bool is_watched(const std::string& service) const;
+  /// Adds a cause (once per key) and stops.
+  void stop(const std::string& key, const std::string& text);
+  void check_joint(const JointLimits& limits, std::size_t i, const JointSample& sample);
+
+  Params params_;
+  TimePoint start_;
+  std::array<bool, kEStopSourceCount> engaged_{};
+  std::map<std::string, Instance> instances_;  // by "service@host"
+  bool robot_heard_ = false;
+  bool robot_start_cause_ = false;
+  uint32_t model_version_ = 0;
+  std::vector<JointLimits> joints_;
+  std::map<std::string, std::size_t> joint_index_;
+  std::vector<std::string> cause_keys_;
+  SafetyStatus status_;
+  uint64_t revision_ = 0;
+};
+
+}  // namespace concert::safety

@@ -1,0 +1,209 @@
+#include "safety/safety_monitor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace concert::safety {
+namespace {
+
+std::string fixed(double value, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, value);
+  return buf;
+}
+
+std::string seconds(std::chrono::nanoseconds d) {
+  return fixed(std::chrono::duration<double>(d).count(), 2) + " s";
+}
+
+}  // namespace
+
+std::string_view to_string(EStopSource source) {
+  switch (source) {
+    case EStopSource::kButtonFrontLeft: return "button front left";
+    case EStopSource::kButtonFrontRight: return "button front right";
+    case EStopSource::kButtonRearLeft: return "button rear left";
+    case EStopSource::kButtonRearRight: return "button rear right";
+    case EStopSource::kWireless: return "wireless";
+    case EStopSource::kSoftware: return "software";
+  }
+  return "unknown";
+}
+
+SafetyMonitor::SafetyMonitor(Params params, TimePoint start) : params_(std::move(params)), start_(start) {
+  if (params_.liveliness_timeout <= std::chrono::milliseconds::zero()) {
+    throw std::invalid_argument("liveliness_timeout must be positive");
+  }
+}
+
+void SafetyMonitor::stop(const std::string& key, const std::string& text) {
+  const bool known = std::find(cause_keys_.begin(), cause_keys_.end(), key) != cause_keys_.end();
+  if (known && status_.mode == Mode::kStopped) return;
+  if (!known) {
+    cause_keys_.push_back(key);
+    status_.causes.push_back(text);
+  }
+  status_.mode = Mode::kStopped;
+  status_.reset_required = true;
+  ++revision_;
+}
+
+void SafetyMonitor::set_estop(EStopSource source, bool engaged, const std::string& reason) {
+  const auto i = static_cast<std::size_t>(source);
+  if (i >= kEStopSourceCount) throw std::invalid_argument("unknown e-stop source " + std::to_string(i));
+  engaged_[i] = engaged;
+  if (engaged) {
+    std::string text = "estop: " + std::string(to_string(source)) + " engaged";
+    if (!reason.empty()) text += " (" + reason + ")";
+    stop("estop:" + std::string(to_string(source)), text);
+  }
+}
+
+bool SafetyMonitor::is_watched(const std::string& service) const {
+  return service == params_.robot_service ||
+         std::find(params_.task_services.begin(), params_.task_services.end(), service) !=
+             params_.task_services.end();
+}
+
+void SafetyMonitor::on_heartbeat(const std::string& service, const std::string& host, bool clean_stop,
+                                 TimePoint now) {
+  if (!is_watched(service)) return;
+  const std::string who = service + "@" + host;
+  const bool robot = service == params_.robot_service;
+  if (clean_stop) {
+    instances_.erase(who);
+    if (robot) stop("stopped:" + who, "liveliness: " + who + " stopped (nothing holds the drives)");
+    return;
+  }
+  if (robot) robot_heard_ = true;
+  auto [it, inserted] = instances_.try_emplace(who, Instance{service, now, false});
+  if (!inserted) {
+    it->second.last_seen = std::max(it->second.last_seen, now);
+    it->second.silent = false;
+  }
+}
+
+void SafetyMonitor::check_liveliness(TimePoint now) {
+  for (auto& [who, instance] : instances_) {
+    const auto silent_for = now - instance.last_seen;
+    if (instance.silent || silent_for <= params_.liveliness_timeout) continue;
+    instance.silent = true;
+    stop("silent:" + who, "liveliness: " + who + " silent for " + seconds(silent_for) + " (bound " +
+                              seconds(params_.liveliness_timeout) + ")");
+  }
+  if (params_.require_robot && !robot_heard_ && !robot_start_cause_ && now - start_ > params_.liveliness_timeout) {
+    robot_start_cause_ = true;
+    stop("silent:" + params_.robot_service,
+         "liveliness: " + params_.robot_service + " not heard within " + seconds(params_.liveliness_timeout) +
+             " of the start");
+  }
+}
+
+void SafetyMonitor::set_model(uint32_t version, std::vector<JointLimits> joints) {
+  model_version_ = version;
+  joints_ = std::move(joints);
+  joint_index_.clear();
+  for (std::size_t i = 0; i < joints_.size(); ++i) joint_index_[joints_[i].name] = i;
+}
+
+void SafetyMonitor::check_joint(const JointLimits& limits, std::size_t i, const JointSample& sample) {
+  const std::string joint = "joint " + limits.name;
+  const double q = sample.position[i];
+  if (!std::isfinite(q) || q < limits.lower - params_.position_tolerance ||
+      q > limits.upper + params_.position_tolerance) {
+    stop("limits:" + limits.name + ":position",
+         "limits: " + joint + " position " + fixed(q, 3) + " beyond [" + fixed(limits.lower, 3) + ", " +
+             fixed(limits.upper, 3) + "] (model v" + std::to_string(model_version_) + ")");
+  }
+  if (i < sample.velocity.size()) {
+    const double qd = sample.velocity[i];
+    const double bound = limits.velocity * (1.0 + params_.velocity_margin);
+    if (!std::isfinite(qd) || std::abs(qd) > bound) {
+      stop("limits:" + limits.name + ":velocity", "limits: " + joint + " velocity " + fixed(qd, 3) +
+                                                      " beyond +-" + fixed(bound, 3) + " (model v" +
+                                                      std::to_string(model_version_) + ")");
+    }
+  }
+  if (i < sample.effort.size()) {
+    const double tau = sample.effort[i];
+    const double bound = limits.effort * (1.0 + params_.effort_margin);
+    if (!std::isfinite(tau) || std::abs(tau) > bound) {
+      stop("limits:" + limits.name + ":effort", "limits: " + joint + " effort " + fixed(tau, 2) + " beyond +-" +
+                                                    fixed(bound, 2) + " (model v" +
+                                                    std::to_string(model_version_) + ")");
+    }
+  }
+}
+
+SampleOutcome SafetyMonitor::on_joint_state(const JointSample& sample) {
+  if (model_version_ == 0) return SampleOutcome::kNoModel;
+  if (sample.model_version != model_version_) return SampleOutcome::kOtherModelVersion;
+  const std::size_t n = sample.name.size();
+  if (sample.position.size() != n || (!sample.velocity.empty() && sample.velocity.size() != n) ||
+      (!sample.effort.empty() && sample.effort.size() != n)) {
+    stop("limits:malformed", "limits: malformed joint state: " + std::to_string(n) + " names, " +
+                                 std::to_string(sample.position.size()) + " positions, " +
+                                 std::to_string(sample.velocity.size()) + " velocities, " +
+                                 std::to_string(sample.effort.size()) + " efforts");
+    return SampleOutcome::kChecked;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto it = joint_index_.find(sample.name[i]);
+    if (it != joint_index_.end()) check_joint(joints_[it->second], i, sample);
+  }
+  return SampleOutcome::kChecked;
+}
+
+ResetOutcome SafetyMonitor::reset(const std::string& source, TimePoint now) {
+  const auto engaged = engaged_inputs();
+  if (!engaged.empty()) {
+    std::string list;
+    for (const auto& e : engaged) list += (list.empty() ? "" : ", ") + e;
+    return {false, "reset by " + source + " refused: e-stop input(s) still engaged: " + list};
+  }
+  check_liveliness(now);
+  for (const auto& [who, instance] : instances_) {
+    if (instance.silent && instance.service == params_.robot_service) {
+      return {false, "reset by " + source + " refused: the robot service " + who + " is silent"};
+    }
+  }
+  if (params_.require_robot && !robot_heard_) {
+    return {false, "reset by " + source + " refused: the robot service has not been heard"};
+  }
+  if (status_.mode == Mode::kRunning) return {true, "reset by " + source + ": not stopped, nothing to reset"};
+  std::string forgotten;
+  for (auto it = instances_.begin(); it != instances_.end();) {
+    if (it->second.silent) {
+      forgotten += (forgotten.empty() ? "" : ", ") + it->first;
+      it = instances_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  const std::size_t cleared = status_.causes.size();
+  status_ = SafetyStatus{};
+  cause_keys_.clear();
+  robot_start_cause_ = robot_heard_;
+  ++revision_;
+  std::string message = "reset by " + source + " accepted: " + std::to_string(cleared) + " cause(s) cleared";
+  if (!forgotten.empty()) message += "; no longer watching silent " + forgotten;
+  return {true, message};
+}
+
+std::vector<std::string> SafetyMonitor::engaged_inputs() const {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < kEStopSourceCount; ++i) {
+    if (engaged_[i]) out.emplace_back(to_string(static_cast<EStopSource>(i)));
+  }
+  return out;
+}
+
+std::vector<std::pair<std::string, bool>> SafetyMonitor::watched() const {
+  std::vector<std::pair<std::string, bool>> out;
+  for (const auto& [who, instance] : instances_) out.emplace_back(who, instance.silent);
+  return out;
+}
+
+}  // namespace concert::safety

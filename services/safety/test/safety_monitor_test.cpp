@@ -1,0 +1,349 @@
+// Unit tests of the safety core: latching, reset rules, liveliness, limits, params.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <unistd.h>
+
+#include "safety/safety_monitor.hpp"
+
+namespace concert::safety {
+namespace {
+
+using namespace std::chrono_literals;
+
+const TimePoint kT0{std::chrono::seconds(1000)};
+
+bool contains(const std::vector<std::string>& causes, const std::string& text) {
+  for (const auto& c : causes) {
+    if (c.find(text) != std::string::npos) return true;
+  }
+  return false;
+}
+
+TEST(SafetyMonitor, StartsRunningWithNothingWatched) {
+  SafetyMonitor m(Params{}, kT0);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+  EXPECT_FALSE(m.status().reset_required);
+  m.check_liveliness(kT0 + 1h);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+  EXPECT_TRUE(m.watched().empty());
+}
+
+TEST(SafetyMonitor, EveryEStopInputStopsAndNamesItself) {
+  for (std::size_t i = 0; i < kEStopSourceCount; ++i) {
+    const auto source = static_cast<EStopSource>(i);
+    SafetyMonitor m(Params{}, kT0);
+    m.set_estop(source, true, "test");
+    EXPECT_EQ(m.status().mode, Mode::kStopped) << to_string(source);
+    EXPECT_TRUE(m.status().reset_required);
+    ASSERT_EQ(m.status().causes.size(), 1u);
+    EXPECT_EQ(m.status().causes[0], "estop: " + std::string(to_string(source)) + " engaged (test)");
+  }
+}
+
+TEST(SafetyMonitor, StopIsLatchedAfterRelease) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_estop(EStopSource::kWireless, true, "");
+  m.set_estop(EStopSource::kWireless, false, "");
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  EXPECT_TRUE(m.status().reset_required);
+  EXPECT_EQ(m.status().causes, std::vector<std::string>{"estop: wireless engaged"});
+  EXPECT_TRUE(m.engaged_inputs().empty());
+}
+
+TEST(SafetyMonitor, ResetRefusedWhileAnyInputEngaged) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_estop(EStopSource::kButtonFrontLeft, true, "");
+  m.set_estop(EStopSource::kButtonRearRight, true, "");
+  m.set_estop(EStopSource::kButtonFrontLeft, false, "");
+  const auto r = m.reset("operator", kT0);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(r.message.find("still engaged: button rear right"), std::string::npos) << r.message;
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  EXPECT_EQ(m.status().causes.size(), 2u);
+
+  m.set_estop(EStopSource::kButtonRearRight, false, "");
+  const auto ok = m.reset("operator", kT0);
+  EXPECT_TRUE(ok.accepted) << ok.message;
+  EXPECT_NE(ok.message.find("2 cause(s) cleared"), std::string::npos) << ok.message;
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+  EXPECT_FALSE(m.status().reset_required);
+  EXPECT_TRUE(m.status().causes.empty());
+}
+
+TEST(SafetyMonitor, ReleaseAloneNeverRestarts) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_estop(EStopSource::kSoftware, true, "");
+  for (int i = 0; i < 10; ++i) {
+    m.set_estop(EStopSource::kSoftware, false, "");
+    m.check_liveliness(kT0 + std::chrono::seconds(i));
+  }
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+}
+
+TEST(SafetyMonitor, ReEngagingAfterResetStopsAgainAndRevisionMoves) {
+  SafetyMonitor m(Params{}, kT0);
+  const auto r0 = m.revision();
+  m.set_estop(EStopSource::kSoftware, true, "a");
+  const auto r1 = m.revision();
+  EXPECT_GT(r1, r0);
+  m.set_estop(EStopSource::kSoftware, true, "a");  // re-sent: nothing new
+  EXPECT_EQ(m.revision(), r1);
+  m.set_estop(EStopSource::kSoftware, false, "");
+  ASSERT_TRUE(m.reset("op", kT0).accepted);
+  EXPECT_GT(m.revision(), r1);
+  m.set_estop(EStopSource::kSoftware, true, "b");
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  EXPECT_EQ(m.status().causes, std::vector<std::string>{"estop: software engaged (b)"});
+}
+
+TEST(SafetyMonitor, ResetWhileRunningIsHarmless) {
+  SafetyMonitor m(Params{}, kT0);
+  const auto r = m.reset("op", kT0);
+  EXPECT_TRUE(r.accepted);
+  EXPECT_NE(r.message.find("nothing to reset"), std::string::npos);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+}
+
+TEST(SafetyMonitor, SilentTaskServiceStopsNamingIt) {
+  Params p;
+  p.liveliness_timeout = 500ms;
+  SafetyMonitor m(p, kT0);
+  m.on_heartbeat("planner", "manip", false, kT0);
+  m.on_heartbeat("robot", "rt", false, kT0);
+  for (int i = 1; i <= 10; ++i) {  // robot keeps beating, planner goes silent after 0 ms
+    m.on_heartbeat("robot", "rt", false, kT0 + i * 100ms);
+    m.check_liveliness(kT0 + i * 100ms);
+    if (i <= 5) {
+      EXPECT_EQ(m.status().mode, Mode::kRunning) << i;
+    }
+  }
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  ASSERT_EQ(m.status().causes.size(), 1u);
+  EXPECT_EQ(m.status().causes[0], "liveliness: planner@manip silent for 0.60 s (bound 0.50 s)");
+  EXPECT_EQ(m.watched(), (std::vector<std::pair<std::string, bool>>{{"planner@manip", true}, {"robot@rt", false}}));
+}
+
+TEST(SafetyMonitor, UnwatchedServicesAreIgnored) {
+  Params p;
+  p.liveliness_timeout = 100ms;
+  SafetyMonitor m(p, kT0);
+  m.on_heartbeat("modelgen", "rt", false, kT0);
+  m.on_heartbeat("discovery", "rt", false, kT0);
+  m.check_liveliness(kT0 + 10s);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+}
+
+TEST(SafetyMonitor, CleanStopOfATaskIsNotAFaultButOfTheRobotIs) {
+  Params p;
+  p.liveliness_timeout = 100ms;
+  SafetyMonitor m(p, kT0);
+  m.on_heartbeat("drill", "manip", false, kT0);
+  m.on_heartbeat("drill", "manip", true, kT0 + 50ms);
+  m.check_liveliness(kT0 + 10s);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+  m.on_heartbeat("robot", "rt", false, kT0);
+  m.on_heartbeat("robot", "rt", true, kT0 + 50ms);
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  EXPECT_TRUE(contains(m.status().causes, "robot@rt stopped")) << m.status().causes[0];
+}
+
+TEST(SafetyMonitor, SilentRobotBlocksResetSilentTaskIsForgottenByReset) {
+  Params p;
+  p.liveliness_timeout = 100ms;
+  SafetyMonitor m(p, kT0);
+  m.on_heartbeat("robot", "rt", false, kT0);
+  m.on_heartbeat("nav", "navpc", false, kT0);
+  m.check_liveliness(kT0 + 200ms);
+  EXPECT_EQ(m.status().causes.size(), 2u);
+  auto r = m.reset("op", kT0 + 200ms);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(r.message.find("robot service robot@rt is silent"), std::string::npos) << r.message;
+
+  m.on_heartbeat("robot", "rt", false, kT0 + 250ms);  // robot back, nav still gone
+  r = m.reset("op", kT0 + 260ms);
+  EXPECT_TRUE(r.accepted) << r.message;
+  EXPECT_NE(r.message.find("no longer watching silent nav@navpc"), std::string::npos) << r.message;
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+  m.check_liveliness(kT0 + 300ms);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);  // nav forgotten, robot fresh
+
+  m.on_heartbeat("nav", "navpc", false, kT0 + 310ms);  // nav returns: watched again
+  m.on_heartbeat("robot", "rt", false, kT0 + 500ms);
+  m.check_liveliness(kT0 + 500ms);
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  EXPECT_TRUE(contains(m.status().causes, "liveliness: nav@navpc silent"));
+}
+
+TEST(SafetyMonitor, RequiredRobotMustBeHeardAfterStart) {
+  Params p;
+  p.liveliness_timeout = 1s;
+  p.require_robot = true;
+  SafetyMonitor m(p, kT0);
+  m.check_liveliness(kT0 + 900ms);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+  m.check_liveliness(kT0 + 1100ms);
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  EXPECT_EQ(m.status().causes[0], "liveliness: robot not heard within 1.00 s of the start");
+  EXPECT_FALSE(m.reset("op", kT0 + 1200ms).accepted);
+  m.on_heartbeat("robot", "rt", false, kT0 + 1300ms);
+  EXPECT_TRUE(m.reset("op", kT0 + 1300ms).accepted);
+}
+
+std::vector<JointLimits> two_joints() {
+  return {{"J1_A", -2.0, 2.0, 1.5, 100.0}, {"J2_A", -1.0, 1.0, 2.0, 50.0}};
+}
+
+JointSample sample(uint32_t version, double q1, double qd1, double tau1) {
+  return {version, {"J1_A", "J2_A"}, {q1, 0.0}, {qd1, 0.0}, {tau1, 0.0}};
+}
+
+TEST(SafetyMonitor, LimitsWithinBoundsAndTolerancesAreFine) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_model(3, two_joints());
+  EXPECT_EQ(m.on_joint_state(sample(3, 2.015, 1.6, 109.0)), SampleOutcome::kChecked);
+  EXPECT_EQ(m.on_joint_state(sample(3, -2.015, -1.6, -109.0)), SampleOutcome::kChecked);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+}
+
+TEST(SafetyMonitor, PositionVelocityEffortViolationsStop) {
+  {
+    SafetyMonitor m(Params{}, kT0);
+    m.set_model(3, two_joints());
+    m.on_joint_state(sample(3, 2.1, 0.0, 0.0));
+    ASSERT_EQ(m.status().mode, Mode::kStopped);
+    EXPECT_EQ(m.status().causes[0], "limits: joint J1_A position 2.100 beyond [-2.000, 2.000] (model v3)");
+  }
+  {
+    SafetyMonitor m(Params{}, kT0);
+    m.set_model(3, two_joints());
+    m.on_joint_state(sample(3, 0.0, -1.7, 0.0));
+    ASSERT_EQ(m.status().mode, Mode::kStopped);
+    EXPECT_EQ(m.status().causes[0], "limits: joint J1_A velocity -1.700 beyond +-1.650 (model v3)");
+  }
+  {
+    SafetyMonitor m(Params{}, kT0);
+    m.set_model(3, two_joints());
+    m.on_joint_state(sample(3, 0.0, 0.0, 111.0));
+    ASSERT_EQ(m.status().mode, Mode::kStopped);
+    EXPECT_EQ(m.status().causes[0], "limits: joint J1_A effort 111.00 beyond +-110.00 (model v3)");
+  }
+  {
+    SafetyMonitor m(Params{}, kT0);
+    m.set_model(3, two_joints());
+    m.on_joint_state(sample(3, std::nan(""), 0.0, 0.0));
+    EXPECT_EQ(m.status().mode, Mode::kStopped);
+  }
+}
+
+TEST(SafetyMonitor, RepeatedViolationGivesOneCause) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_model(3, two_joints());
+  for (int i = 0; i < 1000; ++i) m.on_joint_state(sample(3, 2.5, 0.0, 0.0));
+  EXPECT_EQ(m.status().causes.size(), 1u);
+}
+
+TEST(SafetyMonitor, OtherModelVersionsAndNoModelAreNotChecked) {
+  SafetyMonitor m(Params{}, kT0);
+  EXPECT_EQ(m.on_joint_state(sample(3, 9.0, 0.0, 0.0)), SampleOutcome::kNoModel);
+  m.set_model(4, two_joints());
+  EXPECT_EQ(m.on_joint_state(sample(3, 9.0, 0.0, 0.0)), SampleOutcome::kOtherModelVersion);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+  EXPECT_EQ(m.on_joint_state(sample(4, 9.0, 0.0, 0.0)), SampleOutcome::kChecked);
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+}
+
+TEST(SafetyMonitor, InfiniteLimitsOfContinuousJointsNeverTrip) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_model(1, {{"wheel", -1e300, 1e300, 20.0, 50.0}});
+  m.on_joint_state({1, {"wheel"}, {1e6}, {19.0}, {10.0}});
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+}
+
+TEST(SafetyMonitor, MalformedJointStateStops) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_model(1, two_joints());
+  m.on_joint_state({1, {"J1_A", "J2_A"}, {0.0}, {}, {}});
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  EXPECT_EQ(m.status().causes[0], "limits: malformed joint state: 2 names, 1 positions, 0 velocities, 0 efforts");
+}
+
+TEST(SafetyMonitor, RandomSamplesTripExactlyWhenOutsideBounds) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> q(-2.5, 2.5), qd(-2.0, 2.0), tau(-130.0, 130.0);
+  int tripped = 0;
+  for (int i = 0; i < 2000; ++i) {
+    SafetyMonitor m(Params{}, kT0);
+    m.set_model(1, two_joints());
+    const auto s = sample(1, q(rng), qd(rng), tau(rng));
+    m.on_joint_state(s);
+    const bool outside = std::abs(s.position[0]) > 2.02 || std::abs(s.velocity[0]) > 1.65 ||
+                         std::abs(s.effort[0]) > 110.0;
+    EXPECT_EQ(m.status().mode == Mode::kStopped, outside) << i;
+    tripped += outside ? 1 : 0;
+  }
+  EXPECT_GT(tripped, 100);
+  EXPECT_LT(tripped, 1900);
+}
+
+TEST(SafetyParams, DefaultsAndOverrides) {
+  const auto d = parse_params("", "empty");
+  EXPECT_EQ(d.liveliness_timeout, 1000ms);
+  const auto p = parse_params(
+      "liveliness_timeout: 0.5\nrobot_service: rob\ntask_services: [a, b]\nrequire_robot: true\n"
+      "position_tolerance: 0.1\nvelocity_margin: 0.2\neffort_margin: 0.3\npublish_period: 0.1\ncheck_period: 0.02\n",
+      "x");
+  EXPECT_EQ(p.liveliness_timeout, 500ms);
+  EXPECT_EQ(p.robot_service, "rob");
+  EXPECT_EQ(p.task_services, (std::vector<std::string>{"a", "b"}));
+  EXPECT_TRUE(p.require_robot);
+  EXPECT_DOUBLE_EQ(p.position_tolerance, 0.1);
+  EXPECT_DOUBLE_EQ(p.velocity_margin, 0.2);
+  EXPECT_DOUBLE_EQ(p.effort_margin, 0.3);
+  EXPECT_EQ(p.publish_period, 100ms);
+  EXPECT_EQ(p.check_period, 20ms);
+}
+
+TEST(SafetyParams, ShippedConfigHasTheDefaults) {
+  const auto p = load_params(std::string(CONCERT_SOURCE_DIR) + "/services/safety/config/safety.yaml");
+  const Params d;
+  EXPECT_EQ(p.liveliness_timeout, d.liveliness_timeout);
+  EXPECT_EQ(p.task_services, d.task_services);
+  EXPECT_EQ(p.publish_period, d.publish_period);
+  EXPECT_EQ(p.check_period, d.check_period);
+  EXPECT_DOUBLE_EQ(p.effort_margin, d.effort_margin);
+}
+
+void expect_error(const std::string& yaml, const std::string& text) {
+  try {
+    parse_params(yaml, "f.yaml");
+    ADD_FAILURE() << "no error for: " << yaml;
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+  }
+}
+
+TEST(SafetyParams, ErrorsNameFileAndField) {
+  expect_error("[1, 2]", "f.yaml: expected a mapping");
+  expect_error("liveliness: 1", "f.yaml: liveliness: unknown key");
+  expect_error("liveliness_timeout: fast", "f.yaml: liveliness_timeout: 'fast' is not a number");
+  expect_error("liveliness_timeout: -1", "f.yaml: liveliness_timeout: expected a period in seconds");
+  expect_error("task_services: planner", "f.yaml: task_services: expected a list");
+  expect_error("task_services: [a, [b]]", "f.yaml: task_services[1]: expected a service name");
+  expect_error("require_robot: maybe", "f.yaml: require_robot: 'maybe' is not true or false");
+  expect_error("effort_margin: -0.1", "f.yaml: effort_margin: must not be negative");
+  expect_error("liveliness_timeout: 0.1\ncheck_period: 0.5", "f.yaml: check_period: must not exceed");
+  expect_error("a: [", "f.yaml: invalid YAML");
+  try {
+    load_params("/nonexistent/safety.yaml");
+    ADD_FAILURE();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/safety.yaml: cannot read"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace concert::safety
