@@ -141,9 +141,28 @@ TEST_F(WallContact, AdmittanceAlongOneAxisRegulatesTheContactForce) {
   EXPECT_NEAR(-truth.x(), 30.0, 3.0) << truth.transpose();
 }
 
+TEST_F(WallContact, WrenchEstimateWithinTenPercentWithSensorNoise) {
+  // Same press, with encoder (1e-5 rad) and torque-sensor (0.1 N m) noise.
+  params_.position_noise = 1e-5;
+  params_.effort_noise = 0.1;
+  params_.seed = 7;
+  sim_ = std::make_unique<SimHardware>(read_fixture("arm_drill.urdf"), world_, params_);
+  core_ = std::make_unique<RobotCore>(*sim_);
+  core_->set_model(read_fixture("arm_drill.urdf"), 1);
+  run_cycles(*core_, 200);
+  core_->command_cartesian(press(0.05));
+  run_cycles(*core_, 2000);
+  const Eigen::Vector3d truth = contact_force();
+  const Eigen::Vector3d estimate = core_->state().end_effector_wrench.head<3>();
+  EXPECT_GT(-truth.x(), 25.0);
+  EXPECT_LT((estimate - truth).norm(), 0.10 * truth.norm())
+      << "estimate " << estimate.transpose() << " truth " << truth.transpose();
+}
+
 class MobileBase : public ::testing::Test {
  protected:
-  MobileBase() : sim_(read_fixture("mobile_drill.urdf"), World{}, {}), core_(sim_) {
+  explicit MobileBase(World world = {}, SimParams params = {})
+      : sim_(read_fixture("mobile_drill.urdf"), std::move(world), std::move(params)), core_(sim_) {
     core_.set_model(read_fixture("mobile_drill.urdf"), 1);
     run_cycles(core_, 200);
   }
@@ -191,6 +210,31 @@ TEST_F(MobileBase, SidewaysAndTurningCommands) {
   run_cycles(core_, 1500);
   s = core_.state();
   EXPECT_NEAR(s.odometry.wz, 0.0, 0.01);
+}
+
+class SlipperyFloor : public MobileBase {
+ protected:
+  static World ice() {
+    World w;
+    w.floor_friction = 0.02;
+    return w;
+  }
+  static SimParams worn_tyres() {
+    SimParams p;
+    p.wheel_friction = 0.02;  // MuJoCo uses the larger friction of the two geoms in contact
+    return p;
+  }
+  SlipperyFloor() : MobileBase(ice(), worn_tyres()) {}
+};
+
+TEST_F(SlipperyFloor, WheelsSlipAndOdometryOverestimates) {
+  // Wheel-floor contact is simulated, not scripted: on ice the wheels spin faster than the
+  // base moves, and wheel odometry (rolling without slip) runs ahead of the true motion.
+  drive(0.5, 0.0, 0.0, 2.0);
+  const RobotState s = core_.state();
+  const double truth = sim_.base_pose().translation().x();
+  EXPECT_GT(s.odometry.x, 0.5);
+  EXPECT_LT(truth, 0.8 * s.odometry.x) << "odometry " << s.odometry.x << " truth " << truth;
 }
 
 }  // namespace
