@@ -2,6 +2,7 @@
 // factor, for the 6-DoF drill arm on the four-legged mobile base (services/robot fixtures).
 //   bench_robot [--seconds S] [--urdf FILE]
 // Plain main (not Google Benchmark): the quantities are loop statistics, not per-call times.
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -78,6 +79,17 @@ int main(int argc, char** argv) {
       std::printf("as fast as possible: %llu cycles of 1 ms, wall %.3f s, real-time factor %.2f, %.1f us/cycle\n",
                   static_cast<unsigned long long>(stats.cycles), stats.wall_time, seconds / stats.wall_time,
                   1e6 * stats.wall_time / static_cast<double>(stats.cycles));
+    }
+    {
+      // Physics alone (drives holding), to tell simulation cost from controller cost.
+      concert::robot::SimHardware sim(urdf, concert::robot::World{}, {});
+      const auto start = std::chrono::steady_clock::now();
+      for (std::uint64_t k = 0; k < cycles; ++k) {
+        sim.step(0.001);
+      }
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::printf("physics only (MuJoCo, drives holding): real-time factor %.2f, %.1f us/step\n", seconds / wall,
+                  1e6 * wall / static_cast<double>(cycles));
     }
     auto real_time = [&](const char* label, int fifo, double spin) {
       Setup s(urdf);
