@@ -2,11 +2,12 @@
 
 #include <unistd.h>
 
-#include <chrono>
+#include <cstdlib>
 
 namespace concert::dds {
 
 std::string host_name() {
+  if (const char* env = std::getenv("CONCERT_HOST"); env != nullptr && *env != '\0') return env;
   char buf[256] = {};
   if (gethostname(buf, sizeof buf - 1) != 0 || buf[0] == '\0') return "unknown";
   return buf;
@@ -19,8 +20,9 @@ int64_t now_ns() {
 }
 }  // namespace
 
-StatusReporter::StatusReporter(Participant& participant, std::string service, std::string host)
-    : writer_(participant, topics::status) {
+StatusReporter::StatusReporter(Participant& participant, std::string service, std::string host,
+                               std::chrono::milliseconds heartbeat)
+    : writer_(participant, topics::status), heartbeat_(heartbeat) {
   status_.id(status_instance_id(service, host));
   status_.service(std::move(service));
   status_.host(std::move(host));
@@ -28,13 +30,33 @@ StatusReporter::StatusReporter(Participant& participant, std::string service, st
   status_.model_version(0);
   status_.stamp_ns(now_ns());
   writer_.write(status_);
+  if (heartbeat_ > std::chrono::milliseconds::zero()) thread_ = std::thread([this] { beat(); });
 }
 
 StatusReporter::~StatusReporter() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
   std::lock_guard lock(mutex_);
   status_.state(msg::SERVICE_STOPPED);
   status_.stamp_ns(now_ns());
   writer_.write(status_);
+}
+
+void StatusReporter::beat() {
+  std::unique_lock lock(mutex_);
+  auto next = std::chrono::steady_clock::now() + heartbeat_;
+  while (!wake_.wait_until(lock, next, [this] { return stopping_; })) {
+    status_.stamp_ns(now_ns());
+    writer_.write(status_);
+    next += heartbeat_;
+    // After a long stall (suspended process), beat once and realign rather than burst.
+    const auto now = std::chrono::steady_clock::now();
+    if (next < now) next = now + heartbeat_;
+  }
 }
 
 void StatusReporter::report(msg::ServiceState state, uint32_t model_version, const std::string& message) {

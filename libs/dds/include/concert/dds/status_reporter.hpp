@@ -1,22 +1,38 @@
 #pragma once
 // Publishes one service's ServiceStatus (state, model version, last message) on the status
 // topic; every service has one. The instance key is derived from service and host.
+//
+// Heartbeat: the last status is re-published every `heartbeat` period (new stamp_ns) from a
+// background thread, so a service that dies or is cut off from the network goes silent and
+// the safety service can tell (liveliness, services/safety).
 
+#include <chrono>
+#include <condition_variable>
 #include <mutex>
 #include <string>
+#include <thread>
 
 #include "concert/dds/endpoint.hpp"
 
 namespace concert::dds {
 
-/// This machine's host name (or "unknown").
+/// This machine's host name: CONCERT_HOST if set (containers, network namespaces), else the
+/// system host name (or "unknown").
 std::string host_name();
+
+/// Default heartbeat period of a StatusReporter [ms].
+inline constexpr std::chrono::milliseconds kDefaultHeartbeat{200};
 
 class StatusReporter {
  public:
-  StatusReporter(Participant& participant, std::string service, std::string host = host_name());
-  /// Reports SERVICE_STOPPED, so that tools show a clean stop rather than a silent one.
+  /// `heartbeat`: re-publish period of the status [ms]; zero disables the heartbeat.
+  StatusReporter(Participant& participant, std::string service, std::string host = host_name(),
+                 std::chrono::milliseconds heartbeat = kDefaultHeartbeat);
+  /// Stops the heartbeat and reports SERVICE_STOPPED, so that tools show a clean stop rather
+  /// than a silent one.
   ~StatusReporter();
+  StatusReporter(const StatusReporter&) = delete;
+  StatusReporter& operator=(const StatusReporter&) = delete;
 
   void report(msg::ServiceState state, uint32_t model_version, const std::string& message);
   /// Same state and version as last time, new message (e.g. an error that kept the old state).
@@ -24,11 +40,18 @@ class StatusReporter {
 
   msg::ServiceState state() const;
   uint32_t model_version() const;
+  std::chrono::milliseconds heartbeat() const { return heartbeat_; }
 
  private:
+  void beat();
+
   Writer<msg::ServiceStatus> writer_;
   mutable std::mutex mutex_;
+  std::condition_variable wake_;
   msg::ServiceStatus status_;
+  std::chrono::milliseconds heartbeat_;
+  bool stopping_ = false;
+  std::thread thread_;
 };
 
 }  // namespace concert::dds
