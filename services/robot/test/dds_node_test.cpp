@@ -120,9 +120,27 @@ TEST(RobotNode, ModelCommandsAndStateOverDds) {
   EXPECT_GT(odom->x(), 0.2);
   EXPECT_GT(odom->covariance()[0], 0.0);
 
+  // The safety layer stops the robot: commands are refused until it runs again.
+  cdds::Writer<msg::SafetyState> safety(client, cdds::topics::safety_state);
+  ASSERT_TRUE(safety.wait_for_readers(1, 10s));
+  msg::SafetyState stop;
+  stop.mode(msg::SAFETY_STOPPED);
+  stop.causes({"estop: wireless"});
+  safety.write(stop);
+  ASSERT_TRUE(run_until(core, node, [&] { return core.safety_stopped(); }));
+  const auto refused_before = node.refused_commands();
+  base.write(drive);
+  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() > refused_before; }));
+  EXPECT_NE(node.last_error().find("safety stop (estop: wireless)"), std::string::npos) << node.last_error();
+  msg::SafetyState run;
+  run.mode(msg::SAFETY_RUNNING);
+  safety.write(run);
+  ASSERT_TRUE(run_until(core, node, [&] { return !core.safety_stopped(); }));
+
   // A model that does not match the mounted hardware: refused, the old one keeps running.
+  const auto refused_now = node.refused_commands();
   models.write(model_msg(test::read_fixture("mobile_three_legs.urdf"), 8));
-  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() >= 3; }));
+  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() > refused_now; }));
   EXPECT_NE(node.last_error().find("does not match the mounted hardware"), std::string::npos);
   EXPECT_EQ(core.model_version(), 7u);
   EXPECT_TRUE(core.ready());

@@ -140,6 +140,30 @@ TEST_F(RobotCoreTest, GravityCompensationFloatsTheArm) {
   EXPECT_GT(std::abs(s.effort[hw_index(s, "J2_A")]), 5.0);
 }
 
+TEST_F(RobotCoreTest, SafetyStopHoldsAndRefusesCommands) {
+  core_.set_model(read_fixture("mobile_drill.urdf"), 1);
+  core_.command_joints({1, {{"J1_A", DriveMode::kVelocity, 0, 1.0, 0, 0, 0}}});
+  for (int k = 0; k < 400; ++k) {
+    if (k % 100 == 0) {
+      core_.command_base({1, 0.3, 0.0, 0.0});
+    }
+    core_.cycle();
+  }
+  core_.set_safety_stop(true, "estop: wireless");
+  EXPECT_TRUE(core_.safety_stopped());
+  const std::string msg = message_of([&] { core_.command_base({1, 0.3, 0, 0}); });
+  EXPECT_NE(msg.find("safety stop (estop: wireless)"), std::string::npos) << msg;
+  run_cycles(core_, 1000);
+  RobotState s = core_.state();
+  EXPECT_NEAR(s.velocity[hw_index(s, "J1_A")], 0.0, 0.01);
+  EXPECT_NEAR(s.odometry.vx, 0.0, 0.01);
+  for (auto owner : s.owners) {
+    EXPECT_EQ(owner, JointOwner::kHold);
+  }
+  core_.set_safety_stop(false);
+  EXPECT_NO_THROW(core_.command_base({1, 0.1, 0, 0}));
+}
+
 TEST_F(RobotCoreTest, HotSwapThenReconfigureToTheNewModel) {
   core_.set_model(read_fixture("mobile_drill.urdf"), 1);
   run_cycles(core_, 100);

@@ -141,6 +141,11 @@ class RobotCore {
   void command_gravity_compensation(std::uint64_t model_version, const std::vector<std::string>& joints = {});
   /// Every joint holds its current position; the base stops.
   void hold();
+  /// Safety stop (from the safety layer): while stopped every joint holds where it is and
+  /// every command is refused with `reason`; release() lets commands in again (the robot
+  /// keeps holding until commanded).
+  void set_safety_stop(bool stopped, const std::string& reason = "");
+  [[nodiscard]] bool safety_stopped() const;
 
   /// One control period: read the hardware, compute, write, step it by `params.period`.
   void cycle();
@@ -170,6 +175,8 @@ class RobotCore {
   std::uint64_t hw_generation_{0};       // as of the last cycle
   std::uint64_t known_generation_{0};    // generation the current model was accepted for
   bool holding_hw_{false};
+  bool safety_stopped_{false};
+  std::string safety_reason_;
 };
 
 }  // namespace concert::robot

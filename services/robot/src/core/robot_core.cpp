@@ -175,6 +175,9 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
 }
 
 void RobotCore::check_command(std::uint64_t model_version) const {
+  if (safety_stopped_) {
+    throw CommandError("command refused: safety stop (" + safety_reason_ + ")");
+  }
   if (!ctl_ || !state_.ready) {
     throw CommandError("command refused: robot not ready (" + state_.message + ")");
   }
@@ -282,6 +285,25 @@ void RobotCore::command_gravity_compensation(std::uint64_t model_version, const 
   for (int j : indices) {
     ctl_->owner[static_cast<std::size_t>(j)] = JointOwner::kGravityCompensation;
   }
+}
+
+void RobotCore::set_safety_stop(bool stopped, const std::string& reason) {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopped == safety_stopped_ && reason == safety_reason_) {
+      return;
+    }
+    safety_stopped_ = stopped;
+    safety_reason_ = reason.empty() ? std::string("no reason given") : reason;
+  }
+  if (stopped) {
+    hold();
+  }
+}
+
+bool RobotCore::safety_stopped() const {
+  std::lock_guard lock(mutex_);
+  return safety_stopped_;
 }
 
 void RobotCore::hold() {

@@ -40,10 +40,24 @@ RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams
       participant, cdds::topics::base_velocity, [this](const msg::BaseVelocityCommand& c, const auto&) {
         guarded("base command", [&] { core_.command_base(to_core(c)); });
       });
+  safety_reader_ = std::make_unique<cdds::Reader<msg::SafetyState>>(
+      participant, cdds::topics::safety_state, [this](const msg::SafetyState& s, const auto&) {
+        const bool stopped = s.mode() == msg::SAFETY_STOPPED;
+        std::string causes;
+        for (const auto& c : s.causes()) {
+          causes += (causes.empty() ? "" : "; ") + c;
+        }
+        const bool was = core_.safety_stopped();
+        core_.set_safety_stop(stopped, causes);
+        if (stopped != was) {
+          status_.note(stopped ? "safety stop: holding (" + causes + ")" : "safety stop released");
+        }
+      });
 }
 
 RobotNode::~RobotNode() {
   // Readers first: their callbacks use the core and the status writer.
+  safety_reader_.reset();
   base_reader_.reset();
   cartesian_reader_.reset();
   joint_reader_.reset();

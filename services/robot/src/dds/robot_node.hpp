@@ -20,6 +20,7 @@ struct NodeParams {
   int wrench_decimation{10};    ///< end-effector wrench every N cycles
 };
 
+/// A SAFETY_STOPPED safety state holds the robot and refuses commands until SAFETY_RUNNING.
 /// Readers call the core from the DDS listener threads (the core locks); publish() is called
 /// by the loop thread after every cycle. Refused commands and models are reported on the
 /// status topic with the core's message; the last good model stays.
@@ -59,6 +60,7 @@ class RobotNode {
   std::unique_ptr<concert::dds::Reader<msg::JointCommand>> joint_reader_;
   std::unique_ptr<concert::dds::Reader<msg::CartesianImpedanceCommand>> cartesian_reader_;
   std::unique_ptr<concert::dds::Reader<msg::BaseVelocityCommand>> base_reader_;
+  std::unique_ptr<concert::dds::Reader<msg::SafetyState>> safety_reader_;
   std::atomic<std::uint64_t> refused_{0};
   mutable std::mutex mutex_;
   std::string last_error_;
