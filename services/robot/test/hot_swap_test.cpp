@@ -110,5 +110,54 @@ TEST(HotSwap, NewScanNewModelAccepted) {
   }
 }
 
+// The project's own module database (data/module_db), as `concert up` uses it.
+TEST(ProjectDatabase, DemoDrillRobotStandsDrivesAndHoldsItsArm) {
+  const AssemblyBuilder builder({fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db"});
+  const SimulatedRobot robot = builder.build_from_text(R"(modules:
+  - {name: base, key: concert_mobile_base_hub, robot_id: [100, 101]}
+  - {name: steer_fl, key: concert_steering_fl_rr, parent: base, connector: 1, robot_id: 11}
+  - {name: wheel_fl, key: concert_wheel, parent: steer_fl, connector: 1, robot_id: 12}
+  - {name: steer_fr, key: concert_steering_fr_rl, parent: base, connector: 2, robot_id: 21}
+  - {name: wheel_fr, key: concert_wheel, parent: steer_fr, connector: 1, robot_id: 22}
+  - {name: steer_rl, key: concert_steering_fr_rl, parent: base, connector: 3, robot_id: 31}
+  - {name: wheel_rl, key: concert_wheel, parent: steer_rl, connector: 1, robot_id: 32}
+  - {name: steer_rr, key: concert_steering_fl_rr, parent: base, connector: 4, robot_id: 41}
+  - {name: wheel_rr, key: concert_wheel, parent: steer_rr, connector: 1, robot_id: 42}
+  - {name: yaw_1, key: concert_straight_a, parent: base, connector: 5, robot_id: 51}
+  - {name: elbow_1, key: concert_elbow_a, parent: yaw_1, connector: 1, robot_id: 52}
+  - {name: link_1, key: concert_link_400, parent: elbow_1, connector: 1}
+  - {name: elbow_2, key: concert_elbow_a, parent: link_1, connector: 1, robot_id: 53}
+  - {name: yaw_2, key: concert_straight_b, parent: elbow_2, connector: 1, robot_id: 54}
+  - {name: link_2, key: concert_link_400, parent: yaw_2, connector: 1}
+  - {name: elbow_3, key: concert_elbow_b, parent: link_2, connector: 1, robot_id: 55}
+  - {name: yaw_3, key: concert_straight_b, parent: elbow_3, connector: 1, robot_id: 56}
+  - {name: tool, key: concert_drill, parent: yaw_3, connector: 1, robot_id: 60}
+)",
+                                                       "demo.yaml");
+  SimHardware sim(robot.urdf, World{}, {});
+  RobotCore core(sim);
+  core.set_model(robot.urdf, 1);
+  EXPECT_EQ(core.legs().size(), 4u);
+  EXPECT_EQ(core.arm_joints().size(), 6u);
+  test::run_cycles(core, 500);
+  double expected_z = 0.0;
+  for (const auto& leg : core.legs()) {
+    expected_z = std::max(expected_z, leg.wheel_radius - leg.wheel_center_height);
+  }
+  EXPECT_NEAR(sim.base_pose().translation().z(), expected_z, 0.02);
+  for (int k = 0; k < 2000; ++k) {
+    if (k % 100 == 0) {
+      core.command_base({1, 0.0, 0.2, 0.0});
+    }
+    core.cycle();
+  }
+  const RobotState s = core.state();
+  EXPECT_NEAR(s.odometry.vy, 0.2, 0.02);
+  EXPECT_NEAR(s.odometry.y, sim.base_pose().translation().y(), 0.05);
+  for (const auto& joint : core.arm_joints()) {
+    EXPECT_NEAR(s.position[test::hw_index(s, joint)], 0.0, 0.02) << joint;
+  }
+}
+
 }  // namespace
 }  // namespace concert::robot
