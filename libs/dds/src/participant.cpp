@@ -37,6 +37,15 @@ void use_localhost_only(DomainParticipantQos& qos) {
   builtin.metatrafficUnicastLocatorList.push_back(local);
   builtin.metatrafficMulticastLocatorList.clear();
   qos.wire_protocol().default_unicast_locator_list.push_back(local);
+
+  // Announce often: unicast announcements to 48 local ports cost nothing on loopback, and a
+  // participant that starts late (a tool, a restarted service) is seen within half a second
+  // instead of Fast DDS's 3 s; a participant that died is forgotten after 5 s, not 20 s.
+  auto& discovery = builtin.discovery_config;
+  discovery.initial_announcements.count = 10;
+  discovery.initial_announcements.period = eprosima::fastrtps::Duration_t(0, 50'000'000);
+  discovery.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0, 500'000'000);
+  discovery.leaseDuration = eprosima::fastrtps::Duration_t(5, 0);
 }
 
 }  // namespace

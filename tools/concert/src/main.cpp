@@ -4,7 +4,9 @@
 #include <vector>
 
 #include "args.hpp"
+#include "launcher.hpp"
 #include "scan_verbs.hpp"
+#include "status_verbs.hpp"
 #include "topic_verbs.hpp"
 #ifdef CONCERT_HAVE_DISCOVERY_CLI
 #include "discovery/cli.hpp"
@@ -18,6 +20,14 @@ namespace {
 const char* kUsage = R"(usage: concert <verb> [arguments]
 
 verbs:
+  up [--assembly FILE] [--world FILE] [--module-db DIR ...] [--duration S]
+                                                start every service on this machine (simulated robot),
+                                                restart one that dies, stop all on Ctrl-C
+  status [--json] [--wait-ms MS]                every service: host, state, model version, last message
+  status --until-version N [--services a,b] [--timeout-ms MS]
+                                                wait until every model consumer is ready at version N
+  sim assemble|swap FILE                        mount another assembly on the running simulated robot
+  sim world FILE                                change the simulated world
   topic list [--json] [--wait-ms MS]            topics on the domain (ours and others'), with types,
                                                 writer/reader counts and QoS
   topic info NAME [--wait-ms MS]                type, QoS, endpoints and type shape of a topic
@@ -52,6 +62,9 @@ int main(int argc, char** argv) {
   try {
     if (verb == "topic") return concert::cli::run_topic(rest, std::cout, std::cerr);
     if (verb == "scan") return concert::cli::run_scan(rest, std::cout, std::cerr);
+    if (verb == "status") return concert::cli::run_status(rest, std::cout, std::cerr);
+    if (verb == "up") return concert::cli::run_up(rest, std::cout, std::cerr);
+    if (verb == "sim") return concert::cli::run_sim(rest, std::cout, std::cerr);
 #ifdef CONCERT_HAVE_DISCOVERY_CLI
     if (verb == "discover") return concert::discovery::cli_main(rest, std::cout, std::cerr);
 #endif

@@ -1,0 +1,278 @@
+#include "launcher.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdlib>
+#include <iomanip>
+#include <sstream>
+#include <thread>
+
+#include "args.hpp"
+#include "concert/dds/catalogue.hpp"
+
+namespace concert::cli {
+
+namespace fs = std::filesystem;
+
+Supervisor::Supervisor(std::vector<ServiceSpec> services, fs::path log_dir, std::ostream& log, BackoffParams backoff)
+    : log_dir_(std::move(log_dir)), log_(log), backoff_(backoff) {
+  for (auto& s : services) children_.push_back(Child{std::move(s)});
+  fs::create_directories(log_dir_);
+}
+
+Supervisor::~Supervisor() { stop_all(); }
+
+void Supervisor::say(const std::string& line) {
+  const double t = std::chrono::duration<double>(Clock::now() - t0_).count();
+  log_ << "[up " << std::fixed << std::setprecision(2) << std::setw(7) << t << " s] " << line << std::endl;
+}
+
+void Supervisor::start(Child& child) {
+  const auto log_file = log_dir_ / (child.spec.name + ".log");
+  const pid_t pid = fork();
+  if (pid < 0) {
+    say("cannot fork for " + child.spec.name);
+    child.restart_at = Clock::now() + backoff_.max;
+    return;
+  }
+  if (pid == 0) {
+    const int fd = open(log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    const int in = open("/dev/null", O_RDONLY);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    dup2(in, 0);
+    setpgid(0, 0);  // Ctrl-C in the terminal reaches `concert up`, which stops the services in order
+    std::vector<char*> argv;
+    for (auto& a : child.spec.argv) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  child.pid = pid;
+  child.started = Clock::now();
+  child.restart_at.reset();
+  say("started " + child.spec.name + " (pid " + std::to_string(pid) + "), log " + log_file.string());
+}
+
+void Supervisor::start_all() {
+  for (auto& c : children_) start(c);
+}
+
+void Supervisor::poll() {
+  for (auto& c : children_) {
+    if (c.pid > 0) {
+      int status = 0;
+      if (waitpid(c.pid, &status, WNOHANG) != c.pid) continue;
+      const std::string how = WIFEXITED(status) ? "exited with code " + std::to_string(WEXITSTATUS(status))
+                                                : "was killed by signal " + std::to_string(WTERMSIG(status));
+      c.pid = -1;
+      const bool stable = Clock::now() - c.started > backoff_.stable;
+      c.failures_in_a_row = stable ? 0 : c.failures_in_a_row + 1;
+      auto delay = backoff_.first * (1 << std::min(c.failures_in_a_row, 10));
+      if (delay > backoff_.max) delay = backoff_.max;
+      c.restart_at = Clock::now() + delay;
+      ++c.restarts;
+      std::ostringstream msg;
+      msg << c.spec.name << " " << how << "; restarting in " << std::fixed << std::setprecision(1)
+          << std::chrono::duration<double>(delay).count() << " s (restart " << c.restarts << ", see "
+          << (log_dir_ / (c.spec.name + ".log")).string() << ")";
+      say(msg.str());
+    } else if (c.restart_at && Clock::now() >= *c.restart_at) {
+      start(c);
+    }
+  }
+}
+
+void Supervisor::stop_all(std::chrono::milliseconds grace) {
+  bool any = false;
+  for (auto it = children_.rbegin(); it != children_.rend(); ++it) {
+    if (it->pid > 0) {
+      kill(it->pid, SIGINT);
+      any = true;
+    }
+    it->restart_at.reset();
+  }
+  if (!any) return;
+  const auto deadline = Clock::now() + grace;
+  for (auto& c : children_) {
+    while (c.pid > 0) {
+      int status = 0;
+      if (waitpid(c.pid, &status, WNOHANG) == c.pid) {
+        say("stopped " + c.spec.name);
+        c.pid = -1;
+      } else if (Clock::now() >= deadline) {
+        kill(c.pid, SIGKILL);
+        waitpid(c.pid, &status, 0);
+        say("killed " + c.spec.name + " (did not stop within " + std::to_string(grace.count()) + " ms)");
+        c.pid = -1;
+      } else {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    }
+  }
+}
+
+int Supervisor::restarts(const std::string& name) const {
+  for (const auto& c : children_) {
+    if (c.spec.name == name) return c.restarts;
+  }
+  return 0;
+}
+
+std::optional<pid_t> Supervisor::pid(const std::string& name) const {
+  for (const auto& c : children_) {
+    if (c.spec.name == name && c.pid > 0) return c.pid;
+  }
+  return std::nullopt;
+}
+
+std::string find_executable(const std::string& name, const std::string& service, const std::string& bin_dir) {
+  auto executable = [](const fs::path& p) { return access(p.c_str(), X_OK) == 0 && fs::is_regular_file(p); };
+  if (!bin_dir.empty() && executable(fs::path(bin_dir) / name)) return (fs::path(bin_dir) / name).string();
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path in_build = self.parent_path().parent_path().parent_path() / "services" / service / name;
+    if (executable(in_build)) return in_build.string();
+    if (executable(self.parent_path() / name)) return (self.parent_path() / name).string();
+  }
+  if (const char* path = std::getenv("PATH")) {
+    std::istringstream dirs(path);
+    for (std::string d; std::getline(dirs, d, ':');) {
+      if (executable(fs::path(d) / name)) return (fs::path(d) / name).string();
+    }
+  }
+  return "";
+}
+
+fs::path run_dir(int32_t domain) {
+  const char* base = std::getenv("XDG_RUNTIME_DIR");
+  return fs::path(base != nullptr && *base != '\0' ? base : "/tmp") / ("concert-d" + std::to_string(domain));
+}
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+
+/// Copies `from` over `to` atomically (rename), so a watcher never sees a half-written file.
+void install_file(const fs::path& from, const fs::path& to) {
+  if (!fs::is_regular_file(from)) throw Failure(from.string() + ": no such file");
+  const fs::path tmp = to.string() + ".tmp";
+  fs::copy_file(from, tmp, fs::copy_options::overwrite_existing);
+  fs::rename(tmp, to);
+}
+
+int32_t domain_of(Args& a) {
+  const auto d = a.value("--domain");
+  return d ? dds::parse_domain_id(*d, "--domain") : dds::domain_id_from_env();
+}
+
+}  // namespace
+
+int run_up(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  Args a(args);
+  a.flag("--sim");  // the simulator is the default (and only buildable) backend
+  const std::string backend = a.value("--backend").value_or("sim");
+  const std::string assembly = a.value("--assembly").value_or(CONCERT_DEFAULT_ASSEMBLY);
+  const auto world = a.value("--world");
+  const auto module_dbs = a.values("--module-db");
+  const std::string bin_dir = a.value("--bin-dir").value_or(std::getenv("CONCERT_BIN_DIR") ? std::getenv("CONCERT_BIN_DIR") : "");
+  const auto duration_s = a.integer("--duration", 0, 0, 86'400 * 365);
+  const int32_t domain = domain_of(a);
+  a.finish();
+  if (backend != "sim") {
+    throw UsageError("--backend " + backend + ": only 'sim' runs on this machine (the EtherCAT backend needs the robot's master; see services/robot/README.md)");
+  }
+  // Validate inputs before anything starts: a bad file never disturbs a running stack.
+  if (!fs::is_regular_file(assembly)) throw Failure("--assembly " + assembly + ": no such file");
+  if (world && !fs::is_regular_file(*world)) throw Failure("--world " + *world + ": no such file");
+  for (const auto& db : module_dbs) {
+    if (!fs::is_directory(db)) throw Failure("--module-db " + db + ": no such folder");
+  }
+
+  const fs::path dir = run_dir(domain);
+  fs::create_directories(dir / "logs");
+  install_file(assembly, dir / "assembly.yaml");
+  if (world) install_file(*world, dir / "world.yaml");
+
+  std::vector<std::string> db_args;
+  for (const auto& db : module_dbs) {
+    db_args.push_back("--module-db");
+    db_args.push_back(fs::absolute(db).string());
+  }
+  struct Plan {
+    std::string service, executable;
+    std::vector<std::string> args;
+    bool required;
+  };
+  std::vector<std::string> robot_args = {"--assembly", (dir / "assembly.yaml").string()};
+  if (world) robot_args.insert(robot_args.end(), {"--world", (dir / "world.yaml").string()});
+  robot_args.insert(robot_args.end(), db_args.begin(), db_args.end());
+  const std::vector<Plan> plan = {
+      {"safety", "concert_safety", {}, false},
+      {"discovery", "concert_discovery", db_args, true},
+      {"modelgen", "concert_modelgen", db_args, true},
+      {"robot", "concert_robot", robot_args, true},
+      {"planner", "concert_planner", {}, false},
+  };
+  std::vector<ServiceSpec> services;
+  for (const auto& p : plan) {
+    const std::string exe = find_executable(p.executable, p.service, bin_dir);
+    if (exe.empty()) {
+      if (p.required) throw Failure(p.executable + " not found (build it, or give --bin-dir / CONCERT_BIN_DIR)");
+      err << "concert up: " << p.executable << " is not built; running without " << p.service << "\n";
+      continue;
+    }
+    ServiceSpec spec{p.service, {exe}};
+    spec.argv.insert(spec.argv.end(), p.args.begin(), p.args.end());
+    services.push_back(std::move(spec));
+  }
+
+  setenv("CONCERT_DOMAIN_ID", std::to_string(domain).c_str(), 1);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  out << "concert up: domain " << domain << ", run folder " << dir.string() << "\n"
+      << "  hot swap: concert sim swap FILE    status: concert status    stop: Ctrl-C" << std::endl;
+  Supervisor supervisor(std::move(services), dir / "logs", out);
+  supervisor.start_all();
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(duration_s);
+  while (!g_stop && (duration_s == 0 || std::chrono::steady_clock::now() < until)) {
+    supervisor.poll();
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  out << "concert up: stopping" << std::endl;
+  supervisor.stop_all();
+  return 0;
+}
+
+int run_sim(const std::vector<std::string>& args, std::ostream& out, std::ostream& /*err*/) {
+  Args a(args);
+  const std::string verb = a.positional("sim verb: assemble, swap or world");
+  const std::string file = a.positional("a file");
+  const int32_t domain = domain_of(a);
+  a.finish();
+  const fs::path dir = run_dir(domain);
+  if (!fs::is_directory(dir)) {
+    throw Failure("no stack runs on domain " + std::to_string(domain) + " from this machine (" + dir.string() +
+                  " is missing): start one with `concert up`");
+  }
+  if (verb == "assemble" || verb == "swap") {
+    install_file(file, dir / "assembly.yaml");
+    out << "concert sim " << verb << ": " << file << " is now the mounted assembly; the robot service rescans\n";
+    return 0;
+  }
+  if (verb == "world") {
+    install_file(file, dir / "world.yaml");
+    out << "concert sim world: " << file << " is now the simulated world\n";
+    return 0;
+  }
+  throw UsageError("unknown sim verb '" + verb + "' (assemble, swap, world)");
+}
+
+}  // namespace concert::cli

@@ -1,0 +1,74 @@
+#pragma once
+// Starts the stack's services as processes on this machine, restarts one that dies (with
+// exponential back-off, logged) and stops all cleanly.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace concert::cli {
+
+struct ServiceSpec {
+  std::string name;               ///< e.g. "discovery"
+  std::vector<std::string> argv;  ///< argv[0] is the executable's path
+};
+
+struct BackoffParams {
+  std::chrono::milliseconds first{500};  ///< delay before the first restart
+  std::chrono::milliseconds max{10'000};
+  std::chrono::seconds stable{30};       ///< a run this long resets the back-off
+};
+
+class Supervisor {
+ public:
+  Supervisor(std::vector<ServiceSpec> services, std::filesystem::path log_dir, std::ostream& log,
+             BackoffParams backoff = {});
+  ~Supervisor();
+
+  void start_all();
+  /// Reaps services that exited and (re)starts those whose back-off has passed. Call often.
+  void poll();
+  /// SIGINT to every service, then SIGKILL after `grace`.
+  void stop_all(std::chrono::milliseconds grace = std::chrono::milliseconds(5000));
+
+  int restarts(const std::string& name) const;
+  std::optional<pid_t> pid(const std::string& name) const;
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  struct Child {
+    ServiceSpec spec;
+    pid_t pid = -1;
+    int restarts = 0;
+    int failures_in_a_row = 0;
+    Clock::time_point started;
+    std::optional<Clock::time_point> restart_at;
+  };
+  void start(Child& child);
+  void say(const std::string& line);
+
+  std::vector<Child> children_;
+  std::filesystem::path log_dir_;
+  std::ostream& log_;
+  BackoffParams backoff_;
+  Clock::time_point t0_ = Clock::now();
+};
+
+/// Where a service's executable is: `bin_dir`/NAME, else the build tree next to this program
+/// (<build>/services/<service>/NAME), else PATH. Empty if not found.
+std::string find_executable(const std::string& name, const std::string& service, const std::string& bin_dir);
+
+/// Folder for one domain's running stack: assembly, world and logs
+/// (${XDG_RUNTIME_DIR:-/tmp}/concert-d<domain>).
+std::filesystem::path run_dir(int32_t domain);
+
+/// `concert up ...` and `concert sim ...`; args start after the verb.
+int run_up(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int run_sim(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+}  // namespace concert::cli

@@ -1,0 +1,168 @@
+#include "status_verbs.hpp"
+
+#include <algorithm>
+#include <iomanip>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "args.hpp"
+#include "concert/dds/endpoint.hpp"
+#include "concert/idl_schema/cdr.hpp"
+
+namespace concert::cli {
+namespace {
+
+std::string state_name(msg::ServiceState s) {
+  switch (s) {
+    case msg::SERVICE_STARTING: return "starting";
+    case msg::SERVICE_READY: return "ready";
+    case msg::SERVICE_RECONFIGURING: return "reconfiguring";
+    case msg::SERVICE_ERROR: return "error";
+    case msg::SERVICE_STOPPED: return "stopped";
+  }
+  return "unknown";
+}
+
+int64_t wall_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+std::vector<ServiceRow> read_statuses(int32_t domain, std::chrono::milliseconds wait) {
+  dds::Participant participant({.name = "concert-status", .domain_id = domain});
+  std::mutex mutex;
+  std::map<uint32_t, msg::ServiceStatus> latest;
+  dds::Reader<msg::ServiceStatus> reader(participant, dds::topics::status, [&](const msg::ServiceStatus& s, const auto&) {
+    std::lock_guard lock(mutex);
+    latest[s.id()] = s;
+  });
+  std::this_thread::sleep_for(wait);
+  std::lock_guard lock(mutex);
+  std::vector<ServiceRow> rows;
+  const int64_t now = wall_ns();
+  for (const auto& [id, s] : latest) {
+    rows.push_back({s.service(), s.host(), state_name(s.state()), s.model_version(), s.message(),
+                    static_cast<double>(now - s.stamp_ns()) / 1e9});
+  }
+  std::sort(rows.begin(), rows.end(), [](const ServiceRow& a, const ServiceRow& b) {
+    return std::tie(a.service, a.host) < std::tie(b.service, b.host);
+  });
+  return rows;
+}
+
+namespace {
+
+/// Services that run on the robot model (discovery works on the module tree instead).
+const std::set<std::string> kModelConsumers = {"modelgen", "robot", "safety", "planner", "nav",
+                                               "drill", "collab", "surface_finish"};
+/// Statuses are latched, but a new reader needs discovery first: before declaring everyone
+/// ready, give every running service this long to be heard.
+constexpr auto kSettle = std::chrono::milliseconds(1000);
+
+/// Waits until every model consumer is ready at `version` or later, printing when each got
+/// there. Model consumers: the services named in `only`, else the stack's model consumers and
+/// any other service that reports a model version.
+int until_version(int32_t domain, uint32_t version, const std::vector<std::string>& only, long timeout_ms,
+                  std::ostream& out, std::ostream& err) {
+  using Clock = std::chrono::steady_clock;
+  dds::Participant participant({.name = "concert-status", .domain_id = domain});
+  std::mutex mutex;
+  std::map<std::string, msg::ServiceStatus> latest;  // "service@host"
+  dds::Reader<msg::ServiceStatus> reader(participant, dds::topics::status, [&](const msg::ServiceStatus& s, const auto&) {
+    std::lock_guard lock(mutex);
+    latest[s.service() + "@" + s.host()] = s;
+  });
+  const auto t0 = Clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  auto consumer = [&](const msg::ServiceStatus& s) {
+    if (!only.empty()) return std::find(only.begin(), only.end(), s.service()) != only.end();
+    return kModelConsumers.count(s.service()) > 0 || s.model_version() != 0;
+  };
+  out << std::fixed << std::setprecision(3) << "[" << std::setw(7) << 0.0 << " s] waiting for model version "
+      << version << std::endl;
+  std::set<std::string> done;
+  while (Clock::now() - t0 < std::chrono::milliseconds(timeout_ms)) {
+    {
+      std::lock_guard lock(mutex);
+      size_t consumers = 0;
+      for (const auto& [key, s] : latest) {
+        if (!consumer(s)) continue;
+        ++consumers;
+        if (s.state() == msg::SERVICE_READY && s.model_version() >= version && done.insert(key).second) {
+          out << "[" << std::setw(7) << elapsed() << " s] " << key << " ready at model version " << s.model_version()
+              << std::endl;
+        }
+      }
+      const bool named_all = only.empty() || std::all_of(only.begin(), only.end(), [&](const std::string& n) {
+        return std::any_of(done.begin(), done.end(), [&](const std::string& k) { return k.rfind(n + "@", 0) == 0; });
+      });
+      if (consumers > 0 && done.size() == consumers && named_all && Clock::now() - t0 >= kSettle) return 0;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::lock_guard lock(mutex);
+  err << "concert status: not every service is ready at model version " << version << " after " << timeout_ms
+      << " ms:";
+  for (const auto& [key, s] : latest) {
+    if (consumer(s) && !done.count(key)) {
+      err << " " << key << " is " << state_name(s.state()) << " at " << s.model_version() << " (" << s.message() << ")";
+    }
+  }
+  if (latest.empty()) err << " no service reported";
+  err << "\n";
+  return 1;
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+}  // namespace
+
+int run_status(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  Args a(args);
+  const bool json = a.flag("--json");
+  const long wait_ms = a.integer("--wait-ms", 1500, 0, 600000);
+  const long until = a.integer("--until-version", 0, 0, 4'000'000'000);
+  const long timeout_ms = a.integer("--timeout-ms", 30'000, 1, 86'400'000);
+  const auto services = split(a.value("--services").value_or(""));
+  const auto domain_arg = a.value("--domain");
+  a.finish();
+  const int32_t domain = domain_arg ? dds::parse_domain_id(*domain_arg, "--domain") : dds::domain_id_from_env();
+  if (until > 0) return until_version(domain, static_cast<uint32_t>(until), services, timeout_ms, out, err);
+  const auto rows = read_statuses(domain, std::chrono::milliseconds(wait_ms));
+  if (json) {
+    idl::Json arr = idl::Json::array();
+    for (const auto& r : rows) {
+      arr.push_back({{"service", r.service}, {"host", r.host}, {"state", r.state}, {"model_version", r.model_version},
+                     {"message", r.message}, {"age_s", r.age_s}});
+    }
+    out << arr.dump(2) << "\n";
+    return 0;
+  }
+  if (rows.empty()) {
+    err << "concert status: no service reported on domain " << domain << " within " << wait_ms << " ms\n";
+    return 1;
+  }
+  out << std::left << std::setw(16) << "SERVICE" << std::setw(18) << "HOST" << std::setw(15) << "STATE" << std::setw(7)
+      << "MODEL" << std::setw(9) << "AGE" << "MESSAGE\n";
+  for (const auto& r : rows) {
+    std::ostringstream age;
+    age << std::fixed << std::setprecision(1) << r.age_s << "s";
+    out << std::setw(16) << r.service << std::setw(18) << r.host << std::setw(15) << r.state << std::setw(7)
+        << r.model_version << std::setw(9) << age.str() << r.message << "\n";
+  }
+  return 0;
+}
+
+}  // namespace concert::cli
