@@ -79,6 +79,8 @@ TEST(SimHardware, HotSwapKeepsStateAndBumpsGeneration) {
     sim.step(0.001);
   }
   const auto gen = sim.generation();
+  sim.swap_model(read_fixture("mobile_drill.urdf"));  // the same robot again: no change
+  EXPECT_EQ(sim.generation(), gen);
   const double z = sim.base_pose().translation().z();
   sim.swap_model(read_fixture("mobile_sander.urdf"));
   EXPECT_EQ(sim.generation(), gen + 1);

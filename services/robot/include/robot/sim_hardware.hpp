@@ -61,7 +61,8 @@ class SimHardware final : public Hardware {
   void step(double dt) override;
 
   /// Hot swap: the robot becomes `urdf` (the base pose and joints with the same name keep
-  /// their state, every drive holds position); generation() increases.
+  /// their state, every drive holds position); generation() increases. The same URDF again
+  /// is no change (nothing happens).
   void swap_model(const std::string& urdf);
   /// Replaces the world (keeps the robot state and the hardware generation).
   void set_world(const World& world);

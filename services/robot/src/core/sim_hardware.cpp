@@ -445,7 +445,12 @@ void SimHardware::step(double dt) {
   // (mj_step computes forces before integrating); a second mj_forward would double the cost.
 }
 
-void SimHardware::swap_model(const std::string& urdf) { impl_->load(urdf, true); }
+void SimHardware::swap_model(const std::string& urdf) {
+  if (urdf == impl_->urdf) {
+    return;  // the same robot was mounted again: no hardware change
+  }
+  impl_->load(urdf, true);
+}
 
 void SimHardware::set_world(const World& world) {
   impl_->world = world;
