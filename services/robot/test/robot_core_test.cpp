@@ -164,6 +164,26 @@ TEST_F(RobotCoreTest, SafetyStopHoldsAndRefusesCommands) {
   EXPECT_NO_THROW(core_.command_base({1, 0.1, 0, 0}));
 }
 
+TEST(RobotCore, CartesianWithZeroGainsIsGravityCompensation) {
+  // What DDS clients use for teaching mode (README): no stiffness, no damping.
+  SimParams params;
+  params.initial_positions = {{"J2_A", 0.5}, {"J3_A", 0.6}};
+  SimHardware sim(read_fixture("arm_drill.urdf"), World{}, params);
+  RobotCore core(sim);
+  core.set_model(read_fixture("arm_drill.urdf"), 1);
+  run_cycles(core, 200);
+  CartesianCommand c;
+  c.model_version = 1;
+  c.stiffness.setZero();
+  c.damping.setZero();
+  core.command_cartesian(c);  // target pose irrelevant without stiffness
+  run_cycles(core, 1000);
+  const RobotState s = core.state();
+  EXPECT_NEAR(s.position[hw_index(s, "J2_A")], 0.5, 5e-3);
+  EXPECT_NEAR(s.position[hw_index(s, "J3_A")], 0.6, 5e-3);
+  EXPECT_EQ(s.owners[hw_index(s, "J2_A")], JointOwner::kCartesian);
+}
+
 TEST_F(RobotCoreTest, HotSwapThenReconfigureToTheNewModel) {
   core_.set_model(read_fixture("mobile_drill.urdf"), 1);
   run_cycles(core_, 100);
