@@ -14,6 +14,11 @@
 
 #include "args.hpp"
 #include "concert/dds/catalogue.hpp"
+#include "concert/simbus/assembly.hpp"
+#include "scan_verbs.hpp"
+#ifdef CONCERT_HAVE_ROBOT_CORE
+#include "robot/world.hpp"
+#endif
 
 namespace concert::cli {
 
@@ -168,6 +173,28 @@ void install_file(const fs::path& from, const fs::path& to) {
   fs::rename(tmp, to);
 }
 
+/// Rejects an assembly file that the robot could not mount: parse errors, unknown module keys,
+/// connectors the parent does not have. The message names the file and what is wrong.
+void check_assembly(const fs::path& file, const std::vector<std::string>& module_dbs) {
+  if (!fs::is_regular_file(file)) throw Failure(file.string() + ": no such file");
+  try {
+    simbus::validate(simbus::load_assembly(file), load_catalogs(module_dbs));
+  } catch (const std::exception& e) {
+    throw Failure(std::string("assembly rejected, nothing changed: ") + e.what());
+  }
+}
+
+void check_world(const fs::path& file) {
+  if (!fs::is_regular_file(file)) throw Failure(file.string() + ": no such file");
+#ifdef CONCERT_HAVE_ROBOT_CORE
+  try {
+    robot::load_world_file(file.string());
+  } catch (const std::exception& e) {
+    throw Failure(std::string("world rejected, nothing changed: ") + e.what());
+  }
+#endif
+}
+
 int32_t domain_of(Args& a) {
   const auto d = a.value("--domain");
   return d ? dds::parse_domain_id(*d, "--domain") : dds::domain_id_from_env();
@@ -190,11 +217,11 @@ int run_up(const std::vector<std::string>& args, std::ostream& out, std::ostream
     throw UsageError("--backend " + backend + ": only 'sim' runs on this machine (the EtherCAT backend needs the robot's master; see services/robot/README.md)");
   }
   // Validate inputs before anything starts: a bad file never disturbs a running stack.
-  if (!fs::is_regular_file(assembly)) throw Failure("--assembly " + assembly + ": no such file");
-  if (world && !fs::is_regular_file(*world)) throw Failure("--world " + *world + ": no such file");
   for (const auto& db : module_dbs) {
     if (!fs::is_directory(db)) throw Failure("--module-db " + db + ": no such folder");
   }
+  check_assembly(assembly, module_dbs);
+  if (world) check_world(*world);
 
   const fs::path dir = run_dir(domain);
   fs::create_directories(dir / "logs");
@@ -255,6 +282,7 @@ int run_sim(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   Args a(args);
   const std::string verb = a.positional("sim verb: assemble, swap or world");
   const std::string file = a.positional("a file");
+  const auto module_dbs = a.values("--module-db");
   const int32_t domain = domain_of(a);
   a.finish();
   const fs::path dir = run_dir(domain);
@@ -263,11 +291,13 @@ int run_sim(const std::vector<std::string>& args, std::ostream& out, std::ostrea
                   " is missing): start one with `concert up`");
   }
   if (verb == "assemble" || verb == "swap") {
+    check_assembly(file, module_dbs);
     install_file(file, dir / "assembly.yaml");
     out << "concert sim " << verb << ": " << file << " is now the mounted assembly; the robot service rescans\n";
     return 0;
   }
   if (verb == "world") {
+    check_world(file);
     install_file(file, dir / "world.yaml");
     out << "concert sim world: " << file << " is now the simulated world\n";
     return 0;

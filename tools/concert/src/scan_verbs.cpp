@@ -17,6 +17,17 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 
+}  // namespace
+
+topology::EscCatalog load_catalogs(std::vector<std::string> module_dbs) {
+  if (module_dbs.empty()) module_dbs.push_back(CONCERT_DEFAULT_MODULE_DB);
+  auto catalog = topology::EscCatalog::load(module_dbs.front());
+  for (size_t i = 1; i < module_dbs.size(); ++i) catalog.merge(topology::EscCatalog::load(module_dbs[i]));
+  return catalog;
+}
+
+namespace {
+
 /// The scan named on the command line: a scan file, or the scan an assembly gives on the
 /// simulated bus (with the module databases' ESC catalogue).
 topology::EscScan scan_from(Args& a) {
@@ -27,10 +38,7 @@ topology::EscScan scan_from(Args& a) {
     throw UsageError("give exactly one of --scan FILE or --assembly FILE");
   }
   if (scan_file) return topology::load_scan(*scan_file);
-  if (dbs.empty()) dbs.push_back(CONCERT_DEFAULT_MODULE_DB);
-  auto catalog = topology::EscCatalog::load(dbs.front());
-  for (size_t i = 1; i < dbs.size(); ++i) catalog.merge(topology::EscCatalog::load(dbs[i]));
-  return simbus::simulate_scan(simbus::load_assembly(*assembly_file), catalog);
+  return simbus::simulate_scan(simbus::load_assembly(*assembly_file), load_catalogs(dbs));
 }
 
 int64_t now_ns() {
