@@ -44,6 +44,8 @@ StatusReporter::~StatusReporter() {
   status_.state(msg::SERVICE_STOPPED);
   status_.stamp_ns(now_ns());
   writer_.write(status_);
+  // The writer goes away with us: give remote readers a moment to acknowledge the goodbye.
+  writer_.get()->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 500'000'000));
 }
 
 void StatusReporter::beat() {

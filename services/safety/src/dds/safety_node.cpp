@@ -1,0 +1,151 @@
+#include "dds/safety_node.hpp"
+
+#include <thread>
+
+#include <fastrtps/xmlparser/XMLProfileManager.h>
+
+#include "dds/conversions.hpp"
+
+namespace concert::safety::dds {
+namespace {
+
+int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string summary(const SafetyStatus& status) {
+  if (status.mode == Mode::kRunning) return "RUNNING";
+  std::string text = "STOPPED";
+  for (std::size_t i = 0; i < status.causes.size(); ++i) text += (i == 0 ? ": " : "; ") + status.causes[i];
+  return text;
+}
+
+}  // namespace
+
+void use_interprocess_delivery_only() {
+  eprosima::fastrtps::LibrarySettingsAttributes settings;
+  settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+}
+
+SafetyNode::SafetyNode(concert::dds::Participant& participant, Params params, std::ostream& log)
+    : monitor_(std::move(params), Clock::now()),
+      log_(log),
+      state_writer_(participant, concert::dds::topics::safety_state),
+      status_(participant, "safety"),
+      estops_(participant, concert::dds::topics::estop, [this](const auto& s, const auto&) { on_estop(s); }),
+      statuses_(participant, concert::dds::topics::status, [this](const auto& s, const auto&) { on_status(s); }),
+      models_(participant, concert::dds::topics::robot_model, [this](const auto& s, const auto&) { on_model(s); }),
+      joint_states_(participant, concert::dds::topics::joint_state,
+                    [this](const auto& s, const auto&) { on_joint_state(s); }),
+      resets_(participant, concert::dds::topics::safety_reset, [this](const auto& s, const auto&) { on_reset(s); }) {
+  {
+    std::lock_guard lock(mutex_);
+    publish_locked(true);
+  }
+  status_.report(msg::SERVICE_READY, 0, "RUNNING");
+}
+
+SafetyNode::~SafetyNode() = default;
+
+std::optional<std::string> SafetyNode::publish_locked(bool force) {
+  const auto now = Clock::now();
+  const bool changed = monitor_.revision() != published_revision_;
+  if (!changed && !force && now - last_publish_ < monitor_.params().publish_period) return std::nullopt;
+  state_writer_.write(to_msg(monitor_.status(), now_ns()));
+  last_publish_ = now;
+  if (!changed) return std::nullopt;
+  published_revision_ = monitor_.revision();
+  auto text = summary(monitor_.status());
+  log_ << "safety: " << text << std::endl;
+  return text;
+}
+
+void SafetyNode::note(const std::optional<std::string>& text) {
+  if (text) status_.note(*text);
+}
+
+void SafetyNode::on_estop(const msg::EStopInput& input) {
+  std::unique_lock lock(mutex_);
+  auto source = to_core(input.source());
+  if (!source) {
+    // An input we cannot name is still an input: treat it as the software stop.
+    log_ << "safety: e-stop input with unknown source " << static_cast<int>(input.source())
+         << " treated as the software stop" << std::endl;
+    source = EStopSource::kSoftware;
+  }
+  monitor_.set_estop(*source, input.engaged(), input.reason());
+  const auto text = publish_locked(false);
+  lock.unlock();
+  note(text);
+}
+
+void SafetyNode::on_status(const msg::ServiceStatus& status) {
+  std::unique_lock lock(mutex_);
+  monitor_.on_heartbeat(status.service(), status.host(), status.state() == msg::SERVICE_STOPPED, Clock::now());
+  const auto text = publish_locked(false);
+  lock.unlock();
+  note(text);
+}
+
+void SafetyNode::on_model(const msg::RobotModel& model) {
+  std::string text;
+  {
+    std::lock_guard lock(mutex_);
+    monitor_.set_model(model.version(), joint_limits(model));
+    log_ << "safety: limits of model v" << model.version() << " (" << model.joints().size() << " joints)"
+         << std::endl;
+    text = summary(monitor_.status());
+  }
+  status_.report(msg::SERVICE_READY, model.version(), text);
+}
+
+void SafetyNode::on_joint_state(const msg::JointState& state) {
+  std::unique_lock lock(mutex_);
+  if (monitor_.on_joint_state(to_core(state)) == SampleOutcome::kChecked) ++checked_samples_;
+  const auto text = publish_locked(false);
+  lock.unlock();
+  note(text);
+}
+
+void SafetyNode::on_reset(const msg::SafetyReset& reset) {
+  std::unique_lock lock(mutex_);
+  const auto outcome = monitor_.reset(reset.source().empty() ? "unnamed" : reset.source(), Clock::now());
+  log_ << "safety: " << outcome.message << std::endl;
+  auto text = publish_locked(true);
+  lock.unlock();
+  note(outcome.accepted ? text : std::optional<std::string>(outcome.message));
+}
+
+void SafetyNode::tick() {
+  std::unique_lock lock(mutex_);
+  monitor_.check_liveliness(Clock::now());
+  const auto text = publish_locked(false);
+  lock.unlock();
+  note(text);
+}
+
+void SafetyNode::spin(const std::atomic<bool>& stop) {
+  const auto period = monitor_.params().check_period;
+  auto next = Clock::now();
+  while (!stop) {
+    tick();
+    next += period;
+    const auto now = Clock::now();
+    if (next < now) next = now;
+    std::this_thread::sleep_until(next);
+  }
+}
+
+SafetyStatus SafetyNode::status() const {
+  std::lock_guard lock(mutex_);
+  return monitor_.status();
+}
+
+uint64_t SafetyNode::checked_samples() const {
+  std::lock_guard lock(mutex_);
+  return checked_samples_;
+}
+
+}  // namespace concert::safety::dds

@@ -1,0 +1,219 @@
+// Safety adapter over real DDS (one process): inputs in, SafetyState out; and the heartbeat
+// of StatusReporter that the liveliness check relies on.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <functional>
+#include <sstream>
+#include <thread>
+
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/status_reporter.hpp"
+#include "dds/conversions.hpp"
+#include "dds/safety_node.hpp"
+
+namespace concert::safety::dds {
+namespace {
+
+using namespace std::chrono_literals;
+using concert::dds::Participant;
+using concert::dds::Reader;
+using concert::dds::Writer;
+namespace topics = concert::dds::topics;
+
+/// Polls `done` every 20 ms for at most `timeout`.
+bool eventually(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (done()) return true;
+    std::this_thread::sleep_for(20ms);
+  }
+  return done();
+}
+
+/// Reads SafetyState samples until one satisfies `pred` (bounded).
+bool wait_state(Reader<msg::SafetyState>& reader, const std::function<bool(const msg::SafetyState&)>& pred,
+                std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (auto s = reader.wait(100ms); s && pred(*s)) return true;
+  }
+  return false;
+}
+
+msg::EStopInput estop(msg::EStopSource source, bool engaged) {
+  msg::EStopInput in;
+  in.source(source);
+  in.engaged(engaged);
+  in.reason("test");
+  return in;
+}
+
+/// As in concert_safety: no intra-process delivery (see use_interprocess_delivery_only()).
+const auto* const kInterprocessOnly = ::testing::AddGlobalTestEnvironment([] {
+  struct Env : ::testing::Environment {
+    void SetUp() override { use_interprocess_delivery_only(); }
+  };
+  return new Env;
+}());
+
+TEST(StatusHeartbeat, StatusIsRepublishedPeriodicallyThenStops) {
+  Participant p({.name = "hb"});
+  Reader<msg::ServiceStatus> reader(p, topics::status);
+  int beats = 0;
+  int64_t last_stamp = 0;
+  bool stopped = false;
+  {
+    concert::dds::StatusReporter status(p, "hb_test", "h1", 50ms);
+    EXPECT_EQ(status.heartbeat(), 50ms);
+    status.report(msg::SERVICE_READY, 3, "ok");
+    const auto deadline = std::chrono::steady_clock::now() + 10s;
+    while (beats < 5 && std::chrono::steady_clock::now() < deadline) {
+      if (auto s = reader.wait(100ms); s && s->state() == msg::SERVICE_READY) {
+        EXPECT_EQ(s->model_version(), 3u);
+        EXPECT_EQ(s->message(), "ok");
+        EXPECT_GT(s->stamp_ns(), last_stamp);
+        last_stamp = s->stamp_ns();
+        ++beats;
+      }
+    }
+  }
+  EXPECT_EQ(beats, 5);
+  for (int i = 0; i < 50 && !stopped; ++i) {
+    if (auto s = reader.wait(100ms)) stopped = s->state() == msg::SERVICE_STOPPED;
+  }
+  EXPECT_TRUE(stopped);
+}
+
+TEST(StatusHeartbeat, HostNameFollowsConcertHost) {
+  setenv("CONCERT_HOST", "manip-pc", 1);
+  EXPECT_EQ(concert::dds::host_name(), "manip-pc");
+  unsetenv("CONCERT_HOST");
+  EXPECT_NE(concert::dds::host_name(), "manip-pc");
+}
+
+class SafetyNodeTest : public ::testing::Test {
+ protected:
+  SafetyNodeTest() {
+    Params params;
+    params.liveliness_timeout = 400ms;
+    params.check_period = 20ms;
+    node_ = std::make_unique<SafetyNode>(participant_, params, log_);
+    spinner_ = std::thread([this] { node_->spin(stop_); });
+  }
+  ~SafetyNodeTest() override {
+    stop_ = true;
+    spinner_.join();
+  }
+
+  Participant participant_{{.name = "safety_node_test"}};
+  std::ostringstream log_;
+  std::unique_ptr<SafetyNode> node_;
+  std::atomic<bool> stop_{false};
+  std::thread spinner_;
+  Reader<msg::SafetyState> states_{participant_, topics::safety_state};
+};
+
+TEST_F(SafetyNodeTest, EStopLatchesUntilReleasedAndReset) {
+  Writer<msg::EStopInput> inputs(participant_, topics::estop);
+  Writer<msg::SafetyReset> resets(participant_, topics::safety_reset);
+  ASSERT_TRUE(wait_state(states_, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 10s));
+
+  ASSERT_TRUE(inputs.write(estop(msg::ESTOP_WIRELESS, true)));
+  ASSERT_TRUE(wait_state(
+      states_,
+      [](const auto& s) {
+        return s.mode() == msg::SAFETY_STOPPED && s.reset_required() && s.causes().size() == 1 &&
+               s.causes()[0] == "estop: wireless engaged (test)";
+      },
+      10s));
+
+  msg::SafetyReset reset;
+  reset.request_id(1);
+  reset.source("unit test");
+  ASSERT_TRUE(resets.write(reset));
+  EXPECT_TRUE(eventually([&] { return log_.str().find("refused: e-stop input(s) still engaged: wireless") !=
+                                      std::string::npos; },
+                         10s))
+      << log_.str();
+  EXPECT_EQ(node_->status().mode, Mode::kStopped);
+
+  ASSERT_TRUE(inputs.write(estop(msg::ESTOP_WIRELESS, false)));
+  EXPECT_TRUE(eventually([&] { return node_->status().mode == Mode::kStopped; }, 1s));
+  reset.request_id(2);
+  ASSERT_TRUE(resets.write(reset));
+  EXPECT_TRUE(wait_state(states_, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING && s.causes().empty(); },
+                         10s));
+}
+
+TEST_F(SafetyNodeTest, SilentTaskServiceStopsWithItsName) {
+  Writer<msg::ServiceStatus> statuses(participant_, topics::status);
+  msg::ServiceStatus beat;
+  beat.id(concert::dds::status_instance_id("planner", "manip"));
+  beat.service("planner");
+  beat.host("manip");
+  beat.state(msg::SERVICE_READY);
+  for (int i = 0; i < 10; ++i) {  // 0.5 s of heartbeats: alive
+    ASSERT_TRUE(statuses.write(beat));
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(node_->status().mode, Mode::kRunning);
+  ASSERT_TRUE(wait_state(
+      states_,
+      [](const auto& s) {
+        return s.mode() == msg::SAFETY_STOPPED && s.causes().size() == 1 &&
+               s.causes()[0].find("liveliness: planner@manip silent for") == 0;
+      },
+      10s))
+      << log_.str();
+}
+
+TEST_F(SafetyNodeTest, JointBeyondModelLimitStops) {
+  Writer<msg::RobotModel> models(participant_, topics::robot_model);
+  Writer<msg::JointState> joints(participant_, topics::joint_state);
+  msg::RobotModel model;
+  model.version(5);
+  msg::JointInfo j;
+  j.name("J1_A");
+  j.lower(-1.0);
+  j.upper(1.0);
+  j.velocity(2.0);
+  j.effort(80.0);
+  model.joints({j});
+  ASSERT_TRUE(models.write(model));
+  ASSERT_TRUE(eventually([&] { return log_.str().find("limits of model v5 (1 joints)") != std::string::npos; }, 10s));
+  ASSERT_TRUE(joints.wait_for_readers(1, 10s));
+
+  msg::JointState state;
+  state.model_version(5);
+  state.name({"J1_A"});
+  state.position({0.5});
+  state.velocity({0.0});
+  state.effort({10.0});
+  // Best-effort stream: send until the node has checked some samples (bounded).
+  for (int i = 0; i < 200 && node_->checked_samples() < 5; ++i) {
+    joints.write(state);
+    std::this_thread::sleep_for(5ms);
+  }
+  EXPECT_GE(node_->checked_samples(), 5u);
+  EXPECT_EQ(node_->status().mode, Mode::kRunning);
+
+  state.effort({95.0});
+  for (int i = 0; i < 200 && node_->status().mode == Mode::kRunning; ++i) {
+    joints.write(state);
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_EQ(node_->status().mode, Mode::kStopped);
+  EXPECT_EQ(node_->status().causes[0], "limits: joint J1_A effort 95.00 beyond +-88.00 (model v5)");
+}
+
+TEST(SafetyConversions, EStopSourcesRoundTrip) {
+  for (std::size_t i = 0; i < kEStopSourceCount; ++i) {
+    const auto s = static_cast<EStopSource>(i);
+    EXPECT_EQ(to_core(to_msg(s)), s);
+  }
+  EXPECT_FALSE(to_core(static_cast<msg::EStopSource>(42)));
+}
+
+}  // namespace
+}  // namespace concert::safety::dds

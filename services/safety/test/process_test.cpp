@@ -1,0 +1,136 @@
+// concert_safety as a real process over DDS: e-stop -> STOPPED, reset refused while engaged,
+// released + reset -> RUNNING, a silent task service named in the stop, clean SIGINT stop;
+// bad arguments and params files exit non-zero with one line naming the problem.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <thread>
+
+#include "concert/dds/endpoint.hpp"
+#include "process.hpp"
+
+namespace concert::safety {
+namespace {
+
+using namespace std::chrono_literals;
+using concert::dds::Participant;
+using concert::dds::Reader;
+using concert::dds::Writer;
+namespace topics = concert::dds::topics;
+
+bool wait_state(Reader<msg::SafetyState>& reader, const std::function<bool(const msg::SafetyState&)>& pred,
+                std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (auto s = reader.wait(100ms); s && pred(*s)) return true;
+  }
+  return false;
+}
+
+std::filesystem::path temp_file(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(SafetyProcess, EStopResetAndLivelinessOverDds) {
+  const auto params = temp_file("safety_params", "liveliness_timeout: 0.5\ntask_services: [drill]\n");
+  testing::Process safety({SAFETY_BINARY, "--params", params.string()});
+  {
+    Participant p({.name = "safety_process_test"});
+    Reader<msg::SafetyState> states(p, topics::safety_state);
+    Writer<msg::EStopInput> inputs(p, topics::estop);
+    Writer<msg::SafetyReset> resets(p, topics::safety_reset);
+    Writer<msg::ServiceStatus> statuses(p, topics::status);
+    ASSERT_TRUE(wait_state(states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 20s))
+        << safety.err();
+    ASSERT_TRUE(inputs.wait_for_readers(1, 10s));
+    ASSERT_TRUE(resets.wait_for_readers(1, 10s));
+
+    msg::EStopInput button;
+    button.source(msg::ESTOP_BUTTON_REAR_LEFT);
+    button.engaged(true);
+    button.reason("pressed");
+    ASSERT_TRUE(inputs.write(button));
+    ASSERT_TRUE(wait_state(
+        states,
+        [](const auto& s) {
+          return s.mode() == msg::SAFETY_STOPPED && s.reset_required() && s.causes().size() == 1 &&
+                 s.causes()[0] == "estop: button rear left engaged (pressed)";
+        },
+        10s))
+        << safety.err();
+
+    msg::SafetyReset reset;
+    reset.request_id(1);
+    reset.source("process test");
+    ASSERT_TRUE(resets.write(reset));
+    // Refused: the state stays STOPPED through at least one more publication.
+    EXPECT_FALSE(wait_state(states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 1s));
+
+    button.engaged(false);
+    ASSERT_TRUE(inputs.write(button));
+    EXPECT_FALSE(wait_state(states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 1s));
+    reset.request_id(2);
+    ASSERT_TRUE(resets.write(reset));
+    ASSERT_TRUE(wait_state(states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 10s))
+        << safety.err();
+
+    // A drill service beats for a while, then goes silent (writer alive, no more samples).
+    msg::ServiceStatus beat;
+    beat.id(concert::dds::status_instance_id("drill", "manip-pc"));
+    beat.service("drill");
+    beat.host("manip-pc");
+    beat.state(msg::SERVICE_READY);
+    for (int i = 0; i < 8; ++i) {
+      ASSERT_TRUE(statuses.write(beat));
+      std::this_thread::sleep_for(50ms);
+    }
+    ASSERT_TRUE(wait_state(
+        states,
+        [](const auto& s) {
+          return s.mode() == msg::SAFETY_STOPPED && !s.causes().empty() &&
+                 s.causes()[0].find("liveliness: drill@manip-pc silent for") == 0;
+        },
+        10s))
+        << safety.err();
+  }
+  EXPECT_EQ(safety.stop(15s), 0);
+  const auto err = safety.err();
+  EXPECT_NE(err.find("safety: reset by process test refused: e-stop input(s) still engaged: button rear left"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(err.find("safety: reset by process test accepted: 1 cause(s) cleared"), std::string::npos) << err;
+  EXPECT_NE(err.find("safety: STOPPED: liveliness: drill@manip-pc silent"), std::string::npos) << err;
+  std::filesystem::remove(params);
+}
+
+std::pair<int, std::string> run(std::vector<std::string> args) {
+  args.insert(args.begin(), SAFETY_BINARY);
+  testing::Process p(args);
+  const auto code = p.wait(15s);
+  return {code.value_or(-1), p.err()};
+}
+
+TEST(SafetyProcess, BadArgumentsExitNonZeroWithOneLine) {
+  auto [code, err] = run({"--bogus"});
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(err.find("concert_safety: unknown argument '--bogus'"), std::string::npos) << err;
+  std::tie(code, err) = run({"--params"});
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(err.find("option --params needs a value"), std::string::npos) << err;
+  std::tie(code, err) = run({"--params", "/nonexistent/safety.yaml"});
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(err.find("/nonexistent/safety.yaml: cannot read"), std::string::npos) << err;
+  const auto bad = temp_file("safety_bad", "liveliness_timeout: soon\n");
+  std::tie(code, err) = run({"--params", bad.string()});
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(err.find(bad.string() + ": liveliness_timeout: 'soon' is not a number"), std::string::npos) << err;
+  std::filesystem::remove(bad);
+}
+
+}  // namespace
+}  // namespace concert::safety
