@@ -16,12 +16,14 @@ namespace {
 using namespace std::chrono_literals;
 namespace cdds = concert::dds;
 
-// Runs cycles (publishing after each) until `done` or `max_cycles`.
-template <class F> bool run_until(RobotCore& core, dds::RobotNode& node, F done, int max_cycles = 5000) {
-  for (int i = 0; i < max_cycles; ++i) {
+// Runs cycles (publishing after each) until `done`, at most `max_cycles` cycles and 20 s of
+// wall time (DDS delivery on a loaded machine can take a while).
+template <class F> bool run_until(RobotCore& core, dds::RobotNode& node, F done, int max_cycles = 200000) {
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  for (int i = 0; i < max_cycles && std::chrono::steady_clock::now() < deadline; ++i) {
     core.cycle();
     node.publish(core.state());
-    if (i % 50 == 0) {
+    if (i % 20 == 0) {
       std::this_thread::sleep_for(1ms);  // let the DDS threads deliver
     }
     if (done()) {
