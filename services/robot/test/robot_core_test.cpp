@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <thread>
 
 #include "test_helpers.hpp"
 
@@ -182,6 +184,40 @@ TEST(RobotCore, CartesianWithZeroGainsIsGravityCompensation) {
   EXPECT_NEAR(s.position[hw_index(s, "J2_A")], 0.5, 5e-3);
   EXPECT_NEAR(s.position[hw_index(s, "J3_A")], 0.6, 5e-3);
   EXPECT_EQ(s.owners[hw_index(s, "J2_A")], JointOwner::kCartesian);
+}
+
+TEST_F(RobotCoreTest, CommandsAndModelsFromAnotherThreadWhileCycling) {
+  core_.set_model(read_fixture("mobile_drill.urdf"), 1);
+  std::atomic<bool> finished{false};
+  std::atomic<int> accepted{0};
+  std::atomic<int> bumps{0};
+  std::thread client([&] {
+    for (int k = 0; k < 300; ++k) {
+      try {
+        core_.command_base({core_.model_version(), 0.1, 0.0, 0.0});
+        core_.command_joints({core_.model_version(), {{"J1_A", DriveMode::kPosition, 0.001 * k, 0, 0, 0, 0}}});
+        if (k % 100 == 50) {
+          core_.set_model(read_fixture("mobile_drill.urdf"), core_.model_version() + 1);
+          ++bumps;
+        }
+        (void)core_.state();
+        ++accepted;
+      } catch (const CommandError&) {
+        // A version bump between reading model_version() and commanding: refused, fine.
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    finished = true;
+  });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  for (int i = 0; i < 1000000 && !finished.load() && std::chrono::steady_clock::now() < deadline; ++i) {
+    core_.cycle();
+  }
+  client.join();
+  EXPECT_GE(accepted.load(), 200);
+  EXPECT_GE(bumps.load(), 2);
+  EXPECT_EQ(core_.model_version(), 1u + static_cast<unsigned>(bumps.load()));
+  EXPECT_TRUE(core_.ready());
 }
 
 TEST_F(RobotCoreTest, HotSwapThenReconfigureToTheNewModel) {
