@@ -1,0 +1,177 @@
+// Syntax and placement checks of the deployment files (no Docker engine runs on these
+// machines): deploy/compose.yaml parsed as YAML with its merge keys resolved and checked
+// against the compose specification's keys and the three-PC placement; deploy/Dockerfile's
+// sources exist. If a `docker compose` CLI is installed, `docker compose config` must accept
+// the file too (it needs no engine).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <yaml-cpp/yaml.h>
+
+namespace concert::system_test {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kDeploy = fs::path(CONCERT_SOURCE_DIR) / "deploy";
+
+/// yaml-cpp keeps `<<: *anchor` as an ordinary key: apply YAML merge keys (local keys win).
+YAML::Node resolve_merges(const YAML::Node& node) {
+  if (node.IsSequence()) {
+    YAML::Node out(YAML::NodeType::Sequence);
+    for (const auto& item : node) out.push_back(resolve_merges(item));
+    return out;
+  }
+  if (!node.IsMap()) return node;
+  YAML::Node out(YAML::NodeType::Map);
+  for (const auto& entry : node) {
+    if (entry.first.Scalar() != "<<") out[entry.first.Scalar()] = resolve_merges(entry.second);
+  }
+  if (const auto merge = node["<<"]) {
+    std::vector<YAML::Node> sources;
+    if (merge.IsSequence()) {
+      for (const auto& m : merge) sources.push_back(m);
+    } else {
+      sources.push_back(merge);
+    }
+    for (const auto& source : sources) {
+      const auto resolved = resolve_merges(source);
+      for (const auto& entry : resolved) {
+        if (!out[entry.first.Scalar()]) out[entry.first.Scalar()] = entry.second;
+      }
+    }
+  }
+  return out;
+}
+
+/// "${VAR:-default}" -> "default"; other text unchanged.
+std::string with_defaults(const std::string& text) {
+  return std::regex_replace(text, std::regex(R"(\$\{[A-Z_]+:-([^}]*)\})"), "$1");
+}
+
+const std::map<std::string, std::string> kPlacement = {
+    {"robot", "rt"},     {"safety", "rt"}, {"discovery", "rt"}, {"modelgen", "rt"},
+    {"nav", "nav"},      {"planner", "manip"}, {"drill", "manip"}, {"collab", "manip"},
+    {"surface_finish", "manip"}};
+const std::map<std::string, std::string> kHostOf = {{"rt", "rt-pc"}, {"nav", "nav-pc"}, {"manip", "manip-pc"}};
+
+// Service keys of the compose specification that this file may use.
+const std::set<std::string> kServiceKeys = {
+    "image", "build", "command", "entrypoint", "environment", "env_file", "volumes", "network_mode", "networks",
+    "ipc", "pid", "restart", "init", "stop_signal", "stop_grace_period", "profiles", "deploy", "cap_add",
+    "cap_drop", "ulimits", "hostname", "depends_on", "healthcheck", "labels", "devices", "privileged",
+    "user", "working_dir", "shm_size", "sysctls", "logging", "extra_hosts", "security_opt", "cpuset"};
+
+YAML::Node load_compose() { return resolve_merges(YAML::LoadFile((kDeploy / "compose.yaml").string())); }
+
+TEST(DeployCompose, ParsesWithOnlyComposeKeys) {
+  YAML::Node compose;
+  ASSERT_NO_THROW(compose = load_compose());
+  ASSERT_TRUE(compose.IsMap());
+  for (const auto& entry : compose) {
+    const auto key = entry.first.Scalar();
+    EXPECT_TRUE(key.rfind("x-", 0) == 0 || key == "name" || key == "services" || key == "volumes" ||
+                key == "networks" || key == "configs" || key == "secrets")
+        << "unknown top-level key '" << key << "'";
+  }
+  ASSERT_TRUE(compose["services"].IsMap());
+  for (const auto& service : compose["services"]) {
+    const auto name = service.first.Scalar();
+    for (const auto& key : service.second) {
+      EXPECT_TRUE(kServiceKeys.count(key.first.Scalar())) << name << ": unknown key '" << key.first.Scalar() << "'";
+    }
+  }
+}
+
+TEST(DeployCompose, EveryServiceOnItsPcWithHostNetworkingAndDds) {
+  const auto compose = load_compose();
+  std::set<std::string> seen;
+  for (const auto& entry : compose["services"]) {
+    const auto name = entry.first.Scalar();
+    const auto& s = entry.second;
+    seen.insert(name);
+    ASSERT_TRUE(kPlacement.count(name)) << "service '" << name << "' is not one of the stack's services";
+    const auto pc = kPlacement.at(name);
+    EXPECT_FALSE(s["image"].Scalar().empty()) << name;
+    EXPECT_EQ(s["network_mode"].Scalar(), "host") << name;
+    EXPECT_EQ(s["ipc"].Scalar(), "host") << name << ": shared memory between containers needs the host IPC";
+    EXPECT_FALSE(s["hostname"]) << name << ": docker refuses hostname together with network_mode host";
+    ASSERT_TRUE(s["profiles"].IsSequence()) << name;
+    EXPECT_EQ(s["profiles"].size(), 1u) << name;
+    EXPECT_EQ(s["profiles"][0].Scalar(), pc) << name;
+    ASSERT_TRUE(s["deploy"]["placement"]["constraints"].IsSequence()) << name;
+    EXPECT_EQ(s["deploy"]["placement"]["constraints"][0].Scalar(), "node.labels.concert.pc == " + pc) << name;
+    const auto env = s["environment"];
+    ASSERT_TRUE(env.IsMap()) << name;
+    EXPECT_TRUE(env["CONCERT_DOMAIN_ID"]) << name;
+    EXPECT_EQ(env["CONCERT_HOST"].Scalar(), kHostOf.at(pc)) << name;
+    EXPECT_EQ(env["CONCERT_DDS_PROFILES"].Scalar(), "/etc/concert/fastdds_profiles.xml") << name;
+    ASSERT_TRUE(s["command"].IsSequence()) << name;
+    EXPECT_EQ(s["command"][0].Scalar(), "concert_" + name) << name;
+    bool profile_mounted = false;
+    for (const auto& v : s["volumes"]) {
+      const auto spec = with_defaults(v.Scalar());
+      const auto source = spec.substr(0, spec.find(':'));
+      if (source.rfind("./", 0) == 0) {
+        EXPECT_TRUE(fs::exists(kDeploy / source)) << name << ": volume source " << source << " is missing";
+      } else {
+        EXPECT_TRUE(compose["volumes"][source]) << name << ": named volume '" << source << "' is not declared";
+      }
+      profile_mounted |= spec.find(":/etc/concert/fastdds_profiles.xml") != std::string::npos;
+    }
+    EXPECT_TRUE(profile_mounted) << name;
+  }
+  for (const auto& [name, pc] : kPlacement) EXPECT_TRUE(seen.count(name)) << name << " (" << pc << ") is missing";
+}
+
+TEST(DeployCompose, DockerComposeAcceptsItWhenInstalled) {
+  FILE* probe = popen("docker compose version 2>/dev/null", "r");
+  ASSERT_NE(probe, nullptr);
+  char buf[256] = {};
+  const bool have = fgets(buf, sizeof buf, probe) != nullptr;
+  const int rc = pclose(probe);
+  if (!have || rc != 0) {
+    std::cout << "no `docker compose` CLI here: the YAML checks above are the syntax check\n";
+    return;
+  }
+  for (const char* profile : {"rt", "nav", "manip"}) {
+    const auto cmd = "docker compose -f '" + (kDeploy / "compose.yaml").string() + "' --profile " + profile +
+                     " config -q 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  }
+}
+
+TEST(DeployDockerfile, DebianBaseInstallDepsAndSourcesExist) {
+  std::ifstream in(kDeploy / "Dockerfile");
+  ASSERT_TRUE(in);
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto dockerfile = text.str();
+  EXPECT_NE(dockerfile.find("ARG DEBIAN_IMAGE=debian:12"), std::string::npos);
+  EXPECT_NE(dockerfile.find("RUN /opt/concert/src/deploy/install-deps.sh"), std::string::npos);
+  const std::regex copy(R"(^COPY (?!--from)(\S+) )", std::regex::multiline);
+  int copies = 0;
+  for (auto it = std::sregex_iterator(dockerfile.begin(), dockerfile.end(), copy); it != std::sregex_iterator();
+       ++it) {
+    const auto source = (*it)[1].str();
+    EXPECT_TRUE(fs::exists(fs::path(CONCERT_SOURCE_DIR) / source)) << "COPY source missing: " << source;
+    ++copies;
+  }
+  EXPECT_GE(copies, 6);
+  // Every service binary the compose file runs on the RT PC is built into the image.
+  const auto compose = load_compose();
+  for (const char* rt : {"robot", "safety", "discovery", "modelgen"}) {
+    const auto binary = compose["services"][rt]["command"][0].Scalar();
+    EXPECT_NE(dockerfile.find(" " + binary), std::string::npos) << binary << " is not built by the Dockerfile";
+  }
+}
+
+}  // namespace
+}  // namespace concert::system_test
