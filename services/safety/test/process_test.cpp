@@ -7,10 +7,12 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <sstream>
 #include <thread>
 
 #include "concert/dds/endpoint.hpp"
 #include "process.hpp"
+#include "safety/cli.hpp"
 
 namespace concert::safety {
 namespace {
@@ -106,6 +108,59 @@ TEST(SafetyProcess, EStopResetAndLivelinessOverDds) {
   EXPECT_NE(err.find("safety: reset by process test accepted: 1 cause(s) cleared"), std::string::npos) << err;
   EXPECT_NE(err.find("safety: STOPPED: liveliness: drill@manip-pc silent"), std::string::npos) << err;
   std::filesystem::remove(params);
+}
+
+/// Runs `concert safety <args>` in this process; returns (code, stdout + stderr).
+std::pair<int, std::string> cli(const std::vector<std::string>& args) {
+  std::ostringstream out, err;
+  const int code = cli_main(args, out, err);
+  return {code, out.str() + err.str()};
+}
+
+TEST(SafetyProcess, OperatorVerbsEStopStatusReset) {
+  testing::Process safety({SAFETY_BINARY});
+  auto [code, text] = cli({"status", "--timeout-ms", "20000"});
+  ASSERT_EQ(code, 0) << text << safety.err();
+  EXPECT_EQ(text, "safety: RUNNING\n");
+
+  std::tie(code, text) = cli({"estop", "--source", "wireless", "--reason", "operator walked away"});
+  ASSERT_EQ(code, 0) << text;
+  EXPECT_EQ(text, "safety: e-stop wireless engaged\n");
+  std::tie(code, text) = cli({"status"});
+  EXPECT_EQ(code, 0);
+  EXPECT_NE(text.find("STOPPED (reset required)\n  estop: wireless engaged (operator walked away)"), std::string::npos)
+      << text;
+
+  std::tie(code, text) = cli({"reset", "--source", "operator panel"});
+  EXPECT_EQ(code, 1) << text;
+  EXPECT_NE(text.find("concert safety reset: reset by operator panel refused: e-stop input(s) still engaged: wireless"),
+            std::string::npos)
+      << text;
+
+  std::tie(code, text) = cli({"estop", "--source", "wireless", "--release"});
+  EXPECT_EQ(code, 0) << text;
+  std::tie(code, text) = cli({"reset"});
+  EXPECT_EQ(code, 0) << text << safety.err();
+  EXPECT_EQ(text, "safety: RUNNING\n");
+  EXPECT_EQ(safety.stop(15s), 0);
+}
+
+TEST(SafetyCli, UsageErrorsAndNoService) {
+  auto [code, text] = cli({});
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(text.find("expected a verb: status, estop or reset"), std::string::npos) << text;
+  std::tie(code, text) = cli({"estop", "--source", "left"});
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(text.find("--source: 'left' is not front-left, front-right"), std::string::npos) << text;
+  std::tie(code, text) = cli({"status", "--timeout-ms", "soon"});
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(text.find("--timeout-ms: 'soon' is not a number"), std::string::npos) << text;
+  std::tie(code, text) = cli({"status", "--release"});
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(text.find("safety status: unknown argument '--release'"), std::string::npos) << text;
+  std::tie(code, text) = cli({"reset", "--timeout-ms", "300"});  // no safety service running
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(text.find("concert safety: no safety service on domain"), std::string::npos) << text;
 }
 
 std::pair<int, std::string> run(std::vector<std::string> args) {
