@@ -1,0 +1,131 @@
+// bench_planner: a fixed, seeded set of drilling-approach problems per morphology (paper
+// section 6.1: walls with drilling areas at heights 0.35-2.9 m, obstacles on the floor), run
+// through the whole planner (NSPG + RRT-Connect + simplification + timing). Reports success
+// rate and planning time median / p95 per morphology. Not a test: no assertions on time.
+//
+//   bench_planner [--problems N] [--seed S] [--contact-force NEWTON] [--verbose]
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <random>
+#include <string>
+
+#include "planner/fixtures.hpp"
+#include "planner/planner.hpp"
+
+using namespace concert::planner;
+
+namespace {
+
+struct Problem {
+  double wall_x;
+  double y;
+  double z;
+  World world;
+  Eigen::Vector3d start_base;
+};
+
+std::vector<Problem> make_problems(int count, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> wall(1.8, 2.6);
+  std::uniform_real_distribution<double> lateral(-0.6, 0.6);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Problem> out;
+  for (int i = 0; i < count; ++i) {
+    Problem p;
+    p.wall_x = wall(rng);
+    p.y = lateral(rng);
+    // Heights spread evenly over the paper's range 0.35-2.9 m, jittered.
+    p.z = 0.35 + (2.9 - 0.35) * (i + unit(rng)) / count;
+    p.world.boxes.push_back(fixtures::wall_at(p.wall_x));
+    // One or two obstacles between the robot and the wall, off the straight line.
+    const int obstacles = 1 + static_cast<int>(rng() % 2);
+    for (int k = 0; k < obstacles; ++k) {
+      const double side = (k % 2 == 0) ? 1.0 : -1.0;
+      const double oy = side * (0.9 + 0.5 * unit(rng));
+      const double ox = 0.6 + (p.wall_x - 1.0) * unit(rng);
+      if (rng() % 2 == 0) {
+        p.world.boxes.push_back({"box" + std::to_string(k), Eigen::Vector3d(0.5 + 0.4 * unit(rng), 0.4 + 0.3 * unit(rng), 0.3 + 0.9 * unit(rng)),
+                                 Eigen::Vector3d(ox, oy, 0.0), 3.0 * unit(rng)});
+        p.world.boxes.back().position.z() = 0.5 * p.world.boxes.back().size.z();
+      } else {
+        p.world.cylinders.push_back({"pillar" + std::to_string(k), 0.1 + 0.1 * unit(rng), 3.0, Eigen::Vector3d(ox, oy, 1.5)});
+      }
+    }
+    p.start_base = Eigen::Vector3d(0.0, 0.0, 0.3 * (unit(rng) - 0.5));
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto i = static_cast<std::size_t>(std::ceil(p * static_cast<double>(v.size()))) - 1;
+  return v[std::min(i, v.size() - 1)];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int count = 24;
+  uint64_t seed = 2024;
+  bool verbose = false;
+  double contact_force = Params{}.contact_force;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--problems" && i + 1 < argc) {
+      count = std::stoi(argv[++i]);
+    } else if (a == "--seed" && i + 1 < argc) {
+      seed = std::stoull(argv[++i]);
+    } else if (a == "--contact-force" && i + 1 < argc) {
+      contact_force = std::stod(argv[++i]);
+    } else if (a == "--verbose") {
+      verbose = true;
+    } else {
+      std::cerr << "bench_planner: unknown argument '" << a << "' (use --problems N, --seed S, --contact-force NEWTON, --verbose)\n";
+      return 2;
+    }
+  }
+  const std::vector<Problem> problems = make_problems(count, seed);
+  std::printf("drilling force checked at the goal: %.0f N\n", contact_force);
+  std::printf("%-12s %8s %9s %11s %11s %11s\n", "morphology", "problems", "success", "median ms", "p95 ms", "max ms");
+  for (const char m : {'a', 'b'}) {
+    Params params;
+    params.seed = seed;
+    params.contact_force = contact_force;
+    Planner planner(params);
+    planner.set_model(fixtures::model_from_assembly(fixtures::data_dir() / (std::string("morphology_") + m + ".yaml"), 1));
+    const auto model = planner.model();
+    std::vector<double> times;
+    int ok = 0;
+    std::map<std::string, int> failures;
+    for (std::size_t i = 0; i < problems.size(); ++i) {
+      const Problem& p = problems[i];
+      Environment env(params.octomap_resolution);
+      env.add_world(p.world);
+      planner.set_environment(env);
+      Eigen::VectorXd start = Eigen::VectorXd::Zero(model->full_dof());
+      start.head<3>() = p.start_base;
+      PlanRequest req{i + 1, 1, "", {{fixtures::drilling_area(p.wall_x, p.y, p.z)}}};
+      const auto t0 = std::chrono::steady_clock::now();
+      const PlanResult r = planner.plan(req, start, {});
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      times.push_back(ms);
+      const bool success = r.status == Status::kSucceeded && ms <= 2000.0;
+      ok += success ? 1 : 0;
+      if (!success) failures[to_string(r.status)] += 1;
+      if (verbose) {
+        std::printf("  %c #%02zu wall %.2f m, area (%.2f, %.2f) m: %-12s %8.1f ms (nspg %.1f ms)  %s\n", m, i, p.wall_x, p.y, p.z,
+                    to_string(r.status), ms, r.goals.empty() ? 0.0 : 1e3 * r.goals[0].nspg_seconds, r.reason.c_str());
+      }
+    }
+    std::printf("%-12c %8zu %8.1f%% %11.1f %11.1f %11.1f\n", std::toupper(m), problems.size(), 100.0 * ok / static_cast<double>(problems.size()),
+                percentile(times, 0.5), percentile(times, 0.95), percentile(times, 1.0));
+    for (const auto& [why, n] : failures) std::printf("    failed: %d x %s\n", n, why.c_str());
+  }
+  return 0;
+}

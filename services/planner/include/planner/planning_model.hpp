@@ -1,0 +1,108 @@
+#pragma once
+// The planner's view of one robot model version: whole-body configuration space (planar base
+// x, y, yaw + the arm joints), link geometry for FCL, SRDF-disabled pairs, torque limits.
+// Immutable once built (Model/Data split: per-thread state lives in StateChecker).
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "concert/kinematics/model.hpp"
+#include "planner/types.hpp"
+
+namespace concert::planner {
+
+/// A collision primitive of a link, in the link frame.
+struct LinkShape {
+  enum class Type { kBox, kCylinder, kSphere };
+  Type type = Type::kBox;
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();  ///< box: full extents; cylinder: (r, r, length); sphere: (r, r, r) [m]
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
+};
+
+/// A link of the URDF tree in topological order (parents first).
+struct LinkNode {
+  std::string name;
+  int parent = -1;                  ///< index in PlanningModel::links(); -1 for the root
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< parent_T_joint at q = 0
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< joint axis in the joint frame
+  int full_index = -1;              ///< index of the joint in the full q; -1: fixed joint
+  bool prismatic = false;
+  std::vector<LinkShape> shapes;    ///< collision primitives
+  bool leg = false;                 ///< belongs to a leg chain (touches the floor)
+  int rigid_group = -1;             ///< nearest planned arm joint above it (-1: base group)
+};
+
+/// One model version, ready for planning. Build with PlanningModel::build.
+class PlanningModel {
+ public:
+  /// Builds from a model description. Throws PlannerError naming what is wrong (URDF parse
+  /// error, joint listed but absent from the URDF, no arm chain, mesh-only links are reported
+  /// in ignored_shapes()).
+  static std::shared_ptr<const PlanningModel> build(const ModelDescription& description, const Params& params);
+
+  [[nodiscard]] uint64_t version() const { return version_; }
+  [[nodiscard]] const ModelDescription& description() const { return description_; }
+  /// orocos-kdl model with a planar base (base_x, base_y, base_yaw first).
+  [[nodiscard]] const kinematics::Model& kinematics() const { return kinematics_; }
+  /// Size of the full joint vector (kinematics().dof()).
+  [[nodiscard]] int full_dof() const { return kinematics_.dof(); }
+  /// Planned joints: base_x, base_y, base_yaw, then the arm joints (chains of role "arm").
+  [[nodiscard]] int dof() const { return static_cast<int>(planned_.size()); }
+  [[nodiscard]] const std::vector<std::string>& joint_names() const { return planned_names_; }
+  /// Index in the full q of each planned joint.
+  [[nodiscard]] const std::vector<int>& planned_indices() const { return planned_; }
+  /// Position limits of the planned joints (base: +-infinity) [m, rad].
+  [[nodiscard]] const Eigen::VectorXd& lower() const { return lower_; }
+  [[nodiscard]] const Eigen::VectorXd& upper() const { return upper_; }
+  /// Velocity limits of the planned joints [m/s, rad/s] (base from Params).
+  [[nodiscard]] const Eigen::VectorXd& velocity_limits() const { return velocity_; }
+  /// Continuous torque limit per full joint [N m]; 0: not limited (virtual, legs).
+  [[nodiscard]] const Eigen::VectorXd& torque_limits() const { return torque_; }
+  /// World z of the base link [m].
+  [[nodiscard]] double base_height() const { return base_height_; }
+  [[nodiscard]] const std::vector<LinkNode>& links() const { return links_; }
+  /// Pairs of link indices never checked against each other (SRDF or rigidly attached).
+  [[nodiscard]] bool pair_disabled(int a, int b) const;
+  /// Collision elements the model has but the planner ignores (meshes), as "link: reason".
+  [[nodiscard]] const std::vector<std::string>& ignored_shapes() const { return ignored_; }
+
+  /// The tool end-effector (`name`, or the first with a camera frame when empty); throws
+  /// PlannerError listing the candidates.
+  [[nodiscard]] const EndEffectorSpec& tool(const std::string& name) const;
+  /// Camera frame of a tool end-effector; throws PlannerError if the model has none.
+  [[nodiscard]] std::string camera_frame(const EndEffectorSpec& tool) const;
+
+  /// World pose of every link (links() order) for a full q [m, rad].
+  void link_poses(const Eigen::VectorXd& q_full, std::vector<Eigen::Isometry3d>& poses) const;
+  /// World pose of one link (with the base height).
+  [[nodiscard]] Eigen::Isometry3d link_pose(const Eigen::VectorXd& q_full, const std::string& link) const;
+  /// Index of a link in links(), or -1.
+  [[nodiscard]] int link_index(const std::string& name) const;
+
+  /// Full q from planned q, other joints from `full_template`.
+  [[nodiscard]] Eigen::VectorXd to_full(const Eigen::VectorXd& planned, const Eigen::VectorXd& full_template) const;
+  /// Planned part of a full q.
+  [[nodiscard]] Eigen::VectorXd to_planned(const Eigen::VectorXd& full) const;
+  /// Full q from joint names and positions (missing joints 0; unknown names are errors) and a
+  /// base pose (x, y, yaw).
+  [[nodiscard]] Eigen::VectorXd full_from_named(const std::vector<std::string>& names, const std::vector<double>& positions,
+                                                const Eigen::Vector3d& base) const;
+
+ private:
+  explicit PlanningModel(kinematics::Model kinematics) : kinematics_(std::move(kinematics)) {}
+
+  uint64_t version_ = 0;
+  ModelDescription description_;
+  kinematics::Model kinematics_;
+  std::vector<int> planned_;
+  std::vector<std::string> planned_names_;
+  Eigen::VectorXd lower_, upper_, velocity_, torque_;
+  double base_height_ = 0.0;
+  std::vector<LinkNode> links_;
+  std::vector<std::vector<bool>> disabled_;
+  std::vector<std::string> ignored_;
+  std::string camera_prefix_;
+};
+
+}  // namespace concert::planner

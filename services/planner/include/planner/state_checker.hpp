@@ -1,0 +1,44 @@
+#pragma once
+// State validity (paper section 5.4.2): joint limits, self-collision (FCL, SRDF-disabled pairs
+// skipped), collision with the OctoMap environment and the floor, torque limits (static gravity
+// torques plus the expected contact force under each continuous torque).
+
+#include <memory>
+#include <string>
+
+#include "planner/environment.hpp"
+#include "planner/planning_model.hpp"
+
+namespace concert::planner {
+
+/// Per-thread checker of one model version and one environment (holds FCL objects and KDL
+/// scratch data). Not thread-safe; make one per thread.
+class StateChecker {
+ public:
+  /// `padding` [m] grows the robot shapes against the environment (not against themselves).
+  StateChecker(std::shared_ptr<const PlanningModel> model, const Environment& environment, const Params& params, double padding);
+  ~StateChecker();
+  StateChecker(const StateChecker&) = delete;
+  StateChecker& operator=(const StateChecker&) = delete;
+
+  /// Checks a full q. With `contact_frame` non-empty, the expected contact force
+  /// (Params::contact_force) pushes back on that frame along its -z axis in the torque check.
+  /// Returns the first constraint violated, in the order joint limit, torque, floor,
+  /// environment, self collision.
+  [[nodiscard]] Validity check(const Eigen::VectorXd& q_full, const std::string& contact_frame = {});
+  /// Joint torques the state needs (gravity + contact) [N m], full q order.
+  [[nodiscard]] Eigen::VectorXd required_torques(const Eigen::VectorXd& q_full, const std::string& contact_frame);
+  /// Number of check() calls so far.
+  [[nodiscard]] std::size_t checks() const { return checks_; }
+  [[nodiscard]] const PlanningModel& model() const { return *model_; }
+
+  struct Impl;
+
+ private:
+  std::shared_ptr<const PlanningModel> model_;
+  Params params_;
+  std::unique_ptr<Impl> impl_;
+  std::size_t checks_ = 0;
+};
+
+}  // namespace concert::planner

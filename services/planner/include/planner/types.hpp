@@ -1,0 +1,187 @@
+#pragma once
+// Plain data of the planner core (paper section 5.4.2): the robot model it is built from,
+// parameters, requests, trajectories and results. No DDS, no generated IDL types.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace concert::planner {
+
+/// A model, request or environment the planner cannot use; what() names the field or item.
+class PlannerError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// One moving joint of the robot model (RobotModel.joints).
+struct JointSpec {
+  std::string name;
+  std::string chain;      ///< chain tag ("A", "B", ...)
+  double lower = 0.0;     ///< [rad] (or [m])
+  double upper = 0.0;     ///< [rad]
+  double velocity = 0.0;  ///< limit [rad/s]
+  double effort = 0.0;    ///< continuous torque limit [N m]
+};
+
+/// A kinematic chain (RobotModel.chains).
+struct ChainSpec {
+  std::string name;                 ///< chain tag
+  std::string role;                 ///< "arm", "leg" or "other"
+  std::vector<std::string> joints;  ///< root to tip
+};
+
+/// An end-effector (RobotModel.end_effectors).
+struct EndEffectorSpec {
+  std::string name;        ///< e.g. "drill_E"
+  std::string chain;
+  std::string frame;       ///< TCP link
+  std::string module_key;  ///< e.g. "concert_drill"
+};
+
+/// What the planner is rebuilt from on every model version.
+struct ModelDescription {
+  uint64_t version = 0;
+  std::string urdf;
+  std::string srdf;
+  std::vector<JointSpec> joints;
+  std::vector<ChainSpec> chains;
+  std::vector<EndEffectorSpec> end_effectors;
+};
+
+/// Parameters of the planner core (loaded from YAML by the adapter).
+struct Params {
+  // Task (paper section 5.4.2).
+  double camera_distance = 0.6;      ///< d: camera frame to wall along the normal [m]
+  std::string camera_frame_prefix = "camera_";  ///< camera frame = prefix + chain tag of the tool
+  double contact_force = 200.0;      ///< expected drilling force along the tool axis [N]
+  double torque_margin = 1.0;        ///< allowed fraction of the continuous torque [-]
+
+  // World.
+  double floor_height = 0.0;         ///< [m] world z of the floor
+  /// World z of the base link [m]; NaN: from the model (lowest leg collision on the floor).
+  double base_height = std::numeric_limits<double>::quiet_NaN();
+  double octomap_resolution = 0.05;  ///< [m]
+  double environment_padding = 0.03; ///< robot shapes grown by this against the world [m]
+  double floor_clearance = 0.02;     ///< non-leg shapes stay this far above the floor [m]
+  double base_range = 3.0;           ///< base x, y sampled within start +- this [m]
+
+  // Planning.
+  double planning_time = 2.0;        ///< per goal, NSPG included [s]
+  double check_resolution = 0.02;    ///< largest step between checked states [rad or m]
+  int simplify_iterations = 50;      ///< shortcutting attempts after RRT-Connect
+  uint64_t seed = 1;                 ///< random seed of NSPG and OMPL
+
+  // NSPG.
+  int nspg_samples = 30;             ///< null-space random walks tried per goal (if seeds fail)
+  int nspg_arm_seeds = 4;            ///< arm postures (start + random) per base stand-off
+  int nspg_enough = 2;               ///< stop after this many valid postures
+  double nspg_step = 0.35;           ///< largest null-space step per walk [rad or m]
+  double nspg_tolerance = 1e-3;      ///< task error accepted [m, rad]
+  double nspg_distance_weight = 1.0; ///< cost of the distance to the start [1/rad]
+  double nspg_singularity_weight = 0.5;  ///< cost of 1/manipulability of the arm [-]
+  int nspg_torque_iterations = 8;    ///< null-space descent steps on the torque utilisation
+
+  // Time parameterisation.
+  double velocity_scale = 0.5;       ///< fraction of each joint's velocity limit [-]
+  double joint_acceleration = 1.0;   ///< [rad/s^2]
+  double base_linear_velocity = 0.4; ///< [m/s]
+  double base_linear_acceleration = 0.5;  ///< [m/s^2]
+  double base_angular_velocity = 0.5;     ///< [rad/s]
+  double base_angular_acceleration = 1.0; ///< [rad/s^2]
+  double sample_period = 0.02;       ///< output trajectory sample period [s]
+};
+
+/// Which constraint rejected a state.
+enum class Constraint { kNone, kJointLimit, kSelfCollision, kEnvironmentCollision, kFloor, kTorqueLimit };
+
+/// Result of a state validity check.
+struct Validity {
+  Constraint constraint = Constraint::kNone;
+  std::string detail;  ///< joint or link pair / link and obstacle concerned
+  [[nodiscard]] bool valid() const { return constraint == Constraint::kNone; }
+};
+
+/// Name of a constraint ("joint limit", "self collision", ...).
+const char* to_string(Constraint constraint);
+
+/// A box in the world (a wall or an obstacle).
+struct WorldBox {
+  std::string name;
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();      ///< full extents [m]
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< centre [m]
+  double yaw = 0.0;                                    ///< [rad]
+};
+
+/// A vertical cylinder in the world.
+struct WorldCylinder {
+  std::string name;
+  double radius = 0.0;                                 ///< [m]
+  double height = 0.0;                                 ///< [m]
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< centre [m]
+};
+
+/// World description (walls/boxes, cylinders), as in the robot service's world file.
+struct World {
+  std::vector<WorldBox> boxes;
+  std::vector<WorldCylinder> cylinders;
+};
+
+/// A whole-body trajectory sample: q over the planned joints.
+struct TrajectoryPoint {
+  double time = 0.0;     ///< [s] from the trajectory start
+  Eigen::VectorXd q;     ///< [m, m, rad, rad...]
+  Eigen::VectorXd qd;    ///< [m/s, m/s, rad/s, rad/s...]
+};
+
+/// Time-parameterised whole-body trajectory. joint_names: base_x, base_y, base_yaw, then the
+/// arm joints of the model.
+struct Trajectory {
+  std::vector<std::string> joint_names;
+  std::vector<TrajectoryPoint> points;
+  [[nodiscard]] double duration() const { return points.empty() ? 0.0 : points.back().time; }
+};
+
+/// Outcome of a request or of one goal.
+enum class Status { kSucceeded, kNoModel, kStaleModel, kInvalidRequest, kInvalidStart, kUnreachable, kNoPath };
+const char* to_string(Status status);
+
+/// A drilling area goal: frame with z along the outward surface normal (paper section 5.4).
+struct Goal {
+  Eigen::Isometry3d area = Eigen::Isometry3d::Identity();  ///< world frame
+};
+
+/// A planning request: goals in FIFO order.
+struct PlanRequest {
+  uint64_t request_id = 0;
+  uint64_t model_version = 0;     ///< must equal the planner's model version
+  std::string end_effector;       ///< tool end-effector name; empty: the first with a camera
+  std::vector<Goal> goals;
+};
+
+/// Result for one goal.
+struct GoalResult {
+  std::size_t index = 0;
+  Status status = Status::kNoPath;
+  std::string reason;             ///< empty on success
+  Eigen::VectorXd goal_q;         ///< planned joints (see Trajectory::joint_names)
+  Trajectory trajectory;
+  double nspg_seconds = 0.0;      ///< goal posture generation time [s]
+  double plan_seconds = 0.0;      ///< RRT-Connect + simplification + timing [s]
+};
+
+/// Result of a request.
+struct PlanResult {
+  uint64_t request_id = 0;
+  uint64_t model_version = 0;
+  Status status = Status::kNoPath;  ///< kSucceeded when every goal succeeded
+  std::string reason;
+  std::vector<GoalResult> goals;
+};
+
+}  // namespace concert::planner

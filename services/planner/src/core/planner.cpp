@@ -1,0 +1,236 @@
+#include "planner/planner.hpp"
+
+#include <ompl/base/samplers/UniformValidStateSampler.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/geometric/PathSimplifier.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+#include <ompl/util/RandomNumbers.h>
+
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <sstream>
+
+#include "planner/trajectory.hpp"
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+namespace concert::planner {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// OMPL's uniform sampler with a per-plan seed, so plans are reproducible.
+class SeededSampler : public ob::RealVectorStateSampler {
+ public:
+  SeededSampler(const ob::StateSpace* space, uint64_t seed) : ob::RealVectorStateSampler(space) {
+    rng_.setLocalSeed(static_cast<std::uint_fast32_t>(seed));
+  }
+};
+
+Eigen::VectorXd to_eigen(const ob::State* s, int n) {
+  const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
+  Eigen::VectorXd q(n);
+  for (int i = 0; i < n; ++i) q[i] = v->values[i];
+  return q;
+}
+
+void from_eigen(const Eigen::VectorXd& q, ob::State* s) {
+  auto* v = s->as<ob::RealVectorStateSpace::StateType>();
+  for (Eigen::Index i = 0; i < q.size(); ++i) v->values[i] = q[i];
+}
+
+}  // namespace
+
+Planner::Planner(Params params) : params_(std::move(params)), environment_(params_.octomap_resolution) {
+  static std::once_flag once;
+  std::call_once(once, [&] {
+    ompl::msg::setLogLevel(ompl::msg::LOG_ERROR);
+    ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(params_.seed));
+  });
+}
+
+void Planner::set_model(const ModelDescription& description) {
+  auto model = PlanningModel::build(description, params_);
+  std::lock_guard lock(mutex_);
+  model_ = std::move(model);
+}
+
+void Planner::set_environment(Environment environment) {
+  std::lock_guard lock(mutex_);
+  environment_ = std::move(environment);
+}
+
+uint64_t Planner::model_version() const {
+  std::lock_guard lock(mutex_);
+  return model_ ? model_->version() : 0;
+}
+
+std::shared_ptr<const PlanningModel> Planner::model() const {
+  std::lock_guard lock(mutex_);
+  return model_;
+}
+
+Environment Planner::environment() const {
+  std::lock_guard lock(mutex_);
+  return environment_;
+}
+
+GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& q_start_full,
+                              const Eigen::VectorXd& q_goal_in, double time_budget, uint64_t seed) const {
+  const auto t0 = Clock::now();
+  GoalResult r;
+  const int n = model.dof();
+  const Eigen::VectorXd q_start = model.to_planned(q_start_full);
+  Eigen::VectorXd q_goal = q_goal_in;
+  q_goal[2] = q_start[2] + std::remainder(q_goal[2] - q_start[2], 2.0 * M_PI);
+  r.goal_q = q_goal;
+
+  auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(n));
+  ob::RealVectorBounds bounds(static_cast<unsigned>(n));
+  for (int i = 0; i < n; ++i) {
+    const auto u = static_cast<unsigned>(i);
+    if (i < 2) {
+      bounds.setLow(u, std::min(q_start[i], q_goal[i]) - params_.base_range);
+      bounds.setHigh(u, std::max(q_start[i], q_goal[i]) + params_.base_range);
+    } else if (i == 2) {
+      bounds.setLow(u, std::min(q_start[i], q_goal[i]) - M_PI);
+      bounds.setHigh(u, std::max(q_start[i], q_goal[i]) + M_PI);
+    } else {
+      bounds.setLow(u, model.lower()[i]);
+      bounds.setHigh(u, model.upper()[i]);
+    }
+  }
+  space->setBounds(bounds);
+  space->setStateSamplerAllocator([seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed); });
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  Validity last_rejection;
+  si->setStateValidityChecker([&](const ob::State* s) {
+    const Validity v = checker.check(model.to_full(to_eigen(s, n), q_start_full));
+    if (!v.valid()) last_rejection = v;
+    return v.valid();
+  });
+  si->setStateValidityCheckingResolution(params_.check_resolution / space->getMaximumExtent());
+  si->setup();
+
+  ob::ScopedState<> start(space);
+  ob::ScopedState<> goal(space);
+  from_eigen(q_start, start.get());
+  from_eigen(q_goal, goal.get());
+  const Validity vs = checker.check(q_start_full);
+  if (!vs.valid()) {
+    r.status = Status::kInvalidStart;
+    r.reason = std::string("start state rejected by ") + to_string(vs.constraint) + ": " + vs.detail;
+    return r;
+  }
+
+  std::vector<Eigen::VectorXd> waypoints;
+  if (si->checkMotion(start.get(), goal.get())) {
+    waypoints = {q_start, q_goal};
+  } else {
+    auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+    pdef->setStartAndGoalStates(start, goal);
+    og::RRTConnect rrt(si);
+    rrt.setProblemDefinition(pdef);
+    rrt.setup();
+    const double budget = std::max(0.0, time_budget - seconds_since(t0));
+    const ob::PlannerStatus st = rrt.solve(ob::timedPlannerTerminationCondition(budget));
+    if (st != ob::PlannerStatus::EXACT_SOLUTION) {
+      r.status = Status::kNoPath;
+      std::ostringstream s;
+      s << "RRT-Connect found no collision-free path within " << budget << " s";
+      if (!last_rejection.valid()) s << " (last rejection: " << to_string(last_rejection.constraint) << ": " << last_rejection.detail << ")";
+      r.reason = s.str();
+      r.plan_seconds = seconds_since(t0);
+      return r;
+    }
+    auto& path = *pdef->getSolutionPath()->as<og::PathGeometric>();
+    og::PathSimplifier simplifier(si);
+    simplifier.shortcutPath(path, static_cast<unsigned>(params_.simplify_iterations), static_cast<unsigned>(params_.simplify_iterations));
+    simplifier.reduceVertices(path, static_cast<unsigned>(params_.simplify_iterations));
+    simplifier.collapseCloseVertices(path);
+    for (std::size_t i = 0; i < path.getStateCount(); ++i) waypoints.push_back(to_eigen(path.getState(static_cast<unsigned>(i)), n));
+  }
+  r.trajectory = time_parameterize(waypoints, model.joint_names(), motion_limits(model, params_), params_.sample_period);
+  r.status = Status::kSucceeded;
+  r.plan_seconds = seconds_since(t0);
+  return r;
+}
+
+PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_start_full, const GoalCallback& on_goal) {
+  PlanResult out;
+  out.request_id = request.request_id;
+  const std::shared_ptr<const PlanningModel> model = this->model();
+  const Environment env = environment();
+  out.model_version = model ? model->version() : 0;
+  auto fail = [&](Status s, std::string why) {
+    out.status = s;
+    out.reason = std::move(why);
+    return out;
+  };
+  if (!model) return fail(Status::kNoModel, "no robot model received yet");
+  if (request.model_version != model->version()) {
+    return fail(Status::kStaleModel, "request made for model version " + std::to_string(request.model_version) +
+                                         " but the planner runs model version " + std::to_string(model->version()));
+  }
+  if (request.goals.empty()) return fail(Status::kInvalidRequest, "request has no goals");
+  if (q_start_full.size() != model->full_dof() || !q_start_full.allFinite()) {
+    return fail(Status::kInvalidStart, "start state has " + std::to_string(q_start_full.size()) + " joints, model version " +
+                                           std::to_string(model->version()) + " has " + std::to_string(model->full_dof()));
+  }
+  const EndEffectorSpec* tool = nullptr;
+  try {
+    tool = &model->tool(request.end_effector);
+    (void)model->camera_frame(*tool);
+  } catch (const PlannerError& e) {
+    return fail(Status::kInvalidRequest, e.what());
+  }
+  for (std::size_t g = 0; g < request.goals.size(); ++g) {
+    const Eigen::Isometry3d& a = request.goals[g].area;
+    if (!a.matrix().allFinite() || std::abs(a.linear().determinant() - 1.0) > 1e-3) {
+      return fail(Status::kInvalidRequest, "goal " + std::to_string(g) + ": drilling area frame is not a finite rigid transform");
+    }
+  }
+
+  StateChecker checker(model, env, params_, params_.environment_padding);
+  const Validity start_ok = checker.check(q_start_full);
+  if (!start_ok.valid()) {
+    return fail(Status::kInvalidStart,
+                std::string("start state rejected by ") + to_string(start_ok.constraint) + ": " + start_ok.detail);
+  }
+  Eigen::VectorXd current = q_start_full;
+  out.status = Status::kSucceeded;
+  for (std::size_t g = 0; g < request.goals.size(); ++g) {
+    const auto t0 = Clock::now();
+    const uint64_t seed = params_.seed + 7919u * request.request_id + 104729u * g;
+    const PostureResult posture = generate_posture(*model, checker, params_, *tool, current, request.goals[g].area, seed);
+    GoalResult r;
+    if (!posture.found) {
+      r.status = Status::kUnreachable;
+      r.reason = "goal " + std::to_string(g) + ": no feasible posture puts camera '" + model->camera_frame(*tool) + "' " +
+                 std::to_string(params_.camera_distance) + " m in front of the drilling area (" + std::to_string(posture.candidates) +
+                 " postures on the task examined; " + posture.reason + ")";
+    } else {
+      const double nspg = seconds_since(t0);
+      r = plan_path(*model, checker, current, posture.q, params_.planning_time - nspg, seed);
+      r.nspg_seconds = nspg;
+      if (r.status != Status::kSucceeded) r.reason = "goal " + std::to_string(g) + ": " + r.reason;
+    }
+    r.index = g;
+    if (r.status == Status::kSucceeded) {
+      current = model->to_full(r.trajectory.points.back().q, current);
+    } else if (out.status == Status::kSucceeded) {
+      out.status = r.status;
+      out.reason = r.reason;
+    }
+    if (on_goal) on_goal(r);
+    out.goals.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace concert::planner

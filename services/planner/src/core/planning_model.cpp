@@ -1,0 +1,333 @@
+#include "planner/planning_model.hpp"
+
+#include <tinyxml2.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <map>
+#include <set>
+
+namespace concert::planner {
+namespace {
+
+Eigen::Isometry3d to_eigen(const urdf::Pose& p) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
+  t.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
+  return t;
+}
+
+// SRDF <disable_collisions link1 link2>: the only SRDF content the planner needs, so a small
+// tinyxml2 read instead of a full SRDF model.
+std::vector<std::pair<std::string, std::string>> disabled_pairs(const std::string& srdf) {
+  std::vector<std::pair<std::string, std::string>> out;
+  if (srdf.empty()) return out;
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(srdf.c_str()) != tinyxml2::XML_SUCCESS) {
+    throw PlannerError(std::string("model SRDF: XML parse error: ") + doc.ErrorStr());
+  }
+  const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  if (robot == nullptr) throw PlannerError("model SRDF: no <robot> element");
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("disable_collisions"); e != nullptr;
+       e = e->NextSiblingElement("disable_collisions")) {
+    const char* a = e->Attribute("link1");
+    const char* b = e->Attribute("link2");
+    if (a == nullptr || b == nullptr) throw PlannerError("model SRDF: <disable_collisions> without link1/link2");
+    out.emplace_back(a, b);
+  }
+  return out;
+}
+
+}  // namespace
+
+const char* to_string(Constraint constraint) {
+  switch (constraint) {
+    case Constraint::kNone: return "none";
+    case Constraint::kJointLimit: return "joint limit";
+    case Constraint::kSelfCollision: return "self collision";
+    case Constraint::kEnvironmentCollision: return "environment collision";
+    case Constraint::kFloor: return "floor";
+    case Constraint::kTorqueLimit: return "torque limit";
+  }
+  return "?";
+}
+
+const char* to_string(Status status) {
+  switch (status) {
+    case Status::kSucceeded: return "succeeded";
+    case Status::kNoModel: return "no model";
+    case Status::kStaleModel: return "stale model";
+    case Status::kInvalidRequest: return "invalid request";
+    case Status::kInvalidStart: return "invalid start";
+    case Status::kUnreachable: return "unreachable";
+    case Status::kNoPath: return "no path";
+  }
+  return "?";
+}
+
+std::shared_ptr<const PlanningModel> PlanningModel::build(const ModelDescription& d, const Params& params) {
+  kinematics::Model kin = [&] {
+    try {
+      return kinematics::Model::from_urdf_string(d.urdf, {.planar_base = true});
+    } catch (const kinematics::ModelError& e) {
+      throw PlannerError("model version " + std::to_string(d.version) + ": URDF: " + e.what());
+    }
+  }();
+  std::shared_ptr<PlanningModel> m(new PlanningModel(std::move(kin)));
+  m->version_ = d.version;
+  m->description_ = d;
+  m->camera_prefix_ = params.camera_frame_prefix;
+  const kinematics::Model& k = m->kinematics_;
+  const std::string where = "model version " + std::to_string(d.version);
+
+  // Planned joints: the virtual base joints, then the joints of every arm chain.
+  std::set<std::string> leg_chains;
+  std::vector<std::string> arm_joints;
+  for (const ChainSpec& c : d.chains) {
+    if (c.role == "leg") leg_chains.insert(c.name);
+    if (c.role != "arm") continue;
+    for (const std::string& j : c.joints) arm_joints.push_back(j);
+  }
+  if (arm_joints.empty()) throw PlannerError(where + ": no chain with role \"arm\" (nothing to plan for)");
+  for (int i = 0; i < k.num_virtual_joints(); ++i) m->planned_.push_back(i);
+  for (const std::string& j : arm_joints) {
+    const auto idx = k.joint_index(j);
+    if (!idx) throw PlannerError(where + ": arm joint '" + j + "' is not a moving joint of the URDF");
+    m->planned_.push_back(*idx);
+  }
+  const int n = static_cast<int>(m->planned_.size());
+  m->lower_.resize(n);
+  m->upper_.resize(n);
+  m->velocity_.resize(n);
+  m->torque_ = Eigen::VectorXd::Zero(k.dof());
+  std::map<std::string, const JointSpec*> spec;
+  for (const JointSpec& j : d.joints) spec[j.name] = &j;
+  for (int i = 0; i < n; ++i) {
+    const int fi = m->planned_[static_cast<std::size_t>(i)];
+    m->planned_names_.push_back(k.joint_names()[static_cast<std::size_t>(fi)]);
+    if (k.is_virtual_joint(fi)) {
+      m->lower_[i] = -std::numeric_limits<double>::infinity();
+      m->upper_[i] = std::numeric_limits<double>::infinity();
+      m->velocity_[i] = i == 2 ? params.base_angular_velocity : params.base_linear_velocity;
+      continue;
+    }
+    const kinematics::JointLimits& lim = k.joint_limits()[static_cast<std::size_t>(fi)];
+    m->lower_[i] = lim.has_position_limits ? lim.lower : -M_PI;
+    m->upper_[i] = lim.has_position_limits ? lim.upper : M_PI;
+    double vel = lim.velocity;
+    double eff = lim.effort;
+    if (const auto it = spec.find(m->planned_names_.back()); it != spec.end()) {
+      if (it->second->velocity > 0.0) vel = it->second->velocity;
+      if (it->second->effort > 0.0) eff = it->second->effort;
+    }
+    if (vel <= 0.0) throw PlannerError(where + ": joint '" + m->planned_names_.back() + "' has no velocity limit");
+    m->velocity_[i] = vel;
+    m->torque_[fi] = eff;
+  }
+
+  // Link tree with collision primitives (urdfdom: the geometry KDL does not keep).
+  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(d.urdf);
+  if (!urdf) throw PlannerError(where + ": URDF cannot be parsed");
+  std::map<std::string, int> index;
+  std::function<void(const urdf::LinkConstSharedPtr&, int, int)> walk = [&](const urdf::LinkConstSharedPtr& link, int parent,
+                                                                          int group) {
+    LinkNode node;
+    node.name = link->name;
+    node.parent = parent;
+    if (parent >= 0) {
+      const urdf::JointConstSharedPtr& j = link->parent_joint;
+      node.origin = to_eigen(j->parent_to_joint_origin_transform);
+      node.axis = Eigen::Vector3d(j->axis.x, j->axis.y, j->axis.z);
+      if (j->type != urdf::Joint::FIXED) {
+        const auto fi = k.joint_index(j->name);
+        if (!fi) throw PlannerError(where + ": URDF joint '" + j->name + "' unknown to the kinematic model");
+        node.full_index = *fi;
+        node.prismatic = j->type == urdf::Joint::PRISMATIC;
+        if (std::find(arm_joints.begin(), arm_joints.end(), j->name) != arm_joints.end()) group = *fi;
+        const auto s = spec.find(j->name);
+        if (s != spec.end() && leg_chains.count(s->second->chain) > 0) node.leg = true;
+      }
+      node.leg = node.leg || m->links_[static_cast<std::size_t>(parent)].leg;
+    }
+    node.rigid_group = group;
+    for (const urdf::CollisionSharedPtr& c : link->collision_array) {
+      if (!c || !c->geometry) continue;
+      LinkShape s;
+      s.origin = to_eigen(c->origin);
+      switch (c->geometry->type) {
+        case urdf::Geometry::BOX: {
+          const auto* b = static_cast<const urdf::Box*>(c->geometry.get());
+          s.type = LinkShape::Type::kBox;
+          s.size = Eigen::Vector3d(b->dim.x, b->dim.y, b->dim.z);
+          break;
+        }
+        case urdf::Geometry::CYLINDER: {
+          const auto* cy = static_cast<const urdf::Cylinder*>(c->geometry.get());
+          s.type = LinkShape::Type::kCylinder;
+          s.size = Eigen::Vector3d(cy->radius, cy->radius, cy->length);
+          break;
+        }
+        case urdf::Geometry::SPHERE: {
+          const auto* sp = static_cast<const urdf::Sphere*>(c->geometry.get());
+          s.type = LinkShape::Type::kSphere;
+          s.size = Eigen::Vector3d::Constant(sp->radius);
+          break;
+        }
+        default:
+          m->ignored_.push_back(link->name + ": mesh collision geometry (planner uses primitives only)");
+          continue;
+      }
+      node.shapes.push_back(s);
+    }
+    const int self = static_cast<int>(m->links_.size());
+    index[node.name] = self;
+    m->links_.push_back(std::move(node));
+    for (const urdf::LinkSharedPtr& child : link->child_links) walk(child, self, group);
+  };
+  walk(urdf->getRoot(), -1, -1);
+
+  const std::size_t nl = m->links_.size();
+  m->disabled_.assign(nl, std::vector<bool>(nl, false));
+  for (std::size_t a = 0; a < nl; ++a) {
+    for (std::size_t b = 0; b < nl; ++b) {
+      if (a == b || m->links_[a].rigid_group == m->links_[b].rigid_group) m->disabled_[a][b] = true;
+    }
+  }
+  for (const auto& [a, b] : disabled_pairs(d.srdf)) {
+    const auto ia = index.find(a);
+    const auto ib = index.find(b);
+    if (ia == index.end() || ib == index.end()) {
+      throw PlannerError(where + ": SRDF disables collisions of unknown link '" + (ia == index.end() ? a : b) + "'");
+    }
+    m->disabled_[static_cast<std::size_t>(ia->second)][static_cast<std::size_t>(ib->second)] = true;
+    m->disabled_[static_cast<std::size_t>(ib->second)][static_cast<std::size_t>(ia->second)] = true;
+  }
+
+  // Base height: the lowest leg collision point of the zero posture rests on the floor.
+  m->base_height_ = params.base_height;
+  if (std::isnan(m->base_height_)) {
+    m->base_height_ = params.floor_height;
+    std::vector<Eigen::Isometry3d> poses;
+    const double saved = m->base_height_;
+    m->base_height_ = 0.0;
+    m->link_poses(Eigen::VectorXd::Zero(k.dof()), poses);
+    double lowest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < nl; ++i) {
+      if (!m->links_[i].leg) continue;
+      for (const LinkShape& s : m->links_[i].shapes) {
+        const Eigen::Isometry3d t = poses[i] * s.origin;
+        double extent = 0.0;
+        if (s.type == LinkShape::Type::kBox) {
+          extent = 0.5 * (t.linear().cwiseAbs() * s.size).z();
+        } else if (s.type == LinkShape::Type::kSphere) {
+          extent = s.size.x();
+        } else {
+          const Eigen::Vector3d axis = t.linear().col(2);
+          extent = 0.5 * s.size.z() * std::abs(axis.z()) + s.size.x() * std::sqrt(std::max(0.0, 1.0 - axis.z() * axis.z()));
+        }
+        lowest = std::min(lowest, t.translation().z() - extent);
+      }
+    }
+    m->base_height_ = std::isfinite(lowest) ? params.floor_height - lowest : saved;
+  }
+  return m;
+}
+
+bool PlanningModel::pair_disabled(int a, int b) const {
+  return disabled_[static_cast<std::size_t>(a)][static_cast<std::size_t>(b)];
+}
+
+void PlanningModel::link_poses(const Eigen::VectorXd& q, std::vector<Eigen::Isometry3d>& poses) const {
+  // One pass over the tree for all links: collision checking needs every link, and KDL's
+  // per-frame solver would walk the chain again for each of them.
+  poses.resize(links_.size());
+  Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
+  base.translation() = Eigen::Vector3d(q[0], q[1], base_height_);
+  base.linear() = Eigen::AngleAxisd(q[2], Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    const LinkNode& l = links_[i];
+    if (l.parent < 0) {
+      poses[i] = base;
+      continue;
+    }
+    Eigen::Isometry3d t = poses[static_cast<std::size_t>(l.parent)] * l.origin;
+    if (l.full_index >= 0) {
+      const double v = q[l.full_index];
+      if (l.prismatic) {
+        t.translate(l.axis * v);
+      } else {
+        t.rotate(Eigen::AngleAxisd(v, l.axis));
+      }
+    }
+    poses[i] = t;
+  }
+}
+
+Eigen::Isometry3d PlanningModel::link_pose(const Eigen::VectorXd& q, const std::string& link) const {
+  const int i = link_index(link);
+  if (i < 0) throw PlannerError("model version " + std::to_string(version_) + ": no link '" + link + "'");
+  std::vector<Eigen::Isometry3d> poses;
+  link_poses(q, poses);
+  return poses[static_cast<std::size_t>(i)];
+}
+
+int PlanningModel::link_index(const std::string& name) const {
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    if (links_[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+const EndEffectorSpec& PlanningModel::tool(const std::string& name) const {
+  std::string candidates;
+  for (const EndEffectorSpec& e : description_.end_effectors) {
+    const bool has_camera = link_index(camera_prefix_ + e.chain) >= 0;
+    if (name.empty() ? has_camera : e.name == name) return e;
+    candidates += (candidates.empty() ? "" : ", ") + e.name + (has_camera ? " (camera)" : "");
+  }
+  throw PlannerError("model version " + std::to_string(version_) + ": " +
+                     (name.empty() ? std::string("no end-effector with a camera frame") : "no end-effector '" + name + "'") +
+                     "; end-effectors: " + (candidates.empty() ? "none" : candidates));
+}
+
+std::string PlanningModel::camera_frame(const EndEffectorSpec& tool) const {
+  const std::string frame = camera_prefix_ + tool.chain;
+  if (link_index(frame) < 0) {
+    throw PlannerError("model version " + std::to_string(version_) + ": end-effector '" + tool.name + "' has no camera frame '" +
+                       frame + "'");
+  }
+  return frame;
+}
+
+Eigen::VectorXd PlanningModel::to_full(const Eigen::VectorXd& planned, const Eigen::VectorXd& full_template) const {
+  Eigen::VectorXd q = full_template;
+  for (std::size_t i = 0; i < planned_.size(); ++i) q[planned_[i]] = planned[static_cast<Eigen::Index>(i)];
+  return q;
+}
+
+Eigen::VectorXd PlanningModel::to_planned(const Eigen::VectorXd& full) const {
+  Eigen::VectorXd q(dof());
+  for (std::size_t i = 0; i < planned_.size(); ++i) q[static_cast<Eigen::Index>(i)] = full[planned_[i]];
+  return q;
+}
+
+Eigen::VectorXd PlanningModel::full_from_named(const std::vector<std::string>& names, const std::vector<double>& positions,
+                                               const Eigen::Vector3d& base) const {
+  if (names.size() != positions.size()) {
+    throw PlannerError("joint state: " + std::to_string(names.size()) + " names but " + std::to_string(positions.size()) +
+                       " positions");
+  }
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(full_dof());
+  q.head<3>() = base;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto idx = kinematics_.joint_index(names[i]);
+    if (!idx) throw PlannerError("joint state: joint '" + names[i] + "' is not in model version " + std::to_string(version_));
+    q[*idx] = positions[i];
+  }
+  return q;
+}
+
+}  // namespace concert::planner

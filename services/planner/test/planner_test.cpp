@@ -1,0 +1,229 @@
+// Whole-body planning on the paper's morphologies A and B and after a hot swap: every plan is
+// re-checked densely (collision-free without padding, within joint, velocity, acceleration
+// and torque limits, camera on the task at the end). Seeded.
+
+#include <gtest/gtest.h>
+
+#include <octomap/OcTree.h>
+
+#include <random>
+
+#include "planner/fixtures.hpp"
+#include "planner/planner.hpp"
+#include "planner/trajectory.hpp"
+
+using namespace concert::planner;
+
+namespace {
+
+ModelDescription morphology(char which, uint64_t version) {
+  return fixtures::model_from_assembly(fixtures::data_dir() / (std::string("morphology_") + which + ".yaml"), version);
+}
+
+World site(double wall_x) {
+  World w;
+  w.boxes.push_back(fixtures::wall_at(wall_x));
+  // A pallet on the floor to the robot's left and a pillar to its right.
+  w.boxes.push_back({"pallet", Eigen::Vector3d(0.8, 0.8, 0.5), Eigen::Vector3d(1.0, 1.6, 0.25), 0.3});
+  w.cylinders.push_back({"pillar", 0.15, 3.0, Eigen::Vector3d(0.9, -1.5, 1.5)});
+  return w;
+}
+
+Environment environment_of(const World& w, const Params& p) {
+  Environment env(p.octomap_resolution);
+  env.add_world(w);
+  return env;
+}
+
+// Dense re-check of one goal's plan. Returns the number of states checked.
+int recheck(const PlanningModel& model, const Environment& env, const Params& params, const GoalResult& r,
+            const Eigen::VectorXd& start_full, const Eigen::Isometry3d& area) {
+  StateChecker exact(std::shared_ptr<const PlanningModel>(&model, [](const PlanningModel*) {}), env, params, 0.0);
+  const Trajectory& t = r.trajectory;
+  EXPECT_EQ(t.joint_names, model.joint_names());
+  EXPECT_GE(t.points.size(), 2u);
+  EXPECT_LT((t.points.front().q - model.to_planned(start_full)).norm(), 1e-9) << "trajectory does not start at the start state";
+  const MotionLimits lim = motion_limits(model, params);
+  int checked = 0;
+  for (std::size_t i = 1; i < t.points.size(); ++i) {
+    const TrajectoryPoint& a = t.points[i - 1];
+    const TrajectoryPoint& b = t.points[i];
+    const double dt = b.time - a.time;
+    EXPECT_GT(dt, 0.0);
+    EXPECT_TRUE((b.qd.cwiseAbs().array() <= lim.velocity.array() * (1 + 1e-6)).all()) << "velocity at sample " << i;
+    EXPECT_TRUE((((b.qd - a.qd) / dt).cwiseAbs().array() <= lim.acceleration.array() * (1 + 1e-6)).all()) << "acceleration at " << i;
+    const double span = (b.q - a.q).cwiseAbs().maxCoeff();
+    const int steps = std::max(1, static_cast<int>(std::ceil(span / 0.005)));  // 5 mm / 0.005 rad
+    for (int s = 1; s <= steps; ++s) {
+      const Eigen::VectorXd q = a.q + (b.q - a.q) * (static_cast<double>(s) / steps);
+      const Validity v = exact.check(model.to_full(q, start_full));
+      EXPECT_TRUE(v.valid()) << "sample " << i << " step " << s << ": " << to_string(v.constraint) << ": " << v.detail;
+      if (!v.valid()) return checked;
+      checked += 1;
+    }
+  }
+  const Eigen::VectorXd end = model.to_full(t.points.back().q, start_full);
+  const Validity at_goal = exact.check(end, model.tool("").frame);
+  EXPECT_TRUE(at_goal.valid()) << "goal with drilling force: " << at_goal.detail;
+  const auto [pos, ang] = task_error(model, params, model.tool(""), end, area);
+  EXPECT_LT(pos, 5e-3);
+  EXPECT_LT(ang, 5e-3);
+  EXPECT_TRUE(t.points.back().qd.isZero());
+  return checked;
+}
+
+Eigen::VectorXd start_state(const PlanningModel& m) {
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(m.full_dof());
+  // Arm up, slightly bent, base turned a little (the arm's parking posture).
+  const auto& k = m.kinematics();
+  q[2] = 0.1;
+  q[k.joint_index_or_throw("J2_E")] = 0.2;
+  q[k.joint_index_or_throw("J4_E")] = -0.3;
+  return q;
+}
+
+struct Case {
+  char morphology;
+  std::vector<Eigen::Vector2d> areas;  // (y, z) on the wall
+};
+
+}  // namespace
+
+class MorphologyPlans : public ::testing::TestWithParam<Case> {};
+
+TEST_P(MorphologyPlans, DrillingApproachesAreCollisionFreeAndWithinLimits) {
+  const Case c = GetParam();
+  Params params;
+  params.seed = 17;
+  Planner planner(params);
+  planner.set_model(morphology(c.morphology, 4));
+  const World world = site(2.2);
+  planner.set_environment(environment_of(world, params));
+  const auto model = planner.model();
+  const Eigen::VectorXd start = start_state(*model);
+  PlanRequest req;
+  req.request_id = 1;
+  req.model_version = 4;
+  for (const Eigen::Vector2d& yz : c.areas) req.goals.push_back({fixtures::drilling_area(2.2, yz.x(), yz.y())});
+  std::vector<std::size_t> order;
+  const PlanResult res = planner.plan(req, start, [&](const GoalResult& g) { order.push_back(g.index); });
+  ASSERT_EQ(res.goals.size(), c.areas.size());
+  EXPECT_EQ(res.status, Status::kSucceeded) << res.reason;
+  for (std::size_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], i) << "goals not reported in FIFO order";
+  Eigen::VectorXd from = start;
+  for (std::size_t g = 0; g < res.goals.size(); ++g) {
+    const GoalResult& r = res.goals[g];
+    ASSERT_EQ(r.status, Status::kSucceeded) << "goal " << g << ": " << r.reason;
+    const int n = recheck(*model, environment_of(world, params), params, r, from, req.goals[g].area);
+    EXPECT_GT(n, 10);
+    from = model->to_full(r.trajectory.points.back().q, from);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Paper, MorphologyPlans,
+    ::testing::Values(Case{'a', {{0.0, 1.9}, {0.4, 2.3}, {-0.4, 2.1}}}, Case{'b', {{0.0, 2.2}, {-0.3, 2.6}, {0.4, 2.0}}}),
+    [](const ::testing::TestParamInfo<Case>& i) { return std::string("morphology_") + i.param.morphology; });
+
+TEST(Planner, HotSwapRebuildsTheConfigurationSpace) {
+  Params params;
+  params.seed = 23;
+  Planner planner(params);
+  const World world = site(2.0);
+  planner.set_environment(environment_of(world, params));
+  planner.set_model(morphology('a', 7));
+  const Eigen::Isometry3d high = fixtures::drilling_area(2.0, 0.0, 2.2);
+  PlanRequest req{1, 7, "", {{high}}};
+  const PlanResult a = planner.plan(req, start_state(*planner.model()), {});
+  // Swap: the second passive link is bolted in, modelgen publishes version 8.
+  planner.set_model(morphology('b', 8));
+  EXPECT_EQ(planner.model_version(), 8u);
+  const PlanResult stale = planner.plan(req, start_state(*planner.model()), {});
+  EXPECT_EQ(stale.status, Status::kStaleModel);
+  EXPECT_NE(stale.reason.find("version 7"), std::string::npos) << stale.reason;
+  EXPECT_NE(stale.reason.find("version 8"), std::string::npos) << stale.reason;
+  req.model_version = 8;
+  const auto model_b = planner.model();
+  const PlanResult b = planner.plan(req, start_state(*model_b), {});
+  ASSERT_EQ(b.status, Status::kSucceeded) << b.reason;
+  recheck(*model_b, environment_of(world, params), params, b.goals[0], start_state(*model_b), high);
+  // Both models plan the goal; after the swap the trajectory has the new model's joints and
+  // ends on B's longer arm.
+  if (a.status == Status::kSucceeded) {
+    EXPECT_GT((a.goals[0].goal_q - b.goals[0].goal_q).norm(), 1e-3);
+  }
+}
+
+TEST(Planner, ClearErrorsForBadRequests) {
+  Params params;
+  Planner planner(params);
+  PlanRequest req{5, 1, "", {{fixtures::drilling_area(2.0, 0.0, 1.0)}}};
+  const PlanResult none = planner.plan(req, Eigen::VectorXd::Zero(3), {});
+  EXPECT_EQ(none.status, Status::kNoModel);
+  planner.set_model(morphology('a', 1));
+  const auto model = planner.model();
+  const Eigen::VectorXd start = start_state(*model);
+
+  // A wall 6 m up: no posture can put the camera there.
+  PlanRequest far = req;
+  far.goals = {{fixtures::drilling_area(2.0, 0.0, 6.0)}};
+  const PlanResult unreachable = planner.plan(far, start, {});
+  EXPECT_EQ(unreachable.status, Status::kUnreachable);
+  EXPECT_NE(unreachable.reason.find("camera_E"), std::string::npos) << unreachable.reason;
+
+  PlanRequest empty = req;
+  empty.goals.clear();
+  EXPECT_EQ(planner.plan(empty, start, {}).status, Status::kInvalidRequest);
+  PlanRequest tool = req;
+  tool.end_effector = "sander_E";
+  const PlanResult bad_tool = planner.plan(tool, start, {});
+  EXPECT_EQ(bad_tool.status, Status::kInvalidRequest);
+  EXPECT_NE(bad_tool.reason.find("sander_E"), std::string::npos) << bad_tool.reason;
+  EXPECT_EQ(planner.plan(req, Eigen::VectorXd::Zero(4), {}).status, Status::kInvalidStart);
+
+  // Start state in collision: the base stands inside the wall.
+  Environment env(params.octomap_resolution);
+  World w;
+  w.boxes.push_back(fixtures::wall_at(0.2));
+  env.add_world(w);
+  planner.set_environment(env);
+  const PlanResult bad_start = planner.plan(req, start, {});
+  EXPECT_EQ(bad_start.status, Status::kInvalidStart) << bad_start.reason;
+  EXPECT_NE(bad_start.reason.find("environment collision"), std::string::npos) << bad_start.reason;
+
+  // A failed model keeps the previous one.
+  ModelDescription broken = morphology('b', 2);
+  broken.urdf = "<robot name=\"x\"/>";
+  EXPECT_THROW(planner.set_model(broken), PlannerError);
+  EXPECT_EQ(planner.model_version(), 1u);
+}
+
+TEST(Planner, ObstacleFromAPointCloudIsAvoided) {
+  Params params;
+  params.seed = 31;
+  Planner planner(params);
+  planner.set_model(morphology('a', 1));
+  // A wall seen by a lidar as points (5 cm grid), plus a box of points in front of it.
+  std::vector<Eigen::Vector3d> points;
+  for (double y = -2.0; y <= 2.0; y += 0.04) {
+    for (double z = 0.0; z <= 3.0; z += 0.04) points.emplace_back(2.0, y, z);
+  }
+  for (double x = 1.0; x <= 1.3; x += 0.04) {
+    for (double y = 0.5; y <= 0.9; y += 0.04) {
+      for (double z = 0.0; z <= 0.8; z += 0.04) points.emplace_back(x, y, z);
+    }
+  }
+  Environment env(params.octomap_resolution);
+  env.insert_point_cloud(points, Eigen::Vector3d(0.0, 0.0, 1.0), 10.0);
+  EXPECT_GT(env.occupied_cells(), 3000u);
+  EXPECT_TRUE(env.occupied({2.0, 0.0, 1.5}));
+  EXPECT_FALSE(env.occupied({1.0, 0.0, 1.5}));
+  planner.set_environment(env);
+  const auto model = planner.model();
+  const Eigen::VectorXd start = start_state(*model);
+  const Eigen::Isometry3d area = fixtures::drilling_area(2.0, 0.0, 2.0);
+  const PlanResult r = planner.plan({2, 1, "", {{area}}}, start, {});
+  ASSERT_EQ(r.status, Status::kSucceeded) << r.reason;
+  recheck(*model, env, params, r.goals[0], start, area);
+  EXPECT_THROW(env.insert_point_cloud({Eigen::Vector3d(0, 0, std::nan(""))}, Eigen::Vector3d::Zero()), PlannerError);
+}

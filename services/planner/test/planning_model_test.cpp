@@ -1,0 +1,172 @@
+// PlanningModel and StateChecker on the paper's morphologies: configuration space, FK against
+// orocos-kdl, base on the floor, each constraint rejecting what it should.
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "planner/state_checker.hpp"
+#include "planner/fixtures.hpp"
+#include "planner/trajectory.hpp"
+
+using namespace concert::planner;
+
+namespace {
+
+std::shared_ptr<const PlanningModel> morphology(char which, const Params& params = {}) {
+  return PlanningModel::build(fixtures::model_from_assembly(fixtures::data_dir() / (std::string("morphology_") + which + ".yaml"), 1),
+                              params);
+}
+
+}  // namespace
+
+TEST(PlanningModel, ConfigurationSpaceIsBasePlusArm) {
+  for (char which : {'a', 'b'}) {
+    const auto m = morphology(which);
+    ASSERT_EQ(m->dof(), 9) << which;  // x, y, yaw + 6 arm joints
+    EXPECT_EQ(m->joint_names()[0], "base_x");
+    EXPECT_EQ(m->joint_names()[3], "J1_E");
+    EXPECT_EQ(m->joint_names()[8], "J6_E");
+    EXPECT_GT(m->full_dof(), m->dof());  // legs are in the model but not planned
+    EXPECT_NEAR(m->torque_limits()[m->kinematics().joint_index_or_throw("J2_E")], 160.0, 1e-9);  // Large A continuous
+    EXPECT_NEAR(m->torque_limits()[m->kinematics().joint_index_or_throw("J6_E")], 120.0, 1e-9);  // Large B continuous
+    EXPECT_TRUE(m->ignored_shapes().empty());
+  }
+}
+
+TEST(PlanningModel, LinkPosesAgreeWithKdl) {
+  const auto m = morphology('b');
+  concert::kinematics::Data data = m->kinematics().make_data();
+  std::mt19937 rng(5u);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  std::vector<Eigen::Isometry3d> poses;
+  for (int s = 0; s < 20; ++s) {
+    Eigen::VectorXd q(m->full_dof());
+    for (Eigen::Index i = 0; i < q.size(); ++i) q[i] = u(rng);
+    m->link_poses(q, poses);
+    for (std::size_t l = 0; l < m->links().size(); ++l) {
+      Eigen::Isometry3d kdl = m->kinematics().frame_pose(data, q, m->links()[l].name);
+      kdl.translation().z() += m->base_height();
+      EXPECT_LT((kdl.translation() - poses[l].translation()).norm(), 1e-9) << m->links()[l].name;
+      EXPECT_LT((kdl.linear() - poses[l].linear()).norm(), 1e-9) << m->links()[l].name;
+    }
+  }
+}
+
+TEST(PlanningModel, BaseStandsOnTheFloorAndArmGrowsWithMorphology) {
+  const auto a = morphology('a');
+  const auto b = morphology('b');
+  EXPECT_GT(a->base_height(), 0.3);
+  EXPECT_LT(a->base_height(), 1.0);
+  EXPECT_NEAR(a->base_height(), b->base_height(), 1e-12);
+  // Arm straight up: B's tool is 0.4 m higher (the second passive link).
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(a->full_dof());
+  const double za = a->link_pose(q, "tcp_E").translation().z();
+  const double zb = b->link_pose(Eigen::VectorXd::Zero(b->full_dof()), "tcp_E").translation().z();
+  EXPECT_NEAR(zb - za, 0.4, 1e-6);
+}
+
+TEST(PlanningModel, ToolAndCameraFrames) {
+  const auto m = morphology('a');
+  EXPECT_EQ(m->tool("").name, "drill_E");
+  EXPECT_EQ(m->camera_frame(m->tool("drill_E")), "camera_E");
+  try {
+    (void)m->tool("sander_E");
+    FAIL() << "unknown end-effector accepted";
+  } catch (const PlannerError& e) {
+    EXPECT_NE(std::string(e.what()).find("drill_E"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PlanningModel, BadModelsNameTheProblem) {
+  ModelDescription d = fixtures::model_from_assembly(fixtures::data_dir() / "morphology_a.yaml", 3);
+  ModelDescription no_arm = d;
+  for (ChainSpec& c : no_arm.chains) {
+    if (c.role == "arm") c.role = "other";
+  }
+  EXPECT_THROW((void)PlanningModel::build(no_arm, {}), PlannerError);
+  ModelDescription bad_srdf = d;
+  bad_srdf.srdf = "<robot><disable_collisions link1=\"nope\" link2=\"base_link\"/></robot>";
+  try {
+    (void)PlanningModel::build(bad_srdf, {});
+    FAIL();
+  } catch (const PlannerError& e) {
+    EXPECT_NE(std::string(e.what()).find("nope"), std::string::npos) << e.what();
+  }
+  ModelDescription bad_urdf = d;
+  bad_urdf.urdf = "<robot";
+  EXPECT_THROW((void)PlanningModel::build(bad_urdf, {}), PlannerError);
+}
+
+TEST(StateChecker, EachConstraintRejects) {
+  const Params params;
+  const auto m = morphology('a');
+  Environment env(0.05);
+  World world;
+  world.boxes.push_back(fixtures::wall_at(1.5));
+  env.add_world(world);
+  EXPECT_TRUE(env.occupied({1.55, 0.0, 1.0}));
+  EXPECT_FALSE(env.occupied({1.2, 0.0, 1.0}));
+  StateChecker checker(m, env, params, 0.0);
+  const auto& k = m->kinematics();
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(m->full_dof());
+  // Arm straight up, robot at the origin: valid.
+  const Validity home = checker.check(q);
+  EXPECT_TRUE(home.valid()) << to_string(home.constraint) << ": " << home.detail;
+
+  Eigen::VectorXd over = q;
+  over[k.joint_index_or_throw("J2_E")] = 3.0;
+  EXPECT_EQ(checker.check(over).constraint, Constraint::kJointLimit);
+
+  // Arm horizontal: gravity alone exceeds the shoulder's continuous torque.
+  Eigen::VectorXd flat = q;
+  flat[k.joint_index_or_throw("J2_E")] = M_PI / 2;
+  const Validity torque = checker.check(flat);
+  EXPECT_EQ(torque.constraint, Constraint::kTorqueLimit) << torque.detail;
+  EXPECT_NE(torque.detail.find("J2_E"), std::string::npos) << torque.detail;
+
+  // Base driven into the wall.
+  Eigen::VectorXd into_wall = q;
+  into_wall[0] = 1.2;
+  EXPECT_EQ(checker.check(into_wall).constraint, Constraint::kEnvironmentCollision);
+
+  // Elbow folded back onto the arm: self collision.
+  Eigen::VectorXd folded_back = q;
+  folded_back[k.joint_index_or_throw("J4_E")] = 2.75;
+  folded_back[k.joint_index_or_throw("J6_E")] = 2.75;
+  const Validity self = checker.check(folded_back);
+  EXPECT_TRUE(self.constraint == Constraint::kSelfCollision || self.constraint == Constraint::kFloor) << self.detail;
+
+  // The contact force of drilling adds torque: the same posture can pass without it and fail with it.
+  const Eigen::VectorXd g = checker.required_torques(q, "");
+  const Eigen::VectorXd gc = checker.required_torques(q, "tcp_E");
+  EXPECT_GT((gc - g).norm(), 50.0);
+}
+
+TEST(Trajectory, TimingRespectsLimitsAndPassesThroughWaypoints) {
+  const auto m = morphology('a');
+  const Params params;
+  const MotionLimits lim = motion_limits(*m, params);
+  std::vector<Eigen::VectorXd> wp;
+  std::mt19937 rng(3u);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 4; ++i) {
+    Eigen::VectorXd q(m->dof());
+    for (Eigen::Index j = 0; j < q.size(); ++j) q[j] = u(rng);
+    wp.push_back(q);
+  }
+  const Trajectory t = time_parameterize(wp, m->joint_names(), lim, 0.005);
+  ASSERT_GT(t.points.size(), 10u);
+  EXPECT_LT((t.points.front().q - wp.front()).norm(), 1e-12);
+  EXPECT_LT((t.points.back().q - wp.back()).norm(), 1e-12);
+  for (std::size_t i = 1; i < t.points.size(); ++i) {
+    const double dt = t.points[i].time - t.points[i - 1].time;
+    ASSERT_GT(dt, 0.0);
+    const Eigen::VectorXd v = (t.points[i].q - t.points[i - 1].q) / dt;
+    EXPECT_TRUE((v.cwiseAbs().array() <= lim.velocity.array() * 1.0001).all()) << "sample " << i;
+    EXPECT_TRUE((t.points[i].qd.cwiseAbs().array() <= lim.velocity.array() * 1.0001).all()) << "sample " << i;
+    const Eigen::VectorXd acc = (t.points[i].qd - t.points[i - 1].qd) / dt;
+    EXPECT_TRUE((acc.cwiseAbs().array() <= lim.acceleration.array() * 1.0001).all()) << "sample " << i;
+  }
+  EXPECT_THROW((void)time_parameterize({}, m->joint_names(), lim, 0.01), PlannerError);
+}
