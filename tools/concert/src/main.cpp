@@ -14,6 +14,12 @@
 #ifdef CONCERT_HAVE_MODELGEN_CLI
 #include "modelgen/cli.hpp"
 #endif
+#ifdef CONCERT_HAVE_SAFETY_CLI
+#include "safety/cli.hpp"
+#endif
+#ifdef CONCERT_HAVE_PLANNER_CLI
+#include "planner/cli.hpp"
+#endif
 
 namespace {
 
@@ -42,7 +48,10 @@ verbs:
                                                 publish a scan as an EtherCAT master would (latched)
   model generate (--scan F | --tree F | --assembly F) --module-db DIR [...] --out DIR
                                                 write URDF, SRDF, controller config and manifest
-  model show [--json]                           the live robot model: version, modules, chains, joints
+  model show [--timeout S]                      the live robot model: version, modules, chains, joints
+  safety status | estop [--source S] [--release] | reset
+                                                the safety layer: state, e-stop inputs, reset a latched stop
+  plan ...                                      whole-body planning requests (see `concert plan --help`)
   help                                          this text
 
 common options: --domain N (DDS domain id; default: CONCERT_DOMAIN_ID or 0)
@@ -67,6 +76,12 @@ int main(int argc, char** argv) {
     if (verb == "sim") return concert::cli::run_sim(rest, std::cout, std::cerr);
 #ifdef CONCERT_HAVE_DISCOVERY_CLI
     if (verb == "discover") return concert::discovery::cli_main(rest, std::cout, std::cerr);
+#endif
+#ifdef CONCERT_HAVE_SAFETY_CLI
+    if (verb == "safety") return concert::safety::cli_main(rest, std::cout, std::cerr);
+#endif
+#ifdef CONCERT_HAVE_PLANNER_CLI
+    if (verb == "plan") return concert::planner::cli_main(rest, std::cout, std::cerr);
 #endif
 #ifdef CONCERT_HAVE_MODELGEN_CLI
     if (verb == "model") return concert::modelgen::cli_main(rest, std::cout, std::cerr);
