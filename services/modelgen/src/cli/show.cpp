@@ -48,8 +48,14 @@ int show_main(const std::vector<std::string>& args, std::ostream& out, std::ostr
     }
     out << "joints (" << m->joints().size() << "):\n";
     for (const msg::JointInfo& j : m->joints()) {
-      out << "  " << j.name() << " chain " << j.chain() << " position [" << j.lower() << ", " << j.upper() << "] rad, velocity "
-          << j.velocity() << " rad/s, effort " << j.effort() << " N m\n";
+      out << "  " << j.name() << " chain " << j.chain();
+      // Continuous joints travel with limits of +-1e300 (no bound).
+      if (j.lower() <= -1e299 && j.upper() >= 1e299) {
+        out << " continuous";
+      } else {
+        out << " position [" << j.lower() << ", " << j.upper() << "] rad";
+      }
+      out << ", velocity " << j.velocity() << " rad/s, effort " << j.effort() << " N m\n";
     }
     out << "end-effectors (" << m->end_effectors().size() << "):\n";
     for (const msg::EndEffectorInfo& e : m->end_effectors()) {
