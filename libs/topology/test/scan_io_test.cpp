@@ -176,6 +176,18 @@ TEST(TreeJson, HasTheDiscoverShape) {
   const std::string text = tree_to_text(tree);
   EXPECT_NE(text.find("#0 elbow (joint) slave 1 robot_id 7"), std::string::npos) << text;
   EXPECT_NE(text.find("`-- [1] #1 drill (end_effector) slave 2"), std::string::npos) << text;
+
+  // What `concert discover --json` prints reads back as the same tree.
+  EXPECT_EQ(tree_from_json(j, "tree.json").modules, tree.modules);
+  nlohmann::json broken = j;
+  broken["modules"][1].erase("parent_connector");
+  try {
+    tree_from_json(broken, "tree.json");
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("tree.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("parent_connector"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -27,8 +27,5 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
 /// `concert model show` (args[0] == "show").
 int show_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
-/// Reads a module tree in the `concert discover --json` shape (topology::tree_to_json).
-/// Throws std::runtime_error naming `source` and the field.
-topology::ModuleTree tree_from_json(const nlohmann::json& doc, const std::string& source);
 
 }  // namespace concert::modelgen

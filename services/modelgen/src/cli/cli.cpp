@@ -103,7 +103,7 @@ int generate(const Options& o, std::ostream& out) {
     } catch (const nlohmann::json::exception& e) {
       throw std::runtime_error(o.tree + ": invalid JSON: " + e.what());
     }
-    tree = tree_from_json(doc, o.tree);
+    tree = topology::tree_from_json(doc, o.tree);
     source = o.tree;
   } else if (!o.scan.empty()) {
     tree = discovery::discover(topology::load_scan(o.scan), catalog_of(o.module_dbs), {o.order});

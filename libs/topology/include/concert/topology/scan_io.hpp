@@ -42,6 +42,9 @@ nlohmann::json scan_to_json(const EscScan& scan);
 /// key, kind, mod_type, mod_id, mod_size, mod_rev, slave_positions, parent_module,
 /// parent_connector, robot_id}]}.
 nlohmann::json tree_to_json(const ModuleTree& tree);
+/// Reads a module tree in the tree_to_json shape (what `concert discover --json` prints).
+/// Throws std::runtime_error naming `source` and the field.
+ModuleTree tree_from_json(const nlohmann::json& doc, const std::string& source);
 
 /// A module tree as indented readable text, one module per line, children under parents.
 std::string tree_to_text(const ModuleTree& tree);

@@ -1,8 +1,8 @@
 #include <stdexcept>
 
-#include "modelgen/cli.hpp"
+#include "concert/topology/scan_io.hpp"
 
-namespace concert::modelgen {
+namespace concert::topology {
 namespace {
 
 using nlohmann::json;
@@ -14,18 +14,18 @@ int32_t int_field(const json& obj, const char* key, const std::string& where) {
   return v.get<int32_t>();
 }
 
-topology::ModuleKind kind_from(const std::string& s, const std::string& where) {
-  for (auto k : {topology::ModuleKind::kJoint, topology::ModuleKind::kHub, topology::ModuleKind::kEndEffector,
-                 topology::ModuleKind::kLink, topology::ModuleKind::kWheel, topology::ModuleKind::kBaseLink}) {
-    if (topology::to_string(k) == s) return k;
+ModuleKind kind_from(const std::string& s, const std::string& where) {
+  for (auto k : {ModuleKind::kJoint, ModuleKind::kHub, ModuleKind::kEndEffector,
+                 ModuleKind::kLink, ModuleKind::kWheel, ModuleKind::kBaseLink}) {
+    if (to_string(k) == s) return k;
   }
   throw std::runtime_error(where + ".kind: unknown kind '" + s + "'");
 }
 
 }  // namespace
 
-topology::ModuleTree tree_from_json(const json& doc, const std::string& source) {
-  topology::ModuleTree tree;
+ModuleTree tree_from_json(const json& doc, const std::string& source) {
+  ModuleTree tree;
   if (!doc.is_object() || !doc.contains("modules") || !doc.at("modules").is_array()) {
     throw std::runtime_error(source + ": modules: missing or not a list");
   }
@@ -34,7 +34,7 @@ topology::ModuleTree tree_from_json(const json& doc, const std::string& source) 
     const json& m = mods[i];
     const std::string where = source + ": modules[" + std::to_string(i) + "]";
     if (!m.is_object()) throw std::runtime_error(where + ": expected an object");
-    topology::ModuleNode n;
+    ModuleNode n;
     n.index = m.contains("index") ? int_field(m, "index", where) : static_cast<int32_t>(i);
     if (n.index != static_cast<int32_t>(i)) throw std::runtime_error(where + ".index: " + std::to_string(n.index) + " but it is entry " + std::to_string(i));
     n.key = m.value("key", std::string());
@@ -51,9 +51,13 @@ topology::ModuleTree tree_from_json(const json& doc, const std::string& source) 
       }
     }
     n.parent_module = int_field(m, "parent_module", where);
+    if (n.parent_module >= 0 && !m.contains("parent_connector")) {
+      throw std::runtime_error(where + ".parent_connector: missing (module " + std::to_string(i) + " has parent " +
+                               std::to_string(n.parent_module) + ")");
+    }
     n.parent_connector = m.contains("parent_connector") ? int_field(m, "parent_connector", where) : -1;
     n.robot_id = m.contains("robot_id") ? int_field(m, "robot_id", where) : -1;
-    if (n.key.empty() && n.identity == topology::EscIdentity{}) {
+    if (n.key.empty() && n.identity == EscIdentity{}) {
       throw std::runtime_error(where + ": needs a key or an identity (mod_type, mod_id, mod_size, mod_rev)");
     }
     tree.modules.push_back(std::move(n));
@@ -63,7 +67,7 @@ topology::ModuleTree tree_from_json(const json& doc, const std::string& source) 
     for (size_t i = 0; i < slaves.size(); ++i) {
       const json& s = slaves[i];
       const std::string where = source + ": slaves[" + std::to_string(i) + "]";
-      topology::SlaveNode node;
+      SlaveNode node;
       node.slave.position = int_field(s, "position", where);
       node.slave.active_ports = static_cast<uint8_t>(s.contains("active_ports") ? int_field(s, "active_ports", where) : 0);
       node.slave.topology = s.contains("topology") ? int_field(s, "topology", where) : 0;
@@ -80,4 +84,4 @@ topology::ModuleTree tree_from_json(const json& doc, const std::string& source) 
   return tree;
 }
 
-}  // namespace concert::modelgen
+}  // namespace concert::topology
