@@ -9,6 +9,7 @@
 
 #include "ethercat.h"
 #include "model.h"
+#include "planning.h"
 #include "robot.h"
 #include "system.h"
 #include "topology.h"
@@ -31,6 +32,8 @@ static const struct {
     {"concert::msg::EStopInput", &concert_msg_EStopInput_desc},
     {"concert::msg::SafetyState", &concert_msg_SafetyState_desc},
     {"concert::msg::SafetyReset", &concert_msg_SafetyReset_desc},
+    {"concert::msg::PlanRequest", &concert_msg_PlanRequest_desc},
+    {"concert::msg::PlanResult", &concert_msg_PlanResult_desc},
 };
 
 #define MAX_ENDPOINTS 64

@@ -37,6 +37,10 @@ constexpr std::array kTopics = {
               "safety: running or stopped, and why"},
     TopicInfo{"concert/safety/reset", "concert::msg::SafetyReset", QosClass::kCommand,
               "operator/tools: reset a latched safety stop once every e-stop input is released"},
+    TopicInfo{"concert/planner/request", "concert::msg::PlanRequest", QosClass::kCommand,
+              "tasks/tools: drilling-area goals for whole-body planning (and execution)"},
+    TopicInfo{"concert/planner/result", "concert::msg::PlanResult", QosClass::kLatched,
+              "planner: progress, trajectory or failure reason, one instance per request"},
 };
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "ethercatPubSubTypes.h"
 #include "modelPubSubTypes.h"
+#include "planningPubSubTypes.h"
 #include "robotPubSubTypes.h"
 #include "systemPubSubTypes.h"
 #include "topologyPubSubTypes.h"
@@ -32,6 +33,8 @@ CONCERT_BIND_PUBSUB(ServiceStatus);
 CONCERT_BIND_PUBSUB(EStopInput);
 CONCERT_BIND_PUBSUB(SafetyState);
 CONCERT_BIND_PUBSUB(SafetyReset);
+CONCERT_BIND_PUBSUB(PlanRequest);
+CONCERT_BIND_PUBSUB(PlanResult);
 #undef CONCERT_BIND_PUBSUB
 
 /// A catalogue topic carrying T.
@@ -55,6 +58,8 @@ inline constexpr TopicHandle<msg::ServiceStatus> status{"concert/system/status"}
 inline constexpr TopicHandle<msg::EStopInput> estop{"concert/safety/estop"};
 inline constexpr TopicHandle<msg::SafetyState> safety_state{"concert/safety/state"};
 inline constexpr TopicHandle<msg::SafetyReset> safety_reset{"concert/safety/reset"};
+inline constexpr TopicHandle<msg::PlanRequest> plan_request{"concert/planner/request"};
+inline constexpr TopicHandle<msg::PlanResult> plan_result{"concert/planner/result"};
 }  // namespace topics
 
 /// Calls f(handle) for every typed topic handle (e.g. to dispatch on a topic name).
@@ -73,6 +78,8 @@ template <class F> void for_each_topic(F&& f) {
   f(topics::estop);
   f(topics::safety_state);
   f(topics::safety_reset);
+  f(topics::plan_request);
+  f(topics::plan_result);
 }
 
 }  // namespace concert::dds
