@@ -60,6 +60,9 @@ TEST_F(UpTest, BadInputIsRefusedBeforeAnythingStarts) {
   EXPECT_NE(r.err.find("missing.yaml"), std::string::npos) << r.err;
   r = concert({"up", "--backend", "ethercat"});
   EXPECT_EQ(r.code, 2);
+  r = concert({"up", "--domain", "300"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("'300' is not a DDS domain id"), std::string::npos) << r.err;
   r = concert({"sim", "swap", CONCERT_SOURCE_DIR "/deploy/demo/sanding_robot.yaml"});
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("concert up"), std::string::npos) << r.err;
