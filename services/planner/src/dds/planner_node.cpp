@@ -1,0 +1,316 @@
+#include "dds/planner_node.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace concert::planner::dds {
+namespace {
+
+int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+// Linear interpolation of a trajectory at time t [s] (samples are dense, 20 ms by default).
+TrajectoryPoint sample_at(const Trajectory& t, double time) {
+  const auto& p = t.points;
+  if (time <= p.front().time) return p.front();
+  if (time >= p.back().time) return p.back();
+  const auto it = std::upper_bound(p.begin(), p.end(), time, [](double v, const TrajectoryPoint& q) { return v < q.time; });
+  const TrajectoryPoint& b = *it;
+  const TrajectoryPoint& a = *(it - 1);
+  const double u = (time - a.time) / (b.time - a.time);
+  return {time, a.q + u * (b.q - a.q), a.qd + u * (b.qd - a.qd)};
+}
+
+}  // namespace
+
+ModelDescription to_core(const msg::RobotModel& m) {
+  ModelDescription d;
+  d.version = m.version();
+  d.urdf = m.urdf();
+  d.srdf = m.srdf();
+  for (const msg::JointInfo& j : m.joints()) d.joints.push_back({j.name(), j.chain(), j.lower(), j.upper(), j.velocity(), j.effort()});
+  for (const msg::ChainInfo& c : m.chains()) d.chains.push_back({c.name(), c.role(), c.joints()});
+  for (const msg::EndEffectorInfo& e : m.end_effectors()) d.end_effectors.push_back({e.name(), e.chain(), e.frame(), e.module_key()});
+  return d;
+}
+
+Eigen::Isometry3d to_core(const msg::Pose& p) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(p.position().x(), p.position().y(), p.position().z());
+  const Eigen::Quaterniond q(p.orientation().w(), p.orientation().x(), p.orientation().y(), p.orientation().z());
+  // A zero quaternion stays zero so the planner rejects it (not a rigid transform).
+  t.linear() = q.norm() > 1e-9 ? q.normalized().toRotationMatrix() : Eigen::Matrix3d::Zero();
+  return t;
+}
+
+msg::Pose to_msg(const Eigen::Isometry3d& t) {
+  msg::Pose p;
+  p.position().x(t.translation().x());
+  p.position().y(t.translation().y());
+  p.position().z(t.translation().z());
+  const Eigen::Quaterniond q(t.linear());
+  p.orientation().x(q.x());
+  p.orientation().y(q.y());
+  p.orientation().z(q.z());
+  p.orientation().w(q.w());
+  return p;
+}
+
+msg::PlanFailure to_failure(Status s) {
+  switch (s) {
+    case Status::kSucceeded: return msg::PLAN_OK;
+    case Status::kNoModel: return msg::PLAN_NO_MODEL;
+    case Status::kStaleModel: return msg::PLAN_STALE_MODEL;
+    case Status::kInvalidRequest: return msg::PLAN_INVALID_REQUEST;
+    case Status::kInvalidStart: return msg::PLAN_INVALID_START;
+    case Status::kUnreachable: return msg::PLAN_UNREACHABLE;
+    case Status::kNoPath: return msg::PLAN_NO_PATH;
+  }
+  return msg::PLAN_NO_PATH;
+}
+
+PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planner, NodeOptions options, std::ostream& log)
+    : planner_(planner),
+      options_(options),
+      log_(log),
+      results_(participant, concert::dds::topics::plan_result),
+      joint_commands_(participant, concert::dds::topics::joint_command),
+      base_commands_(participant, concert::dds::topics::base_velocity),
+      status_(participant, "planner"),
+      models_(participant, concert::dds::topics::robot_model, [this](const auto& s, const auto&) { on_model(s); }),
+      joint_states_(participant, concert::dds::topics::joint_state,
+                    [this](const auto& s, const auto&) {
+                      std::lock_guard lock(mutex_);
+                      joint_state_ = s;
+                    }),
+      odometries_(participant, concert::dds::topics::odometry,
+                  [this](const auto& s, const auto&) {
+                    std::lock_guard lock(mutex_);
+                    odometry_ = s;
+                  }),
+      request_reader_(participant, concert::dds::topics::plan_request, [this](const auto& s, const auto&) {
+        {
+          std::lock_guard lock(mutex_);
+          requests_.push_back(s);
+        }
+        wake_.notify_all();
+      }) {
+  if (planner_.model_version() == 0) status_.report(msg::SERVICE_STARTING, 0, "waiting for a robot model");
+  executor_ = std::thread([this] { execute_loop(); });
+}
+
+PlannerNode::~PlannerNode() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  executor_.join();
+}
+
+void PlannerNode::on_model(const msg::RobotModel& model) {
+  status_.report(msg::SERVICE_RECONFIGURING, static_cast<uint32_t>(planner_.model_version()),
+                 "reconfiguring to model version " + std::to_string(model.version()));
+  try {
+    planner_.set_model(to_core(model));
+    const auto m = planner_.model();
+    std::string note = "planning " + std::to_string(m->dof()) + " joints (base x, y, yaw + arm)";
+    if (!m->ignored_shapes().empty()) note += "; " + std::to_string(m->ignored_shapes().size()) + " mesh collisions ignored";
+    status_.report(msg::SERVICE_READY, model.version(), note);
+    log_ << "planner: model version " << model.version() << ": " << note << std::endl;
+  } catch (const std::exception& e) {
+    const uint64_t kept = planner_.model_version();
+    status_.report(kept == 0 ? msg::SERVICE_ERROR : msg::SERVICE_READY, static_cast<uint32_t>(kept),
+                   std::string("model version ") + std::to_string(model.version()) + " refused: " + e.what());
+    log_ << "planner: model version " << model.version() << " refused (keeping " << kept << "): " << e.what() << std::endl;
+  }
+}
+
+void PlannerNode::publish(msg::PlanResult result) {
+  result.stamp_ns(now_ns());
+  results_.write(result);
+}
+
+void PlannerNode::spin(const std::atomic<bool>& stop, std::chrono::milliseconds poll) {
+  while (!stop) spin_once(poll);
+}
+
+bool PlannerNode::spin_once(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  if (!wake_.wait_for(lock, timeout, [&] { return !requests_.empty() || stopping_; }) || requests_.empty()) return false;
+  const msg::PlanRequest request = requests_.front();
+  requests_.pop_front();
+  lock.unlock();
+  handle(request);
+  return true;
+}
+
+void PlannerNode::handle(const msg::PlanRequest& request) {
+  msg::PlanResult base;
+  base.request_id(request.request_id());
+  base.model_version(static_cast<uint32_t>(planner_.model_version()));
+  base.goal_count(static_cast<uint32_t>(request.goals().size()));
+  base.state(msg::PLAN_PLANNING);
+  publish(base);
+  const auto model = planner_.model();
+
+  // Start state: the robot's joint state and odometry; without a robot (planning only) the
+  // model's zero posture at the origin.
+  Eigen::VectorXd start;
+  std::string start_error;
+  if (model && request.model_version() == model->version()) {
+    std::optional<msg::JointState> js;
+    std::optional<msg::Odometry> odom;
+    {
+      std::lock_guard lock(mutex_);
+      js = joint_state_;
+      odom = odometry_;
+    }
+    const Eigen::Vector3d pose = odom ? Eigen::Vector3d(odom->x(), odom->y(), odom->yaw()) : Eigen::Vector3d::Zero();
+    try {
+      if (js && js->model_version() == model->version()) {
+        start = model->full_from_named(js->name(), js->position(), pose);
+      } else if (request.execute()) {
+        start_error = js ? "the robot runs model version " + std::to_string(js->model_version()) + ", the planner " +
+                               std::to_string(model->version())
+                         : "no joint state from the robot service yet (needed to execute)";
+      } else {
+        start = Eigen::VectorXd::Zero(model->full_dof());
+        start.head<3>() = pose;
+      }
+    } catch (const std::exception& e) {
+      start_error = e.what();
+    }
+  }
+  if (!start_error.empty()) {
+    base.state(msg::PLAN_FAILED);
+    base.failure(msg::PLAN_INVALID_START);
+    base.reason(start_error);
+    publish(base);
+    log_ << "planner: request " << request.request_id() << " failed: " << start_error << std::endl;
+    return;
+  }
+
+  PlanRequest core;
+  core.request_id = request.request_id();
+  core.model_version = request.model_version();
+  core.end_effector = request.end_effector();
+  for (const msg::Pose& g : request.goals()) core.goals.push_back({to_core(g)});
+  const bool execute = request.execute();
+  const std::size_t count = core.goals.size();
+  const PlanResult result = planner_.plan(core, start, [&](const GoalResult& g) {
+    msg::PlanResult r = base;
+    r.goal_index(static_cast<uint32_t>(g.index));
+    r.planning_time(g.nspg_seconds + g.plan_seconds);
+    if (g.status != Status::kSucceeded) {
+      r.state(msg::PLAN_FAILED);
+      r.failure(to_failure(g.status));
+      r.reason(g.reason);
+      publish(r);
+      return;
+    }
+    r.state(msg::PLAN_PLANNED);
+    r.joint_names(g.trajectory.joint_names);
+    for (const TrajectoryPoint& p : g.trajectory.points) {
+      msg::TrajectorySample s;
+      s.time(p.time);
+      s.position(std::vector<double>(p.q.data(), p.q.data() + p.q.size()));
+      s.velocity(std::vector<double>(p.qd.data(), p.qd.data() + p.qd.size()));
+      r.trajectory().push_back(std::move(s));
+    }
+    publish(r);
+    if (execute) {
+      {
+        std::lock_guard lock(mutex_);
+        executions_.push_back({r, model, g.trajectory, g.index + 1 == count});
+      }
+      wake_.notify_all();
+    }
+  });
+  log_ << "planner: request " << request.request_id() << ": " << to_string(result.status)
+       << (result.reason.empty() ? "" : " (" + result.reason + ")") << std::endl;
+  if (result.goals.empty()) {  // refused before any goal (stale model, bad request...)
+    base.state(msg::PLAN_FAILED);
+    base.failure(to_failure(result.status));
+    base.reason(result.reason);
+    publish(base);
+  } else if (!execute && result.status == Status::kSucceeded) {
+    base.state(msg::PLAN_SUCCEEDED);
+    base.goal_index(static_cast<uint32_t>(count - 1));
+    base.planning_time(result.goals.back().nspg_seconds + result.goals.back().plan_seconds);
+    publish(base);
+  }
+}
+
+void PlannerNode::execute_loop() {
+  while (true) {
+    std::unique_lock lock(mutex_);
+    wake_.wait(lock, [&] { return stopping_ || !executions_.empty(); });
+    if (stopping_) return;
+    Execution e = std::move(executions_.front());
+    executions_.pop_front();
+    lock.unlock();
+    const bool ok = execute(e);
+    msg::PlanResult r = e.result;
+    r.trajectory().clear();
+    r.progress(ok ? 1.0 : r.progress());
+    r.state(ok ? (e.last ? msg::PLAN_SUCCEEDED : msg::PLAN_PLANNED) : msg::PLAN_FAILED);
+    if (!ok) {
+      r.failure(msg::PLAN_EXECUTION_ABORTED);
+      r.reason("execution of goal " + std::to_string(r.goal_index()) + " aborted: the robot model changed");
+      std::lock_guard relock(mutex_);
+      executions_.clear();
+    }
+    publish(r);
+  }
+}
+
+bool PlannerNode::execute(Execution& e) {
+  const PlanningModel& m = *e.model;
+  const Trajectory& t = e.trajectory;
+  msg::JointCommand cmd;
+  cmd.model_version(static_cast<uint32_t>(m.version()));
+  cmd.source("planner");
+  cmd.mode(msg::JOINT_POSITION);
+  for (std::size_t i = 3; i < t.joint_names.size(); ++i) cmd.name().push_back(t.joint_names[i]);
+  msg::BaseVelocityCommand base;
+  base.model_version(static_cast<uint32_t>(m.version()));
+  base.source("planner");
+  const auto t0 = std::chrono::steady_clock::now();
+  auto last_progress = t0;
+  e.result.state(msg::PLAN_EXECUTING);
+  e.result.trajectory().clear();
+  while (true) {
+    {
+      std::lock_guard lock(mutex_);
+      if (stopping_) return false;
+    }
+    if (planner_.model_version() != m.version()) return false;
+    const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const TrajectoryPoint p = sample_at(t, time);
+    const auto n = static_cast<std::size_t>(p.q.size());
+    cmd.position(std::vector<double>(p.q.data() + 3, p.q.data() + n));
+    cmd.velocity(std::vector<double>(p.qd.data() + 3, p.qd.data() + n));
+    cmd.stamp_ns(now_ns());
+    joint_commands_.write(cmd);
+    // World-frame base velocity into the base frame.
+    const double c = std::cos(p.q[2]);
+    const double s = std::sin(p.q[2]);
+    base.vx(c * p.qd[0] + s * p.qd[1]);
+    base.vy(-s * p.qd[0] + c * p.qd[1]);
+    base.wz(p.qd[2]);
+    base.stamp_ns(now_ns());
+    base_commands_.write(base);
+    if (time >= t.duration()) return true;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_progress >= options_.progress_period) {
+      e.result.progress(t.duration() > 0 ? std::min(1.0, time / t.duration()) : 1.0);
+      publish(e.result);
+      last_progress = now;
+    }
+    std::this_thread::sleep_for(options_.command_period);
+  }
+}
+
+}  // namespace concert::planner::dds

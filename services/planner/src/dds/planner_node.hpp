@@ -1,0 +1,83 @@
+#pragma once
+// DDS adapter of the planner service: RobotModel in (reconfigure, status READY at the
+// version), joint state and odometry in (start state), PlanRequest in; PlanResult out per
+// request (planning, planned with the trajectory, executing with progress, succeeded/failed
+// with the reason). Execution streams JointCommand (position mode) for the arm joints and
+// BaseVelocityCommand for the base, while later goals are still being planned (FIFO).
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <ostream>
+#include <thread>
+
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/status_reporter.hpp"
+#include "planner/planner.hpp"
+
+namespace concert::planner::dds {
+
+/// Conversions between IDL and core types.
+ModelDescription to_core(const msg::RobotModel& model);
+Eigen::Isometry3d to_core(const msg::Pose& pose);
+msg::Pose to_msg(const Eigen::Isometry3d& pose);
+msg::PlanFailure to_failure(Status status);
+
+struct NodeOptions {
+  std::chrono::milliseconds command_period{10};   ///< execution command period
+  std::chrono::milliseconds progress_period{100}; ///< progress updates while executing
+};
+
+class PlannerNode {
+ public:
+  /// `participant` and `planner` must outlive the node. Reports STARTING until a model arrives.
+  PlannerNode(concert::dds::Participant& participant, Planner& planner, NodeOptions options, std::ostream& log);
+  ~PlannerNode();
+  PlannerNode(const PlannerNode&) = delete;
+  PlannerNode& operator=(const PlannerNode&) = delete;
+
+  /// Handles requests until `stop` is set (checked every `poll`).
+  void spin(const std::atomic<bool>& stop, std::chrono::milliseconds poll = std::chrono::milliseconds(50));
+  /// Handles at most one request, waiting up to `timeout`; true if one was handled.
+  bool spin_once(std::chrono::milliseconds timeout);
+  /// Model version the node runs (0: none).
+  [[nodiscard]] uint64_t model_version() const { return planner_.model_version(); }
+
+ private:
+  struct Execution {
+    msg::PlanResult result;  // planned goal (trajectory filled)
+    std::shared_ptr<const PlanningModel> model;
+    Trajectory trajectory;
+    bool last = false;
+  };
+  void on_model(const msg::RobotModel& model);
+  void handle(const msg::PlanRequest& request);
+  void publish(msg::PlanResult result);
+  void execute_loop();
+  bool execute(Execution& e);
+
+  Planner& planner_;
+  NodeOptions options_;
+  std::ostream& log_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<msg::PlanRequest> requests_;
+  std::deque<Execution> executions_;
+  std::optional<msg::JointState> joint_state_;
+  std::optional<msg::Odometry> odometry_;
+  bool stopping_ = false;
+  concert::dds::Writer<msg::PlanResult> results_;
+  concert::dds::Writer<msg::JointCommand> joint_commands_;
+  concert::dds::Writer<msg::BaseVelocityCommand> base_commands_;
+  concert::dds::StatusReporter status_;
+  concert::dds::Reader<msg::RobotModel> models_;
+  concert::dds::Reader<msg::JointState> joint_states_;
+  concert::dds::Reader<msg::Odometry> odometries_;
+  concert::dds::Reader<msg::PlanRequest> request_reader_;
+  std::thread executor_;
+};
+
+}  // namespace concert::planner::dds
