@@ -79,7 +79,10 @@ struct Params {
 
   // NSPG.
   int nspg_samples = 30;             ///< null-space random walks tried per goal (if seeds fail)
-  int nspg_arm_seeds = 4;            ///< arm postures (start + random) per base stand-off
+  int nspg_arm_samples = 20000;      ///< random arm postures screened for task-aligned seeds
+  int nspg_ranked_seeds = 40;        ///< best screened postures (by torque) tried first
+  int nspg_arm_seeds = 6;            ///< arm postures (start + random) per base placement
+  double nspg_time = 1.2;            ///< NSPG time budget per goal [s]
   int nspg_enough = 2;               ///< stop after this many valid postures
   double nspg_step = 0.35;           ///< largest null-space step per walk [rad or m]
   double nspg_tolerance = 1e-3;      ///< task error accepted [m, rad]

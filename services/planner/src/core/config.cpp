@@ -59,6 +59,7 @@ Params parse_params(const std::string& yaml, const std::string& source) {
       {"planning_time", &p.planning_time},
       {"check_resolution", &p.check_resolution},
       {"nspg_step", &p.nspg_step},
+      {"nspg_time", &p.nspg_time},
       {"nspg_tolerance", &p.nspg_tolerance},
       {"nspg_distance_weight", &p.nspg_distance_weight},
       {"nspg_singularity_weight", &p.nspg_singularity_weight},
@@ -72,7 +73,8 @@ Params parse_params(const std::string& yaml, const std::string& source) {
   };
   const std::map<std::string, int*> integers = {
       {"simplify_iterations", &p.simplify_iterations}, {"nspg_samples", &p.nspg_samples},
-      {"nspg_arm_seeds", &p.nspg_arm_seeds},           {"nspg_enough", &p.nspg_enough},
+      {"nspg_arm_seeds", &p.nspg_arm_seeds},
+      {"nspg_arm_samples", &p.nspg_arm_samples},       {"nspg_ranked_seeds", &p.nspg_ranked_seeds},           {"nspg_enough", &p.nspg_enough},
       {"nspg_torque_iterations", &p.nspg_torque_iterations},
   };
   for (const auto& kv : root) {

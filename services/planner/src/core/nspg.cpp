@@ -2,6 +2,8 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -217,11 +219,18 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   // approaching (gravity only) and while drilling (gravity + contact force on the tool).
   auto consider = [&](Eigen::VectorXd q) {
     out.candidates += 1;
-    solver.relieve_torques(q, task, checker, tool.frame, params.nspg_torque_iterations);
+    auto validity = [&](const Eigen::VectorXd& full) {
+      Validity v = checker.check(full, tool.frame);
+      return v.valid() ? checker.check(full) : v;
+    };
+    Validity v = validity(model.to_full(q, q_start_full));
+    if (v.constraint == Constraint::kTorqueLimit) {
+      // Only torque-limited postures are worth the (costly) null-space torque descent.
+      solver.relieve_torques(q, task, checker, tool.frame, params.nspg_torque_iterations);
+      v = validity(model.to_full(q, q_start_full));
+    }
     on_task.push_back(q);
     const Eigen::VectorXd full = model.to_full(q, q_start_full);
-    Validity v = checker.check(full, tool.frame);
-    if (v.valid()) v = checker.check(full);
     if (!v.valid()) {
       reject(v);
       const double sc = score(full, v);
@@ -240,9 +249,52 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
     }
   };
 
+  // Seeds from sampled arm postures: keep those whose camera axis and height already match
+  // the task, place the base analytically (yaw aligns the axis, x/y the position) and rank
+  // them by torque utilisation (with and without the contact force). Forward kinematics is
+  // cheap, so thousands of arm postures cost a few milliseconds.
+  std::vector<std::pair<double, Eigen::VectorXd>> ranked;
+  {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const std::string camera = model.camera_frame(tool);
+    const auto& idx = model.planned_indices();
+    Eigen::VectorXd full = q_start_full;
+    for (int k = 0; k < params.nspg_arm_samples; ++k) {
+      Eigen::VectorXd q = start;
+      q.head<3>().setZero();
+      for (int i = 3; i < n; ++i) q[i] = lo[i] + (hi[i] - lo[i]) * unit(rng);
+      full = model.to_full(q, q_start_full);
+      const Eigen::Isometry3d cam = model.link_pose(full, camera);
+      const Eigen::Vector3d a = cam.linear().col(2);
+      if (std::abs(a.z() - task.axis.z()) > 0.25 || std::abs(cam.translation().z() - task.position.z()) > 0.25) continue;
+      if (a.head<2>().norm() < 1e-3 || task.axis.head<2>().norm() < 1e-3) continue;
+      const double yaw = std::atan2(task.axis.y(), task.axis.x()) - std::atan2(a.y(), a.x());
+      const Eigen::Rotation2Dd rot(yaw);
+      q[2] = start[2] + std::remainder(yaw - start[2], 2.0 * M_PI);
+      q.head<2>() = task.position.head<2>() - rot * cam.translation().head<2>();
+      full = model.to_full(q, q_start_full);
+      double worst = 0.0;
+      for (const std::string& frame : {tool.frame, std::string()}) {
+        const Eigen::VectorXd tau = checker.required_torques(full, frame);
+        for (std::size_t i = 3; i < idx.size(); ++i) {
+          const double lim = model.torque_limits()[idx[i]];
+          if (lim > 0.0) worst = std::max(worst, std::abs(tau[idx[i]]) / lim);
+        }
+      }
+      if (worst >= 1.5) continue;
+      const Constraint c = checker.check(full).constraint;
+      if (c == Constraint::kNone || c == Constraint::kTorqueLimit) ranked.emplace_back(worst, q);
+    }
+    std::sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  }
+
   // Seeds: the start posture; then the base facing the area with the arm mount at a few
   // stand-offs from the camera target, with the start arm and random arm postures.
-  std::vector<Eigen::VectorXd> seeds{start};
+  std::vector<Eigen::VectorXd> seeds;
+  for (std::size_t i = 0; i < ranked.size() && i < static_cast<std::size_t>(params.nspg_ranked_seeds); ++i) {
+    seeds.push_back(ranked[i].second);
+  }
+  seeds.push_back(start);
   const Eigen::Vector2d n_xy = -task.axis.head<2>();
   if (n_xy.norm() > 1e-6) {
     const Eigen::Vector2d nrm = n_xy.normalized();
@@ -268,11 +320,15 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
       }
     }
   }
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto out_of_time = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > params.nspg_time;
+  };
   for (Eigen::VectorXd s : seeds) {
     if (solver.converge(s, task, 60)) consider(s);
-    if (valid_found >= params.nspg_enough) break;
+    if (valid_found >= params.nspg_enough || out_of_time()) break;
   }
-  for (int k = 0; k < params.nspg_samples && !on_task.empty() && valid_found < params.nspg_enough; ++k) {
+  for (int k = 0; k < params.nspg_samples && !on_task.empty() && valid_found < params.nspg_enough && !out_of_time(); ++k) {
     // Walk from the best valid posture, else climb from the least infeasible one (and now and
     // then from any posture on the task, to leave a local minimum).
     Eigen::VectorXd q = out.found ? out.q : (k % 4 == 3 || best_invalid.size() == 0) ? on_task[rng() % on_task.size()] : best_invalid;

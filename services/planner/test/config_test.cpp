@@ -1,0 +1,56 @@
+// Params and world YAML: defaults, values read, and errors naming the file and field.
+
+#include <gtest/gtest.h>
+
+#include "planner/config.hpp"
+
+using namespace concert::planner;
+
+TEST(Config, ParamsReadAndDefaultsKept) {
+  const Params p = parse_params("contact_force: 150\nplanning_time: 1.5\nseed: 9\nnspg_samples: 12\n", "p.yaml");
+  EXPECT_DOUBLE_EQ(p.contact_force, 150.0);
+  EXPECT_DOUBLE_EQ(p.planning_time, 1.5);
+  EXPECT_EQ(p.seed, 9u);
+  EXPECT_EQ(p.nspg_samples, 12);
+  EXPECT_DOUBLE_EQ(p.camera_distance, Params{}.camera_distance);
+  const Params file = load_params(std::string(CONCERT_SOURCE_DIR) + "/services/planner/config/planner.yaml");
+  EXPECT_DOUBLE_EQ(file.camera_distance, 0.6);
+}
+
+TEST(Config, ParamErrorsNameFileAndField) {
+  auto message = [](const std::string& yaml) {
+    try {
+      (void)parse_params(yaml, "p.yaml");
+    } catch (const PlannerError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("bogus: 1").find("p.yaml: bogus: unknown parameter"), std::string::npos);
+  EXPECT_NE(message("contact_force: lots").find("p.yaml: contact_force: expected a number"), std::string::npos);
+  EXPECT_NE(message("planning_time: 0").find("planning_time"), std::string::npos);
+  EXPECT_NE(message("nspg_samples: 1.5").find("nspg_samples"), std::string::npos);
+  EXPECT_THROW((void)load_params("/nonexistent/planner.yaml"), PlannerError);
+}
+
+TEST(Config, WorldFileLikeTheRobotService) {
+  const World w = parse_world(
+      "floor: {height: 0.0}\n"
+      "walls:\n  - {name: north, size: [4.0, 0.2, 2.5], position: [2.0, 3.0, 1.25], yaw: 0.5}\n"
+      "obstacles:\n  - {name: pillar, shape: cylinder, radius: 0.2, height: 2.0, position: [-3.0, 3.0, 1.0]}\n"
+      "  - {name: crate, size: [0.5, 0.5, 0.5], position: [1.0, -1.0, 0.25]}\n",
+      "w.yaml");
+  ASSERT_EQ(w.boxes.size(), 2u);
+  ASSERT_EQ(w.cylinders.size(), 1u);
+  EXPECT_EQ(w.boxes[0].name, "north");
+  EXPECT_DOUBLE_EQ(w.boxes[0].yaw, 0.5);
+  EXPECT_DOUBLE_EQ(w.cylinders[0].radius, 0.2);
+  try {
+    (void)parse_world("walls:\n  - {size: [1, 2], position: [0, 0, 0]}\n", "w.yaml");
+    FAIL();
+  } catch (const PlannerError& e) {
+    EXPECT_NE(std::string(e.what()).find("w.yaml: walls[0].size: expected a list of 3 numbers"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)parse_world("ceiling: 1\n", "w.yaml"), PlannerError);
+  EXPECT_THROW((void)parse_world("obstacles:\n  - {shape: cone, size: [1,1,1], position: [0,0,0]}\n", "w.yaml"), PlannerError);
+}
