@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "process.hpp"
+#include "wait_for.hpp"
 
 namespace concert::system_test {
 namespace {
@@ -186,16 +187,6 @@ std::string model_line(const std::string& out, int version) {
     if (line.rfind("model " + std::to_string(version) + " ", 0) == 0) return line;
   }
   return "";
-}
-
-/// Waits (bounded) until the process' stderr contains `text`.
-bool wait_for_err(const testing::Process& p, const std::string& text, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (p.err().find(text) == std::string::npos) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(50ms);
-  }
-  return true;
 }
 
 std::string dump(const char* name, const testing::Process& p) {
