@@ -47,12 +47,15 @@ std::pair<int, std::string> shell(const std::string& command) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
 
-std::string ip_binary() {
-  for (const char* p : {"/usr/sbin/ip", "/sbin/ip", "/usr/bin/ip", "/bin/ip"}) {
-    if (fs::exists(p)) return p;
+/// Absolute path of a system tool (the test helper runs programs without a PATH search).
+std::string tool(const std::string& name, const std::string& package) {
+  for (const char* dir : {"/usr/sbin/", "/sbin/", "/usr/bin/", "/bin/"}) {
+    if (fs::exists(dir + name)) return dir + name;
   }
-  throw std::runtime_error("the 'ip' tool (Debian package iproute2) is not installed");
+  throw std::runtime_error("the '" + name + "' tool (Debian package " + package + ") is not installed");
 }
+
+std::string ip_binary() { return tool("ip", "iproute2"); }
 
 /// Three namespaces "concert-sys-<pid>-{rt,nav,man}" with veth links to one bridge.
 class ThreeHosts {
@@ -109,6 +112,7 @@ class ThreeHosts {
     std::string rest = list;
     while (std::regex_search(rest, m, name)) {
       if (!fs::exists("/proc/" + m[1].str())) {
+        shell("ip netns pids " + m[0].str() + " | xargs -r kill -KILL");
         shell("ip netns del " + m[0].str());
         shell("ip link del cbr" + m[1].str());
       }
@@ -157,16 +161,18 @@ fs::path write_profile(const fs::path& dir, std::size_t i) {
 
 class Stack {
  public:
-  Stack(const ThreeHosts& hosts, fs::path dir) : hosts_(hosts), dir_(std::move(dir)), ip_(ip_binary()) {
+  Stack(const ThreeHosts& hosts, fs::path dir)
+      : hosts_(hosts), dir_(std::move(dir)), ip_(ip_binary()), setpriv_(tool("setpriv", "util-linux")) {
     for (std::size_t i = 0; i < kHosts.size(); ++i) profiles_[i] = write_profile(dir_, i);
   }
   ~Stack() {
     for (auto it = processes_.rbegin(); it != processes_.rend(); ++it) (*it)->stop(10s);
   }
 
-  /// Starts `argv` on host i (in its namespace, with its DDS profile and host name).
+  /// Starts `argv` on host i (in its namespace, with its DDS profile and host name). The
+  /// process gets SIGKILL if the test dies first (setpriv --pdeathsig).
   testing::Process& start(std::size_t i, std::vector<std::string> argv) {
-    argv.insert(argv.begin(), {ip_, "netns", "exec", hosts_.ns(i)});
+    argv.insert(argv.begin(), {setpriv_, "--pdeathsig", "KILL", "--", ip_, "netns", "exec", hosts_.ns(i)});
     processes_.push_back(std::make_unique<testing::Process>(
         argv, std::vector<std::string>{"CONCERT_DDS_PROFILES=" + profiles_[i].string(),
                                        "CONCERT_HOST=" + std::string(kHosts[i])}));
@@ -177,6 +183,7 @@ class Stack {
   const ThreeHosts& hosts_;
   fs::path dir_;
   std::string ip_;
+  std::string setpriv_;
   std::array<fs::path, 3> profiles_;
   std::vector<std::unique_ptr<testing::Process>> processes_;
 };
