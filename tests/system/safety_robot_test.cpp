@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "process.hpp"
-#include "wait_for.hpp"
+#include "helpers.hpp"
 
 namespace concert::system_test {
 namespace {
@@ -19,11 +19,12 @@ using namespace std::chrono_literals;
 
 TEST(SafetyWithRobot, NoFalseStopWhileHoldingThenKilledRobotIsNamed) {
   const std::vector<std::string> env = {"CONCERT_HOST=rt-pc"};
-  testing::Process safety({SAFETY_BINARY}, env);
-  testing::Process discovery({DISCOVERY_BINARY}, env);
-  testing::Process modelgen({MODELGEN_BINARY}, env);
+  testing::Process safety(dies_with_test({SAFETY_BINARY}), env);
+  testing::Process discovery(dies_with_test({DISCOVERY_BINARY}), env);
+  testing::Process modelgen(dies_with_test({MODELGEN_BINARY}), env);
   testing::Process robot(
-      {ROBOT_BINARY, "--assembly", std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml"}, env);
+      dies_with_test({ROBOT_BINARY, "--assembly", std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml"}),
+      env);
   const auto logs = [&] {
     return "\n--- safety:\n" + safety.err() + "--- robot:\n" + robot.err() + robot.out() + "--- modelgen:\n" +
            modelgen.err() + "--- discovery:\n" + discovery.err();

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "process.hpp"
-#include "wait_for.hpp"
+#include "helpers.hpp"
 
 namespace concert::system_test {
 namespace {
@@ -45,14 +45,6 @@ std::pair<int, std::string> shell(const std::string& command) {
   while (fgets(buf.data(), buf.size(), pipe) != nullptr) output += buf.data();
   const int status = pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
-
-/// Absolute path of a system tool (the test helper runs programs without a PATH search).
-std::string tool(const std::string& name, const std::string& package) {
-  for (const char* dir : {"/usr/sbin/", "/sbin/", "/usr/bin/", "/bin/"}) {
-    if (fs::exists(dir + name)) return dir + name;
-  }
-  throw std::runtime_error("the '" + name + "' tool (Debian package " + package + ") is not installed");
 }
 
 std::string ip_binary() { return tool("ip", "iproute2"); }
@@ -162,7 +154,7 @@ fs::path write_profile(const fs::path& dir, std::size_t i) {
 class Stack {
  public:
   Stack(const ThreeHosts& hosts, fs::path dir)
-      : hosts_(hosts), dir_(std::move(dir)), ip_(ip_binary()), setpriv_(tool("setpriv", "util-linux")) {
+      : hosts_(hosts), dir_(std::move(dir)), ip_(ip_binary()) {
     for (std::size_t i = 0; i < kHosts.size(); ++i) profiles_[i] = write_profile(dir_, i);
   }
   ~Stack() {
@@ -172,9 +164,9 @@ class Stack {
   /// Starts `argv` on host i (in its namespace, with its DDS profile and host name). The
   /// process gets SIGKILL if the test dies first (setpriv --pdeathsig).
   testing::Process& start(std::size_t i, std::vector<std::string> argv) {
-    argv.insert(argv.begin(), {setpriv_, "--pdeathsig", "KILL", "--", ip_, "netns", "exec", hosts_.ns(i)});
+    argv.insert(argv.begin(), {ip_, "netns", "exec", hosts_.ns(i)});
     processes_.push_back(std::make_unique<testing::Process>(
-        argv, std::vector<std::string>{"CONCERT_DDS_PROFILES=" + profiles_[i].string(),
+        dies_with_test(argv), std::vector<std::string>{"CONCERT_DDS_PROFILES=" + profiles_[i].string(),
                                        "CONCERT_HOST=" + std::string(kHosts[i])}));
     return *processes_.back();
   }
@@ -183,7 +175,6 @@ class Stack {
   const ThreeHosts& hosts_;
   fs::path dir_;
   std::string ip_;
-  std::string setpriv_;
   std::array<fs::path, 3> profiles_;
   std::vector<std::unique_ptr<testing::Process>> processes_;
 };

@@ -1,0 +1,41 @@
+#pragma once
+// Helpers of the system tests (tests/support/process.hpp waits on stdout only and does not
+// tie its children's life to the test's).
+
+#include <chrono>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "process.hpp"
+
+namespace concert::system_test {
+
+/// Waits (bounded) until the process' stderr contains `text`.
+inline bool wait_for_err(const testing::Process& p, const std::string& text, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (p.err().find(text) == std::string::npos) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return true;
+}
+
+/// Absolute path of a system tool (the test helper runs programs without a PATH search).
+inline std::string tool(const std::string& name, const std::string& package) {
+  for (const char* dir : {"/usr/sbin/", "/sbin/", "/usr/bin/", "/bin/"}) {
+    if (std::filesystem::exists(dir + name)) return dir + name;
+  }
+  throw std::runtime_error("the '" + name + "' tool (Debian package " + package + ") is not installed");
+}
+
+/// `argv` run so that it gets SIGKILL if the test process dies first (a ctest timeout kills
+/// the test before its destructors run).
+inline std::vector<std::string> dies_with_test(std::vector<std::string> argv) {
+  argv.insert(argv.begin(), {tool("setpriv", "util-linux"), "--pdeathsig", "KILL", "--"});
+  return argv;
+}
+
+}  // namespace concert::system_test
