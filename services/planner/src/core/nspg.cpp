@@ -253,13 +253,13 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   // the task, place the base analytically (yaw aligns the axis, x/y the position) and rank
   // them by torque utilisation (with and without the contact force). Forward kinematics is
   // cheap, so thousands of arm postures cost a few milliseconds.
-  std::vector<std::pair<double, Eigen::VectorXd>> ranked;
-  {
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    const std::string camera = model.camera_frame(tool);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const std::string camera = model.camera_frame(tool);
+  auto screen = [&](int count) {
+    std::vector<std::pair<double, Eigen::VectorXd>> ranked;
     const auto& idx = model.planned_indices();
     Eigen::VectorXd full = q_start_full;
-    for (int k = 0; k < params.nspg_arm_samples; ++k) {
+    for (int k = 0; k < count; ++k) {
       Eigen::VectorXd q = start;
       q.head<3>().setZero();
       for (int i = 3; i < n; ++i) q[i] = lo[i] + (hi[i] - lo[i]) * unit(rng);
@@ -286,15 +286,29 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
       if (c == Constraint::kNone || c == Constraint::kTorqueLimit) ranked.emplace_back(worst, q);
     }
     std::sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    return ranked;
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto out_of_time = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > params.nspg_time;
+  };
+  // In two rounds: a small screening first (easy goals end here, fast), the rest only when
+  // it found nothing valid.
+  for (const int round : {0, 1}) {
+    if (valid_found > 0 || out_of_time()) break;
+    const int count = round == 0 ? params.nspg_arm_samples / 8 : params.nspg_arm_samples - params.nspg_arm_samples / 8;
+    const int tries = round == 0 ? std::max(1, params.nspg_ranked_seeds / 8) : params.nspg_ranked_seeds;
+    const auto ranked = screen(count);
+    for (std::size_t i = 0; i < ranked.size() && i < static_cast<std::size_t>(tries); ++i) {
+      Eigen::VectorXd s = ranked[i].second;
+      if (solver.converge(s, task, 60)) consider(s);
+      if (valid_found >= params.nspg_enough || out_of_time()) break;
+    }
   }
 
   // Seeds: the start posture; then the base facing the area with the arm mount at a few
   // stand-offs from the camera target, with the start arm and random arm postures.
-  std::vector<Eigen::VectorXd> seeds;
-  for (std::size_t i = 0; i < ranked.size() && i < static_cast<std::size_t>(params.nspg_ranked_seeds); ++i) {
-    seeds.push_back(ranked[i].second);
-  }
-  seeds.push_back(start);
+  std::vector<Eigen::VectorXd> seeds{start};
   const Eigen::Vector2d n_xy = -task.axis.head<2>();
   if (n_xy.norm() > 1e-6) {
     const Eigen::Vector2d nrm = n_xy.normalized();
@@ -302,7 +316,6 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
     Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.full_dof());
     const double mount = model.link_pose(zero, model.kinematics().joint_parent_link(first_arm)).translation().x();
     const double yaw = std::atan2(-nrm.y(), -nrm.x());
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
     // Facing the wall, and sideways: then the shoulder pitch axis lies along the normal and
     // the drilling force loads it least (its moment about a joint axis parallel to it is 0).
     for (int arm = 0; arm < params.nspg_arm_seeds; ++arm) {
@@ -320,11 +333,8 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
       }
     }
   }
-  const auto t0 = std::chrono::steady_clock::now();
-  const auto out_of_time = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > params.nspg_time;
-  };
   for (Eigen::VectorXd s : seeds) {
+    if (valid_found >= params.nspg_enough || out_of_time()) break;
     if (solver.converge(s, task, 60)) consider(s);
     if (valid_found >= params.nspg_enough || out_of_time()) break;
   }
