@@ -4,6 +4,7 @@
 // sources exist. If a `docker compose` CLI is installed, `docker compose config` must accept
 // the file too (it needs no engine).
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -13,8 +14,6 @@
 #include <set>
 #include <sstream>
 #include <string>
-
-#include <yaml-cpp/yaml.h>
 
 namespace concert::system_test {
 namespace {
@@ -57,19 +56,25 @@ std::string with_defaults(const std::string& text) {
 }
 
 const std::map<std::string, std::string> kPlacement = {
-    {"robot", "rt"},     {"safety", "rt"}, {"discovery", "rt"}, {"modelgen", "rt"},
-    {"nav", "nav"},      {"planner", "manip"}, {"drill", "manip"}, {"collab", "manip"},
-    {"surface_finish", "manip"}};
-const std::map<std::string, std::string> kHostOf = {{"rt", "rt-pc"}, {"nav", "nav-pc"}, {"manip", "manip-pc"}};
+    {"robot", "rt"},    {"safety", "rt"},    {"discovery", "rt"},
+    {"modelgen", "rt"}, {"nav", "nav"},      {"planner", "manip"},
+    {"drill", "manip"}, {"collab", "manip"}, {"surface_finish", "manip"}};
+const std::map<std::string, std::string> kHostOf = {
+    {"rt", "rt-pc"}, {"nav", "nav-pc"}, {"manip", "manip-pc"}};
 
 // Service keys of the compose specification that this file may use.
 const std::set<std::string> kServiceKeys = {
-    "image", "build", "command", "entrypoint", "environment", "env_file", "volumes", "network_mode", "networks",
-    "ipc", "pid", "restart", "init", "stop_signal", "stop_grace_period", "profiles", "deploy", "cap_add",
-    "cap_drop", "ulimits", "hostname", "depends_on", "healthcheck", "labels", "devices", "privileged",
-    "user", "working_dir", "shm_size", "sysctls", "logging", "extra_hosts", "security_opt", "cpuset"};
+    "image",      "build",       "command",      "entrypoint",  "environment",
+    "env_file",   "volumes",     "network_mode", "networks",    "ipc",
+    "pid",        "restart",     "init",         "stop_signal", "stop_grace_period",
+    "profiles",   "deploy",      "cap_add",      "cap_drop",    "ulimits",
+    "hostname",   "depends_on",  "healthcheck",  "labels",      "devices",
+    "privileged", "user",        "working_dir",  "shm_size",    "sysctls",
+    "logging",    "extra_hosts", "security_opt", "cpuset"};
 
-YAML::Node load_compose() { return resolve_merges(YAML::LoadFile((kDeploy / "compose.yaml").string())); }
+YAML::Node load_compose() {
+  return resolve_merges(YAML::LoadFile((kDeploy / "compose.yaml").string()));
+}
 
 TEST(DeployCompose, ParsesWithOnlyComposeKeys) {
   YAML::Node compose;
@@ -85,7 +90,8 @@ TEST(DeployCompose, ParsesWithOnlyComposeKeys) {
   for (const auto& service : compose["services"]) {
     const auto name = service.first.Scalar();
     for (const auto& key : service.second) {
-      EXPECT_TRUE(kServiceKeys.count(key.first.Scalar())) << name << ": unknown key '" << key.first.Scalar() << "'";
+      EXPECT_TRUE(kServiceKeys.count(key.first.Scalar()))
+          << name << ": unknown key '" << key.first.Scalar() << "'";
     }
   }
 }
@@ -97,17 +103,22 @@ TEST(DeployCompose, EveryServiceOnItsPcWithHostNetworkingAndDds) {
     const auto name = entry.first.Scalar();
     const auto& s = entry.second;
     seen.insert(name);
-    ASSERT_TRUE(kPlacement.count(name)) << "service '" << name << "' is not one of the stack's services";
+    ASSERT_TRUE(kPlacement.count(name))
+        << "service '" << name << "' is not one of the stack's services";
     const auto pc = kPlacement.at(name);
     EXPECT_FALSE(s["image"].Scalar().empty()) << name;
     EXPECT_EQ(s["network_mode"].Scalar(), "host") << name;
-    EXPECT_EQ(s["ipc"].Scalar(), "host") << name << ": shared memory between containers needs the host IPC";
-    EXPECT_FALSE(s["hostname"]) << name << ": docker refuses hostname together with network_mode host";
+    EXPECT_EQ(s["ipc"].Scalar(), "host")
+        << name << ": shared memory between containers needs the host IPC";
+    EXPECT_FALSE(s["hostname"]) << name
+                                << ": docker refuses hostname together with network_mode host";
     ASSERT_TRUE(s["profiles"].IsSequence()) << name;
     EXPECT_EQ(s["profiles"].size(), 1u) << name;
     EXPECT_EQ(s["profiles"][0].Scalar(), pc) << name;
     ASSERT_TRUE(s["deploy"]["placement"]["constraints"].IsSequence()) << name;
-    EXPECT_EQ(s["deploy"]["placement"]["constraints"][0].Scalar(), "node.labels.concert.pc == " + pc) << name;
+    EXPECT_EQ(s["deploy"]["placement"]["constraints"][0].Scalar(),
+              "node.labels.concert.pc == " + pc)
+        << name;
     const auto env = s["environment"];
     ASSERT_TRUE(env.IsMap()) << name;
     EXPECT_TRUE(env["CONCERT_DOMAIN_ID"]) << name;
@@ -120,15 +131,18 @@ TEST(DeployCompose, EveryServiceOnItsPcWithHostNetworkingAndDds) {
       const auto spec = with_defaults(v.Scalar());
       const auto source = spec.substr(0, spec.find(':'));
       if (source.rfind("./", 0) == 0) {
-        EXPECT_TRUE(fs::exists(kDeploy / source)) << name << ": volume source " << source << " is missing";
+        EXPECT_TRUE(fs::exists(kDeploy / source))
+            << name << ": volume source " << source << " is missing";
       } else {
-        EXPECT_TRUE(compose["volumes"][source]) << name << ": named volume '" << source << "' is not declared";
+        EXPECT_TRUE(compose["volumes"][source])
+            << name << ": named volume '" << source << "' is not declared";
       }
       profile_mounted |= spec.find(":/etc/concert/fastdds_profiles.xml") != std::string::npos;
     }
     EXPECT_TRUE(profile_mounted) << name;
   }
-  for (const auto& [name, pc] : kPlacement) EXPECT_TRUE(seen.count(name)) << name << " (" << pc << ") is missing";
+  for (const auto& [name, pc] : kPlacement)
+    EXPECT_TRUE(seen.count(name)) << name << " (" << pc << ") is missing";
 }
 
 TEST(DeployCompose, DockerComposeAcceptsItWhenInstalled) {
@@ -142,8 +156,8 @@ TEST(DeployCompose, DockerComposeAcceptsItWhenInstalled) {
     return;
   }
   for (const char* profile : {"rt", "nav", "manip"}) {
-    const auto cmd = "docker compose -f '" + (kDeploy / "compose.yaml").string() + "' --profile " + profile +
-                     " config -q 2>&1";
+    const auto cmd = "docker compose -f '" + (kDeploy / "compose.yaml").string() + "' --profile " +
+                     profile + " config -q 2>&1";
     EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
   }
 }
@@ -158,10 +172,11 @@ TEST(DeployDockerfile, DebianBaseInstallDepsAndSourcesExist) {
   EXPECT_NE(dockerfile.find("RUN /opt/concert/src/deploy/install-deps.sh"), std::string::npos);
   const std::regex copy(R"(^COPY (?!--from)(\S+) )", std::regex::multiline);
   int copies = 0;
-  for (auto it = std::sregex_iterator(dockerfile.begin(), dockerfile.end(), copy); it != std::sregex_iterator();
-       ++it) {
+  for (auto it = std::sregex_iterator(dockerfile.begin(), dockerfile.end(), copy);
+       it != std::sregex_iterator(); ++it) {
     const auto source = (*it)[1].str();
-    EXPECT_TRUE(fs::exists(fs::path(CONCERT_SOURCE_DIR) / source)) << "COPY source missing: " << source;
+    EXPECT_TRUE(fs::exists(fs::path(CONCERT_SOURCE_DIR) / source))
+        << "COPY source missing: " << source;
     ++copies;
   }
   EXPECT_GE(copies, 6);
@@ -169,7 +184,8 @@ TEST(DeployDockerfile, DebianBaseInstallDepsAndSourcesExist) {
   const auto compose = load_compose();
   for (const char* rt : {"robot", "safety", "discovery", "modelgen"}) {
     const auto binary = compose["services"][rt]["command"][0].Scalar();
-    EXPECT_NE(dockerfile.find(" " + binary), std::string::npos) << binary << " is not built by the Dockerfile";
+    EXPECT_NE(dockerfile.find(" " + binary), std::string::npos)
+        << binary << " is not built by the Dockerfile";
   }
 }
 

@@ -14,7 +14,8 @@
 namespace concert::system_test {
 
 /// Waits (bounded) until the process' stderr contains `text`.
-inline bool wait_for_err(const testing::Process& p, const std::string& text, std::chrono::milliseconds timeout) {
+inline bool wait_for_err(const testing::Process& p, const std::string& text,
+                         std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (p.err().find(text) == std::string::npos) {
     if (std::chrono::steady_clock::now() > deadline) return false;
@@ -28,7 +29,8 @@ inline std::string tool(const std::string& name, const std::string& package) {
   for (const char* dir : {"/usr/sbin/", "/sbin/", "/usr/bin/", "/bin/"}) {
     if (std::filesystem::exists(dir + name)) return dir + name;
   }
-  throw std::runtime_error("the '" + name + "' tool (Debian package " + package + ") is not installed");
+  throw std::runtime_error("the '" + name + "' tool (Debian package " + package +
+                           ") is not installed");
 }
 
 /// `argv` run so that it gets SIGKILL if the test process dies first (a ctest timeout kills

@@ -38,13 +38,14 @@ int main(int argc, char** argv) {
     std::string last_safety;
     while (!g_stop) {
       if (auto m = models.wait(std::chrono::milliseconds(50))) {
-        std::cout << "model " << m->version() << " " << m->content_hash() << " " << m->joints().size()
-                  << std::endl;
+        std::cout << "model " << m->version() << " " << m->content_hash() << " "
+                  << m->joints().size() << std::endl;
         status.report(msg::SERVICE_READY, m->version(), "ready");
       }
       while (auto s = safety.take()) {
         std::string text = s->mode() == msg::SAFETY_STOPPED ? "safety STOPPED" : "safety RUNNING";
-        for (std::size_t i = 0; i < s->causes().size(); ++i) text += (i == 0 ? ": " : "; ") + s->causes()[i];
+        for (std::size_t i = 0; i < s->causes().size(); ++i)
+          text += (i == 0 ? ": " : "; ") + s->causes()[i];
         if (text != last_safety) std::cout << text << std::endl;
         last_safety = text;
       }

@@ -9,8 +9,8 @@
 #include <string>
 #include <thread>
 
-#include "process.hpp"
 #include "helpers.hpp"
+#include "process.hpp"
 
 namespace concert::system_test {
 namespace {
@@ -23,11 +23,12 @@ TEST(SafetyWithRobot, NoFalseStopWhileHoldingThenKilledRobotIsNamed) {
   testing::Process discovery(dies_with_test({DISCOVERY_BINARY}), env);
   testing::Process modelgen(dies_with_test({MODELGEN_BINARY}), env);
   testing::Process robot(
-      dies_with_test({ROBOT_BINARY, "--assembly", std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml"}),
+      dies_with_test({ROBOT_BINARY, "--assembly",
+                      std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml"}),
       env);
   const auto logs = [&] {
-    return "\n--- safety:\n" + safety.err() + "--- robot:\n" + robot.err() + robot.out() + "--- modelgen:\n" +
-           modelgen.err() + "--- discovery:\n" + discovery.err();
+    return "\n--- safety:\n" + safety.err() + "--- robot:\n" + robot.err() + robot.out() +
+           "--- modelgen:\n" + modelgen.err() + "--- discovery:\n" + discovery.err();
   };
 
   // The robot's scan -> tree -> model v1 -> the safety service enforces its joint limits.
@@ -41,7 +42,8 @@ TEST(SafetyWithRobot, NoFalseStopWhileHoldingThenKilledRobotIsNamed) {
   EXPECT_EQ(safety.err().find("STOPPED"), std::string::npos) << logs();
 
   kill(robot.pid(), SIGKILL);
-  EXPECT_TRUE(wait_for_err(safety, "safety: STOPPED: liveliness: robot@rt-pc silent for", 15s)) << logs();
+  EXPECT_TRUE(wait_for_err(safety, "safety: STOPPED: liveliness: robot@rt-pc silent for", 15s))
+      << logs();
   EXPECT_EQ(safety.stop(10s), 0);
   modelgen.stop(10s);
   discovery.stop(10s);

@@ -24,8 +24,8 @@
 #include <thread>
 #include <vector>
 
-#include "process.hpp"
 #include "helpers.hpp"
+#include "process.hpp"
 
 namespace concert::system_test {
 namespace {
@@ -85,7 +85,9 @@ class ThreeHosts {
 
   static void run(const std::string& command) {
     const auto [code, output] = shell(command);
-    if (code != 0) throw std::runtime_error("'" + command + "' failed (" + std::to_string(code) + "): " + output);
+    if (code != 0)
+      throw std::runtime_error("'" + command + "' failed (" + std::to_string(code) +
+                               "): " + output);
   }
 
   void remove() const {
@@ -139,7 +141,8 @@ fs::path write_profile(const fs::path& dir, std::size_t i) {
           <initialPeersList>
 )";
   for (std::size_t j = 0; j < kHosts.size(); ++j) {
-    out << "            <locator><udpv4><address>" << ThreeHosts::address(j) << "</address></udpv4></locator>\n";
+    out << "            <locator><udpv4><address>" << ThreeHosts::address(j)
+        << "</address></udpv4></locator>\n";
   }
   out << R"(          </initialPeersList>
         </builtin>
@@ -166,8 +169,9 @@ class Stack {
   testing::Process& start(std::size_t i, std::vector<std::string> argv) {
     argv.insert(argv.begin(), {ip_, "netns", "exec", hosts_.ns(i)});
     processes_.push_back(std::make_unique<testing::Process>(
-        dies_with_test(argv), std::vector<std::string>{"CONCERT_DDS_PROFILES=" + profiles_[i].string(),
-                                       "CONCERT_HOST=" + std::string(kHosts[i])}));
+        dies_with_test(argv),
+        std::vector<std::string>{"CONCERT_DDS_PROFILES=" + profiles_[i].string(),
+                                 "CONCERT_HOST=" + std::string(kHosts[i])}));
     return *processes_.back();
   }
 
@@ -188,12 +192,14 @@ std::string model_line(const std::string& out, int version) {
 }
 
 std::string dump(const char* name, const testing::Process& p) {
-  return std::string("\n--- ") + name + " stdout:\n" + p.out() + "--- " + name + " stderr:\n" + p.err();
+  return std::string("\n--- ") + name + " stdout:\n" + p.out() + "--- " + name + " stderr:\n" +
+         p.err();
 }
 
 TEST(ThreeHostSystem, ModelReachesEveryHostLateJoinerGetsItCutLinkStopsTheRobot) {
-  ASSERT_EQ(geteuid(), 0u) << "this test creates network namespaces and a bridge and must run as root "
-                              "(CI runs as root); run it with sudo";
+  ASSERT_EQ(geteuid(), 0u)
+      << "this test creates network namespaces and a bridge and must run as root "
+         "(CI runs as root); run it with sudo";
   std::unique_ptr<ThreeHosts> hosts;
   try {
     hosts = std::make_unique<ThreeHosts>();
@@ -206,7 +212,8 @@ TEST(ThreeHostSystem, ModelReachesEveryHostLateJoinerGetsItCutLinkStopsTheRobot)
 
   const auto dir = fs::temp_directory_path() / ("concert_three_hosts_" + std::to_string(getpid()));
   fs::create_directories(dir);
-  std::ofstream(dir / "safety.yaml") << "liveliness_timeout: 1.0\ntask_services: [nav, planner, drill]\n";
+  std::ofstream(dir / "safety.yaml")
+      << "liveliness_timeout: 1.0\ntask_services: [nav, planner, drill]\n";
   {
     Stack stack(*hosts, dir);
     auto& discovery = stack.start(0, {DISCOVERY_BINARY});
@@ -215,8 +222,8 @@ TEST(ThreeHostSystem, ModelReachesEveryHostLateJoinerGetsItCutLinkStopsTheRobot)
     auto& nav = stack.start(1, {PROBE_BINARY, "--service", "nav"});
     auto& planner = stack.start(2, {PROBE_BINARY, "--service", "planner"});
     auto& bus = stack.start(0, {CONCERT_BIN, "scan", "publish", "--assembly",
-                                std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml", "--source",
-                                "three-host-test"});
+                                std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml",
+                                "--source", "three-host-test"});
     const auto all = [&] {
       return dump("discovery", discovery) + dump("modelgen", modelgen) + dump("safety", safety) +
              dump("bus", bus) + dump("nav", nav) + dump("planner", planner);
@@ -227,7 +234,8 @@ TEST(ThreeHostSystem, ModelReachesEveryHostLateJoinerGetsItCutLinkStopsTheRobot)
     ASSERT_TRUE(planner.wait_for_output("model 1 ", 30s)) << all();
     const auto line = model_line(nav.out(), 1);
     EXPECT_EQ(model_line(planner.out(), 1), line);
-    EXPECT_TRUE(std::regex_match(line, std::regex("model 1 sha256:[0-9a-f]{64} [1-9][0-9]*"))) << line;
+    EXPECT_TRUE(std::regex_match(line, std::regex("model 1 sha256:[0-9a-f]{64} [1-9][0-9]*")))
+        << line;
     EXPECT_TRUE(wait_for_err(safety, "safety: limits of model v1 (", 10s)) << all();
 
     // 2. A service started late on the manipulation host gets the current model at once.

@@ -15,7 +15,8 @@ std::string host_name() {
 
 namespace {
 int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 }  // namespace
@@ -61,7 +62,8 @@ void StatusReporter::beat() {
   }
 }
 
-void StatusReporter::report(msg::ServiceState state, uint32_t model_version, const std::string& message) {
+void StatusReporter::report(msg::ServiceState state, uint32_t model_version,
+                            const std::string& message) {
   std::lock_guard lock(mutex_);
   status_.state(state);
   status_.model_version(model_version);

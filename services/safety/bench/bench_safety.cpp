@@ -32,9 +32,11 @@ void report(const char* what, std::vector<double> v, const char* unit) {
     return;
   }
   std::sort(v.begin(), v.end());
-  const auto at = [&](double q) { return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))]; };
-  std::printf("%-44s median %8.3f %s   p95 %8.3f %s   max %8.3f %s   (n=%zu)\n", what, at(0.5), unit, at(0.95), unit,
-              v.back(), unit, v.size());
+  const auto at = [&](double q) {
+    return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+  };
+  std::printf("%-44s median %8.3f %s   p95 %8.3f %s   max %8.3f %s   (n=%zu)\n", what, at(0.5),
+              unit, at(0.95), unit, v.back(), unit, v.size());
 }
 
 void bench_core() {
@@ -55,14 +57,16 @@ void bench_core() {
     constexpr int kSamples = 10'000;
     const auto t0 = std::chrono::steady_clock::now();
     for (int i = 0; i < kSamples; ++i) monitor.on_joint_state(sample);
-    per_sample.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() /
-                         kSamples);
+    per_sample.push_back(
+        std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() /
+        kSamples);
   }
   if (monitor.status().mode != safety::Mode::kRunning) std::printf("unexpected stop\n");
   report("limits check, 14 joints (per sample)", per_sample, "ns");
 }
 
-template <class F> bool wait_mode(dds::Reader<msg::SafetyState>& states, msg::SafetyMode mode, F&& on_time) {
+template <class F>
+bool wait_mode(dds::Reader<msg::SafetyState>& states, msg::SafetyMode mode, F&& on_time) {
   const auto deadline = std::chrono::steady_clock::now() + 5s;
   while (std::chrono::steady_clock::now() < deadline) {
     if (auto s = states.wait(100ms); s && s->mode() == mode) {
@@ -98,14 +102,19 @@ void bench_dds(int repetitions) {
       in.engaged(true);
       auto t0 = std::chrono::steady_clock::now();
       inputs.write(in);
-      if (!wait_mode(states, msg::SAFETY_STOPPED, [&] { stop_ms.push_back(Ms(std::chrono::steady_clock::now() - t0).count()); })) break;
+      if (!wait_mode(states, msg::SAFETY_STOPPED,
+                     [&] { stop_ms.push_back(Ms(std::chrono::steady_clock::now() - t0).count()); }))
+        break;
       in.engaged(false);
       inputs.write(in);
       std::this_thread::sleep_for(5ms);
       reset.request_id(static_cast<uint32_t>(i));
       t0 = std::chrono::steady_clock::now();
       resets.write(reset);
-      if (!wait_mode(states, msg::SAFETY_RUNNING, [&] { reset_ms.push_back(Ms(std::chrono::steady_clock::now() - t0).count()); })) break;
+      if (!wait_mode(states, msg::SAFETY_RUNNING, [&] {
+            reset_ms.push_back(Ms(std::chrono::steady_clock::now() - t0).count());
+          }))
+        break;
     }
     report("e-stop engaged -> STOPPED received (DDS)", stop_ms, "ms");
     report("reset -> RUNNING received (DDS)", reset_ms, "ms");

@@ -32,7 +32,8 @@ bool eventually(const std::function<bool()>& done, std::chrono::milliseconds tim
 }
 
 /// Reads SafetyState samples until one satisfies `pred` (bounded).
-bool wait_state(Reader<msg::SafetyState>& reader, const std::function<bool(const msg::SafetyState&)>& pred,
+bool wait_state(Reader<msg::SafetyState>& reader,
+                const std::function<bool(const msg::SafetyState&)>& pred,
                 std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < deadline) {
@@ -117,7 +118,8 @@ class SafetyNodeTest : public ::testing::Test {
 TEST_F(SafetyNodeTest, EStopLatchesUntilReleasedAndReset) {
   Writer<msg::EStopInput> inputs(participant_, topics::estop);
   Writer<msg::SafetyReset> resets(participant_, topics::safety_reset);
-  ASSERT_TRUE(wait_state(states_, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 10s));
+  ASSERT_TRUE(wait_state(
+      states_, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 10s));
 
   ASSERT_TRUE(inputs.write(estop(msg::ESTOP_WIRELESS, true)));
   ASSERT_TRUE(wait_state(
@@ -132,9 +134,12 @@ TEST_F(SafetyNodeTest, EStopLatchesUntilReleasedAndReset) {
   reset.request_id(1);
   reset.source("unit test");
   ASSERT_TRUE(resets.write(reset));
-  EXPECT_TRUE(eventually([&] { return log_.str().find("refused: e-stop input(s) still engaged: wireless") !=
-                                      std::string::npos; },
-                         10s))
+  EXPECT_TRUE(eventually(
+      [&] {
+        return log_.str().find("refused: e-stop input(s) still engaged: wireless") !=
+               std::string::npos;
+      },
+      10s))
       << log_.str();
   EXPECT_EQ(node_->status().mode, Mode::kStopped);
 
@@ -142,8 +147,9 @@ TEST_F(SafetyNodeTest, EStopLatchesUntilReleasedAndReset) {
   EXPECT_TRUE(eventually([&] { return node_->status().mode == Mode::kStopped; }, 1s));
   reset.request_id(2);
   ASSERT_TRUE(resets.write(reset));
-  EXPECT_TRUE(wait_state(states_, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING && s.causes().empty(); },
-                         10s));
+  EXPECT_TRUE(wait_state(
+      states_, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING && s.causes().empty(); },
+      10s));
 }
 
 TEST_F(SafetyNodeTest, SilentTaskServiceStopsWithItsName) {
@@ -181,7 +187,8 @@ TEST_F(SafetyNodeTest, JointBeyondModelLimitStops) {
   j.effort(80.0);
   model.joints({j});
   ASSERT_TRUE(models.write(model));
-  ASSERT_TRUE(eventually([&] { return log_.str().find("limits of model v5 (1 joints)") != std::string::npos; }, 10s));
+  ASSERT_TRUE(eventually(
+      [&] { return log_.str().find("limits of model v5 (1 joints)") != std::string::npos; }, 10s));
   ASSERT_TRUE(joints.wait_for_readers(1, 10s));
 
   msg::JointState state;

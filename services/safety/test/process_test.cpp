@@ -1,6 +1,8 @@
 // concert_safety as a real process over DDS: e-stop -> STOPPED, reset refused while engaged,
 // released + reset -> RUNNING, a silent task service named in the stop, clean SIGINT stop;
 // bad arguments and params files exit non-zero with one line naming the problem.
+#include "process.hpp"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,7 +13,6 @@
 #include <thread>
 
 #include "concert/dds/endpoint.hpp"
-#include "process.hpp"
 #include "safety/cli.hpp"
 
 namespace concert::safety {
@@ -23,7 +24,8 @@ using concert::dds::Reader;
 using concert::dds::Writer;
 namespace topics = concert::dds::topics;
 
-bool wait_state(Reader<msg::SafetyState>& reader, const std::function<bool(const msg::SafetyState&)>& pred,
+bool wait_state(Reader<msg::SafetyState>& reader,
+                const std::function<bool(const msg::SafetyState&)>& pred,
                 std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < deadline) {
@@ -33,13 +35,15 @@ bool wait_state(Reader<msg::SafetyState>& reader, const std::function<bool(const
 }
 
 std::filesystem::path temp_file(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid()) + ".yaml");
+  const auto path =
+      std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid()) + ".yaml");
   std::ofstream(path) << text;
   return path;
 }
 
 TEST(SafetyProcess, EStopResetAndLivelinessOverDds) {
-  const auto params = temp_file("safety_params", "liveliness_timeout: 0.5\ntask_services: [drill]\n");
+  const auto params =
+      temp_file("safety_params", "liveliness_timeout: 0.5\ntask_services: [drill]\n");
   testing::Process safety({SAFETY_BINARY, "--params", params.string()});
   {
     Participant p({.name = "safety_process_test"});
@@ -47,7 +51,8 @@ TEST(SafetyProcess, EStopResetAndLivelinessOverDds) {
     Writer<msg::EStopInput> inputs(p, topics::estop);
     Writer<msg::SafetyReset> resets(p, topics::safety_reset);
     Writer<msg::ServiceStatus> statuses(p, topics::status);
-    ASSERT_TRUE(wait_state(states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 20s))
+    ASSERT_TRUE(wait_state(
+        states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 20s))
         << safety.err();
     ASSERT_TRUE(inputs.wait_for_readers(1, 10s));
     ASSERT_TRUE(resets.wait_for_readers(1, 10s));
@@ -71,14 +76,17 @@ TEST(SafetyProcess, EStopResetAndLivelinessOverDds) {
     reset.source("process test");
     ASSERT_TRUE(resets.write(reset));
     // Refused: the state stays STOPPED through at least one more publication.
-    EXPECT_FALSE(wait_state(states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 1s));
+    EXPECT_FALSE(wait_state(
+        states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 1s));
 
     button.engaged(false);
     ASSERT_TRUE(inputs.write(button));
-    EXPECT_FALSE(wait_state(states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 1s));
+    EXPECT_FALSE(wait_state(
+        states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 1s));
     reset.request_id(2);
     ASSERT_TRUE(resets.write(reset));
-    ASSERT_TRUE(wait_state(states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 10s))
+    ASSERT_TRUE(wait_state(
+        states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 10s))
         << safety.err();
 
     // A drill service beats for a while, then goes silent (writer alive, no more samples).
@@ -102,11 +110,16 @@ TEST(SafetyProcess, EStopResetAndLivelinessOverDds) {
   }
   EXPECT_EQ(safety.stop(15s), 0);
   const auto err = safety.err();
-  EXPECT_NE(err.find("safety: reset by process test refused: e-stop input(s) still engaged: button rear left"),
+  EXPECT_NE(
+      err.find(
+          "safety: reset by process test refused: e-stop input(s) still engaged: button rear left"),
+      std::string::npos)
+      << err;
+  EXPECT_NE(err.find("safety: reset by process test accepted: 1 cause(s) cleared"),
             std::string::npos)
       << err;
-  EXPECT_NE(err.find("safety: reset by process test accepted: 1 cause(s) cleared"), std::string::npos) << err;
-  EXPECT_NE(err.find("safety: STOPPED: liveliness: drill@manip-pc silent"), std::string::npos) << err;
+  EXPECT_NE(err.find("safety: STOPPED: liveliness: drill@manip-pc silent"), std::string::npos)
+      << err;
   std::filesystem::remove(params);
 }
 
@@ -128,12 +141,14 @@ TEST(SafetyProcess, OperatorVerbsEStopStatusReset) {
   EXPECT_EQ(text, "safety: e-stop wireless engaged\n");
   std::tie(code, text) = cli({"status"});
   EXPECT_EQ(code, 0);
-  EXPECT_NE(text.find("STOPPED (reset required)\n  estop: wireless engaged (operator walked away)"), std::string::npos)
+  EXPECT_NE(text.find("STOPPED (reset required)\n  estop: wireless engaged (operator walked away)"),
+            std::string::npos)
       << text;
 
   std::tie(code, text) = cli({"reset", "--source", "operator panel"});
   EXPECT_EQ(code, 1) << text;
-  EXPECT_NE(text.find("concert safety reset: reset by operator panel refused: e-stop input(s) still engaged: wireless"),
+  EXPECT_NE(text.find("concert safety reset: reset by operator panel refused: e-stop input(s) "
+                      "still engaged: wireless"),
             std::string::npos)
       << text;
 
@@ -151,7 +166,8 @@ TEST(SafetyCli, UsageErrorsAndNoService) {
   EXPECT_NE(text.find("expected a verb: status, estop or reset"), std::string::npos) << text;
   std::tie(code, text) = cli({"estop", "--source", "left"});
   EXPECT_EQ(code, 2);
-  EXPECT_NE(text.find("--source: 'left' is not front-left, front-right"), std::string::npos) << text;
+  EXPECT_NE(text.find("--source: 'left' is not front-left, front-right"), std::string::npos)
+      << text;
   std::tie(code, text) = cli({"status", "--timeout-ms", "soon"});
   EXPECT_EQ(code, 2);
   EXPECT_NE(text.find("--timeout-ms: 'soon' is not a number"), std::string::npos) << text;
@@ -183,7 +199,9 @@ TEST(SafetyProcess, BadArgumentsExitNonZeroWithOneLine) {
   const auto bad = temp_file("safety_bad", "liveliness_timeout: soon\n");
   std::tie(code, err) = run({"--params", bad.string()});
   EXPECT_EQ(code, 1);
-  EXPECT_NE(err.find(bad.string() + ": liveliness_timeout: 'soon' is not a number"), std::string::npos) << err;
+  EXPECT_NE(err.find(bad.string() + ": liveliness_timeout: 'soon' is not a number"),
+            std::string::npos)
+      << err;
   std::filesystem::remove(bad);
 }
 

@@ -1,13 +1,13 @@
 // Unit tests of the safety core: latching, reset rules, liveliness, limits, params.
+#include "safety/safety_monitor.hpp"
+
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <unistd.h>
-
-#include "safety/safety_monitor.hpp"
 
 namespace concert::safety {
 namespace {
@@ -124,7 +124,8 @@ TEST(SafetyMonitor, SilentTaskServiceStopsNamingIt) {
   EXPECT_EQ(m.status().mode, Mode::kStopped);
   ASSERT_EQ(m.status().causes.size(), 1u);
   EXPECT_EQ(m.status().causes[0], "liveliness: planner@manip silent for 0.60 s (bound 0.50 s)");
-  EXPECT_EQ(m.watched(), (std::vector<std::pair<std::string, bool>>{{"planner@manip", true}, {"robot@rt", false}}));
+  EXPECT_EQ(m.watched(), (std::vector<std::pair<std::string, bool>>{{"planner@manip", true},
+                                                                    {"robot@rt", false}}));
 }
 
 TEST(SafetyMonitor, UnwatchedServicesAreIgnored) {
@@ -215,7 +216,8 @@ TEST(SafetyMonitor, PositionVelocityEffortViolationsStop) {
     m.set_model(3, two_joints());
     m.on_joint_state(sample(3, 2.1, 0.0, 0.0));
     ASSERT_EQ(m.status().mode, Mode::kStopped);
-    EXPECT_EQ(m.status().causes[0], "limits: joint J1_A position 2.100 beyond [-2.000, 2.000] (model v3)");
+    EXPECT_EQ(m.status().causes[0],
+              "limits: joint J1_A position 2.100 beyond [-2.000, 2.000] (model v3)");
   }
   {
     SafetyMonitor m(Params{}, kT0);
@@ -268,7 +270,8 @@ TEST(SafetyMonitor, MalformedJointStateStops) {
   m.set_model(1, two_joints());
   m.on_joint_state({1, {"J1_A", "J2_A"}, {0.0}, {}, {}});
   EXPECT_EQ(m.status().mode, Mode::kStopped);
-  EXPECT_EQ(m.status().causes[0], "limits: malformed joint state: 2 names, 1 positions, 0 velocities, 0 efforts");
+  EXPECT_EQ(m.status().causes[0],
+            "limits: malformed joint state: 2 names, 1 positions, 0 velocities, 0 efforts");
 }
 
 TEST(SafetyMonitor, RandomSamplesTripExactlyWhenOutsideBounds) {
@@ -294,7 +297,8 @@ TEST(SafetyParams, DefaultsAndOverrides) {
   EXPECT_EQ(d.liveliness_timeout, 1000ms);
   const auto p = parse_params(
       "liveliness_timeout: 0.5\nrobot_service: rob\ntask_services: [a, b]\nrequire_robot: true\n"
-      "position_tolerance: 0.1\nvelocity_margin: 0.2\neffort_margin: 0.3\npublish_period: 0.1\ncheck_period: 0.02\n",
+      "position_tolerance: 0.1\nvelocity_margin: 0.2\neffort_margin: 0.3\npublish_period: "
+      "0.1\ncheck_period: 0.02\n",
       "x");
   EXPECT_EQ(p.liveliness_timeout, 500ms);
   EXPECT_EQ(p.robot_service, "rob");
@@ -308,7 +312,8 @@ TEST(SafetyParams, DefaultsAndOverrides) {
 }
 
 TEST(SafetyParams, ShippedConfigHasTheDefaults) {
-  const auto p = load_params(std::string(CONCERT_SOURCE_DIR) + "/services/safety/config/safety.yaml");
+  const auto p =
+      load_params(std::string(CONCERT_SOURCE_DIR) + "/services/safety/config/safety.yaml");
   const Params d;
   EXPECT_EQ(p.liveliness_timeout, d.liveliness_timeout);
   EXPECT_EQ(p.task_services, d.task_services);
@@ -330,18 +335,21 @@ TEST(SafetyParams, ErrorsNameFileAndField) {
   expect_error("[1, 2]", "f.yaml: expected a mapping");
   expect_error("liveliness: 1", "f.yaml: liveliness: unknown key");
   expect_error("liveliness_timeout: fast", "f.yaml: liveliness_timeout: 'fast' is not a number");
-  expect_error("liveliness_timeout: -1", "f.yaml: liveliness_timeout: expected a period in seconds");
+  expect_error("liveliness_timeout: -1",
+               "f.yaml: liveliness_timeout: expected a period in seconds");
   expect_error("task_services: planner", "f.yaml: task_services: expected a list");
   expect_error("task_services: [a, [b]]", "f.yaml: task_services[1]: expected a service name");
   expect_error("require_robot: maybe", "f.yaml: require_robot: 'maybe' is not true or false");
   expect_error("effort_margin: -0.1", "f.yaml: effort_margin: must not be negative");
-  expect_error("liveliness_timeout: 0.1\ncheck_period: 0.5", "f.yaml: check_period: must not exceed");
+  expect_error("liveliness_timeout: 0.1\ncheck_period: 0.5",
+               "f.yaml: check_period: must not exceed");
   expect_error("a: [", "f.yaml: invalid YAML");
   try {
     load_params("/nonexistent/safety.yaml");
     ADD_FAILURE();
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/safety.yaml: cannot read"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/safety.yaml: cannot read"),
+              std::string::npos);
   }
 }
 

@@ -24,7 +24,14 @@ using TimePoint = Clock::time_point;
 
 /// The six e-stop inputs of the CONCERT base (paper section 3): four corner buttons, the
 /// wireless receiver, and a software stop. Same order as msg::EStopSource.
-enum class EStopSource { kButtonFrontLeft, kButtonFrontRight, kButtonRearLeft, kButtonRearRight, kWireless, kSoftware };
+enum class EStopSource {
+  kButtonFrontLeft,
+  kButtonFrontRight,
+  kButtonRearLeft,
+  kButtonRearRight,
+  kWireless,
+  kSoftware
+};
 inline constexpr std::size_t kEStopSourceCount = 6;
 
 /// "button front left", ..., "wireless", "software".
@@ -78,7 +85,8 @@ class SafetyMonitor {
   /// the service said it stops (SERVICE_STOPPED). Services other than the robot and the
   /// task services are ignored. A task service that stops cleanly is no longer watched; the
   /// robot service stopping is a stop cause (nothing holds the drives any more).
-  void on_heartbeat(const std::string& service, const std::string& host, bool clean_stop, TimePoint now);
+  void on_heartbeat(const std::string& service, const std::string& host, bool clean_stop,
+                    TimePoint now);
 
   /// Checks liveliness at `now`: a watched instance silent beyond the bound stops the robot,
   /// with a cause naming it.

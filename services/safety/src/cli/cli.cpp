@@ -22,13 +22,17 @@ struct Failure : std::runtime_error {
 };
 
 const std::map<std::string, msg::EStopSource> kSources = {
-    {"front-left", msg::ESTOP_BUTTON_FRONT_LEFT}, {"front-right", msg::ESTOP_BUTTON_FRONT_RIGHT},
-    {"rear-left", msg::ESTOP_BUTTON_REAR_LEFT},   {"rear-right", msg::ESTOP_BUTTON_REAR_RIGHT},
-    {"wireless", msg::ESTOP_WIRELESS},            {"software", msg::ESTOP_SOFTWARE}};
+    {"front-left", msg::ESTOP_BUTTON_FRONT_LEFT},
+    {"front-right", msg::ESTOP_BUTTON_FRONT_RIGHT},
+    {"rear-left", msg::ESTOP_BUTTON_REAR_LEFT},
+    {"rear-right", msg::ESTOP_BUTTON_REAR_RIGHT},
+    {"wireless", msg::ESTOP_WIRELESS},
+    {"software", msg::ESTOP_SOFTWARE}};
 
 constexpr const char* kUsage =
     "usage: concert safety status [--timeout-ms MS]\n"
-    "       concert safety estop [--source front-left|front-right|rear-left|rear-right|wireless|software]\n"
+    "       concert safety estop [--source "
+    "front-left|front-right|rear-left|rear-right|wireless|software]\n"
     "                            [--release] [--reason TEXT] [--timeout-ms MS]\n"
     "       concert safety reset [--source NAME] [--reason TEXT] [--timeout-ms MS]";
 
@@ -48,8 +52,10 @@ Options parse(const std::vector<std::string>& args) {
     const auto& a = args[i];
     if (a == "--release" && o.verb == "estop") {
       o.release = true;
-    } else if (a == "--timeout-ms" || ((a == "--source" || a == "--reason") && o.verb != "status")) {
-      if (i + 1 >= args.size()) throw UsageError("safety " + o.verb + ": option " + a + " needs a value");
+    } else if (a == "--timeout-ms" ||
+               ((a == "--source" || a == "--reason") && o.verb != "status")) {
+      if (i + 1 >= args.size())
+        throw UsageError("safety " + o.verb + ": option " + a + " needs a value");
       o.values[a] = args[++i];
     } else {
       throw UsageError("safety " + o.verb + ": unknown argument '" + a + "'");
@@ -76,7 +82,8 @@ std::chrono::milliseconds timeout(const Options& o) {
 }
 
 int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 
@@ -89,8 +96,8 @@ std::string describe(const msg::SafetyState& s) {
 
 /// Waits for a SafetyState sample satisfying `accept`, or nullopt at the deadline.
 template <class F>
-std::optional<msg::SafetyState> wait_state(dds::Reader<msg::SafetyState>& reader, std::chrono::milliseconds limit,
-                                           F accept) {
+std::optional<msg::SafetyState> wait_state(dds::Reader<msg::SafetyState>& reader,
+                                           std::chrono::milliseconds limit, F accept) {
   const auto deadline = std::chrono::steady_clock::now() + limit;
   while (std::chrono::steady_clock::now() < deadline) {
     if (auto s = reader.wait(50ms); s && accept(*s)) return s;
@@ -101,7 +108,9 @@ std::optional<msg::SafetyState> wait_state(dds::Reader<msg::SafetyState>& reader
 int status(const Options& o, dds::Participant& p, std::ostream& out) {
   dds::Reader<msg::SafetyState> states(p, dds::topics::safety_state);
   const auto s = wait_state(states, timeout(o), [](const auto&) { return true; });
-  if (!s) throw Failure("no safety state on domain " + std::to_string(p.domain_id()) + " (is concert_safety running?)");
+  if (!s)
+    throw Failure("no safety state on domain " + std::to_string(p.domain_id()) +
+                  " (is concert_safety running?)");
   out << "safety: " << describe(*s) << "\n";
   return 0;
 }
@@ -110,12 +119,14 @@ int estop(const Options& o, dds::Participant& p, std::ostream& out) {
   const auto name = o.values.count("--source") ? o.values.at("--source") : "software";
   const auto source = kSources.find(name);
   if (source == kSources.end()) {
-    throw UsageError("safety estop: --source: '" + name +
-                     "' is not front-left, front-right, rear-left, rear-right, wireless or software");
+    throw UsageError(
+        "safety estop: --source: '" + name +
+        "' is not front-left, front-right, rear-left, rear-right, wireless or software");
   }
   dds::Writer<msg::EStopInput> writer(p, dds::topics::estop);
   if (!writer.wait_for_readers(1, timeout(o))) {
-    throw Failure("no safety service on domain " + std::to_string(p.domain_id()) + " read the e-stop input");
+    throw Failure("no safety service on domain " + std::to_string(p.domain_id()) +
+                  " read the e-stop input");
   }
   msg::EStopInput input;
   input.source(source->second);
@@ -144,20 +155,24 @@ int reset(const Options& o, dds::Participant& p, std::ostream& out, std::ostream
   msg::SafetyReset request;
   request.request_id(static_cast<uint32_t>(sent / 1000 % 4'000'000'000));
   request.stamp_ns(sent);
-  request.source(o.values.count("--source") ? o.values.at("--source") : "concert safety reset@" + dds::host_name());
+  request.source(o.values.count("--source") ? o.values.at("--source")
+                                            : "concert safety reset@" + dds::host_name());
   request.reason(o.values.count("--reason") ? o.values.at("--reason") : "");
   writer.write(request);
   // The service answers every reset with a state publication stamped after it.
-  const auto s = wait_state(states, timeout(o), [&](const auto& st) { return st.stamp_ns() >= sent; });
+  const auto s =
+      wait_state(states, timeout(o), [&](const auto& st) { return st.stamp_ns() >= sent; });
   if (!s) throw Failure("the safety service did not answer the reset");
   out << "safety: " << describe(*s) << "\n";
   if (s->mode() == msg::SAFETY_RUNNING) return 0;
   // The reason follows on the service's status (stamped after the request).
   std::string why = "reset refused (no reason received)";
-  const auto deadline = std::chrono::steady_clock::now() + std::min<std::chrono::milliseconds>(timeout(o), 2000ms);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::min<std::chrono::milliseconds>(timeout(o), 2000ms);
   while (std::chrono::steady_clock::now() < deadline) {
     const auto st = statuses.wait(50ms);
-    if (st && st->service() == "safety" && st->stamp_ns() >= sent && st->message().find("refused") != std::string::npos) {
+    if (st && st->service() == "safety" && st->stamp_ns() >= sent &&
+        st->message().find("refused") != std::string::npos) {
       why = st->message();
       break;
     }

@@ -1,17 +1,18 @@
 #include "safety/params.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
-
 namespace concert::safety {
 namespace {
 
-std::runtime_error field_error(const std::string& origin, const std::string& field, const std::string& what) {
+std::runtime_error field_error(const std::string& origin, const std::string& field,
+                               const std::string& what) {
   return std::runtime_error(origin + ": " + field + ": " + what);
 }
 
@@ -33,10 +34,12 @@ double non_negative(const YAML::Node& node, const std::string& origin, const std
 }
 
 /// A period in seconds in the file, milliseconds in Params; must be > 0.
-std::chrono::milliseconds period(const YAML::Node& node, const std::string& origin, const std::string& field) {
+std::chrono::milliseconds period(const YAML::Node& node, const std::string& origin,
+                                 const std::string& field) {
   const double s = number(node, origin, field);
   if (s <= 0.0 || s > 3600.0) {
-    throw field_error(origin, field, "expected a period in seconds in (0, 3600] (got " + node.Scalar() + ")");
+    throw field_error(origin, field,
+                      "expected a period in seconds in (0, 3600] (got " + node.Scalar() + ")");
   }
   const auto ms = std::chrono::milliseconds(static_cast<int64_t>(std::llround(s * 1000.0)));
   if (ms.count() == 0) throw field_error(origin, field, "must be at least 0.001 s");
@@ -44,7 +47,8 @@ std::chrono::milliseconds period(const YAML::Node& node, const std::string& orig
 }
 
 std::string name(const YAML::Node& node, const std::string& origin, const std::string& field) {
-  if (!node.IsScalar() || node.Scalar().empty()) throw field_error(origin, field, "expected a service name");
+  if (!node.IsScalar() || node.Scalar().empty())
+    throw field_error(origin, field, "expected a service name");
   return node.Scalar();
 }
 
@@ -61,8 +65,9 @@ Params parse_params(const std::string& yaml, const std::string& origin) {
   if (root.IsNull()) return p;
   if (!root.IsMap()) throw std::runtime_error(origin + ": expected a mapping of safety parameters");
   static const std::set<std::string> kKeys = {
-      "liveliness_timeout", "robot_service",   "task_services",  "require_robot", "position_tolerance",
-      "velocity_margin",    "effort_margin",   "publish_period", "check_period"};
+      "liveliness_timeout", "robot_service",      "task_services",
+      "require_robot",      "position_tolerance", "velocity_margin",
+      "effort_margin",      "publish_period",     "check_period"};
   for (const auto& entry : root) {
     const auto key = entry.first.Scalar();
     if (!kKeys.count(key)) throw field_error(origin, key, "unknown key");

@@ -22,17 +22,24 @@ std::string seconds(std::chrono::nanoseconds d) {
 
 std::string_view to_string(EStopSource source) {
   switch (source) {
-    case EStopSource::kButtonFrontLeft: return "button front left";
-    case EStopSource::kButtonFrontRight: return "button front right";
-    case EStopSource::kButtonRearLeft: return "button rear left";
-    case EStopSource::kButtonRearRight: return "button rear right";
-    case EStopSource::kWireless: return "wireless";
-    case EStopSource::kSoftware: return "software";
+    case EStopSource::kButtonFrontLeft:
+      return "button front left";
+    case EStopSource::kButtonFrontRight:
+      return "button front right";
+    case EStopSource::kButtonRearLeft:
+      return "button rear left";
+    case EStopSource::kButtonRearRight:
+      return "button rear right";
+    case EStopSource::kWireless:
+      return "wireless";
+    case EStopSource::kSoftware:
+      return "software";
   }
   return "unknown";
 }
 
-SafetyMonitor::SafetyMonitor(Params params, TimePoint start) : params_(std::move(params)), start_(start) {
+SafetyMonitor::SafetyMonitor(Params params, TimePoint start)
+    : params_(std::move(params)), start_(start) {
   if (params_.liveliness_timeout <= std::chrono::milliseconds::zero()) {
     throw std::invalid_argument("liveliness_timeout must be positive");
   }
@@ -52,7 +59,8 @@ void SafetyMonitor::stop(const std::string& key, const std::string& text) {
 
 void SafetyMonitor::set_estop(EStopSource source, bool engaged, const std::string& reason) {
   const auto i = static_cast<std::size_t>(source);
-  if (i >= kEStopSourceCount) throw std::invalid_argument("unknown e-stop source " + std::to_string(i));
+  if (i >= kEStopSourceCount)
+    throw std::invalid_argument("unknown e-stop source " + std::to_string(i));
   engaged_[i] = engaged;
   if (engaged) {
     std::string text = "estop: " + std::string(to_string(source)) + " engaged";
@@ -67,8 +75,8 @@ bool SafetyMonitor::is_watched(const std::string& service) const {
              params_.task_services.end();
 }
 
-void SafetyMonitor::on_heartbeat(const std::string& service, const std::string& host, bool clean_stop,
-                                 TimePoint now) {
+void SafetyMonitor::on_heartbeat(const std::string& service, const std::string& host,
+                                 bool clean_stop, TimePoint now) {
   if (!is_watched(service)) return;
   const std::string who = service + "@" + host;
   const bool robot = service == params_.robot_service;
@@ -93,11 +101,12 @@ void SafetyMonitor::check_liveliness(TimePoint now) {
     stop("silent:" + who, "liveliness: " + who + " silent for " + seconds(silent_for) + " (bound " +
                               seconds(params_.liveliness_timeout) + ")");
   }
-  if (params_.require_robot && !robot_heard_ && !robot_start_cause_ && now - start_ > params_.liveliness_timeout) {
+  if (params_.require_robot && !robot_heard_ && !robot_start_cause_ &&
+      now - start_ > params_.liveliness_timeout) {
     robot_start_cause_ = true;
     stop("silent:" + params_.robot_service,
-         "liveliness: " + params_.robot_service + " not heard within " + seconds(params_.liveliness_timeout) +
-             " of the start");
+         "liveliness: " + params_.robot_service + " not heard within " +
+             seconds(params_.liveliness_timeout) + " of the start");
   }
 }
 
@@ -108,14 +117,15 @@ void SafetyMonitor::set_model(uint32_t version, std::vector<JointLimits> joints)
   for (std::size_t i = 0; i < joints_.size(); ++i) joint_index_[joints_[i].name] = i;
 }
 
-void SafetyMonitor::check_joint(const JointLimits& limits, std::size_t i, const JointSample& sample) {
+void SafetyMonitor::check_joint(const JointLimits& limits, std::size_t i,
+                                const JointSample& sample) {
   const std::string joint = "joint " + limits.name;
   const double q = sample.position[i];
   if (!std::isfinite(q) || q < limits.lower - params_.position_tolerance ||
       q > limits.upper + params_.position_tolerance) {
     stop("limits:" + limits.name + ":position",
-         "limits: " + joint + " position " + fixed(q, 3) + " beyond [" + fixed(limits.lower, 3) + ", " +
-             fixed(limits.upper, 3) + "] (model v" + std::to_string(model_version_) + ")");
+         "limits: " + joint + " position " + fixed(q, 3) + " beyond [" + fixed(limits.lower, 3) +
+             ", " + fixed(limits.upper, 3) + "] (model v" + std::to_string(model_version_) + ")");
   }
   if (i < sample.velocity.size()) {
     const double qd = sample.velocity[i];
@@ -130,8 +140,8 @@ void SafetyMonitor::check_joint(const JointLimits& limits, std::size_t i, const 
     const double tau = sample.effort[i];
     const double bound = limits.effort * (1.0 + params_.effort_margin);
     if (!std::isfinite(tau) || std::abs(tau) > bound) {
-      stop("limits:" + limits.name + ":effort", "limits: " + joint + " effort " + fixed(tau, 2) + " beyond +-" +
-                                                    fixed(bound, 2) + " (model v" +
+      stop("limits:" + limits.name + ":effort", "limits: " + joint + " effort " + fixed(tau, 2) +
+                                                    " beyond +-" + fixed(bound, 2) + " (model v" +
                                                     std::to_string(model_version_) + ")");
     }
   }
@@ -172,7 +182,8 @@ ResetOutcome SafetyMonitor::reset(const std::string& source, TimePoint now) {
   if (params_.require_robot && !robot_heard_) {
     return {false, "reset by " + source + " refused: the robot service has not been heard"};
   }
-  if (status_.mode == Mode::kRunning) return {true, "reset by " + source + ": not stopped, nothing to reset"};
+  if (status_.mode == Mode::kRunning)
+    return {true, "reset by " + source + ": not stopped, nothing to reset"};
   std::string forgotten;
   for (auto it = instances_.begin(); it != instances_.end();) {
     if (it->second.silent) {
@@ -187,7 +198,8 @@ ResetOutcome SafetyMonitor::reset(const std::string& source, TimePoint now) {
   cause_keys_.clear();
   robot_start_cause_ = robot_heard_;
   ++revision_;
-  std::string message = "reset by " + source + " accepted: " + std::to_string(cleared) + " cause(s) cleared";
+  std::string message =
+      "reset by " + source + " accepted: " + std::to_string(cleared) + " cause(s) cleared";
   if (!forgotten.empty()) message += "; no longer watching silent " + forgotten;
   return {true, message};
 }

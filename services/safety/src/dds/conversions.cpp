@@ -4,24 +4,36 @@ namespace concert::safety::dds {
 
 std::optional<EStopSource> to_core(msg::EStopSource source) {
   switch (source) {
-    case msg::ESTOP_BUTTON_FRONT_LEFT: return EStopSource::kButtonFrontLeft;
-    case msg::ESTOP_BUTTON_FRONT_RIGHT: return EStopSource::kButtonFrontRight;
-    case msg::ESTOP_BUTTON_REAR_LEFT: return EStopSource::kButtonRearLeft;
-    case msg::ESTOP_BUTTON_REAR_RIGHT: return EStopSource::kButtonRearRight;
-    case msg::ESTOP_WIRELESS: return EStopSource::kWireless;
-    case msg::ESTOP_SOFTWARE: return EStopSource::kSoftware;
+    case msg::ESTOP_BUTTON_FRONT_LEFT:
+      return EStopSource::kButtonFrontLeft;
+    case msg::ESTOP_BUTTON_FRONT_RIGHT:
+      return EStopSource::kButtonFrontRight;
+    case msg::ESTOP_BUTTON_REAR_LEFT:
+      return EStopSource::kButtonRearLeft;
+    case msg::ESTOP_BUTTON_REAR_RIGHT:
+      return EStopSource::kButtonRearRight;
+    case msg::ESTOP_WIRELESS:
+      return EStopSource::kWireless;
+    case msg::ESTOP_SOFTWARE:
+      return EStopSource::kSoftware;
   }
   return std::nullopt;
 }
 
 msg::EStopSource to_msg(EStopSource source) {
   switch (source) {
-    case EStopSource::kButtonFrontLeft: return msg::ESTOP_BUTTON_FRONT_LEFT;
-    case EStopSource::kButtonFrontRight: return msg::ESTOP_BUTTON_FRONT_RIGHT;
-    case EStopSource::kButtonRearLeft: return msg::ESTOP_BUTTON_REAR_LEFT;
-    case EStopSource::kButtonRearRight: return msg::ESTOP_BUTTON_REAR_RIGHT;
-    case EStopSource::kWireless: return msg::ESTOP_WIRELESS;
-    case EStopSource::kSoftware: return msg::ESTOP_SOFTWARE;
+    case EStopSource::kButtonFrontLeft:
+      return msg::ESTOP_BUTTON_FRONT_LEFT;
+    case EStopSource::kButtonFrontRight:
+      return msg::ESTOP_BUTTON_FRONT_RIGHT;
+    case EStopSource::kButtonRearLeft:
+      return msg::ESTOP_BUTTON_REAR_LEFT;
+    case EStopSource::kButtonRearRight:
+      return msg::ESTOP_BUTTON_REAR_RIGHT;
+    case EStopSource::kWireless:
+      return msg::ESTOP_WIRELESS;
+    case EStopSource::kSoftware:
+      return msg::ESTOP_SOFTWARE;
   }
   return msg::ESTOP_SOFTWARE;
 }
@@ -29,7 +41,8 @@ msg::EStopSource to_msg(EStopSource source) {
 std::vector<JointLimits> joint_limits(const msg::RobotModel& model) {
   std::vector<JointLimits> out;
   out.reserve(model.joints().size());
-  for (const auto& j : model.joints()) out.push_back({j.name(), j.lower(), j.upper(), j.velocity(), j.effort()});
+  for (const auto& j : model.joints())
+    out.push_back({j.name(), j.lower(), j.upper(), j.velocity(), j.effort()});
   return out;
 }
 

@@ -1,8 +1,8 @@
 #include "dds/safety_node.hpp"
 
-#include <thread>
-
 #include <fastrtps/xmlparser/XMLProfileManager.h>
+
+#include <thread>
 
 #include "dds/conversions.hpp"
 
@@ -10,14 +10,16 @@ namespace concert::safety::dds {
 namespace {
 
 int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 
 std::string summary(const SafetyStatus& status) {
   if (status.mode == Mode::kRunning) return "RUNNING";
   std::string text = "STOPPED";
-  for (std::size_t i = 0; i < status.causes.size(); ++i) text += (i == 0 ? ": " : "; ") + status.causes[i];
+  for (std::size_t i = 0; i < status.causes.size(); ++i)
+    text += (i == 0 ? ": " : "; ") + status.causes[i];
   return text;
 }
 
@@ -34,12 +36,16 @@ SafetyNode::SafetyNode(concert::dds::Participant& participant, Params params, st
       log_(log),
       state_writer_(participant, concert::dds::topics::safety_state),
       status_(participant, "safety"),
-      estops_(participant, concert::dds::topics::estop, [this](const auto& s, const auto&) { on_estop(s); }),
-      statuses_(participant, concert::dds::topics::status, [this](const auto& s, const auto&) { on_status(s); }),
-      models_(participant, concert::dds::topics::robot_model, [this](const auto& s, const auto&) { on_model(s); }),
+      estops_(participant, concert::dds::topics::estop,
+              [this](const auto& s, const auto&) { on_estop(s); }),
+      statuses_(participant, concert::dds::topics::status,
+                [this](const auto& s, const auto&) { on_status(s); }),
+      models_(participant, concert::dds::topics::robot_model,
+              [this](const auto& s, const auto&) { on_model(s); }),
       joint_states_(participant, concert::dds::topics::joint_state,
                     [this](const auto& s, const auto&) { on_joint_state(s); }),
-      resets_(participant, concert::dds::topics::safety_reset, [this](const auto& s, const auto&) { on_reset(s); }) {
+      resets_(participant, concert::dds::topics::safety_reset,
+              [this](const auto& s, const auto&) { on_reset(s); }) {
   {
     std::lock_guard lock(mutex_);
     publish_locked(true);
@@ -52,7 +58,8 @@ SafetyNode::~SafetyNode() = default;
 std::optional<std::string> SafetyNode::publish_locked(bool force) {
   const auto now = Clock::now();
   const bool changed = monitor_.revision() != published_revision_;
-  if (!changed && !force && now - last_publish_ < monitor_.params().publish_period) return std::nullopt;
+  if (!changed && !force && now - last_publish_ < monitor_.params().publish_period)
+    return std::nullopt;
   state_writer_.write(to_msg(monitor_.status(), now_ns()));
   last_publish_ = now;
   if (!changed) return std::nullopt;
@@ -83,7 +90,8 @@ void SafetyNode::on_estop(const msg::EStopInput& input) {
 
 void SafetyNode::on_status(const msg::ServiceStatus& status) {
   std::unique_lock lock(mutex_);
-  monitor_.on_heartbeat(status.service(), status.host(), status.state() == msg::SERVICE_STOPPED, Clock::now());
+  monitor_.on_heartbeat(status.service(), status.host(), status.state() == msg::SERVICE_STOPPED,
+                        Clock::now());
   const auto text = publish_locked(false);
   lock.unlock();
   note(text);
@@ -94,8 +102,8 @@ void SafetyNode::on_model(const msg::RobotModel& model) {
   {
     std::lock_guard lock(mutex_);
     monitor_.set_model(model.version(), joint_limits(model));
-    log_ << "safety: limits of model v" << model.version() << " (" << model.joints().size() << " joints)"
-         << std::endl;
+    log_ << "safety: limits of model v" << model.version() << " (" << model.joints().size()
+         << " joints)" << std::endl;
     text = summary(monitor_.status());
   }
   status_.report(msg::SERVICE_READY, model.version(), text);
@@ -111,7 +119,8 @@ void SafetyNode::on_joint_state(const msg::JointState& state) {
 
 void SafetyNode::on_reset(const msg::SafetyReset& reset) {
   std::unique_lock lock(mutex_);
-  const auto outcome = monitor_.reset(reset.source().empty() ? "unnamed" : reset.source(), Clock::now());
+  const auto outcome =
+      monitor_.reset(reset.source().empty() ? "unnamed" : reset.source(), Clock::now());
   log_ << "safety: " << outcome.message << std::endl;
   auto text = publish_locked(true);
   lock.unlock();

@@ -9,8 +9,8 @@
 #include <chrono>
 #include <mutex>
 #include <optional>
-#include <string>
 #include <ostream>
+#include <string>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
