@@ -199,6 +199,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   for (const msg::Pose& g : request.goals()) core.goals.push_back({to_core(g)});
   const bool execute = request.execute();
   const std::size_t count = core.goals.size();
+  msg::PlanResult last_planned;
   const PlanResult result = planner_.plan(core, start, [&](const GoalResult& g) {
     msg::PlanResult r = base;
     r.goal_index(static_cast<uint32_t>(g.index));
@@ -220,6 +221,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
       r.trajectory().push_back(std::move(s));
     }
     publish(r);
+    last_planned = r;
     if (execute) {
       {
         std::lock_guard lock(mutex_);
@@ -236,10 +238,10 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     base.reason(result.reason);
     publish(base);
   } else if (!execute && result.status == Status::kSucceeded) {
-    base.state(msg::PLAN_SUCCEEDED);
-    base.goal_index(static_cast<uint32_t>(count - 1));
-    base.planning_time(result.goals.back().nspg_seconds + result.goals.back().plan_seconds);
-    publish(base);
+    // The result topic keeps the last sample per request: the final one carries the last
+    // goal's trajectory again, so a reader that missed PLANNED still gets it.
+    last_planned.state(msg::PLAN_SUCCEEDED);
+    publish(last_planned);
   }
 }
 
