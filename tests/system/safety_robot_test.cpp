@@ -1,23 +1,38 @@
 // Safety with the real simulated robot on one machine (loopback DDS): discovery, modelgen, the
 // robot service (MuJoCo sim of deploy/demo/drill_robot.yaml) and safety. Holding still at the
 // generated model must not trip the limits watchdog; a robot process killed hard (no goodbye)
-// goes silent and the safety service stops, naming it.
+// goes silent and the safety service stops, naming it. Between the two, an operator e-stop
+// (concert safety verbs) makes the robot hold, and a reset releases it.
 #include <gtest/gtest.h>
 #include <signal.h>
 
 #include <chrono>
+#include <sstream>
 #include <string>
 #include <thread>
 
+#include "concert/dds/endpoint.hpp"
 #include "helpers.hpp"
 #include "process.hpp"
+#include "safety/cli.hpp"
 
 namespace concert::system_test {
 namespace {
 
 using namespace std::chrono_literals;
 
-TEST(SafetyWithRobot, NoFalseStopWhileHoldingThenKilledRobotIsNamed) {
+/// Waits (bounded) for a status of the robot service whose message is `text`.
+bool wait_robot_note(concert::dds::Reader<msg::ServiceStatus>& statuses, const std::string& text,
+                     std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    const auto s = statuses.wait(100ms);
+    if (s && s->service() == "robot" && s->message() == text) return true;
+  }
+  return false;
+}
+
+TEST(SafetyWithRobot, NoFalseStopEStopHoldsResetReleasesKilledRobotNamed) {
   const std::vector<std::string> env = {"CONCERT_HOST=rt-pc"};
   testing::Process safety(dies_with_test({SAFETY_BINARY}), env);
   testing::Process discovery(dies_with_test({DISCOVERY_BINARY}), env);
@@ -40,6 +55,25 @@ TEST(SafetyWithRobot, NoFalseStopWhileHoldingThenKilledRobotIsNamed) {
     ASSERT_TRUE(robot.running()) << logs();
   }
   EXPECT_EQ(safety.err().find("STOPPED"), std::string::npos) << logs();
+
+  // E-stop from the operator verbs -> safety STOPPED -> the robot holds and says why; released
+  // and reset -> the robot is released.
+  {
+    concert::dds::Participant p({.name = "safety_robot_test"});
+    concert::dds::Reader<msg::ServiceStatus> statuses(p, concert::dds::topics::status);
+    std::ostringstream out, err;
+    ASSERT_EQ(safety::cli_main({"estop", "--source", "front-left", "--reason", "test"}, out, err),
+              0)
+        << err.str();
+    EXPECT_TRUE(wait_robot_note(
+        statuses, "safety stop: holding (estop: button front left engaged (test))", 10s))
+        << logs();
+    ASSERT_EQ(safety::cli_main({"estop", "--source", "front-left", "--release"}, out, err), 0)
+        << err.str();
+    ASSERT_EQ(safety::cli_main({"reset", "--source", "system test"}, out, err), 0)
+        << out.str() << err.str();
+    EXPECT_TRUE(wait_robot_note(statuses, "safety stop released", 10s)) << logs();
+  }
 
   kill(robot.pid(), SIGKILL);
   EXPECT_TRUE(wait_for_err(safety, "safety: STOPPED: liveliness: robot@rt-pc silent for", 15s))
