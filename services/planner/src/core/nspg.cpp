@@ -150,8 +150,6 @@ class TaskSolver {
   Eigen::VectorXd weights_;
 };
 
-int n_dof(const PlanningModel& m) { return m.dof(); }
-
 Task make_task(const Params& params, const Eigen::Isometry3d& area) {
   const Eigen::Vector3d n = area.linear().col(2).normalized();
   return {area.translation() + params.camera_distance * n, -n};
@@ -326,7 +324,7 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
         s.head<2>() = task.position.head<2>() + nrm * (standoff + (turn == 0.0 ? mount : 0.0)) + (turn == 0.0 ? 0.0 : (turn > 0 ? -mount : mount)) * side;
         s[2] = start[2] + std::remainder(yaw + turn - start[2], 2.0 * M_PI);
         if (arm > 0) {
-          for (int i = 3; i < n_dof(model); ++i) s[i] = lo[i] + (hi[i] - lo[i]) * (0.2 + 0.6 * unit(rng));
+          for (int i = 3; i < n; ++i) s[i] = lo[i] + (hi[i] - lo[i]) * (0.2 + 0.6 * unit(rng));
         }
         seeds.push_back(s);
       }
