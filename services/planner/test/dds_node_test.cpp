@@ -11,6 +11,7 @@
 #include "dds/planner_node.hpp"
 #include "planner/cli.hpp"
 #include "planner/fixtures.hpp"
+#include "model_message.hpp"
 
 using namespace concert;
 using namespace concert::planner;
@@ -18,38 +19,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-msg::RobotModel to_msg(const ModelDescription& d) {
-  msg::RobotModel m;
-  m.version(static_cast<uint32_t>(d.version));
-  m.urdf(d.urdf);
-  m.srdf(d.srdf);
-  for (const JointSpec& j : d.joints) {
-    msg::JointInfo i;
-    i.name(j.name);
-    i.chain(j.chain);
-    i.lower(j.lower);
-    i.upper(j.upper);
-    i.velocity(j.velocity);
-    i.effort(j.effort);
-    m.joints().push_back(i);
-  }
-  for (const ChainSpec& c : d.chains) {
-    msg::ChainInfo i;
-    i.name(c.name);
-    i.role(c.role);
-    i.joints(c.joints);
-    m.chains().push_back(i);
-  }
-  for (const EndEffectorSpec& e : d.end_effectors) {
-    msg::EndEffectorInfo i;
-    i.name(e.name);
-    i.chain(e.chain);
-    i.frame(e.frame);
-    i.module_key(e.module_key);
-    m.end_effectors().push_back(i);
-  }
-  return m;
-}
+using planner::testing::to_msg;
 
 msg::PlanRequest request(uint32_t id, uint32_t version, double z, bool execute) {
   msg::PlanRequest r;

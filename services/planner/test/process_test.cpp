@@ -20,6 +20,7 @@
 #include "concert/dds/participant.hpp"
 #include "planner/cli.hpp"
 #include "planner/fixtures.hpp"
+#include "model_message.hpp"
 
 extern char** environ;
 
@@ -60,38 +61,7 @@ std::string read(const std::filesystem::path& p) {
   return s.str();
 }
 
-msg::RobotModel to_msg(const planner::ModelDescription& d) {
-  msg::RobotModel m;
-  m.version(static_cast<uint32_t>(d.version));
-  m.urdf(d.urdf);
-  m.srdf(d.srdf);
-  for (const auto& j : d.joints) {
-    msg::JointInfo i;
-    i.name(j.name);
-    i.chain(j.chain);
-    i.lower(j.lower);
-    i.upper(j.upper);
-    i.velocity(j.velocity);
-    i.effort(j.effort);
-    m.joints().push_back(i);
-  }
-  for (const auto& c : d.chains) {
-    msg::ChainInfo i;
-    i.name(c.name);
-    i.role(c.role);
-    i.joints(c.joints);
-    m.chains().push_back(i);
-  }
-  for (const auto& e : d.end_effectors) {
-    msg::EndEffectorInfo i;
-    i.name(e.name);
-    i.chain(e.chain);
-    i.frame(e.frame);
-    i.module_key(e.module_key);
-    m.end_effectors().push_back(i);
-  }
-  return m;
-}
+using planner::testing::to_msg;
 
 }  // namespace
 
