@@ -158,24 +158,37 @@ int reset(const Options& o, dds::Participant& p, std::ostream& out, std::ostream
   request.source(o.values.count("--source") ? o.values.at("--source")
                                             : "concert safety reset@" + dds::host_name());
   request.reason(o.values.count("--reason") ? o.values.at("--reason") : "");
+  // Heartbeats repeat the service's last message with a fresh stamp, so a refusal is
+  // recognised by naming this request's source, not by its time.
+  const std::string refusal = "reset by " + request.source() + " refused";
   writer.write(request);
-  // The service answers every reset with a state publication stamped after it.
-  const auto s =
-      wait_state(states, timeout(o), [&](const auto& st) { return st.stamp_ns() >= sent; });
-  if (!s) throw Failure("the safety service did not answer the reset");
-  out << "safety: " << describe(*s) << "\n";
-  if (s->mode() == msg::SAFETY_RUNNING) return 0;
-  // The reason follows on the service's status (stamped after the request).
+  // The service answers a reset with a state publication stamped after it, but it also
+  // publishes states for other reasons (an input just released, a heartbeat): a STOPPED state
+  // alone is no answer. Success is a RUNNING state; refusal is the service's status naming
+  // the reason. Wait (bounded) for either.
   std::string why = "reset refused (no reason received)";
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::min<std::chrono::milliseconds>(timeout(o), 2000ms);
+  std::optional<msg::SafetyState> last;
+  const auto deadline = std::chrono::steady_clock::now() + timeout(o);
   while (std::chrono::steady_clock::now() < deadline) {
-    const auto st = statuses.wait(50ms);
-    if (st && st->service() == "safety" && st->stamp_ns() >= sent &&
-        st->message().find("refused") != std::string::npos) {
-      why = st->message();
+    while (auto st = states.take()) {
+      if (st->stamp_ns() < sent) continue;
+      last = *st;
+      if (st->mode() == msg::SAFETY_RUNNING) {
+        out << "safety: " << describe(*st) << "\n";
+        return 0;
+      }
+    }
+    const auto status = statuses.wait(20ms);
+    if (status && status->service() == "safety" && status->stamp_ns() >= sent &&
+        status->message().find(refusal) != std::string::npos) {
+      why = status->message();
       break;
     }
+  }
+  if (last) {
+    out << "safety: " << describe(*last) << "\n";
+  } else if (why.find(refusal) == std::string::npos) {
+    throw Failure("the safety service did not answer the reset");
   }
   err << "concert safety reset: " << why << "\n";
   return 1;
