@@ -19,7 +19,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-using planner::testing::to_msg;
+using planner::testing::model_message;
 
 msg::PlanRequest request(uint32_t id, uint32_t version, double z, bool execute) {
   msg::PlanRequest r;
@@ -67,7 +67,7 @@ class PlannerNodeTest : public ::testing::Test {
     spinner_.join();
   }
   void publish_model(char which, uint32_t version) {
-    models_->write(to_msg(fixtures::model_from_assembly(fixtures::data_dir() / (std::string("morphology_") + which + ".yaml"), version)));
+    models_->write(model_message(fixtures::data_dir() / (std::string("morphology_") + which + ".yaml"), static_cast<uint32_t>(version)));
     const auto deadline = std::chrono::steady_clock::now() + 10s;
     while (node_->model_version() != version && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(10ms);
     ASSERT_EQ(node_->model_version(), version) << log_.str();

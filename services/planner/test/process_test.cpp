@@ -61,7 +61,7 @@ std::string read(const std::filesystem::path& p) {
   return s.str();
 }
 
-using planner::testing::to_msg;
+using planner::testing::model_message;
 
 }  // namespace
 
@@ -86,7 +86,7 @@ TEST(PlannerProcess, ModelInRequestPlannedCleanStop) {
     concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "planner_process_test"});
     concert::dds::Writer<msg::RobotModel> models(participant, concert::dds::topics::robot_model);
     ASSERT_TRUE(models.wait_for_readers(1, 20s)) << read(dir / "planner.log");
-    models.write(to_msg(planner::fixtures::model_from_assembly(planner::fixtures::data_dir() / "morphology_a.yaml", 2)));
+    models.write(model_message(planner::fixtures::data_dir() / "morphology_a.yaml", 2));
     std::ostringstream out;
     std::ostringstream err;
     // The model may still be on its way: retry (bounded) while the planner reports no model.

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 
+#include "modelgen/model.hpp"
 #include "planner/types.hpp"
 
 namespace concert::planner::fixtures {
@@ -13,6 +14,8 @@ namespace concert::planner::fixtures {
 std::filesystem::path data_dir();
 /// Model of an assembly file with the project's module database (data/module_db).
 ModelDescription model_from_assembly(const std::filesystem::path& assembly, uint64_t version);
+/// The model modelgen generates for an assembly (what it would publish), for adapter tests.
+modelgen::RobotModel generated_model(const std::filesystem::path& assembly);
 /// A wall (normal -x, facing the robot at the origin) at x = `wall_x` and a drilling area on it
 /// at height `z` [m] and lateral offset `y` [m]: frame z along the outward normal (-x).
 Eigen::Isometry3d drilling_area(double wall_x, double y, double z);
