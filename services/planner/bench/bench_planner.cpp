@@ -3,16 +3,19 @@
 // through the whole planner (NSPG + RRT-Connect + simplification + timing). Reports success
 // rate and planning time median / p95 per morphology. Not a test: no assertions on time.
 //
-//   bench_planner [--problems N] [--seed S] [--contact-force NEWTON] [--verbose]
+//   bench_planner [--problems N] [--seed S] [--contact-force NEWTON] [--params FILE] [--only I]
+//                 [--morphology a|b] [--verbose]
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <random>
 #include <string>
 
+#include "planner/config.hpp"
 #include "planner/fixtures.hpp"
 #include "planner/planner.hpp"
 
@@ -74,7 +77,10 @@ int main(int argc, char** argv) {
   int count = 24;
   uint64_t seed = 2024;
   bool verbose = false;
-  double contact_force = Params{}.contact_force;
+  Params base_params;
+  std::optional<double> contact_force;
+  int only = -1;
+  std::string morphologies = "ab";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--problems" && i + 1 < argc) {
@@ -83,21 +89,33 @@ int main(int argc, char** argv) {
       seed = std::stoull(argv[++i]);
     } else if (a == "--contact-force" && i + 1 < argc) {
       contact_force = std::stod(argv[++i]);
+    } else if (a == "--params" && i + 1 < argc) {
+      try {
+        base_params = load_params(argv[++i]);
+      } catch (const PlannerError& e) {
+        std::cerr << "bench_planner: " << e.what() << "\n";
+        return 2;
+      }
+    } else if (a == "--only" && i + 1 < argc) {
+      only = std::stoi(argv[++i]);
+    } else if (a == "--morphology" && i + 1 < argc) {
+      morphologies = argv[++i];
     } else if (a == "--verbose") {
       verbose = true;
     } else {
-      std::cerr << "bench_planner: unknown argument '" << a << "' (use --problems N, --seed S, --contact-force NEWTON, --verbose)\n";
+      std::cerr << "bench_planner: unknown argument '" << a
+                << "' (use --problems N, --seed S, --contact-force NEWTON, --params FILE, --only I, --morphology a|b, --verbose)\n";
       return 2;
     }
   }
   const std::vector<Problem> problems = make_problems(count, seed);
-  std::printf("drilling force checked at the goal: %.0f N\n", contact_force);
+  if (contact_force) base_params.contact_force = *contact_force;
+  std::printf("drilling force checked at the goal: %.0f N\n", base_params.contact_force);
   std::printf("%-12s %8s %9s %11s %11s %11s %13s %11s\n", "morphology", "problems", "success", "median ms", "p95 ms", "max ms",
               "ok median ms", "ok p95 ms");
-  for (const char m : {'a', 'b'}) {
-    Params params;
+  for (const char m : morphologies) {
+    Params params = base_params;
     params.seed = seed;
-    params.contact_force = contact_force;
     Planner planner(params);
     planner.set_model(fixtures::model_from_assembly(fixtures::data_dir() / (std::string("morphology_") + m + ".yaml"), 1));
     const auto model = planner.model();
@@ -106,6 +124,7 @@ int main(int argc, char** argv) {
     int ok = 0;
     std::map<std::string, int> failures;
     for (std::size_t i = 0; i < problems.size(); ++i) {
+      if (only >= 0 && static_cast<int>(i) != only) continue;
       const Problem& p = problems[i];
       Environment env(params.octomap_resolution);
       env.add_world(p.world);
@@ -124,6 +143,12 @@ int main(int argc, char** argv) {
       if (verbose) {
         std::printf("  %c #%02zu wall %.2f m, area (%.2f, %.2f) m: %-12s %8.1f ms (nspg %.1f ms)  %s\n", m, i, p.wall_x, p.y, p.z,
                     to_string(r.status), ms, r.goals.empty() ? 0.0 : 1e3 * r.goals[0].nspg_seconds, r.reason.c_str());
+        if (std::getenv("BENCH_GOALS") != nullptr && !r.goals.empty() && r.goals[0].goal_q.size() > 0) {
+          const Eigen::VectorXd& q = r.goals[0].goal_q;
+          std::printf("      goal:");
+          for (Eigen::Index j = 0; j < q.size(); ++j) std::printf(" %.2f", q[j]);
+          std::printf("\n");
+        }
       }
     }
     std::printf("%-12c %8zu %8.1f%% %11.1f %11.1f %11.1f %13.1f %11.1f\n", std::toupper(m), problems.size(),

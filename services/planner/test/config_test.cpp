@@ -7,11 +7,11 @@
 using namespace concert::planner;
 
 TEST(Config, ParamsReadAndDefaultsKept) {
-  const Params p = parse_params("contact_force: 150\nplanning_time: 1.5\nseed: 9\nnspg_samples: 12\n", "p.yaml");
+  const Params p = parse_params("contact_force: 150\nplanning_time: 1.5\nseed: 9\nnspg_seeds: 12\n", "p.yaml");
   EXPECT_DOUBLE_EQ(p.contact_force, 150.0);
   EXPECT_DOUBLE_EQ(p.planning_time, 1.5);
   EXPECT_EQ(p.seed, 9u);
-  EXPECT_EQ(p.nspg_samples, 12);
+  EXPECT_EQ(p.nspg_seeds, 12);
   EXPECT_DOUBLE_EQ(p.camera_distance, Params{}.camera_distance);
   const Params file = load_params(std::string(CONCERT_SOURCE_DIR) + "/services/planner/config/planner.yaml");
   EXPECT_DOUBLE_EQ(file.camera_distance, 0.6);
@@ -29,7 +29,7 @@ TEST(Config, ParamErrorsNameFileAndField) {
   EXPECT_NE(message("bogus: 1").find("p.yaml: bogus: unknown parameter"), std::string::npos);
   EXPECT_NE(message("contact_force: lots").find("p.yaml: contact_force: expected a number"), std::string::npos);
   EXPECT_NE(message("planning_time: 0").find("planning_time"), std::string::npos);
-  EXPECT_NE(message("nspg_samples: 1.5").find("nspg_samples"), std::string::npos);
+  EXPECT_NE(message("nspg_seeds: 1.5").find("nspg_seeds"), std::string::npos);
   EXPECT_THROW((void)load_params("/nonexistent/planner.yaml"), PlannerError);
 }
 

@@ -53,6 +53,38 @@ TEST(PlanningModel, LinkPosesAgreeWithKdl) {
   }
 }
 
+TEST(PlanningModel, StaticTorquesAgreeWithKdl) {
+  // The one-pass static torques (gravity + a contact force) equal orocos-kdl's recursive
+  // Newton-Euler gravity torques minus J^T f, on random postures of both morphologies.
+  for (const char which : {'a', 'b'}) {
+    const auto m = morphology(which);
+    const concert::kinematics::Model& k = m->kinematics();
+    concert::kinematics::Data data = k.make_data();
+    std::mt19937 rng(11u);
+    std::uniform_real_distribution<double> u(-2.5, 2.5);
+    std::vector<Eigen::Isometry3d> poses;
+    Eigen::VectorXd tau;
+    const int tool = m->link_index("tcp_E");
+    ASSERT_GE(tool, 0);
+    for (int s = 0; s < 20; ++s) {
+      Eigen::VectorXd q(m->full_dof());
+      for (Eigen::Index i = 0; i < q.size(); ++i) q[i] = u(rng);
+      const Eigen::Vector3d force(u(rng) * 100.0, u(rng) * 100.0, u(rng) * 100.0);
+      m->link_poses(q, poses);
+      m->static_torques(poses, -1, Eigen::Vector3d::Zero(), tau);
+      const Eigen::VectorXd gravity = k.gravity_torques(data, q);
+      EXPECT_LT((tau - gravity).cwiseAbs().maxCoeff(), 1e-7) << which << " sample " << s;
+      m->static_torques(poses, tool, force, tau);
+      const Eigen::VectorXd with_force = gravity - k.frame_jacobian(data, q, "tcp_E").topRows<3>().transpose() * force;
+      // The virtual base joints carry no torque in static_torques (the floor holds the base).
+      const Eigen::Index joints = q.size() - 3;
+      EXPECT_LT((tau - with_force).tail(joints).cwiseAbs().maxCoeff(), 1e-7) << which << " sample " << s;
+      EXPECT_EQ(tau.head<3>().norm(), 0.0);
+      EXPECT_GT(gravity.cwiseAbs().maxCoeff(), 1.0);  // not trivially zero
+    }
+  }
+}
+
 TEST(PlanningModel, BaseStandsOnTheFloorAndArmGrowsWithMorphology) {
   const auto a = morphology('a');
   const auto b = morphology('b');

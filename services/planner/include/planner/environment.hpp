@@ -3,6 +3,7 @@
 // from point clouds or from the world description (walls, boxes, cylinders).
 
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,33 @@ class OcTree;
 }
 
 namespace concert::planner {
+
+/// Signed Euclidean distance to the occupied voxels of a map, on a grid of the map's voxels over
+/// the occupied extent grown by `margin` on every side. Positive outside obstacles, negative
+/// inside. Points off the grid read as `margin` (at least that far from anything occupied).
+/// The planner's posture solver uses it to push the robot off obstacles smoothly; the exact
+/// collision check stays FCL against the OctoMap. (The octomap package's DynamicEDT3D is not
+/// packaged in Debian; an exact transform over a bounded grid is a few dozen lines.)
+class DistanceField {
+ public:
+  DistanceField(const octomap::OcTree& tree, double margin);
+  /// Distance [m] from `p` to the nearest occupied voxel centre minus the voxel's half diagonal
+  /// (so never more than the distance to the voxel), trilinear between grid points.
+  [[nodiscard]] double distance(const Eigen::Vector3d& p) const;
+  [[nodiscard]] double margin() const { return margin_; }
+  /// Grid spacing [m] (the map's, or coarser for a huge map).
+  [[nodiscard]] double resolution() const { return resolution_; }
+  /// Grid size (cells).
+  [[nodiscard]] std::size_t cells() const { return values_.size(); }
+
+ private:
+  [[nodiscard]] double at(long i, long j, long k) const;
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  // centre of cell (0, 0, 0)
+  double resolution_ = 0.0;
+  double margin_ = 0.0;
+  long nx_ = 0, ny_ = 0, nz_ = 0;
+  std::vector<float> values_;  // signed distance of each cell centre [m]
+};
 
 /// Occupancy map. Cheap to copy (the tree is shared and never modified after it is published
 /// to a StateChecker: every insert makes a new tree).
@@ -38,11 +66,16 @@ class Environment {
   [[nodiscard]] bool occupied(const Eigen::Vector3d& p) const;
   /// The tree (never null).
   [[nodiscard]] std::shared_ptr<const octomap::OcTree> octree() const { return tree_; }
+  /// Signed distance field of the map (grid margin 0.6 m), computed on first use and shared
+  /// by copies of this map; thread-safe.
+  [[nodiscard]] std::shared_ptr<const DistanceField> distance_field() const;
 
  private:
   std::shared_ptr<octomap::OcTree> mutable_copy() const;
+  struct LazyField;
   double resolution_;
   std::shared_ptr<const octomap::OcTree> tree_;
+  std::shared_ptr<LazyField> field_;  // reset whenever the tree changes
 };
 
 }  // namespace concert::planner

@@ -31,6 +31,8 @@ struct LinkNode {
   std::vector<LinkShape> shapes;    ///< collision primitives
   bool leg = false;                 ///< belongs to a leg chain (touches the floor)
   int rigid_group = -1;             ///< nearest planned arm joint above it (-1: base group)
+  double mass = 0.0;                ///< URDF inertial mass [kg]
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();  ///< centre of mass in the link frame [m]
 };
 
 /// One model version, ready for planning. Build with PlanningModel::build.
@@ -77,6 +79,15 @@ class PlanningModel {
   void link_poses(const Eigen::VectorXd& q_full, std::vector<Eigen::Isometry3d>& poses) const;
   /// World pose of one link (with the base height).
   [[nodiscard]] Eigen::Isometry3d link_pose(const Eigen::VectorXd& q_full, const std::string& link) const;
+  /// Joint torques [N m] (full q order; forces [N] for prismatic joints) that hold the robot
+  /// still at the link poses `poses` (from link_poses) against gravity and, when `contact_link`
+  /// >= 0, against `force` [N, world frame] that the environment applies at that link's origin:
+  /// tau_j = -a_j . sum (r x f) over the external forces beyond joint j; 0 for the virtual base
+  /// joints (the floor holds the base). One pass over the link
+  /// tree, no allocation besides `tau` (the planner evaluates it thousands of times per goal;
+  /// equal to KDL's RNE with zero velocities, see StaticTorquesAgreeWithKdl).
+  void static_torques(const std::vector<Eigen::Isometry3d>& poses, int contact_link, const Eigen::Vector3d& force,
+                      Eigen::VectorXd& tau) const;
   /// Index of a link in links(), or -1.
   [[nodiscard]] int link_index(const std::string& name) const;
 
@@ -100,6 +111,7 @@ class PlanningModel {
   Eigen::VectorXd lower_, upper_, velocity_, torque_;
   double base_height_ = 0.0;
   std::vector<LinkNode> links_;
+  Eigen::Vector3d gravity_ = Eigen::Vector3d(0.0, 0.0, -9.81);
   std::vector<std::vector<bool>> disabled_;
   std::vector<std::string> ignored_;
   std::string camera_prefix_;

@@ -26,18 +26,24 @@ class StateChecker {
   /// Returns the first constraint violated, in the order joint limit, torque, floor,
   /// environment, self collision.
   [[nodiscard]] Validity check(const Eigen::VectorXd& q_full, const std::string& contact_frame = {});
-  /// Joint torques the state needs (gravity + contact) [N m], full q order.
+  /// Joint torques the state needs (gravity + contact) [N m], full q order
+  /// (PlanningModel::static_torques). Throws PlannerError for an unknown contact frame.
   [[nodiscard]] Eigen::VectorXd required_torques(const Eigen::VectorXd& q_full, const std::string& contact_frame);
   /// Number of check() calls so far.
   [[nodiscard]] std::size_t checks() const { return checks_; }
   [[nodiscard]] const PlanningModel& model() const { return *model_; }
+  /// Signed distance field of the environment the checker was made with (Environment::distance_field).
+  [[nodiscard]] std::shared_ptr<const DistanceField> distance_field() const { return environment_.distance_field(); }
 
   struct Impl;
 
  private:
+  void torques_at_poses(const std::string& contact_frame, Eigen::VectorXd& tau);
   std::shared_ptr<const PlanningModel> model_;
+  Environment environment_;
   Params params_;
   std::unique_ptr<Impl> impl_;
+  double padding_ = 0.0;
   std::size_t checks_ = 0;
 };
 

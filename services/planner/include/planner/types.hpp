@@ -78,17 +78,14 @@ struct Params {
   uint64_t seed = 1;                 ///< random seed of NSPG and OMPL
 
   // NSPG.
-  int nspg_samples = 30;             ///< null-space random walks tried per goal (if seeds fail)
-  int nspg_arm_samples = 20000;      ///< random arm postures screened for task-aligned seeds
-  int nspg_ranked_seeds = 40;        ///< best screened postures (by torque) tried first
-  int nspg_arm_seeds = 6;            ///< arm postures (start + random) per base placement
+  int nspg_seeds = 64;               ///< seeds tried per goal at most (start posture first)
+  int nspg_screen = 24;              ///< random arm postures drawn per random seed (closest kept)
+  int nspg_iterations = 40;          ///< Levenberg-Marquardt iterations per seed
   double nspg_time = 1.2;            ///< NSPG time budget per goal [s]
-  int nspg_enough = 2;               ///< stop after this many valid postures
-  double nspg_step = 0.35;           ///< largest null-space step per walk [rad or m]
+  int nspg_enough = 1;               ///< stop after this many valid postures
   double nspg_tolerance = 1e-3;      ///< task error accepted [m, rad]
   double nspg_distance_weight = 1.0; ///< cost of the distance to the start [1/rad]
   double nspg_singularity_weight = 0.5;  ///< cost of 1/manipulability of the arm [-]
-  int nspg_torque_iterations = 8;    ///< null-space descent steps on the torque utilisation
 
   // Time parameterisation.
   double velocity_scale = 0.5;       ///< fraction of each joint's velocity limit [-]

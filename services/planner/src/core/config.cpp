@@ -58,7 +58,6 @@ Params parse_params(const std::string& yaml, const std::string& source) {
       {"base_range", &p.base_range},
       {"planning_time", &p.planning_time},
       {"check_resolution", &p.check_resolution},
-      {"nspg_step", &p.nspg_step},
       {"nspg_time", &p.nspg_time},
       {"nspg_tolerance", &p.nspg_tolerance},
       {"nspg_distance_weight", &p.nspg_distance_weight},
@@ -72,10 +71,11 @@ Params parse_params(const std::string& yaml, const std::string& source) {
       {"sample_period", &p.sample_period},
   };
   const std::map<std::string, int*> integers = {
-      {"simplify_iterations", &p.simplify_iterations}, {"nspg_samples", &p.nspg_samples},
-      {"nspg_arm_seeds", &p.nspg_arm_seeds},
-      {"nspg_arm_samples", &p.nspg_arm_samples},       {"nspg_ranked_seeds", &p.nspg_ranked_seeds},           {"nspg_enough", &p.nspg_enough},
-      {"nspg_torque_iterations", &p.nspg_torque_iterations},
+      {"simplify_iterations", &p.simplify_iterations},
+      {"nspg_seeds", &p.nspg_seeds},
+      {"nspg_screen", &p.nspg_screen},
+      {"nspg_iterations", &p.nspg_iterations},
+      {"nspg_enough", &p.nspg_enough},
   };
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();

@@ -1,4 +1,20 @@
 // Null-Space Posture Generator (Rossini et al. 2021, paper section 5.4.2).
+//
+// The goal posture is the solution of a small constrained problem over the planned joints
+// (base x, y, yaw + arm): the camera task (5-D: position, optical axis) as equalities, and as
+// inequalities the torque limits (gravity, and gravity + drilling force), clearance from the
+// drilled surface, from the floor and between the robot's own links. Each seed is driven onto
+// it by Levenberg-Marquardt on the residual vector [task; hinge(inequalities)]: the task rows
+// pull it onto the task manifold while the hinge rows move it along that manifold (its null
+// space) out of infeasibility, which is what the NSPG's null-space descent does, but on every
+// constraint at once. A seed ends on a posture that the exact checker (FCL, OctoMap, KDL
+// torques) then judges; the smooth terms only approximate it (spheres for self collision, the
+// surface plane for the wall), so the checker has the last word.
+//
+// Hand-written instead of a library solver (Ipopt is in Debian): the problem has 9-12
+// variables and the residuals are cheap, so a dense LM with a finite-difference Jacobian is a
+// few dozen lines and needs no problem adapter; an interior-point solver would need the same
+// residuals plus a sparsity structure and would not be faster at this size.
 
 #include <Eigen/Dense>
 
@@ -14,145 +30,427 @@
 namespace concert::planner {
 namespace {
 
-constexpr double kDamping = 1e-2;
-constexpr double kMaxStep = 0.2;  // [rad or m] per iteration
+// Residual weights: the task must win over the inequalities (1 mm of task error weighs as much
+// as 1 cm of penetration).
+constexpr double kTaskWeight = 10.0;
+constexpr double kTorqueWeight = 3.0;
+constexpr double kClearanceWeight = 1.0;
+// Torque utilisation the smooth problem aims under (the checker allows 1.0 x torque_margin).
+constexpr double kTorqueTarget = 0.97;
+// Extra clearance the smooth problem keeps, so the exact checks pass [m].
+constexpr double kClearanceSlack = 0.015;
+// Clearance kept between the robot's own links (FCL counts touching as colliding) [m].
+constexpr double kSelfSlack = 0.005;
+constexpr double kMaxStep = 0.3;  // [rad or m] per LM iteration
+constexpr double kFiniteDifference = 1e-6;
 
 struct Task {
   Eigen::Vector3d position;  // camera target [m]
   Eigen::Vector3d axis;      // camera z target (unit)
+  Eigen::Vector3d surface;   // a point of the drilled surface [m]
+  Eigen::Vector3d normal;    // its outward normal (unit)
 };
 
-class TaskSolver {
- public:
-  TaskSolver(const PlanningModel& model, const Params& params, std::string camera, const Eigen::VectorXd& full_template,
-             Eigen::VectorXd lo, Eigen::VectorXd hi)
-      : model_(model),
-        params_(params),
-        camera_(std::move(camera)),
-        template_(full_template),
-        data_(model.kinematics().make_data()),
-        lo_(std::move(lo)),
-        hi_(std::move(hi)) {
-    // Moving the base costs more than moving the arm, so postures stay near the start base.
-    weights_ = Eigen::VectorXd::Ones(model.dof());
-    weights_.head<3>() << 0.2, 0.2, 0.2;
-  }
+Task make_task(const Params& params, const Eigen::Isometry3d& area) {
+  const Eigen::Vector3d n = area.linear().col(2).normalized();
+  return {area.translation() + params.camera_distance * n, -n, area.translation(), n};
+}
 
-  // Task error (6: position, axis cross product) and task Jacobian over the planned joints.
-  void evaluate(const Eigen::VectorXd& q, const Task& task, Eigen::Matrix<double, 6, 1>& error, Eigen::MatrixXd& jac) {
-    const Eigen::VectorXd full = model_.to_full(q, template_);
-    const Eigen::Isometry3d pose = model_.link_pose(full, camera_);
-    const Eigen::Vector3d z = pose.linear().col(2);
-    error.head<3>() = task.position - pose.translation();
-    error.tail<3>() = z.cross(task.axis);
-    const Eigen::MatrixXd j_full = model_.kinematics().frame_jacobian(data_, full, camera_);
-    jac.resize(6, model_.dof());
-    const auto& idx = model_.planned_indices();
-    const Eigen::Matrix3d proj = Eigen::Matrix3d::Identity() - z * z.transpose();
-    for (std::size_t i = 0; i < idx.size(); ++i) {
-      jac.col(static_cast<Eigen::Index>(i)).head<3>() = j_full.col(idx[i]).head<3>();
-      jac.col(static_cast<Eigen::Index>(i)).tail<3>() = proj * j_full.col(idx[i]).tail<3>();
+// Signed distance of a collision primitive (pose `t`) from the plane (point o, normal n): the
+// smallest n.(x - o) over the shape. Exact for boxes, cylinders and spheres.
+double plane_distance(const LinkShape& s, const Eigen::Isometry3d& t, const Eigen::Vector3d& o, const Eigen::Vector3d& n) {
+  const double centre = (t.translation() - o).dot(n);
+  switch (s.type) {
+    case LinkShape::Type::kBox: {
+      double extent = 0.0;
+      for (int k = 0; k < 3; ++k) extent += 0.5 * s.size[k] * std::abs(t.linear().col(k).dot(n));
+      return centre - extent;
     }
-  }
-
-  // Weighted damped least squares onto the task; true when within tolerance.
-  bool converge(Eigen::VectorXd& q, const Task& task, int iterations) {
-    Eigen::Matrix<double, 6, 1> e;
-    Eigen::MatrixXd j;
-    for (int it = 0; it < iterations; ++it) {
-      evaluate(q, task, e, j);
-      if (e.head<3>().norm() < params_.nspg_tolerance && e.tail<3>().norm() < params_.nspg_tolerance) return true;
-      const Eigen::MatrixXd jw = j * weights_.asDiagonal();
-      const Eigen::Matrix<double, 6, 6> a = jw * j.transpose() + kDamping * kDamping * Eigen::Matrix<double, 6, 6>::Identity();
-      Eigen::VectorXd dq = weights_.asDiagonal() * (j.transpose() * a.ldlt().solve(e));
-      const double big = dq.cwiseAbs().maxCoeff();
-      if (big > kMaxStep) dq *= kMaxStep / big;
-      q = (q + dq).cwiseMax(lo_).cwiseMin(hi_);
+    case LinkShape::Type::kCylinder: {
+      const double c = std::abs(t.linear().col(2).dot(n));
+      return centre - (s.size.x() * std::sqrt(std::max(0.0, 1.0 - c * c)) + 0.5 * s.size.z() * c);
     }
-    evaluate(q, task, e, j);
-    return e.head<3>().norm() < params_.nspg_tolerance && e.tail<3>().norm() < params_.nspg_tolerance;
+    case LinkShape::Type::kSphere:
+      return centre - s.size.x();
   }
+  return centre;
+}
 
-  // A random step in the null space of the task Jacobian at q.
-  Eigen::VectorXd null_step(const Eigen::VectorXd& q, const Task& task, const Eigen::VectorXd& random) {
-    Eigen::Matrix<double, 6, 1> e;
-    Eigen::MatrixXd j;
-    evaluate(q, task, e, j);
-    const Eigen::MatrixXd pinv = j.completeOrthogonalDecomposition().pseudoInverse();
-    const Eigen::MatrixXd n = Eigen::MatrixXd::Identity(model_.dof(), model_.dof()) - pinv * j;
-    return n * random;
-  }
-
-  // Secondary task: torque utilisation sum((tau_i / limit_i)^2) over the arm joints, with the
-  // contact force on the tool.
-  double torque_cost(const Eigen::VectorXd& q, StateChecker& checker, const std::string& tool_frame) {
-    const Eigen::VectorXd full = model_.to_full(q, template_);
-    const Eigen::VectorXd tau = checker.required_torques(full, tool_frame);
-    const auto& idx = model_.planned_indices();
-    double c = 0.0;
-    for (std::size_t i = 3; i < idx.size(); ++i) {
-      const double lim = model_.torque_limits()[idx[i]];
-      if (lim > 0.0) c += (tau[idx[i]] / lim) * (tau[idx[i]] / lim);
+// Signed distance from a point to a primitive, the point given in the primitive's frame:
+// negative inside.
+double signed_distance(const LinkShape& s, const Eigen::Vector3d& local) {
+  switch (s.type) {
+    case LinkShape::Type::kBox: {
+      const Eigen::Vector3d q = local.cwiseAbs() - 0.5 * s.size;
+      return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
     }
-    return c;
+    case LinkShape::Type::kCylinder: {
+      const Eigen::Vector2d q(local.head<2>().norm() - s.size.x(), std::abs(local.z()) - 0.5 * s.size.z());
+      return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+    }
+    case LinkShape::Type::kSphere:
+      return local.norm() - s.size.x();
   }
+  return 0.0;
+}
 
-  // Descends the torque cost in the null space of the task, staying on the task.
-  void relieve_torques(Eigen::VectorXd& q, const Task& task, StateChecker& checker, const std::string& tool_frame, int iterations) {
-    Eigen::Matrix<double, 6, 1> e;
-    Eigen::MatrixXd j;
-    double c = torque_cost(q, checker, tool_frame);
-    for (int it = 0; it < iterations; ++it) {
-      Eigen::VectorXd grad(q.size());
-      for (Eigen::Index i = 0; i < q.size(); ++i) {
-        Eigen::VectorXd qi = q;
-        qi[i] += 1e-4;
-        grad[i] = (torque_cost(qi, checker, tool_frame) - c) / 1e-4;
-      }
-      evaluate(q, task, e, j);
-      const Eigen::MatrixXd pinv = j.completeOrthogonalDecomposition().pseudoInverse();
-      Eigen::VectorXd step = -(Eigen::MatrixXd::Identity(q.size(), q.size()) - pinv * j) * grad;
-      const double big = step.cwiseAbs().maxCoeff();
-      if (big < 1e-6) return;
-      bool improved = false;
-      for (double len = 0.2; len > 0.02; len *= 0.4) {
-        Eigen::VectorXd trial = (q + step * (len / big)).cwiseMax(lo_).cwiseMin(hi_);
-        if (!converge(trial, task, 20)) continue;
-        const double ct = torque_cost(trial, checker, tool_frame);
-        if (ct < c) {
-          q = trial;
-          c = ct;
-          improved = true;
-          break;
+// Spheres inside a primitive, spaced at most half a radius apart (their union then dips at
+// most 3 % of the radius below the primitive's surface): a smooth stand-in for the
+// primitive in the self-collision term (distance of two spheres is differentiable, FCL's
+// boolean answer is not).
+struct Sphere {
+  Eigen::Vector3d centre;  // in the link frame
+  double radius = 0.0;
+};
+
+void add_line(std::vector<Sphere>& out, const Eigen::Isometry3d& origin, const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+              double radius) {
+  const double length = (to - from).norm();
+  const int count = length < 1e-9 ? 1 : static_cast<int>(std::ceil(2.0 * length / radius)) + 1;
+  for (int i = 0; i < count; ++i) {
+    const double f = count == 1 ? 0.5 : static_cast<double>(i) / (count - 1);
+    out.push_back({origin * (from + f * (to - from)), radius});
+  }
+}
+
+std::vector<Sphere> sphere_cover(const LinkShape& s) {
+  std::vector<Sphere> out;
+  switch (s.type) {
+    case LinkShape::Type::kSphere:
+      out.push_back({s.origin.translation(), s.size.x()});
+      break;
+    case LinkShape::Type::kCylinder: {
+      const double r = s.size.x();
+      const double half = 0.5 * s.size.z();
+      if (half >= r) {
+        add_line(out, s.origin, Eigen::Vector3d(0, 0, -(half - r)), Eigen::Vector3d(0, 0, half - r), r);
+      } else {
+        // A disc (wheel): spheres of its half thickness on a ring and at the centre.
+        out.push_back({s.origin.translation(), half});
+        const int ring = std::max(6, static_cast<int>(std::ceil(2.0 * M_PI * (r - half) / half)));
+        for (int i = 0; i < ring; ++i) {
+          const double a = 2.0 * M_PI * i / ring;
+          out.push_back({s.origin * Eigen::Vector3d((r - half) * std::cos(a), (r - half) * std::sin(a), 0.0), half});
         }
       }
-      if (!improved) return;
+      break;
+    }
+    case LinkShape::Type::kBox: {
+      const double r = 0.5 * s.size.minCoeff();
+      int count[3];
+      for (int k = 0; k < 3; ++k) count[k] = std::max(1, static_cast<int>(std::ceil(2.0 * (s.size[k] - 2.0 * r) / r)) + 1);
+      for (int i = 0; i < count[0]; ++i) {
+        for (int j = 0; j < count[1]; ++j) {
+          for (int k = 0; k < count[2]; ++k) {
+            Eigen::Vector3d p;
+            const int idx[3] = {i, j, k};
+            for (int d = 0; d < 3; ++d) {
+              const double span = s.size[d] - 2.0 * r;
+              p[d] = count[d] == 1 ? 0.0 : -0.5 * span + span * idx[d] / (count[d] - 1);
+            }
+            out.push_back({s.origin * p, r});
+          }
+        }
+      }
+      // Corners and edge midpoints (radius 0): the spheres do not reach a box's edges.
+      for (int i = -1; i <= 1; ++i) {
+        for (int j = -1; j <= 1; ++j) {
+          for (int k = -1; k <= 1; ++k) {
+            if ((i != 0) + (j != 0) + (k != 0) < 2) continue;
+            out.push_back({s.origin * Eigen::Vector3d(0.5 * i * s.size.x(), 0.5 * j * s.size.y(), 0.5 * k * s.size.z()), 0.0});
+          }
+        }
+      }
+      break;
+    }
+  }
+  // Rims of a cylinder (radius 0), where its axis spheres leave gaps.
+  if (s.type == LinkShape::Type::kCylinder) {
+    for (const double end : {-0.5, 0.5}) {
+      for (int i = 0; i < 8; ++i) {
+        const double a = 2.0 * M_PI * i / 8.0;
+        out.push_back({s.origin * Eigen::Vector3d(s.size.x() * std::cos(a), s.size.x() * std::sin(a), end * s.size.z()), 0.0});
+      }
+    }
+  }
+  return out;
+}
+
+enum class Term { kTask, kTorque, kSurface, kFloor, kSelf, kObstacle };
+
+// Residual vector of the posture problem over the planned joints.
+class PostureProblem {
+ public:
+  PostureProblem(const PlanningModel& model, const Params& params, const EndEffectorSpec& tool,
+                 const Eigen::VectorXd& full_template, const Task& task, std::shared_ptr<const DistanceField> field)
+      : model_(model), params_(params), tool_(model.link_index(tool.frame)), template_(full_template), task_(task), field_(std::move(field)) {
+    camera_ = model.link_index(model.camera_frame(tool));
+    const auto& links = model.links();
+    // The surface term keeps the robot in front of the drilled surface; legs stand on the
+    // floor, so they are left out when the surface is the floor itself.
+    const bool floor_like = task.normal.z() > 0.7;
+    for (std::size_t l = 0; l < links.size(); ++l) {
+      for (const LinkShape& s : links[l].shapes) {
+        if (!(floor_like && links[l].leg)) surface_shapes_.emplace_back(static_cast<int>(l), &s);
+        if (!links[l].leg && links[l].rigid_group >= 0) floor_shapes_.emplace_back(static_cast<int>(l), &s);
+        for (const Sphere& sp : sphere_cover(s)) spheres_.emplace_back(static_cast<int>(l), sp);
+      }
+    }
+    std::vector<std::vector<int>> by_link(links.size());
+    for (std::size_t i = 0; i < spheres_.size(); ++i) by_link[static_cast<std::size_t>(spheres_[i].first)].push_back(static_cast<int>(i));
+    bounds_.resize(links.size());
+    for (std::size_t l = 0; l < links.size(); ++l) {
+      if (by_link[l].empty()) continue;
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (const int i : by_link[l]) centre += spheres_[static_cast<std::size_t>(i)].second.centre;
+      centre /= static_cast<double>(by_link[l].size());
+      double radius = 0.0;
+      for (const int i : by_link[l]) {
+        const Sphere& sp = spheres_[static_cast<std::size_t>(i)].second;
+        radius = std::max(radius, (sp.centre - centre).norm() + sp.radius);
+      }
+      bounds_[l] = {centre, radius};
+    }
+    for (std::size_t a = 0; a < links.size(); ++a) {
+      if (!by_link[a].empty()) obstacle_links_.emplace_back(static_cast<int>(a), by_link[a]);
+      for (std::size_t b = a + 1; b < links.size(); ++b) {
+        if (by_link[a].empty() || by_link[b].empty() || model.pair_disabled(static_cast<int>(a), static_cast<int>(b))) continue;
+        self_pairs_.push_back({static_cast<int>(a), static_cast<int>(b), by_link[a], by_link[b]});
+      }
+    }
+    const auto& idx = model.planned_indices();
+    arm_joints_ = static_cast<int>(idx.size()) - 3;
+    size_ = 6 + 2 * arm_joints_ +
+            static_cast<int>(surface_shapes_.size() + floor_shapes_.size() + self_pairs_.size() + obstacle_links_.size());
+    // The map's voxels may stand up to a voxel in front of the surface they were made from.
+    clearance_ = params.environment_padding + params.octomap_resolution + kClearanceSlack;
+    obstacle_clearance_ = params.environment_padding + kClearanceSlack;
+  }
+
+  [[nodiscard]] int size() const { return size_; }
+  /// Fraction of the contact force in the torque rows (continuation from 0 to 1).
+  void set_force_scale(double scale) { force_scale_ = scale; }
+
+  // The planned q for arm joints `arm`: the base is placed where that arm posture reaches the
+  // task (yaw turns the camera axis onto the task axis about the vertical, x/y then bring the
+  // camera onto the target; yaw stays `yaw_hint` when either axis is vertical). Leaves the
+  // world link poses in poses_.
+  Eigen::VectorXd place(const Eigen::VectorXd& arm, double yaw_hint) {
+    Eigen::VectorXd q(arm.size() + 3);
+    q.head<3>().setZero();
+    q.tail(arm.size()) = arm;
+    model_.link_poses(model_.to_full(q, template_), poses_);
+    const Eigen::Isometry3d& cam = poses_[static_cast<std::size_t>(camera_)];
+    const Eigen::Vector3d a = cam.linear().col(2);
+    double yaw = yaw_hint;
+    if (a.head<2>().norm() > 1e-3 && task_.axis.head<2>().norm() > 1e-3) {
+      yaw = std::atan2(task_.axis.y(), task_.axis.x()) - std::atan2(a.y(), a.x());
+      yaw = yaw_hint + std::remainder(yaw - yaw_hint, 2.0 * M_PI);
+    }
+    const Eigen::Rotation2Dd rot(yaw);
+    q[2] = yaw;
+    q.head<2>() = task_.position.head<2>() - rot * cam.translation().head<2>();
+    // Rotating about the vertical through the origin and shifting in x/y moves every link
+    // pose the same way (the base height is along the rotation axis).
+    Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
+    base.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    base.translation() = Eigen::Vector3d(q[0], q[1], 0.0);
+    for (Eigen::Isometry3d& p : poses_) p = base * p;
+    return q;
+  }
+
+  // Residuals at planned q.
+  void evaluate(const Eigen::VectorXd& q, Eigen::VectorXd& r) {
+    r.resize(size_);
+    model_.link_poses(model_.to_full(q, template_), poses_);
+    const Eigen::Isometry3d& cam = poses_[static_cast<std::size_t>(camera_)];
+    r.segment<3>(0) = kTaskWeight * (cam.translation() - task_.position);
+    r.segment<3>(3) = kTaskWeight * cam.linear().col(2).cross(task_.axis);
+    int row = 6;
+    const auto& idx = model_.planned_indices();
+    // Gravity + drilling force (the surface pushes back along -z of the tool frame), then
+    // gravity alone.
+    const Eigen::Vector3d force = -force_scale_ * params_.contact_force * poses_[static_cast<std::size_t>(tool_)].linear().col(2);
+    for (const bool drilling : {true, false}) {
+      model_.static_torques(poses_, drilling && params_.contact_force != 0.0 ? tool_ : -1, force, tau_);
+      for (std::size_t i = 3; i < idx.size(); ++i) {
+        const double lim = params_.torque_margin * model_.torque_limits()[idx[i]];
+        r[row++] = lim > 0.0 ? kTorqueWeight * std::max(0.0, std::abs(tau_[idx[i]]) / lim - kTorqueTarget) : 0.0;
+      }
+    }
+    for (const auto& [link, shape] : surface_shapes_) {
+      const double d = plane_distance(*shape, poses_[static_cast<std::size_t>(link)] * shape->origin, task_.surface, task_.normal);
+      r[row++] = kClearanceWeight * std::max(0.0, clearance_ - d);
+    }
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d floor(0.0, 0.0, params_.floor_height);
+    for (const auto& [link, shape] : floor_shapes_) {
+      const double d = plane_distance(*shape, poses_[static_cast<std::size_t>(link)] * shape->origin, floor, up);
+      r[row++] = kClearanceWeight * std::max(0.0, params_.floor_clearance + kClearanceSlack - d);
+    }
+    world_spheres_.resize(spheres_.size());
+    for (std::size_t i = 0; i < spheres_.size(); ++i) {
+      world_spheres_[i] = poses_[static_cast<std::size_t>(spheres_[i].first)] * spheres_[i].second.centre;
+    }
+    for (const LinkPair& p : self_pairs_) {
+      double sum = 0.0;
+      // Bounding spheres of the two links first: most pairs are far apart.
+      const Eigen::Vector3d ca = poses_[static_cast<std::size_t>(p.a)] * bounds_[static_cast<std::size_t>(p.a)].centre;
+      const Eigen::Vector3d cb = poses_[static_cast<std::size_t>(p.b)] * bounds_[static_cast<std::size_t>(p.b)].centre;
+      const double reach = bounds_[static_cast<std::size_t>(p.a)].radius + bounds_[static_cast<std::size_t>(p.b)].radius;
+      if ((ca - cb).squaredNorm() < reach * reach) {
+        // The spheres of each link against the exact primitives of the other: penetration
+        // depth, both ways (inscribed spheres alone leave gaps at flat faces and edges).
+        for (const auto& [mine, other] : {std::pair{p.a, p.b}, std::pair{p.b, p.a}}) {
+          const auto& shapes = model_.links()[static_cast<std::size_t>(other)].shapes;
+          for (std::size_t k = 0; k < shapes.size(); ++k) {
+            // World to shape frame, once per shape (rigid: R^T (x - t)).
+            const Eigen::Isometry3d t = poses_[static_cast<std::size_t>(other)] * shapes[k].origin;
+            const Eigen::Matrix3d rt = t.linear().transpose();
+            for (const int i : mine == p.a ? p.spheres_a : p.spheres_b) {
+              const double radius = spheres_[static_cast<std::size_t>(i)].second.radius;
+              const double d =
+                  signed_distance(shapes[k], rt * (world_spheres_[static_cast<std::size_t>(i)] - t.translation())) - kSelfSlack;
+              if (d < radius) sum += (radius - d) * (radius - d);
+            }
+          }
+        }
+      }
+      r[row++] = kClearanceWeight * std::sqrt(sum);
+    }
+    // Obstacles of the map (distance field): every sphere of a link clear by the padding.
+    for (const auto& [link, spheres] : obstacle_links_) {
+      double sum = 0.0;
+      const Eigen::Vector3d c = poses_[static_cast<std::size_t>(link)] * bounds_[static_cast<std::size_t>(link)].centre;
+      if (field_->distance(c) < bounds_[static_cast<std::size_t>(link)].radius + obstacle_clearance_) {
+        for (const int i : spheres) {
+          const double need = spheres_[static_cast<std::size_t>(i)].second.radius + obstacle_clearance_;
+          const double d = field_->distance(world_spheres_[static_cast<std::size_t>(i)]);
+          if (d < need) sum += (need - d) * (need - d);
+        }
+      }
+      r[row++] = kClearanceWeight * std::sqrt(sum);
     }
   }
 
-  // Yoshikawa manipulability of the arm joints for the camera frame.
-  double manipulability(const Eigen::VectorXd& q) {
-    const Eigen::VectorXd full = model_.to_full(q, template_);
-    const Eigen::MatrixXd j_full = model_.kinematics().frame_jacobian(data_, full, camera_);
-    const auto& idx = model_.planned_indices();
-    Eigen::MatrixXd j(6, static_cast<Eigen::Index>(idx.size()) - 3);
-    for (std::size_t i = 3; i < idx.size(); ++i) j.col(static_cast<Eigen::Index>(i) - 3) = j_full.col(idx[i]);
-    return std::sqrt(std::max(0.0, (j * j.transpose()).determinant()));
+  std::string pair_name(int row) const {
+    row -= 6 + 2 * arm_joints_ + static_cast<int>(surface_shapes_.size() + floor_shapes_.size());
+    if (row < 0 || row >= static_cast<int>(self_pairs_.size())) return "";
+    const auto& p = self_pairs_[static_cast<std::size_t>(row)];
+    return model_.links()[p.a].name + "/" + model_.links()[p.b].name;
+  }
+  [[nodiscard]] Term term_of_row(int row) const {
+    if (row < 6) return Term::kTask;
+    row -= 6;
+    if (row < 2 * arm_joints_) return Term::kTorque;
+    row -= 2 * arm_joints_;
+    if (row < static_cast<int>(surface_shapes_.size())) return Term::kSurface;
+    row -= static_cast<int>(surface_shapes_.size());
+    if (row < static_cast<int>(floor_shapes_.size())) return Term::kFloor;
+    row -= static_cast<int>(floor_shapes_.size());
+    return row < static_cast<int>(self_pairs_.size()) ? Term::kSelf : Term::kObstacle;
   }
 
  private:
   const PlanningModel& model_;
   const Params& params_;
-  std::string camera_;
+  int tool_ = -1;
   Eigen::VectorXd template_;
-  kinematics::Data data_;
-  Eigen::VectorXd lo_, hi_;
-  Eigen::VectorXd weights_;
+  Task task_;
+  int camera_ = -1;
+  int arm_joints_ = 0;
+  int size_ = 0;
+  double clearance_ = 0.0;
+  std::vector<std::pair<int, const LinkShape*>> surface_shapes_;
+  std::vector<std::pair<int, const LinkShape*>> floor_shapes_;
+  std::vector<std::pair<int, Sphere>> spheres_;
+  struct LinkPair {
+    int a, b;
+    std::vector<int> spheres_a, spheres_b;
+  };
+  std::vector<LinkPair> self_pairs_;
+  std::vector<Sphere> bounds_;  // per link, in the link frame
+  std::vector<std::pair<int, std::vector<int>>> obstacle_links_;
+  std::shared_ptr<const DistanceField> field_;
+  double obstacle_clearance_ = 0.0;
+  double force_scale_ = 1.0;
+  Eigen::VectorXd tau_;
+  std::vector<Eigen::Isometry3d> poses_;
+  std::vector<Eigen::Vector3d> world_spheres_;
 };
 
-Task make_task(const Params& params, const Eigen::Isometry3d& area) {
-  const Eigen::Vector3d n = area.linear().col(2).normalized();
-  return {area.translation() + params.camera_distance * n, -n};
+// Two-priority Gauss-Newton with Levenberg-Marquardt damping and a forward-difference
+// Jacobian, steps clamped to [lo, hi]: each step first reduces the task error (damped
+// pseudo-inverse of the task Jacobian), then the inequality residuals within the task's null
+// space, so the inequalities never trade off against the task (the NSPG's null-space motion).
+// Leaves the final residual vector in `r`.
+void solve(PostureProblem& problem, Eigen::VectorXd& q, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, int iterations,
+           double tolerance, Eigen::VectorXd& r) {
+  const Eigen::Index n = q.size();
+  problem.evaluate(q, r);
+  const Eigen::Index m = r.size() - 6;
+  auto merit = [](const Eigen::VectorXd& v) { return 100.0 * v.head<6>().squaredNorm() + v.tail(v.size() - 6).squaredNorm(); };
+  double f = merit(r);
+  double lambda = 1e-3;
+  Eigen::MatrixXd jac(r.size(), n);
+  Eigen::VectorXd ri;
+  for (int it = 0; it < iterations; ++it) {
+    const bool on_task = r.head<6>().norm() < kTaskWeight * tolerance;
+    if (on_task && r.tail(m).isZero()) return;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      Eigen::VectorXd qi = q;
+      qi[i] += kFiniteDifference;
+      problem.evaluate(qi, ri);
+      jac.col(i) = (ri - r) / kFiniteDifference;
+    }
+    const Eigen::MatrixXd jt = jac.topRows<6>();
+    const Eigen::MatrixXd jh = jac.bottomRows(m);
+    // Task step and null-space projector from the SVD (the axis rows have rank 2).
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jt, Eigen::ComputeFullV);
+    const Eigen::VectorXd& sv = svd.singularValues();
+    const Eigen::MatrixXd& v = svd.matrixV();
+    Eigen::MatrixXd null = Eigen::MatrixXd::Identity(n, n);
+    for (Eigen::Index k = 0; k < sv.size(); ++k) {
+      if (sv[k] > 1e-6 * std::max(1.0, sv[0])) null -= v.col(k) * v.col(k).transpose();
+    }
+    const Eigen::MatrixXd a = jh * null;
+    const Eigen::MatrixXd h = a.transpose() * a;
+    bool improved = false;
+    for (int attempt = 0; attempt < 6 && !improved; ++attempt) {
+      // Damped least-squares task step, then the inequalities in the task's null space.
+      const Eigen::Matrix<double, 6, 6> jjt = jt * jt.transpose() + lambda * Eigen::Matrix<double, 6, 6>::Identity();
+      const Eigen::VectorXd dq1 = jt.transpose() * jjt.ldlt().solve(-r.head<6>());
+      Eigen::MatrixXd hh = h;
+      hh.diagonal().array() += lambda * (h.diagonal().array() + 1e-9);
+      const Eigen::VectorXd dq2 = null * hh.ldlt().solve(a.transpose() * (-r.tail(m) - jh * dq1));
+      Eigen::VectorXd dq = dq1 + dq2;
+      const double big = dq.cwiseAbs().maxCoeff();
+      if (!std::isfinite(big)) break;
+      if (big > kMaxStep) dq *= kMaxStep / big;
+      const Eigen::VectorXd trial = (q + dq).cwiseMax(lo).cwiseMin(hi);
+      problem.evaluate(trial, ri);
+      const double ft = merit(ri);
+      if (ft < f) {
+        q = trial;
+        r = ri;
+        f = ft;
+        lambda = std::max(1e-7, lambda * 0.2);
+        improved = true;
+      } else {
+        lambda *= 10.0;
+      }
+    }
+    if (!improved) return;
+  }
+}
+
+// Yoshikawa manipulability of the arm joints for the camera frame.
+double manipulability(const PlanningModel& model, kinematics::Data& data, const Eigen::VectorXd& full, const std::string& camera) {
+  const Eigen::MatrixXd j_full = model.kinematics().frame_jacobian(data, full, camera);
+  const auto& idx = model.planned_indices();
+  Eigen::MatrixXd j(6, static_cast<Eigen::Index>(idx.size()) - 3);
+  for (std::size_t i = 3; i < idx.size(); ++i) j.col(static_cast<Eigen::Index>(i) - 3) = j_full.col(idx[i]);
+  return std::sqrt(std::max(0.0, (j * j.transpose()).determinant()));
 }
 
 }  // namespace
@@ -168,194 +466,111 @@ std::pair<double, double> task_error(const PlanningModel& model, const Params& p
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
                                const EndEffectorSpec& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
                                uint64_t seed) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto out_of_time = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > params.nspg_time;
+  };
   const Task task = make_task(params, area);
   const int n = model.dof();
   const Eigen::VectorXd start = model.to_planned(q_start_full);
   Eigen::VectorXd lo = model.lower();
   Eigen::VectorXd hi = model.upper();
-  lo.head<2>() = start.head<2>().array() - params.base_range;
-  hi.head<2>() = start.head<2>().array() + params.base_range;
-  // The target may lie farther than base_range: let the base reach it.
-  lo.head<2>() = lo.head<2>().cwiseMin(task.position.head<2>() - Eigen::Vector2d::Constant(params.base_range));
-  hi.head<2>() = hi.head<2>().cwiseMax(task.position.head<2>() + Eigen::Vector2d::Constant(params.base_range));
+  // The base may go anywhere within base_range of the start or of the camera target.
+  lo.head<2>() = start.head<2>().cwiseMin(task.position.head<2>()).array() - params.base_range;
+  hi.head<2>() = start.head<2>().cwiseMax(task.position.head<2>()).array() + params.base_range;
   lo[2] = start[2] - 2.0 * M_PI;
   hi[2] = start[2] + 2.0 * M_PI;
-  TaskSolver solver(model, params, model.camera_frame(tool), q_start_full, lo, hi);
+  const double yaw_hint = start[2];
+
+  PostureProblem problem(model, params, tool, q_start_full, task, checker.distance_field());
+  const std::string camera = model.camera_frame(tool);
+  kinematics::Data data = model.kinematics().make_data();
   std::mt19937_64 rng(seed);
-  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+
+  // The best of a few random arm postures (base placed for each): the one with the smallest
+  // residual (camera height and axis elevation, torques, clearances) seeds the solver.
+  Eigen::VectorXd r;
+  auto random_seed = [&] {
+    Eigen::VectorXd best;
+    double best_score = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < params.nspg_screen; ++k) {
+      Eigen::VectorXd arm(n - 3);
+      for (int i = 0; i < n - 3; ++i) arm[i] = lo[i + 3] + (hi[i + 3] - lo[i + 3]) * unit(rng);
+      const Eigen::VectorXd q = problem.place(arm, yaw_hint);
+      problem.evaluate(q, r);
+      const double score = r.squaredNorm();
+      if (score < best_score) {
+        best_score = score;
+        best = q;
+      }
+    }
+    return best;
+  };
 
   PostureResult out;
   std::map<std::string, int> rejections;
-  auto cost_of = [&](const Eigen::VectorXd& q) {
-    Eigen::VectorXd d = q - start;
-    return params.nspg_distance_weight * d.norm() + params.nspg_singularity_weight / (solver.manipulability(q) + 1e-3);
+  auto reject = [&](const std::string& key, const std::string& detail) {
+    if (rejections[key]++ == 0 && out.reason.empty()) out.reason = key + (detail.empty() ? "" : ": " + detail);
   };
-  auto reject = [&](const Validity& v) {
-    const std::string key = to_string(v.constraint);
-    if (rejections[key]++ == 0 && out.reason.empty()) out.reason = key + ": " + v.detail;
-  };
-  std::vector<Eigen::VectorXd> on_task;  // converged postures
   int valid_found = 0;
-  // Infeasible postures are ranked (collision worse than torque excess) so the null-space
-  // walks climb from the least infeasible one.
-  Eigen::VectorXd best_invalid;
-  double best_invalid_score = std::numeric_limits<double>::infinity();
-  auto score = [&](const Eigen::VectorXd& full, const Validity& v) {
-    if (v.constraint != Constraint::kTorqueLimit) return 10.0;
-    double excess = 0.0;
-    const auto& idx = model.planned_indices();
-    for (const std::string& frame : {tool.frame, std::string()}) {
-      const Eigen::VectorXd tau = checker.required_torques(full, frame);
-      for (std::size_t i = 3; i < idx.size(); ++i) {
-        const double lim = params.torque_margin * model.torque_limits()[idx[i]];
-        if (lim > 0.0) excess = std::max(excess, std::abs(tau[idx[i]]) / lim - 1.0);
-      }
+  int on_task = 0;
+  for (int k = 0; k < params.nspg_seeds && valid_found < params.nspg_enough && !out_of_time(); ++k) {
+    // Seeds: the start posture with the base placed for it, the start posture as it is, then
+    // random arm postures with the base placed for them.
+    Eigen::VectorXd q = k == 0 ? problem.place(start.tail(n - 3), yaw_hint) : k == 1 ? start : random_seed();
+    // Continuation on the drilling force: a posture that holds the arm up is found first, then
+    // moved along the task's null space as the force grows (the torque rows change smoothly).
+    for (const double scale : {0.0, 0.5, 1.0}) {
+      problem.set_force_scale(scale);
+      solve(problem, q, lo, hi, params.nspg_iterations, params.nspg_tolerance, r);
+      if (r.head<6>().norm() >= kTaskWeight * params.nspg_tolerance) break;
     }
-    return excess;
-  };
-  // A posture on the task: lower its torques in the null space, then it must hold both while
-  // approaching (gravity only) and while drilling (gravity + contact force on the tool).
-  auto consider = [&](Eigen::VectorXd q) {
     out.candidates += 1;
-    auto validity = [&](const Eigen::VectorXd& full) {
-      Validity v = checker.check(full, tool.frame);
-      return v.valid() ? checker.check(full) : v;
-    };
-    Validity v = validity(model.to_full(q, q_start_full));
-    if (v.constraint == Constraint::kTorqueLimit) {
-      // Only torque-limited postures are worth the (costly) null-space torque descent.
-      solver.relieve_torques(q, task, checker, tool.frame, params.nspg_torque_iterations);
-      v = validity(model.to_full(q, q_start_full));
-    }
-    on_task.push_back(q);
-    const Eigen::VectorXd full = model.to_full(q, q_start_full);
-    if (!v.valid()) {
-      reject(v);
-      const double sc = score(full, v);
-      if (sc < best_invalid_score) {
-        best_invalid_score = sc;
-        best_invalid = q;
+    if (r.head<6>().norm() >= kTaskWeight * params.nspg_tolerance) {
+      // Off the task: name the inequality that held it off, if any.
+      Eigen::Index row = 0;
+      if (r.tail(r.size() - 6).maxCoeff(&row) > 0.0) {
+        switch (problem.term_of_row(static_cast<int>(row) + 6)) {
+          case Term::kTorque: reject(to_string(Constraint::kTorqueLimit), "torques kept the camera off the task"); break;
+          case Term::kSurface: reject(to_string(Constraint::kEnvironmentCollision), "the drilled surface kept the camera off the task"); break;
+          case Term::kFloor: reject(to_string(Constraint::kFloor), "the floor kept the camera off the task"); break;
+          case Term::kSelf: reject(to_string(Constraint::kSelfCollision), "the robot's own links kept the camera off the task"); break;
+          case Term::kObstacle: reject(to_string(Constraint::kEnvironmentCollision), "obstacles kept the camera off the task"); break;
+          case Term::kTask: break;
+        }
+      } else {
+        reject("off the task", "");
       }
-      return;
+      continue;
+    }
+    on_task += 1;
+    const Eigen::VectorXd full = model.to_full(q, q_start_full);
+    // It must hold both while drilling (contact force on the tool) and while approaching.
+    Validity v = checker.check(full, tool.frame);
+    if (v.valid()) v = checker.check(full);
+    if (!v.valid()) {
+      reject(to_string(v.constraint), v.detail);
+      continue;
     }
     valid_found += 1;
-    const double c = cost_of(q);
-    if (!out.found || c < out.cost) {
+    const double cost = params.nspg_distance_weight * (q - start).norm() +
+                        params.nspg_singularity_weight / (manipulability(model, data, full, camera) + 1e-3);
+    if (!out.found || cost < out.cost) {
       out.found = true;
-      out.cost = c;
+      out.cost = cost;
       out.q = q;
     }
-  };
-
-  // Seeds from sampled arm postures: keep those whose camera axis and height already match
-  // the task, place the base analytically (yaw aligns the axis, x/y the position) and rank
-  // them by torque utilisation (with and without the contact force). Forward kinematics is
-  // cheap, so thousands of arm postures cost a few milliseconds.
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const std::string camera = model.camera_frame(tool);
-  auto screen = [&](int count) {
-    std::vector<std::pair<double, Eigen::VectorXd>> ranked;
-    const auto& idx = model.planned_indices();
-    Eigen::VectorXd full = q_start_full;
-    for (int k = 0; k < count; ++k) {
-      Eigen::VectorXd q = start;
-      q.head<3>().setZero();
-      for (int i = 3; i < n; ++i) q[i] = lo[i] + (hi[i] - lo[i]) * unit(rng);
-      full = model.to_full(q, q_start_full);
-      const Eigen::Isometry3d cam = model.link_pose(full, camera);
-      const Eigen::Vector3d a = cam.linear().col(2);
-      if (std::abs(a.z() - task.axis.z()) > 0.25 || std::abs(cam.translation().z() - task.position.z()) > 0.25) continue;
-      if (a.head<2>().norm() < 1e-3 || task.axis.head<2>().norm() < 1e-3) continue;
-      const double yaw = std::atan2(task.axis.y(), task.axis.x()) - std::atan2(a.y(), a.x());
-      const Eigen::Rotation2Dd rot(yaw);
-      q[2] = start[2] + std::remainder(yaw - start[2], 2.0 * M_PI);
-      q.head<2>() = task.position.head<2>() - rot * cam.translation().head<2>();
-      full = model.to_full(q, q_start_full);
-      double worst = 0.0;
-      for (const std::string& frame : {tool.frame, std::string()}) {
-        const Eigen::VectorXd tau = checker.required_torques(full, frame);
-        for (std::size_t i = 3; i < idx.size(); ++i) {
-          const double lim = model.torque_limits()[idx[i]];
-          if (lim > 0.0) worst = std::max(worst, std::abs(tau[idx[i]]) / lim);
-        }
-      }
-      if (worst >= 1.5) continue;
-      const Constraint c = checker.check(full).constraint;
-      if (c == Constraint::kNone || c == Constraint::kTorqueLimit) ranked.emplace_back(worst, q);
-    }
-    std::sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-    return ranked;
-  };
-  const auto t0 = std::chrono::steady_clock::now();
-  const auto out_of_time = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > params.nspg_time;
-  };
-  // In two rounds: a small screening first (easy goals end here, fast), the rest only when
-  // it found nothing valid.
-  for (const int round : {0, 1}) {
-    if (valid_found > 0 || out_of_time()) break;
-    const int count = round == 0 ? params.nspg_arm_samples / 8 : params.nspg_arm_samples - params.nspg_arm_samples / 8;
-    const int tries = round == 0 ? std::max(1, params.nspg_ranked_seeds / 8) : params.nspg_ranked_seeds;
-    const auto ranked = screen(count);
-    for (std::size_t i = 0; i < ranked.size() && i < static_cast<std::size_t>(tries); ++i) {
-      Eigen::VectorXd s = ranked[i].second;
-      if (solver.converge(s, task, 60)) consider(s);
-      if (valid_found >= params.nspg_enough || out_of_time()) break;
-    }
   }
-
-  // Seeds: the start posture; then the base facing the area with the arm mount at a few
-  // stand-offs from the camera target, with the start arm and random arm postures.
-  std::vector<Eigen::VectorXd> seeds{start};
-  const Eigen::Vector2d n_xy = -task.axis.head<2>();
-  if (n_xy.norm() > 1e-6) {
-    const Eigen::Vector2d nrm = n_xy.normalized();
-    const int first_arm = model.planned_indices()[3];
-    Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.full_dof());
-    const double mount = model.link_pose(zero, model.kinematics().joint_parent_link(first_arm)).translation().x();
-    const double yaw = std::atan2(-nrm.y(), -nrm.x());
-    // Facing the wall, and sideways: then the shoulder pitch axis lies along the normal and
-    // the drilling force loads it least (its moment about a joint axis parallel to it is 0).
-    for (int arm = 0; arm < params.nspg_arm_seeds; ++arm) {
-      for (const double turn : {0.0, M_PI / 2, -M_PI / 2}) {
-      for (double standoff : {0.7, 0.45, 0.95}) {
-        Eigen::VectorXd s = start;
-        const Eigen::Vector2d side(-nrm.y(), nrm.x());
-        s.head<2>() = task.position.head<2>() + nrm * (standoff + (turn == 0.0 ? mount : 0.0)) + (turn == 0.0 ? 0.0 : (turn > 0 ? -mount : mount)) * side;
-        s[2] = start[2] + std::remainder(yaw + turn - start[2], 2.0 * M_PI);
-        if (arm > 0) {
-          for (int i = 3; i < n; ++i) s[i] = lo[i] + (hi[i] - lo[i]) * (0.2 + 0.6 * unit(rng));
-        }
-        seeds.push_back(s);
-      }
-      }
-    }
-  }
-  for (Eigen::VectorXd s : seeds) {
-    if (valid_found >= params.nspg_enough || out_of_time()) break;
-    if (solver.converge(s, task, 60)) consider(s);
-    if (valid_found >= params.nspg_enough || out_of_time()) break;
-  }
-  for (int k = 0; k < params.nspg_samples && !on_task.empty() && valid_found < params.nspg_enough && !out_of_time(); ++k) {
-    // Walk from the best valid posture, else climb from the least infeasible one (and now and
-    // then from any posture on the task, to leave a local minimum).
-    Eigen::VectorXd q = out.found ? out.q : (k % 4 == 3 || best_invalid.size() == 0) ? on_task[rng() % on_task.size()] : best_invalid;
-    Eigen::VectorXd r(n);
-    for (int i = 0; i < n; ++i) r[i] = gauss(rng);
-    Eigen::VectorXd step = solver.null_step(q, task, r);
-    const double big = step.cwiseAbs().maxCoeff();
-    if (big < 1e-9) continue;
-    step *= params.nspg_step * std::uniform_real_distribution<double>(0.2, 1.0)(rng) / big;
-    q = (q + step).cwiseMax(lo).cwiseMin(hi);
-    if (solver.converge(q, task, 30)) consider(q);
-  }
-  if (!rejections.empty()) {
+  if (out.found) {
+    out.reason.clear();
+  } else if (on_task == 0 && rejections.size() == 1 && rejections.count("off the task") > 0) {
+    out.reason = "camera frame cannot reach the task pose (kinematically unreachable)";
+  } else {
     std::string counts;
     for (const auto& [what, count] : rejections) counts += (counts.empty() ? "" : ", ") + what + " x" + std::to_string(count);
     out.reason = "rejected: " + counts + "; first: " + out.reason;
   }
-  if (on_task.empty()) out.reason = "camera frame cannot reach the task pose (kinematically unreachable)";
-  if (out.found) out.reason.clear();
   return out;
 }
 

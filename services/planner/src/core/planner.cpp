@@ -61,6 +61,8 @@ void Planner::set_model(const ModelDescription& description) {
 }
 
 void Planner::set_environment(Environment environment) {
+  // The posture solver's distance field is part of the map update, not of each plan.
+  (void)environment.distance_field();
   std::lock_guard lock(mutex_);
   environment_ = std::move(environment);
 }

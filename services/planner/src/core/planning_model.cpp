@@ -153,6 +153,10 @@ std::shared_ptr<const PlanningModel> PlanningModel::build(const ModelDescription
       node.leg = node.leg || m->links_[static_cast<std::size_t>(parent)].leg;
     }
     node.rigid_group = group;
+    if (link->inertial) {
+      node.mass = link->inertial->mass;
+      node.com = to_eigen(link->inertial->origin).translation();
+    }
     for (const urdf::CollisionSharedPtr& c : link->collision_array) {
       if (!c || !c->geometry) continue;
       LinkShape s;
@@ -263,6 +267,43 @@ void PlanningModel::link_poses(const Eigen::VectorXd& q, std::vector<Eigen::Isom
       }
     }
     poses[i] = t;
+  }
+}
+
+void PlanningModel::static_torques(const std::vector<Eigen::Isometry3d>& poses, int contact_link, const Eigen::Vector3d& force,
+                                   Eigen::VectorXd& tau) const {
+  // Subtree mass and first moment (sum m c) per link, leaves first (links_ is parents first).
+  thread_local std::vector<double> mass;
+  thread_local std::vector<Eigen::Vector3d> moment;
+  const std::size_t nl = links_.size();
+  mass.resize(nl);
+  moment.resize(nl);
+  for (std::size_t i = 0; i < nl; ++i) {
+    mass[i] = links_[i].mass;
+    moment[i] = links_[i].mass * (poses[i] * links_[i].com);
+  }
+  for (std::size_t i = nl; i-- > 1;) {
+    const auto p = static_cast<std::size_t>(links_[i].parent);
+    mass[p] += mass[i];
+    moment[p] += moment[i];
+  }
+  tau.setZero(kinematics_.dof());
+  for (std::size_t i = 0; i < nl; ++i) {
+    const LinkNode& l = links_[i];
+    if (l.full_index < 0) continue;
+    const Eigen::Vector3d a = poses[i].linear() * l.axis;
+    // Gravity m g acts at the subtree's centre of mass c: moment about the joint (c - p) x m g.
+    tau[l.full_index] = l.prismatic ? -a.dot(mass[i] * gravity_)
+                                    : -a.dot((moment[i] - mass[i] * poses[i].translation()).cross(gravity_));
+  }
+  if (contact_link < 0) return;
+  const Eigen::Vector3d at = poses[static_cast<std::size_t>(contact_link)].translation();
+  for (int i = contact_link; i >= 0; i = links_[static_cast<std::size_t>(i)].parent) {
+    const LinkNode& l = links_[static_cast<std::size_t>(i)];
+    if (l.full_index < 0) continue;
+    const Eigen::Isometry3d& t = poses[static_cast<std::size_t>(i)];
+    const Eigen::Vector3d a = t.linear() * l.axis;
+    tau[l.full_index] -= l.prismatic ? a.dot(force) : a.dot((at - t.translation()).cross(force));
   }
 }
 

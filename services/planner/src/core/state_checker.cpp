@@ -23,6 +23,7 @@ std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const LinkShape& s, doubl
 
 struct ShapeObject {
   int link = -1;
+  double bounding_radius = 0.0;  // about the shape origin [m]
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
   std::unique_ptr<fcl::CollisionObjectd> exact;
   std::unique_ptr<fcl::CollisionObjectd> padded;
@@ -38,17 +39,22 @@ struct StateChecker::Impl {
   fcl::AABBd octree_box;
   bool octree_empty = true;
   std::vector<Eigen::Isometry3d> poses;
+  Eigen::VectorXd tau;
+  std::shared_ptr<const DistanceField> field;
 };
 
 StateChecker::StateChecker(std::shared_ptr<const PlanningModel> model, const Environment& environment, const Params& params,
                            double padding)
-    : model_(std::move(model)), params_(params), impl_(new Impl{model_->kinematics().make_data(), {}, {}, nullptr, {}, true, {}}) {
+    : model_(std::move(model)), environment_(environment), params_(params), impl_(new Impl{model_->kinematics().make_data(), {}, {}, nullptr, {}, true, {}, {}, nullptr}), padding_(padding) {
   const auto& links = model_->links();
   for (std::size_t l = 0; l < links.size(); ++l) {
     for (const LinkShape& s : links[l].shapes) {
       ShapeObject o;
       o.link = static_cast<int>(l);
       o.origin = s.origin;
+      o.bounding_radius = s.type == LinkShape::Type::kBox        ? 0.5 * s.size.norm()
+                          : s.type == LinkShape::Type::kCylinder ? std::hypot(s.size.x(), 0.5 * s.size.z())
+                                                                 : s.size.x();
       o.exact = std::make_unique<fcl::CollisionObjectd>(make_geometry(s, 0.0));
       o.padded = std::make_unique<fcl::CollisionObjectd>(make_geometry(s, padding));
       impl_->shapes.push_back(std::move(o));
@@ -68,22 +74,29 @@ StateChecker::StateChecker(std::shared_ptr<const PlanningModel> model, const Env
     impl_->octree->computeAABB();
     impl_->octree_box = impl_->octree->getAABB();
     impl_->octree_empty = false;
+    impl_->field = environment.distance_field();
   }
 }
 
 StateChecker::~StateChecker() = default;
 
 Eigen::VectorXd StateChecker::required_torques(const Eigen::VectorXd& q, const std::string& contact_frame) {
-  const kinematics::Model& k = model_->kinematics();
-  Eigen::VectorXd tau = k.gravity_torques(impl_->data, q);
-  if (!contact_frame.empty() && params_.contact_force != 0.0) {
-    // The surface pushes back on the tool along -z of the contact frame: tau = g - J^T f.
-    const Eigen::Isometry3d frame = k.frame_pose(impl_->data, q, contact_frame);
-    const Eigen::MatrixXd jac = k.frame_jacobian(impl_->data, q, contact_frame);
-    const Eigen::Vector3d force = -params_.contact_force * frame.linear().col(2);
-    tau -= jac.topRows<3>().transpose() * force;
-  }
+  model_->link_poses(q, impl_->poses);
+  Eigen::VectorXd tau;
+  torques_at_poses(contact_frame, tau);
   return tau;
+}
+
+void StateChecker::torques_at_poses(const std::string& contact_frame, Eigen::VectorXd& tau) {
+  int link = -1;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  if (!contact_frame.empty() && params_.contact_force != 0.0) {
+    link = model_->link_index(contact_frame);
+    if (link < 0) throw PlannerError("no contact frame '" + contact_frame + "' in model version " + std::to_string(model_->version()));
+    // The surface pushes back on the tool along -z of the contact frame.
+    force = -params_.contact_force * impl_->poses[static_cast<std::size_t>(link)].linear().col(2);
+  }
+  model_->static_torques(impl_->poses, link, force, tau);
 }
 
 Validity StateChecker::check(const Eigen::VectorXd& q, const std::string& contact_frame) {
@@ -99,7 +112,9 @@ Validity StateChecker::check(const Eigen::VectorXd& q, const std::string& contac
       return {Constraint::kJointLimit, s.str()};
     }
   }
-  const Eigen::VectorXd tau = required_torques(q, contact_frame);
+  m.link_poses(q, impl_->poses);
+  Eigen::VectorXd& tau = impl_->tau;
+  torques_at_poses(contact_frame, tau);
   const Eigen::VectorXd& limit = m.torque_limits();
   for (std::size_t i = 3; i < planned.size(); ++i) {
     const int fi = planned[i];
@@ -111,7 +126,6 @@ Validity StateChecker::check(const Eigen::VectorXd& q, const std::string& contac
     }
   }
 
-  m.link_poses(q, impl_->poses);
   const auto& links = m.links();
   for (ShapeObject& o : impl_->shapes) {
     const fcl::Transform3d t(impl_->poses[static_cast<std::size_t>(o.link)] * o.origin);
@@ -132,8 +146,14 @@ Validity StateChecker::check(const Eigen::VectorXd& q, const std::string& contac
   }
   if (!impl_->octree_empty) {
     fcl::CollisionRequestd request;
+    const DistanceField& field = *impl_->field;
+    // The distance field is a lower bound of the distance to the occupied voxels up to its
+    // interpolation error (one cell diagonal): shapes clear of it by more skip FCL's octree
+    // traversal, which is most of the cost of a check.
+    const double field_error = std::sqrt(3.0) * field.resolution();
     for (const ShapeObject& o : impl_->shapes) {
       if (!o.padded->getAABB().overlap(impl_->octree_box)) continue;
+      if (field.distance(o.padded->getTranslation()) - field_error > o.bounding_radius + padding_) continue;
       fcl::CollisionResultd result;
       fcl::collide(o.padded.get(), impl_->octree.get(), request, result);
       if (result.isCollision()) {
