@@ -75,6 +75,7 @@ struct Params {
   double planning_time = 2.0;        ///< per goal, NSPG included [s]
   double check_resolution = 0.02;    ///< largest step between checked states [rad or m]
   int simplify_iterations = 50;      ///< shortcutting attempts after RRT-Connect
+  int sample_iterations = 4;         ///< Gauss-Newton steps pulling every other RRT sample toward feasibility (0: uniform)
   uint64_t seed = 1;                 ///< random seed of NSPG and OMPL
 
   // NSPG.

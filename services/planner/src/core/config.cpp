@@ -72,6 +72,7 @@ Params parse_params(const std::string& yaml, const std::string& source) {
   };
   const std::map<std::string, int*> integers = {
       {"simplify_iterations", &p.simplify_iterations},
+      {"sample_iterations", &p.sample_iterations},
       {"nspg_seeds", &p.nspg_seeds},
       {"nspg_screen", &p.nspg_screen},
       {"nspg_iterations", &p.nspg_iterations},

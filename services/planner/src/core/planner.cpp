@@ -8,11 +8,13 @@
 #include <ompl/util/RandomNumbers.h>
 
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <mutex>
 #include <sstream>
 
 #include "planner/trajectory.hpp"
+#include "posture_problem.hpp"
 
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
@@ -22,14 +24,41 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Largest joint change [rad or m] between the states of a projected straight line.
+constexpr double kLineStep = 0.15;
+
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// OMPL's uniform sampler with a per-plan seed, so plans are reproducible.
+// OMPL's uniform sampler with a per-plan seed, so plans are reproducible. Every other sample
+// is pulled toward the feasible set by a few Gauss-Newton steps on the posture problem's
+// inequality rows (gravity torque, self collision, floor, map obstacles): with a long arm the
+// torque-feasible states are a thin subset of the joint box, and uniform samples alone
+// rarely land in it, so RRT-Connect's trees stop growing (morphology B).
 class SeededSampler : public ob::RealVectorStateSampler {
  public:
-  SeededSampler(const ob::StateSpace* space, uint64_t seed) : ob::RealVectorStateSampler(space) {
+  SeededSampler(const ob::StateSpace* space, uint64_t seed, detail::PostureProblem* feasible, int iterations, const bool* active)
+      : ob::RealVectorStateSampler(space), feasible_(feasible), iterations_(iterations), active_(active) {
     rng_.setLocalSeed(static_cast<std::uint_fast32_t>(seed));
+    const auto& bounds = space->as<ob::RealVectorStateSpace>()->getBounds();
+    lo_ = Eigen::Map<const Eigen::VectorXd>(bounds.low.data(), static_cast<Eigen::Index>(bounds.low.size()));
+    hi_ = Eigen::Map<const Eigen::VectorXd>(bounds.high.data(), static_cast<Eigen::Index>(bounds.high.size()));
   }
+  void sampleUniform(ob::State* state) override {
+    ob::RealVectorStateSampler::sampleUniform(state);
+    if (feasible_ == nullptr || !*active_ || (count_++ % 2) == 0) return;
+    auto* v = state->as<ob::RealVectorStateSpace::StateType>();
+    Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(v->values, lo_.size());
+    Eigen::VectorXd r;
+    detail::solve(*feasible_, q, lo_, hi_, iterations_, 1.0, r);
+    for (Eigen::Index i = 0; i < q.size(); ++i) v->values[i] = q[i];
+  }
+
+ private:
+  detail::PostureProblem* feasible_;
+  int iterations_;
+  const bool* active_;  // off during OMPL's set-up (its sanity checks draw many samples)
+  Eigen::VectorXd lo_, hi_;
+  unsigned long count_ = 0;
 };
 
 Eigen::VectorXd to_eigen(const ob::State* s, int n) {
@@ -108,7 +137,14 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
     }
   }
   space->setBounds(bounds);
-  space->setStateSamplerAllocator([seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed); });
+  // Inequalities only: no task, gravity alone (no drilling force while moving).
+  detail::PostureProblem feasible(model, params_, nullptr, q_start_full, std::nullopt, checker.distance_field());
+  feasible.set_force_scale(0.0);
+  const int iterations = params_.sample_iterations;
+  bool planning = false;
+  space->setStateSamplerAllocator([seed, &feasible, iterations, &planning](const ob::StateSpace* s) {
+    return std::make_shared<SeededSampler>(s, seed, iterations > 0 ? &feasible : nullptr, iterations, &planning);
+  });
   auto si = std::make_shared<ob::SpaceInformation>(space);
   Validity last_rejection;
   si->setStateValidityChecker([&](const ob::State* s) {
@@ -118,6 +154,7 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   });
   si->setStateValidityCheckingResolution(params_.check_resolution / space->getMaximumExtent());
   si->setup();
+  planning = true;
 
   ob::ScopedState<> start(space);
   ob::ScopedState<> goal(space);
@@ -131,8 +168,62 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   }
 
   std::vector<Eigen::VectorXd> waypoints;
+  // A straight line whose intermediate states are pulled into the feasible set (each from
+  // its point on the line, by the inequality rows): for a long arm the straight joint-space
+  // line usually swings the arm out past its torque limits, and a slight fold on the way is
+  // all it needs. Cheap compared with RRT-Connect, so it is tried first.
+  auto projected_line = [&]() -> std::vector<Eigen::VectorXd> {
+    if (params_.sample_iterations <= 0) return {};
+    Eigen::VectorXd residual;
+    Eigen::VectorXd lo(n), hi(n);
+    for (int i = 0; i < n; ++i) {
+      lo[i] = bounds.low[static_cast<std::size_t>(i)];
+      hi[i] = bounds.high[static_cast<std::size_t>(i)];
+    }
+    ob::ScopedState<> a(space), b(space);
+    auto motion_ok = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
+      from_eigen(x, a.get());
+      from_eigen(y, b.get());
+      return si->checkMotion(a.get(), b.get());
+    };
+    std::vector<Eigen::VectorXd> line{q_start};
+    // Appends a feasible chain from line.back() to `to`: the direct motion, else a projected
+    // midpoint and the two halves (bounded depth).
+    std::function<bool(const Eigen::VectorXd&, int)> reach = [&](const Eigen::VectorXd& to, int depth) {
+      if (motion_ok(line.back(), to)) {
+        line.push_back(to);
+        return true;
+      }
+      if (depth == 0) return false;
+      Eigen::VectorXd mid = 0.5 * (line.back() + to);
+      detail::solve(feasible, mid, lo, hi, 3 * params_.sample_iterations, 1.0, residual);
+      return reach(mid, depth - 1) && reach(to, depth - 1);
+    };
+    const Eigen::VectorXd delta = q_goal - q_start;
+    const int segments = std::max(2, static_cast<int>(std::ceil(delta.cwiseAbs().maxCoeff() / kLineStep)));
+    for (int k = 1; k <= segments; ++k) {
+      // From the previous state moved by one step of the line, so a fold made on the way is
+      // kept; the last segments steer back onto the goal.
+      const double left = static_cast<double>(segments - k + 1);
+      Eigen::VectorXd q = k == segments ? q_goal : Eigen::VectorXd(line.back() + (q_goal - line.back()) / left);
+      if (k < segments) detail::solve(feasible, q, lo, hi, 3 * params_.sample_iterations, 1.0, residual);
+      if (!reach(q, 3)) return {};
+    }
+    return line;
+  };
   if (si->checkMotion(start.get(), goal.get())) {
     waypoints = {q_start, q_goal};
+  } else if (auto line = projected_line(); !line.empty()) {
+    og::PathGeometric path(si);
+    for (const Eigen::VectorXd& q : line) {
+      ob::ScopedState<> st(space);
+      from_eigen(q, st.get());
+      path.append(st.get());
+    }
+    og::PathSimplifier simplifier(si);
+    simplifier.shortcutPath(path, static_cast<unsigned>(params_.simplify_iterations), static_cast<unsigned>(params_.simplify_iterations));
+    simplifier.reduceVertices(path, static_cast<unsigned>(params_.simplify_iterations));
+    for (std::size_t i = 0; i < path.getStateCount(); ++i) waypoints.push_back(to_eigen(path.getState(static_cast<unsigned>(i)), n));
   } else {
     auto pdef = std::make_shared<ob::ProblemDefinition>(si);
     pdef->setStartAndGoalStates(start, goal);
