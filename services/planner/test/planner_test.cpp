@@ -227,3 +227,27 @@ TEST(Planner, ObstacleFromAPointCloudIsAvoided) {
   recheck(*model, env, params, r.goals[0], start, area);
   EXPECT_THROW(env.insert_point_cloud({Eigen::Vector3d(0, 0, std::nan(""))}, Eigen::Vector3d::Zero()), PlannerError);
 }
+
+TEST(Planner, WarmUpFillsThePostureMemoryAndPlansStayValid) {
+  Params params;
+  params.seed = 23;
+  Planner planner(params);
+  planner.set_model(morphology('a', 9));
+  // Mid heights on a bare wall: every one has goal postures.
+  EXPECT_EQ(planner.warm_up(1.0, 1.4, 0.2, 3.0), 3);
+  // No model: nothing to warm up.
+  EXPECT_EQ(Planner(params).warm_up(1.0, 1.4, 0.2, 1.0), 0);
+  // Goals near the remembered heights plan (seeded from memory) and re-check densely.
+  const World world = site(2.2);
+  planner.set_environment(environment_of(world, params));
+  const auto model = planner.model();
+  const Eigen::VectorXd start = start_state(*model);
+  PlanRequest req{5, 9, "", {{fixtures::drilling_area(2.2, 0.2, 1.1)}, {fixtures::drilling_area(2.2, -0.3, 1.3)}}};
+  const PlanResult res = planner.plan(req, start);
+  ASSERT_EQ(res.status, Status::kSucceeded) << res.reason;
+  Eigen::VectorXd from = start;
+  for (std::size_t g = 0; g < res.goals.size(); ++g) {
+    EXPECT_GT(recheck(*model, environment_of(world, params), params, res.goals[g], from, req.goals[g].area), 10);
+    from = model->to_full(res.goals[g].trajectory.points.back().q, from);
+  }
+}

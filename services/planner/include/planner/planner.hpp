@@ -18,17 +18,20 @@ struct PostureResult {
   Eigen::VectorXd q;          ///< planned joints; valid when found
   double cost = 0.0;          ///< distance to start + singularity cost
   std::string reason;         ///< why nothing was found (most frequent rejection)
-  int candidates = 0;         ///< postures on the task manifold examined
+  int candidates = 0;         ///< seeds solved (each ends on the task or held off it)
+  std::vector<Eigen::VectorXd> valid;  ///< every valid posture found (q among them)
 };
 
-/// Null-Space Posture Generator: from `q_start_full`, converge the camera frame onto the task
-/// (camera at Params::camera_distance in front of `area` along its z axis, optical axis
-/// along -z of `area`) by weighted damped least squares, then random-walk in the task's null
-/// space; keep the valid posture (contact force on the tool checked) of least cost. Seeded
-/// by `seed`.
+/// Null-Space Posture Generator: the camera frame at Params::camera_distance in front of `area`
+/// along its z axis, optical axis along -z of `area`, found by solving the task with the
+/// inequalities (torque with the contact force, clearances) in its null space from the start
+/// posture and seeded random ones, until Params::nspg_time; keeps the valid posture of least
+/// cost. Seeded by `seed`.
+/// `hints`: arm postures (planned joints after the base) to seed after the start posture,
+/// best first (the planner passes postures that solved nearby areas before).
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
                                const EndEffectorSpec& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
-                               uint64_t seed);
+                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints = {});
 
 /// Task error of a full q against a drilling area: (position error [m], axis error [rad]).
 std::pair<double, double> task_error(const PlanningModel& model, const Params& params, const EndEffectorSpec& tool,
@@ -51,6 +54,13 @@ class Planner {
   [[nodiscard]] Environment environment() const;
   [[nodiscard]] const Params& params() const { return params_; }
 
+  /// Fills the posture memory of the current model: goal postures for drilling areas on a bare
+  /// wall (the model's first tool, camera axis horizontal) at heights `from`..`to` every `step`
+  /// [m], each searched for up to `seconds_per_height`. Later goals near those heights start
+  /// from them (the low, torque-bound areas otherwise cost the NSPG most of its budget). Stops
+  /// early if the model changes. Returns the number of heights solved.
+  int warm_up(double from, double to, double step, double seconds_per_height);
+
   /// Called after each goal is planned (FIFO), so its trajectory can be executed while the
   /// next goals are planned.
   using GoalCallback = std::function<void(const GoalResult&)>;
@@ -65,10 +75,20 @@ class Planner {
                        const Eigen::VectorXd& q_goal, double time_budget, uint64_t seed) const;
 
  private:
+  /// Arm postures that solved earlier goals of this model version, with their camera height
+  /// (seeds for later goals at similar heights; cleared with every new model).
+  struct Remembered {
+    double height = 0.0;
+    Eigen::VectorXd arm;
+  };
+  std::vector<Eigen::VectorXd> hints_for(const PlanningModel& model, double height) const;
+  void remember(const PlanningModel& model, double height, const Eigen::VectorXd& q);
+
   Params params_;
   mutable std::mutex mutex_;
   std::shared_ptr<const PlanningModel> model_;
   Environment environment_;
+  std::vector<Remembered> memory_;  // guarded by mutex_, for model_
 };
 
 }  // namespace concert::planner

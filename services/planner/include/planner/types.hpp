@@ -73,17 +73,19 @@ struct Params {
 
   // Planning.
   double planning_time = 2.0;        ///< per goal, NSPG included [s]
+  double path_attempt_time = 0.5;    ///< path search per goal posture before another posture is tried [s]
   double check_resolution = 0.02;    ///< largest step between checked states [rad or m]
   int simplify_iterations = 50;      ///< shortcutting attempts after RRT-Connect
   int sample_iterations = 4;         ///< Gauss-Newton steps pulling every other RRT sample toward feasibility (0: uniform)
   uint64_t seed = 1;                 ///< random seed of NSPG and OMPL
 
   // NSPG.
-  int nspg_seeds = 64;               ///< seeds tried per goal at most (start posture first)
+  int nspg_seeds = 256;              ///< seeds tried per goal at most (start posture first; nspg_time usually ends it first)
   int nspg_screen = 24;              ///< random arm postures drawn per random seed (closest kept)
   int nspg_iterations = 40;          ///< Levenberg-Marquardt iterations per seed
-  double nspg_time = 1.2;            ///< NSPG time budget per goal [s]
+  double nspg_time = 1.6;            ///< NSPG time budget per goal [s] (of planning_time)
   int nspg_enough = 1;               ///< stop after this many valid postures
+  int nspg_memory = 128;             ///< goal postures remembered per model version as seeds for similar heights (0: off)
   double nspg_tolerance = 1e-3;      ///< task error accepted [m, rad]
   double nspg_distance_weight = 1.0; ///< cost of the distance to the start [1/rad]
   double nspg_singularity_weight = 0.5;  ///< cost of 1/manipulability of the arm [-]

@@ -57,6 +57,7 @@ Params parse_params(const std::string& yaml, const std::string& source) {
       {"floor_clearance", &p.floor_clearance},
       {"base_range", &p.base_range},
       {"planning_time", &p.planning_time},
+      {"path_attempt_time", &p.path_attempt_time},
       {"check_resolution", &p.check_resolution},
       {"nspg_time", &p.nspg_time},
       {"nspg_tolerance", &p.nspg_tolerance},
@@ -77,6 +78,7 @@ Params parse_params(const std::string& yaml, const std::string& source) {
       {"nspg_screen", &p.nspg_screen},
       {"nspg_iterations", &p.nspg_iterations},
       {"nspg_enough", &p.nspg_enough},
+      {"nspg_memory", &p.nspg_memory},
   };
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();

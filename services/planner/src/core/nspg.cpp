@@ -1,20 +1,17 @@
 // Null-Space Posture Generator (Rossini et al. 2021, paper section 5.4.2).
 //
-// The goal posture is the solution of a small constrained problem over the planned joints
-// (base x, y, yaw + arm): the camera task (5-D: position, optical axis) as equalities, and as
-// inequalities the torque limits (gravity, and gravity + drilling force), clearance from the
-// drilled surface, from the floor and between the robot's own links. Each seed is driven onto
-// it by Levenberg-Marquardt on the residual vector [task; hinge(inequalities)]: the task rows
-// pull it onto the task manifold while the hinge rows move it along that manifold (its null
-// space) out of infeasibility, which is what the NSPG's null-space descent does, but on every
-// constraint at once. A seed ends on a posture that the exact checker (FCL, OctoMap, KDL
-// torques) then judges; the smooth terms only approximate it (spheres for self collision, the
-// surface plane for the wall), so the checker has the last word.
+// The goal posture solves the posture problem of posture_problem.hpp: the camera task as the
+// first priority, and within the task's null space the inequalities (torque limits with and
+// without the drilling force, clearance from the drilled surface, the floor, the robot's own
+// links and the map's obstacles). Seeds: the start posture with the base placed for it, the
+// start posture as it is, then random arm postures (the best of a few draws, base placed for
+// each). Every converged posture is judged by the exact StateChecker; the valid one of least
+// cost (distance to the start, inverse manipulability) is kept.
 //
-// Hand-written instead of a library solver (Ipopt is in Debian): the problem has 9-12
-// variables and the residuals are cheap, so a dense LM with a finite-difference Jacobian is a
-// few dozen lines and needs no problem adapter; an interior-point solver would need the same
-// residuals plus a sparsity structure and would not be faster at this size.
+// The solver is hand-written instead of a library's (Ipopt is in Debian): 9-12 variables and
+// a few hundred cheap residual rows, a dense two-priority Gauss-Newton step with a
+// finite-difference Jacobian is a few dozen lines, and an NLP solver would need the same
+// residuals plus derivatives and a problem adapter without being faster at this size.
 
 #include <Eigen/Dense>
 
@@ -59,7 +56,7 @@ std::pair<double, double> task_error(const PlanningModel& model, const Params& p
 
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
                                const EndEffectorSpec& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
-                               uint64_t seed) {
+                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto out_of_time = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > params.nspg_time;
@@ -110,16 +107,14 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   int valid_found = 0;
   int on_task = 0;
   for (int k = 0; k < params.nspg_seeds && valid_found < params.nspg_enough && !out_of_time(); ++k) {
-    // Seeds: the start posture with the base placed for it, the start posture as it is, then
-    // random arm postures with the base placed for them.
-    Eigen::VectorXd q = k == 0 ? problem.place(start.tail(n - 3), yaw_hint) : k == 1 ? start : random_seed();
-    // Continuation on the drilling force: a posture that holds the arm up is found first, then
-    // moved along the task's null space as the force grows (the torque rows change smoothly).
-    for (const double scale : {0.0, 0.5, 1.0}) {
-      problem.set_force_scale(scale);
-      solve(problem, q, lo, hi, params.nspg_iterations, params.nspg_tolerance, r);
-      if (r.head<6>().norm() >= kTaskWeight * params.nspg_tolerance) break;
-    }
+    // Seeds: the start posture with the base placed for it, the start posture as it is, the
+    // hints, then random arm postures; the base placed for each arm posture.
+    const auto hint = static_cast<std::size_t>(k - 2);
+    Eigen::VectorXd q = k == 0                 ? problem.place(start.tail(n - 3), yaw_hint)
+                        : k == 1               ? start
+                        : hint < hints.size() ? problem.place(hints[hint], yaw_hint)
+                                               : random_seed();
+    solve(problem, q, lo, hi, params.nspg_iterations, params.nspg_tolerance, r);
     out.candidates += 1;
     if (r.head<6>().norm() >= kTaskWeight * params.nspg_tolerance) {
       // Off the task: name the inequality that held it off, if any.
@@ -148,6 +143,7 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
       continue;
     }
     valid_found += 1;
+    out.valid.push_back(q);
     const double cost = params.nspg_distance_weight * (q - start).norm() +
                         params.nspg_singularity_weight / (manipulability(model, data, full, camera) + 1e-3);
     if (!out.found || cost < out.cost) {

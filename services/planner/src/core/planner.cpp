@@ -7,6 +7,7 @@
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <cmath>
@@ -23,6 +24,11 @@ namespace concert::planner {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Remembered postures whose camera height is within this of a new goal's seed it [m], at most
+// kHints of them (nearest first).
+constexpr double kHintHeight = 0.3;
+constexpr std::size_t kHints = 8;
 
 // Largest joint change [rad or m] between the states of a projected straight line.
 constexpr double kLineStep = 0.15;
@@ -87,6 +93,63 @@ void Planner::set_model(const ModelDescription& description) {
   auto model = PlanningModel::build(description, params_);
   std::lock_guard lock(mutex_);
   model_ = std::move(model);
+  memory_.clear();
+}
+
+int Planner::warm_up(double from, double to, double step, double seconds_per_height) {
+  const std::shared_ptr<const PlanningModel> model = this->model();
+  if (!model || !(step > 0.0)) return 0;
+  const EndEffectorSpec* tool = nullptr;
+  try {
+    tool = &model->tool("");
+  } catch (const PlannerError&) {
+    return 0;  // no tool with a camera: nothing to drill with
+  }
+  Params params = params_;
+  params.nspg_time = seconds_per_height;
+  params.nspg_enough = 3;  // a few postures per height: an obstacle may block one of them
+  const Environment empty(params.octomap_resolution);
+  StateChecker checker(model, empty, params, params.environment_padding);
+  const Eigen::VectorXd start = Eigen::VectorXd::Zero(model->full_dof());
+  int solved = 0;
+  int index = 0;
+  for (double z = from; z <= to + 1e-9; z += step, ++index) {
+    if (this->model() != model) break;  // a new model arrived
+    // A wall facing the robot 2 m ahead, the area at height z.
+    Eigen::Isometry3d area = Eigen::Isometry3d::Identity();
+    area.linear() << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // z along -x (the wall's outward normal)
+    area.translation() = Eigen::Vector3d(2.0, 0.0, z);
+    const double height = z;  // the camera stays at the area's height (horizontal axis)
+    const PostureResult p = generate_posture(*model, checker, params, *tool, start, area, params.seed + 31u * static_cast<uint64_t>(index),
+                                             hints_for(*model, height));
+    if (!p.found) continue;
+    for (const Eigen::VectorXd& q : p.valid) remember(*model, height, q);
+    solved += 1;
+  }
+  return solved;
+}
+
+std::vector<Eigen::VectorXd> Planner::hints_for(const PlanningModel& model, double height) const {
+  std::vector<std::pair<double, Eigen::VectorXd>> near;
+  {
+    std::lock_guard lock(mutex_);
+    if (model_.get() != &model) return {};
+    for (const Remembered& m : memory_) {
+      if (std::abs(m.height - height) <= kHintHeight) near.emplace_back(std::abs(m.height - height), m.arm);
+    }
+  }
+  std::sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Eigen::VectorXd> out;
+  for (std::size_t i = 0; i < near.size() && out.size() < kHints; ++i) out.push_back(near[i].second);
+  return out;
+}
+
+void Planner::remember(const PlanningModel& model, double height, const Eigen::VectorXd& q) {
+  if (params_.nspg_memory <= 0) return;
+  std::lock_guard lock(mutex_);
+  if (model_.get() != &model) return;
+  if (static_cast<int>(memory_.size()) >= params_.nspg_memory) memory_.erase(memory_.begin());
+  memory_.push_back({height, q.tail(q.size() - 3)});
 }
 
 void Planner::set_environment(Environment environment) {
@@ -300,19 +363,35 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   for (std::size_t g = 0; g < request.goals.size(); ++g) {
     const auto t0 = Clock::now();
     const uint64_t seed = params_.seed + 7919u * request.request_id + 104729u * g;
-    const PostureResult posture = generate_posture(*model, checker, params_, *tool, current, request.goals[g].area, seed);
+    // Goal posture, then a path to it; when no path is found within the attempt's share of
+    // the budget, another goal posture (a new NSPG seed) is tried while time remains: with a
+    // long arm some goal postures sit in torque-feasible pockets no path reaches.
     GoalResult r;
-    if (!posture.found) {
-      r.status = Status::kUnreachable;
-      r.reason = "goal " + std::to_string(g) + ": no feasible posture puts camera '" + model->camera_frame(*tool) + "' " +
-                 std::to_string(params_.camera_distance) + " m in front of the drilling area (" + std::to_string(posture.candidates) +
-                 " postures on the task examined; " + posture.reason + ")";
-    } else {
-      const double nspg = seconds_since(t0);
-      r = plan_path(*model, checker, current, posture.q, params_.planning_time - nspg, seed);
+    double nspg = 0.0;
+    for (int attempt = 0;; ++attempt) {
+      const auto t_posture = Clock::now();
+      Params attempt_params = params_;
+      attempt_params.nspg_time = std::min(params_.nspg_time, params_.planning_time - seconds_since(t0));
+      const double height = (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, params_.camera_distance)).z();
+      const PostureResult posture = generate_posture(*model, checker, attempt_params, *tool, current, request.goals[g].area,
+                                                     seed + 7777u * static_cast<uint64_t>(attempt),
+                                                     attempt == 0 ? hints_for(*model, height) : std::vector<Eigen::VectorXd>{});
+      nspg += seconds_since(t_posture);
+      if (!posture.found) {
+        if (attempt > 0) break;  // keep the previous attempt's "no path"
+        r.status = Status::kUnreachable;
+        r.reason = "no feasible posture puts camera '" + model->camera_frame(*tool) + "' " +
+                   std::to_string(params_.camera_distance) + " m in front of the drilling area (" + std::to_string(posture.candidates) +
+                   " seeds solved; " + posture.reason + ")";
+        break;
+      }
+      const double remaining = params_.planning_time - seconds_since(t0);
+      r = plan_path(*model, checker, current, posture.q, std::min(remaining, params_.path_attempt_time), seed);
       r.nspg_seconds = nspg;
-      if (r.status != Status::kSucceeded) r.reason = "goal " + std::to_string(g) + ": " + r.reason;
+      if (r.status == Status::kSucceeded) remember(*model, height, posture.q);
+      if (r.status != Status::kNoPath || params_.planning_time - seconds_since(t0) < 0.05) break;
     }
+    if (r.status != Status::kSucceeded) r.reason = "goal " + std::to_string(g) + ": " + r.reason;
     r.index = g;
     if (r.status == Status::kSucceeded) {
       current = model->to_full(r.trajectory.points.back().q, current);

@@ -228,7 +228,8 @@ class PostureProblem {
   }
 
   [[nodiscard]] int size() const { return size_; }
-  /// Fraction of the contact force in the torque rows (continuation from 0 to 1).
+  /// Fraction of the contact force in the "drilling" torque rows (0: both rows gravity only,
+  /// as for states on a path).
   void set_force_scale(double scale) { force_scale_ = scale; }
 
   // The planned q for arm joints `arm`: the base is placed where that arm posture reaches the
@@ -310,12 +311,16 @@ class PostureProblem {
         // depth, both ways (inscribed spheres alone leave gaps at flat faces and edges).
         for (const auto& [mine, other] : {std::pair{p.a, p.b}, std::pair{p.b, p.a}}) {
           const auto& shapes = model_.links()[static_cast<std::size_t>(other)].shapes;
+          const Eigen::Vector3d& other_centre = other == p.a ? ca : cb;
+          const double other_radius = bounds_[static_cast<std::size_t>(other)].radius + kSelfSlack;
           for (std::size_t k = 0; k < shapes.size(); ++k) {
             // World to shape frame, once per shape (rigid: R^T (x - t)).
             const Eigen::Isometry3d t = poses_[static_cast<std::size_t>(other)] * shapes[k].origin;
             const Eigen::Matrix3d rt = t.linear().transpose();
             for (const int i : mine == p.a ? p.spheres_a : p.spheres_b) {
               const double radius = spheres_[static_cast<std::size_t>(i)].second.radius;
+              const double reach_i = radius + other_radius;
+              if ((world_spheres_[static_cast<std::size_t>(i)] - other_centre).squaredNorm() > reach_i * reach_i) continue;
               const double d =
                   signed_distance(shapes[k], rt * (world_spheres_[static_cast<std::size_t>(i)] - t.translation())) - kSelfSlack;
               if (d < radius) sum += (radius - d) * (radius - d);
