@@ -58,8 +58,10 @@ class Planner {
   /// wall (the model's first tool, camera axis horizontal) at heights `from`..`to` every `step`
   /// [m], each searched for up to `seconds_per_height`. Later goals near those heights start
   /// from them (the low, torque-bound areas otherwise cost the NSPG most of its budget). Stops
-  /// early if the model changes. Returns the number of heights solved.
-  int warm_up(double from, double to, double step, double seconds_per_height);
+  /// early if the model changes or `keep_going` returns false. Returns the number of heights
+  /// solved.
+  int warm_up(double from, double to, double step, double seconds_per_height,
+              const std::function<bool()>& keep_going = [] { return true; });
 
   /// Called after each goal is planned (FIFO), so its trajectory can be executed while the
   /// next goals are planned.

@@ -85,6 +85,7 @@ struct Params {
   int nspg_iterations = 40;          ///< Levenberg-Marquardt iterations per seed
   double nspg_time = 1.6;            ///< NSPG time budget per goal [s] (of planning_time)
   int nspg_enough = 1;               ///< stop after this many valid postures
+  double warm_up_time = 2.0;         ///< service: per height of the background warm-up after each model [s] (0: none)
   int nspg_memory = 128;             ///< goal postures remembered per model version as seeds for similar heights (0: off)
   double nspg_tolerance = 1e-3;      ///< task error accepted [m, rad]
   double nspg_distance_weight = 1.0; ///< cost of the distance to the start [1/rad]

@@ -57,6 +57,7 @@ Params parse_params(const std::string& yaml, const std::string& source) {
       {"floor_clearance", &p.floor_clearance},
       {"base_range", &p.base_range},
       {"planning_time", &p.planning_time},
+      {"warm_up_time", &p.warm_up_time},
       {"path_attempt_time", &p.path_attempt_time},
       {"check_resolution", &p.check_resolution},
       {"nspg_time", &p.nspg_time},

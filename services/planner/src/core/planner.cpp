@@ -96,7 +96,7 @@ void Planner::set_model(const ModelDescription& description) {
   memory_.clear();
 }
 
-int Planner::warm_up(double from, double to, double step, double seconds_per_height) {
+int Planner::warm_up(double from, double to, double step, double seconds_per_height, const std::function<bool()>& keep_going) {
   const std::shared_ptr<const PlanningModel> model = this->model();
   if (!model || !(step > 0.0)) return 0;
   const EndEffectorSpec* tool = nullptr;
@@ -114,7 +114,7 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
   int solved = 0;
   int index = 0;
   for (double z = from; z <= to + 1e-9; z += step, ++index) {
-    if (this->model() != model) break;  // a new model arrived
+    if (this->model() != model || !keep_going()) break;  // a new model arrived, or shutdown
     // A wall facing the robot 2 m ahead, the area at height z.
     Eigen::Isometry3d area = Eigen::Isometry3d::Identity();
     area.linear() << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // z along -x (the wall's outward normal)

@@ -1,5 +1,8 @@
 #include "dds/planner_node.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -98,6 +101,7 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
       }) {
   if (planner_.model_version() == 0) status_.report(msg::SERVICE_STARTING, 0, "waiting for a robot model");
   executor_ = std::thread([this] { execute_loop(); });
+  if (planner_.params().warm_up_time > 0.0) warmer_ = std::thread([this] { warm_up_loop(); });
 }
 
 PlannerNode::~PlannerNode() {
@@ -107,6 +111,30 @@ PlannerNode::~PlannerNode() {
   }
   wake_.notify_all();
   executor_.join();
+  if (warmer_.joinable()) warmer_.join();
+}
+
+void PlannerNode::warm_up_loop() {
+  // Lowest CPU priority for this thread (Linux: per-thread nice): warming up must not take
+  // the core from planning, control or the other services.
+  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 19);
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_.wait(lock, [&] { return stopping_ || warm_version_ != 0; });
+    if (stopping_) return;
+    const uint64_t version = warm_version_;
+    warm_version_ = 0;
+    lock.unlock();
+    const auto t0 = std::chrono::steady_clock::now();
+    const int solved = planner_.warm_up(0.3, 2.9, 0.1, planner_.params().warm_up_time, [&] {
+      std::lock_guard guard(mutex_);
+      return !stopping_ && warm_version_ == 0;
+    });
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    log_ << "planner: model version " << version << ": posture memory warmed up at " << solved << " of 27 heights (0.3-2.9 m) in "
+         << seconds << " s" << std::endl;
+    lock.lock();
+  }
 }
 
 void PlannerNode::on_model(const msg::RobotModel& model) {
@@ -119,6 +147,11 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
     if (!m->ignored_shapes().empty()) note += "; " + std::to_string(m->ignored_shapes().size()) + " mesh collisions ignored";
     status_.report(msg::SERVICE_READY, model.version(), note);
     log_ << "planner: model version " << model.version() << ": " << note << std::endl;
+    {
+      std::lock_guard lock(mutex_);
+      warm_version_ = model.version();
+    }
+    wake_.notify_all();
   } catch (const std::exception& e) {
     const uint64_t kept = planner_.model_version();
     status_.report(kept == 0 ? msg::SERVICE_ERROR : msg::SERVICE_READY, static_cast<uint32_t>(kept),

@@ -57,6 +57,7 @@ class PlannerNode {
   void handle(const msg::PlanRequest& request);
   void publish(msg::PlanResult result);
   void execute_loop();
+  void warm_up_loop();
   bool execute(Execution& e);
 
   Planner& planner_;
@@ -69,6 +70,7 @@ class PlannerNode {
   std::optional<msg::JointState> joint_state_;
   std::optional<msg::Odometry> odometry_;
   bool stopping_ = false;
+  uint64_t warm_version_ = 0;  // model version the warm-up thread should prepare (0: none)
   concert::dds::Writer<msg::PlanResult> results_;
   concert::dds::Writer<msg::JointCommand> joint_commands_;
   concert::dds::Writer<msg::BaseVelocityCommand> base_commands_;
@@ -78,6 +80,7 @@ class PlannerNode {
   concert::dds::Reader<msg::Odometry> odometries_;
   concert::dds::Reader<msg::PlanRequest> request_reader_;
   std::thread executor_;
+  std::thread warmer_;
 };
 
 }  // namespace concert::planner::dds
