@@ -5,12 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace concert::planner::dds {
 namespace {
 
 int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 // Linear interpolation of a trajectory at time t [s] (samples are dense, 20 ms by default).
@@ -18,7 +21,8 @@ TrajectoryPoint sample_at(const Trajectory& t, double time) {
   const auto& p = t.points;
   if (time <= p.front().time) return p.front();
   if (time >= p.back().time) return p.back();
-  const auto it = std::upper_bound(p.begin(), p.end(), time, [](double v, const TrajectoryPoint& q) { return v < q.time; });
+  const auto it = std::upper_bound(p.begin(), p.end(), time,
+                                   [](double v, const TrajectoryPoint& q) { return v < q.time; });
   const TrajectoryPoint& b = *it;
   const TrajectoryPoint& a = *(it - 1);
   const double u = (time - a.time) / (b.time - a.time);
@@ -32,16 +36,19 @@ ModelDescription to_core(const msg::RobotModel& m) {
   d.version = m.version();
   d.urdf = m.urdf();
   d.srdf = m.srdf();
-  for (const msg::JointInfo& j : m.joints()) d.joints.push_back({j.name(), j.chain(), j.lower(), j.upper(), j.velocity(), j.effort()});
+  for (const msg::JointInfo& j : m.joints())
+    d.joints.push_back({j.name(), j.chain(), j.lower(), j.upper(), j.velocity(), j.effort()});
   for (const msg::ChainInfo& c : m.chains()) d.chains.push_back({c.name(), c.role(), c.joints()});
-  for (const msg::EndEffectorInfo& e : m.end_effectors()) d.end_effectors.push_back({e.name(), e.chain(), e.frame(), e.module_key()});
+  for (const msg::EndEffectorInfo& e : m.end_effectors())
+    d.end_effectors.push_back({e.name(), e.chain(), e.frame(), e.module_key()});
   return d;
 }
 
 Eigen::Isometry3d to_core(const msg::Pose& p) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.translation() = Eigen::Vector3d(p.position().x(), p.position().y(), p.position().z());
-  const Eigen::Quaterniond q(p.orientation().w(), p.orientation().x(), p.orientation().y(), p.orientation().z());
+  const Eigen::Quaterniond q(p.orientation().w(), p.orientation().x(), p.orientation().y(),
+                             p.orientation().z());
   // A zero quaternion stays zero so the planner rejects it (not a rigid transform).
   t.linear() = q.norm() > 1e-9 ? q.normalized().toRotationMatrix() : Eigen::Matrix3d::Zero();
   return t;
@@ -62,18 +69,26 @@ msg::Pose to_msg(const Eigen::Isometry3d& t) {
 
 msg::PlanFailure to_failure(Status s) {
   switch (s) {
-    case Status::kSucceeded: return msg::PLAN_OK;
-    case Status::kNoModel: return msg::PLAN_NO_MODEL;
-    case Status::kStaleModel: return msg::PLAN_STALE_MODEL;
-    case Status::kInvalidRequest: return msg::PLAN_INVALID_REQUEST;
-    case Status::kInvalidStart: return msg::PLAN_INVALID_START;
-    case Status::kUnreachable: return msg::PLAN_UNREACHABLE;
-    case Status::kNoPath: return msg::PLAN_NO_PATH;
+    case Status::kSucceeded:
+      return msg::PLAN_OK;
+    case Status::kNoModel:
+      return msg::PLAN_NO_MODEL;
+    case Status::kStaleModel:
+      return msg::PLAN_STALE_MODEL;
+    case Status::kInvalidRequest:
+      return msg::PLAN_INVALID_REQUEST;
+    case Status::kInvalidStart:
+      return msg::PLAN_INVALID_START;
+    case Status::kUnreachable:
+      return msg::PLAN_UNREACHABLE;
+    case Status::kNoPath:
+      return msg::PLAN_NO_PATH;
   }
   return msg::PLAN_NO_PATH;
 }
 
-PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planner, NodeOptions options, std::ostream& log)
+PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planner,
+                         NodeOptions options, std::ostream& log)
     : planner_(planner),
       options_(options),
       log_(log),
@@ -81,7 +96,8 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
       joint_commands_(participant, concert::dds::topics::joint_command),
       base_commands_(participant, concert::dds::topics::base_velocity),
       status_(participant, "planner"),
-      models_(participant, concert::dds::topics::robot_model, [this](const auto& s, const auto&) { on_model(s); }),
+      models_(participant, concert::dds::topics::robot_model,
+              [this](const auto& s, const auto&) { on_model(s); }),
       joint_states_(participant, concert::dds::topics::joint_state,
                     [this](const auto& s, const auto&) {
                       std::lock_guard lock(mutex_);
@@ -92,14 +108,16 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
                     std::lock_guard lock(mutex_);
                     odometry_ = s;
                   }),
-      request_reader_(participant, concert::dds::topics::plan_request, [this](const auto& s, const auto&) {
-        {
-          std::lock_guard lock(mutex_);
-          requests_.push_back(s);
-        }
-        wake_.notify_all();
-      }) {
-  if (planner_.model_version() == 0) status_.report(msg::SERVICE_STARTING, 0, "waiting for a robot model");
+      request_reader_(participant, concert::dds::topics::plan_request,
+                      [this](const auto& s, const auto&) {
+                        {
+                          std::lock_guard lock(mutex_);
+                          requests_.push_back(s);
+                        }
+                        wake_.notify_all();
+                      }) {
+  if (planner_.model_version() == 0)
+    status_.report(msg::SERVICE_STARTING, 0, "waiting for a robot model");
   executor_ = std::thread([this] { execute_loop(); });
   if (planner_.params().warm_up_time > 0.0) warmer_ = std::thread([this] { warm_up_loop(); });
 }
@@ -114,6 +132,12 @@ PlannerNode::~PlannerNode() {
   if (warmer_.joinable()) warmer_.join();
 }
 
+void PlannerNode::log_line(const std::string& line) {
+  // Lines come from the DDS listener, the request loop and the warm-up thread.
+  std::lock_guard lock(log_mutex_);
+  log_ << line << std::endl;
+}
+
 void PlannerNode::warm_up_loop() {
   // Lowest CPU priority for this thread (Linux: per-thread nice): warming up must not take
   // the core from planning, control or the other services.
@@ -125,14 +149,39 @@ void PlannerNode::warm_up_loop() {
     const uint64_t version = warm_version_;
     warm_version_ = 0;
     lock.unlock();
-    const auto t0 = std::chrono::steady_clock::now();
-    const int solved = planner_.warm_up(0.3, 2.9, 0.1, planner_.params().warm_up_time, [&] {
+    const auto model = planner_.model();
+    bool drill = false;
+    try {
+      drill = model && !model->camera_frame(model->tool("")).empty();
+    } catch (const PlannerError&) {
+      drill = false;  // no tool with a camera (e.g. the sanding tool): nothing to warm up
+    }
+    if (drill) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const int solved = planner_.warm_up(0.3, 2.9, 0.1, planner_.params().warm_up_time, [&] {
+        std::lock_guard guard(mutex_);
+        return !stopping_ && warm_version_ == 0;
+      });
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       std::lock_guard guard(mutex_);
-      return !stopping_ && warm_version_ == 0;
-    });
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    log_ << "planner: model version " << version << ": posture memory warmed up at " << solved << " of 27 heights (0.3-2.9 m) in "
-         << seconds << " s" << std::endl;
+      {
+        std::ostringstream line;
+        line << "planner: model version " << version << ": posture memory warmed up at " << solved
+             << " of 27 heights (0.3-2.9 m) in " << seconds << " s"
+             << (stopping_            ? " (stopped: shutting down)"
+                 : warm_version_ != 0 ? " (stopped: a newer model)"
+                                      : "");
+        log_line(line.str());
+      }
+    } else {
+      {
+        std::ostringstream line;
+        line << "planner: model version " << version
+             << ": no tool with a camera, no posture warm-up";
+        log_line(line.str());
+      }
+    }
     lock.lock();
   }
 }
@@ -144,9 +193,14 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
     planner_.set_model(to_core(model));
     const auto m = planner_.model();
     std::string note = "planning " + std::to_string(m->dof()) + " joints (base x, y, yaw + arm)";
-    if (!m->ignored_shapes().empty()) note += "; " + std::to_string(m->ignored_shapes().size()) + " mesh collisions ignored";
+    if (!m->ignored_shapes().empty())
+      note += "; " + std::to_string(m->ignored_shapes().size()) + " mesh collisions ignored";
     status_.report(msg::SERVICE_READY, model.version(), note);
-    log_ << "planner: model version " << model.version() << ": " << note << std::endl;
+    {
+      std::ostringstream line;
+      line << "planner: model version " << model.version() << ": " << note;
+      log_line(line.str());
+    }
     {
       std::lock_guard lock(mutex_);
       warm_version_ = model.version();
@@ -154,9 +208,15 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
     wake_.notify_all();
   } catch (const std::exception& e) {
     const uint64_t kept = planner_.model_version();
-    status_.report(kept == 0 ? msg::SERVICE_ERROR : msg::SERVICE_READY, static_cast<uint32_t>(kept),
-                   std::string("model version ") + std::to_string(model.version()) + " refused: " + e.what());
-    log_ << "planner: model version " << model.version() << " refused (keeping " << kept << "): " << e.what() << std::endl;
+    status_.report(
+        kept == 0 ? msg::SERVICE_ERROR : msg::SERVICE_READY, static_cast<uint32_t>(kept),
+        std::string("model version ") + std::to_string(model.version()) + " refused: " + e.what());
+    {
+      std::ostringstream line;
+      line << "planner: model version " << model.version() << " refused (keeping " << kept
+           << "): " << e.what();
+      log_line(line.str());
+    }
   }
 }
 
@@ -171,7 +231,9 @@ void PlannerNode::spin(const std::atomic<bool>& stop, std::chrono::milliseconds 
 
 bool PlannerNode::spin_once(std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
-  if (!wake_.wait_for(lock, timeout, [&] { return !requests_.empty() || stopping_; }) || requests_.empty()) return false;
+  if (!wake_.wait_for(lock, timeout, [&] { return !requests_.empty() || stopping_; }) ||
+      requests_.empty())
+    return false;
   const msg::PlanRequest request = requests_.front();
   requests_.pop_front();
   lock.unlock();
@@ -200,13 +262,14 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
       js = joint_state_;
       odom = odometry_;
     }
-    const Eigen::Vector3d pose = odom ? Eigen::Vector3d(odom->x(), odom->y(), odom->yaw()) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d pose =
+        odom ? Eigen::Vector3d(odom->x(), odom->y(), odom->yaw()) : Eigen::Vector3d::Zero();
     try {
       if (js && js->model_version() == model->version()) {
         start = model->full_from_named(js->name(), js->position(), pose);
       } else if (request.execute()) {
-        start_error = js ? "the robot runs model version " + std::to_string(js->model_version()) + ", the planner " +
-                               std::to_string(model->version())
+        start_error = js ? "the robot runs model version " + std::to_string(js->model_version()) +
+                               ", the planner " + std::to_string(model->version())
                          : "no joint state from the robot service yet (needed to execute)";
       } else {
         start = Eigen::VectorXd::Zero(model->full_dof());
@@ -221,7 +284,11 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     base.failure(msg::PLAN_INVALID_START);
     base.reason(start_error);
     publish(base);
-    log_ << "planner: request " << request.request_id() << " failed: " << start_error << std::endl;
+    {
+      std::ostringstream line;
+      line << "planner: request " << request.request_id() << " failed: " << start_error;
+      log_line(line.str());
+    }
     return;
   }
 
@@ -263,8 +330,12 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
       wake_.notify_all();
     }
   });
-  log_ << "planner: request " << request.request_id() << ": " << to_string(result.status)
-       << (result.reason.empty() ? "" : " (" + result.reason + ")") << std::endl;
+  {
+    std::ostringstream line;
+    line << "planner: request " << request.request_id() << ": " << to_string(result.status)
+         << (result.reason.empty() ? "" : " (" + result.reason + ")");
+    log_line(line.str());
+  }
   if (result.goals.empty()) {  // refused before any goal (stale model, bad request...)
     base.state(msg::PLAN_FAILED);
     base.failure(to_failure(result.status));
@@ -293,7 +364,8 @@ void PlannerNode::execute_loop() {
     r.state(ok ? (e.last ? msg::PLAN_SUCCEEDED : msg::PLAN_PLANNED) : msg::PLAN_FAILED);
     if (!ok) {
       r.failure(msg::PLAN_EXECUTION_ABORTED);
-      r.reason("execution of goal " + std::to_string(r.goal_index()) + " aborted: the robot model changed");
+      r.reason("execution of goal " + std::to_string(r.goal_index()) +
+               " aborted: the robot model changed");
       std::lock_guard relock(mutex_);
       executions_.clear();
     }
@@ -322,7 +394,8 @@ bool PlannerNode::execute(Execution& e) {
       if (stopping_) return false;
     }
     if (planner_.model_version() != m.version()) return false;
-    const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double time =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const TrajectoryPoint p = sample_at(t, time);
     const auto n = static_cast<std::size_t>(p.q.size());
     cmd.position(std::vector<double>(p.q.data() + 3, p.q.data() + n));

@@ -58,11 +58,13 @@ class PlannerNode {
   void publish(msg::PlanResult result);
   void execute_loop();
   void warm_up_loop();
+  void log_line(const std::string& line);
   bool execute(Execution& e);
 
   Planner& planner_;
   NodeOptions options_;
   std::ostream& log_;
+  std::mutex log_mutex_;
   std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<msg::PlanRequest> requests_;
