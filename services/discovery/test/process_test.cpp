@@ -1,14 +1,12 @@
 // The service as a real process: concert_discovery reads scans from DDS, publishes trees and
 // its status, reports faulty scans on stderr and stops cleanly on SIGTERM.
 #include <gtest/gtest.h>
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <csignal>
 #include <filesystem>
+#include <optional>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -19,8 +17,8 @@
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/esc_catalog.hpp"
 #include "dds/conversions.hpp"
+#include "process.hpp"
 
-extern char** environ;
 
 namespace concert::discovery {
 namespace {
@@ -30,31 +28,8 @@ using namespace std::chrono_literals;
 const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
 const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
 
-/// Waits (bounded) for the child to exit; returns its exit status or -1.
-int wait_exit(pid_t pid, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    int status = 0;
-    if (waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::this_thread::sleep_for(20ms);
-  }
-  kill(pid, SIGKILL);
-  waitpid(pid, nullptr, 0);
-  return -1;
-}
-
 TEST(DiscoveryProcess, ScansInTreesAndStatusOutCleanStop) {
-  const auto log = std::filesystem::temp_directory_path() /
-                   ("concert_discovery_process_" + std::to_string(getpid()) + ".log");
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  std::string binary = DISCOVERY_BINARY, db_flag = "--module-db", db = kPublicDb;
-  char* argv[] = {binary.data(), db_flag.data(), db.data(), nullptr};
-  pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), &actions, nullptr, argv, environ), 0);
-  posix_spawn_file_actions_destroy(&actions);
+  concert::testing::Process discovery({DISCOVERY_BINARY, "--module-db", kPublicDb});
 
   {
     const auto catalog = topology::EscCatalog::load(kPublicDb);
@@ -86,41 +61,22 @@ TEST(DiscoveryProcess, ScansInTreesAndStatusOutCleanStop) {
     EXPECT_TRUE(error_seen);
     EXPECT_FALSE(trees.wait(300ms));
   }
-  kill(pid, SIGTERM);
-  EXPECT_EQ(wait_exit(pid, 15s), 0);
-  std::ifstream in(log);
-  std::stringstream text;
-  text << in.rdbuf();
-  EXPECT_NE(text.str().find("discovery: scan 1: tree version 1 (18 modules, 19 slaves)"),
+  kill(discovery.pid(), SIGTERM);
+  EXPECT_EQ(discovery.wait(15s), 0);
+  const std::string log = discovery.err();
+  EXPECT_NE(log.find("discovery: scan 1: tree version 1 (18 modules, 19 slaves)"), std::string::npos)
+      << log;
+  EXPECT_NE(log.find("scan 2 rejected: slave 18: port 3 is open but no slave hangs on it"),
             std::string::npos)
-      << text.str();
-  EXPECT_NE(text.str().find("scan 2 rejected: slave 18: port 3 is open but no slave hangs on it"),
-            std::string::npos)
-      << text.str();
-  std::filesystem::remove(log);
+      << log;
 }
 
-/// Runs the binary with `args`; returns (exit status, stderr).
+/// Runs the binary with `args`; returns (exit status, stderr); -1 if it does not end in 15 s.
 std::pair<int, std::string> run_binary(std::vector<std::string> args) {
-  const auto log = std::filesystem::temp_directory_path() /
-                   ("concert_discovery_args_" + std::to_string(getpid()) + ".log");
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  std::string binary = DISCOVERY_BINARY;
-  std::vector<char*> argv{binary.data()};
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, binary.c_str(), &actions, nullptr, argv.data(), environ) != 0) return {-1, ""};
-  posix_spawn_file_actions_destroy(&actions);
-  const int status = wait_exit(pid, 15s);
-  std::ifstream in(log);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::filesystem::remove(log);
-  return {status, text.str()};
+  args.insert(args.begin(), DISCOVERY_BINARY);
+  concert::testing::Process p(args);
+  const std::optional<int> status = p.wait(15s);
+  return {status.value_or(-1), p.err()};
 }
 
 TEST(DiscoveryProcess, BadArgumentsExitNonZeroWithOneLine) {
