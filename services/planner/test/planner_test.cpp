@@ -251,3 +251,36 @@ TEST(Planner, WarmUpFillsThePostureMemoryAndPlansStayValid) {
     from = model->to_full(res.goals[g].trajectory.points.back().q, from);
   }
 }
+
+TEST(Planner, TurnedHintGetsPastAnObstacleThatBlocksItsBase) {
+  Params params;
+  params.seed = 5;
+  const auto model = PlanningModel::build(morphology('a', 1), params);
+  const EndEffectorSpec& tool = model->tool("");
+  const Eigen::VectorXd start = start_state(*model);
+  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.3, 0.55);
+  // A low area on a bare wall: a goal posture to remember.
+  World bare;
+  bare.boxes.push_back(fixtures::wall_at(2.2));
+  StateChecker bare_checker(model, environment_of(bare, params), params, params.environment_padding);
+  const PostureResult first = generate_posture(*model, bare_checker, params, tool, start, area, 1);
+  ASSERT_TRUE(first.found) << first.reason;
+  // A crate where that posture's base stands: the remembered posture, placed as it is, collides.
+  World blocked = bare;
+  blocked.boxes.push_back({"crate", Eigen::Vector3d(0.5, 0.5, 0.4), Eigen::Vector3d(first.q[0], first.q[1], 0.2), 0.0});
+  StateChecker checker(model, environment_of(blocked, params), params, params.environment_padding);
+  ASSERT_FALSE(checker.check(model->to_full(first.q, start)).valid());
+  // Seeded with that posture and a budget that ends before any random seed (the start posture
+  // placed and as it is, the hint, then the first joint turned either way, at most 5 steps
+  // each for the start posture and the hint): a turned variant gets past the crate.
+  Params few = params;
+  few.nspg_seeds = 2 + 1 + 2 * 2 * 5;
+  few.nspg_time = 60.0;  // the seed count ends it, not the clock
+  const Eigen::VectorXd hint = first.q.tail(first.q.size() - 3);
+  const PostureResult turned = generate_posture(*model, checker, few, tool, start, area, 1, {hint});
+  ASSERT_TRUE(turned.found) << turned.reason;
+  EXPECT_GT((turned.q.head<2>() - first.q.head<2>()).norm(), 0.25) << "the base should stand clear of the crate";
+  StateChecker exact(model, environment_of(blocked, params), params, 0.0);
+  EXPECT_TRUE(exact.check(model->to_full(turned.q, start), tool.frame).valid());
+  EXPECT_TRUE(exact.check(model->to_full(turned.q, start)).valid());
+}

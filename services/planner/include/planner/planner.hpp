@@ -28,7 +28,9 @@ struct PostureResult {
 /// posture and seeded random ones, until Params::nspg_time; keeps the valid posture of least
 /// cost. Seeded by `seed`.
 /// `hints`: arm postures (planned joints after the base) to seed after the start posture,
-/// best first (the planner passes postures that solved nearby areas before).
+/// best first (the planner passes postures that solved nearby areas before). The start
+/// posture and the hints are then tried again with the first arm joint turned (the base
+/// placement follows, so the posture reaches the area from another side) before random seeds.
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
                                const EndEffectorSpec& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
                                uint64_t seed, const std::vector<Eigen::VectorXd>& hints = {});

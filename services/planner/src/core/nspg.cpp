@@ -4,8 +4,9 @@
 // first priority, and within the task's null space the inequalities (torque limits with and
 // without the drilling force, clearance from the drilled surface, the floor, the robot's own
 // links and the map's obstacles). Seeds: the start posture with the base placed for it, the
-// start posture as it is, then random arm postures (the best of a few draws, base placed for
-// each). Every converged posture is judged by the exact StateChecker; the valid one of least
+// start posture as it is, the hints (remembered postures), the start posture and the hints
+// with the first arm joint turned, then random arm postures (the best of a few draws, base
+// placed for each). Every converged posture is judged by the exact StateChecker; the valid one of least
 // cost (distance to the start, inverse manipulability) is kept.
 //
 // The solver is hand-written instead of a library's (Ipopt is in Debian): 9-12 variables and
@@ -43,6 +44,12 @@ double manipulability(const PlanningModel& model, kinematics::Data& data, const 
   for (std::size_t i = 3; i < idx.size(); ++i) j.col(static_cast<Eigen::Index>(i) - 3) = j_full.col(idx[i]);
   return std::sqrt(std::max(0.0, (j * j.transpose()).determinant()));
 }
+
+// Turned seeds: the first arm joint turned by +-kTurnStep, +-2 kTurnStep, ... (kTurns each way).
+// On the benchmark's low areas beside obstacles a turned bare-wall posture converges to a valid
+// one about 15 % of the time, a random arm posture under 1 %.
+constexpr double kTurnStep = 0.6;
+constexpr int kTurns = 5;
 
 }  // namespace
 
@@ -104,15 +111,32 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   auto reject = [&](const std::string& key, const std::string& detail) {
     if (rejections[key]++ == 0 && out.reason.empty()) out.reason = key + (detail.empty() ? "" : ": " + detail);
   };
+  // Seeds in order: the start posture with the base placed for it, the start posture as it
+  // is, the hints, then the start posture and the hints with the first arm joint turned (the
+  // same posture seen from another side of the area: the base placement follows it around, past
+  // an obstacle that blocked the original), then random arm postures; the base placed for each.
+  std::vector<Eigen::VectorXd> arms;
+  arms.push_back(start.tail(n - 3));
+  arms.insert(arms.end(), hints.begin(), hints.end());
+  std::vector<Eigen::VectorXd> turned;
+  for (int step = 1; step <= kTurns; ++step) {
+    for (const double sign : {1.0, -1.0}) {
+      for (const Eigen::VectorXd& arm : arms) {
+        Eigen::VectorXd a = arm;
+        a[0] += sign * kTurnStep * step;
+        if (a[0] >= lo[3] && a[0] <= hi[3]) turned.push_back(std::move(a));
+      }
+    }
+  }
   int valid_found = 0;
   int on_task = 0;
   for (int k = 0; k < params.nspg_seeds && valid_found < params.nspg_enough && !out_of_time(); ++k) {
-    // Seeds: the start posture with the base placed for it, the start posture as it is, the
-    // hints, then random arm postures; the base placed for each arm posture.
     const auto hint = static_cast<std::size_t>(k - 2);
-    Eigen::VectorXd q = k == 0                 ? problem.place(start.tail(n - 3), yaw_hint)
+    const std::size_t turn = hint - hints.size();
+    Eigen::VectorXd q = k == 0                 ? problem.place(arms[0], yaw_hint)
                         : k == 1               ? start
-                        : hint < hints.size() ? problem.place(hints[hint], yaw_hint)
+                        : hint < hints.size()  ? problem.place(hints[hint], yaw_hint)
+                        : turn < turned.size() ? problem.place(turned[turn], yaw_hint)
                                                : random_seed();
     solve(problem, q, lo, hi, params.nspg_iterations, params.nspg_tolerance, r);
     out.candidates += 1;
