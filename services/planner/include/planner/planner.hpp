@@ -58,8 +58,10 @@ class Planner {
 
   /// Fills the posture memory of the current model: goal postures for drilling areas on a bare
   /// wall (the model's first tool, camera axis horizontal) at heights `from`..`to` every `step`
-  /// [m], each searched for up to `seconds_per_height`. Later goals near those heights start
-  /// from them (the low, torque-bound areas otherwise cost the NSPG most of its budget). Stops
+  /// [m], each searched twice for up to `seconds_per_height` (once seeded by the neighbouring
+  /// heights, once from random seeds for other posture families). Later goals near those
+  /// heights start from them (the low, torque-bound areas otherwise cost the NSPG most of its
+  /// budget). Stops
   /// early if the model changes or `keep_going` returns false. Returns the number of heights
   /// solved.
   int warm_up(double from, double to, double step, double seconds_per_height,

@@ -107,7 +107,6 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
   }
   Params params = params_;
   params.nspg_time = seconds_per_height;
-  params.nspg_enough = 3;  // a few postures per height: an obstacle may block one of them
   const Environment empty(params.octomap_resolution);
   StateChecker checker(model, empty, params, params.environment_padding);
   const Eigen::VectorXd start = Eigen::VectorXd::Zero(model->full_dof());
@@ -120,11 +119,19 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
     area.linear() << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // z along -x (the wall's outward normal)
     area.translation() = Eigen::Vector3d(2.0, 0.0, z);
     const double height = z;  // the camera stays at the area's height (horizontal axis)
-    const PostureResult p = generate_posture(*model, checker, params, *tool, start, area, params.seed + 31u * static_cast<uint64_t>(index),
-                                             hints_for(*model, height));
-    if (!p.found) continue;
-    for (const Eigen::VectorXd& q : p.valid) remember(*model, height, q);
-    solved += 1;
+    // Twice: seeded with the neighbouring heights' postures (one family followed up the
+    // wall), then from the start posture and random seeds only, for other families: near an
+    // obstacle the one that fits is often another family.
+    bool found = false;
+    for (const bool seeded : {true, false}) {
+      params.nspg_enough = seeded ? 1 : 2;
+      const uint64_t seed = params.seed + 31u * static_cast<uint64_t>(index) + (seeded ? 0u : 17u);
+      const PostureResult p = generate_posture(*model, checker, params, *tool, start, area, seed,
+                                               seeded ? hints_for(*model, height) : std::vector<Eigen::VectorXd>{});
+      for (const Eigen::VectorXd& q : p.valid) remember(*model, height, q);
+      found = found || p.found;
+    }
+    if (found) solved += 1;
   }
   return solved;
 }
