@@ -188,8 +188,9 @@ int main(int argc, char** argv) {
       rows[i] = {r.status == Status::kSucceeded && ms <= 2000.0, ms, to_string(r.status)};
       rows[i].solvable = rows[i].success;
       if (verbose) {
-        std::printf("  %c #%02zu wall %.2f m, area (%.2f, %.2f) m: %-12s %8.1f ms (nspg %.1f ms)  %s\n", m, i, p.wall_x, p.y, p.z,
-                    to_string(r.status), ms, r.goals.empty() ? 0.0 : 1e3 * r.goals[0].nspg_seconds, r.reason.c_str());
+        std::printf("  %c #%02zu wall %.2f m, area (%.2f, %.2f) m: %-12s %8.1f ms (nspg %.1f ms, path: %s)  %s\n", m, i, p.wall_x,
+                    p.y, p.z, to_string(r.status), ms, r.goals.empty() ? 0.0 : 1e3 * r.goals[0].nspg_seconds,
+                    r.goals.empty() ? "" : r.goals[0].path_method.c_str(), r.reason.c_str());
       }
       if (oracle > 0.0 && !rows[i].success) {
         // The same problem with a long budget and other seeds: was the 2 s budget the limit?

@@ -284,3 +284,28 @@ TEST(Planner, TurnedHintGetsPastAnObstacleThatBlocksItsBase) {
   EXPECT_TRUE(exact.check(model->to_full(turned.q, start), tool.frame).valid());
   EXPECT_TRUE(exact.check(model->to_full(turned.q, start)).valid());
 }
+
+TEST(Planner, LongArmReachesALowAreaAndTheArmOnlyPathsStayValid) {
+  // Morphology B (2.15 m arm) at a low area: the shoulder's continuous torque leaves the arm a
+  // narrow pocket of folded postures. Budget generous so the test does not depend on the
+  // machine's speed; whichever path method succeeds, the plan must re-check densely.
+  Params params;
+  params.seed = 29;
+  params.planning_time = 20.0;
+  params.nspg_time = 10.0;
+  params.path_attempt_time = 6.0;
+  Planner planner(params);
+  planner.set_model(morphology('b', 3));
+  const World world = site(2.2);
+  planner.set_environment(environment_of(world, params));
+  const auto model = planner.model();
+  const Eigen::VectorXd start = start_state(*model);
+  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.0, 0.6);
+  const PlanResult res = planner.plan({7, 3, "", {{area}}}, start);
+  ASSERT_EQ(res.status, Status::kSucceeded) << res.reason;
+  const GoalResult& g = res.goals[0];
+  // Here the direct motion and the whole-body projected line fail; the arm-only search finds
+  // the way into the pocket.
+  EXPECT_TRUE(g.path_method == "arm, then drive" || g.path_method == "drive, then arm") << g.path_method;
+  EXPECT_GT(recheck(*model, environment_of(world, params), params, g, start, area), 10) << "path found by " << g.path_method;
+}

@@ -176,7 +176,8 @@ struct GoalResult {
   Eigen::VectorXd goal_q;         ///< planned joints (see Trajectory::joint_names)
   Trajectory trajectory;
   double nspg_seconds = 0.0;      ///< goal posture generation time [s]
-  double plan_seconds = 0.0;      ///< RRT-Connect + simplification + timing [s]
+  double plan_seconds = 0.0;      ///< path search + simplification + timing [s]
+  std::string path_method;        ///< how the path was found: "direct", "projected line", "arm, then drive", "drive, then arm", "RRT-Connect"
 };
 
 /// Result of a request.

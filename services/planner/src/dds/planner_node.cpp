@@ -334,6 +334,11 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     std::ostringstream line;
     line << "planner: request " << request.request_id() << ": " << to_string(result.status)
          << (result.reason.empty() ? "" : " (" + result.reason + ")");
+    for (const GoalResult& g : result.goals) {
+      if (g.status != Status::kSucceeded) continue;
+      line << "; goal " << g.index << " in " << static_cast<int>(1e3 * (g.nspg_seconds + g.plan_seconds)) << " ms ("
+           << g.path_method << ")";
+    }
     log_line(line.str());
   }
   if (result.goals.empty()) {  // refused before any goal (stale model, bad request...)
