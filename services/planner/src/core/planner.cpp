@@ -32,8 +32,8 @@ constexpr std::size_t kHints = 8;
 
 // Largest joint change [rad or m] between the states of a projected straight line.
 constexpr double kLineStep = 0.15;
-// Share of a path attempt's remaining time for the arm-only search of drive-then-reach; the
-// rest is the whole-body RRT-Connect's.
+// Share of a path attempt's remaining time for each order of the arm-alone-and-drive search
+// (arm first, then drive first, each of what is left); the rest is whole-body RRT-Connect's.
 constexpr double kArmShare = 0.5;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
@@ -292,52 +292,75 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   // pocket is cheap to enter in the arm's 6 dimensions and rarely entered by a whole-body tree
   // that also drives (on the benchmark's low areas for morphology B: arm-only 0.03-1.3 s,
   // whole-body 2 of 12 in 8 s).
-  auto arm_and_drive = [&](bool reach_first, double budget) -> std::vector<Eigen::VectorXd> {
-    Eigen::VectorXd base_still = reach_first ? q_start : q_goal;  // the arm's search: base here
-    base_still.tail(n - 3) = q_start.tail(n - 3);
-    std::vector<Eigen::VectorXd> line{q_start};
-    if (!reach_first && (line = projected_line(q_start, base_still), line.empty())) return {};
-    const int na = n - 3;
-    auto arm_space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(na));
-    ob::RealVectorBounds arm_bounds(static_cast<unsigned>(na));
-    for (int i = 0; i < na; ++i) {
-      arm_bounds.setLow(static_cast<unsigned>(i), model.lower()[i + 3]);
-      arm_bounds.setHigh(static_cast<unsigned>(i), model.upper()[i + 3]);
+  // RRT-Connect over the joints [first, first + count) alone, the others held as in `from`:
+  // the chain of states from `from` to `to` (which differ only in those joints), or none.
+  auto subspace_path = [&](int first, int count, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                           double budget) -> std::vector<Eigen::VectorXd> {
+    auto sub = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(count));
+    ob::RealVectorBounds sub_bounds(static_cast<unsigned>(count));
+    for (int i = 0; i < count; ++i) {
+      sub_bounds.setLow(static_cast<unsigned>(i), bounds.low[static_cast<std::size_t>(first + i)]);
+      sub_bounds.setHigh(static_cast<unsigned>(i), bounds.high[static_cast<std::size_t>(first + i)]);
     }
-    arm_space->setBounds(arm_bounds);
-    arm_space->setStateSamplerAllocator([seed, &planning](const ob::StateSpace* s) {
+    sub->setBounds(sub_bounds);
+    sub->setStateSamplerAllocator([seed, &planning](const ob::StateSpace* s) {
       return std::make_shared<SeededSampler>(s, seed, nullptr, 0, &planning);
     });
-    auto arm_si = std::make_shared<ob::SpaceInformation>(arm_space);
-    Eigen::VectorXd q = base_still;
-    arm_si->setStateValidityChecker([&](const ob::State* s) {
-      q.tail(na) = to_eigen(s, na);
+    auto sub_si = std::make_shared<ob::SpaceInformation>(sub);
+    Eigen::VectorXd q = from;
+    sub_si->setStateValidityChecker([&](const ob::State* s) {
+      q.segment(first, count) = to_eigen(s, count);
       const Validity v = checker.check(model.to_full(q, q_start_full));
       if (!v.valid()) last_rejection = v;
       return v.valid();
     });
-    arm_si->setStateValidityCheckingResolution(params_.check_resolution / arm_space->getMaximumExtent());
-    arm_si->setup();
-    ob::ScopedState<> from(arm_space), to(arm_space);
-    from_eigen(base_still.tail(na), from.get());
-    from_eigen(q_goal.tail(na), to.get());
-    auto arm_pdef = std::make_shared<ob::ProblemDefinition>(arm_si);
-    arm_pdef->setStartAndGoalStates(from, to);
-    og::RRTConnect arm_rrt(arm_si);
-    arm_rrt.setProblemDefinition(arm_pdef);
-    arm_rrt.setup();
-    if (arm_rrt.solve(ob::timedPlannerTerminationCondition(budget)) != ob::PlannerStatus::EXACT_SOLUTION) return {};
-    const auto& arm_path = *arm_pdef->getSolutionPath()->as<og::PathGeometric>();
-    for (std::size_t i = 1; i < arm_path.getStateCount(); ++i) {
-      q.tail(na) = to_eigen(arm_path.getState(static_cast<unsigned>(i)), na);
-      line.push_back(q);
+    sub_si->setStateValidityCheckingResolution(params_.check_resolution / sub->getMaximumExtent());
+    sub_si->setup();
+    ob::ScopedState<> a(sub), b(sub);
+    from_eigen(from.segment(first, count), a.get());
+    from_eigen(to.segment(first, count), b.get());
+    auto sub_pdef = std::make_shared<ob::ProblemDefinition>(sub_si);
+    sub_pdef->setStartAndGoalStates(a, b);
+    og::RRTConnect rrt(sub_si);
+    rrt.setProblemDefinition(sub_pdef);
+    rrt.setup();
+    if (rrt.solve(ob::timedPlannerTerminationCondition(budget)) != ob::PlannerStatus::EXACT_SOLUTION) return {};
+    const auto& path = *sub_pdef->getSolutionPath()->as<og::PathGeometric>();
+    std::vector<Eigen::VectorXd> out;
+    for (std::size_t i = 0; i < path.getStateCount(); ++i) {
+      q.segment(first, count) = to_eigen(path.getState(static_cast<unsigned>(i)), count);
+      out.push_back(q);
     }
-    if (reach_first) {
-      const std::vector<Eigen::VectorXd> drive = projected_line(line.back(), q_goal);
-      if (drive.empty()) return {};
-      line.insert(line.end(), drive.begin() + 1, drive.end());
-    }
-    return line;
+    return out;
+  };
+  // The drive alone (x, y, yaw; the arm held): the projected line, else RRT-Connect over the
+  // base's three joints around the obstacles.
+  auto drive = [&](const Eigen::VectorXd& from, const Eigen::VectorXd& to, double budget) {
+    std::vector<Eigen::VectorXd> line = projected_line(from, to);
+    return line.empty() ? subspace_path(0, 3, from, to, budget) : line;
+  };
+  // The arm alone, its path found by RRT-Connect in the arm's joint space with the base
+  // standing still (the environment still checked), and a drive before or after it: first
+  // the arm at the start's base pose then a drive with the goal's arm posture, else a drive
+  // with the start's arm posture then the arm at the goal's base pose. A long arm holding a
+  // low area sits in a narrow pocket of torque-feasible, self-collision-free arm postures; the
+  // pocket is cheap to enter in the arm's 6 dimensions and rarely entered by a whole-body tree
+  // that also drives (on the benchmark's low areas for morphology B: arm-only 0.03-1.3 s,
+  // whole-body 2 of 12 in 8 s). Half the budget for each part.
+  auto arm_and_drive = [&](bool reach_first, double budget) -> std::vector<Eigen::VectorXd> {
+    const auto t_order = Clock::now();
+    const auto rest = [&] { return std::max(0.0, budget - seconds_since(t_order)); };
+    Eigen::VectorXd turn = q_start;  // where the arm moves: the start's or the goal's base pose
+    if (!reach_first) turn.head<3>() = q_goal.head<3>();
+    Eigen::VectorXd turned = turn;
+    turned.tail(n - 3) = q_goal.tail(n - 3);
+    std::vector<Eigen::VectorXd> first = reach_first ? subspace_path(3, n - 3, q_start, turned, 0.5 * budget)
+                                                     : drive(q_start, turn, 0.5 * budget);
+    if (first.empty()) return {};
+    std::vector<Eigen::VectorXd> second = reach_first ? drive(turned, q_goal, rest()) : subspace_path(3, n - 3, turn, q_goal, rest());
+    if (second.empty()) return {};
+    first.insert(first.end(), second.begin() + 1, second.end());
+    return first;
   };
   // A chain of feasible waypoints, shortcut and thinned in the whole-body space.
   auto simplified = [&](const std::vector<Eigen::VectorXd>& line) {
@@ -361,7 +384,7 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   } else if (line = projected_line(q_start, q_goal); !line.empty()) {
     waypoints = simplified(line);
     r.path_method = "projected line";
-  } else if (line = arm_and_drive(true, 0.5 * kArmShare * std::max(0.0, time_budget - seconds_since(t0))), !line.empty()) {
+  } else if (line = arm_and_drive(true, kArmShare * std::max(0.0, time_budget - seconds_since(t0))), !line.empty()) {
     waypoints = simplified(line);
     r.path_method = "arm, then drive";
   } else if (line = arm_and_drive(false, kArmShare * std::max(0.0, time_budget - seconds_since(t0))), !line.empty()) {
