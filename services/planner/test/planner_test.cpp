@@ -306,6 +306,26 @@ TEST(Planner, LongArmReachesALowAreaAndTheArmOnlyPathsStayValid) {
   const GoalResult& g = res.goals[0];
   // Here the direct motion and the whole-body projected line fail; the arm-only search finds
   // the way into the pocket.
-  EXPECT_TRUE(g.path_method == "arm, then drive" || g.path_method == "drive, then arm") << g.path_method;
+  EXPECT_TRUE(g.path_method == "arm, then drive" || g.path_method == "drive, then arm") << g.path_method;  // no memory here
+  EXPECT_GT(recheck(*model, environment_of(world, params), params, g, start, area), 10) << "path found by " << g.path_method;
+}
+
+TEST(Planner, WarmUpRemembersArmPathsThatLaterPlansReplay) {
+  // Morphology B: the warm-up stores, with each low posture, the arm's way to it from the
+  // parked arm; a later low goal near a box replays it (checked against the map).
+  Params params;
+  params.seed = 31;
+  Planner planner(params);
+  planner.set_model(morphology('b', 5));
+  ASSERT_EQ(planner.warm_up(0.5, 0.7, 0.1, 2.0), 3);
+  const World world = site(2.2);
+  planner.set_environment(environment_of(world, params));
+  const auto model = planner.model();
+  const Eigen::VectorXd start = start_state(*model);
+  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, -0.3, 0.6);
+  const PlanResult res = planner.plan({8, 5, "", {{area}}}, start);
+  ASSERT_EQ(res.status, Status::kSucceeded) << res.reason;
+  const GoalResult& g = res.goals[0];
+  EXPECT_NE(g.path_method.find("remembered arm path"), std::string::npos) << g.path_method;
   EXPECT_GT(recheck(*model, environment_of(world, params), params, g, start, area), 10) << "path found by " << g.path_method;
 }

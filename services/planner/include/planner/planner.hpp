@@ -86,9 +86,13 @@ class Planner {
   struct Remembered {
     double height = 0.0;
     Eigen::VectorXd arm;
+    std::vector<Eigen::VectorXd> arm_path;  // arm postures from the parked arm to `arm` (warm-up), or empty
   };
   std::vector<Eigen::VectorXd> hints_for(const PlanningModel& model, double height) const;
-  void remember(const PlanningModel& model, double height, const Eigen::VectorXd& q);
+  void remember(const PlanningModel& model, double height, const Eigen::VectorXd& q, std::vector<Eigen::VectorXd> arm_path = {});
+  // A remembered arm path that ends near `arm` (all joints but the first within 0.3 rad; the
+  // first joint's offset is added along the path), or empty.
+  std::vector<Eigen::VectorXd> arm_path_to(const PlanningModel& model, const Eigen::VectorXd& arm) const;
 
   Params params_;
   mutable std::mutex mutex_;

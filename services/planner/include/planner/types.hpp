@@ -177,7 +177,8 @@ struct GoalResult {
   Trajectory trajectory;
   double nspg_seconds = 0.0;      ///< goal posture generation time [s]
   double plan_seconds = 0.0;      ///< path search + simplification + timing [s]
-  std::string path_method;        ///< how the path was found: "direct", "projected line", "arm, then drive", "drive, then arm", "RRT-Connect"
+  std::string path_method;        ///< how the path was found: "direct", "projected line", "arm, then drive", "drive, then arm" (or
+                                  ///< with a "remembered arm path"), "RRT-Connect"
 };
 
 /// Result of a request.

@@ -32,6 +32,10 @@ constexpr std::size_t kHints = 8;
 
 // Largest joint change [rad or m] between the states of a projected straight line.
 constexpr double kLineStep = 0.15;
+// Warm-up: search time for the arm's path to each remembered posture.
+constexpr double kWarmUpPathTime = 0.5;
+// A remembered arm path serves a goal whose arm joints after the first are this close [rad].
+constexpr double kArmPathReuse = 0.3;
 // Share of a path attempt's remaining time for each order of the arm-alone-and-drive search
 // (arm first, then drive first, each of what is left); the rest is whole-body RRT-Connect's.
 constexpr double kArmShare = 0.5;
@@ -69,6 +73,54 @@ class SeededSampler : public ob::RealVectorStateSampler {
   Eigen::VectorXd lo_, hi_;
   unsigned long count_ = 0;
 };
+
+Eigen::VectorXd to_eigen(const ob::State* s, int n);
+void from_eigen(const Eigen::VectorXd& q, ob::State* s);
+
+// RRT-Connect over the planned joints [first, first + count) alone, the others held as in
+// `from`, within [lo, hi]: the chain of planned states from `from` to `to` (which differ only
+// in those joints), or none within `budget`.
+std::vector<Eigen::VectorXd> subspace_rrt(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& full_template,
+                                          double check_resolution, int first, int count, const Eigen::VectorXd& lo,
+                                          const Eigen::VectorXd& hi, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                          double budget, uint64_t seed, Validity* last_rejection) {
+  static const bool kActive = true;
+  auto sub = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(count));
+  ob::RealVectorBounds sub_bounds(static_cast<unsigned>(count));
+  for (int i = 0; i < count; ++i) {
+    sub_bounds.setLow(static_cast<unsigned>(i), lo[first + i]);
+    sub_bounds.setHigh(static_cast<unsigned>(i), hi[first + i]);
+  }
+  sub->setBounds(sub_bounds);
+  sub->setStateSamplerAllocator(
+      [seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed, nullptr, 0, &kActive); });
+  auto sub_si = std::make_shared<ob::SpaceInformation>(sub);
+  Eigen::VectorXd q = from;
+  sub_si->setStateValidityChecker([&](const ob::State* s) {
+    q.segment(first, count) = to_eigen(s, count);
+    const Validity v = checker.check(model.to_full(q, full_template));
+    if (!v.valid() && last_rejection != nullptr) *last_rejection = v;
+    return v.valid();
+  });
+  sub_si->setStateValidityCheckingResolution(check_resolution / sub->getMaximumExtent());
+  sub_si->setup();
+  ob::ScopedState<> a(sub), b(sub);
+  from_eigen(from.segment(first, count), a.get());
+  from_eigen(to.segment(first, count), b.get());
+  auto pdef = std::make_shared<ob::ProblemDefinition>(sub_si);
+  pdef->setStartAndGoalStates(a, b);
+  og::RRTConnect rrt(sub_si);
+  rrt.setProblemDefinition(pdef);
+  rrt.setup();
+  if (rrt.solve(ob::timedPlannerTerminationCondition(budget)) != ob::PlannerStatus::EXACT_SOLUTION) return {};
+  const auto& path = *pdef->getSolutionPath()->as<og::PathGeometric>();
+  std::vector<Eigen::VectorXd> out;
+  for (std::size_t i = 0; i < path.getStateCount(); ++i) {
+    q.segment(first, count) = to_eigen(path.getState(static_cast<unsigned>(i)), count);
+    out.push_back(q);
+  }
+  return out;
+}
 
 Eigen::VectorXd to_eigen(const ob::State* s, int n) {
   const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
@@ -131,7 +183,17 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
       const uint64_t seed = params.seed + 31u * static_cast<uint64_t>(index) + (seeded ? 0u : 17u);
       const PostureResult p = generate_posture(*model, checker, params, *tool, start, area, seed,
                                                seeded ? hints_for(*model, height) : std::vector<Eigen::VectorXd>{});
-      for (const Eigen::VectorXd& q : p.valid) remember(*model, height, q);
+      for (const Eigen::VectorXd& q : p.valid) {
+        // The arm's way from the start posture to it, where the map cannot interfere: later
+        // plans replay it (checked against their map) instead of searching for it.
+        Eigen::VectorXd parked = model->to_planned(start);
+        parked.head<3>() = q.head<3>();
+        std::vector<Eigen::VectorXd> path = subspace_rrt(*model, checker, start, params.check_resolution, 3, model->dof() - 3, model->lower(),
+                                                         model->upper(), parked, q, kWarmUpPathTime, seed, nullptr);
+        std::vector<Eigen::VectorXd> arms;
+        for (const Eigen::VectorXd& w : path) arms.push_back(w.tail(w.size() - 3));
+        remember(*model, height, q, std::move(arms));
+      }
       found = found || p.found;
     }
     if (found) solved += 1;
@@ -154,12 +216,32 @@ std::vector<Eigen::VectorXd> Planner::hints_for(const PlanningModel& model, doub
   return out;
 }
 
-void Planner::remember(const PlanningModel& model, double height, const Eigen::VectorXd& q) {
+void Planner::remember(const PlanningModel& model, double height, const Eigen::VectorXd& q, std::vector<Eigen::VectorXd> arm_path) {
   if (params_.nspg_memory <= 0) return;
   std::lock_guard lock(mutex_);
   if (model_.get() != &model) return;
   if (static_cast<int>(memory_.size()) >= params_.nspg_memory) memory_.erase(memory_.begin());
-  memory_.push_back({height, q.tail(q.size() - 3)});
+  memory_.push_back({height, q.tail(q.size() - 3), std::move(arm_path)});
+}
+
+std::vector<Eigen::VectorXd> Planner::arm_path_to(const PlanningModel& model, const Eigen::VectorXd& arm) const {
+  std::lock_guard lock(mutex_);
+  if (model_.get() != &model) return {};
+  const Remembered* best = nullptr;
+  double best_d = kArmPathReuse;
+  for (const Remembered& m : memory_) {
+    if (m.arm_path.empty()) continue;
+    const double d = (m.arm.tail(m.arm.size() - 1) - arm.tail(arm.size() - 1)).cwiseAbs().maxCoeff();
+    if (d < best_d) {
+      best_d = d;
+      best = &m;
+    }
+  }
+  if (best == nullptr) return {};
+  std::vector<Eigen::VectorXd> out = best->arm_path;
+  const double turn = arm[0] - best->arm[0];
+  for (Eigen::VectorXd& a : out) a[0] += turn;
+  return out;
 }
 
 void Planner::set_environment(Environment environment) {
@@ -292,46 +374,41 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   // pocket is cheap to enter in the arm's 6 dimensions and rarely entered by a whole-body tree
   // that also drives (on the benchmark's low areas for morphology B: arm-only 0.03-1.3 s,
   // whole-body 2 of 12 in 8 s).
-  // RRT-Connect over the joints [first, first + count) alone, the others held as in `from`:
-  // the chain of states from `from` to `to` (which differ only in those joints), or none.
-  auto subspace_path = [&](int first, int count, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
-                           double budget) -> std::vector<Eigen::VectorXd> {
-    auto sub = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(count));
-    ob::RealVectorBounds sub_bounds(static_cast<unsigned>(count));
-    for (int i = 0; i < count; ++i) {
-      sub_bounds.setLow(static_cast<unsigned>(i), bounds.low[static_cast<std::size_t>(first + i)]);
-      sub_bounds.setHigh(static_cast<unsigned>(i), bounds.high[static_cast<std::size_t>(first + i)]);
+  Eigen::VectorXd box_lo(n), box_hi(n);
+  for (int i = 0; i < n; ++i) {
+    box_lo[i] = bounds.low[static_cast<std::size_t>(i)];
+    box_hi[i] = bounds.high[static_cast<std::size_t>(i)];
+  }
+  auto subspace_path = [&](int first, int count, const Eigen::VectorXd& from, const Eigen::VectorXd& to, double budget) {
+    return subspace_rrt(model, checker, q_start_full, params_.check_resolution, first, count, box_lo, box_hi, from, to, budget, seed,
+                        &last_rejection);
+  };
+  // The arm's moves with the base held: a path remembered by the warm-up for a posture like the
+  // goal's (checked here against the map), else RRT-Connect over the arm's joints.
+  bool replayed = false;  // the arm's path came from the memory
+  auto arm_path = [&](const Eigen::VectorXd& from, const Eigen::VectorXd& to, double budget) -> std::vector<Eigen::VectorXd> {
+    const std::vector<Eigen::VectorXd> known = arm_path_to(model, to.tail(n - 3));
+    if (!known.empty()) {
+      std::vector<Eigen::VectorXd> chain{from};
+      for (const Eigen::VectorXd& arm : known) {
+        Eigen::VectorXd q = from;
+        q.tail(n - 3) = arm;
+        chain.push_back(q);
+      }
+      chain.push_back(to);
+      bool ok = true;
+      ob::ScopedState<> a(space), b(space);
+      for (std::size_t i = 1; i < chain.size() && ok; ++i) {
+        from_eigen(chain[i - 1], a.get());
+        from_eigen(chain[i], b.get());
+        ok = si->checkMotion(a.get(), b.get());
+      }
+      if (ok) {
+        replayed = true;
+        return chain;
+      }
     }
-    sub->setBounds(sub_bounds);
-    sub->setStateSamplerAllocator([seed, &planning](const ob::StateSpace* s) {
-      return std::make_shared<SeededSampler>(s, seed, nullptr, 0, &planning);
-    });
-    auto sub_si = std::make_shared<ob::SpaceInformation>(sub);
-    Eigen::VectorXd q = from;
-    sub_si->setStateValidityChecker([&](const ob::State* s) {
-      q.segment(first, count) = to_eigen(s, count);
-      const Validity v = checker.check(model.to_full(q, q_start_full));
-      if (!v.valid()) last_rejection = v;
-      return v.valid();
-    });
-    sub_si->setStateValidityCheckingResolution(params_.check_resolution / sub->getMaximumExtent());
-    sub_si->setup();
-    ob::ScopedState<> a(sub), b(sub);
-    from_eigen(from.segment(first, count), a.get());
-    from_eigen(to.segment(first, count), b.get());
-    auto sub_pdef = std::make_shared<ob::ProblemDefinition>(sub_si);
-    sub_pdef->setStartAndGoalStates(a, b);
-    og::RRTConnect rrt(sub_si);
-    rrt.setProblemDefinition(sub_pdef);
-    rrt.setup();
-    if (rrt.solve(ob::timedPlannerTerminationCondition(budget)) != ob::PlannerStatus::EXACT_SOLUTION) return {};
-    const auto& path = *sub_pdef->getSolutionPath()->as<og::PathGeometric>();
-    std::vector<Eigen::VectorXd> out;
-    for (std::size_t i = 0; i < path.getStateCount(); ++i) {
-      q.segment(first, count) = to_eigen(path.getState(static_cast<unsigned>(i)), count);
-      out.push_back(q);
-    }
-    return out;
+    return subspace_path(3, n - 3, from, to, budget);
   };
   // The drive alone (x, y, yaw; the arm held): the projected line, else RRT-Connect over the
   // base's three joints around the obstacles.
@@ -354,10 +431,9 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
     if (!reach_first) turn.head<3>() = q_goal.head<3>();
     Eigen::VectorXd turned = turn;
     turned.tail(n - 3) = q_goal.tail(n - 3);
-    std::vector<Eigen::VectorXd> first = reach_first ? subspace_path(3, n - 3, q_start, turned, 0.5 * budget)
-                                                     : drive(q_start, turn, 0.5 * budget);
+    std::vector<Eigen::VectorXd> first = reach_first ? arm_path(q_start, turned, 0.5 * budget) : drive(q_start, turn, 0.5 * budget);
     if (first.empty()) return {};
-    std::vector<Eigen::VectorXd> second = reach_first ? drive(turned, q_goal, rest()) : subspace_path(3, n - 3, turn, q_goal, rest());
+    std::vector<Eigen::VectorXd> second = reach_first ? drive(turned, q_goal, rest()) : arm_path(turn, q_goal, rest());
     if (second.empty()) return {};
     first.insert(first.end(), second.begin() + 1, second.end());
     return first;
@@ -386,10 +462,10 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
     r.path_method = "projected line";
   } else if (line = arm_and_drive(true, kArmShare * std::max(0.0, time_budget - seconds_since(t0))), !line.empty()) {
     waypoints = simplified(line);
-    r.path_method = "arm, then drive";
+    r.path_method = replayed ? "remembered arm path, then drive" : "arm, then drive";
   } else if (line = arm_and_drive(false, kArmShare * std::max(0.0, time_budget - seconds_since(t0))), !line.empty()) {
     waypoints = simplified(line);
-    r.path_method = "drive, then arm";
+    r.path_method = replayed ? "drive, then remembered arm path" : "drive, then arm";
   } else {
     r.path_method = "RRT-Connect";
     auto pdef = std::make_shared<ob::ProblemDefinition>(si);
