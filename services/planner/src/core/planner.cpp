@@ -35,7 +35,7 @@ constexpr double kLineStep = 0.15;
 // Warm-up: search time for the arm's path to each remembered posture.
 constexpr double kWarmUpPathTime = 0.5;
 // A remembered arm path serves a goal whose arm joints after the first are this close [rad].
-constexpr double kArmPathReuse = 0.3;
+constexpr double kArmPathReuse = 0.6;
 // Share of a path attempt's remaining time for each order of the arm-alone-and-drive search
 // (arm first, then drive first, each of what is left); the rest is whole-body RRT-Connect's.
 constexpr double kArmShare = 0.5;
