@@ -323,6 +323,8 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   }
 
   std::vector<Eigen::VectorXd> waypoints;
+  const Eigen::VectorXd box_lo = Eigen::Map<const Eigen::VectorXd>(bounds.low.data(), n);  // the planning space's bounds
+  const Eigen::VectorXd box_hi = Eigen::Map<const Eigen::VectorXd>(bounds.high.data(), n);
   // A straight line whose intermediate states are pulled into the feasible set (each from
   // its point on the line, by the inequality rows): for a long arm the straight joint-space
   // line usually swings the arm out past its torque limits, and a slight fold on the way is
@@ -330,11 +332,6 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   auto projected_line = [&](const Eigen::VectorXd& from, const Eigen::VectorXd& target) -> std::vector<Eigen::VectorXd> {
     if (params_.sample_iterations <= 0) return {};
     Eigen::VectorXd residual;
-    Eigen::VectorXd lo(n), hi(n);
-    for (int i = 0; i < n; ++i) {
-      lo[i] = bounds.low[static_cast<std::size_t>(i)];
-      hi[i] = bounds.high[static_cast<std::size_t>(i)];
-    }
     ob::ScopedState<> a(space), b(space);
     auto motion_ok = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
       from_eigen(x, a.get());
@@ -351,7 +348,7 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
       }
       if (depth == 0) return false;
       Eigen::VectorXd mid = 0.5 * (line.back() + to);
-      detail::solve(feasible, mid, lo, hi, 3 * params_.sample_iterations, 1.0, residual);
+      detail::solve(feasible, mid, box_lo, box_hi, 3 * params_.sample_iterations, 1.0, residual);
       return reach(mid, depth - 1) && reach(to, depth - 1);
     };
     const Eigen::VectorXd delta = target - from;
@@ -361,24 +358,12 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
       // kept; the last segments steer back onto the target.
       const double left = static_cast<double>(segments - k + 1);
       Eigen::VectorXd q = k == segments ? target : Eigen::VectorXd(line.back() + (target - line.back()) / left);
-      if (k < segments) detail::solve(feasible, q, lo, hi, 3 * params_.sample_iterations, 1.0, residual);
+      if (k < segments) detail::solve(feasible, q, box_lo, box_hi, 3 * params_.sample_iterations, 1.0, residual);
       if (!reach(q, 3)) return {};
     }
     return line;
   };
-  // The arm alone, its path found by RRT-Connect in the arm's joint space with the base
-  // standing still (the environment still checked), and a drive before or after it: first
-  // the arm at the start's base pose then a drive with the goal's arm posture, else a drive
-  // with the start's arm posture then the arm at the goal's base pose. A long arm holding a
-  // low area sits in a narrow pocket of torque-feasible, self-collision-free arm postures; the
-  // pocket is cheap to enter in the arm's 6 dimensions and rarely entered by a whole-body tree
-  // that also drives (on the benchmark's low areas for morphology B: arm-only 0.03-1.3 s,
-  // whole-body 2 of 12 in 8 s).
-  Eigen::VectorXd box_lo(n), box_hi(n);
-  for (int i = 0; i < n; ++i) {
-    box_lo[i] = bounds.low[static_cast<std::size_t>(i)];
-    box_hi[i] = bounds.high[static_cast<std::size_t>(i)];
-  }
+  // RRT-Connect over the joints [first, first + count) with the others held.
   auto subspace_path = [&](int first, int count, const Eigen::VectorXd& from, const Eigen::VectorXd& to, double budget) {
     return subspace_rrt(model, checker, q_start_full, params_.check_resolution, first, count, box_lo, box_hi, from, to, budget, seed,
                         &last_rejection);
@@ -425,6 +410,7 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   // that also drives (on the benchmark's low areas for morphology B: arm-only 0.03-1.3 s,
   // whole-body 2 of 12 in 8 s). Half the budget for each part.
   auto arm_and_drive = [&](bool reach_first, double budget) -> std::vector<Eigen::VectorXd> {
+    replayed = false;
     const auto t_order = Clock::now();
     const auto rest = [&] { return std::max(0.0, budget - seconds_since(t_order)); };
     Eigen::VectorXd turn = q_start;  // where the arm moves: the start's or the goal's base pose
