@@ -6,8 +6,8 @@
 // links and the map's obstacles). Seeds: the start posture with the base placed for it, the
 // start posture as it is, the hints (remembered postures), the start posture and the hints
 // with the first arm joint turned, then random arm postures (the best of a few draws, base
-// placed for each). Every converged posture is judged by the exact StateChecker; the valid one of least
-// cost (distance to the start, inverse manipulability) is kept.
+// placed for each). Every converged posture is judged by the exact StateChecker; the valid
+// one of least cost (distance to the start, inverse manipulability) is kept.
 //
 // The solver is hand-written instead of a library's (Ipopt is in Debian): 9-12 variables and
 // a few hundred cheap residual rows, a dense two-priority Gauss-Newton step with a
@@ -46,8 +46,8 @@ double manipulability(const PlanningModel& model, kinematics::Data& data, const 
 }
 
 // Turned seeds: the first arm joint turned by +-kTurnStep, +-2 kTurnStep, ... (kTurns each way).
-// On the benchmark's low areas beside obstacles a turned bare-wall posture converges to a valid
-// one about 15 % of the time, a random arm posture under 1 %.
+// On one of the benchmark's low areas beside a pillar (seed 7, #01; A) 34 of 234 turned
+// bare-wall postures converged to valid ones, 1 of 150 random arm postures.
 constexpr double kTurnStep = 0.6;
 constexpr int kTurns = 5;
 
