@@ -84,6 +84,15 @@ std::vector<Eigen::VectorXd> subspace_rrt(const PlanningModel& model, StateCheck
                                           double check_resolution, int first, int count, const Eigen::VectorXd& lo,
                                           const Eigen::VectorXd& hi, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                                           double budget, uint64_t seed, Validity* last_rejection) {
+  // Both ends must be valid (e.g. the goal's arm posture where the base stands at the start
+  // may hit the wall); OMPL would otherwise report it as an error and search in vain.
+  for (const Eigen::VectorXd* end : {&from, &to}) {
+    const Validity v = checker.check(model.to_full(*end, full_template));
+    if (!v.valid()) {
+      if (last_rejection != nullptr) *last_rejection = v;
+      return {};
+    }
+  }
   static const bool kActive = true;
   auto sub = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(count));
   ob::RealVectorBounds sub_bounds(static_cast<unsigned>(count));
