@@ -6,6 +6,7 @@
 
 #include <octomap/OcTree.h>
 
+#include <memory>
 #include <random>
 
 #include "planner/fixtures.hpp"
@@ -80,6 +81,14 @@ Eigen::VectorXd start_state(const PlanningModel& m) {
   q[k.joint_index_or_throw("J2_E")] = 0.2;
   q[k.joint_index_or_throw("J4_E")] = -0.3;
   return q;
+}
+
+// A planner with `params` on morphology `which` (model `version`) and the map of site(2.2).
+std::unique_ptr<Planner> planner_at_site(const Params& params, char which, uint64_t version) {
+  auto planner = std::make_unique<Planner>(params);
+  planner->set_model(morphology(which, version));
+  planner->set_environment(environment_of(site(2.2), params));
+  return planner;
 }
 
 struct Case {
@@ -231,19 +240,17 @@ TEST(Planner, ObstacleFromAPointCloudIsAvoided) {
 TEST(Planner, WarmUpFillsThePostureMemoryAndPlansStayValid) {
   Params params;
   params.seed = 23;
-  Planner planner(params);
-  planner.set_model(morphology('a', 9));
+  const auto planner = planner_at_site(params, 'a', 9);
   // Mid heights on a bare wall: every one has goal postures.
-  EXPECT_EQ(planner.warm_up(1.0, 1.4, 0.2, 3.0), 3);
+  EXPECT_EQ(planner->warm_up(1.0, 1.4, 0.2, 3.0), 3);
   // No model: nothing to warm up.
   EXPECT_EQ(Planner(params).warm_up(1.0, 1.4, 0.2, 1.0), 0);
   // Goals near the remembered heights plan (seeded from memory) and re-check densely.
   const World world = site(2.2);
-  planner.set_environment(environment_of(world, params));
-  const auto model = planner.model();
+  const auto model = planner->model();
   const Eigen::VectorXd start = start_state(*model);
   PlanRequest req{5, 9, "", {{fixtures::drilling_area(2.2, 0.2, 1.1)}, {fixtures::drilling_area(2.2, -0.3, 1.3)}}};
-  const PlanResult res = planner.plan(req, start);
+  const PlanResult res = planner->plan(req, start);
   ASSERT_EQ(res.status, Status::kSucceeded) << res.reason;
   Eigen::VectorXd from = start;
   for (std::size_t g = 0; g < res.goals.size(); ++g) {
@@ -294,14 +301,12 @@ TEST(Planner, LongArmReachesALowAreaAndTheArmOnlyPathsStayValid) {
   params.planning_time = 20.0;
   params.nspg_time = 10.0;
   params.path_attempt_time = 6.0;
-  Planner planner(params);
-  planner.set_model(morphology('b', 3));
+  const auto planner = planner_at_site(params, 'b', 3);
   const World world = site(2.2);
-  planner.set_environment(environment_of(world, params));
-  const auto model = planner.model();
+  const auto model = planner->model();
   const Eigen::VectorXd start = start_state(*model);
   const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.0, 0.6);
-  const PlanResult res = planner.plan({7, 3, "", {{area}}}, start);
+  const PlanResult res = planner->plan({7, 3, "", {{area}}}, start);
   ASSERT_EQ(res.status, Status::kSucceeded) << res.reason;
   const GoalResult& g = res.goals[0];
   // Here the direct motion and the whole-body projected line fail; the arm-only search finds
@@ -315,15 +320,13 @@ TEST(Planner, WarmUpRemembersArmPathsThatLaterPlansReplay) {
   // parked arm; a later low goal near a box replays it (checked against the map).
   Params params;
   params.seed = 31;
-  Planner planner(params);
-  planner.set_model(morphology('b', 5));
-  ASSERT_EQ(planner.warm_up(0.5, 0.7, 0.1, 2.0), 3);
+  const auto planner = planner_at_site(params, 'b', 5);
+  ASSERT_EQ(planner->warm_up(0.5, 0.7, 0.1, 2.0), 3);
   const World world = site(2.2);
-  planner.set_environment(environment_of(world, params));
-  const auto model = planner.model();
+  const auto model = planner->model();
   const Eigen::VectorXd start = start_state(*model);
   const Eigen::Isometry3d area = fixtures::drilling_area(2.2, -0.3, 0.6);
-  const PlanResult res = planner.plan({8, 5, "", {{area}}}, start);
+  const PlanResult res = planner->plan({8, 5, "", {{area}}}, start);
   ASSERT_EQ(res.status, Status::kSucceeded) << res.reason;
   const GoalResult& g = res.goals[0];
   EXPECT_NE(g.path_method.find("remembered arm path"), std::string::npos) << g.path_method;
