@@ -259,6 +259,64 @@ TEST(Planner, WarmUpFillsThePostureMemoryAndPlansStayValid) {
   }
 }
 
+namespace {
+
+// A goal posture found for a low area on a bare wall (morphology A), and the wall with a crate
+// where that posture's base stands: the posture, remembered and placed as it is, collides.
+struct BlockedHint {
+  PostureResult first;
+  World blocked;
+};
+
+BlockedHint hint_blocked_by_crate(const std::shared_ptr<const PlanningModel>& model, const Params& params,
+                                  const Eigen::Isometry3d& area) {
+  const Eigen::VectorXd start = start_state(*model);
+  World bare;
+  bare.boxes.push_back(fixtures::wall_at(area.translation().x()));
+  StateChecker bare_checker(model, environment_of(bare, params), params, params.environment_padding);
+  BlockedHint out{generate_posture(*model, bare_checker, params, model->tool(""), start, area, 1), bare};
+  EXPECT_TRUE(out.first.found) << out.first.reason;
+  if (!out.first.found) return out;
+  out.blocked.boxes.push_back({"crate", Eigen::Vector3d(0.5, 0.5, 0.4), Eigen::Vector3d(out.first.q[0], out.first.q[1], 0.2), 0.0});
+  StateChecker checker(model, environment_of(out.blocked, params), params, params.environment_padding);
+  EXPECT_FALSE(checker.check(model->to_full(out.first.q, start)).valid());
+  return out;
+}
+
+// Only the seeds before the random ones: nspg_seeds ends the search, not the clock.
+Params without_random_seeds(const Params& params, int seeds) {
+  Params few = params;
+  few.nspg_seeds = seeds;
+  few.nspg_time = 60.0;
+  return few;
+}
+
+}  // namespace
+
+TEST(Planner, MirroredHintStandsOnTheAreasOtherSide) {
+  Params params;
+  params.seed = 5;
+  const auto model = PlanningModel::build(morphology('a', 1), params);
+  const EndEffectorSpec& tool = model->tool("");
+  const Eigen::VectorXd start = start_state(*model);
+  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.0, 0.55);
+  const BlockedHint b = hint_blocked_by_crate(model, params, area);
+  ASSERT_TRUE(b.first.found);
+  ASSERT_GT(std::abs(b.first.q[1]), 0.2) << "a low area: the base stands beside it";
+  // Seeds: the start posture placed and as it is, the hint, its mirror image; nothing else.
+  StateChecker checker(model, environment_of(b.blocked, params), params, params.environment_padding);
+  const Eigen::VectorXd hint = b.first.q.tail(b.first.q.size() - 3);
+  const PostureResult mirrored = generate_posture(*model, checker, without_random_seeds(params, 2 + 1 + 1), tool, start, area, 1, {hint});
+  ASSERT_TRUE(mirrored.found) << mirrored.reason;
+  EXPECT_LT(mirrored.q[1] * b.first.q[1], 0.0) << "the base should stand on the other side of the area";
+  const Eigen::VectorXd image = *model->mirrored_arm(hint);
+  EXPECT_LT((mirrored.q.tail(hint.size() - 1) - image.tail(hint.size() - 1)).cwiseAbs().maxCoeff(), 0.3)
+      << "the posture should be the hint's image";
+  StateChecker exact(model, environment_of(b.blocked, params), params, 0.0);
+  EXPECT_TRUE(exact.check(model->to_full(mirrored.q, start), tool.frame).valid());
+  EXPECT_TRUE(exact.check(model->to_full(mirrored.q, start)).valid());
+}
+
 TEST(Planner, TurnedHintGetsPastAnObstacleThatBlocksItsBase) {
   Params params;
   params.seed = 5;
@@ -266,30 +324,32 @@ TEST(Planner, TurnedHintGetsPastAnObstacleThatBlocksItsBase) {
   const EndEffectorSpec& tool = model->tool("");
   const Eigen::VectorXd start = start_state(*model);
   const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.3, 0.55);
-  // A low area on a bare wall: a goal posture to remember.
-  World bare;
-  bare.boxes.push_back(fixtures::wall_at(2.2));
-  StateChecker bare_checker(model, environment_of(bare, params), params, params.environment_padding);
-  const PostureResult first = generate_posture(*model, bare_checker, params, tool, start, area, 1);
-  ASSERT_TRUE(first.found) << first.reason;
-  // A crate where that posture's base stands: the remembered posture, placed as it is, collides.
-  World blocked = bare;
-  blocked.boxes.push_back({"crate", Eigen::Vector3d(0.5, 0.5, 0.4), Eigen::Vector3d(first.q[0], first.q[1], 0.2), 0.0});
-  StateChecker checker(model, environment_of(blocked, params), params, params.environment_padding);
-  ASSERT_FALSE(checker.check(model->to_full(first.q, start)).valid());
-  // Seeded with that posture and a budget that ends before any random seed (the start posture
-  // placed and as it is, the hint, then the first joint turned either way, at most 5 steps
-  // each for the start posture and the hint): a turned variant gets past the crate.
-  Params few = params;
-  few.nspg_seeds = 2 + 1 + 2 * 2 * 5;
-  few.nspg_time = 60.0;  // the seed count ends it, not the clock
-  const Eigen::VectorXd hint = first.q.tail(first.q.size() - 3);
-  const PostureResult turned = generate_posture(*model, checker, few, tool, start, area, 1, {hint});
-  ASSERT_TRUE(turned.found) << turned.reason;
-  EXPECT_GT((turned.q.head<2>() - first.q.head<2>()).norm(), 0.25) << "the base should stand clear of the crate";
-  StateChecker exact(model, environment_of(blocked, params), params, 0.0);
-  EXPECT_TRUE(exact.check(model->to_full(turned.q, start), tool.frame).valid());
-  EXPECT_TRUE(exact.check(model->to_full(turned.q, start)).valid());
+  const BlockedHint b = hint_blocked_by_crate(model, params, area);
+  ASSERT_TRUE(b.first.found);
+  const Eigen::VectorXd hint = b.first.q.tail(b.first.q.size() - 3);
+  const Eigen::VectorXd image = *model->mirrored_arm(hint);
+  // Every seed before the random ones (the start posture placed and as it is, the hint and its
+  // image, then the first joint turned either way, at most 5 steps each for the start posture,
+  // the hint and the image), all valid postures kept: some are the hint or its image turned,
+  // past the crate.
+  Params all = without_random_seeds(params, 2 + 2 + 2 * 3 * 5);
+  all.nspg_enough = 1000;
+  StateChecker checker(model, environment_of(b.blocked, params), params, params.environment_padding);
+  const PostureResult r = generate_posture(*model, checker, all, tool, start, area, 1, {hint});
+  StateChecker exact(model, environment_of(b.blocked, params), params, 0.0);
+  int turned = 0;
+  for (const Eigen::VectorXd& q : r.valid) {
+    const Eigen::VectorXd arm = q.tail(hint.size());
+    for (const Eigen::VectorXd* family : {&hint, &image}) {
+      const bool same_shape = (arm.tail(hint.size() - 1) - family->tail(hint.size() - 1)).cwiseAbs().maxCoeff() < 0.3;
+      if (!same_shape || std::abs(arm[0] - (*family)[0]) < 0.3) continue;
+      turned += 1;
+      EXPECT_GT((q.head<2>() - b.first.q.head<2>()).norm(), 0.25) << "the base should stand clear of the crate";
+      EXPECT_TRUE(exact.check(model->to_full(q, start), tool.frame).valid());
+      EXPECT_TRUE(exact.check(model->to_full(q, start)).valid());
+    }
+  }
+  EXPECT_GT(turned, 0) << r.valid.size() << " valid postures, none a turned hint or image";
 }
 
 TEST(Planner, LongArmReachesALowAreaAndTheArmOnlyPathsStayValid) {

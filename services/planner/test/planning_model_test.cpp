@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <random>
 
 #include "planner/state_checker.hpp"
@@ -108,6 +109,66 @@ TEST(PlanningModel, ToolAndCameraFrames) {
   } catch (const PlannerError& e) {
     EXPECT_NE(std::string(e.what()).find("drill_E"), std::string::npos) << e.what();
   }
+}
+
+TEST(PlanningModel, MirroredArmReflectsTheCamera) {
+  // The image about the vertical plane through the first arm joint: the camera at the same
+  // height and distance from that joint's axis, its optical axis at the same elevation. On A
+  // and on C (the arm on the Passive Base Link).
+  for (const char which : {'a', 'c'}) {
+    const auto m = morphology(which);
+    const std::string camera = m->camera_frame(m->tool(""));
+    std::string first_joint_link;
+    for (const LinkNode& l : m->links()) {
+      if (l.full_index == m->planned_indices()[3]) {
+        first_joint_link = l.name;
+        break;
+      }
+    }
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(m->full_dof());
+    const Eigen::Isometry3d j1 = m->link_pose(zero, first_joint_link);
+    const Eigen::Vector3d up = j1.linear() * m->links()[static_cast<std::size_t>(m->link_index(first_joint_link))].axis;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    int images = 0;
+    for (int k = 0; k < 50; ++k) {
+      Eigen::VectorXd q = Eigen::VectorXd::Zero(m->dof());
+      for (int i = 3; i < m->dof(); ++i) q[i] = m->lower()[i] + (m->upper()[i] - m->lower()[i]) * unit(rng);
+      const std::optional<Eigen::VectorXd> image = m->mirrored_arm(q.tail(m->dof() - 3));
+      if (!image) continue;
+      images += 1;
+      const std::optional<Eigen::VectorXd> back = m->mirrored_arm(*image);
+      ASSERT_TRUE(back.has_value());
+      EXPECT_TRUE(back->isApprox(q.tail(m->dof() - 3), 1e-12));
+      Eigen::VectorXd qm = q;
+      qm.tail(m->dof() - 3) = *image;
+      const Eigen::Isometry3d c1 = m->link_pose(m->to_full(q, zero), camera);
+      const Eigen::Isometry3d c2 = m->link_pose(m->to_full(qm, zero), camera);
+      const auto off_axis = [&](const Eigen::Vector3d& p) {
+        const Eigen::Vector3d d = p - j1.translation();
+        return (d - d.dot(up) * up).norm();
+      };
+      EXPECT_NEAR(c1.translation().dot(up), c2.translation().dot(up), 1e-9) << which;
+      EXPECT_NEAR(off_axis(c1.translation()), off_axis(c2.translation()), 1e-9) << which;
+      EXPECT_NEAR(c1.linear().col(2).dot(up), c2.linear().col(2).dot(up), 1e-9) << which;
+      EXPECT_GT((c1.translation() - c2.translation()).norm() + (*image - q.tail(m->dof() - 3)).norm(), 0.0);
+    }
+    EXPECT_GE(images, 40) << which << ": the joint limits are nearly symmetric, most postures have an image";
+  }
+  // An oblique joint axis (tilted 30 degrees out of both planes): no mirror image.
+  ModelDescription d = fixtures::model_from_assembly(fixtures::data_dir() / "morphology_a.yaml", 1);
+  std::string arm_joint;
+  for (const ChainSpec& c : d.chains) {
+    if (c.role == "arm") arm_joint = c.joints.at(1);
+  }
+  const std::size_t at = d.urdf.find("<joint name=\"" + arm_joint + "\"");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t axis = d.urdf.find("<axis", at);
+  const std::size_t end = d.urdf.find("/>", axis);
+  d.urdf.replace(axis, end + 2 - axis, "<axis xyz=\"0.5 0.5 0.7071068\"/>");
+  const auto oblique = PlanningModel::build(d, {});
+  EXPECT_FALSE(oblique->mirrored_arm(Eigen::VectorXd::Zero(oblique->dof() - 3)).has_value());
+  EXPECT_TRUE(morphology('a')->mirrored_arm(Eigen::VectorXd::Zero(oblique->dof() - 3)).has_value());
 }
 
 TEST(PlanningModel, BadModelsNameTheProblem) {

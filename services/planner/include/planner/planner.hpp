@@ -90,8 +90,9 @@ class Planner {
   };
   std::vector<Eigen::VectorXd> hints_for(const PlanningModel& model, double height) const;
   void remember(const PlanningModel& model, double height, const Eigen::VectorXd& q, std::vector<Eigen::VectorXd> arm_path = {});
-  // A remembered arm path that ends near `arm` (all joints but the first within 0.6 rad; the
-  // first joint's offset is added along the path), or empty.
+  // A remembered arm path that ends near `arm` or near its mirror image (all joints but the
+  // first within 0.6 rad; the path is then mirrored, and the first joint's offset is added
+  // along it), or empty.
   std::vector<Eigen::VectorXd> arm_path_to(const PlanningModel& model, const Eigen::VectorXd& arm) const;
 
   Params params_;

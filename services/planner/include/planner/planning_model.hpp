@@ -4,6 +4,7 @@
 // Immutable once built (Model/Data split: per-thread state lives in StateChecker).
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,13 @@ class PlanningModel {
   /// Index of a link in links(), or -1.
   [[nodiscard]] int link_index(const std::string& name) const;
 
+  /// The mirror image of an arm posture (planned arm joints, base excluded) about the
+  /// vertical plane through the arm's first joint, or none: when the model's arm has an
+  /// oblique joint axis, or the image leaves the joint limits. Exact for modules whose
+  /// offsets lie in that plane, approximate otherwise (a seed: results are always checked);
+  /// mirrored_arm(mirrored_arm(a)) == a.
+  [[nodiscard]] std::optional<Eigen::VectorXd> mirrored_arm(const Eigen::VectorXd& arm) const;
+
   /// Full q from planned q, other joints from `full_template`.
   [[nodiscard]] Eigen::VectorXd to_full(const Eigen::VectorXd& planned, const Eigen::VectorXd& full_template) const;
   /// Planned part of a full q.
@@ -115,6 +123,7 @@ class PlanningModel {
   std::vector<std::vector<bool>> disabled_;
   std::vector<std::string> ignored_;
   std::string camera_prefix_;
+  std::optional<Eigen::VectorXd> arm_mirror_;  // per arm joint: +1 or -1 (see mirrored_arm)
 };
 
 }  // namespace concert::planner

@@ -12,6 +12,7 @@
 #include <functional>
 #include <cmath>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
 #include "planner/trajectory.hpp"
@@ -36,6 +37,8 @@ constexpr double kLineStep = 0.15;
 constexpr double kWarmUpPathTime = 0.5;
 // A remembered arm path serves a goal whose arm joints after the first are this close [rad].
 constexpr double kArmPathReuse = 0.6;
+// Remembered postures this close [m of height, rad] are the same posture.
+constexpr double kSamePosture = 1e-3;
 // Share of a path attempt's remaining time for each order of the arm-alone-and-drive search
 // (arm first, then drive first, each of what is left); the rest is whole-body RRT-Connect's.
 constexpr double kArmShare = 0.5;
@@ -229,26 +232,51 @@ void Planner::remember(const PlanningModel& model, double height, const Eigen::V
   if (params_.nspg_memory <= 0) return;
   std::lock_guard lock(mutex_);
   if (model_.get() != &model) return;
+  const Eigen::VectorXd arm = q.tail(q.size() - 3);
+  for (Remembered& m : memory_) {
+    // The same posture again (both warm-up passes, or a plan that started from it): one entry.
+    if (std::abs(m.height - height) < kSamePosture && (m.arm - arm).cwiseAbs().maxCoeff() < kSamePosture) {
+      if (m.arm_path.empty()) m.arm_path = std::move(arm_path);
+      return;
+    }
+  }
   if (static_cast<int>(memory_.size()) >= params_.nspg_memory) memory_.erase(memory_.begin());
-  memory_.push_back({height, q.tail(q.size() - 3), std::move(arm_path)});
+  memory_.push_back({height, arm, std::move(arm_path)});
 }
 
 std::vector<Eigen::VectorXd> Planner::arm_path_to(const PlanningModel& model, const Eigen::VectorXd& arm) const {
   std::lock_guard lock(mutex_);
   if (model_.get() != &model) return {};
+  // The goal's arm is compared with each remembered posture and with its mirror image (the
+  // path then mirrored too: the robot's torques and self collisions are nearly symmetric, and
+  // the replay is checked anyway).
+  const std::optional<Eigen::VectorXd> goal_mirror = model.mirrored_arm(arm);
   const Remembered* best = nullptr;
+  bool best_mirrored = false;
   double best_d = kArmPathReuse;
+  const auto distance = [](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    return (a.tail(a.size() - 1) - b.tail(b.size() - 1)).cwiseAbs().maxCoeff();
+  };
   for (const Remembered& m : memory_) {
     if (m.arm_path.empty()) continue;
-    const double d = (m.arm.tail(m.arm.size() - 1) - arm.tail(arm.size() - 1)).cwiseAbs().maxCoeff();
-    if (d < best_d) {
-      best_d = d;
-      best = &m;
+    for (const bool mirrored : {false, true}) {
+      if (mirrored && !goal_mirror) continue;
+      const double d = distance(m.arm, mirrored ? *goal_mirror : arm);
+      if (d < best_d) {
+        best_d = d;
+        best = &m;
+        best_mirrored = mirrored;
+      }
     }
   }
   if (best == nullptr) return {};
-  std::vector<Eigen::VectorXd> out = best->arm_path;
-  const double turn = arm[0] - best->arm[0];
+  std::vector<Eigen::VectorXd> out;
+  for (const Eigen::VectorXd& a : best->arm_path) {
+    std::optional<Eigen::VectorXd> w = best_mirrored ? model.mirrored_arm(a) : a;
+    if (!w) return {};  // the image leaves the joint limits
+    out.push_back(std::move(*w));
+  }
+  const double turn = arm[0] - out.back()[0];  // the path ends at the remembered posture (or its image)
   for (Eigen::VectorXd& a : out) a[0] += turn;
   return out;
 }

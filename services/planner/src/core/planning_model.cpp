@@ -68,6 +68,9 @@ const char* to_string(Status status) {
   return "?";
 }
 
+// An axis within this (cosine) of a plane's normal crosses it; within this of 0, lies in it.
+constexpr double kAxisTolerance = 1e-3;
+
 std::shared_ptr<const PlanningModel> PlanningModel::build(const ModelDescription& d, const Params& params) {
   kinematics::Model kin = [&] {
     try {
@@ -237,7 +240,52 @@ std::shared_ptr<const PlanningModel> PlanningModel::build(const ModelDescription
     }
     m->base_height_ = std::isfinite(lowest) ? params.floor_height - lowest : saved;
   }
+
+  // Mirror image of arm postures about the vertical plane through the first arm joint that
+  // holds the axis of the first arm joint across it (a horizontal axis: the shoulder).
+  // Reflecting a posture in a plane negates each revolute angle whose axis lies in the plane
+  // and keeps each one whose axis crosses it (prismatic joints the other way round), so the
+  // signs are read off the joint axes at q = 0. The image is exact when the modules' offsets
+  // lie in that plane (the CONCERT modules': MirroredArmReflectsTheCamera), approximate
+  // otherwise; the planner uses it as a seed and checks every result.
+  {
+    std::vector<Eigen::Isometry3d> poses;
+    m->link_poses(Eigen::VectorXd::Zero(k.dof()), poses);
+    std::map<int, Eigen::Vector3d> axis_of;  // full index -> world axis at q = 0
+    for (std::size_t i = 0; i < nl; ++i) {
+      if (m->links_[i].full_index >= 0) axis_of[m->links_[i].full_index] = poses[i].linear() * m->links_[i].axis;
+    }
+    std::optional<Eigen::Vector3d> normal;
+    for (int i = 3; i < n && !normal; ++i) {
+      const Eigen::Vector3d& a = axis_of[m->planned_[static_cast<std::size_t>(i)]];
+      if (std::abs(a.z()) < kAxisTolerance) normal = a.normalized();
+    }
+    Eigen::VectorXd signs(n - 3);
+    bool clean = normal.has_value();
+    for (int i = 3; i < n && clean; ++i) {
+      const int fi = m->planned_[static_cast<std::size_t>(i)];
+      const double across = std::abs(axis_of[fi].normalized().dot(*normal));
+      bool prismatic = false;
+      for (const LinkNode& l : m->links_) prismatic = prismatic || (l.full_index == fi && l.prismatic);
+      if (across > 1.0 - kAxisTolerance) {
+        signs[i - 3] = prismatic ? -1.0 : 1.0;
+      } else if (across < kAxisTolerance) {
+        signs[i - 3] = prismatic ? 1.0 : -1.0;
+      } else {
+        clean = false;  // an oblique axis: no mirror image within the joint space
+      }
+    }
+    if (clean) m->arm_mirror_ = signs;
+  }
   return m;
+}
+
+std::optional<Eigen::VectorXd> PlanningModel::mirrored_arm(const Eigen::VectorXd& arm) const {
+  if (!arm_mirror_ || arm.size() != arm_mirror_->size()) return std::nullopt;
+  Eigen::VectorXd out = arm.cwiseProduct(*arm_mirror_);
+  const Eigen::Index n = arm.size();
+  if ((out.array() < lower_.tail(n).array()).any() || (out.array() > upper_.tail(n).array()).any()) return std::nullopt;
+  return out;
 }
 
 bool PlanningModel::pair_disabled(int a, int b) const {
