@@ -1,7 +1,8 @@
 // bench_planner: a fixed, seeded set of drilling-approach problems per morphology (paper
 // section 6.1: walls with drilling areas at heights 0.35-2.9 m, obstacles on the floor), run
 // through the whole planner (NSPG + RRT-Connect + simplification + timing). Reports success
-// rate and planning time median / p95 per morphology. Not a test: no assertions on time.
+// rate, planning time median / p95 and the median duration of the planned motions (their
+// quality) per morphology. Not a test: no assertions on time.
 //
 //   bench_planner [--problems N] [--seed S] [--contact-force NEWTON] [--params FILE] [--only I]
 //                 [--morphology abc] [--warm-up] [--oracle SECONDS] [--verbose]
@@ -125,18 +126,19 @@ int main(int argc, char** argv) {
   const std::vector<Problem> problems = make_problems(count, seed);
   if (contact_force) base_params.contact_force = *contact_force;
   std::printf("drilling force checked at the goal: %.0f N\n", base_params.contact_force);
-  std::printf("%-12s %8s %9s %11s %11s %11s %13s %11s%s\n", "morphology", "problems", "success", "median ms", "p95 ms", "max ms",
-              "ok median ms", "ok p95 ms", oracle > 0.0 ? "   of solvable" : "");
+  std::printf("%-12s %8s %9s %11s %11s %11s %13s %11s %10s%s\n", "morphology", "problems", "success", "median ms", "p95 ms", "max ms",
+              "ok median ms", "ok p95 ms", "motion s", oracle > 0.0 ? "   of solvable" : "");
   struct Outcome {
     bool success = false;
     double ms = 0.0;
     std::string status;
+    double motion = 0.0;    // duration of the planned trajectory [s]
     bool solvable = false;  // solved within 2 s or by the oracle's long run
   };
   std::map<char, std::vector<Outcome>> outcomes;
   // One summary row: success rate, times over every problem and over the successes.
   auto report = [&](const std::string& label, const std::vector<Outcome>& rows) {
-    std::vector<double> times, ok_times;
+    std::vector<double> times, ok_times, motions;
     std::map<std::string, int> failures;
     int solvable = 0;
     for (const Outcome& o : rows) {
@@ -144,14 +146,15 @@ int main(int argc, char** argv) {
       times.push_back(o.ms);
       if (o.success) {
         ok_times.push_back(o.ms);
+        motions.push_back(o.motion);
       } else {
         failures[o.status] += 1;
       }
     }
-    std::printf("%-12s %8zu %8.1f%% %11.1f %11.1f %11.1f %13.1f %11.1f", label.c_str(), rows.size(),
+    std::printf("%-12s %8zu %8.1f%% %11.1f %11.1f %11.1f %13.1f %11.1f %10.1f", label.c_str(), rows.size(),
                 100.0 * static_cast<double>(ok_times.size()) / static_cast<double>(std::max<std::size_t>(1, rows.size())),
                 percentile(times, 0.5), percentile(times, 0.95), percentile(times, 1.0), percentile(ok_times, 0.5),
-                percentile(ok_times, 0.95));
+                percentile(ok_times, 0.95), percentile(motions, 0.5));
     if (oracle > 0.0) {
       std::printf("   %zu/%d = %.1f%%", ok_times.size(), solvable,
                   100.0 * static_cast<double>(ok_times.size()) / static_cast<double>(std::max(1, solvable)));
@@ -185,12 +188,13 @@ int main(int argc, char** argv) {
       const auto t0 = std::chrono::steady_clock::now();
       const PlanResult r = planner.plan(req, start, {});
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      rows[i] = {r.status == Status::kSucceeded && ms <= 2000.0, ms, to_string(r.status)};
+      rows[i] = {r.status == Status::kSucceeded && ms <= 2000.0, ms, to_string(r.status),
+                 r.status == Status::kSucceeded ? r.goals[0].trajectory.duration() : 0.0};
       rows[i].solvable = rows[i].success;
       if (verbose) {
-        std::printf("  %c #%02zu wall %.2f m, area (%.2f, %.2f) m: %-12s %8.1f ms (nspg %.1f ms, path: %s)  %s\n", m, i, p.wall_x,
-                    p.y, p.z, to_string(r.status), ms, r.goals.empty() ? 0.0 : 1e3 * r.goals[0].nspg_seconds,
-                    r.goals.empty() ? "" : r.goals[0].path_method.c_str(), r.reason.c_str());
+        std::printf("  %c #%02zu wall %.2f m, area (%.2f, %.2f) m: %-12s %8.1f ms (nspg %.1f ms, path: %s, motion %.1f s)  %s\n", m, i,
+                    p.wall_x, p.y, p.z, to_string(r.status), ms, r.goals.empty() ? 0.0 : 1e3 * r.goals[0].nspg_seconds,
+                    r.goals.empty() ? "" : r.goals[0].path_method.c_str(), rows[i].motion, r.reason.c_str());
       }
       if (oracle > 0.0 && !rows[i].success) {
         // The same problem with a long budget and other seeds: was the 2 s budget the limit?

@@ -461,7 +461,18 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
     first.insert(first.end(), second.begin() + 1, second.end());
     return first;
   };
-  // A chain of feasible waypoints, shortcut and thinned in the whole-body space.
+  // A path shortcut and thinned in the whole-body space (shortcuts join the arm's and the
+  // base's moves where they can go together), as waypoints.
+  auto simplified_path = [&](og::PathGeometric& path) {
+    const auto steps = static_cast<unsigned>(params_.simplify_iterations);
+    og::PathSimplifier simplifier(si);
+    simplifier.shortcutPath(path, steps, steps);
+    simplifier.reduceVertices(path, steps);
+    simplifier.collapseCloseVertices(path);
+    std::vector<Eigen::VectorXd> out;
+    for (std::size_t i = 0; i < path.getStateCount(); ++i) out.push_back(to_eigen(path.getState(static_cast<unsigned>(i)), n));
+    return out;
+  };
   auto simplified = [&](const std::vector<Eigen::VectorXd>& line) {
     og::PathGeometric path(si);
     for (const Eigen::VectorXd& q : line) {
@@ -469,12 +480,7 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
       from_eigen(q, st.get());
       path.append(st.get());
     }
-    og::PathSimplifier simplifier(si);
-    simplifier.shortcutPath(path, static_cast<unsigned>(params_.simplify_iterations), static_cast<unsigned>(params_.simplify_iterations));
-    simplifier.reduceVertices(path, static_cast<unsigned>(params_.simplify_iterations));
-    std::vector<Eigen::VectorXd> out;
-    for (std::size_t i = 0; i < path.getStateCount(); ++i) out.push_back(to_eigen(path.getState(static_cast<unsigned>(i)), n));
-    return out;
+    return simplified_path(path);
   };
   std::vector<Eigen::VectorXd> line;
   if (si->checkMotion(start.get(), goal.get())) {
@@ -508,12 +514,7 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
       r.plan_seconds = seconds_since(t0);
       return r;
     }
-    auto& path = *pdef->getSolutionPath()->as<og::PathGeometric>();
-    og::PathSimplifier simplifier(si);
-    simplifier.shortcutPath(path, static_cast<unsigned>(params_.simplify_iterations), static_cast<unsigned>(params_.simplify_iterations));
-    simplifier.reduceVertices(path, static_cast<unsigned>(params_.simplify_iterations));
-    simplifier.collapseCloseVertices(path);
-    for (std::size_t i = 0; i < path.getStateCount(); ++i) waypoints.push_back(to_eigen(path.getState(static_cast<unsigned>(i)), n));
+    waypoints = simplified_path(*pdef->getSolutionPath()->as<og::PathGeometric>());
   }
   r.trajectory = time_parameterize(waypoints, model.joint_names(), motion_limits(model, params_), params_.sample_period);
   r.status = Status::kSucceeded;
