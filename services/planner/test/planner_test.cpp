@@ -317,6 +317,34 @@ TEST(Planner, MirroredHintStandsOnTheAreasOtherSide) {
   EXPECT_TRUE(exact.check(model->to_full(mirrored.q, start)).valid());
 }
 
+TEST(Planner, ResumedPostureSearchGivesAnotherPosture) {
+  // When no path reaches a goal posture, the planner asks for another from the seed after the
+  // one that gave it: a different posture, later seeds, still valid.
+  Params params;
+  params.seed = 5;
+  params.nspg_time = 60.0;  // the seeds end it, not the clock
+  const auto model = PlanningModel::build(morphology('a', 1), params);
+  const EndEffectorSpec& tool = model->tool("");
+  const Eigen::VectorXd start = start_state(*model);
+  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.0, 0.55);
+  World bare;
+  bare.boxes.push_back(fixtures::wall_at(2.2));
+  StateChecker checker(model, environment_of(bare, params), params, params.environment_padding);
+  const PostureResult first = generate_posture(*model, checker, params, tool, start, area, 1);
+  ASSERT_TRUE(first.found) << first.reason;
+  const std::vector<Eigen::VectorXd> hints{first.q.tail(first.q.size() - 3)};
+  const PostureResult a = generate_posture(*model, checker, params, tool, start, area, 1, hints);
+  ASSERT_TRUE(a.found) << a.reason;
+  EXPECT_EQ(a.next_seed, a.candidates);
+  const PostureResult b = generate_posture(*model, checker, params, tool, start, area, 1, hints, a.next_seed);
+  ASSERT_TRUE(b.found) << b.reason;
+  EXPECT_GT(b.next_seed, a.next_seed);
+  EXPECT_EQ(b.next_seed - a.next_seed, b.candidates);
+  EXPECT_GT((b.q - a.q).cwiseAbs().maxCoeff(), 1e-3) << "the resumed search gave the same posture";
+  StateChecker exact(model, environment_of(bare, params), params, 0.0);
+  EXPECT_TRUE(exact.check(model->to_full(b.q, start), tool.frame).valid());
+}
+
 TEST(Planner, TurnedHintGetsPastAnObstacleThatBlocksItsBase) {
   Params params;
   params.seed = 5;

@@ -20,6 +20,7 @@ struct PostureResult {
   std::string reason;         ///< why nothing was found (most frequent rejection)
   int candidates = 0;         ///< seeds solved (each ends on the task or held off it)
   std::vector<Eigen::VectorXd> valid;  ///< every valid posture found (q among them)
+  int next_seed = 0;          ///< index of the first seed not tried (resume from here)
 };
 
 /// Null-Space Posture Generator: the camera frame at Params::camera_distance in front of `area`
@@ -28,12 +29,15 @@ struct PostureResult {
 /// posture and seeded random ones, until Params::nspg_time; keeps the valid posture of least
 /// cost. Seeded by `seed`.
 /// `hints`: arm postures (planned joints after the base) to seed after the start posture,
-/// best first (the planner passes postures that solved nearby areas before). The start
-/// posture and the hints are then tried again with the first arm joint turned (the base
-/// placement follows, so the posture reaches the area from another side) before random seeds.
+/// best first (the planner passes postures that solved nearby areas before), followed by their
+/// mirror images (PlanningModel::mirrored_arm). The start posture, the hints and the images
+/// are then tried again with the first arm joint turned (the base placement follows, so the
+/// posture reaches the area from another side) before random seeds.
+/// `first_seed`: skip the seeds before this index (a previous result's next_seed: another
+/// posture for the same goal, when no path reached the first one).
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
                                const EndEffectorSpec& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
-                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints = {});
+                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints = {}, int first_seed = 0);
 
 /// Task error of a full q against a drilling area: (position error [m], axis error [rad]).
 std::pair<double, double> task_error(const PlanningModel& model, const Params& params, const EndEffectorSpec& tool,

@@ -64,7 +64,7 @@ std::pair<double, double> task_error(const PlanningModel& model, const Params& p
 
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
                                const EndEffectorSpec& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
-                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints) {
+                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints, int first_seed) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto out_of_time = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > params.nspg_time;
@@ -140,7 +140,8 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   }
   int valid_found = 0;
   int on_task = 0;
-  for (int k = 0; k < params.nspg_seeds && valid_found < params.nspg_enough && !out_of_time(); ++k) {
+  int k = std::max(0, first_seed);
+  for (; k < params.nspg_seeds && valid_found < params.nspg_enough && !out_of_time(); ++k) {
     const auto hint = static_cast<std::size_t>(k - 2);  // index into arms[1...]
     const std::size_t turn = hint - (arms.size() - 1);
     Eigen::VectorXd q = k == 0                      ? problem.place(arms[0], yaw_hint)
@@ -186,6 +187,7 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
       out.q = q;
     }
   }
+  out.next_seed = k;
   if (out.found) {
     out.reason.clear();
   } else if (on_task == 0 && rejections.size() == 1 && rejections.count("off the task") > 0) {

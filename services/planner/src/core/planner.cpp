@@ -37,6 +37,9 @@ constexpr double kLineStep = 0.15;
 constexpr double kWarmUpPathTime = 0.5;
 // A remembered arm path serves a goal whose arm joints after the first are this close [rad].
 constexpr double kArmPathReuse = 0.6;
+// Arm postures whose joints after the first are this close [rad] have the same shape (the
+// first joint only turns the arm about the vertical).
+constexpr double kSameShape = 0.3;
 // Remembered postures this close [m of height, rad] are the same posture.
 constexpr double kSamePosture = 1e-3;
 // Share of a path attempt's remaining time for each order of the arm-alone-and-drive search
@@ -569,18 +572,33 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     const auto t0 = Clock::now();
     const uint64_t seed = params_.seed + 7919u * request.request_id + 104729u * g;
     // Goal posture, then a path to it; when no path is found within the attempt's share of
-    // the budget, another goal posture (a new NSPG seed) is tried while time remains: with a
-    // long arm some goal postures sit in torque-feasible pockets no path reaches.
+    // the budget, another goal posture is tried while time remains (the posture search goes on
+    // from the seed after the one that gave the previous posture): with a long arm some goal
+    // postures sit in torque-feasible pockets no path reaches.
     GoalResult r;
     double nspg = 0.0;
+    const double height = (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, params_.camera_distance)).z();
+    const std::vector<Eigen::VectorXd> hints = hints_for(*model, height);
+    int next_seed = 0;
+    // The arm shapes no path reached: the posture search's next seeds are often the same
+    // posture with the first joint turned, whose arm shape no path reaches either (on the
+    // benchmark, morphology B's low areas: four such attempts in a row used up the budget).
+    std::vector<Eigen::VectorXd> unreached;
+    const auto like_unreached = [&](const Eigen::VectorXd& q) {
+      const Eigen::Index n = q.size() - 4;  // arm joints after the first
+      return std::any_of(unreached.begin(), unreached.end(),
+                         [&](const Eigen::VectorXd& arm) { return (arm.tail(n) - q.tail(n)).cwiseAbs().maxCoeff() < kSameShape; });
+    };
     for (int attempt = 0;; ++attempt) {
       const auto t_posture = Clock::now();
       Params attempt_params = params_;
-      attempt_params.nspg_time = std::min(params_.nspg_time, params_.planning_time - seconds_since(t0));
-      const double height = (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, params_.camera_distance)).z();
-      const PostureResult posture = generate_posture(*model, checker, attempt_params, *tool, current, request.goals[g].area,
-                                                     seed + 7777u * static_cast<uint64_t>(attempt),
-                                                     attempt == 0 ? hints_for(*model, height) : std::vector<Eigen::VectorXd>{});
+      PostureResult posture;
+      do {
+        attempt_params.nspg_time = std::min(params_.nspg_time, params_.planning_time - seconds_since(t0));
+        posture = generate_posture(*model, checker, attempt_params, *tool, current, request.goals[g].area,
+                                   seed + 7777u * static_cast<uint64_t>(attempt), hints, next_seed);
+        next_seed = posture.next_seed;
+      } while (posture.found && like_unreached(posture.q) && params_.planning_time - seconds_since(t0) > 0.05);
       nspg += seconds_since(t_posture);
       if (!posture.found) {
         if (attempt > 0) break;  // keep the previous attempt's "no path"
@@ -594,6 +612,7 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       r = plan_path(*model, checker, current, posture.q, std::min(remaining, params_.path_attempt_time), seed);
       r.nspg_seconds = nspg;
       if (r.status == Status::kSucceeded) remember(*model, height, posture.q);
+      if (r.status == Status::kNoPath) unreached.push_back(posture.q.tail(posture.q.size() - 3));
       if (r.status != Status::kNoPath || params_.planning_time - seconds_since(t0) < 0.05) break;
     }
     if (r.status != Status::kSucceeded) r.reason = "goal " + std::to_string(g) + ": " + r.reason;
