@@ -261,26 +261,34 @@ TEST(Planner, WarmUpFillsThePostureMemoryAndPlansStayValid) {
 
 namespace {
 
-// A goal posture found for a low area on a bare wall (morphology A), and the wall with a crate
-// where that posture's base stands: the posture, remembered and placed as it is, collides.
-struct BlockedHint {
-  PostureResult first;
-  World blocked;
+// Morphology A (seed 5) before a low area on a bare wall 2.2 m ahead: the goal posture found
+// there, and the wall with a crate where that posture's base stands (the posture, remembered
+// and placed as it is, collides).
+struct BlockedLowArea {
+  Params params;
+  std::shared_ptr<const PlanningModel> model;
+  Eigen::VectorXd start;
+  Eigen::Isometry3d area;
+  World bare, blocked;
+  PostureResult first;  // on the bare wall
 };
 
-BlockedHint hint_blocked_by_crate(const std::shared_ptr<const PlanningModel>& model, const Params& params,
-                                  const Eigen::Isometry3d& area) {
-  const Eigen::VectorXd start = start_state(*model);
-  World bare;
-  bare.boxes.push_back(fixtures::wall_at(area.translation().x()));
-  StateChecker bare_checker(model, environment_of(bare, params), params, params.environment_padding);
-  BlockedHint out{generate_posture(*model, bare_checker, params, model->tool(""), start, area, 1), bare};
-  EXPECT_TRUE(out.first.found) << out.first.reason;
-  if (!out.first.found) return out;
-  out.blocked.boxes.push_back({"crate", Eigen::Vector3d(0.5, 0.5, 0.4), Eigen::Vector3d(out.first.q[0], out.first.q[1], 0.2), 0.0});
-  StateChecker checker(model, environment_of(out.blocked, params), params, params.environment_padding);
-  EXPECT_FALSE(checker.check(model->to_full(out.first.q, start)).valid());
-  return out;
+BlockedLowArea blocked_low_area(double lateral) {
+  BlockedLowArea s;
+  s.params.seed = 5;
+  s.model = PlanningModel::build(morphology('a', 1), s.params);
+  s.start = start_state(*s.model);
+  s.area = fixtures::drilling_area(2.2, lateral, 0.55);
+  s.bare.boxes.push_back(fixtures::wall_at(2.2));
+  StateChecker bare_checker(s.model, environment_of(s.bare, s.params), s.params, s.params.environment_padding);
+  s.first = generate_posture(*s.model, bare_checker, s.params, s.model->tool(""), s.start, s.area, 1);
+  EXPECT_TRUE(s.first.found) << s.first.reason;
+  s.blocked = s.bare;
+  if (!s.first.found) return s;
+  s.blocked.boxes.push_back({"crate", Eigen::Vector3d(0.5, 0.5, 0.4), Eigen::Vector3d(s.first.q[0], s.first.q[1], 0.2), 0.0});
+  StateChecker checker(s.model, environment_of(s.blocked, s.params), s.params, s.params.environment_padding);
+  EXPECT_FALSE(checker.check(s.model->to_full(s.first.q, s.start)).valid());
+  return s;
 }
 
 // Only the seeds before the random ones: nspg_seeds ends the search, not the clock.
@@ -294,77 +302,62 @@ Params without_random_seeds(const Params& params, int seeds) {
 }  // namespace
 
 TEST(Planner, MirroredHintStandsOnTheAreasOtherSide) {
-  Params params;
-  params.seed = 5;
-  const auto model = PlanningModel::build(morphology('a', 1), params);
-  const EndEffectorSpec& tool = model->tool("");
-  const Eigen::VectorXd start = start_state(*model);
-  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.0, 0.55);
-  const BlockedHint b = hint_blocked_by_crate(model, params, area);
-  ASSERT_TRUE(b.first.found);
-  ASSERT_GT(std::abs(b.first.q[1]), 0.2) << "a low area: the base stands beside it";
+  const BlockedLowArea s = blocked_low_area(0.0);
+  ASSERT_TRUE(s.first.found);
+  ASSERT_GT(std::abs(s.first.q[1]), 0.2) << "a low area: the base stands beside it";
+  const EndEffectorSpec& tool = s.model->tool("");
   // Seeds: the start posture placed and as it is, the hint, its mirror image; nothing else.
-  StateChecker checker(model, environment_of(b.blocked, params), params, params.environment_padding);
-  const Eigen::VectorXd hint = b.first.q.tail(b.first.q.size() - 3);
-  const PostureResult mirrored = generate_posture(*model, checker, without_random_seeds(params, 2 + 1 + 1), tool, start, area, 1, {hint});
+  StateChecker checker(s.model, environment_of(s.blocked, s.params), s.params, s.params.environment_padding);
+  const Eigen::VectorXd hint = s.first.q.tail(s.first.q.size() - 3);
+  const PostureResult mirrored =
+      generate_posture(*s.model, checker, without_random_seeds(s.params, 2 + 1 + 1), tool, s.start, s.area, 1, {hint});
   ASSERT_TRUE(mirrored.found) << mirrored.reason;
-  EXPECT_LT(mirrored.q[1] * b.first.q[1], 0.0) << "the base should stand on the other side of the area";
-  const Eigen::VectorXd image = *model->mirrored_arm(hint);
+  EXPECT_LT(mirrored.q[1] * s.first.q[1], 0.0) << "the base should stand on the other side of the area";
+  const Eigen::VectorXd image = *s.model->mirrored_arm(hint);
   EXPECT_LT((mirrored.q.tail(hint.size() - 1) - image.tail(hint.size() - 1)).cwiseAbs().maxCoeff(), 0.3)
       << "the posture should be the hint's image";
-  StateChecker exact(model, environment_of(b.blocked, params), params, 0.0);
-  EXPECT_TRUE(exact.check(model->to_full(mirrored.q, start), tool.frame).valid());
-  EXPECT_TRUE(exact.check(model->to_full(mirrored.q, start)).valid());
+  StateChecker exact(s.model, environment_of(s.blocked, s.params), s.params, 0.0);
+  EXPECT_TRUE(exact.check(s.model->to_full(mirrored.q, s.start), tool.frame).valid());
+  EXPECT_TRUE(exact.check(s.model->to_full(mirrored.q, s.start)).valid());
 }
 
 TEST(Planner, ResumedPostureSearchGivesAnotherPosture) {
   // When no path reaches a goal posture, the planner asks for another from the seed after the
   // one that gave it: a different posture, later seeds, still valid.
-  Params params;
-  params.seed = 5;
+  const BlockedLowArea s = blocked_low_area(0.0);
+  ASSERT_TRUE(s.first.found);
+  const EndEffectorSpec& tool = s.model->tool("");
+  Params params = s.params;
   params.nspg_time = 60.0;  // the seeds end it, not the clock
-  const auto model = PlanningModel::build(morphology('a', 1), params);
-  const EndEffectorSpec& tool = model->tool("");
-  const Eigen::VectorXd start = start_state(*model);
-  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.0, 0.55);
-  World bare;
-  bare.boxes.push_back(fixtures::wall_at(2.2));
-  StateChecker checker(model, environment_of(bare, params), params, params.environment_padding);
-  const PostureResult first = generate_posture(*model, checker, params, tool, start, area, 1);
-  ASSERT_TRUE(first.found) << first.reason;
-  const std::vector<Eigen::VectorXd> hints{first.q.tail(first.q.size() - 3)};
-  const PostureResult a = generate_posture(*model, checker, params, tool, start, area, 1, hints);
+  StateChecker checker(s.model, environment_of(s.bare, params), params, params.environment_padding);
+  const std::vector<Eigen::VectorXd> hints{s.first.q.tail(s.first.q.size() - 3)};
+  const PostureResult a = generate_posture(*s.model, checker, params, tool, s.start, s.area, 1, hints);
   ASSERT_TRUE(a.found) << a.reason;
   EXPECT_EQ(a.next_seed, a.candidates);
-  const PostureResult b = generate_posture(*model, checker, params, tool, start, area, 1, hints, a.next_seed);
+  const PostureResult b = generate_posture(*s.model, checker, params, tool, s.start, s.area, 1, hints, a.next_seed);
   ASSERT_TRUE(b.found) << b.reason;
   EXPECT_GT(b.next_seed, a.next_seed);
   EXPECT_EQ(b.next_seed - a.next_seed, b.candidates);
   EXPECT_GT((b.q - a.q).cwiseAbs().maxCoeff(), 1e-3) << "the resumed search gave the same posture";
-  StateChecker exact(model, environment_of(bare, params), params, 0.0);
-  EXPECT_TRUE(exact.check(model->to_full(b.q, start), tool.frame).valid());
+  StateChecker exact(s.model, environment_of(s.bare, params), params, 0.0);
+  EXPECT_TRUE(exact.check(s.model->to_full(b.q, s.start), tool.frame).valid());
 }
 
 TEST(Planner, TurnedHintGetsPastAnObstacleThatBlocksItsBase) {
-  Params params;
-  params.seed = 5;
-  const auto model = PlanningModel::build(morphology('a', 1), params);
-  const EndEffectorSpec& tool = model->tool("");
-  const Eigen::VectorXd start = start_state(*model);
-  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.3, 0.55);
-  const BlockedHint b = hint_blocked_by_crate(model, params, area);
-  ASSERT_TRUE(b.first.found);
-  const Eigen::VectorXd hint = b.first.q.tail(b.first.q.size() - 3);
-  const Eigen::VectorXd image = *model->mirrored_arm(hint);
+  const BlockedLowArea s = blocked_low_area(0.3);
+  ASSERT_TRUE(s.first.found);
+  const EndEffectorSpec& tool = s.model->tool("");
+  const Eigen::VectorXd hint = s.first.q.tail(s.first.q.size() - 3);
+  const Eigen::VectorXd image = *s.model->mirrored_arm(hint);
   // Every seed before the random ones (the start posture placed and as it is, the hint and its
   // image, then the first joint turned either way, at most 5 steps each for the start posture,
   // the hint and the image), all valid postures kept: some are the hint or its image turned,
   // past the crate.
-  Params all = without_random_seeds(params, 2 + 2 + 2 * 3 * 5);
+  Params all = without_random_seeds(s.params, 2 + 2 + 2 * 3 * 5);
   all.nspg_enough = 1000;
-  StateChecker checker(model, environment_of(b.blocked, params), params, params.environment_padding);
-  const PostureResult r = generate_posture(*model, checker, all, tool, start, area, 1, {hint});
-  StateChecker exact(model, environment_of(b.blocked, params), params, 0.0);
+  StateChecker checker(s.model, environment_of(s.blocked, s.params), s.params, s.params.environment_padding);
+  const PostureResult r = generate_posture(*s.model, checker, all, tool, s.start, s.area, 1, {hint});
+  StateChecker exact(s.model, environment_of(s.blocked, s.params), s.params, 0.0);
   int turned = 0;
   for (const Eigen::VectorXd& q : r.valid) {
     const Eigen::VectorXd arm = q.tail(hint.size());
@@ -372,9 +365,9 @@ TEST(Planner, TurnedHintGetsPastAnObstacleThatBlocksItsBase) {
       const bool same_shape = (arm.tail(hint.size() - 1) - family->tail(hint.size() - 1)).cwiseAbs().maxCoeff() < 0.3;
       if (!same_shape || std::abs(arm[0] - (*family)[0]) < 0.3) continue;
       turned += 1;
-      EXPECT_GT((q.head<2>() - b.first.q.head<2>()).norm(), 0.25) << "the base should stand clear of the crate";
-      EXPECT_TRUE(exact.check(model->to_full(q, start), tool.frame).valid());
-      EXPECT_TRUE(exact.check(model->to_full(q, start)).valid());
+      EXPECT_GT((q.head<2>() - s.first.q.head<2>()).norm(), 0.25) << "the base should stand clear of the crate";
+      EXPECT_TRUE(exact.check(s.model->to_full(q, s.start), tool.frame).valid());
+      EXPECT_TRUE(exact.check(s.model->to_full(q, s.start)).valid());
     }
   }
   EXPECT_GT(turned, 0) << r.valid.size() << " valid postures, none a turned hint or image";
