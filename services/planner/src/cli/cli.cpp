@@ -3,6 +3,7 @@
 #include "planner/cli.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <iomanip>
 #include <random>
 
@@ -127,9 +128,19 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
     requests.write(req);
     out << "request " << request_id << ": " << points.size() << " goal(s) for model version " << model->version()
         << (execute ? ", executing" : ", planning only") << "\n";
+    // Execution progress arrives many times a second: one line per 10 % of each goal.
+    long printed_goal = -1;
+    long printed_percent = 0;
     while (left().count() > 0) {
       const auto r = results.wait(left());
       if (!r || r->request_id() != request_id) continue;
+      if (r->state() == msg::PLAN_EXECUTING) {
+        const long percent = std::lround(100.0 * r->progress());
+        const auto goal = static_cast<long>(r->goal_index());
+        if (goal == printed_goal && percent < printed_percent + 10) continue;
+        printed_goal = goal;
+        printed_percent = percent - percent % 10;
+      }
       out << "  goal " << r->goal_index() + 1 << "/" << r->goal_count() << " " << state_name(r->state());
       if (r->state() == msg::PLAN_PLANNED && !r->trajectory().empty()) {
         out << std::fixed << std::setprecision(1) << " in " << 1e3 * r->planning_time() << " ms, " << r->trajectory().size()
