@@ -4,7 +4,9 @@
 #      drill robot of deploy/demo/drill_robot.yaml mounted, discovery, modelgen, safety, ...
 #   2. the robot's simulated EtherCAT bus publishes the scan; discovery rebuilds the module
 #      tree; modelgen publishes robot model version 1; every service reconfigures to it
-#   3. hot swap: the drill is replaced by the sanding tool -> new scan -> tree -> model
+#   3. the main job: a drilling approach planned for model version 1 (NSPG goal posture +
+#      whole-body path, 200 N checked) and executed on the simulated robot
+#   4. hot swap: the drill is replaced by the sanding tool -> new scan -> tree -> model
 #      version 2 -> every service ready again, with the time of each stage
 # Usage: deploy/demo.sh [BUILD_DIR]    Domain: CONCERT_DOMAIN_ID (default 0).
 set -euo pipefail
@@ -43,6 +45,9 @@ stage "concert status"
 
 stage "the live model"
 "$concert" model show --timeout 5 | sed -n '1,8p;/^end-effectors/,$p' | sed 's/^/  /'
+
+stage "drilling approach: concert plan drill --at 2.0 0.0 1.2 --execute (area 2 m ahead, 1.2 m high)"
+"$concert" plan drill --at 2.0 0.0 1.2 --execute --timeout 60 | sed 's/^/  /'
 
 stage "hot swap: concert sim swap deploy/demo/sanding_robot.yaml (drill -> sanding tool)"
 swap=$(date +%s%N)
