@@ -80,7 +80,8 @@ class Planner {
   /// status and reason say what is wrong (no model, stale model version, bad start state...).
   PlanResult plan(const PlanRequest& request, const Eigen::VectorXd& q_start_full, const GoalCallback& on_goal = {});
 
-  /// Plans a path between two planned-joint postures (RRT-Connect, simplification, timing).
+  /// Plans a path between two planned-joint postures (src/core/path_search.hpp: direct, projected
+  /// line, arm alone and drive, RRT-Connect; simplification), then its timing.
   GoalResult plan_path(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& q_start_full,
                        const Eigen::VectorXd& q_goal, double time_budget, uint64_t seed) const;
 
