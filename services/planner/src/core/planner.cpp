@@ -32,6 +32,12 @@ constexpr double kSameShape = 0.3;
 // Remembered postures this close [m of height, rad] are the same posture.
 constexpr double kSamePosture = 1e-3;
 
+// How far apart two arm postures' shapes are: the largest change of the joints after the
+// first [rad] (the first only turns the arm about the vertical).
+double shape_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return (a.tail(a.size() - 1) - b.tail(b.size() - 1)).cwiseAbs().maxCoeff();
+}
+
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 }  // namespace
@@ -142,14 +148,11 @@ std::vector<Eigen::VectorXd> Planner::arm_path_to(const PlanningModel& model, co
   const Remembered* best = nullptr;
   bool best_mirrored = false;
   double best_d = kArmPathReuse;
-  const auto distance = [](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-    return (a.tail(a.size() - 1) - b.tail(b.size() - 1)).cwiseAbs().maxCoeff();
-  };
   for (const Remembered& m : memory_) {
     if (m.arm_path.empty()) continue;
     for (const bool mirrored : {false, true}) {
       if (mirrored && !goal_mirror) continue;
-      const double d = distance(m.arm, mirrored ? *goal_mirror : arm);
+      const double d = shape_distance(m.arm, mirrored ? *goal_mirror : arm);
       if (d < best_d) {
         best_d = d;
         best = &m;
@@ -280,9 +283,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     // benchmark, morphology B's low areas: four such attempts in a row used up the budget).
     std::vector<Eigen::VectorXd> unreached;
     const auto like_unreached = [&](const Eigen::VectorXd& q) {
-      const Eigen::Index n = q.size() - 4;  // arm joints after the first
-      return std::any_of(unreached.begin(), unreached.end(),
-                         [&](const Eigen::VectorXd& arm) { return (arm.tail(n) - q.tail(n)).cwiseAbs().maxCoeff() < kSameShape; });
+      const Eigen::VectorXd arm = q.tail(q.size() - 3);
+      return std::any_of(unreached.begin(), unreached.end(), [&](const Eigen::VectorXd& u) { return shape_distance(u, arm) < kSameShape; });
     };
     for (int attempt = 0;; ++attempt) {
       const auto t_posture = Clock::now();
