@@ -94,12 +94,15 @@ function(concert_check_core_libraries)
 endfunction()
 
 # Tests that talk DDS each get their own domain id (CONCERT_DOMAIN_ID), so `ctest -j` never
-# mixes two tests' traffic. Ids 100..229 are handed out in configuration order.
-set_property(GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN 100)
+# mixes two tests' traffic. Ids from CONCERT_TEST_DOMAIN_BASE on are handed out in
+# configuration order (up to 229); two build trees on one machine whose tests may run at the
+# same time take bases far enough apart (e.g. 100 and 160).
+set(CONCERT_TEST_DOMAIN_BASE 100 CACHE STRING "First DDS domain id handed to the tests (<= 229)")
+set_property(GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN ${CONCERT_TEST_DOMAIN_BASE})
 function(concert_next_test_domain out_var)
   get_property(id GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN)
   if(id GREATER 229)
-    message(FATAL_ERROR "More DDS tests than test domain ids (100..229)")
+    message(FATAL_ERROR "More DDS tests than test domain ids (${CONCERT_TEST_DOMAIN_BASE}..229)")
   endif()
   math(EXPR next "${id} + 1")
   set_property(GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN ${next})
