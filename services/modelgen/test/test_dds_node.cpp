@@ -1,4 +1,4 @@
-// The modelgen node over real DDS (private domain): tree in -> latched RobotModel out, same
+// The modelgen node over real DDS (private domain): tree in -> latched GeneratedModel out, same
 // tree -> no new version, bad tree -> model kept, customisation -> new version, late joiners.
 
 #include <chrono>

@@ -27,8 +27,8 @@ void expect_round_trip(const Db& d, const simbus::Assembly& assembly, const std:
   const modelgen::ModelGenerator gen(d.db);
   const topology::ModuleTree direct = simbus::tree_from_assembly(assembly, d.catalog);
   const topology::ModuleTree discovered = discovery::discover(simbus::simulate_scan(assembly, d.catalog), d.catalog);
-  const modelgen::RobotModel a = gen.generate(direct);
-  const modelgen::RobotModel b = gen.generate(discovered);
+  const modelgen::GeneratedModel a = gen.generate(direct);
+  const modelgen::GeneratedModel b = gen.generate(discovered);
   EXPECT_EQ(a.content_hash, b.content_hash) << what;
   EXPECT_EQ(a.urdf, b.urdf) << what;
   EXPECT_EQ(a.modules.size(), assembly.modules.size()) << what;
@@ -45,7 +45,7 @@ TEST(RoundTrip, PublicDatabaseExampleAssemblies) {
   const simbus::Assembly paper = simbus::load_assembly(fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml");
   const topology::ModuleTree tree = discovery::discover(simbus::simulate_scan(paper, d.catalog), d.catalog);
   ASSERT_EQ(tree.modules[0].slave_positions.size(), 2u);
-  const modelgen::RobotModel model = modelgen::ModelGenerator(d.db).generate(tree);
+  const modelgen::GeneratedModel model = modelgen::ModelGenerator(d.db).generate(tree);
   int base_bodies = 0;
   for (const modelgen::PhysicalBody& b : model.tree.bodies) base_bodies += b.module == 0 ? 1 : 0;
   EXPECT_EQ(base_bodies, 1);
@@ -118,7 +118,7 @@ TEST(RoundTrip, RandomRobotsOfTheProjectDatabase) {
     const std::string what = "robot " + std::to_string(robot) + ":\n" + simbus::assembly_to_yaml(a);
     expect_round_trip(d, a, what);
     const topology::ModuleTree tree = simbus::tree_from_assembly(a, d.catalog);
-    const modelgen::RobotModel model = modelgen::ModelGenerator(d.db).generate(tree);
+    const modelgen::GeneratedModel model = modelgen::ModelGenerator(d.db).generate(tree);
     const auto u = urdf::parseURDF(model.urdf);
     ASSERT_TRUE(u) << what;
     std::map<std::string, double> qn;

@@ -19,9 +19,9 @@
 
 #include "concert/module_db/module_db.hpp"
 #include "concert/topology/types.hpp"
-#include "modelgen/model.hpp"
+#include "concert/model_generation/model.hpp"
 
-namespace concert::modelgen {
+namespace concert::model_generation {
 
 /// Immutable generator over one database. generate() is const and thread-compatible.
 class ModelGenerator {
@@ -37,7 +37,7 @@ class ModelGenerator {
   /// module without ESC (a passive gripper, which the network cannot see) mounts that module on
   /// the first free output connector of the module owning body `module_name`, or of the last
   /// module of chain `module_name` (e.g. "E").
-  RobotModel generate(const topology::ModuleTree& tree, const Customisation& custom = {},
+  GeneratedModel generate(const topology::ModuleTree& tree, const Customisation& custom = {},
                       uint64_t tree_version = 0) const;
 
   /// The description used for module node `node` (by key, else by ESC identity). Throws
@@ -58,11 +58,11 @@ class ModelGenerator {
 std::string write_urdf(const PhysicalTree& tree, const std::string& robot_name);
 /// SRDF text: a group per chain, arms/legs/wheels groups, `chains` group, end-effectors, `home`
 /// group state, disabled collisions between adjacent bodies.
-std::string write_srdf(const RobotModel& model, const std::string& robot_name);
+std::string write_srdf(const GeneratedModel& model, const std::string& robot_name);
 /// Controller configuration YAML (joints with limits, gains, control modes, home; chains;
 /// end-effectors); the robot service reads it.
-std::string write_config_yaml(const RobotModel& model, const std::string& robot_name);
+std::string write_config_yaml(const GeneratedModel& model, const std::string& robot_name);
 /// "sha256:<64 hex digits>" of `text`.
 std::string sha256_hex(const std::string& text);
 
-}  // namespace concert::modelgen
+}  // namespace concert::model_generation
