@@ -21,7 +21,6 @@
 namespace concert::planner::dds {
 
 /// Conversions between IDL and core types.
-ModelDescription to_core(const msg::RobotModel& model);
 Eigen::Isometry3d to_core(const msg::Pose& pose);
 msg::Pose to_msg(const Eigen::Isometry3d& pose);
 msg::PlanFailure to_failure(Status status);
