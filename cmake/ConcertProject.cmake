@@ -1,5 +1,6 @@
 # The one CMake helper of the project: language level, warnings, sanitizers, coverage,
-# core libraries that must not link DDS, and tests.
+# the layout rules checked at configure time (a core links no DDS; no service links another
+# service), and tests.
 include_guard(GLOBAL)
 
 set(CMAKE_CXX_STANDARD 20)
@@ -91,6 +92,100 @@ function(concert_check_core_libraries)
       endif()
     endforeach()
   endforeach()
+endfunction()
+
+# Every target defined in the source tree (recursively from `dir`).
+function(_concert_all_targets dir out_var)
+  get_property(targets DIRECTORY ${dir} PROPERTY BUILDSYSTEM_TARGETS)
+  get_property(subdirs DIRECTORY ${dir} PROPERTY SUBDIRECTORIES)
+  foreach(sub IN LISTS subdirs)
+    _concert_all_targets(${sub} more)
+    list(APPEND targets ${more})
+  endforeach()
+  set(${out_var} ${targets} PARENT_SCOPE)
+endfunction()
+
+# The service a target belongs to (the <name> of services/<name>/...), or "" outside services/.
+function(_concert_service_of target out_var)
+  set(service "")
+  if(TARGET ${target})
+    get_target_property(aliased ${target} ALIASED_TARGET)
+    if(aliased)
+      set(target ${aliased})
+    endif()
+    get_target_property(imported ${target} IMPORTED)
+    if(NOT imported)
+      get_target_property(dir ${target} SOURCE_DIR)
+      file(RELATIVE_PATH rel ${CMAKE_SOURCE_DIR} ${dir})
+      if(rel MATCHES "^services/([^/]+)")
+        set(service ${CMAKE_MATCH_1})
+      endif()
+    endif()
+  endif()
+  set(${out_var} "${service}" PARENT_SCOPE)
+endfunction()
+
+# No service links another service: what two services share goes into libs/. Every target
+# defined under services/<a>/ is checked against its direct link dependencies; one defined under
+# services/<b>/ (b != a) fails configuration. CONCERT_LAYOUT_EXCEPTIONS lists known violations
+# as "target->dependency" (each reported as a warning until it is removed; a listed exception
+# that no longer occurs is reported too, so the list only shrinks).
+function(concert_check_service_links)
+  _concert_all_targets(${CMAKE_SOURCE_DIR} targets)
+  set(errors "")
+  set(used_exceptions "")
+  foreach(target IN LISTS targets)
+    _concert_service_of(${target} service)
+    if(service STREQUAL "")
+      continue()
+    endif()
+    get_target_property(type ${target} TYPE)
+    set(links "")
+    if(NOT type STREQUAL "INTERFACE_LIBRARY")
+      get_target_property(direct ${target} LINK_LIBRARIES)
+      if(direct)
+        list(APPEND links ${direct})
+      endif()
+    endif()
+    get_target_property(iface ${target} INTERFACE_LINK_LIBRARIES)
+    if(iface)
+      list(APPEND links ${iface})
+    endif()
+    set(deps "")
+    foreach(dep IN LISTS links)
+      string(REGEX REPLACE "^\\$<LINK_ONLY:(.*)>$" "\\1" dep "${dep}")
+      list(APPEND deps ${dep})
+    endforeach()
+    list(REMOVE_DUPLICATES deps)
+    foreach(dep IN LISTS deps)
+      _concert_service_of(${dep} other)
+      if(other STREQUAL "" OR other STREQUAL service)
+        continue()
+      endif()
+      if("${target}->${dep}" IN_LIST CONCERT_LAYOUT_EXCEPTIONS)
+        list(APPEND used_exceptions "${target}->${dep}")
+        message(WARNING "Layout exception: '${target}' (service ${service}) links '${dep}' (service ${other}); "
+                        "move what they share into libs/ and remove it from CONCERT_LAYOUT_EXCEPTIONS.")
+      else()
+        string(APPEND errors "\n  '${target}' (services/${service}) links '${dep}' (services/${other})")
+      endif()
+    endforeach()
+  endforeach()
+  foreach(exception IN LISTS CONCERT_LAYOUT_EXCEPTIONS)
+    if(NOT exception IN_LIST used_exceptions)
+      message(WARNING "Layout exception '${exception}' no longer occurs: remove it from CONCERT_LAYOUT_EXCEPTIONS.")
+    endif()
+  endforeach()
+  if(errors)
+    message(FATAL_ERROR "A service links another service:${errors}\n"
+                        "Services are independent: move what they share into libs/ (DESIGN.md section 3).")
+  endif()
+endfunction()
+
+# Both layout checks, once every target is known (call from the top-level CMakeLists.txt).
+function(concert_check_layout)
+  concert_check_core_libraries()
+  concert_check_service_links()
 endfunction()
 
 # Tests that talk DDS each get their own domain id (CONCERT_DOMAIN_ID), so `ctest -j` never
