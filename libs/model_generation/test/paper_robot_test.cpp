@@ -95,7 +95,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Database{fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db", fs::path(CONCERT_SOURCE_DIR) / "deploy/demo/drill_robot.yaml"},
                       Database{fs::path(CONCERT_SHARED_DATA) / "concert_resources",
                                fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml"}),
-    [](const ::testing::TestParamInfo<Database>& info) { return info.index == 0 ? std::string("Project") : std::string("Public"); });
+    [](const ::testing::TestParamInfo<Database>& param) { return param.index == 0 ? std::string("Project") : std::string("Public"); });
 
 }  // namespace
 }  // namespace concert::model_generation
