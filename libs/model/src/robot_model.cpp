@@ -14,13 +14,16 @@ namespace {
 Eigen::Isometry3d to_eigen(const urdf::Pose& p) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
-  t.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
+  t.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z)
+                   .normalized()
+                   .toRotationMatrix();
   return t;
 }
 
 // SRDF <disable_collisions link1 link2>: the only SRDF content not already in the description,
 // so a small tinyxml2 read instead of a full SRDF model.
-std::vector<std::pair<std::string, std::string>> srdf_disabled_pairs(const std::string& srdf, const std::string& where) {
+std::vector<std::pair<std::string, std::string>> srdf_disabled_pairs(const std::string& srdf,
+                                                                     const std::string& where) {
   std::vector<std::pair<std::string, std::string>> out;
   if (srdf.empty()) return out;
   tinyxml2::XMLDocument doc;
@@ -33,7 +36,8 @@ std::vector<std::pair<std::string, std::string>> srdf_disabled_pairs(const std::
        e = e->NextSiblingElement("disable_collisions")) {
     const char* a = e->Attribute("link1");
     const char* b = e->Attribute("link2");
-    if (a == nullptr || b == nullptr) throw ModelError(where + ": SRDF: <disable_collisions> without link1/link2");
+    if (a == nullptr || b == nullptr)
+      throw ModelError(where + ": SRDF: <disable_collisions> without link1/link2");
     out.emplace_back(a, b);
   }
   return out;
@@ -85,10 +89,13 @@ std::string describe_ee(const EndEffectorInfo& e) {
 
 }  // namespace
 
-RobotModel::RobotModel(ModelDescription description, kinematics::Model fixed, kinematics::Model planar)
+RobotModel::RobotModel(ModelDescription description, kinematics::Model fixed,
+                       kinematics::Model planar)
     : description_(std::move(description)), fixed_(std::move(fixed)), planar_(std::move(planar)) {}
 
-std::string RobotModel::where() const { return "model version " + std::to_string(description_.version); }
+std::string RobotModel::where() const {
+  return "model version " + std::to_string(description_.version);
+}
 
 std::shared_ptr<const RobotModel> RobotModel::build(ModelDescription d) {
   const std::string where = "model version " + std::to_string(d.version);
@@ -108,18 +115,22 @@ std::shared_ptr<const RobotModel> RobotModel::build(ModelDescription d) {
   // Every joint, chain end and frame the description names exists in the URDF.
   std::map<std::string, std::string> chain_of_joint;
   for (const JointLimits& j : desc.joints) {
-    if (!m->fixed_.joint_index(j.name)) throw ModelError(where + ": joint '" + j.name + "' is not a moving joint of the URDF");
+    if (!m->fixed_.joint_index(j.name))
+      throw ModelError(where + ": joint '" + j.name + "' is not a moving joint of the URDF");
     chain_of_joint[j.name] = j.chain;
   }
   auto need_frame = [&](const std::string& frame, const std::string& what) {
-    if (!m->fixed_.has_frame(frame)) throw ModelError(where + ": " + what + ": no link '" + frame + "' in the URDF");
+    if (!m->fixed_.has_frame(frame))
+      throw ModelError(where + ": " + what + ": no link '" + frame + "' in the URDF");
   };
   for (const ChainInfo& c : desc.chains) {
     const std::string what = "chain " + c.name;
     need_frame(c.base_link, what + " base_link");
     need_frame(c.tip_link, what + " tip_link");
     for (const std::string& j : c.joints) {
-      if (!m->limits_.find(j)) throw ModelError(where + ": " + what + ": joint '" + j + "' has no row in the limits table");
+      if (!m->limits_.find(j))
+        throw ModelError(where + ": " + what + ": joint '" + j +
+                         "' has no row in the limits table");
     }
   }
   for (const EndEffectorInfo& e : desc.end_effectors) need_frame(e.frame, "end-effector " + e.name);
@@ -147,7 +158,8 @@ std::shared_ptr<const RobotModel> RobotModel::build(ModelDescription d) {
           if (node.moving) {
             const auto it = chain_of_joint.find(j->name);
             if (it == chain_of_joint.end()) {
-              throw ModelError(where + ": URDF joint '" + j->name + "' moves but has no row in the limits table");
+              throw ModelError(where + ": URDF joint '" + j->name +
+                               "' moves but has no row in the limits table");
             }
             node.chain = it->second;
           }
@@ -169,7 +181,9 @@ std::shared_ptr<const RobotModel> RobotModel::build(ModelDescription d) {
   for (const auto& [a, b] : srdf_disabled_pairs(desc.srdf, where)) {
     const int ia = m->link_index(a);
     const int ib = m->link_index(b);
-    if (ia < 0 || ib < 0) throw ModelError(where + ": SRDF disables collisions of unknown link '" + (ia < 0 ? a : b) + "'");
+    if (ia < 0 || ib < 0)
+      throw ModelError(where + ": SRDF disables collisions of unknown link '" + (ia < 0 ? a : b) +
+                       "'");
     m->disabled_.emplace_back(std::min(ia, ib), std::max(ia, ib));
   }
   return m;
@@ -195,16 +209,23 @@ const ChainInfo& RobotModel::chain(std::string_view name) const {
     if (c.name == name) return c;
   }
   throw ModelError(where() + ": no chain '" + std::string(name) + "' (chains: " +
-                   list_of(description_.chains, [](const ChainInfo& c) { return c.name + " (" + std::string(to_string(c.role)) + ")"; }) +
+                   list_of(description_.chains,
+                           [](const ChainInfo& c) {
+                             return c.name + " (" + std::string(to_string(c.role)) + ")";
+                           }) +
                    ")");
 }
 
 const ChainInfo& RobotModel::arm() const {
   const std::vector<const ChainInfo*> arms = chains(ChainRole::kArm);
   if (arms.size() == 1) return *arms.front();
-  const std::string all =
-      list_of(description_.chains, [](const ChainInfo& c) { return c.name + " (" + std::string(to_string(c.role)) + ")"; });
-  throw ModelError(where() + (arms.empty() ? ": no arm" : ": " + std::to_string(arms.size()) + " arms, select one by name") +
+  const std::string all = list_of(description_.chains, [](const ChainInfo& c) {
+    return c.name + " (" + std::string(to_string(c.role)) + ")";
+  });
+  throw ModelError(where() +
+                   (arms.empty()
+                        ? ": no arm"
+                        : ": " + std::to_string(arms.size()) + " arms, select one by name") +
                    " (chains: " + all + ")");
 }
 
@@ -218,7 +239,8 @@ std::vector<Leg> RobotModel::legs() const {
       if (e.chain == c->name && e.kind == EndEffectorKind::kWheel) wheel = &e;
     }
     if (wheel == nullptr || c->joints.empty()) {
-      throw ModelError(where() + ": leg chain " + c->name + " has no wheel end-effector or no moving joint");
+      throw ModelError(where() + ": leg chain " + c->name +
+                       " has no wheel end-effector or no moving joint");
     }
     leg.wheel_frame = wheel->frame;
     leg.wheel_joint = c->joints.back();
@@ -234,7 +256,8 @@ std::vector<Leg> RobotModel::legs() const {
       leg.wheel_radius = std::max(leg.wheel_radius, s.size.x());
     }
     if (leg.wheel_radius <= 0.0) {
-      throw ModelError(where() + ": leg chain " + c->name + ": wheel link '" + links_[static_cast<std::size_t>(link)].name +
+      throw ModelError(where() + ": leg chain " + c->name + ": wheel link '" +
+                       links_[static_cast<std::size_t>(link)].name +
                        "' has no collision cylinder about the wheel axis (no wheel radius)");
     }
     out.push_back(std::move(leg));
@@ -263,12 +286,15 @@ const EndEffectorInfo& RobotModel::tool() const {
   for (const EndEffectorInfo& e : description_.end_effectors) {
     if (e.kind == EndEffectorKind::kWheel) continue;
     for (const ChainInfo& c : description_.chains) {
-      if (c.name == e.chain && (c.role == ChainRole::kArm || c.role == ChainRole::kTool)) tools.push_back(&e);
+      if (c.name == e.chain && (c.role == ChainRole::kArm || c.role == ChainRole::kTool))
+        tools.push_back(&e);
     }
   }
   if (tools.size() == 1) return *tools.front();
-  throw ModelError(where() + (tools.empty() ? ": no tool on an arm" : ": several arm tools, select one by kind or name") +
-                   " (end-effectors: " + list_of(description_.end_effectors, describe_ee) + ")");
+  throw ModelError(
+      where() +
+      (tools.empty() ? ": no tool on an arm" : ": several arm tools, select one by kind or name") +
+      " (end-effectors: " + list_of(description_.end_effectors, describe_ee) + ")");
 }
 
 const EndEffectorInfo& RobotModel::tool(EndEffectorKind kind) const {
@@ -279,9 +305,9 @@ const EndEffectorInfo& RobotModel::tool(EndEffectorKind kind) const {
     }
   }
   if (found.size() == 1) return *found.front();
-  throw ModelError(where() + ": " + (found.empty() ? "no" : "several") + " " +
-                   std::string(to_string(kind)) + " tool on an arm (end-effectors: " +
-                   list_of(description_.end_effectors, describe_ee) + ")");
+  throw ModelError(
+      where() + ": " + (found.empty() ? "no" : "several") + " " + std::string(to_string(kind)) +
+      " tool on an arm (end-effectors: " + list_of(description_.end_effectors, describe_ee) + ")");
 }
 
 std::vector<const SensorFrame*> RobotModel::sensor_frames(SensorKind kind) const {
@@ -305,8 +331,12 @@ const SensorFrame& RobotModel::sensor(const EndEffectorInfo& ee, SensorKind kind
   for (const SensorFrame& s : description_.sensor_frames) {
     if (s.end_effector == ee.name) carried.push_back(s);
   }
-  throw ModelError(where() + ": end-effector '" + ee.name + "' has no " + std::string(to_string(kind)) + " sensor (it carries: " +
-                   list_of(carried, [](const SensorFrame& s) { return s.name + " (" + std::string(to_string(s.kind)) + ")"; }) +
+  throw ModelError(where() + ": end-effector '" + ee.name + "' has no " +
+                   std::string(to_string(kind)) + " sensor (it carries: " +
+                   list_of(carried,
+                           [](const SensorFrame& s) {
+                             return s.name + " (" + std::string(to_string(s.kind)) + ")";
+                           }) +
                    ")");
 }
 

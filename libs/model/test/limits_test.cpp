@@ -1,16 +1,19 @@
+#include "concert/model/limits.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "concert/model/limits.hpp"
-
 namespace concert::model {
 namespace {
 
-JointLimits joint(double continuous, double peak) { return {"J1_A", "A", -1.0, 1.0, 2.0, peak, continuous}; }
+JointLimits joint(double continuous, double peak) {
+  return {"J1_A", "A", -1.0, 1.0, 2.0, peak, continuous};
+}
 
 TEST(LimitsTable, FindsRowsAndListsJointsWhenAskedForAnUnknownOne) {
-  const LimitsTable table({joint(160, 200), {"J2_A", "A", -2.0, 2.0, 1.0, 50, 40}}, "model version 4");
+  const LimitsTable table({joint(160, 200), {"J2_A", "A", -2.0, 2.0, 1.0, 50, 40}},
+                          "model version 4");
   EXPECT_EQ(table.size(), 2u);
   EXPECT_DOUBLE_EQ(table.at("J2_A").peak_torque, 50.0);
   EXPECT_EQ(table.find("J3_A"), nullptr);
@@ -18,7 +21,8 @@ TEST(LimitsTable, FindsRowsAndListsJointsWhenAskedForAnUnknownOne) {
     (void)table.at("J3_A");
     FAIL() << "no throw";
   } catch (const ModelError& e) {
-    EXPECT_STREQ(e.what(), "model version 4: no joint 'J3_A' in the limits table (joints: J1_A, J2_A)");
+    EXPECT_STREQ(e.what(),
+                 "model version 4: no joint 'J3_A' in the limits table (joints: J1_A, J2_A)");
   }
 }
 
@@ -36,7 +40,9 @@ TEST(LimitsTable, RejectsRowsThatBreakTheRule) {
     LimitsTable({still}, "model version 2");
     FAIL() << "no throw";
   } catch (const ModelError& e) {
-    EXPECT_NE(std::string(e.what()).find("model version 2: joint 'J1_A': velocity limit"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("model version 2: joint 'J1_A': velocity limit"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -1,8 +1,8 @@
 // The parsed model on a small hand-written robot: a base with one steering + wheel leg and a
 // two-joint arm carrying a drill with a camera.
-#include <gtest/gtest.h>
-
 #include "concert/model/robot_model.hpp"
+
+#include <gtest/gtest.h>
 
 namespace concert::model {
 namespace {
@@ -50,7 +50,8 @@ ModelDescription mini(uint64_t version = 7) {
   d.urdf = kUrdf;
   d.srdf = kSrdf;
   d.joints = {{"J1_A", "A", -3, 3, 2, 30, 20},
-              {"J2_A", "A", -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), 13, 24, 17.5},
+              {"J2_A", "A", -std::numeric_limits<double>::infinity(),
+               std::numeric_limits<double>::infinity(), 13, 24, 17.5},
               {"J1_B", "B", -2, 2, 1, 200, 160},
               {"J2_B", "B", -2, 2, 1, 200, 160}};
   // The wheel comes first, as in the paper's robot: selection never goes by position.
@@ -58,7 +59,8 @@ ModelDescription mini(uint64_t version = 7) {
               {"B", ChainRole::kArm, "base_link", "tcp_B", {"J1_B", "J2_B"}}};
   d.end_effectors = {{"wheel_A", "A", "wheel_A", "concert_wheel", EndEffectorKind::kWheel},
                      {"drill_B", "B", "tcp_B", "concert_drill", EndEffectorKind::kDrill}};
-  d.sensor_frames = {{"camera_B", SensorKind::kCamera, "camera_B", "B", "drill_B", "concert_drill"}};
+  d.sensor_frames = {
+      {"camera_B", SensorKind::kCamera, "camera_B", "B", "drill_B", "concert_drill"}};
   return d;
 }
 
@@ -84,13 +86,15 @@ TEST(RobotModel, ErrorsListTheCandidates) {
     FAIL() << "no throw";
   } catch (const ModelError& e) {
     EXPECT_STREQ(e.what(),
-                 "model version 7: no gripper tool on an arm (end-effectors: wheel_A (wheel, chain A), drill_B (drill, chain B))");
+                 "model version 7: no gripper tool on an arm (end-effectors: wheel_A (wheel, chain "
+                 "A), drill_B (drill, chain B))");
   }
   try {
     (void)m->sensor(m->end_effector("wheel_A"), SensorKind::kLidar);
     FAIL() << "no throw";
   } catch (const ModelError& e) {
-    EXPECT_STREQ(e.what(), "model version 7: end-effector 'wheel_A' has no lidar sensor (it carries: none)");
+    EXPECT_STREQ(e.what(),
+                 "model version 7: end-effector 'wheel_A' has no lidar sensor (it carries: none)");
   }
   EXPECT_THROW((void)m->chain("C"), ModelError);
   EXPECT_THROW((void)m->end_effector("gripper_B"), ModelError);
@@ -110,9 +114,12 @@ TEST(RobotModel, ErrorsListTheCandidates) {
 TEST(RobotModel, LegsGiveSteeringWheelJointsAndTheWheelRadius) {
   ModelDescription d = mini();
   // The wheel link's collision: a cylinder about the wheel axis (its z), beside a mesh.
-  const std::string mesh = R"(<collision><origin xyz="0 0 0"/><geometry><mesh filename="wheel.stl"/></geometry></collision>)";
-  d.urdf.replace(d.urdf.find(mesh), mesh.size(),
-                 mesh + R"(<collision><origin xyz="0 0 0"/><geometry><cylinder radius="0.2" length="0.1"/></geometry></collision>)");
+  const std::string mesh =
+      R"(<collision><origin xyz="0 0 0"/><geometry><mesh filename="wheel.stl"/></geometry></collision>)";
+  d.urdf.replace(
+      d.urdf.find(mesh), mesh.size(),
+      mesh +
+          R"(<collision><origin xyz="0 0 0"/><geometry><cylinder radius="0.2" length="0.1"/></geometry></collision>)");
   const auto m = RobotModel::build(d);
   const std::vector<Leg> legs = m->legs();
   ASSERT_EQ(legs.size(), 1u);
@@ -135,7 +142,8 @@ TEST(RobotModel, GeometryChainsOfLinksAndSrdfPairs) {
   ASSERT_EQ(link.shapes.size(), 1u);
   EXPECT_EQ(link.shapes[0].type, CollisionShape::Type::kCylinder);
   EXPECT_DOUBLE_EQ(link.shapes[0].size.z(), 0.4);
-  EXPECT_EQ(m->links()[static_cast<std::size_t>(m->link_index("L_2_A"))].shapes[0].type, CollisionShape::Type::kMesh);
+  EXPECT_EQ(m->links()[static_cast<std::size_t>(m->link_index("L_2_A"))].shapes[0].type,
+            CollisionShape::Type::kMesh);
   EXPECT_EQ(m->links()[static_cast<std::size_t>(m->link_index("camera_B"))].chain, "B");
   EXPECT_EQ(m->links()[0].chain, "");
   ASSERT_EQ(m->disabled_pairs().size(), 1u);

@@ -30,7 +30,8 @@ GeneratedModel generate(const Database& where) {
   auto [it, fresh] = dbs.try_emplace(where.dir.string());
   if (fresh) it->second = module_db::load_module_database(where.dir);
   const topology::EscCatalog catalog = topology::EscCatalog::load(where.dir);
-  const topology::ModuleTree tree = simbus::tree_from_assembly(simbus::load_assembly(where.assembly), catalog);
+  const topology::ModuleTree tree =
+      simbus::tree_from_assembly(simbus::load_assembly(where.assembly), catalog);
   GeneratedModel m = ModelGenerator(it->second).generate(tree);
   m.version = 1;
   return m;
@@ -70,13 +71,15 @@ TEST_P(PaperRobot, SelectsTheDrillAsTheToolAndTheLegsByRole) {
 
 TEST(PaperRobotProjectDatabase, LimitsTableKeepsPeakAndContinuousTorqueApart) {
   const auto m = model::RobotModel::build(
-      generate({fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db", fs::path(CONCERT_SOURCE_DIR) / "deploy/demo/drill_robot.yaml"})
+      generate({fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db",
+                fs::path(CONCERT_SOURCE_DIR) / "deploy/demo/drill_robot.yaml"})
           .description());
   // Elbow A (Large A actuator, paper Table 1): 460 N m peak, 160 N m continuous.
   const model::JointLimits& j2 = m->limits().at("J2_E");
   EXPECT_DOUBLE_EQ(j2.peak_torque, 460.0);
   EXPECT_DOUBLE_EQ(j2.continuous_torque, 160.0);
-  for (const model::JointLimits& j : m->limits().rows()) EXPECT_LT(j.continuous_torque, j.peak_torque) << j.name;
+  for (const model::JointLimits& j : m->limits().rows())
+    EXPECT_LT(j.continuous_torque, j.peak_torque) << j.name;
   // The drill's camera is a sensor frame of the tool.
   const model::SensorFrame& camera = m->sensor(m->tool(), SensorKind::kCamera);
   EXPECT_EQ(camera.frame, "camera_E");
@@ -86,16 +89,21 @@ TEST(PaperRobotProjectDatabase, LimitsTableKeepsPeakAndContinuousTorqueApart) {
 
 TEST(PaperRobotPublicDatabase, ContinuousTorqueIsThePeakWhereTheDatabaseGivesNone) {
   const fs::path db = fs::path(CONCERT_SHARED_DATA) / "concert_resources";
-  const auto m = model::RobotModel::build(generate({db, fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml"}).description());
-  for (const model::JointLimits& j : m->limits().rows()) EXPECT_DOUBLE_EQ(j.continuous_torque, j.peak_torque) << j.name;
+  const auto m = model::RobotModel::build(
+      generate({db, fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml"}).description());
+  for (const model::JointLimits& j : m->limits().rows())
+    EXPECT_DOUBLE_EQ(j.continuous_torque, j.peak_torque) << j.name;
 }
 
 INSTANTIATE_TEST_SUITE_P(
     BothDatabases, PaperRobot,
-    ::testing::Values(Database{fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db", fs::path(CONCERT_SOURCE_DIR) / "deploy/demo/drill_robot.yaml"},
+    ::testing::Values(Database{fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db",
+                               fs::path(CONCERT_SOURCE_DIR) / "deploy/demo/drill_robot.yaml"},
                       Database{fs::path(CONCERT_SHARED_DATA) / "concert_resources",
                                fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml"}),
-    [](const ::testing::TestParamInfo<Database>& param) { return param.index == 0 ? std::string("Project") : std::string("Public"); });
+    [](const ::testing::TestParamInfo<Database>& param) {
+      return param.index == 0 ? std::string("Project") : std::string("Public");
+    });
 
 }  // namespace
 }  // namespace concert::model_generation

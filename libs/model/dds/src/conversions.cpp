@@ -33,23 +33,29 @@ ModelDescription to_description(const msg::RobotModel& m) {
   d.config_yaml = m.config_yaml();
   d.modules = m.modules();
   for (const msg::JointInfo& j : m.joints()) {
-    d.joints.push_back({j.name(), j.chain(), from_wire(j.lower()), from_wire(j.upper()), j.velocity(), j.peak_torque(),
-                        j.continuous_torque()});
+    d.joints.push_back({j.name(), j.chain(), from_wire(j.lower()), from_wire(j.upper()),
+                        j.velocity(), j.peak_torque(), j.continuous_torque()});
   }
   for (std::size_t i = 0; i < m.chains().size(); ++i) {
     const msg::ChainInfo& c = m.chains()[i];
-    d.chains.push_back({c.name(), chain_role_from_string(c.role(), where + "chains[" + std::to_string(i) + "].role"),
-                        c.base_link(), c.tip_link(), c.joints()});
+    d.chains.push_back(
+        {c.name(),
+         chain_role_from_string(c.role(), where + "chains[" + std::to_string(i) + "].role"),
+         c.base_link(), c.tip_link(), c.joints()});
   }
   for (std::size_t i = 0; i < m.end_effectors().size(); ++i) {
     const msg::EndEffectorInfo& e = m.end_effectors()[i];
-    d.end_effectors.push_back({e.name(), e.chain(), e.frame(), e.module_key(),
-                               end_effector_kind_from_string(e.kind(), where + "end_effectors[" + std::to_string(i) + "].kind")});
+    d.end_effectors.push_back(
+        {e.name(), e.chain(), e.frame(), e.module_key(),
+         end_effector_kind_from_string(e.kind(),
+                                       where + "end_effectors[" + std::to_string(i) + "].kind")});
   }
   for (std::size_t i = 0; i < m.sensor_frames().size(); ++i) {
     const msg::SensorFrameInfo& s = m.sensor_frames()[i];
-    d.sensor_frames.push_back({s.name(), sensor_kind_from_string(s.kind(), where + "sensor_frames[" + std::to_string(i) + "].kind"),
-                               s.frame(), s.chain(), s.end_effector(), s.module_key()});
+    d.sensor_frames.push_back(
+        {s.name(),
+         sensor_kind_from_string(s.kind(), where + "sensor_frames[" + std::to_string(i) + "].kind"),
+         s.frame(), s.chain(), s.end_effector(), s.module_key()});
   }
   return d;
 }

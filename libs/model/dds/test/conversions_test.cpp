@@ -1,8 +1,8 @@
+#include "concert/model/dds/conversions.hpp"
+
 #include <gtest/gtest.h>
 
 #include <limits>
-
-#include "concert/model/dds/conversions.hpp"
 
 namespace concert::model {
 namespace {
@@ -23,7 +23,8 @@ ModelDescription sample() {
               {"F", ChainRole::kTool, "base_link", "tcp_F", {}}};
   d.end_effectors = {{"wheel_A", "A", "wheel_A", "concert_wheel", EndEffectorKind::kWheel},
                      {"drill_E", "E", "tcp_E", "concert_drill", EndEffectorKind::kDrill}};
-  d.sensor_frames = {{"camera_E", SensorKind::kCamera, "camera_E", "E", "drill_E", "concert_drill"}};
+  d.sensor_frames = {
+      {"camera_E", SensorKind::kCamera, "camera_E", "E", "drill_E", "concert_drill"}};
   return d;
 }
 
@@ -48,7 +49,8 @@ TEST(ModelConversions, UnknownKindsAreErrorsNamingTheField) {
     FAIL() << "no throw";
   } catch (const ModelError& e) {
     EXPECT_STREQ(e.what(),
-                 "RobotModel v5 end_effectors[1].kind: unknown end-effector kind 'laser' (known: drill, gripper, sanding, "
+                 "RobotModel v5 end_effectors[1].kind: unknown end-effector kind 'laser' (known: "
+                 "drill, gripper, sanding, "
                  "spraying, camera, wheel, other)");
   }
   m = dds::to_msg(sample(), 0);

@@ -49,10 +49,10 @@ SensorKind sensor_kind_from_string(std::string_view name, const std::string& wha
 /// See README.md "The limits rule" for which consumer enforces which column.
 struct JointLimits {
   std::string name;
-  std::string chain;               ///< chain tag ("A", "B", ...)
+  std::string chain;                                        ///< chain tag ("A", "B", ...)
   double lower = -std::numeric_limits<double>::infinity();  ///< position [rad] ([m] prismatic)
   double upper = std::numeric_limits<double>::infinity();   ///< position [rad] ([m] prismatic)
-  double velocity = 0.0;           ///< |qd| limit [rad/s] ([m/s])
+  double velocity = 0.0;                                    ///< |qd| limit [rad/s] ([m/s])
   double peak_torque = 0.0;        ///< |tau| the drive can deliver briefly [N m] ([N])
   double continuous_torque = 0.0;  ///< |tau| the drive sustains thermally [N m] ([N]); <= peak
   bool operator==(const JointLimits&) const = default;
@@ -60,43 +60,43 @@ struct JointLimits {
 
 /// A kinematic chain.
 struct ChainInfo {
-  std::string name;                ///< tag "A", "B", ...
+  std::string name;  ///< tag "A", "B", ...
   ChainRole role = ChainRole::kOther;
   std::string base_link;
   std::string tip_link;
-  std::vector<std::string> joints; ///< moving joints, root to tip
+  std::vector<std::string> joints;  ///< moving joints, root to tip
   bool operator==(const ChainInfo&) const = default;
 };
 
 /// An end-effector (tools, grippers; wheels are the end-effectors of legs).
 struct EndEffectorInfo {
-  std::string name;                ///< e.g. "drill_E", "wheel_A"
-  std::string chain;               ///< chain tag
-  std::string frame;               ///< TCP or wheel-centre link
-  std::string module_key;          ///< module-database key of the end-effector module
+  std::string name;        ///< e.g. "drill_E", "wheel_A"
+  std::string chain;       ///< chain tag
+  std::string frame;       ///< TCP or wheel-centre link
+  std::string module_key;  ///< module-database key of the end-effector module
   EndEffectorKind kind = EndEffectorKind::kOther;
   bool operator==(const EndEffectorInfo&) const = default;
 };
 
 /// A frame a sensor is mounted at (the drill's camera; lidars, sonars, IMUs next).
 struct SensorFrame {
-  std::string name;                ///< e.g. "camera_E"
+  std::string name;  ///< e.g. "camera_E"
   SensorKind kind = SensorKind::kOther;
-  std::string frame;               ///< URDF link of the sensor
-  std::string chain;               ///< chain tag; empty on the root hub
-  std::string end_effector;        ///< end-effector it belongs to; empty for none
-  std::string module_key;          ///< module (or add-on) the sensor comes with
+  std::string frame;         ///< URDF link of the sensor
+  std::string chain;         ///< chain tag; empty on the root hub
+  std::string end_effector;  ///< end-effector it belongs to; empty for none
+  std::string module_key;    ///< module (or add-on) the sensor comes with
   bool operator==(const SensorFrame&) const = default;
 };
 
 /// The model as the RobotModel message carries it.
 struct ModelDescription {
-  uint64_t version = 0;            ///< strictly increasing; 0 = not published
-  std::string content_hash;        ///< "sha256:<hex>" of urdf + srdf + config text
-  uint64_t tree_version = 0;       ///< ModuleTree version it was generated from
+  uint64_t version = 0;       ///< strictly increasing; 0 = not published
+  std::string content_hash;   ///< "sha256:<hex>" of urdf + srdf + config text
+  uint64_t tree_version = 0;  ///< ModuleTree version it was generated from
   std::string urdf;
   std::string srdf;
-  std::string config_yaml;         ///< controller configuration
+  std::string config_yaml;           ///< controller configuration
   std::vector<std::string> modules;  ///< module keys in tree order
   std::vector<JointLimits> joints;   ///< the limits table, one row per moving joint
   std::vector<ChainInfo> chains;

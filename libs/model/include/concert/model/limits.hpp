@@ -4,12 +4,14 @@
 // The rule (stated once here and in libs/model/README.md; every service applies it through
 // these functions, so robot, safety and planner agree by construction):
 //
-//  | limit       | robot (drives)                  | safety (stops the robot)                        | planner (plans)                    |
-//  |-------------|---------------------------------|-------------------------------------------------|------------------------------------|
-//  | position    | commands clamped to [lower, upper] | beyond [lower - tol, upper + tol] at once    | every state within [lower, upper]  |
-//  | velocity    | commands saturate at velocity   | |qd| > velocity (1 + margin) at once             | |qd| <= velocity x velocity_scale  |
-//  | torque      | efforts saturate at peak        | |tau| > peak (1 + margin) at once, and RMS of tau  | static/planned torques within      |
-//  |             |                                 | over the thermal window > continuous (1 + margin) | continuous (x torque_margin <= 1)  |
+//  * position: the robot clamps commands to [lower, upper]; safety stops beyond
+//    [lower - tolerance, upper + tolerance]; the planner keeps every state within [lower, upper].
+//  * velocity: the robot saturates commands at the velocity limit; safety stops beyond
+//    velocity x (1 + margin); the planner plans within velocity x velocity_scale (<= 1).
+//  * torque: the robot's drives saturate at the PEAK torque; safety stops at once beyond
+//    peak x (1 + margin), and when the RMS of the torque over the thermal window exceeds
+//    CONTINUOUS x (1 + margin); the planner keeps static/planned torques within the
+//    CONTINUOUS torque (x torque_margin <= 1).
 //
 // Why: the peak torque is what a drive can deliver for a short time, the continuous torque
 // what it can deliver without overheating. A transient above the continuous torque (an arm
@@ -37,14 +39,18 @@ inline double drive_torque_limit(const JointLimits& j) { return j.peak_torque; }
 /// Torque the planner keeps static/planned loads within [N m]: the continuous torque.
 inline double planning_torque_limit(const JointLimits& j) { return j.continuous_torque; }
 /// |tau| beyond which safety stops at once [N m]: peak x (1 + margin).
-inline double instant_torque_bound(const JointLimits& j, double margin) { return j.peak_torque * (1.0 + margin); }
+inline double instant_torque_bound(const JointLimits& j, double margin) {
+  return j.peak_torque * (1.0 + margin);
+}
 /// RMS torque over the thermal window beyond which safety stops [N m]:
 /// continuous x (1 + margin).
 inline double sustained_torque_bound(const JointLimits& j, double margin) {
   return j.continuous_torque * (1.0 + margin);
 }
 /// |qd| beyond which safety stops at once [rad/s]: velocity x (1 + margin).
-inline double velocity_bound(const JointLimits& j, double margin) { return j.velocity * (1.0 + margin); }
+inline double velocity_bound(const JointLimits& j, double margin) {
+  return j.velocity * (1.0 + margin);
+}
 /// True when q [rad] is beyond [lower - tolerance, upper + tolerance] (or not finite).
 bool position_violated(const JointLimits& j, double q, double tolerance);
 
@@ -58,7 +64,10 @@ class ThermalLoad {
   double add(double tau, double dt);
   /// RMS torque [N m] now.
   [[nodiscard]] double rms() const;
-  void reset() { mean_square_ = 0.0; started_ = false; }
+  void reset() {
+    mean_square_ = 0.0;
+    started_ = false;
+  }
 
  private:
   double window_;

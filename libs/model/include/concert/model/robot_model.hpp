@@ -4,14 +4,13 @@
 // kinematics::Data made by kinematics().make_data()). Every service selects chains,
 // end-effectors and sensors by role and kind through it, never by list position or by name.
 
+#include <Eigen/Geometry>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "concert/kinematics/model.hpp"
 #include "concert/model/description.hpp"
@@ -27,20 +26,20 @@ struct CollisionShape {
   /// mesh: scale [m].
   Eigen::Vector3d size = Eigen::Vector3d::Zero();
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< link_T_shape
-  std::string mesh;  ///< mesh file name (kMesh)
+  std::string mesh;                                          ///< mesh file name (kMesh)
 };
 
 /// One URDF link, in topological order (parents first).
 struct Link {
   std::string name;
-  int parent = -1;                 ///< index in RobotModel::links(); -1 for the root
-  std::string joint;               ///< URDF joint from the parent (moving or fixed); empty at the root
-  bool moving = false;             ///< the joint from the parent moves
-  bool prismatic = false;          ///< ... and is prismatic
+  int parent = -1;         ///< index in RobotModel::links(); -1 for the root
+  std::string joint;       ///< URDF joint from the parent (moving or fixed); empty at the root
+  bool moving = false;     ///< the joint from the parent moves
+  bool prismatic = false;  ///< ... and is prismatic
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< parent_T_joint at q = 0
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();           ///< joint axis in the joint frame
-  std::string chain;               ///< chain of the nearest moving joint at or above; "" for none
-  double mass = 0.0;               ///< [kg]
+  std::string chain;  ///< chain of the nearest moving joint at or above; "" for none
+  double mass = 0.0;  ///< [kg]
   Eigen::Vector3d com = Eigen::Vector3d::Zero();  ///< centre of mass in the link frame [m]
   std::vector<CollisionShape> shapes;
 };
@@ -48,10 +47,10 @@ struct Link {
 /// A leg of the mobile base, as the robot's base controller needs it.
 struct Leg {
   const ChainInfo* chain = nullptr;
-  std::string steering_joint;      ///< turns the wheel about the vertical; empty for none
-  std::string wheel_joint;         ///< drives the wheel
-  std::string wheel_frame;         ///< wheel-centre link
-  double wheel_radius = 0.0;       ///< [m], from the wheel link's collision cylinder
+  std::string steering_joint;  ///< turns the wheel about the vertical; empty for none
+  std::string wheel_joint;     ///< drives the wheel
+  std::string wheel_frame;     ///< wheel-centre link
+  double wheel_radius = 0.0;   ///< [m], from the wheel link's collision cylinder
 };
 
 /// The parsed model of one version. Build with RobotModel::build; share the pointer.
@@ -96,7 +95,9 @@ class RobotModel {
   /// Throws ModelError naming a leg without a wheel.
   [[nodiscard]] std::vector<Leg> legs() const;
 
-  [[nodiscard]] const std::vector<EndEffectorInfo>& end_effectors() const { return description_.end_effectors; }
+  [[nodiscard]] const std::vector<EndEffectorInfo>& end_effectors() const {
+    return description_.end_effectors;
+  }
   /// End-effectors of a kind, in model order (may be empty).
   [[nodiscard]] std::vector<const EndEffectorInfo*> end_effectors(EndEffectorKind kind) const;
   /// The end-effector called `name`; throws ModelError listing the end-effectors.
@@ -107,7 +108,9 @@ class RobotModel {
   /// The one arm tool of `kind`; throws ModelError listing the end-effectors with kinds.
   [[nodiscard]] const EndEffectorInfo& tool(EndEffectorKind kind) const;
 
-  [[nodiscard]] const std::vector<SensorFrame>& sensor_frames() const { return description_.sensor_frames; }
+  [[nodiscard]] const std::vector<SensorFrame>& sensor_frames() const {
+    return description_.sensor_frames;
+  }
   /// Sensor frames of a kind, in model order (may be empty).
   [[nodiscard]] std::vector<const SensorFrame*> sensor_frames(SensorKind kind) const;
   /// The sensor of `kind` on end-effector `ee`, or nullptr.
