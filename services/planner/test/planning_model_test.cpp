@@ -11,6 +11,7 @@
 #include "planner/trajectory.hpp"
 
 using namespace concert::planner;
+namespace model = concert::model;
 
 namespace {
 
