@@ -1,6 +1,6 @@
-#include "conversions.hpp"
+#include "concert/topology/dds/conversions.hpp"
 
-namespace concert::discovery::dds {
+namespace concert::topology::dds {
 namespace {
 
 topology::EscSlave slave_to_core(const msg::EscSlave& m) {
@@ -129,4 +129,4 @@ msg::ModuleTree to_msg(const topology::ModuleTree& tree, uint32_t version, uint3
   return out;
 }
 
-}  // namespace concert::discovery::dds
+}  // namespace concert::topology::dds

@@ -1,23 +1,13 @@
 #pragma once
-// IDL <-> core conversions of the EtherCAT scan and the module tree (idl/ethercat.idl,
-// idl/topology.idl). Reusable by any adapter that reads these topics (e.g. modelgen).
+// The scan and module-tree conversions live in libs/topology_dds (concert_topology_dds); this
+// header keeps their discovery names for the code that still includes it (the robot's adapter
+// and the concert tool) until it includes "concert/topology/dds/conversions.hpp" itself.
 
-#include <cstdint>
-#include <string>
-
-#include "concert/topology/types.hpp"
-#include "ethercat.h"
-#include "topology.h"
+#include "concert/topology/dds/conversions.hpp"
 
 namespace concert::discovery::dds {
 
-topology::EscScan to_core(const msg::EscScan& scan);
-msg::EscScan to_msg(const topology::EscScan& scan, uint32_t scan_id, int64_t stamp_ns,
-                    const std::string& source);
-
-/// parent_port -1 on the wire stands for "no parent port" (the first slave).
-topology::ModuleTree to_core(const msg::ModuleTree& tree);
-msg::ModuleTree to_msg(const topology::ModuleTree& tree, uint32_t version, uint32_t scan_id,
-                       int64_t stamp_ns);
+using topology::dds::to_core;
+using topology::dds::to_msg;
 
 }  // namespace concert::discovery::dds
