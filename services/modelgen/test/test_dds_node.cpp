@@ -1,11 +1,11 @@
 // The modelgen node over real DDS (private domain): tree in -> latched GeneratedModel out, same
 // tree -> no new version, bad tree -> model kept, customisation -> new version, late joiners.
 
-#include <chrono>
-#include <sstream>
-
 #include <gtest/gtest.h>
 #include <urdf_parser/urdf_parser.h>
+
+#include <chrono>
+#include <sstream>
 
 #include "concert/dds/participant.hpp"
 #include "concert/topology/dds/conversions.hpp"

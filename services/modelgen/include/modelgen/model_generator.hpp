@@ -9,6 +9,7 @@ namespace concert::modelgen {
 
 using model_generation::AddonChoice;
 using model_generation::ChainInfo;
+using model_generation::check_modelable;
 using model_generation::Customisation;
 using model_generation::EndEffectorInfo;
 using model_generation::GeneratedModel;

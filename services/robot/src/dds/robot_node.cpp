@@ -3,7 +3,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "dds/conversions.hpp"  // discovery's EtherCAT scan conversions
+#include "concert/topology/dds/conversions.hpp"
 #include "robot_conversions.hpp"
 
 namespace concert::robot::dds {
@@ -123,7 +123,7 @@ void RobotNode::publish(const RobotState& s) {
 }
 
 void RobotNode::publish_scan(const topology::EscScan& scan, const std::string& source) {
-  scan_.write(discovery::dds::to_msg(scan, ++scan_id_, wall_ns(), source));
+  scan_.write(topology::dds::to_msg(scan, ++scan_id_, wall_ns(), source));
 }
 
 std::string RobotNode::last_error() const {
