@@ -242,6 +242,14 @@ bool PlannerNode::spin_once(std::chrono::milliseconds timeout) {
 }
 
 void PlannerNode::handle(const msg::PlanRequest& request) {
+  // After a hot swap a client may name the new model version before its sample reached us:
+  // wait (bounded) for it instead of answering "no model" or "stale".
+  if (request.model_version() > planner_.model_version()) {
+    std::unique_lock lock(mutex_);
+    wake_.wait_for(lock, options_.model_wait, [&] {
+      return stopping_ || planner_.model_version() >= request.model_version();
+    });
+  }
   msg::PlanResult base;
   base.request_id(request.request_id());
   base.model_version(static_cast<uint32_t>(planner_.model_version()));

@@ -28,6 +28,9 @@ msg::PlanFailure to_failure(Status status);
 struct NodeOptions {
   std::chrono::milliseconds command_period{10};   ///< execution command period
   std::chrono::milliseconds progress_period{100}; ///< progress updates while executing
+  /// A request for a model version the planner does not have yet (it races the model after a
+  /// hot swap) waits this long for that version before it is answered.
+  std::chrono::milliseconds model_wait{5000};
 };
 
 class PlannerNode {
