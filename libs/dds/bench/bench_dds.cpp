@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
 
 namespace concert {
@@ -24,8 +25,6 @@ using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
 namespace {
-
-int64_t now_ns() { return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count(); }
 
 struct Stats {
   double median, p99, mean, max;
