@@ -38,10 +38,10 @@ sleep 0.5
 sed 's/^/  /' "$log"
 
 stage "scan -> module tree -> robot model v1 -> every service reconfigures"
-"$concert" status --until-version 1 --timeout-ms 60000 | sed 's/^/  /'
+"$concert" status --until-version 1 --timeout 60 | sed 's/^/  /'
 
 stage "concert status"
-"$concert" status --wait-ms 1000 | sed 's/^/  /'
+"$concert" status --timeout 1 | sed 's/^/  /'
 
 stage "the live model"
 "$concert" model show --timeout 5 | sed -n '1,8p;/^end-effectors/,$p' | sed 's/^/  /'
@@ -52,10 +52,10 @@ stage "drilling approach: concert plan drill --at 2.0 0.0 1.2 --execute (area 2 
 stage "hot swap: concert sim swap deploy/demo/sanding_robot.yaml (drill -> sanding tool)"
 swap=$(date +%s%N)
 "$concert" sim swap deploy/demo/sanding_robot.yaml | sed 's/^/  /'
-"$concert" status --until-version 2 --timeout-ms 60000 | sed 's/^/  /'
+"$concert" status --until-version 2 --timeout 60 | sed 's/^/  /'
 stage "model version 2 live in every service (stage times above count from the swap)"
-"$concert" status --wait-ms 1000 | sed 's/^/  /'
+"$concert" status --timeout 1 | sed 's/^/  /'
 "$concert" model show --timeout 5 | sed -n '/^end-effectors/,$p' | sed 's/^/  /'
 
 stage "topics on the domain"
-"$concert" topic list --wait-ms 1000 | sed 's/^/  /'
+"$concert" topic list --timeout 1 | sed 's/^/  /'

@@ -5,7 +5,9 @@
 #include <string>
 #include <vector>
 
-namespace concert::cli {
+#include "concert/cli/cli.hpp"
+
+namespace concert::tool {
 
 /// The last status of one service instance, as read from concert/system/status.
 struct ServiceRow {
@@ -20,7 +22,7 @@ struct ServiceRow {
 /// Statuses seen on the domain within `wait`, sorted by service then host.
 std::vector<ServiceRow> read_statuses(int32_t domain, std::chrono::milliseconds wait);
 
-/// `concert status [--json] [--wait-ms MS] [--domain N]`; args start after "status".
-int run_status(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// Registers `concert status`.
+void register_status_verb(cli::Cli& concert);
 
-}  // namespace concert::cli
+}  // namespace concert::tool
