@@ -140,6 +140,13 @@ CLI::Option* Cli::add_deprecated_ms_option(CLI::App& verb, const std::string& ms
   return ms;
 }
 
+CLI::Option* Cli::add_choice(CLI::App& verb, const std::string& name, std::string& value,
+                             const std::vector<std::string>& choices, const std::string& help) {
+  return verb.add_option(name, value, help)
+      ->type_name(join(choices, "|"))
+      ->check(CLI::IsMember(choices));
+}
+
 void Cli::add_dds_options(CLI::App& verb, DdsOptions& options, double timeout_s,
                           const std::string& timeout_help) {
   add_domain_option(verb, options.domain);

@@ -64,9 +64,8 @@ int main(int argc, char** argv) {
   app.add_option("--module-db", options.module_dbs,
                  "module database folder (repeat to merge; default: the project's)")
       ->type_name("DIR");
-  app.add_option("--port-order", options.port_order, "frame processing order of the ESC ports")
-      ->type_name("0312|0123")
-      ->check(CLI::IsMember({"0312", "0123"}));
+  concert::cli::Cli::add_choice(app, "--port-order", options.port_order, {"0312", "0123"},
+                                "frame processing order of the ESC ports");
   app.add_option("--params", options.params, "parameters file (config/discovery.yaml)")
       ->type_name("FILE");
   cli.on_run(app, [&options] { return run(options); });

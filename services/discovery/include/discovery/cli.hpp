@@ -13,7 +13,7 @@ namespace concert::discovery {
 /// What `concert discover` reads.
 struct DiscoverOptions {
   std::string scan;  ///< scan file (YAML or JSON)
-  topology::PortOrder order = topology::PortOrder::kReal0312;
+  std::string port_order = "0312";  ///< frame processing order of the ESC ports: 0312 or 0123
   /// Module databases, merged in order (later entries override earlier ones with the same
   /// identity); empty: the project database (CONCERT_DEFAULT_MODULE_DB, <source>/data/module_db).
   std::vector<std::string> module_dbs;

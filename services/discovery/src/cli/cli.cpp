@@ -24,7 +24,8 @@ int discover(DiscoverOptions options, std::ostream& out, std::ostream& err) {
     topology::EscCatalog catalog;
     for (const auto& db : options.module_dbs) catalog.merge(topology::EscCatalog::load(db));
     const topology::EscScan scan = topology::load_scan(options.scan);
-    const Discovery discovery(std::move(catalog), Params{options.order});
+    const Discovery discovery(std::move(catalog),
+                              Params{*topology::parse_port_order(options.port_order)});
     const topology::ModuleTree tree = discovery.run(scan);
     if (options.json) {
       out << topology::tree_to_json(tree).dump(2) << "\n";
@@ -46,12 +47,8 @@ void register_verbs(cli::Cli& concert) {
       concert.verb(concert.app(), "discover", "rebuild the module tree from an EtherCAT scan file",
                    [&concert, o] { return discover(*o, concert.out(), concert.err()); });
   verb.add_option("--scan", o->scan, "the scan file (YAML or JSON)")->type_name("FILE")->required();
-  verb.add_option_function<std::string>(
-          "--port-order",
-          [o](const std::string& text) { o->order = *topology::parse_port_order(text); },
-          "frame processing order of the ESC ports (real hardware: 0312)")
-      ->type_name("0312|0123")
-      ->check(CLI::IsMember({"0312", "0123"}));
+  cli::Cli::add_choice(verb, "--port-order", o->port_order, {"0312", "0123"},
+                       "frame processing order of the ESC ports (real hardware: 0312)");
   verb.add_option(
           "--module-db", o->module_dbs,
           "module database folder (repeat to merge, later ones override; default: the project's)")

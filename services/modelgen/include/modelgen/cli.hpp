@@ -19,7 +19,7 @@ struct GenerateOptions {
   std::string scan, tree, assembly;  ///< exactly one: scan file, tree JSON, assembly file
   std::string out;                   ///< bundle folder
   std::vector<std::filesystem::path> module_dbs;  ///< either database format, merged in order
-  topology::PortOrder order = topology::PortOrder::kReal0312;
+  std::string port_order = "0312";  ///< frame processing order of the ESC ports: 0312 or 0123
   Customisation custom;  ///< --home JOINT=RAD, --addon EE=ADDON
 };
 

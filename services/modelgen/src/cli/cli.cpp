@@ -26,6 +26,7 @@ topology::EscCatalog catalog_of(const std::vector<fs::path>& dirs) {
 }  // namespace
 
 int generate(const GenerateOptions& o, std::ostream& out) {
+  const topology::PortOrder order = *topology::parse_port_order(o.port_order);
   const module_db::ModuleDatabase db = module_db::load_module_databases(o.module_dbs);
   topology::ModuleTree tree;
   std::string source;
@@ -41,12 +42,12 @@ int generate(const GenerateOptions& o, std::ostream& out) {
     tree = topology::tree_from_json(doc, o.tree);
     source = o.tree;
   } else if (!o.scan.empty()) {
-    tree = discovery::discover(topology::load_scan(o.scan), catalog_of(o.module_dbs), {o.order});
+    tree = discovery::discover(topology::load_scan(o.scan), catalog_of(o.module_dbs), {order});
     source = o.scan;
   } else {
     const topology::EscCatalog catalog = catalog_of(o.module_dbs);
     const simbus::Assembly assembly = simbus::load_assembly(o.assembly);
-    tree = discovery::discover(simbus::simulate_scan(assembly, catalog, o.order), catalog, {o.order});
+    tree = discovery::discover(simbus::simulate_scan(assembly, catalog, order), catalog, {order});
     source = o.assembly;
   }
   RobotModel model = ModelGenerator(db).generate(tree, o.custom);
@@ -120,12 +121,8 @@ void register_verbs(cli::Cli& concert) {
       ->type_name("DIR")
       ->required();
   gen.add_option("--out", g->out, "the bundle folder")->type_name("DIR")->required();
-  gen.add_option_function<std::string>(
-         "--port-order",
-         [g](const std::string& text) { g->order = *topology::parse_port_order(text); },
-         "frame processing order of the ESC ports")
-      ->type_name("0312|0123")
-      ->check(CLI::IsMember({"0312", "0123"}));
+  cli::Cli::add_choice(gen, "--port-order", g->port_order, {"0312", "0123"},
+                       "frame processing order of the ESC ports");
   gen.add_option_function<std::vector<std::string>>(
          "--home",
          [g](const std::vector<std::string>& items) {

@@ -174,9 +174,8 @@ void register_verbs(cli::Cli& concert) {
           });
   std::vector<std::string> sources;
   for (const auto& [name, value] : kSources) sources.push_back(name);
-  estop_verb->add_option("--source", estop_options->source, "the e-stop input (default: software)")
-      ->type_name("SOURCE")
-      ->check(CLI::IsMember(sources));
+  cli::Cli::add_choice(*estop_verb, "--source", estop_options->source, sources,
+                       "the e-stop input (default: software)");
   estop_verb->add_flag("--release", estop_options->release,
                        "release the input instead of engaging it");
   estop_verb->add_option("--reason", estop_options->reason, "why (shown in the stop causes)")

@@ -97,6 +97,9 @@ class Cli {
   static CLI::Option* add_deprecated_ms_option(CLI::App& verb, const std::string& ms_name,
                                                double& seconds, CLI::Option* instead,
                                                bool* given = nullptr);
+  /// Adds option `name` taking one of `choices` (shown as "a|b"), stored in `value`.
+  static CLI::Option* add_choice(CLI::App& verb, const std::string& name, std::string& value,
+                                 const std::vector<std::string>& choices, const std::string& help);
   /// True if `verb` was given the DDS options.
   bool talks_dds(const CLI::App& verb) const { return dds_verbs_.count(&verb) > 0; }
   /// Every verb (leaf of the tree) with its full name, e.g. "concert topic echo".
