@@ -136,15 +136,14 @@ CLI::Option* Cli::add_deprecated_ms_option(CLI::App& verb, const std::string& ms
                             "deprecated: " + instead->get_name() + " in seconds")
                         ->check(cli::seconds())
                         ->group("");
-  ms->excludes(instead);
   return ms;
 }
 
 CLI::Option* Cli::add_choice(CLI::App& verb, const std::string& name, std::string& value,
                              const std::vector<std::string>& choices, const std::string& help) {
-  return verb.add_option(name, value, help)
-      ->type_name(join(choices, "|"))
-      ->check(CLI::IsMember(choices));
+  CLI::Validator member = CLI::IsMember(choices);
+  member.description("");  // the type name lists the choices already
+  return verb.add_option(name, value, help)->type_name(join(choices, "|"))->check(member);
 }
 
 void Cli::add_dds_options(CLI::App& verb, DdsOptions& options, double timeout_s,
