@@ -39,13 +39,13 @@ fail() {
 }
 check_end_state() {
   local what=$1 safety
-  safety=$("$concert" safety status --timeout-ms 5000) || fail "$what: no safety state ($safety)"
+  safety=$("$concert" safety status --timeout 5) || fail "$what: no safety state ($safety)"
   echo "  $safety"
   case "$safety" in
     "safety: RUNNING"*) ;;
     *) fail "$what: the safety service stopped the robot: $safety" ;;
   esac
-  "$concert" status --check --wait-ms 1500 | sed 's/^/  /' ||
+  "$concert" status --check --timeout 1.5 | sed 's/^/  /' ||
     fail "$what: a service is stopped or in error, disagrees on the model, or refused input (above)"
 }
 
@@ -56,10 +56,10 @@ sleep 0.5
 sed 's/^/  /' "$log"
 
 stage "scan -> module tree -> robot model v1 -> every service reconfigures"
-"$concert" status --until-version 1 --timeout-ms 60000 | sed 's/^/  /'
+"$concert" status --until-version 1 --timeout 60 | sed 's/^/  /'
 
 stage "concert status"
-"$concert" status --wait-ms 1000 | sed 's/^/  /'
+"$concert" status --timeout 1 | sed 's/^/  /'
 
 stage "the live model"
 "$concert" model show --timeout 5 | sed -n '1,8p;/^end-effectors/,$p' | sed 's/^/  /'
@@ -73,13 +73,13 @@ check_end_state "after the drilling approach"
 stage "hot swap: concert sim swap deploy/demo/sanding_robot.yaml (drill -> sanding tool)"
 swap=$(date +%s%N)
 "$concert" sim swap deploy/demo/sanding_robot.yaml | sed 's/^/  /'
-"$concert" status --until-version 2 --timeout-ms 60000 | sed 's/^/  /'
+"$concert" status --until-version 2 --timeout 60 | sed 's/^/  /'
 stage "model version 2 live in every service (stage times above count from the swap)"
-"$concert" status --wait-ms 1000 | sed 's/^/  /'
+"$concert" status --timeout 1 | sed 's/^/  /'
 "$concert" model show --timeout 5 | sed -n '/^end-effectors/,$p' | sed 's/^/  /'
 
 stage "topics on the domain"
-"$concert" topic list --wait-ms 1000 | sed 's/^/  /'
+"$concert" topic list --timeout 1 | sed 's/^/  /'
 
 stage "end state: safety RUNNING, every service ready at model version 2, nothing refused"
 check_end_state "at the end"

@@ -92,6 +92,13 @@ bool Process::wait_for_output(const std::string& text, std::chrono::milliseconds
   return false;
 }
 
+Outcome run(std::vector<std::string> argv, std::chrono::milliseconds timeout,
+            std::vector<std::string> env) {
+  Process p(std::move(argv), std::move(env));
+  const auto code = p.wait(timeout);
+  return {code.value_or(-1), p.out(), p.err()};
+}
+
 std::vector<std::string> lines(const std::string& text) {
   std::vector<std::string> result;
   std::istringstream in(text);

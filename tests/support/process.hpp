@@ -39,6 +39,17 @@ class Process {
   std::string dir_;
 };
 
+/// How a program run to its end went: exit code (-1: it did not end in time and was killed),
+/// stdout and stderr.
+struct Outcome {
+  int code;
+  std::string out, err;
+};
+
+/// Runs argv to its end, at most `timeout` (then it is killed); `env` as for Process.
+Outcome run(std::vector<std::string> argv, std::chrono::milliseconds timeout,
+            std::vector<std::string> env = {});
+
 /// Lines of `text`.
 std::vector<std::string> lines(const std::string& text);
 

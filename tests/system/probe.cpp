@@ -9,6 +9,7 @@
 #include <iostream>
 #include <string>
 
+#include "concert/cli/cli.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 
@@ -17,24 +18,18 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(const std::string& service) {
   namespace dds = concert::dds;
   namespace msg = concert::msg;
-  if (argc != 3 || std::string(argv[1]) != "--service") {
-    std::cerr << "usage: concert_system_probe --service NAME\n";
-    return 1;
-  }
-  try {
+  {
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
-    dds::Participant participant({.name = argv[2]});
+    dds::Participant participant({.name = service});
     dds::Reader<msg::RobotModel> models(participant, dds::topics::robot_model);
     dds::Reader<msg::SafetyState> safety(participant, dds::topics::safety_state);
-    dds::StatusReporter status(participant, argv[2]);
+    dds::StatusReporter status(participant, service);
     status.report(msg::SERVICE_STARTING, 0, "waiting for a robot model");
-    std::cout << "probe " << argv[2] << "@" << dds::host_name() << " started" << std::endl;
+    std::cout << "probe " << service << "@" << dds::host_name() << " started" << std::endl;
     std::string last_safety;
     while (!g_stop) {
       if (auto m = models.wait(std::chrono::milliseconds(50))) {
@@ -51,8 +46,19 @@ int main(int argc, char** argv) {
       }
     }
     return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "concert_system_probe: " << e.what() << "\n";
-    return 1;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  concert::cli::Cli probe("concert_system_probe", "A stand-in task service for system tests.",
+                          std::cout, std::cerr);
+  std::string service;
+  probe.app()
+      .add_option("--service", service, "the service name it reports as")
+      ->type_name("NAME")
+      ->required();
+  probe.on_run(probe.app(), [&service] { return run(service); });
+  return probe.run(argc, argv);
 }

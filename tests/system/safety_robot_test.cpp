@@ -19,6 +19,12 @@
 namespace concert::system_test {
 namespace {
 
+/// `concert safety ARGS...` in this process.
+int safety_cli(std::vector<std::string> args, std::ostream& out, std::ostream& err) {
+  args.insert(args.begin(), "safety");
+  return cli::run("concert", {safety::register_verbs}, args, out, err);
+}
+
 using namespace std::chrono_literals;
 
 /// Waits (bounded) for a status of the robot service whose message is `text`.
@@ -62,15 +68,14 @@ TEST(SafetyWithRobot, NoFalseStopEStopHoldsResetReleasesKilledRobotNamed) {
     concert::dds::Participant p({.name = "safety_robot_test"});
     concert::dds::Reader<msg::ServiceStatus> statuses(p, concert::dds::topics::status);
     std::ostringstream out, err;
-    ASSERT_EQ(safety::cli_main({"estop", "--source", "front-left", "--reason", "test"}, out, err),
-              0)
+    ASSERT_EQ(safety_cli({"estop", "--source", "front-left", "--reason", "test"}, out, err), 0)
         << err.str();
     EXPECT_TRUE(wait_robot_note(
         statuses, "safety stop: holding (estop: button front left engaged (test))", 10s))
         << logs();
-    ASSERT_EQ(safety::cli_main({"estop", "--source", "front-left", "--release"}, out, err), 0)
+    ASSERT_EQ(safety_cli({"estop", "--source", "front-left", "--release"}, out, err), 0)
         << err.str();
-    ASSERT_EQ(safety::cli_main({"reset", "--source", "system test"}, out, err), 0)
+    ASSERT_EQ(safety_cli({"reset", "--source", "system test"}, out, err), 0)
         << out.str() << err.str();
     EXPECT_TRUE(wait_robot_note(statuses, "safety stop released", 10s)) << logs();
   }

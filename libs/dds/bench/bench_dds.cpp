@@ -13,10 +13,12 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
 
 namespace concert {
@@ -24,8 +26,6 @@ using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
 namespace {
-
-int64_t now_ns() { return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count(); }
 
 struct Stats {
   double median, p99, mean, max;
@@ -126,7 +126,13 @@ int bench_main(int argc, char** argv) {
 
   msg::JointState s;
   s.name().resize(static_cast<size_t>(joints));
-  for (int j = 0; j < joints; ++j) s.name()[static_cast<size_t>(j)] = "J" + std::to_string(j) + "_A";
+  for (int j = 0; j < joints; ++j) {
+    // Streamed rather than "J" + ...: GCC 12 flags the string concatenation (and assigning "J")
+    // with a -Wrestrict false positive when inlined here.
+    std::ostringstream name;
+    name << "J" << j << "_A";
+    s.name()[static_cast<size_t>(j)] = name.str();
+  }
   s.position(std::vector<double>(static_cast<size_t>(joints), 0.1));
   s.velocity(std::vector<double>(static_cast<size_t>(joints), 0.2));
   s.effort(std::vector<double>(static_cast<size_t>(joints), 0.3));

@@ -38,7 +38,12 @@ void RawPubSubType::deleteData(void* data) { delete static_cast<RawSample*>(data
 
 bool RawPubSubType::getKey(void* data, eprosima::fastrtps::rtps::InstanceHandle_t* handle, bool /*force_md5*/) {
   if (!m_isGetKeyDefined) return false;
-  const auto& bytes = static_cast<RawSample*>(data)->bytes;
+  const auto& sample = *static_cast<RawSample*>(data);
+  if (sample.key) {
+    for (size_t i = 0; i < 16; ++i) handle->value[i] = (*sample.key)[i];
+    return true;
+  }
+  const auto& bytes = sample.bytes;
   MD5 md5;
   md5.init();
   md5.update(bytes.data(), static_cast<unsigned int>(bytes.size()));

@@ -4,6 +4,8 @@
 
 #include <cstdlib>
 
+#include "concert/common/clock.hpp"
+
 namespace concert::dds {
 
 std::string host_name() {
@@ -12,14 +14,6 @@ std::string host_name() {
   if (gethostname(buf, sizeof buf - 1) != 0 || buf[0] == '\0') return "unknown";
   return buf;
 }
-
-namespace {
-int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-}  // namespace
 
 StatusReporter::StatusReporter(Participant& participant, std::string service, std::string host,
                                std::chrono::milliseconds heartbeat)

@@ -1,5 +1,6 @@
 #include "concert/idl_schema/cdr.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <random>
@@ -317,6 +318,138 @@ std::string representation(std::span<const uint8_t> bytes) {
     case 0x0007: return "XCDR2 little-endian";
     default: return "unknown";
   }
+}
+
+namespace {
+
+Json default_value(const Schema& schema, const TypeRef& type) {
+  switch (type.kind) {
+    case Kind::kStruct: {
+      Json out = Json::object();
+      for (const auto& f : schema.at(type.name).fields) out[f.name] = default_value(schema, f.type);
+      return out;
+    }
+    case Kind::kString:
+      return "";
+    case Kind::kSequence:
+      return Json::array();
+    case Kind::kArray: {
+      Json out = Json::array();
+      for (uint32_t i = 0; i < type.bound; ++i) out.push_back(default_value(schema, *type.element));
+      return out;
+    }
+    case Kind::kEnum: {
+      const auto* en = schema.find_enum(type.name);
+      if (en == nullptr || en->enumerators.empty()) return 0;
+      return en->enumerators.front().first;
+    }
+    case Kind::kBool:
+      return false;
+    case Kind::kChar:
+      return std::string(1, '\0');
+    case Kind::kFloat:
+    case Kind::kDouble:
+      return 0.0;
+    default:
+      return 0;
+  }
+}
+
+Json complete_value(const Schema& schema, const TypeRef& type, const Json& v,
+                    const std::string& path) {
+  if (type.kind == Kind::kStruct) {
+    const StructDef& def = schema.at(type.name);
+    const std::string where = path.empty() ? std::string("sample") : path;
+    if (!v.is_object())
+      throw CdrError(where + ": expected an object of type " + def.name + ", got " + v.dump());
+    for (const auto& [name, value] : v.items()) {
+      const bool known = std::any_of(def.fields.begin(), def.fields.end(),
+                                     [&](const Field& f) { return f.name == name; });
+      if (!known) {
+        std::string fields;
+        for (const auto& f : def.fields) fields += (fields.empty() ? "" : ", ") + f.name;
+        throw CdrError((path.empty() ? name : path + "." + name) + ": no such field in " +
+                       def.name + " (fields: " + fields + ")");
+      }
+    }
+    Json out = Json::object();
+    for (const auto& f : def.fields) {
+      const auto it = v.find(f.name);
+      out[f.name] = it == v.end() ? default_value(schema, f.type)
+                                  : complete_value(schema, f.type, *it,
+                                                   path.empty() ? f.name : path + "." + f.name);
+    }
+    return out;
+  }
+  if ((type.kind == Kind::kSequence || type.kind == Kind::kArray) && v.is_array() &&
+      type.element->kind == Kind::kStruct) {
+    Json out = Json::array();
+    for (size_t i = 0; i < v.size(); ++i) {
+      out.push_back(
+          complete_value(schema, *type.element, v[i], path + "[" + std::to_string(i) + "]"));
+    }
+    return out;
+  }
+  return v;  // checked by encode()
+}
+
+/// Appends the key fields of `def` in `v` as big-endian CDR; false if a key can exceed 16 bytes.
+bool put_key(const Schema& schema, const StructDef& def, const Json& v, bool all_fields,
+             std::vector<uint8_t>& out) {
+  for (const auto& f : def.fields) {
+    if (!all_fields && !f.key) continue;
+    const Json& fv = v.at(f.name);
+    if (f.type.kind == Kind::kStruct) {
+      if (!put_key(schema, schema.at(f.type.name), fv, true, out)) return false;
+      continue;
+    }
+    const size_t size = primitive_size(f.type.kind);
+    if (size == 0) return false;  // strings, sequences, arrays: not a short key
+    uint64_t bits = 0;
+    if (f.type.kind == Kind::kEnum) {
+      if (fv.is_string()) {
+        for (const auto& [name, value] : schema.find_enum(f.type.name)->enumerators) {
+          if (name == fv.get_ref<const std::string&>()) bits = value;
+        }
+      } else {
+        bits = fv.get<uint32_t>();
+      }
+    } else if (f.type.kind == Kind::kFloat) {
+      bits = std::bit_cast<uint32_t>(fv.get<float>());
+    } else if (f.type.kind == Kind::kDouble) {
+      bits = std::bit_cast<uint64_t>(fv.get<double>());
+    } else if (f.type.kind == Kind::kBool) {
+      bits = fv.get<bool>() ? 1 : 0;
+    } else {
+      bits =
+          fv.is_number_unsigned() ? fv.get<uint64_t>() : static_cast<uint64_t>(fv.get<int64_t>());
+    }
+    out.resize(out.size() + (size - out.size() % size) % size, 0);
+    for (size_t i = 0; i < size; ++i)
+      out.push_back(static_cast<uint8_t>(bits >> (8 * (size - 1 - i))));
+    if (out.size() > 16) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Json complete(const Schema& schema, std::string_view type, const Json& partial) {
+  TypeRef ref;
+  ref.kind = Kind::kStruct;
+  ref.name = std::string(type);
+  return complete_value(schema, ref, partial, "");
+}
+
+std::optional<std::array<uint8_t, 16>> key_hash(const Schema& schema, std::string_view type,
+                                                const Json& sample) {
+  const StructDef& def = schema.at(type);
+  if (!def.keyed()) return std::nullopt;
+  std::vector<uint8_t> bytes;
+  if (!put_key(schema, def, sample, false, bytes)) return std::nullopt;
+  std::array<uint8_t, 16> hash{};
+  std::copy(bytes.begin(), bytes.end(), hash.begin());
+  return hash;
 }
 
 Json sample_with_every_field_set(const Schema& schema, std::string_view type, uint32_t seed) {

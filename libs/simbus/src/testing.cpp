@@ -83,7 +83,9 @@ Assembly random_assembly(const topology::EscCatalog& catalog, std::mt19937& rng,
   int32_t next_robot_id = 1;
   const auto add = [&](const Kind& kind, const std::string& parent, int32_t connector) {
     MountedModule m;
-    m.name = "m" + std::to_string(assembly.modules.size());
+    // Appended rather than "m" + ...: GCC 12 at -O3 flags that with a -Wrestrict false positive.
+    m.name = "m";
+    m.name += std::to_string(assembly.modules.size());
     m.key = kind.key;
     m.parent = parent;
     m.connector = connector;

@@ -9,6 +9,7 @@
 #include "concert/topology/dds/conversions.hpp"
 #include "concert/topology/esc_catalog.hpp"
 #include "dds/discovery_node.hpp"
+#include "dds/service_params.hpp"
 
 namespace concert::discovery {
 namespace {
@@ -137,6 +138,37 @@ TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
   EXPECT_NE(ready->message().find("1 unknown; 1 warning: slave 12: blank module identity"),
             std::string::npos)
       << ready->message();
+}
+
+TEST(ServiceParams, ShippedConfigListsEveryParameterWithItsDefault) {
+  auto doc = config::Document::load(std::string(CONCERT_SOURCE_DIR) +
+                                    "/services/discovery/config/discovery.yaml");
+  (void)dds::read_service_params(doc);
+  EXPECT_EQ(doc.keys().size(), 2u);
+  EXPECT_TRUE(doc.differences_from_defaults().empty())
+      << ::testing::PrintToString(doc.differences_from_defaults());
+}
+
+TEST(ServiceParams, ValuesAndErrorsNamingFileAndKey) {
+  auto doc = config::Document::parse("module_db: /db\nport_order: '0123'\n", "d.yaml");
+  const auto p = dds::read_service_params(doc);
+  EXPECT_EQ(p.module_dbs, std::vector<std::string>{"/db"});
+  EXPECT_EQ(p.port_order, "0123");
+  auto error_of = [](const std::string& yaml) {
+    try {
+      auto d = config::Document::parse(yaml, "d.yaml");
+      (void)dds::read_service_params(d);
+    } catch (const config::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(error_of("port_order: '0321'"),
+            "d.yaml: port_order: expected one of 0312, 0123, got '0321' (line 1)");
+  EXPECT_EQ(error_of("module_dbs: [a]"),
+            "d.yaml: module_dbs: unknown key (line 1); known keys: module_db, port_order");
+  EXPECT_EQ(error_of("module_db: {a: 1}"),
+            "d.yaml: module_db: expected a list of strings or one string, got a map (line 1)");
 }
 
 }  // namespace

@@ -80,9 +80,10 @@ std::pair<int, std::string> run_binary(std::vector<std::string> args) {
 }
 
 TEST(DiscoveryProcess, BadArgumentsExitNonZeroWithOneLine) {
+  // A wrong command line: 2, naming the option. A failure (bad folder, bad file): 1.
   auto [status, err] = run_binary({"--port-order", "9"});
-  EXPECT_EQ(status, 1);
-  EXPECT_NE(err.find("concert_discovery: port order '9': expected 0312 or 0123"), std::string::npos)
+  EXPECT_EQ(status, 2);
+  EXPECT_NE(err.find("concert_discovery: --port-order: 9 not in {0312,0123}"), std::string::npos)
       << err;
   std::tie(status, err) = run_binary({"--module-db", "/nonexistent/db"});
   EXPECT_EQ(status, 1);
@@ -93,12 +94,19 @@ TEST(DiscoveryProcess, BadArgumentsExitNonZeroWithOneLine) {
   std::ofstream(params) << "port_order: [1]\n";
   std::tie(status, err) = run_binary({"--params", params.string()});
   EXPECT_EQ(status, 1);
-  EXPECT_NE(err.find(params.string() + ": port_order: expected 0312 or 0123"), std::string::npos)
+  EXPECT_NE(
+      err.find(params.string() + ": port_order: expected one of 0312, 0123, got a list (line 1)"),
+      std::string::npos)
       << err;
   std::filesystem::remove(params);
   std::tie(status, err) = run_binary({"--bogus"});
-  EXPECT_EQ(status, 1);
-  EXPECT_NE(err.find("unknown argument '--bogus'"), std::string::npos) << err;
+  EXPECT_EQ(status, 2);
+  EXPECT_NE(err.find("concert_discovery: The following argument was not expected: --bogus"),
+            std::string::npos)
+      << err;
+  concert::testing::Process help({DISCOVERY_BINARY, "--help"});
+  EXPECT_EQ(help.wait(15s), 0);
+  EXPECT_NE(help.out().find("--port-order"), std::string::npos) << help.out();
 }
 
 }  // namespace

@@ -30,7 +30,9 @@ struct CliRun {
 CliRun run(const std::vector<std::string>& args) {
   std::ostringstream out;
   std::ostringstream err;
-  const int code = modelgen::cli_main(args, out, err);
+  std::vector<std::string> full = args;
+  full.insert(full.begin(), "model");
+  const int code = cli::run("concert", {modelgen::register_verbs}, full, out, err);
   return {code, out.str(), err.str()};
 }
 
@@ -102,15 +104,23 @@ TEST_F(CliTest, ErrorsAreOneLineAndNonZero) {
   const std::string out = (dir_ / "bundle").string();
   CliRun r = run({"generate", "--assembly", kPaperRobot, "--out", out});
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err.substr(0, r.err.find('\n')), "concert model generate: missing --module-db DIR");
+  EXPECT_EQ(
+      r.err,
+      "concert model generate: --module-db is required (see `concert model generate --help`)\n");
   r = run({"generate", "--assembly", kPaperRobot, "--tree", "x.json", "--module-db", kPublic, "--out", out});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("give exactly one of --scan, --tree, --assembly"), std::string::npos);
+  EXPECT_NE(r.err.find("--tree excludes --assembly"), std::string::npos) << r.err;
+  r = run({"generate", "--module-db", kPublic, "--out", out});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("give exactly one of --scan, --tree, --assembly"), std::string::npos)
+      << r.err;
   r = run({"generate", "--assembly", kPaperRobot, "--module-db", kPublic, "--out", out, "--home", "J1_E=abc"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("'abc' is not a number"), std::string::npos);
+  EXPECT_NE(r.err.find("--home: 'J1_E=abc': 'abc' is not a number"), std::string::npos) << r.err;
   r = run({"frobnicate"});
   EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("unknown verb 'frobnicate' (one of: generate, show)"), std::string::npos)
+      << r.err;
   r = run({"generate", "--assembly", kPaperRobot, "--module-db", (dir_ / "nowhere").string(), "--out", out});
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("module database folder does not exist"), std::string::npos) << r.err;

@@ -109,16 +109,34 @@ TEST(ModelgenNode, PublishesVersionedModelsOverDds) {
   // `concert model show` prints the live model.
   std::ostringstream out;
   std::ostringstream err;
-  ASSERT_EQ(modelgen::cli_main({"show", "--timeout", "5"}, out, err), 0) << err.str();
+  ASSERT_EQ(cli::run("concert", {modelgen::register_verbs}, {"model", "show", "--timeout", "5"},
+                     out, err),
+            0)
+      << err.str();
   EXPECT_NE(out.str().find("robot model version 2 (" + service.current()->content_hash + ")"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("  E (arm) base_link -> tcp_E: J1_E J2_E J3_E J4_E J5_E J6_E"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("  ee_E (other) chain E frame tcp_E module passive_end_effector_panel"), std::string::npos) << out.str();
+  std::ostringstream json;
+  ASSERT_EQ(cli::run("concert", {modelgen::register_verbs},
+                     {"model", "show", "--json", "--timeout", "5"}, json, err),
+            0)
+      << err.str();
+  const auto j = nlohmann::json::parse(json.str());
+  EXPECT_EQ(j.at("version"), 2);
+  EXPECT_EQ(j.at("content_hash"), service.current()->content_hash);
+  EXPECT_FALSE(j.at("joints").empty());
 }
 
 TEST(ModelShow, NoModelIsAClearError) {
   std::ostringstream out;
   std::ostringstream err;
-  EXPECT_EQ(modelgen::cli_main({"show", "--timeout", "0.3"}, out, err), 1);
-  EXPECT_NE(err.str().find("no robot model received within 0.3 s"), std::string::npos) << err.str();
-  EXPECT_EQ(modelgen::cli_main({"show", "--timeout", "-1"}, out, err), 2);
+  const auto run = [&](const std::vector<std::string>& args) {
+    return cli::run("concert", {modelgen::register_verbs}, args, out, err);
+  };
+  EXPECT_EQ(run({"model", "show", "--timeout", "0.3"}), 1);
+  EXPECT_NE(err.str().find("concert model show: no robot model received within 0.3 s"),
+            std::string::npos)
+      << err.str();
+  EXPECT_EQ(run({"model", "show", "--timeout", "-1"}), 2);
+  EXPECT_NE(err.str().find("--timeout: '-1' is not a number >= 0"), std::string::npos) << err.str();
 }

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <random>
+#include <sstream>
 
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/scan_io.hpp"
@@ -150,7 +151,10 @@ TEST(RoundTrip, RandomRobotsOfTheProjectDatabase) {
       const auto [parent, connector] = free[slot];
       free.erase(free.begin() + static_cast<long>(slot));
       const std::string key = keys[std::uniform_int_distribution<size_t>(0, keys.size() - 1)(rng)];
-      const std::string name = "m" + std::to_string(a.modules.size());
+      // Streamed rather than "m" + ...: GCC 12 at -O3 flags that with a -Wrestrict false positive.
+      std::ostringstream module_name;
+      module_name << "m" << a.modules.size();
+      const std::string name = module_name.str();
       a.modules.push_back({name, key, parent, connector, {}});
       const size_t outputs = d.db.at(key).output_connectors().size();
       for (size_t c = 1; c <= outputs; ++c) free.emplace_back(name, static_cast<int>(c));

@@ -65,12 +65,15 @@ TEST(Service, BundleVersionsContinueAcrossRestarts) {
   const fs::path dir = fs::temp_directory_path() / ("concert_modelgen_service_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const auto big = test::make_tree(test::public_eighteen_module_robot(), &public_db());
+  // Named rather than {{}, dir}: GCC 12 at -O3 warns (maybe-uninitialized) on that temporary.
+  ServiceParams params;
+  params.bundle_dir = dir;
   {
-    ModelgenService s(public_db(), {{}, dir});
+    ModelgenService s(public_db(), params);
     EXPECT_EQ(s.on_tree(big, 1).version, 1u);
   }
   EXPECT_EQ(read_bundle_version(dir).first, 1u);
-  ModelgenService restarted(public_db(), {{}, dir});
+  ModelgenService restarted(public_db(), params);
   const Outcome same = restarted.on_tree(big, 1);
   EXPECT_TRUE(same.published);  // nobody has it yet after the restart
   EXPECT_EQ(same.version, 1u);  // same content, same version

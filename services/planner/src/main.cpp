@@ -8,6 +8,7 @@
 #include <iostream>
 #include <string>
 
+#include "concert/cli/cli.hpp"
 #include "concert/dds/participant.hpp"
 #include "dds/planner_node.hpp"
 #include "planner/config.hpp"
@@ -18,47 +19,43 @@ std::atomic<bool> g_stop{false};
 
 void on_signal(int) { g_stop = true; }
 
-constexpr const char* kUsage = "usage: concert_planner [--params FILE] [--world FILE]";
+struct Options {
+  std::string params;
+  std::string world;
+};
+
+int run(const Options& options) {
+  using namespace concert;
+  planner::Params params;
+  planner::World world;
+  if (!options.params.empty()) params = planner::load_params(options.params);
+  if (!options.world.empty()) world = planner::load_world(options.world);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  planner::Planner planner(params);
+  planner::Environment env(params.octomap_resolution);
+  env.add_world(world);
+  planner.set_environment(env);
+  concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "planner"});
+  planner::dds::PlannerNode node(participant, planner, {}, std::cerr);
+  std::cerr << "concert_planner: domain " << participant.domain_id() << ", map "
+            << env.occupied_cells() << " occupied cells"
+            << (options.world.empty() ? "" : " from " + options.world) << std::endl;
+  node.spin(g_stop);
+  return 0;
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  using namespace concert;
-  try {
-    planner::Params params;
-    planner::World world;
-    std::string world_file;
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      if (arg == "--params" || arg == "--world") {
-        if (i + 1 >= argc) throw std::runtime_error("option " + arg + " needs a value");
-        if (arg == "--params") {
-          params = planner::load_params(argv[++i]);
-        } else {
-          world_file = argv[++i];
-        }
-      } else if (arg == "--help" || arg == "-h") {
-        std::cout << kUsage << "\n";
-        return 0;
-      } else {
-        throw std::runtime_error("unknown argument '" + arg + "'");
-      }
-    }
-    if (!world_file.empty()) world = planner::load_world(world_file);
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
-    planner::Planner planner(params);
-    planner::Environment env(params.octomap_resolution);
-    env.add_world(world);
-    planner.set_environment(env);
-    concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "planner"});
-    planner::dds::PlannerNode node(participant, planner, {}, std::cerr);
-    std::cerr << "concert_planner: domain " << participant.domain_id() << ", map " << env.occupied_cells() << " occupied cells"
-              << (world_file.empty() ? "" : " from " + world_file) << std::endl;
-    node.spin(g_stop);
-    return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "concert_planner: " << e.what() << "\n" << kUsage << "\n";
-    return 1;
-  }
+  concert::cli::Cli cli("concert_planner", "Whole-body planning for drilling (NSPG + RRT-Connect).",
+                        std::cout, std::cerr);
+  Options options;
+  cli.app()
+      .add_option("--params", options.params,
+                  "parameters file (config/planner.yaml lists every key)")
+      ->type_name("FILE");
+  cli.app().add_option("--world", options.world, "the world (walls, obstacles)")->type_name("FILE");
+  cli.on_run(cli.app(), [&options] { return run(options); });
+  return cli.run(argc, argv);
 }

@@ -1,8 +1,10 @@
 // Params and world YAML: defaults, values read, and errors naming the file and field.
 
+#include "planner/config.hpp"
+
 #include <gtest/gtest.h>
 
-#include "planner/config.hpp"
+#include <cmath>
 
 using namespace concert::planner;
 
@@ -13,8 +15,15 @@ TEST(Config, ParamsReadAndDefaultsKept) {
   EXPECT_EQ(p.seed, 9u);
   EXPECT_EQ(p.nspg_seeds, 12);
   EXPECT_DOUBLE_EQ(p.camera_distance, Params{}.camera_distance);
-  const Params file = load_params(std::string(CONCERT_SOURCE_DIR) + "/services/planner/config/planner.yaml");
-  EXPECT_DOUBLE_EQ(file.camera_distance, 0.6);
+}
+
+TEST(Config, ShippedParamsFileListsEveryParameterWithItsDefault) {
+  auto doc = concert::config::Document::load(std::string(CONCERT_SOURCE_DIR) +
+                                             "/services/planner/config/planner.yaml");
+  (void)read_params(doc);
+  EXPECT_EQ(doc.keys().size(), 32u);  // every parameter of Params
+  EXPECT_TRUE(doc.differences_from_defaults().empty())
+      << ::testing::PrintToString(doc.differences_from_defaults());
 }
 
 TEST(Config, ParamErrorsNameFileAndField) {
@@ -26,10 +35,20 @@ TEST(Config, ParamErrorsNameFileAndField) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message("bogus: 1").find("p.yaml: bogus: unknown parameter"), std::string::npos);
-  EXPECT_NE(message("contact_force: lots").find("p.yaml: contact_force: expected a number"), std::string::npos);
-  EXPECT_NE(message("planning_time: 0").find("planning_time"), std::string::npos);
-  EXPECT_NE(message("nspg_seeds: 1.5").find("nspg_seeds"), std::string::npos);
+  EXPECT_NE(
+      message("bogus: 1")
+          .find("p.yaml: bogus: unknown key (line 1); known keys: base_angular_acceleration,"),
+      std::string::npos);
+  EXPECT_EQ(message("seed: 2\ncontact_force: lots"),
+            "p.yaml: contact_force: expected a number >= 0, got 'lots' (line 2)");
+  EXPECT_EQ(message("planning_time: 0"),
+            "p.yaml: planning_time: expected a positive number, got '0' (line 1)");
+  EXPECT_EQ(message("nspg_seeds: 1.5"),
+            "p.yaml: nspg_seeds: expected a whole number >= 0, got '1.5' (line 1)");
+  EXPECT_EQ(message("base_height: low"),
+            "p.yaml: base_height: expected a number or auto, got 'low' (line 1)");
+  EXPECT_TRUE(std::isnan(parse_params("base_height: auto", "p.yaml").base_height));
+  EXPECT_DOUBLE_EQ(parse_params("base_height: 0.4", "p.yaml").base_height, 0.4);
   EXPECT_THROW((void)load_params("/nonexistent/planner.yaml"), PlannerError);
 }
 

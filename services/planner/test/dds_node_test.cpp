@@ -4,14 +4,16 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
+#include "concert/common/text.hpp"
 #include "concert/dds/participant.hpp"
 #include "dds/planner_node.hpp"
+#include "model_message.hpp"
 #include "planner/cli.hpp"
 #include "planner/fixtures.hpp"
-#include "model_message.hpp"
 
 using namespace concert;
 using namespace concert::planner;
@@ -173,16 +175,32 @@ TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {
   publish_model('b', 8);
   std::ostringstream out;
   std::ostringstream err;
-  EXPECT_EQ(cli_main({"drill"}, out, err), 2);
-  EXPECT_NE(err.str().find("--at"), std::string::npos) << err.str();
+  const auto plan = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), "plan");
+    return cli::run("concert", {register_verbs}, args, out, err);
+  };
+  EXPECT_EQ(plan({"drill"}), 2);
+  EXPECT_NE(err.str().find("--at is required"), std::string::npos) << err.str();
   err.str("");
-  EXPECT_EQ(cli_main({"drill", "--at", "2", "x", "1"}, out, err), 2);
-  EXPECT_NE(err.str().find("'x'"), std::string::npos) << err.str();
+  EXPECT_EQ(plan({"drill", "--at", "2", "x", "1"}), 2);
+  EXPECT_NE(err.str().find("--at: 'x' is not a number"), std::string::npos) << err.str();
   err.str("");
   out.str("");
-  EXPECT_EQ(cli_main({"drill", "--at", "2.0", "0.1", "2.3", "--request-id", "31", "--timeout", "20"}, out, err), 0) << err.str();
+  EXPECT_EQ(plan({"drill", "--at", "2.0", "0.1", "2.3", "--request-id", "31", "--timeout", "20"}),
+            0)
+      << err.str();
   EXPECT_NE(out.str().find("succeeded"), std::string::npos) << out.str();
   err.str("");
-  EXPECT_EQ(cli_main({"drill", "--at", "2.0", "0", "7.0", "--request-id", "32", "--timeout", "20"}, out, err), 1);
+  out.str("");
+  EXPECT_EQ(plan({"drill", "--at", "2.0", "0.1", "2.3", "--request-id", "33", "--timeout", "20",
+                  "--json"}),
+            0)
+      << err.str();
+  const auto lines = concert::split(out.str(), '\n');
+  ASSERT_GE(lines.size(), 2u) << out.str();
+  EXPECT_EQ(nlohmann::json::parse(lines.front()).at("request_id"), 33);
+  EXPECT_EQ(nlohmann::json::parse(lines.back()).at("state"), "succeeded");
+  err.str("");
+  EXPECT_EQ(plan({"drill", "--at", "2.0", "0", "7.0", "--request-id", "32", "--timeout", "20"}), 1);
   EXPECT_NE(err.str().find("camera_E"), std::string::npos) << err.str();
 }

@@ -32,10 +32,20 @@ using planner::testing::model_message;
 TEST(PlannerProcess, BadArgumentsExitNonZeroWithOneLine) {
   concert::testing::Process no_world({PLANNER_BINARY, "--world", "/nonexistent/site.yaml"});
   EXPECT_EQ(no_world.wait(20s), 1);
-  EXPECT_NE(no_world.err().find("world file '/nonexistent/site.yaml' cannot be opened"), std::string::npos) << no_world.err();
+  EXPECT_NE(
+      no_world.err().find("concert_planner: world file '/nonexistent/site.yaml' cannot be opened"),
+      std::string::npos)
+      << no_world.err();
   concert::testing::Process bogus({PLANNER_BINARY, "--bogus"});
-  EXPECT_EQ(bogus.wait(20s), 1);
-  EXPECT_NE(bogus.err().find("unknown argument '--bogus'"), std::string::npos) << bogus.err();
+  EXPECT_EQ(bogus.wait(20s), 2);
+  EXPECT_NE(bogus.err().find("concert_planner: The following argument was not expected: --bogus"),
+            std::string::npos)
+      << bogus.err();
+  concert::testing::Process bad_params({PLANNER_BINARY, "--params", "/nonexistent/planner.yaml"});
+  EXPECT_EQ(bad_params.wait(20s), 1);
+  EXPECT_NE(bad_params.err().find("params file '/nonexistent/planner.yaml' cannot be opened"),
+            std::string::npos)
+      << bad_params.err();
 }
 
 TEST(PlannerProcess, ModelInRequestPlannedCleanStop) {
@@ -57,8 +67,10 @@ TEST(PlannerProcess, ModelInRequestPlannedCleanStop) {
     int rc = 1;
     for (int attempt = 0; attempt < 10 && rc != 0; ++attempt) {
       err.str("");
-      rc = planner::cli_main({"drill", "--at", "2.0", "0.2", "2.1", "--request-id", std::to_string(100 + attempt), "--timeout", "20"},
-                             out, err);
+      rc = cli::run("concert", {planner::register_verbs},
+                    {"plan", "drill", "--at", "2.0", "0.2", "2.1", "--request-id",
+                     std::to_string(100 + attempt), "--timeout", "20"},
+                    out, err);
       if (rc != 0 && err.str().find("no model") == std::string::npos && err.str().find("stale") == std::string::npos) break;
       std::this_thread::sleep_for(200ms);
     }

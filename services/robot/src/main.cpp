@@ -13,26 +13,23 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "concert/cli/cli.hpp"
 #include "concert/dds/participant.hpp"
-#include "robot_node.hpp"
-#include "robot_params.hpp"
 #include "robot/loop.hpp"
 #include "robot/robot_core.hpp"
 #include "robot/sim_assembly.hpp"
 #include "robot/sim_hardware.hpp"
+#include "robot_node.hpp"
+#include "robot_params.hpp"
 
 namespace {
-
-constexpr const char* kUsage =
-    "usage: concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE] "
-    "[--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK] [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...] [--params FILE]";
 
 struct Options {
   std::string backend{"sim"};
@@ -57,88 +54,68 @@ void on_signal(int) {
   }
 }
 
-[[noreturn]] void usage_error(const std::string& what) {
-  std::cerr << "concert_robot: " << what << "\n" << kUsage << "\n";
-  std::exit(2);
+/// The command line (CLI11); what it cannot check alone is checked in check().
+void add_options(CLI::App& app, Options& o) {
+  CLI::Option* assembly =
+      app.add_option("--assembly", o.assembly,
+                     "the mounted modules (an assembly file; watched for hot swaps)")
+          ->type_name("FILE");
+  CLI::Option* urdf = app.add_option("--urdf", o.urdf, "a fixed robot model instead of an assembly")
+                          ->type_name("FILE");
+  assembly->excludes(urdf);
+  app.add_option("--module-db", o.module_dbs,
+                 "module database folder (repeat to merge; default: the project's)")
+      ->type_name("DIR");
+  app.add_option("--world", o.world, "the simulated world (walls, obstacles; watched)")
+      ->type_name("FILE");
+  app.add_option("--backend", o.backend, "hardware backend")
+      ->type_name("sim|ethercat")
+      ->default_str("sim");
+  app.add_flag("--fast", o.fast, "run as fast as possible (simulated time only)");
+  app.add_option("--duration", o.duration,
+                 "stop after S seconds of loop time (0: run until stopped)")
+      ->type_name("S")
+      ->check(concert::cli::seconds());
+  app.add_option("--ee-frame", o.ee_frame, "the Cartesian end-effector frame")->type_name("LINK");
+  app.add_flag("--standalone", o.standalone, "apply the model itself, without modelgen");
+  app.add_option("--fifo", o.fifo, "SCHED_FIFO priority of the loop (1..99)")
+      ->type_name("PRIORITY")
+      ->check(concert::cli::number(0, 99, true));
+  app.add_option_function<std::vector<std::string>>(
+         "--package",
+         [&o](const std::vector<std::string>& items) {
+           for (const auto& v : items)
+             o.packages[v.substr(0, v.find('='))] = v.substr(v.find('=') + 1);
+         },
+         "package://NAME/ resolves to DIR (repeat)")
+      ->type_name("NAME=DIR")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            const auto eq = v.find('=');
+            return eq == std::string::npos || eq == 0 ? "expected NAME=DIR, got '" + v + "'"
+                                                      : std::string();
+          },
+          "", "NAME=DIR"));
+  app.add_option("--params", o.params, "parameters file (config/robot.yaml lists every key)")
+      ->type_name("FILE");
 }
 
-double parse_number(const std::string& flag, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(text, &used);
-    if (used != text.size()) {
-      throw std::invalid_argument(text);
-    }
-    return v;
-  } catch (const std::exception&) {
-    usage_error(flag + ": expected a number, got '" + text + "'");
-  }
-}
-
-Options parse(int argc, char** argv) {
-  Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        usage_error(arg + " needs a value");
-      }
-      return argv[++i];
-    };
-    if (arg == "--backend") {
-      o.backend = value();
-    } else if (arg == "--assembly") {
-      o.assembly = value();
-    } else if (arg == "--urdf") {
-      o.urdf = value();
-    } else if (arg == "--module-db") {
-      o.module_dbs.emplace_back(value());
-    } else if (arg == "--world") {
-      o.world = value();
-    } else if (arg == "--fast") {
-      o.fast = true;
-    } else if (arg == "--duration") {
-      o.duration = parse_number(arg, value());
-    } else if (arg == "--ee-frame") {
-      o.ee_frame = value();
-    } else if (arg == "--standalone") {
-      o.standalone = true;
-    } else if (arg == "--params") {
-      o.params = value();
-    } else if (arg == "--package") {
-      const std::string v = value();
-      const auto eq = v.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        usage_error("--package: expected NAME=DIR, got '" + v + "'");
-      }
-      o.packages[v.substr(0, eq)] = v.substr(eq + 1);
-    } else if (arg == "--fifo") {
-      o.fifo = static_cast<int>(parse_number(arg, value()));
-    } else if (arg == "--help" || arg == "-h") {
-      std::cout << kUsage << "\n";
-      std::exit(0);
-    } else {
-      usage_error("unknown argument '" + arg + "'");
-    }
-  }
+/// Checks of the parsed options that involve several of them.
+void check(Options& o) {
   if (o.backend == "ethercat") {
-    std::cerr << "concert_robot: backend 'ethercat' is not part of this build (no EtherCAT master here); "
-                 "see services/robot/README.md for what it must provide\n";
-    std::exit(2);
+    throw concert::cli::UsageError(
+        "backend 'ethercat' is not part of this build (no EtherCAT master here); "
+        "see services/robot/README.md for what it must provide");
   }
   if (o.backend != "sim") {
-    usage_error("unknown backend '" + o.backend + "' (sim or ethercat)");
+    throw concert::cli::UsageError("unknown backend '" + o.backend + "' (sim or ethercat)");
   }
   if (o.assembly.empty() == o.urdf.empty()) {
-    usage_error("give exactly one of --assembly FILE or --urdf FILE");
+    throw concert::cli::UsageError("give exactly one of --assembly FILE or --urdf FILE");
   }
   if (o.module_dbs.empty()) {
     o.module_dbs.emplace_back(CONCERT_DEFAULT_MODULE_DB);
   }
-  if (o.duration < 0.0) {
-    usage_error("--duration must not be negative");
-  }
-  return o;
 }
 
 std::string read_file(const std::string& path) {
@@ -160,12 +137,9 @@ std::optional<std::filesystem::file_time_type> mtime(const std::string& path) {
   return t;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(const Options& options) {
   using namespace concert;
-  const Options options = parse(argc, argv);
-  try {
+  {
     std::optional<robot::AssemblyBuilder> builder;
     robot::SimulatedRobot simulated;
     if (!options.assembly.empty()) {
@@ -258,10 +232,24 @@ int main(int argc, char** argv) {
                                                 : std::numeric_limits<std::uint64_t>::max();
     const robot::LoopStats stats = loop.run(cycles);
     g_loop = nullptr;
-    std::cerr << "concert_robot: stopped after " << stats.cycles << " cycles (" << stats.overruns << " overruns)\n";
-  } catch (const std::exception& e) {
-    std::cerr << "concert_robot: " << e.what() << "\n";
-    return 1;
+    std::cerr << "concert_robot: stopped after " << stats.cycles << " cycles (" << stats.overruns
+              << " overruns)\n";
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  concert::cli::Cli cli(
+      "concert_robot",
+      "The robot service: hardware abstraction (simulated by default), 1 kHz loop.", std::cout,
+      std::cerr);
+  Options options;
+  add_options(cli.app(), options);
+  cli.on_run(cli.app(), [&options] {
+    check(options);
+    return run(options);
+  });
+  return cli.run(argc, argv);
 }

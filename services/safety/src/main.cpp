@@ -8,6 +8,7 @@
 #include <iostream>
 #include <string>
 
+#include "concert/cli/cli.hpp"
 #include "concert/dds/participant.hpp"
 #include "dds/safety_node.hpp"
 #include "safety/params.hpp"
@@ -18,39 +19,34 @@ std::atomic<bool> g_stop{false};
 
 void on_signal(int) { g_stop = true; }
 
-constexpr const char* kUsage = "usage: concert_safety [--params FILE]";
+int run(const std::string& params_file) {
+  using namespace concert;
+  safety::Params params;
+  if (!params_file.empty()) params = safety::load_params(params_file);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  safety::dds::use_interprocess_delivery_only();
+  concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "safety"});
+  safety::dds::SafetyNode node(participant, params, std::cerr);
+  std::string watched = params.robot_service;
+  for (const auto& s : params.task_services) watched += ", " + s;
+  std::cerr << "concert_safety: domain " << participant.domain_id() << ", watching " << watched
+            << " (silent > " << params.liveliness_timeout.count() << " ms -> stop)" << std::endl;
+  node.spin(g_stop);
+  return 0;
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  using namespace concert;
-  try {
-    safety::Params params;
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      if (arg == "--params") {
-        if (i + 1 >= argc) throw std::runtime_error("option --params needs a value");
-        params = safety::load_params(argv[++i]);
-      } else if (arg == "--help" || arg == "-h") {
-        std::cout << kUsage << "\n";
-        return 0;
-      } else {
-        throw std::runtime_error("unknown argument '" + arg + "'");
-      }
-    }
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
-    safety::dds::use_interprocess_delivery_only();
-    concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "safety"});
-    safety::dds::SafetyNode node(participant, params, std::cerr);
-    std::string watched = params.robot_service;
-    for (const auto& s : params.task_services) watched += ", " + s;
-    std::cerr << "concert_safety: domain " << participant.domain_id() << ", watching " << watched
-              << " (silent > " << params.liveliness_timeout.count() << " ms -> stop)" << std::endl;
-    node.spin(g_stop);
-    return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "concert_safety: " << e.what() << "\n" << kUsage << "\n";
-    return 1;
-  }
+  concert::cli::Cli cli(
+      "concert_safety",
+      "The safety layer: e-stop inputs, liveliness of the services, joint limits.", std::cout,
+      std::cerr);
+  std::string params;
+  cli.app()
+      .add_option("--params", params, "parameters file (config/safety.yaml lists every key)")
+      ->type_name("FILE");
+  cli.on_run(cli.app(), [&params] { return run(params); });
+  return cli.run(argc, argv);
 }

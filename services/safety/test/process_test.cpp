@@ -126,13 +126,15 @@ TEST(SafetyProcess, EStopResetAndLivelinessOverDds) {
 /// Runs `concert safety <args>` in this process; returns (code, stdout + stderr).
 std::pair<int, std::string> cli(const std::vector<std::string>& args) {
   std::ostringstream out, err;
-  const int code = cli_main(args, out, err);
+  std::vector<std::string> full = args;
+  full.insert(full.begin(), "safety");
+  const int code = cli::run("concert", {register_verbs}, full, out, err);
   return {code, out.str() + err.str()};
 }
 
 TEST(SafetyProcess, OperatorVerbsEStopStatusReset) {
   testing::Process safety({SAFETY_BINARY});
-  auto [code, text] = cli({"status", "--timeout-ms", "20000"});
+  auto [code, text] = cli({"status", "--timeout", "20"});
   ASSERT_EQ(code, 0) << text << safety.err();
   EXPECT_EQ(text, "safety: RUNNING\n");
 
@@ -163,20 +165,27 @@ TEST(SafetyProcess, OperatorVerbsEStopStatusReset) {
 TEST(SafetyCli, UsageErrorsAndNoService) {
   auto [code, text] = cli({});
   EXPECT_EQ(code, 2);
-  EXPECT_NE(text.find("expected a verb: status, estop or reset"), std::string::npos) << text;
+  EXPECT_NE(text.find("concert safety: missing verb (one of: status, estop, reset)"),
+            std::string::npos)
+      << text;
   std::tie(code, text) = cli({"estop", "--source", "left"});
   EXPECT_EQ(code, 2);
-  EXPECT_NE(text.find("--source: 'left' is not front-left, front-right"), std::string::npos)
+  EXPECT_NE(text.find("--source: left not in {front-left,front-right,rear-left,rear-right,"
+                      "software,wireless}"),
+            std::string::npos)
       << text;
-  std::tie(code, text) = cli({"status", "--timeout-ms", "soon"});
+  std::tie(code, text) = cli({"status", "--timeout", "soon"});
   EXPECT_EQ(code, 2);
-  EXPECT_NE(text.find("--timeout-ms: 'soon' is not a number"), std::string::npos) << text;
+  EXPECT_NE(text.find("--timeout: 'soon' is not a number >= 0"), std::string::npos) << text;
   std::tie(code, text) = cli({"status", "--release"});
   EXPECT_EQ(code, 2);
-  EXPECT_NE(text.find("safety status: unknown argument '--release'"), std::string::npos) << text;
-  std::tie(code, text) = cli({"reset", "--timeout-ms", "300"});  // no safety service running
+  EXPECT_NE(text.find("concert safety status: The following argument was not expected: --release"),
+            std::string::npos)
+      << text;
+  std::tie(code, text) = cli({"reset", "--timeout", "0.3"});  // no safety service running
   EXPECT_EQ(code, 1);
-  EXPECT_NE(text.find("concert safety: no safety service on domain"), std::string::npos) << text;
+  EXPECT_NE(text.find("concert safety reset: no safety service on domain"), std::string::npos)
+      << text;
 }
 
 std::pair<int, std::string> run(std::vector<std::string> args) {
@@ -188,18 +197,24 @@ std::pair<int, std::string> run(std::vector<std::string> args) {
 
 TEST(SafetyProcess, BadArgumentsExitNonZeroWithOneLine) {
   auto [code, err] = run({"--bogus"});
-  EXPECT_EQ(code, 1);
-  EXPECT_NE(err.find("concert_safety: unknown argument '--bogus'"), std::string::npos) << err;
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("concert_safety: The following argument was not expected: --bogus"),
+            std::string::npos)
+      << err;
   std::tie(code, err) = run({"--params"});
-  EXPECT_EQ(code, 1);
-  EXPECT_NE(err.find("option --params needs a value"), std::string::npos) << err;
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("--params: 1 required FILE missing"), std::string::npos) << err;
   std::tie(code, err) = run({"--params", "/nonexistent/safety.yaml"});
   EXPECT_EQ(code, 1);
-  EXPECT_NE(err.find("/nonexistent/safety.yaml: cannot read"), std::string::npos) << err;
+  EXPECT_NE(err.find("parameters file '/nonexistent/safety.yaml' cannot be opened"),
+            std::string::npos)
+      << err;
   const auto bad = temp_file("safety_bad", "liveliness_timeout: soon\n");
   std::tie(code, err) = run({"--params", bad.string()});
   EXPECT_EQ(code, 1);
-  EXPECT_NE(err.find(bad.string() + ": liveliness_timeout: 'soon' is not a number"),
+  EXPECT_NE(err.find(bad.string() +
+                     ": liveliness_timeout: expected a duration in seconds in (0, 3600], got "
+                     "'soon' (line 1)"),
             std::string::npos)
       << err;
   std::filesystem::remove(bad);

@@ -135,8 +135,16 @@ int bench(int argc, char** argv) {
   std::string json = "{";
   for (const auto& [stage, v] : stage_ms) {
     std::printf("  %-28s %10.1f %10.1f %10.1f\n", stage.substr(2).c_str(), pct(v, 0.5), pct(v, 0.95), pct(v, 1.0));
-    json += (json.size() > 1 ? "," : "") + std::string("\"") + stage.substr(2) + "\":{\"median\":" +
-            std::to_string(pct(v, 0.5)) + ",\"p95\":" + std::to_string(pct(v, 0.95)) + "}";
+    // Appended piece by piece: GCC 12 at -O3 flags `"," + std::string(...)` with a -Wrestrict
+    // false positive.
+    if (json.size() > 1) json += ',';
+    json += '"';
+    json += stage.substr(2);
+    json += "\":{\"median\":";
+    json += std::to_string(pct(v, 0.5));
+    json += ",\"p95\":";
+    json += std::to_string(pct(v, 0.95));
+    json += '}';
   }
   std::printf("%s}\n", json.c_str());
   return 0;

@@ -2,7 +2,7 @@
 
 #include <sstream>
 
-namespace concert::cli {
+namespace concert::tool {
 
 using eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
 using eprosima::fastrtps::rtps::ReaderDiscoveryInfo;
@@ -72,4 +72,4 @@ std::vector<EndpointInfo> DomainGraph::endpoints_of(const std::string& topic) co
   return out;
 }
 
-}  // namespace concert::cli
+}  // namespace concert::tool

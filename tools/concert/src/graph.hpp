@@ -12,7 +12,7 @@
 
 #include "concert/dds/participant.hpp"
 
-namespace concert::cli {
+namespace concert::tool {
 
 struct EndpointInfo {
   bool writer = false;
@@ -50,4 +50,4 @@ class DomainGraph : public eprosima::fastdds::dds::DomainParticipantListener {
   std::unique_ptr<dds::Participant> participant_;
 };
 
-}  // namespace concert::cli
+}  // namespace concert::tool

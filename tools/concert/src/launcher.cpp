@@ -12,7 +12,6 @@
 #include <sstream>
 #include <thread>
 
-#include "args.hpp"
 #include "concert/dds/catalogue.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "scan_verbs.hpp"
@@ -20,7 +19,7 @@
 #include "robot/world.hpp"
 #endif
 
-namespace concert::cli {
+namespace concert::tool {
 
 namespace fs = std::filesystem;
 
@@ -162,6 +161,9 @@ fs::path run_dir(int32_t domain) {
 
 namespace {
 
+using cli::Failure;
+using cli::UsageError;
+
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 
@@ -195,24 +197,22 @@ void check_world(const fs::path& file) {
 #endif
 }
 
-int32_t domain_of(Args& a) {
-  const auto d = a.value("--domain");
-  return d ? dds::parse_domain_id(*d, "--domain") : dds::domain_id_from_env();
+int32_t domain_of(const std::optional<int32_t>& domain) {
+  return domain ? *domain : cli::DdsOptions{}.domain_id();
 }
 
 }  // namespace
 
-int run_up(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  Args a(args);
-  a.flag("--sim");  // the simulator is the default (and only buildable) backend
-  const std::string backend = a.value("--backend").value_or("sim");
-  const std::string assembly = a.value("--assembly").value_or(CONCERT_DEFAULT_ASSEMBLY);
-  const auto world = a.value("--world");
-  const auto module_dbs = a.values("--module-db");
-  const std::string bin_dir = a.value("--bin-dir").value_or(std::getenv("CONCERT_BIN_DIR") ? std::getenv("CONCERT_BIN_DIR") : "");
-  const auto duration_s = a.integer("--duration", 0, 0, 86'400 * 365);
-  const int32_t domain = domain_of(a);
-  a.finish();
+int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
+  const std::string& backend = o.backend;
+  const std::string& assembly = o.assembly;
+  const auto world = o.world.empty() ? std::nullopt : std::optional<std::string>(o.world);
+  const auto& module_dbs = o.module_dbs;
+  const std::string bin_dir = !o.bin_dir.empty()               ? o.bin_dir
+                              : std::getenv("CONCERT_BIN_DIR") ? std::getenv("CONCERT_BIN_DIR")
+                                                               : "";
+  const double duration_s = o.duration_s;
+  const int32_t domain = domain_of(o.domain);
   if (backend != "sim") {
     throw UsageError("--backend " + backend + ": only 'sim' runs on this machine (the EtherCAT backend needs the robot's master; see services/robot/README.md)");
   }
@@ -268,7 +268,9 @@ int run_up(const std::vector<std::string>& args, std::ostream& out, std::ostream
       << "  hot swap: concert sim swap FILE    status: concert status    stop: Ctrl-C" << std::endl;
   Supervisor supervisor(std::move(services), dir / "logs", out);
   supervisor.start_all();
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(duration_s);
+  const auto until = std::chrono::steady_clock::now() +
+                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                         std::chrono::duration<double>(duration_s));
   while (!g_stop && (duration_s == 0 || std::chrono::steady_clock::now() < until)) {
     supervisor.poll();
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -278,13 +280,11 @@ int run_up(const std::vector<std::string>& args, std::ostream& out, std::ostream
   return 0;
 }
 
-int run_sim(const std::vector<std::string>& args, std::ostream& out, std::ostream& /*err*/) {
-  Args a(args);
-  const std::string verb = a.positional("sim verb: assemble, swap or world");
-  const std::string file = a.positional("a file");
-  const auto module_dbs = a.values("--module-db");
-  const int32_t domain = domain_of(a);
-  a.finish();
+int run_sim(const SimOptions& o, std::ostream& out, std::ostream& /*err*/) {
+  const std::string& verb = o.verb;
+  const std::string& file = o.file;
+  const auto& module_dbs = o.module_dbs;
+  const int32_t domain = domain_of(o.domain);
   const fs::path dir = run_dir(domain);
   if (!fs::is_directory(dir)) {
     throw Failure("no stack runs on domain " + std::to_string(domain) + " from this machine (" + dir.string() +
@@ -305,4 +305,56 @@ int run_sim(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   throw UsageError("unknown sim verb '" + verb + "' (assemble, swap, world)");
 }
 
-}  // namespace concert::cli
+void register_launcher_verbs(cli::Cli& concert) {
+  auto up = std::make_shared<UpOptions>();
+  CLI::App& up_verb =
+      concert.verb(concert.app(), "up",
+                   "start every service on this machine (simulated robot), restart one that dies, "
+                   "stop all on Ctrl-C",
+                   [&concert, up] { return run_up(*up, concert.out(), concert.err()); });
+  up_verb.add_option("--assembly", up->assembly, "the mounted modules (an assembly file)")
+      ->type_name("FILE")
+      ->default_str(up->assembly);
+  up_verb.add_option("--world", up->world, "the simulated world (walls, obstacles)")
+      ->type_name("FILE");
+  up_verb
+      .add_option("--module-db", up->module_dbs,
+                  "module database folder (repeat to merge; default: the project's)")
+      ->type_name("DIR");
+  up_verb.add_option("--backend", up->backend, "robot backend (only sim runs on this machine)")
+      ->type_name("sim|ethercat")
+      ->default_str("sim");
+  up_verb.add_flag_callback(
+      "--sim", [up] { up->backend = "sim"; }, "the simulated robot (the default)");
+  up_verb
+      .add_option(
+          "--bin-dir", up->bin_dir,
+          "where the service executables are (default: CONCERT_BIN_DIR, the build tree, PATH)")
+      ->type_name("DIR");
+  up_verb.add_option("--duration", up->duration_s, "stop after S seconds (0: run until Ctrl-C)")
+      ->type_name("S")
+      ->check(cli::seconds());
+  cli::Cli::add_domain_option(up_verb, up->domain);
+
+  CLI::App& sim =
+      concert.group(concert.app(), "sim", "the running simulated robot: mounted modules and world");
+  for (const auto& [name, what] : std::vector<std::pair<std::string, std::string>>{
+           {"assemble", "mount another assembly on the running simulated robot"},
+           {"swap", "hot swap: mount another assembly on the running simulated robot"},
+           {"world", "change the simulated world"}}) {
+    auto o = std::make_shared<SimOptions>();
+    o->verb = name;
+    CLI::App& verb = concert.verb(
+        sim, name, what, [&concert, o] { return run_sim(*o, concert.out(), concert.err()); });
+    verb.add_option("FILE", o->file, name == "world" ? "a world file" : "an assembly file")
+        ->required();
+    if (name != "world") {
+      verb.add_option("--module-db", o->module_dbs,
+                      "module database folder to check the assembly against (repeat to merge)")
+          ->type_name("DIR");
+    }
+    cli::Cli::add_domain_option(verb, o->domain);
+  }
+}
+
+}  // namespace concert::tool

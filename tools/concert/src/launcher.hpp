@@ -11,7 +11,9 @@
 #include <string>
 #include <vector>
 
-namespace concert::cli {
+#include "concert/cli/cli.hpp"
+
+namespace concert::tool {
 
 struct ServiceSpec {
   std::string name;               ///< e.g. "discovery"
@@ -67,8 +69,29 @@ std::string find_executable(const std::string& name, const std::string& service,
 /// (${XDG_RUNTIME_DIR:-/tmp}/concert-d<domain>).
 std::filesystem::path run_dir(int32_t domain);
 
-/// `concert up ...` and `concert sim ...`; args start after the verb.
-int run_up(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
-int run_sim(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `concert up`: what to start.
+struct UpOptions {
+  std::string backend = "sim";
+  std::string assembly = CONCERT_DEFAULT_ASSEMBLY;
+  std::string world;                    ///< "" = none
+  std::vector<std::string> module_dbs;  ///< "" = the project's
+  std::string bin_dir;                  ///< "" = CONCERT_BIN_DIR, the build tree, PATH
+  double duration_s = 0.0;              ///< 0 = until Ctrl-C
+  std::optional<int32_t> domain;
+};
 
-}  // namespace concert::cli
+/// `concert sim assemble|swap|world FILE`.
+struct SimOptions {
+  std::string verb;  ///< assemble, swap or world
+  std::string file;
+  std::vector<std::string> module_dbs;
+  std::optional<int32_t> domain;
+};
+
+int run_up(const UpOptions& options, std::ostream& out, std::ostream& err);
+int run_sim(const SimOptions& options, std::ostream& out, std::ostream& err);
+
+/// Registers `concert up` and `concert sim assemble|swap|world`.
+void register_launcher_verbs(cli::Cli& concert);
+
+}  // namespace concert::tool

@@ -5,19 +5,13 @@
 #include <csignal>
 #include <thread>
 
-#include "args.hpp"
+#include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/dds/conversions.hpp"
 #include "concert/topology/scan_io.hpp"
 
-namespace concert::cli {
-namespace {
-
-std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
-
-}  // namespace
+namespace concert::tool {
 
 topology::EscCatalog load_catalogs(std::vector<std::string> module_dbs) {
   if (module_dbs.empty()) module_dbs.push_back(CONCERT_DEFAULT_MODULE_DB);
@@ -28,63 +22,113 @@ topology::EscCatalog load_catalogs(std::vector<std::string> module_dbs) {
 
 namespace {
 
-/// The scan named on the command line: a scan file, or the scan an assembly gives on the
-/// simulated bus (with the module databases' ESC catalogue).
-topology::EscScan scan_from(Args& a) {
-  const auto scan_file = a.value("--scan");
-  const auto assembly_file = a.value("--assembly");
-  auto dbs = a.values("--module-db");
-  if (scan_file.has_value() == assembly_file.has_value()) {
-    throw UsageError("give exactly one of --scan FILE or --assembly FILE");
+/// Where a scan comes from: a scan file, or the scan an assembly gives on the simulated bus
+/// (with the module databases' ESC catalogue).
+struct ScanSource {
+  std::string scan_file;
+  std::string assembly_file;
+  std::vector<std::string> module_dbs;
+
+  topology::EscScan load() const {
+    if (!scan_file.empty()) return topology::load_scan(scan_file);
+    return simbus::simulate_scan(simbus::load_assembly(assembly_file), load_catalogs(module_dbs));
   }
-  if (scan_file) return topology::load_scan(*scan_file);
-  return simbus::simulate_scan(simbus::load_assembly(*assembly_file), load_catalogs(dbs));
-}
+};
 
-int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
-
-int run_scan(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  Args a(args);
-  const std::string verb = a.positional("scan verb: show or publish");
-  if (verb == "show") {
-    const bool json = a.flag("--json");
-    const auto scan = scan_from(a);
-    a.finish();
-    if (json) {
-      out << topology::scan_to_json(scan).dump(2) << "\n";
-    } else {
-      out << topology::scan_to_yaml(scan);
+void add_source_options(CLI::App& verb, ScanSource& source) {
+  CLI::Option* scan =
+      verb.add_option("--scan", source.scan_file, "a scan file (YAML or JSON)")->type_name("FILE");
+  CLI::Option* assembly = verb.add_option("--assembly", source.assembly_file,
+                                          "an assembly file, scanned on the simulated bus")
+                              ->type_name("FILE");
+  scan->excludes(assembly);
+  verb.add_option("--module-db", source.module_dbs,
+                  "module database folder (repeat to merge; default: the project's)")
+      ->type_name("DIR");
+  verb.callback([scan, assembly] {
+    if (scan->count() + assembly->count() != 1) {
+      throw CLI::ValidationError("give exactly one of --scan FILE or --assembly FILE");
     }
-    return 0;
-  }
-  if (verb != "publish") throw UsageError("unknown scan verb '" + verb + "' (show, publish)");
+  });
+}
 
-  const auto domain_arg = a.value("--domain");
-  const long hold_ms = a.integer("--hold-ms", 0, 0, 86'400'000);
-  const long scan_id = a.integer("--scan-id", 1, 1, 4'000'000'000);
-  const std::string source = a.value("--source").value_or("concert-scan");
-  const auto scan = scan_from(a);
-  a.finish();
-  const int32_t domain = domain_arg ? dds::parse_domain_id(*domain_arg, "--domain") : dds::domain_id_from_env();
+struct PublishOptions {
+  ScanSource source;
+  double hold_s = 0.0;
+  uint32_t scan_id = 1;
+  std::string name = "concert-scan";
+  cli::DdsOptions dds;
+};
 
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+
+int publish(const PublishOptions& o, std::ostream& out, std::ostream& err) {
+  const auto scan = o.source.load();
+  const int32_t domain = o.dds.domain_id();
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   dds::Participant participant({.name = "concert-scan", .domain_id = domain});
   dds::Writer<msg::EscScan> writer(participant, dds::topics::esc_scan);
-  writer.write(topology::dds::to_msg(scan, static_cast<uint32_t>(scan_id), now_ns(), source));
-  err << "concert scan publish: published " << scan.slaves.size() << " slaves as scan " << scan_id << " on domain "
-      << domain << (hold_ms ? "; holding it for late joiners" : "; holding it until Ctrl-C") << std::endl;
+  // --timeout: wait (bounded) for a reader, e.g. the discovery service, before publishing.
+  if (o.dds.timeout_s > 0 && !writer.wait_for_readers(1, o.dds.timeout())) {
+    err << "concert scan publish: no reader of the scan within " << o.dds.timeout_s
+        << " s; publishing anyway\n";
+  }
+  writer.write(topology::dds::to_msg(scan, o.scan_id, now_ns(), o.name));
+  if (o.dds.json) out << topology::scan_to_json(scan).dump() << std::endl;
+  err << "concert scan publish: published " << scan.slaves.size() << " slaves as scan " << o.scan_id
+      << " on domain " << domain
+      << (o.hold_s > 0 ? "; holding it for late joiners" : "; holding it until Ctrl-C")
+      << std::endl;
   // The scan is latched: it stays available to late joiners while this writer lives.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(hold_ms);
-  while (!g_stop && (hold_ms == 0 || std::chrono::steady_clock::now() < deadline)) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.hold_s);
+  while (!g_stop && (o.hold_s == 0 || std::chrono::steady_clock::now() < deadline)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return 0;
 }
 
-}  // namespace concert::cli
+}  // namespace
+
+void register_scan_verbs(cli::Cli& concert) {
+  CLI::App& scan = concert.group(concert.app(), "scan",
+                                 "EtherCAT scans: show one, or publish one as a master would");
+
+  struct ShowOptions {
+    ScanSource source;
+    bool json = false;
+  };
+  auto show_options = std::make_shared<ShowOptions>();
+  CLI::App& show =
+      concert.verb(scan, "show", "the scan an assembly gives on the simulated bus (or a scan file)",
+                   [&concert, show_options] {
+                     const auto s = show_options->source.load();
+                     if (show_options->json) {
+                       concert.out() << topology::scan_to_json(s).dump(2) << "\n";
+                     } else {
+                       concert.out() << topology::scan_to_yaml(s);
+                     }
+                     return 0;
+                   });
+  add_source_options(show, show_options->source);
+  show.add_flag("--json", show_options->json, "JSON instead of YAML");
+
+  auto o = std::make_shared<PublishOptions>();
+  CLI::App& pub =
+      concert.verb(scan, "publish", "publish a scan as an EtherCAT master would (latched)",
+                   [&concert, o] { return publish(*o, concert.out(), concert.err()); });
+  add_source_options(pub, o->source);
+  cli::Cli::add_seconds_option(
+      pub, "--hold", "--hold-ms", o->hold_s,
+      "keep the latched scan for late joiners this long (0: until Ctrl-C)");
+  pub.add_option("--scan-id", o->scan_id, "the scan's id")
+      ->type_name("N")
+      ->check(cli::number(1, 4e9, true));
+  pub.add_option("--source", o->name, "the scan's source name")->type_name("NAME");
+  concert.add_dds_options(
+      pub, o->dds, 0.0,
+      "wait up to S seconds for a reader of the scan before publishing (0: do not wait)");
+}
+
+}  // namespace concert::tool

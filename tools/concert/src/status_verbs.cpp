@@ -1,6 +1,7 @@
 #include "status_verbs.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <map>
 #include <mutex>
@@ -8,11 +9,12 @@
 #include <sstream>
 #include <thread>
 
-#include "args.hpp"
+#include "concert/common/clock.hpp"
+#include "concert/common/text.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/idl_schema/cdr.hpp"
 
-namespace concert::cli {
+namespace concert::tool {
 namespace {
 
 std::string state_name(msg::ServiceState s) {
@@ -24,11 +26,6 @@ std::string state_name(msg::ServiceState s) {
     case msg::SERVICE_STOPPED: return "stopped";
   }
   return "unknown";
-}
-
-int64_t wall_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
 }
 
 }  // namespace
@@ -44,7 +41,7 @@ std::vector<ServiceRow> read_statuses(int32_t domain, std::chrono::milliseconds 
   std::this_thread::sleep_for(wait);
   std::lock_guard lock(mutex);
   std::vector<ServiceRow> rows;
-  const int64_t now = wall_ns();
+  const int64_t now = now_ns();
   for (const auto& [id, s] : latest) {
     rows.push_back({s.service(), s.host(), state_name(s.state()), s.model_version(), s.model_hash(),
                     s.refusals(), s.message(), static_cast<double>(now - s.stamp_ns()) / 1e9});
@@ -190,31 +187,22 @@ int until_version(int32_t domain, uint32_t version, const std::vector<std::strin
   return 1;
 }
 
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) {
-    if (!item.empty()) out.push_back(item);
+struct StatusOptions {
+  cli::DdsOptions dds;
+  uint32_t until_version = 0;
+  std::string services;
+  bool check = false;
+};
+
+int status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
+  const int32_t domain = o.dds.domain_id();
+  if (o.until_version > 0) {
+    const double timeout_s = o.dds.timeout_given ? o.dds.timeout_s : 30.0;
+    return until_version(domain, o.until_version, split(o.services),
+                         std::llround(timeout_s * 1000.0), out, err);
   }
-  return out;
-}
-
-}  // namespace
-
-int run_status(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  Args a(args);
-  const bool json = a.flag("--json");
-  const bool check = a.flag("--check");
-  const long wait_ms = a.integer("--wait-ms", 1500, 0, 600000);
-  const long until = a.integer("--until-version", 0, 0, 4'000'000'000);
-  const long timeout_ms = a.integer("--timeout-ms", 30'000, 1, 86'400'000);
-  const auto services = split(a.value("--services").value_or(""));
-  const auto domain_arg = a.value("--domain");
-  a.finish();
-  const int32_t domain = domain_arg ? dds::parse_domain_id(*domain_arg, "--domain") : dds::domain_id_from_env();
-  if (until > 0) return until_version(domain, static_cast<uint32_t>(until), services, timeout_ms, out, err);
-  const auto rows = read_statuses(domain, std::chrono::milliseconds(wait_ms));
-  if (json) {
+  const auto rows = read_statuses(domain, o.dds.timeout());
+  if (o.dds.json) {
     idl::Json arr = idl::Json::array();
     for (const auto& r : rows) {
       arr.push_back({{"service", r.service},
@@ -227,10 +215,11 @@ int run_status(const std::vector<std::string>& args, std::ostream& out, std::ost
                      {"age_s", r.age_s}});
     }
     out << arr.dump(2) << "\n";
-    return check && !status_problems(rows).empty() ? 1 : 0;
+    return o.check && !status_problems(rows).empty() ? 1 : 0;
   }
   if (rows.empty()) {
-    err << "concert status: no service reported on domain " << domain << " within " << wait_ms << " ms\n";
+    err << "concert status: no service reported on domain " << domain << " within "
+        << o.dds.timeout_s << " s\n";
     return 1;
   }
   out << std::left << std::setw(16) << "SERVICE" << std::setw(18) << "HOST" << std::setw(15)
@@ -256,10 +245,36 @@ int run_status(const std::vector<std::string>& args, std::ostream& out, std::ost
     for (const auto& d : agreement.disagreeing) out << "; " << d;
     out << "\n";
   }
-  if (!check) return 0;
+  if (!o.check) return 0;
   const auto problems = status_problems(rows);
   for (const auto& p : problems) err << "concert status: " << p << "\n";
   return problems.empty() ? 0 : 1;
 }
 
-}  // namespace concert::cli
+}  // namespace
+
+void register_status_verb(cli::Cli& concert) {
+  auto o = std::make_shared<StatusOptions>();
+  CLI::App& verb = concert.verb(
+      concert.app(), "status",
+      "every service: host, state, model version and hash, refusals, last message; or wait until "
+      "every model consumer is ready at a version (and they agree on its hash)",
+      [&concert, o] { return status(*o, concert.out(), concert.err()); });
+  concert.add_dds_options(
+      verb, o->dds, 1.5,
+      "how long to listen for the services (with --until-version: how long to wait, default 30)");
+  cli::Cli::add_deprecated_ms_option(verb, "--wait-ms", o->dds.timeout_s,
+                                     verb.get_option("--timeout"));
+  verb.add_option("--until-version", o->until_version,
+                  "wait until every model consumer is ready at version N or later")
+      ->type_name("N")
+      ->check(cli::number(1, 4e9, true));
+  verb.add_flag("--check", o->check,
+                "exit 1 if a service is stopped or in error, the services disagree on the model, "
+                "or one refused input (each problem on stderr)");
+  verb.add_option("--services", o->services,
+                  "with --until-version: only these services (comma-separated)")
+      ->type_name("a,b");
+}
+
+}  // namespace concert::tool

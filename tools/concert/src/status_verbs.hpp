@@ -5,7 +5,9 @@
 #include <string>
 #include <vector>
 
-namespace concert::cli {
+#include "concert/cli/cli.hpp"
+
+namespace concert::tool {
 
 /// The last status of one service instance, as read from concert/system/status.
 struct ServiceRow {
@@ -36,7 +38,7 @@ ModelAgreement model_agreement(const std::vector<ServiceRow>& rows);
 /// error, a model disagreement, and every service that refused inputs. Empty = all good.
 std::vector<std::string> status_problems(const std::vector<ServiceRow>& rows);
 
-/// `concert status [--json] [--check] [--wait-ms MS] [--domain N]`; args start after "status".
-int run_status(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// Registers `concert status` ([--json] [--check] [--until-version N] [--services a,b]).
+void register_status_verb(cli::Cli& concert);
 
-}  // namespace concert::cli
+}  // namespace concert::tool

@@ -1,11 +1,12 @@
 #pragma once
-#include <ostream>
-#include <string>
-#include <vector>
+// `concert topic list|info|echo|hz|pub`: any topic on the domain, ours (typed through the
+// schema-driven CDR <-> JSON codec) or another program's.
 
-namespace concert::cli {
+#include "concert/cli/cli.hpp"
 
-/// `concert topic list|info|echo|hz ...`; args start after "topic". Returns the exit code.
-int run_topic(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+namespace concert::tool {
 
-}  // namespace concert::cli
+/// Registers the `topic` verbs into `concert`.
+void register_topic_verbs(cli::Cli& concert);
+
+}  // namespace concert::tool

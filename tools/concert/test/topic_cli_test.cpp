@@ -23,17 +23,11 @@ std::string domain() {
   return d ? d : "0";
 }
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-
-Result concert(std::vector<std::string> args) {
+testing::Outcome concert(std::vector<std::string> args) {
   args.insert(args.begin(), CONCERT_BIN);
-  Process p(args);
-  const auto code = p.wait(60s);
-  EXPECT_TRUE(code.has_value()) << "concert did not terminate";
-  return {code.value_or(-1), p.out(), p.err()};
+  const auto r = testing::run(args, 60s);
+  EXPECT_NE(r.code, -1) << "concert did not terminate";
+  return r;
 }
 
 class TopicCli : public ::testing::Test {
@@ -57,10 +51,10 @@ Process* TopicCli::foreign_ = nullptr;
 TEST_F(TopicCli, ListShowsEveryTopicOursAndOthers) {
   // Discovery of ~30 endpoints can take longer than one listing's wait on a loaded machine:
   // list again (at most 4 times) until every topic has shown up, as a user would.
-  Result r;
+  testing::Outcome r;
   std::map<std::string, idl::Json> by_topic;
   for (int attempt = 0; attempt < 4; ++attempt) {
-    r = concert({"topic", "list", "--json", "--wait-ms", "2500"});
+    r = concert({"topic", "list", "--json", "--timeout", "2.5"});
     ASSERT_EQ(r.code, 0) << r.err;
     by_topic.clear();
     for (const auto& row : idl::Json::parse(r.out)) by_topic[row.at("topic").get<std::string>()] = row;
@@ -83,7 +77,7 @@ TEST_F(TopicCli, ListShowsEveryTopicOursAndOthers) {
 }
 
 TEST_F(TopicCli, InfoShowsTypeQosEndpointsAndShape) {
-  const auto r = concert({"topic", "info", "concert/robot/joint_state", "--wait-ms", "2000"});
+  const auto r = concert({"topic", "info", "concert/robot/joint_state", "--timeout", "2"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("concert::msg::JointState"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("writer"), std::string::npos) << r.out;
@@ -92,7 +86,8 @@ TEST_F(TopicCli, InfoShowsTypeQosEndpointsAndShape) {
 }
 
 TEST_F(TopicCli, EchoPrintsSamplesWithFieldNames) {
-  const auto r = concert({"topic", "echo", "concert/robot/cartesian_command", "--count", "3", "--timeout-ms", "15000"});
+  const auto r = concert(
+      {"topic", "echo", "concert/robot/cartesian_command", "--count", "3", "--timeout", "15"});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto lines = testing::lines(r.out);
   ASSERT_EQ(lines.size(), 3u) << r.out;
@@ -101,23 +96,24 @@ TEST_F(TopicCli, EchoPrintsSamplesWithFieldNames) {
 }
 
 TEST_F(TopicCli, HzMeasuresTheRateOfAnyTopic) {
-  auto r = concert({"topic", "hz", "concert/robot/odometry", "--count", "30", "--timeout-ms", "15000", "--json"});
+  auto r = concert(
+      {"topic", "hz", "concert/robot/odometry", "--count", "30", "--timeout", "15", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   auto j = idl::Json::parse(r.out);
   EXPECT_EQ(j.at("samples"), 30);
   EXPECT_GT(j.at("rate_hz").get<double>(), 0.0);
   EXPECT_LE(j.at("period_ms").at("min").get<double>(), j.at("period_ms").at("max").get<double>());
   // A topic of a program that is not ours: its type is unknown, but it can be timed.
-  r = concert({"topic", "hz", "DDSPerfRDataKS", "--count", "5", "--timeout-ms", "15000", "--json"});
+  r = concert({"topic", "hz", "DDSPerfRDataKS", "--count", "5", "--timeout", "15", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(idl::Json::parse(r.out).at("samples"), 5);
 }
 
 TEST_F(TopicCli, ClearErrors) {
-  auto r = concert({"topic", "echo", "no/such_topic", "--wait-ms", "500", "--count", "1"});
+  auto r = concert({"topic", "echo", "no/such_topic", "--wait", "0.5", "--count", "1"});
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("no/such_topic"), std::string::npos) << r.err;
-  r = concert({"topic", "echo", "DDSPerfRDataKS", "--count", "1", "--timeout-ms", "5000"});
+  r = concert({"topic", "echo", "DDSPerfRDataKS", "--count", "1", "--timeout", "5"});
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("not in the project's IDL"), std::string::npos) << r.err;
   r = concert({"topic", "frob"});
@@ -130,7 +126,8 @@ TEST_F(TopicCli, ClearErrors) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--count"), std::string::npos);
   // A topic without writers times out with a count of what arrived.
-  r = concert({"topic", "echo", "concert/robot/ee_wrench", "--domain", "231", "--count", "1", "--timeout-ms", "500"});
+  r = concert({"topic", "echo", "concert/robot/ee_wrench", "--domain", "231", "--count", "1",
+               "--timeout", "0.5"});
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("received 0 of 1"), std::string::npos) << r.err;
 }

@@ -21,11 +21,6 @@ using namespace std::chrono_literals;
 using testing::Process;
 namespace fs = std::filesystem;
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-
 class UpTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -35,12 +30,11 @@ class UpTest : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(run_); }
 
-  Result concert(std::vector<std::string> args, std::chrono::seconds timeout = 90s) {
+  testing::Outcome concert(std::vector<std::string> args, std::chrono::seconds timeout = 90s) {
     args.insert(args.begin(), CONCERT_BIN);
-    Process p(args, env_);
-    const auto code = p.wait(timeout);
-    EXPECT_TRUE(code.has_value()) << "concert did not terminate: " << args[1];
-    return {code.value_or(-1), p.out(), p.err()};
+    const auto r = testing::run(args, timeout, env_);
+    EXPECT_NE(r.code, -1) << "concert did not terminate: " << args[1];
+    return r;
   }
 
   std::string run_;
@@ -71,12 +65,12 @@ TEST_F(UpTest, BadInputIsRefusedBeforeAnythingStarts) {
 TEST_F(UpTest, WholeStackSwapRestartAndStop) {
   Process up({CONCERT_BIN, "up", "--assembly", CONCERT_SOURCE_DIR "/deploy/demo/drill_robot.yaml", "--duration", "150"},
              env_);
-  auto r = concert({"status", "--until-version", "1", "--timeout-ms", "60000"});
+  auto r = concert({"status", "--until-version", "1", "--timeout", "60"});
   ASSERT_EQ(r.code, 0) << r.out << r.err << up.out();
   EXPECT_NE(r.out.find("robot@"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("modelgen@"), std::string::npos) << r.out;
 
-  r = concert({"status", "--json", "--wait-ms", "1500"});
+  r = concert({"status", "--json", "--timeout", "1.5"});
   ASSERT_EQ(r.code, 0) << r.err;
   std::map<std::string, idl::Json> by_service;
   for (const auto& s : idl::Json::parse(r.out)) by_service[s.at("service").get<std::string>()] = s;
@@ -96,7 +90,7 @@ TEST_F(UpTest, WholeStackSwapRestartAndStop) {
 
   r = concert({"sim", "swap", CONCERT_SOURCE_DIR "/deploy/demo/sanding_robot.yaml"});
   ASSERT_EQ(r.code, 0) << r.err;
-  r = concert({"status", "--until-version", "2", "--timeout-ms", "60000"});
+  r = concert({"status", "--until-version", "2", "--timeout", "60"});
   ASSERT_EQ(r.code, 0) << r.out << r.err;
 
   // A service that dies is restarted (with back-off) and the stack is whole again.
@@ -112,7 +106,7 @@ TEST_F(UpTest, WholeStackSwapRestartAndStop) {
     if (std::distance(std::sregex_iterator(out.begin(), out.end(), started), std::sregex_iterator()) >= 2) break;
     std::this_thread::sleep_for(100ms);
   }
-  r = concert({"status", "--json", "--wait-ms", "2500"});
+  r = concert({"status", "--json", "--timeout", "2.5"});
   bool discovery_back = false;
   for (const auto& s : idl::Json::parse(r.out)) {
     if (s.at("service") == "discovery" && s.at("state") == "ready") discovery_back = true;

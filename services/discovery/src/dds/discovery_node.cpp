@@ -1,18 +1,9 @@
 #include "discovery_node.hpp"
 
+#include "concert/common/clock.hpp"
 #include "concert/topology/dds/conversions.hpp"
 
 namespace concert::discovery::dds {
-namespace {
-
-int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
-
 DiscoveryNode::DiscoveryNode(concert::dds::Participant& participant, DiscoveryService service,
                              std::ostream& log)
     : service_(std::move(service)),

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
 #include "concert/module_db/module_db.hpp"
 #include "concert/simbus/assembly.hpp"
@@ -16,81 +17,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kUsage =
-    "usage: concert model generate (--scan FILE | --tree FILE | --assembly FILE) --module-db DIR [--module-db DIR ...] "
-    "--out DIR [--port-order 0312|0123] [--home JOINT=RAD ...] [--addon EE=ADDON ...]";
-
-struct Options {
-  std::string scan, tree, assembly, out;
-  std::vector<fs::path> module_dbs;
-  topology::PortOrder order = topology::PortOrder::kReal0312;
-  Customisation custom;
-};
-
-std::string parse(const std::vector<std::string>& args, Options& o) {
-  for (size_t i = 1; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    auto value = [&](std::string& into) -> std::string {
-      if (i + 1 >= args.size()) return "option " + arg + " needs a value";
-      into = args[++i];
-      return {};
-    };
-    std::string text;
-    std::string e;
-    if (arg == "--scan") {
-      e = value(o.scan);
-    } else if (arg == "--tree") {
-      e = value(o.tree);
-    } else if (arg == "--assembly") {
-      e = value(o.assembly);
-    } else if (arg == "--out") {
-      e = value(o.out);
-    } else if (arg == "--module-db") {
-      e = value(text);
-      o.module_dbs.emplace_back(text);
-    } else if (arg == "--port-order") {
-      e = value(text);
-      const auto order = topology::parse_port_order(text);
-      if (e.empty() && !order) return "--port-order '" + text + "': expected 0312 or 0123";
-      if (order) o.order = *order;
-    } else if (arg == "--home" || arg == "--addon") {
-      e = value(text);
-      const size_t eq = text.find('=');
-      if (e.empty() && (eq == std::string::npos || eq == 0 || eq + 1 == text.size())) {
-        return arg + " '" + text + "': expected " + (arg == "--home" ? "JOINT=RAD" : "EE=ADDON");
-      }
-      if (!e.empty()) return e;
-      if (arg == "--home") {
-        try {
-          size_t pos = 0;
-          const double v = std::stod(text.substr(eq + 1), &pos);
-          if (pos != text.size() - eq - 1) throw std::invalid_argument("trailing characters");
-          o.custom.home[text.substr(0, eq)] = v;
-        } catch (const std::exception&) {
-          return "--home '" + text + "': '" + text.substr(eq + 1) + "' is not a number";
-        }
-      } else {
-        o.custom.addons.push_back({text.substr(0, eq), text.substr(eq + 1)});
-      }
-    } else {
-      return "unknown argument '" + arg + "'";
-    }
-    if (!e.empty()) return e;
-  }
-  const int sources = (o.scan.empty() ? 0 : 1) + (o.tree.empty() ? 0 : 1) + (o.assembly.empty() ? 0 : 1);
-  if (sources != 1) return "give exactly one of --scan, --tree, --assembly";
-  if (o.module_dbs.empty()) return "missing --module-db DIR";
-  if (o.out.empty()) return "missing --out DIR";
-  return {};
-}
-
 topology::EscCatalog catalog_of(const std::vector<fs::path>& dirs) {
   topology::EscCatalog catalog;
   for (const fs::path& d : dirs) catalog.merge(topology::EscCatalog::load(d));
   return catalog;
 }
 
-int generate(const Options& o, std::ostream& out) {
+}  // namespace
+
+int generate(const GenerateOptions& o, std::ostream& out) {
+  const topology::PortOrder order = *topology::parse_port_order(o.port_order);
   const module_db::ModuleDatabase db = module_db::load_module_databases(o.module_dbs);
   topology::ModuleTree tree;
   std::string source;
@@ -106,12 +42,12 @@ int generate(const Options& o, std::ostream& out) {
     tree = topology::tree_from_json(doc, o.tree);
     source = o.tree;
   } else if (!o.scan.empty()) {
-    tree = discovery::discover(topology::load_scan(o.scan), catalog_of(o.module_dbs), {o.order});
+    tree = discovery::discover(topology::load_scan(o.scan), catalog_of(o.module_dbs), {order});
     source = o.scan;
   } else {
     const topology::EscCatalog catalog = catalog_of(o.module_dbs);
     const simbus::Assembly assembly = simbus::load_assembly(o.assembly);
-    tree = discovery::discover(simbus::simulate_scan(assembly, catalog, o.order), catalog, {o.order});
+    tree = discovery::discover(simbus::simulate_scan(assembly, catalog, order), catalog, {order});
     source = o.assembly;
   }
   GeneratedModel model = ModelGenerator(db).generate(tree, o.custom);
@@ -132,29 +68,94 @@ int generate(const Options& o, std::ostream& out) {
   return 0;
 }
 
+namespace {
+
+/// "NAME=VALUE" split at the first '=', both parts non-empty.
+std::pair<std::string, std::string> pair_of(const std::string& text) {
+  const size_t eq = text.find('=');
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+CLI::Validator name_equals(const std::string& what, bool number) {
+  return CLI::Validator(
+      [what, number](std::string& text) -> std::string {
+        const size_t eq = text.find('=');
+        if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) {
+          return "'" + text + "': expected " + what;
+        }
+        if (number) {
+          const std::string value = text.substr(eq + 1);
+          size_t pos = 0;
+          try {
+            (void)std::stod(value, &pos);
+          } catch (const std::exception&) {
+            pos = 0;
+          }
+          if (pos != value.size()) return "'" + text + "': '" + value + "' is not a number";
+        }
+        return "";
+      },
+      "", what);
+}
+
 }  // namespace
 
-int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    (args.empty() ? err : out) << kUsage << "\n";
-    return args.empty() ? 2 : 0;
-  }
-  if (args[0] == "show") return show_main(args, out, err);
-  if (args[0] != "generate") {
-    err << "concert model: unknown verb '" << args[0] << "' (expected generate or show)\n";
-    return 2;
-  }
-  Options o;
-  if (const std::string e = parse(args, o); !e.empty()) {
-    err << "concert model generate: " << e << "\n" << kUsage << "\n";
-    return 2;
-  }
-  try {
-    return generate(o, out);
-  } catch (const std::exception& e) {
-    err << "concert model generate: " << e.what() << "\n";
-    return 1;
-  }
+void register_verbs(cli::Cli& concert) {
+  CLI::App& model =
+      concert.group(concert.app(), "model", "robot models: generate a bundle, show the live model");
+
+  auto g = std::make_shared<GenerateOptions>();
+  CLI::App& gen = concert.verb(
+      model, "generate", "write URDF, SRDF, controller config and manifest to a bundle folder",
+      [&concert, g] { return generate(*g, concert.out()); });
+  CLI::Option* scan = gen.add_option("--scan", g->scan, "an EtherCAT scan file")->type_name("FILE");
+  CLI::Option* tree = gen.add_option("--tree", g->tree, "a module tree (JSON)")->type_name("FILE");
+  CLI::Option* assembly =
+      gen.add_option("--assembly", g->assembly,
+                     "an assembly file (through the simulated bus and discovery)")
+          ->type_name("FILE");
+  scan->excludes(tree)->excludes(assembly);
+  tree->excludes(assembly);
+  gen.add_option("--module-db", g->module_dbs,
+                 "module database folder, either format (repeat to merge)")
+      ->type_name("DIR")
+      ->required();
+  gen.add_option("--out", g->out, "the bundle folder")->type_name("DIR")->required();
+  cli::Cli::add_choice(gen, "--port-order", g->port_order, {"0312", "0123"},
+                       "frame processing order of the ESC ports");
+  gen.add_option_function<std::vector<std::string>>(
+         "--home",
+         [g](const std::vector<std::string>& items) {
+           for (const auto& item : items) {
+             const auto [joint, value] = pair_of(item);
+             g->custom.home[joint] = std::stod(value);
+           }
+         },
+         "homing position of a joint (repeat)")
+      ->type_name("JOINT=RAD")
+      ->check(name_equals("JOINT=RAD", true));
+  gen.add_option_function<std::vector<std::string>>(
+         "--addon",
+         [g](const std::vector<std::string>& items) {
+           for (const auto& item : items) {
+             const auto [ee, addon] = pair_of(item);
+             g->custom.addons.push_back({ee, addon});
+           }
+         },
+         "mount an add-on on an end-effector or body (repeat)")
+      ->type_name("EE=ADDON")
+      ->check(name_equals("EE=ADDON", false));
+  gen.callback([scan, tree, assembly] {
+    if (scan->count() + tree->count() + assembly->count() != 1) {
+      throw CLI::ValidationError("give exactly one of --scan, --tree, --assembly");
+    }
+  });
+
+  auto s = std::make_shared<cli::DdsOptions>();
+  CLI::App& show_verb = concert.verb(
+      model, "show", "the live robot model: version, modules, chains, joints, end-effectors",
+      [&concert, s] { return show(*s, concert.out()); });
+  concert.add_dds_options(show_verb, *s, 3.0, "how long to wait for the latched model");
 }
 
 }  // namespace concert::modelgen

@@ -2,19 +2,12 @@
 
 #include <chrono>
 
+#include "concert/common/clock.hpp"
 #include "concert/model/dds/conversions.hpp"
 #include "concert/topology/dds/conversions.hpp"
 #include "conversions.hpp"
 
 namespace concert::modelgen::dds {
-
-namespace {
-
-int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-}  // namespace
 
 ModelgenNode::ModelgenNode(concert::dds::Participant& participant, ModelgenService& service,
                            std::ostream& log, std::chrono::milliseconds resume_wait)

@@ -5,8 +5,11 @@
 #include <chrono>
 #include <cmath>
 #include <iomanip>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <random>
 
+#include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/participant.hpp"
 #include "dds/planner_node.hpp"
@@ -14,9 +17,15 @@
 namespace concert::planner {
 namespace {
 
-constexpr const char* kUsage =
-    "usage: concert plan drill --at X Y Z [--at X Y Z ...] [--normal NX NY NZ] [--execute] [--end-effector NAME] "
-    "[--request-id N] [--timeout S]";
+/// What `concert plan drill` sends.
+struct DrillOptions {
+  std::vector<std::vector<double>> at;  ///< goals, 3 numbers each [m]
+  std::vector<double> normal{-1.0, 0.0, 0.0};
+  bool execute = false;
+  std::string end_effector;
+  uint32_t request_id = std::random_device{}() & 0x7fffffffu;
+  cli::DdsOptions dds;
+};
 
 const char* state_name(msg::PlanState s) {
   switch (s) {
@@ -29,68 +38,17 @@ const char* state_name(msg::PlanState s) {
   return "?";
 }
 
-double parse_number(const std::string& text, const std::string& what) {
-  size_t pos = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(text, &pos);
-  } catch (const std::exception&) {
-    pos = 0;
-  }
-  if (pos == 0 || pos != text.size() || !std::isfinite(v)) throw std::invalid_argument(what + " '" + text + "': expected a number");
-  return v;
-}
-
-}  // namespace
-
-int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    (args.empty() ? err : out) << kUsage << "\n";
-    return args.empty() ? 2 : 0;
-  }
-  if (args[0] != "drill") {
-    err << "concert plan: unknown verb '" << args[0] << "'\n" << kUsage << "\n";
-    return 2;
-  }
+int drill(const DrillOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<Eigen::Vector3d> points;
-  Eigen::Vector3d normal(-1.0, 0.0, 0.0);
-  bool execute = false;
-  std::string end_effector;
-  double timeout_s = 30.0;
-  uint32_t request_id = std::random_device{}() & 0x7fffffffu;
+  for (const auto& p : o.at) points.emplace_back(p[0], p[1], p[2]);
+  const Eigen::Vector3d normal(o.normal[0], o.normal[1], o.normal[2]);
+  if (normal.norm() < 1e-9) throw cli::UsageError("--normal: must not be zero");
+  const bool execute = o.execute;
+  const std::string& end_effector = o.end_effector;
+  const double timeout_s = o.dds.timeout_s;
+  const uint32_t request_id = o.request_id;
   try {
-    auto vec = [&](size_t& i, const std::string& opt) {
-      if (i + 3 >= args.size()) throw std::invalid_argument(opt + " needs 3 numbers");
-      Eigen::Vector3d v;
-      for (int k = 0; k < 3; ++k) v[k] = parse_number(args[++i], opt);
-      return v;
-    };
-    for (size_t i = 1; i < args.size(); ++i) {
-      const std::string& a = args[i];
-      if (a == "--at") {
-        points.push_back(vec(i, a));
-      } else if (a == "--normal") {
-        normal = vec(i, a);
-        if (normal.norm() < 1e-9) throw std::invalid_argument("--normal: must not be zero");
-      } else if (a == "--execute") {
-        execute = true;
-      } else if ((a == "--end-effector" || a == "--request-id" || a == "--timeout") && i + 1 < args.size()) {
-        const std::string& v = args[++i];
-        if (a == "--end-effector") end_effector = v;
-        if (a == "--timeout") timeout_s = parse_number(v, a);
-        if (a == "--request-id") request_id = static_cast<uint32_t>(parse_number(v, a));
-        if (a == "--timeout" && !(timeout_s > 0.0)) throw std::invalid_argument("--timeout: must be > 0");
-      } else {
-        throw std::invalid_argument("unknown or incomplete argument '" + a + "'");
-      }
-    }
-    if (points.empty()) throw std::invalid_argument("no goal: give at least one --at X Y Z");
-  } catch (const std::exception& e) {
-    err << "concert plan drill: " << e.what() << "\n" << kUsage << "\n";
-    return 2;
-  }
-  try {
-    concert::dds::Participant participant({.name = "concert_plan"});
+    concert::dds::Participant participant({.name = "concert_plan", .domain_id = o.dds.domain_id()});
     concert::dds::Reader<msg::RobotModel> models(participant, concert::dds::topics::robot_model);
     concert::dds::Reader<msg::PlanResult> results(participant, concert::dds::topics::plan_result);
     concert::dds::Writer<msg::PlanRequest> requests(participant, concert::dds::topics::plan_request);
@@ -124,10 +82,19 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
       frame.translation() = p;
       req.goals().push_back(dds::to_msg(frame));
     }
-    req.stamp_ns(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+    req.stamp_ns(now_ns());
     requests.write(req);
-    out << "request " << request_id << ": " << points.size() << " goal(s) for model version " << model->version()
-        << (execute ? ", executing" : ", planning only") << "\n";
+    if (o.dds.json) {
+      out << nlohmann::ordered_json{{"request_id", request_id},
+                                    {"goals", points.size()},
+                                    {"model_version", model->version()},
+                                    {"execute", execute}}
+                 .dump()
+          << std::endl;
+    } else {
+      out << "request " << request_id << ": " << points.size() << " goal(s) for model version "
+          << model->version() << (execute ? ", executing" : ", planning only") << "\n";
+    }
     // Execution progress arrives many times a second: one line per 10 % of each goal.
     long printed_goal = -1;
     long printed_percent = 0;
@@ -141,14 +108,30 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
         printed_goal = goal;
         printed_percent = percent - percent % 10;
       }
-      out << "  goal " << r->goal_index() + 1 << "/" << r->goal_count() << " " << state_name(r->state());
-      if (r->state() == msg::PLAN_PLANNED && !r->trajectory().empty()) {
-        out << std::fixed << std::setprecision(1) << " in " << 1e3 * r->planning_time() << " ms, " << r->trajectory().size()
-            << " samples, " << r->trajectory().back().time() << " s" << std::defaultfloat;
+      if (o.dds.json) {
+        nlohmann::ordered_json j = {
+            {"request_id", r->request_id()}, {"goal", r->goal_index() + 1},
+            {"goals", r->goal_count()},      {"state", state_name(r->state())},
+            {"progress", r->progress()},     {"reason", r->reason()}};
+        if (r->state() == msg::PLAN_PLANNED && !r->trajectory().empty()) {
+          j["planning_time_s"] = r->planning_time();
+          j["samples"] = r->trajectory().size();
+          j["duration_s"] = r->trajectory().back().time();
+        }
+        out << j.dump() << std::endl;
+      } else {
+        out << "  goal " << r->goal_index() + 1 << "/" << r->goal_count() << " "
+            << state_name(r->state());
+        if (r->state() == msg::PLAN_PLANNED && !r->trajectory().empty()) {
+          out << std::fixed << std::setprecision(1) << " in " << 1e3 * r->planning_time() << " ms, "
+              << r->trajectory().size() << " samples, " << r->trajectory().back().time() << " s"
+              << std::defaultfloat;
+        }
+        if (r->state() == msg::PLAN_EXECUTING)
+          out << " " << std::lround(100.0 * r->progress()) << " %";
+        if (!r->reason().empty()) out << ": " << r->reason();
+        out << "\n";
       }
-      if (r->state() == msg::PLAN_EXECUTING) out << " " << std::lround(100.0 * r->progress()) << " %";
-      if (!r->reason().empty()) out << ": " << r->reason();
-      out << "\n";
       if (r->state() == msg::PLAN_SUCCEEDED) return 0;
       if (r->state() == msg::PLAN_FAILED) {
         err << "concert plan drill: " << r->reason() << "\n";
@@ -157,10 +140,42 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
     }
     err << "concert plan drill: no final result within " << timeout_s << " s\n";
     return 1;
+  } catch (const cli::UsageError&) {
+    throw;
   } catch (const std::exception& e) {
     err << "concert plan drill: " << e.what() << "\n";
     return 1;
   }
+}
+
+}  // namespace
+
+void register_verbs(cli::Cli& concert) {
+  CLI::App& plan =
+      concert.group(concert.app(), "plan", "whole-body planning requests to the planner service");
+  auto o = std::make_shared<DrillOptions>();
+  CLI::App& verb =
+      concert.verb(plan, "drill", "plan (and with --execute run) the approach to drilling areas",
+                   [&concert, o] { return drill(*o, concert.out(), concert.err()); });
+  verb.add_option("--at", o->at,
+                  "a drilling-area centre in the world frame [m] (repeat for several goals)")
+      ->type_size(3)
+      ->type_name("X Y Z")
+      ->required()
+      ->check(cli::real());
+  verb.add_option("--normal", o->normal, "outward normal of the drilled surface")
+      ->expected(3)
+      ->type_name("NX NY NZ")
+      ->check(cli::real())
+      ->default_str("-1 0 0");
+  verb.add_flag("--execute", o->execute, "execute the planned motion on the robot");
+  verb.add_option("--end-effector", o->end_effector,
+                  "the tool end-effector (default: the planner's choice)")
+      ->type_name("NAME");
+  verb.add_option("--request-id", o->request_id, "the request's id (default: random)")
+      ->type_name("N")
+      ->check(cli::number(0, 4294967295.0, true));
+  concert.add_dds_options(verb, o->dds, 30.0, "how long to follow the request");
 }
 
 }  // namespace concert::planner

@@ -2,20 +2,17 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <fstream>
-#include <functional>
-#include <map>
-#include <sstream>
+#include "concert/common/text.hpp"
 
 namespace concert::planner {
 namespace {
 
 std::string read_file(const std::filesystem::path& file, const char* what) {
-  std::ifstream in(file);
-  if (!in) throw PlannerError(std::string(what) + " file '" + file.string() + "' cannot be opened");
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
+  try {
+    return concert::read_file(file, what);
+  } catch (const std::runtime_error& e) {
+    throw PlannerError(e.what());
+  }
 }
 
 YAML::Node parse(const std::string& yaml, const std::string& source) {
@@ -41,26 +38,20 @@ Eigen::Vector3d vec3(const YAML::Node& n, const std::string& where) {
 
 }  // namespace
 
-Params parse_params(const std::string& yaml, const std::string& source) {
+Params read_params(config::Document& doc) {
   Params p;
-  const YAML::Node root = parse(yaml, source);
-  if (!root || root.IsNull()) return p;
-  if (!root.IsMap()) throw PlannerError(source + ": expected a map of parameters");
-  const std::map<std::string, double*> numbers = {
+  config::Map root = doc.root();
+  // Every key of Params (config/planner.yaml lists them with their defaults and units).
+  const std::pair<const char*, double*> non_negative[] = {
       {"camera_distance", &p.camera_distance},
       {"contact_force", &p.contact_force},
       {"torque_margin", &p.torque_margin},
-      {"floor_height", &p.floor_height},
-      {"base_height", &p.base_height},
-      {"octomap_resolution", &p.octomap_resolution},
       {"environment_padding", &p.environment_padding},
       {"floor_clearance", &p.floor_clearance},
       {"base_range", &p.base_range},
-      {"planning_time", &p.planning_time},
-      {"warm_up_time", &p.warm_up_time},
       {"path_attempt_time", &p.path_attempt_time},
-      {"check_resolution", &p.check_resolution},
       {"nspg_time", &p.nspg_time},
+      {"warm_up_time", &p.warm_up_time},
       {"nspg_tolerance", &p.nspg_tolerance},
       {"nspg_distance_weight", &p.nspg_distance_weight},
       {"nspg_singularity_weight", &p.nspg_singularity_weight},
@@ -72,7 +63,12 @@ Params parse_params(const std::string& yaml, const std::string& source) {
       {"base_angular_acceleration", &p.base_angular_acceleration},
       {"sample_period", &p.sample_period},
   };
-  const std::map<std::string, int*> integers = {
+  const std::pair<const char*, double*> positive[] = {
+      {"octomap_resolution", &p.octomap_resolution},
+      {"planning_time", &p.planning_time},
+      {"check_resolution", &p.check_resolution},
+  };
+  const std::pair<const char*, int*> counts[] = {
       {"simplify_iterations", &p.simplify_iterations},
       {"sample_iterations", &p.sample_iterations},
       {"nspg_seeds", &p.nspg_seeds},
@@ -81,35 +77,29 @@ Params parse_params(const std::string& yaml, const std::string& source) {
       {"nspg_enough", &p.nspg_enough},
       {"nspg_memory", &p.nspg_memory},
   };
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    const std::string where = source + ": " + key;
-    if (const auto it = numbers.find(key); it != numbers.end()) {
-      *it->second = number(kv.second, where);
-    } else if (const auto jt = integers.find(key); jt != integers.end()) {
-      const double v = number(kv.second, where);
-      if (v < 0 || v != static_cast<int>(v)) throw PlannerError(where + ": expected a non-negative integer");
-      *jt->second = static_cast<int>(v);
-    } else if (key == "seed") {
-      const double v = number(kv.second, where);
-      if (v < 0) throw PlannerError(where + ": expected a non-negative integer");
-      p.seed = static_cast<uint64_t>(v);
-    } else {
-      throw PlannerError(where + ": unknown parameter");
-    }
-  }
-  for (const auto& [key, value] : numbers) {
-    if (key != "base_height" && key != "floor_height" && !(*value >= 0.0)) {
-      throw PlannerError(source + ": " + key + ": must be >= 0");
-    }
-  }
-  if (!(p.planning_time > 0.0)) throw PlannerError(source + ": planning_time: must be > 0");
-  if (!(p.check_resolution > 0.0)) throw PlannerError(source + ": check_resolution: must be > 0");
-  if (!(p.octomap_resolution > 0.0)) throw PlannerError(source + ": octomap_resolution: must be > 0");
+  for (const auto& [key, value] : non_negative)
+    root.number(key, *value, config::Range::non_negative());
+  for (const auto& [key, value] : positive) root.number(key, *value, config::Range::positive());
+  for (const auto& [key, value] : counts) root.integer(key, *value, 0);
+  root.number("floor_height", p.floor_height);
+  root.number_or_auto("base_height", p.base_height);
+  root.integer("seed", p.seed);
+  doc.finish();
   return p;
 }
 
-Params load_params(const std::filesystem::path& file) { return parse_params(read_file(file, "params"), file.string()); }
+Params parse_params(const std::string& yaml, const std::string& source) {
+  try {
+    auto doc = config::Document::parse(yaml, source);
+    return read_params(doc);
+  } catch (const config::ConfigError& e) {
+    throw PlannerError(e.what());
+  }
+}
+
+Params load_params(const std::filesystem::path& file) {
+  return parse_params(read_file(file, "params"), file.string());
+}
 
 World parse_world(const std::string& yaml, const std::string& source) {
   World w;

@@ -9,14 +9,10 @@
 #include <cmath>
 #include <sstream>
 
+#include "concert/common/clock.hpp"
+
 namespace concert::planner::dds {
 namespace {
-
-int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // Linear interpolation of a trajectory at time t [s] (samples are dense, 20 ms by default).
 TrajectoryPoint sample_at(const Trajectory& t, double time) {

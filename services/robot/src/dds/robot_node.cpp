@@ -3,19 +3,13 @@
 #include <chrono>
 #include <cmath>
 
+#include "concert/common/clock.hpp"
 #include "concert/topology/dds/conversions.hpp"
 #include "robot_conversions.hpp"
 
 namespace concert::robot::dds {
 
 namespace cdds = concert::dds;
-
-namespace {
-int64_t wall_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-}  // namespace
 
 RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams params)
     : participant_(participant),
@@ -132,7 +126,7 @@ void RobotNode::publish(const RobotState& s) {
 }
 
 void RobotNode::publish_scan(const topology::EscScan& scan, const std::string& source) {
-  scan_.write(topology::dds::to_msg(scan, ++scan_id_, wall_ns(), source));
+  scan_.write(topology::dds::to_msg(scan, ++scan_id_, now_ns(), source));
 }
 
 std::string RobotNode::last_error() const {

@@ -1,148 +1,65 @@
 #include "robot_params.hpp"
 
-#include <yaml-cpp/yaml.h>
-
-#include <fstream>
-#include <functional>
-#include <map>
-#include <sstream>
-#include <stdexcept>
-
 namespace concert::robot::dds {
-namespace {
 
-struct Section {
-  const std::string& source;
-  std::string name;
-  std::map<std::string, std::function<void(const YAML::Node&)>> keys;
-
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw std::runtime_error("parameters '" + source + "': " + name + "." + key + ": " + what);
-  }
-  template <class T> std::function<void(const YAML::Node&)> to(const std::string& key, T& out) {
-    return [this, key, &out](const YAML::Node& n) {
-      try {
-        out = n.as<T>();
-      } catch (const YAML::Exception&) {
-        fail(key, "wrong type");
-      }
-    };
-  }
-  template <class T> void add(const std::string& key, T& out) { keys[key] = to(key, out); }
-  void apply(const YAML::Node& node) {
-    if (!node) {
-      return;
-    }
-    if (!node.IsMap()) {
-      throw std::runtime_error("parameters '" + source + "': " + name + ": expected a map");
-    }
-    for (const auto& kv : node) {
-      const auto key = kv.first.as<std::string>();
-      const auto it = keys.find(key);
-      if (it == keys.end()) {
-        fail(key, "unknown key");
-      }
-      it->second(kv.second);
-    }
-  }
-};
-
-}  // namespace
-
-ServiceParams parse_service_params(const std::string& yaml_text, const std::string& source) {
+ServiceParams read_service_params(config::Document& doc) {
   ServiceParams p;
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error("parameters '" + source + "': YAML error at line " + std::to_string(e.mark.line + 1) +
-                             ": " + e.msg);
-  }
-  if (root.IsNull()) {
-    return p;
-  }
-  if (!root.IsMap()) {
-    throw std::runtime_error("parameters '" + source + "': expected a map with robot, sim, loop, node");
-  }
-  for (const auto& kv : root) {
-    const auto key = kv.first.as<std::string>();
-    if (key != "robot" && key != "sim" && key != "loop" && key != "node") {
-      throw std::runtime_error("parameters '" + source + "': unknown section '" + key +
-                               "' (robot, sim, loop, node)");
-    }
-  }
-  Section robot{source, "robot", {}};
-  robot.add("period", p.robot.period);
-  robot.add("end_effector_frame", p.robot.end_effector_frame);
-  robot.add("default_wheel_radius", p.robot.default_wheel_radius);
-  robot.add("wrench_filter_time_constant", p.robot.wrench_filter_time_constant);
-  robot.add("base_command_timeout", p.robot.base_command_timeout);
-  robot.add("velocity_guard_gain", p.robot.velocity_guard_gain);
-  robot.apply(root["robot"]);
+  const auto non_negative = config::Range::non_negative();
+  const auto positive = config::Range::positive();
+  config::Map root = doc.root();
 
-  Section sim{source, "sim", {}};
-  sim.add("timestep", p.sim.timestep);
-  sim.add("position_stiffness", p.sim.position_stiffness);
-  sim.add("position_damping", p.sim.position_damping);
-  sim.add("velocity_gain", p.sim.velocity_gain);
-  sim.add("armature", p.sim.armature);
-  sim.add("friction_scale", p.sim.friction_scale);
-  sim.add("damping_scale", p.sim.damping_scale);
-  sim.add("wheel_friction", p.sim.wheel_friction);
-  sim.add("robot_friction", p.sim.robot_friction);
-  sim.add("base_yaw", p.sim.base_yaw);
-  sim.add("initial_positions", p.sim.initial_positions);
-  sim.add("position_noise", p.sim.position_noise);
-  sim.add("effort_noise", p.sim.effort_noise);
-  sim.add("seed", p.sim.seed);
-  sim.add("package_paths", p.sim.package_paths);
-  sim.keys["floating_base"] = [&](const YAML::Node& n) {
-    try {
-      p.sim.floating_base = n.as<bool>();
-    } catch (const YAML::Exception&) {
-      sim.fail("floating_base", "expected true or false");
-    }
-  };
-  sim.keys["base_position"] = [&](const YAML::Node& n) {
-    try {
-      const auto v = n.as<std::vector<double>>();
-      if (v.size() != 3) {
-        throw YAML::Exception(YAML::Mark::null_mark(), "size");
-      }
-      p.sim.base_position = {v[0], v[1], v[2]};
-    } catch (const YAML::Exception&) {
-      sim.fail("base_position", "expected [x, y, z]");
-    }
-  };
-  sim.apply(root["sim"]);
+  config::Map robot = root.section("robot");
+  robot.number("period", p.robot.period, positive);
+  robot.string("end_effector_frame", p.robot.end_effector_frame);
+  robot.number("default_wheel_radius", p.robot.default_wheel_radius, positive);
+  robot.number("wrench_filter_time_constant", p.robot.wrench_filter_time_constant, non_negative);
+  robot.number("base_command_timeout", p.robot.base_command_timeout, positive);
+  robot.number("velocity_guard_gain", p.robot.velocity_guard_gain, non_negative);
 
-  Section loop{source, "loop", {}};
-  loop.add("real_time", p.loop.real_time);
-  loop.add("spin_time", p.loop.spin_time);
-  loop.add("fifo_priority", p.loop.fifo_priority);
-  loop.apply(root["loop"]);
+  config::Map sim = root.section("sim");
+  sim.number("timestep", p.sim.timestep, positive);
+  sim.number("position_stiffness", p.sim.position_stiffness, non_negative);
+  sim.number("position_damping", p.sim.position_damping, non_negative);
+  sim.number("velocity_gain", p.sim.velocity_gain, non_negative);
+  sim.number("armature", p.sim.armature, non_negative);
+  sim.number("friction_scale", p.sim.friction_scale, non_negative);
+  sim.number("damping_scale", p.sim.damping_scale, non_negative);
+  sim.number("wheel_friction", p.sim.wheel_friction, non_negative);
+  sim.number("robot_friction", p.sim.robot_friction, non_negative);
+  sim.boolean_or_auto("floating_base", p.sim.floating_base);
+  std::vector<double> base_position(p.sim.base_position.data(), p.sim.base_position.data() + 3);
+  sim.numbers("base_position", base_position, 3);
+  p.sim.base_position = {base_position[0], base_position[1], base_position[2]};
+  sim.number("base_yaw", p.sim.base_yaw);
+  sim.number_map("initial_positions", p.sim.initial_positions);
+  sim.number("position_noise", p.sim.position_noise, non_negative);
+  sim.number("effort_noise", p.sim.effort_noise, non_negative);
+  sim.integer("seed", p.sim.seed);
+  sim.string_map("package_paths", p.sim.package_paths);
 
-  Section node{source, "node", {}};
-  node.add("service_name", p.node.service_name);
-  node.add("odometry_decimation", p.node.odometry_decimation);
-  node.add("wrench_decimation", p.node.wrench_decimation);
-  node.apply(root["node"]);
+  config::Map loop = root.section("loop");
+  loop.boolean("real_time", p.loop.real_time);
+  loop.number("spin_time", p.loop.spin_time, non_negative);
+  loop.integer("fifo_priority", p.loop.fifo_priority, 0, 99);
 
-  if (p.robot.period <= 0.0 || p.sim.timestep <= 0.0) {
-    throw std::runtime_error("parameters '" + source + "': periods and timestep must be positive");
-  }
+  config::Map node = root.section("node");
+  node.string("service_name", p.node.service_name, false);
+  node.integer("odometry_decimation", p.node.odometry_decimation, 1);
+  node.integer("wrench_decimation", p.node.wrench_decimation, 1);
+
+  doc.finish();
   p.loop.period = p.robot.period;
   return p;
 }
 
+ServiceParams parse_service_params(const std::string& yaml_text, const std::string& source) {
+  auto doc = config::Document::parse(yaml_text, source);
+  return read_service_params(doc);
+}
+
 ServiceParams load_service_params(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error("cannot open parameters file '" + path + "'");
-  }
-  std::stringstream s;
-  s << in.rdbuf();
-  return parse_service_params(s.str(), path);
+  auto doc = config::Document::load(path);
+  return read_service_params(doc);
 }
 
 }  // namespace concert::robot::dds

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "concert/config/config.hpp"
 #include "robot/loop.hpp"
 #include "robot/robot_core.hpp"
 #include "robot/sim_hardware.hpp"
@@ -17,9 +18,12 @@ struct ServiceParams {
   NodeParams node;
 };
 
-/// Parses parameters YAML; unknown sections/keys and wrong types are errors naming `source`
-/// and the key (std::runtime_error). Missing keys keep their defaults.
+/// Parses parameters YAML; unknown sections/keys and wrong types are errors naming `source`,
+/// the key and the line (config::ConfigError, a std::runtime_error). Missing keys keep their
+/// defaults.
 ServiceParams parse_service_params(const std::string& yaml_text, const std::string& source);
 ServiceParams load_service_params(const std::string& path);
+/// Reads the parameters of `doc`, starting from the defaults.
+ServiceParams read_service_params(config::Document& doc);
 
 }  // namespace concert::robot::dds

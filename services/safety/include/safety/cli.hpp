@@ -1,23 +1,20 @@
 #pragma once
 // `concert safety ...` verbs (operator side of the safety service), for the concert tool:
-//   safety status [--timeout-ms MS]
-//       prints the live safety state: RUNNING, or STOPPED with its causes
-//   safety estop [--source SOURCE] [--release] [--reason TEXT] [--timeout-ms MS]
-//       engages (or releases) an e-stop input; SOURCE: front-left, front-right, rear-left,
-//       rear-right, wireless, software (default software)
-//   safety reset [--source NAME] [--reason TEXT] [--timeout-ms MS]
-//       asks the safety service to reset a latched stop; prints the resulting state
-// Domain: CONCERT_DOMAIN_ID. Uses DDS: not a core library.
+//   safety status            prints the live safety state: RUNNING, or STOPPED with its causes
+//   safety estop [--source SOURCE] [--release] [--reason TEXT]
+//                            engages (or releases) an e-stop input; SOURCE: front-left,
+//                            front-right, rear-left, rear-right, wireless, software (default)
+//   safety reset [--source NAME] [--reason TEXT]
+//                            asks the safety service to reset a latched stop; prints the result
+// Each takes --domain N, --timeout S (default 5) and --json. Uses DDS: not a core library.
 
-#include <ostream>
-#include <string>
-#include <vector>
+#include "concert/cli/cli.hpp"
 
 namespace concert::safety {
 
-/// Runs `concert safety <args>`. Returns 0 on success; 1 when the work failed (no safety
-/// service answered, reset refused: the reason is printed), 2 for a bad command line; errors
-/// are one line on `err`.
-int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// Registers `concert safety status|estop|reset` into `concert`. The verbs return 0 on
+/// success; 1 when the work failed (no safety service answered, reset refused: the reason is
+/// printed), 2 for a bad command line.
+void register_verbs(cli::Cli& concert);
 
 }  // namespace concert::safety

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "concert/config/config.hpp"
+
 namespace concert::safety {
 
 struct Params {
@@ -31,10 +33,13 @@ struct Params {
 };
 
 /// Reads a params YAML file: every key optional, unknown keys are errors. Throws
-/// std::runtime_error naming the file and the field.
+/// config::ConfigError (a std::runtime_error) naming the file, the key and the line.
 Params load_params(const std::string& file);
 
 /// Same from YAML text; `origin` names the source in error messages.
 Params parse_params(const std::string& yaml, const std::string& origin);
+
+/// Reads the parameters of `doc` (periods in seconds in the file), starting from the defaults.
+Params read_params(config::Document& doc);
 
 }  // namespace concert::safety

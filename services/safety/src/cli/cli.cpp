@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 
+#include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 
@@ -14,12 +17,7 @@ namespace {
 
 using namespace std::chrono_literals;
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-struct Failure : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using cli::Failure;
 
 const std::map<std::string, msg::EStopSource> kSources = {
     {"front-left", msg::ESTOP_BUTTON_FRONT_LEFT},
@@ -29,62 +27,17 @@ const std::map<std::string, msg::EStopSource> kSources = {
     {"wireless", msg::ESTOP_WIRELESS},
     {"software", msg::ESTOP_SOFTWARE}};
 
-constexpr const char* kUsage =
-    "usage: concert safety status [--timeout-ms MS]\n"
-    "       concert safety estop [--source "
-    "front-left|front-right|rear-left|rear-right|wireless|software]\n"
-    "                            [--release] [--reason TEXT] [--timeout-ms MS]\n"
-    "       concert safety reset [--source NAME] [--reason TEXT] [--timeout-ms MS]";
-
+/// What the operator verbs take.
 struct Options {
-  std::string verb;
-  std::map<std::string, std::string> values;
+  cli::DdsOptions dds;
+  std::string source;  ///< estop: the input (default software); reset: who asks
+  std::string reason;
   bool release = false;
 };
 
-Options parse(const std::vector<std::string>& args) {
-  if (args.empty()) throw UsageError("safety: expected a verb: status, estop or reset");
-  Options o{args[0], {}, false};
-  if (o.verb != "status" && o.verb != "estop" && o.verb != "reset") {
-    throw UsageError("safety: unknown verb '" + o.verb + "' (status, estop, reset)");
-  }
-  for (std::size_t i = 1; i < args.size(); ++i) {
-    const auto& a = args[i];
-    if (a == "--release" && o.verb == "estop") {
-      o.release = true;
-    } else if (a == "--timeout-ms" ||
-               ((a == "--source" || a == "--reason") && o.verb != "status")) {
-      if (i + 1 >= args.size())
-        throw UsageError("safety " + o.verb + ": option " + a + " needs a value");
-      o.values[a] = args[++i];
-    } else {
-      throw UsageError("safety " + o.verb + ": unknown argument '" + a + "'");
-    }
-  }
-  return o;
-}
-
-std::chrono::milliseconds timeout(const Options& o) {
-  const auto it = o.values.find("--timeout-ms");
-  if (it == o.values.end()) return 5000ms;
-  std::size_t used = 0;
-  long ms = -1;
-  try {
-    ms = std::stol(it->second, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != it->second.size() || ms < 1 || ms > 600'000) {
-    throw UsageError("safety " + o.verb + ": --timeout-ms: '" + it->second +
-                     "' is not a number of milliseconds (1..600000)");
-  }
-  return std::chrono::milliseconds(ms);
-}
-
-int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
+nlohmann::ordered_json json_of(const msg::SafetyState& s) {
+  return {{"mode", s.mode() == msg::SAFETY_RUNNING ? "RUNNING" : "STOPPED"},
+          {"causes", s.causes()}};
 }
 
 std::string describe(const msg::SafetyState& s) {
@@ -107,24 +60,23 @@ std::optional<msg::SafetyState> wait_state(dds::Reader<msg::SafetyState>& reader
 
 int status(const Options& o, dds::Participant& p, std::ostream& out) {
   dds::Reader<msg::SafetyState> states(p, dds::topics::safety_state);
-  const auto s = wait_state(states, timeout(o), [](const auto&) { return true; });
+  const auto s = wait_state(states, o.dds.timeout(), [](const auto&) { return true; });
   if (!s)
     throw Failure("no safety state on domain " + std::to_string(p.domain_id()) +
                   " (is concert_safety running?)");
-  out << "safety: " << describe(*s) << "\n";
+  if (o.dds.json) {
+    out << json_of(*s).dump() << "\n";
+  } else {
+    out << "safety: " << describe(*s) << "\n";
+  }
   return 0;
 }
 
 int estop(const Options& o, dds::Participant& p, std::ostream& out) {
-  const auto name = o.values.count("--source") ? o.values.at("--source") : "software";
+  const std::string name = o.source.empty() ? "software" : o.source;
   const auto source = kSources.find(name);
-  if (source == kSources.end()) {
-    throw UsageError(
-        "safety estop: --source: '" + name +
-        "' is not front-left, front-right, rear-left, rear-right, wireless or software");
-  }
   dds::Writer<msg::EStopInput> writer(p, dds::topics::estop);
-  if (!writer.wait_for_readers(1, timeout(o))) {
+  if (!writer.wait_for_readers(1, o.dds.timeout())) {
     throw Failure("no safety service on domain " + std::to_string(p.domain_id()) +
                   " read the e-stop input");
   }
@@ -132,15 +84,19 @@ int estop(const Options& o, dds::Participant& p, std::ostream& out) {
   input.source(source->second);
   input.engaged(!o.release);
   input.stamp_ns(now_ns());
-  input.reason(o.values.count("--reason") ? o.values.at("--reason") : "concert safety estop");
+  input.reason(o.reason.empty() ? "concert safety estop" : o.reason);
   writer.write(input);
-  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(timeout(o)).count();
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(o.dds.timeout()).count();
   if (writer.get()->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(
           static_cast<int32_t>(ns / 1'000'000'000), static_cast<uint32_t>(ns % 1'000'000'000))) !=
       eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
     throw Failure("the safety service did not acknowledge the e-stop input");
   }
-  out << "safety: e-stop " << name << (o.release ? " released" : " engaged") << "\n";
+  if (o.dds.json) {
+    out << nlohmann::ordered_json{{"source", name}, {"engaged", !o.release}}.dump() << "\n";
+  } else {
+    out << "safety: e-stop " << name << (o.release ? " released" : " engaged") << "\n";
+  }
   return 0;
 }
 
@@ -148,16 +104,15 @@ int reset(const Options& o, dds::Participant& p, std::ostream& out, std::ostream
   dds::Reader<msg::SafetyState> states(p, dds::topics::safety_state);
   dds::Reader<msg::ServiceStatus> statuses(p, dds::topics::status);
   dds::Writer<msg::SafetyReset> writer(p, dds::topics::safety_reset);
-  if (!writer.wait_for_readers(1, timeout(o))) {
+  if (!writer.wait_for_readers(1, o.dds.timeout())) {
     throw Failure("no safety service on domain " + std::to_string(p.domain_id()) + " to reset");
   }
   const int64_t sent = now_ns();
   msg::SafetyReset request;
   request.request_id(static_cast<uint32_t>(sent / 1000 % 4'000'000'000));
   request.stamp_ns(sent);
-  request.source(o.values.count("--source") ? o.values.at("--source")
-                                            : "concert safety reset@" + dds::host_name());
-  request.reason(o.values.count("--reason") ? o.values.at("--reason") : "");
+  request.source(o.source.empty() ? "concert safety reset@" + dds::host_name() : o.source);
+  request.reason(o.reason);
   // Heartbeats repeat the service's last message with a fresh stamp, so a refusal is
   // recognised by naming this request's source, not by its time.
   const std::string refusal = "reset by " + request.source() + " refused";
@@ -168,13 +123,13 @@ int reset(const Options& o, dds::Participant& p, std::ostream& out, std::ostream
   // the reason. Wait (bounded) for either.
   std::string why = "reset refused (no reason received)";
   std::optional<msg::SafetyState> last;
-  const auto deadline = std::chrono::steady_clock::now() + timeout(o);
+  const auto deadline = std::chrono::steady_clock::now() + o.dds.timeout();
   while (std::chrono::steady_clock::now() < deadline) {
     while (auto st = states.take()) {
       if (st->stamp_ns() < sent) continue;
       last = *st;
       if (st->mode() == msg::SAFETY_RUNNING) {
-        out << "safety: " << describe(*st) << "\n";
+        out << (o.dds.json ? json_of(*st).dump() : "safety: " + describe(*st)) << "\n";
         return 0;
       }
     }
@@ -186,7 +141,7 @@ int reset(const Options& o, dds::Participant& p, std::ostream& out, std::ostream
     }
   }
   if (last) {
-    out << "safety: " << describe(*last) << "\n";
+    out << (o.dds.json ? json_of(*last).dump() : "safety: " + describe(*last)) << "\n";
   } else if (why.find(refusal) == std::string::npos) {
     throw Failure("the safety service did not answer the reset");
   }
@@ -196,21 +151,42 @@ int reset(const Options& o, dds::Participant& p, std::ostream& out, std::ostream
 
 }  // namespace
 
-int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  try {
-    const auto o = parse(args);
-    timeout(o);  // validate before touching DDS
-    dds::Participant participant({.name = "concert-safety-cli"});
-    if (o.verb == "status") return status(o, participant, out);
-    if (o.verb == "estop") return estop(o, participant, out);
-    return reset(o, participant, out, err);
-  } catch (const UsageError& e) {
-    err << "concert " << e.what() << "\n" << kUsage << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    err << "concert safety: " << e.what() << "\n";
-    return 1;
-  }
+void register_verbs(cli::Cli& concert) {
+  CLI::App& safety = concert.group(concert.app(), "safety",
+                                   "the safety layer: state, e-stop inputs, reset a latched stop");
+  auto add = [&concert, &safety](const std::string& name, const std::string& what, auto body) {
+    auto o = std::make_shared<Options>();
+    CLI::App& verb = concert.verb(safety, name, what, [&concert, o, body] {
+      dds::Participant participant({.name = "concert-safety-cli", .domain_id = o->dds.domain_id()});
+      return body(*o, participant, concert.out(), concert.err());
+    });
+    concert.add_dds_options(verb, o->dds, 5.0, "how long to wait for the safety service");
+    return std::make_pair(&verb, o);
+  };
+  add("status", "the live safety state: RUNNING, or STOPPED with its causes",
+      [](const Options& o, dds::Participant& p, std::ostream& out, std::ostream&) {
+        return status(o, p, out);
+      });
+  auto [estop_verb, estop_options] =
+      add("estop", "engage (or release) an e-stop input",
+          [](const Options& o, dds::Participant& p, std::ostream& out, std::ostream&) {
+            return estop(o, p, out);
+          });
+  std::vector<std::string> sources;
+  for (const auto& [name, value] : kSources) sources.push_back(name);
+  cli::Cli::add_choice(*estop_verb, "--source", estop_options->source, sources,
+                       "the e-stop input (default: software)");
+  estop_verb->add_flag("--release", estop_options->release,
+                       "release the input instead of engaging it");
+  estop_verb->add_option("--reason", estop_options->reason, "why (shown in the stop causes)")
+      ->type_name("TEXT");
+  auto [reset_verb, reset_options] = add(
+      "reset", "ask the safety service to reset a latched stop; prints the resulting state", reset);
+  reset_verb
+      ->add_option("--source", reset_options->source,
+                   "who asks (default: concert safety reset@HOST)")
+      ->type_name("NAME");
+  reset_verb->add_option("--reason", reset_options->reason, "why")->type_name("TEXT");
 }
 
 }  // namespace concert::safety

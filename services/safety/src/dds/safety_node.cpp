@@ -5,17 +5,12 @@
 #include <optional>
 #include <thread>
 
+#include "concert/common/clock.hpp"
 #include "concert/model/dds/conversions.hpp"
 #include "dds/conversions.hpp"
 
 namespace concert::safety::dds {
 namespace {
-
-int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 std::string summary(const SafetyStatus& status) {
   if (status.mode == Mode::kRunning) return "RUNNING";

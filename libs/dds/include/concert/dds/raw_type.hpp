@@ -2,17 +2,20 @@
 // A Fast DDS type that carries serialized samples as bytes, for tools that handle any topic
 // (concert topic echo/hz): it matches writers of any type name, ours or not.
 
+#include <array>
 #include <cstdint>
+#include <fastdds/dds/topic/TopicDataType.hpp>
+#include <optional>
 #include <string>
 #include <vector>
-
-#include <fastdds/dds/topic/TopicDataType.hpp>
 
 namespace concert::dds {
 
 /// A sample as serialized bytes, encapsulation header included.
 struct RawSample {
   std::vector<uint8_t> bytes;
+  /// For writing a keyed type: its key hash (idl::key_hash); unset: MD5 of the bytes.
+  std::optional<std::array<uint8_t, 16>> key;
 };
 
 class RawPubSubType : public eprosima::fastdds::dds::TopicDataType {
@@ -25,7 +28,8 @@ class RawPubSubType : public eprosima::fastdds::dds::TopicDataType {
   std::function<uint32_t()> getSerializedSizeProvider(void* data) override;
   void* createData() override;
   void deleteData(void* data) override;
-  /// Without the type's key layout, each sample is its own instance (MD5 of its bytes).
+  /// The sample's `key` when set; else, without the type's key layout, each sample is its own
+  /// instance (MD5 of its bytes).
   bool getKey(void* data, eprosima::fastrtps::rtps::InstanceHandle_t* handle, bool force_md5) override;
 };
 

@@ -2,14 +2,15 @@
 // Schema-driven XCDR1 (plain CDR) encoding and decoding of samples as JSON. The bytes include
 // the 4-byte encapsulation header, exactly as they travel in a DDS DATA submessage.
 
+#include <array>
 #include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <span>
-#include <string>
 #include <stdexcept>
+#include <string>
 #include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "concert/idl_schema/schema.hpp"
 
@@ -37,6 +38,18 @@ std::string representation(std::span<const uint8_t> bytes);
 /// Decodes XCDR1 bytes (with encapsulation header, either endianness) into a JSON object with
 /// field names; enums become enumerator names. Trailing bytes beyond padding are an error.
 Json decode(const Schema& schema, std::string_view type, std::span<const uint8_t> bytes);
+
+/// `partial` (a JSON object of the struct type, possibly with fields left out) completed with
+/// the default value of every missing field, recursively: 0, false, "", empty sequences,
+/// arrays of defaults, the first enumerator. Throws CdrError naming the field path of a field
+/// the type does not have (and listing those it has) or of an object where none fits.
+Json complete(const Schema& schema, std::string_view type, const Json& partial);
+
+/// The DDS key hash of a sample of a keyed type, as Fast DDS and Cyclone compute it: the key
+/// fields serialized as big-endian CDR, zero-padded to 16 bytes. nullopt for a type without
+/// key, or one whose key can exceed 16 bytes (strings, sequences: the hash would be an MD5).
+std::optional<std::array<uint8_t, 16>> key_hash(const Schema& schema, std::string_view type,
+                                                const Json& sample);
 
 /// A sample with every field set to a non-default value derived from `seed`: non-empty
 /// sequences and strings, every array element, non-zero numbers. Deterministic.

@@ -1,0 +1,48 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "concert/common/clock.hpp"
+#include "concert/common/text.hpp"
+
+namespace concert {
+namespace {
+
+TEST(Text, JoinAnyRangeOfStrings) {
+  EXPECT_EQ(join(std::vector<std::string>{}), "");
+  EXPECT_EQ(join(std::vector<std::string>{"a"}), "a");
+  EXPECT_EQ(join(std::set<std::string>{"b", "a"}), "a, b");
+  EXPECT_EQ(join(std::vector<const char*>{"x", "y", "z"}, "|"), "x|y|z");
+}
+
+TEST(Text, SplitLeavesOutEmptyPieces) {
+  EXPECT_EQ(split("a,b"), (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(split(",a,,b,"), (std::vector<std::string>{"a", "b"}));
+  EXPECT_TRUE(split("").empty());
+  EXPECT_EQ(split("x y", ' '), (std::vector<std::string>{"x", "y"}));
+}
+
+TEST(Text, ReadFileNamesTheFileItCannotOpen) {
+  const auto file = std::filesystem::temp_directory_path() / "concert_common_test.txt";
+  std::ofstream(file) << "line 1\nline 2\n";
+  EXPECT_EQ(read_file(file), "line 1\nline 2\n");
+  std::filesystem::remove(file);
+  try {
+    read_file(file, "world");
+    FAIL() << "no error for a missing file";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "world file '" + file.string() + "' cannot be opened");
+  }
+}
+
+TEST(Clock, NowIsWallClockNanoseconds) {
+  const int64_t a = now_ns();
+  const int64_t b = now_ns();
+  EXPECT_LE(a, b);
+  EXPECT_GT(a, int64_t{1'600'000'000} * 1'000'000'000);  // after September 2020
+}
+
+}  // namespace
+}  // namespace concert

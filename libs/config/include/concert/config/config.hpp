@@ -1,0 +1,161 @@
+#pragma once
+// Parameter files of the services: YAML read key by key into plain Params structs.
+//
+//   config::Document doc = config::Document::load("robot.yaml");
+//   config::Map sim = doc.root().section("sim");
+//   sim.number("timestep", params.sim.timestep, config::Range::positive());
+//   doc.finish();  // keys of the file nobody asked for are errors
+//
+// A key missing from the file keeps the value it had (the default in code). Every error names
+// the file, the key's dotted path and the line, e.g.
+//   robot.yaml: sim.timestep: expected a positive number, got 'abc' (line 12)
+// Every key a reader asks for is recorded, so a test can check that a shipped file lists every
+// parameter with exactly its default (Document::differences_from_defaults).
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+namespace concert::config {
+
+/// A parameter file that cannot be used; the message names the file, the key and the line.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The allowed values of a number: [min, max], or (min, max] when `min_open`.
+struct Range {
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool min_open = false;
+
+  static Range any() { return {}; }
+  static Range positive() { return {0.0, std::numeric_limits<double>::infinity(), true}; }
+  static Range non_negative() { return at_least(0.0); }
+  static Range at_least(double min) { return {min, std::numeric_limits<double>::infinity()}; }
+  static Range between(double min, double max) { return {min, max}; }
+
+  bool contains(double v) const;
+  /// "a number", "a positive number", "a number >= 0", "a number in [0, 1]".
+  std::string describe(std::string_view noun = "number") const;
+};
+
+namespace detail {
+struct State;
+}
+
+/// One mapping of a parameter file (the root or a section), read key by key. Getters leave
+/// `value` unchanged when the key is absent and throw ConfigError when it is present but wrong.
+class Map {
+ public:
+  /// A real number in `range` (finite).
+  void number(std::string_view key, double& value, Range range = {});
+  /// A real number in `range`, or `auto` (stored as NaN: decided at run time).
+  void number_or_auto(std::string_view key, double& value, Range range = {});
+  /// A whole number in [min, max].
+  template <class Int>
+  requires std::is_integral_v<Int>
+  void integer(std::string_view key, Int& value, long long min = std::numeric_limits<Int>::min(),
+               long long max = static_cast<long long>(std::min<unsigned long long>(
+                   std::numeric_limits<Int>::max(), std::numeric_limits<long long>::max()))) {
+    long long v = static_cast<long long>(value);
+    integer_value(key, v, min, max);
+    value = static_cast<Int>(v);
+  }
+  /// true or false (YAML's yes/no/on/off too).
+  void boolean(std::string_view key, bool& value);
+  /// true, false or `auto` (nullopt: decided at run time).
+  void boolean_or_auto(std::string_view key, std::optional<bool>& value);
+  /// A string; with `allow_empty == false` an empty one is an error.
+  void string(std::string_view key, std::string& value, bool allow_empty = true);
+  /// One of `choices`.
+  void choice(std::string_view key, std::string& value, const std::vector<std::string>& choices);
+  /// A duration given in seconds in the file, each within `seconds`; a positive value shorter
+  /// than one tick of Duration is an error.
+  template <class Duration>
+  void duration(std::string_view key, Duration& value, Range seconds = Range::non_negative()) {
+    double s = std::chrono::duration<double>(value).count();
+    duration_value(key, s, seconds, std::chrono::duration<double>(Duration(1)).count());
+    if constexpr (std::chrono::treat_as_floating_point_v<typename Duration::rep>) {
+      value = std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s));
+    } else {
+      value = std::chrono::round<Duration>(std::chrono::duration<double>(s));
+    }
+  }
+  /// A list of numbers, each in `each`; `size` > 0 requires exactly that many.
+  void numbers(std::string_view key, std::vector<double>& value, size_t size = 0, Range each = {});
+  /// A list of strings (none empty); with `scalar_as_list`, a single string is a list of one.
+  void strings(std::string_view key, std::vector<std::string>& value, bool scalar_as_list = false);
+  /// A map from names to numbers, each in `each`.
+  void number_map(std::string_view key, std::map<std::string, double>& value, Range each = {});
+  /// A map from names to strings.
+  void string_map(std::string_view key, std::map<std::string, std::string>& value);
+  /// The nested mapping under `key` (empty when absent). Its keys are checked by finish().
+  Map section(std::string_view key);
+
+  /// True if the file sets `key` in this mapping.
+  bool has(std::string_view key) const;
+  /// "section.key" as errors name it.
+  std::string path(std::string_view key) const;
+  /// Throws ConfigError "FILE: PATH: WHAT (line N)" for this mapping's `key`.
+  [[noreturn]] void fail(std::string_view key, std::string_view what) const;
+
+ private:
+  friend class Document;
+  Map(std::shared_ptr<detail::State> state, size_t index)
+      : state_(std::move(state)), index_(index) {}
+  void integer_value(std::string_view key, long long& value, long long min, long long max);
+  void duration_value(std::string_view key, double& seconds, Range range, double tick_s);
+
+  std::shared_ptr<detail::State> state_;
+  size_t index_;
+};
+
+/// A key a reader asked for, and what the file did with it.
+struct KeyRecord {
+  std::string path;    ///< dotted path, e.g. "sim.timestep"
+  bool set = false;    ///< the file gives it
+  std::string before;  ///< the value before reading (the default in code), as text
+  std::string after;   ///< the value after reading, as text
+};
+
+/// One parameter file.
+class Document {
+ public:
+  /// Reads `file`; throws ConfigError when it cannot be read or is not YAML.
+  static Document load(const std::filesystem::path& file);
+  /// Parses YAML `text`; `source` names it in errors (a file name).
+  static Document parse(std::string_view text, std::string source);
+
+  /// The top-level mapping (an empty file is an empty mapping).
+  Map root();
+  /// Throws ConfigError for the first key of the file no reader asked for, naming it and the
+  /// keys that are known at its place; also for a key given twice.
+  void finish() const;
+
+  const std::string& source() const;
+  /// Every key read so far, in reading order.
+  const std::vector<KeyRecord>& keys() const;
+  /// For a file that documents the defaults: one line per known key the file leaves out and
+  /// per key whose value differs from the default in code (the value it replaced). Empty when
+  /// the file lists every parameter with its default.
+  std::vector<std::string> differences_from_defaults() const;
+
+ private:
+  explicit Document(std::shared_ptr<detail::State> state) : state_(std::move(state)) {}
+  std::shared_ptr<detail::State> state_;
+};
+
+}  // namespace concert::config
