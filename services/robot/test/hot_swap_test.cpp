@@ -12,14 +12,16 @@
 #include "discovery/discovery.hpp"
 #include "modelgen/model_generator.hpp"
 #include "robot/robot_core.hpp"
-#include "robot/sim_assembly.hpp"
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_assembly.hpp"
+#include "concert/sim/sim_hardware.hpp"
 #include "test_helpers.hpp"
 
 namespace concert::robot {
 namespace {
 
 namespace fs = std::filesystem;
+using sim::AssemblyBuilder;
+using sim::SimulatedRobot;
 const fs::path kPublicDb = fs::path(CONCERT_SHARED_DATA) / "concert_resources";
 const fs::path kPaperRobot = fs::path(CONCERT_SOURCE_DIR) / "libs" / "simbus" / "examples" / "concert_paper_robot.yaml";
 

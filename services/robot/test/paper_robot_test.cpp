@@ -9,7 +9,7 @@
 #include "concert/topology/esc_catalog.hpp"
 #include "modelgen/model_generator.hpp"
 #include "robot/robot_core.hpp"
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_hardware.hpp"
 #include "test_helpers.hpp"
 
 namespace concert::robot {

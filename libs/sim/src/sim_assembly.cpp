@@ -1,4 +1,4 @@
-#include "robot/sim_assembly.hpp"
+#include "concert/sim/sim_assembly.hpp"
 
 #include <fstream>
 #include <sstream>
@@ -9,7 +9,7 @@
 #include "concert/topology/esc_catalog.hpp"
 #include "modelgen/model_generator.hpp"
 
-namespace concert::robot {
+namespace concert::sim {
 
 struct AssemblyBuilder::Impl {
   module_db::ModuleDatabase db;
@@ -59,4 +59,4 @@ SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const s
   return out;
 }
 
-}  // namespace concert::robot
+}  // namespace concert::sim
