@@ -12,7 +12,7 @@
 
 #include "robot/loop.hpp"
 #include "robot/robot_core.hpp"
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_hardware.hpp"
 
 namespace {
 
@@ -27,7 +27,7 @@ std::string read_file(const std::string& path) {
 }
 
 struct Setup {
-  explicit Setup(const std::string& urdf) : sim(urdf, concert::robot::World{}, {}), core(sim) {
+  explicit Setup(const std::string& urdf) : sim(urdf, concert::world::World{}, {}), core(sim) {
     core.set_model(urdf, 1);
     for (int i = 0; i < 100; ++i) {
       core.cycle();
@@ -44,7 +44,7 @@ struct Setup {
     }
     core.cycle();
   }
-  concert::robot::SimHardware sim;
+  concert::sim::SimHardware sim;
   concert::robot::RobotCore core;
   long ticks{0};
 };
@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
     }
     {
       // Physics alone (drives holding), to tell simulation cost from controller cost.
-      concert::robot::SimHardware sim(urdf, concert::robot::World{}, {});
+      concert::sim::SimHardware sim(urdf, concert::world::World{}, {});
       const auto start = std::chrono::steady_clock::now();
       for (std::uint64_t k = 0; k < cycles; ++k) {
         sim.step(0.001);
