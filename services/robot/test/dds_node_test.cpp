@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <map>
+#include <optional>
 #include <thread>
 
 #include "concert/dds/endpoint.hpp"
@@ -146,6 +148,126 @@ TEST(RobotNode, ModelCommandsAndStateOverDds) {
   EXPECT_NE(node.last_error().find("does not match the mounted hardware"), std::string::npos);
   EXPECT_EQ(core.model_version(), 7u);
   EXPECT_TRUE(core.ready());
+}
+
+/// Newest TrajectoryStatus of `request` seen so far (drains the reader).
+struct StatusLog {
+  cdds::Reader<msg::TrajectoryStatus>& reader;
+  std::map<uint32_t, msg::TrajectoryStatus> latest;
+  std::map<uint32_t, int> executing_updates;
+  std::optional<msg::TrajectoryStatus> of(uint32_t request) {
+    while (auto s = reader.take()) {
+      latest[s->request_id()] = *s;
+      if (s->state() == msg::TRAJECTORY_EXECUTING) {
+        ++executing_updates[s->request_id()];
+      }
+    }
+    const auto it = latest.find(request);
+    return it == latest.end() ? std::nullopt : std::optional<msg::TrajectoryStatus>(it->second);
+  }
+};
+
+msg::JointTrajectoryCommand ramp(uint32_t request, uint32_t version, const std::string& joint, double from, double to,
+                                 double duration) {
+  msg::JointTrajectoryCommand c;
+  c.request_id(request);
+  c.model_version(version);
+  c.source("test");
+  c.joint_names({joint});
+  for (int k = 0; k <= 20; ++k) {
+    const double s = k / 20.0;
+    msg::JointTrajectorySample p;
+    p.time(duration * s);
+    p.position({from + (to - from) * (3 * s * s - 2 * s * s * s)});
+    p.velocity({(to - from) * 6 * s * (1 - s) / duration});
+    c.samples().push_back(p);
+  }
+  return c;
+}
+
+TEST(RobotNode, TrajectoriesOverDdsWithProgressResultRefusalAndEstop) {
+  SimHardware sim(test::read_fixture("mobile_drill.urdf"), World{}, {});
+  RobotCore core(sim);
+  cdds::Participant robot_side({.name = "robot"});
+  dds::RobotNode node(robot_side, core);
+  cdds::Participant client({.name = "client"});
+  cdds::Writer<msg::RobotModel> models(client, cdds::topics::robot_model);
+  cdds::Writer<msg::JointTrajectoryCommand> trajectories(client, cdds::topics::trajectory_command);
+  cdds::Writer<msg::SafetyState> safety(client, cdds::topics::safety_state);
+  cdds::Reader<msg::TrajectoryStatus> statuses(client, cdds::topics::trajectory_status);
+  StatusLog log{statuses, {}, {}};
+  ASSERT_TRUE(models.wait_for_readers(1, 10s));
+  ASSERT_TRUE(trajectories.wait_for_readers(1, 10s));
+  ASSERT_TRUE(safety.wait_for_readers(1, 10s));
+  models.write(model_msg(test::read_fixture("mobile_drill.urdf"), 2));
+  ASSERT_TRUE(run_until(core, node, [&] { return core.ready(); }));
+
+  // Tracked to the end, with progress on the way.
+  trajectories.write(ramp(41, 2, "J2_A", 0.0, 0.6, 1.5));
+  ASSERT_TRUE(run_until(core, node, [&] {
+    const auto s = log.of(41);
+    return s && s->state() != msg::TRAJECTORY_EXECUTING;
+  }));
+  EXPECT_EQ(log.of(41)->state(), msg::TRAJECTORY_SUCCEEDED) << log.of(41)->reason();
+  EXPECT_DOUBLE_EQ(log.of(41)->progress(), 1.0);
+  EXPECT_LT(log.of(41)->max_joint_error(), 0.05);
+  EXPECT_EQ(log.of(41)->source(), "test");
+  EXPECT_GE(log.executing_updates[41], 3);  // 10 Hz progress over 1.5 s
+  const RobotState s = core.state();
+  EXPECT_NEAR(s.position[test::hw_index(s, "J2_A")], 0.6, 0.03);
+
+  // Refused at once with the reason.
+  trajectories.write(ramp(42, 1, "J2_A", 0.6, 0.0, 1.0));
+  ASSERT_TRUE(run_until(core, node, [&] { return log.of(42).has_value(); }));
+  EXPECT_EQ(log.of(42)->state(), msg::TRAJECTORY_REFUSED);
+  EXPECT_NE(log.of(42)->reason().find("current model version is 2"), std::string::npos) << log.of(42)->reason();
+
+  // An e-stop aborts a running trajectory.
+  trajectories.write(ramp(43, 2, "J2_A", 0.6, -0.6, 4.0));
+  ASSERT_TRUE(run_until(core, node, [&] {
+    const auto st = log.of(43);
+    return st && st->state() == msg::TRAJECTORY_EXECUTING && st->progress() > 0.1;
+  }));
+  msg::SafetyState stop;
+  stop.mode(msg::SAFETY_STOPPED);
+  stop.causes({"estop: front left"});
+  safety.write(stop);
+  ASSERT_TRUE(run_until(core, node, [&] {
+    const auto st = log.of(43);
+    return st && st->state() != msg::TRAJECTORY_EXECUTING;
+  }));
+  EXPECT_EQ(log.of(43)->state(), msg::TRAJECTORY_ABORTED);
+  EXPECT_NE(log.of(43)->reason().find("safety stop (estop: front left)"), std::string::npos) << log.of(43)->reason();
+  EXPECT_LT(log.of(43)->progress(), 0.9);
+}
+
+TEST(RobotNode, ToolEndEffectorIsChosenByChainRoleNotListPosition) {
+  msg::RobotModel m;
+  msg::ChainInfo leg, arm;
+  leg.name("A");
+  leg.role("leg");
+  arm.name("E");
+  arm.role("arm");
+  m.chains({leg, arm});
+  msg::EndEffectorInfo wheel, camera, drill;
+  wheel.name("wheel_A");
+  wheel.chain("A");
+  wheel.frame("wheel_A");
+  wheel.module_key("module_wheel_concert");
+  camera.name("cam_E");
+  camera.chain("E");
+  camera.frame("cam_E");
+  camera.module_key("module_camera");
+  drill.name("drill_E");
+  drill.chain("E");
+  drill.frame("tcp_E");
+  drill.module_key("module_drill_concert");
+  m.end_effectors({wheel, camera, drill});
+  EXPECT_EQ(dds::tool_end_effector(m), "tcp_E");
+  m.end_effectors({wheel, camera});
+  EXPECT_EQ(dds::tool_end_effector(m), "cam_E");
+  m.end_effectors({wheel});
+  EXPECT_EQ(dds::tool_end_effector(m), "");  // never a wheel: the core picks its default
 }
 
 TEST(RobotConversions, JointCommandLengthsAreChecked) {

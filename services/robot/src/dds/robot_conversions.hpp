@@ -12,6 +12,10 @@ namespace concert::robot::dds {
 JointCommandSet to_core(const msg::JointCommand& command);
 CartesianCommand to_core(const msg::CartesianImpedanceCommand& command);
 BaseCommand to_core(const msg::BaseVelocityCommand& command);
+JointTrajectory to_core(const msg::JointTrajectoryCommand& command);
+
+/// The trajectory state of the IDL for a core progress (kIdle has none: EXECUTING).
+msg::TrajectoryState to_msg(TrajectoryState state);
 
 msg::JointState to_joint_state(const RobotState& state);
 /// `distance` [m] travelled since start grows the (x, y, yaw) variances (documented in README).
@@ -20,5 +24,7 @@ msg::EndEffectorWrench to_wrench(const RobotState& state);
 
 /// Simulated or real time [s] -> stamp [ns].
 int64_t to_stamp_ns(double time);
+/// Wall-clock stamp [ns since the Unix epoch] of messages that are not about robot time.
+int64_t wall_ns();
 
 }  // namespace concert::robot::dds
