@@ -2,6 +2,7 @@
 // every RobotModel, plans PlanRequests (NSPG + RRT-Connect) and executes them through the
 // robot service.
 //   concert_planner [--params FILE] [--world FILE]
+// The latched world topic (concert/world/world) replaces the map whenever it changes.
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
 #include <atomic>
 #include <csignal>
@@ -10,6 +11,7 @@
 
 #include "concert/dds/participant.hpp"
 #include "dds/planner_node.hpp"
+#include "concert/world/world.hpp"
 #include "planner/config.hpp"
 
 namespace {
@@ -44,7 +46,8 @@ int main(int argc, char** argv) {
         throw std::runtime_error("unknown argument '" + arg + "'");
       }
     }
-    if (!world_file.empty()) world = planner::load_world(world_file);
+    // The world file (libs/world format) is the map until the world topic brings another.
+    if (!world_file.empty()) world = planner::dds::to_planner_world(world::load_world_file(world_file));
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     planner::Planner planner(params);
