@@ -6,6 +6,10 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <condition_variable>
+#include <fstream>
+#include <mutex>
+#include <optional>
 #include <csignal>
 #include <cstdlib>
 #include <iomanip>
@@ -14,11 +18,10 @@
 
 #include "args.hpp"
 #include "concert/dds/catalogue.hpp"
+#include "concert/dds/endpoint.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "scan_verbs.hpp"
-#ifdef CONCERT_HAVE_ROBOT_CORE
-#include "robot/world.hpp"
-#endif
+#include "concert/world/world.hpp"
 
 namespace concert::cli {
 
@@ -186,13 +189,11 @@ void check_assembly(const fs::path& file, const std::vector<std::string>& module
 
 void check_world(const fs::path& file) {
   if (!fs::is_regular_file(file)) throw Failure(file.string() + ": no such file");
-#ifdef CONCERT_HAVE_ROBOT_CORE
   try {
-    robot::load_world_file(file.string());
+    world::load_world_file(file.string());
   } catch (const std::exception& e) {
     throw Failure(std::string("world rejected, nothing changed: ") + e.what());
   }
-#endif
 }
 
 int32_t domain_of(Args& a) {
@@ -278,31 +279,72 @@ int run_up(const std::vector<std::string>& args, std::ostream& out, std::ostream
   return 0;
 }
 
+int sim_command(const SimOptions& o, std::ostream& out) {
+  if (o.verb != "assemble" && o.verb != "swap" && o.verb != "world") {
+    throw UsageError("unknown sim verb '" + o.verb + "' (assemble, swap, world)");
+  }
+  const bool assembly = o.verb != "world";
+  // Checked here first: a bad file never reaches the simulator (which checks again).
+  if (assembly) {
+    check_assembly(o.file, o.module_dbs);
+  } else {
+    check_world(o.file);
+  }
+  std::ifstream in(o.file);
+  std::stringstream content;
+  content << in.rdbuf();
+
+  dds::Participant participant({.name = "concert_sim", .domain_id = o.domain});
+  std::mutex m;
+  std::condition_variable cv;
+  std::optional<msg::SimCommandReply> reply;
+  const auto request_id = static_cast<uint32_t>(
+      std::chrono::steady_clock::now().time_since_epoch().count() & 0x7fffffff);
+  dds::Reader<msg::SimCommandReply> replies(participant, dds::topics::sim_reply,
+                                            [&](const msg::SimCommandReply& r, const auto&) {
+                                              if (r.request_id() != request_id) return;
+                                              {
+                                                std::lock_guard lock(m);
+                                                reply = r;
+                                              }
+                                              cv.notify_all();
+                                            });
+  dds::Writer<msg::SimCommand> commands(participant, dds::topics::sim_command);
+  msg::SimCommand c;
+  c.request_id(request_id);
+  c.stamp_ns(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                 std::chrono::system_clock::now().time_since_epoch())
+                 .count());
+  c.source("concert sim");
+  c.kind(assembly ? msg::SIM_SWAP_ASSEMBLY : msg::SIM_SET_WORLD);
+  c.name(fs::path(o.file).filename().string());
+  c.content(content.str());
+  // The command topic is volatile: wait for the simulator's reader before writing.
+  const auto deadline = std::chrono::steady_clock::now() + o.timeout;
+  if (!commands.wait_for_readers(1, o.timeout)) {
+    throw Failure("no simulator on domain " + std::to_string(participant.domain_id()) +
+                  " (start one with `concert up`)");
+  }
+  commands.write(c);
+  std::unique_lock lock(m);
+  if (!cv.wait_until(lock, deadline, [&] { return reply.has_value(); })) {
+    throw Failure("the simulator did not answer within " +
+                  std::to_string(std::chrono::duration_cast<std::chrono::seconds>(o.timeout).count()) + " s");
+  }
+  if (!reply->accepted()) throw Failure(reply->message());
+  out << "concert sim " << o.verb << ": " << o.file << ": " << reply->message() << "\n";
+  return 0;
+}
+
 int run_sim(const std::vector<std::string>& args, std::ostream& out, std::ostream& /*err*/) {
   Args a(args);
-  const std::string verb = a.positional("sim verb: assemble, swap or world");
-  const std::string file = a.positional("a file");
-  const auto module_dbs = a.values("--module-db");
-  const int32_t domain = domain_of(a);
+  SimOptions o;
+  o.verb = a.positional("sim verb: assemble, swap or world");
+  o.file = a.positional("a file");
+  o.module_dbs = a.values("--module-db");
+  o.domain = domain_of(a);
   a.finish();
-  const fs::path dir = run_dir(domain);
-  if (!fs::is_directory(dir)) {
-    throw Failure("no stack runs on domain " + std::to_string(domain) + " from this machine (" + dir.string() +
-                  " is missing): start one with `concert up`");
-  }
-  if (verb == "assemble" || verb == "swap") {
-    check_assembly(file, module_dbs);
-    install_file(file, dir / "assembly.yaml");
-    out << "concert sim " << verb << ": " << file << " is now the mounted assembly; the robot service rescans\n";
-    return 0;
-  }
-  if (verb == "world") {
-    check_world(file);
-    install_file(file, dir / "world.yaml");
-    out << "concert sim world: " << file << " is now the simulated world\n";
-    return 0;
-  }
-  throw UsageError("unknown sim verb '" + verb + "' (assemble, swap, world)");
+  return sim_command(o, out);
 }
 
 }  // namespace concert::cli

@@ -67,6 +67,18 @@ std::string find_executable(const std::string& name, const std::string& service,
 /// (${XDG_RUNTIME_DIR:-/tmp}/concert-d<domain>).
 std::filesystem::path run_dir(int32_t domain);
 
+/// Options of `concert sim VERB FILE` once parsed.
+struct SimOptions {
+  std::string verb;                     ///< assemble | swap | world
+  std::string file;                     ///< assembly or world YAML on this host
+  std::vector<std::string> module_dbs;  ///< extra module databases to check the assembly against
+  int32_t domain{0};
+  std::chrono::milliseconds timeout{10'000};  ///< for the simulator's answer
+};
+/// Checks the file here, sends its content to the simulator over DDS (SimCommand; works from
+/// any host) and prints its answer. Throws Failure with the simulator's reason if refused.
+int sim_command(const SimOptions& options, std::ostream& out);
+
 /// `concert up ...` and `concert sim ...`; args start after the verb.
 int run_up(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int run_sim(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
