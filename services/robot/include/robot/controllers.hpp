@@ -62,8 +62,8 @@ struct CycleData {
   /// Clamps a position to joint i's limits.
   [[nodiscard]] double clamp_position(int i, double p) const;
   /// Moves joint i's rate-limited reference towards `target` (clamped to the limits) by at
-  /// most the velocity limit times dt, and returns it.
-  double ramp(int i, double target);
+  /// most `rate` times the velocity limit times dt, and returns it.
+  double ramp(int i, double target, double rate = 1.0);
   /// Joint i leaves torque-level control: its references follow the measurement.
   void follow(int i);
 };
@@ -124,7 +124,9 @@ class GravityCompensationController final : public Controller {
 /// Base velocity through the steering+wheel legs; also integrates the odometry.
 class BaseController final : public Controller {
  public:
-  BaseController(std::vector<Leg> legs, double command_timeout);
+  /// `trajectory_steering_rate`: fraction of the steering velocity limit used while a
+  /// trajectory drives the legs.
+  BaseController(std::vector<Leg> legs, double command_timeout, double trajectory_steering_rate);
   [[nodiscard]] JointOwner kind() const override { return JointOwner::kBase; }
   /// New twist (base frame) at hardware time `time`.
   void set(const BaseCommand& command, double time);
@@ -138,6 +140,7 @@ class BaseController final : public Controller {
  private:
   BaseKinematics kinematics_;
   double timeout_;
+  double trajectory_steering_rate_;
   Eigen::Vector3d twist_{Eigen::Vector3d::Zero()};
   double command_time_{-1e9};
   std::vector<double> steering_, wheel_velocity_;

@@ -153,6 +153,10 @@ struct RobotParams {
   double trajectory_base_goal_tolerance{0.08};  ///< final base position error to succeed [m]
   double trajectory_goal_time{3.0};      ///< time after the last sample to get within the goal tolerance [s]
   double trajectory_base_gain{1.5};      ///< odometry feedback of the base [1/s]
+  double trajectory_base_deadband{0.01};  ///< base twists below this keep the steering [m/s, rad/s]
+  /// Fraction of the steering velocity limit while tracking a trajectory: at the limit the
+  /// drive's damping costs more than the steering's continuous torque (safety's limit).
+  double trajectory_steering_rate{0.35};
 };
 
 /// Everything the robot publishes, sampled at the end of a cycle.

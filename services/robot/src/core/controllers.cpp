@@ -56,8 +56,8 @@ double CycleData::clamp_position(int i, double p) const {
   return lim.has_position_limits ? std::clamp(p, lim.lower, lim.upper) : p;
 }
 
-double CycleData::ramp(int i, double target) {
-  const double vmax = limits(i).velocity;
+double CycleData::ramp(int i, double target, double rate) {
+  const double vmax = rate * limits(i).velocity;
   double& ref = position_ref[static_cast<std::size_t>(i)];
   const double step = vmax > 0.0 ? vmax * dt : 1e9;
   ref += std::clamp(clamp_position(i, target) - ref, -step, step);
@@ -200,9 +200,10 @@ void GravityCompensationController::update(CycleData& data) {
   }
 }
 
-BaseController::BaseController(std::vector<Leg> legs, double command_timeout)
+BaseController::BaseController(std::vector<Leg> legs, double command_timeout, double trajectory_steering_rate)
     : kinematics_(std::move(legs)),
       timeout_(command_timeout),
+      trajectory_steering_rate_(trajectory_steering_rate),
       steering_(kinematics_.legs().size(), 0.0),
       wheel_velocity_(kinematics_.legs().size(), 0.0),
       setpoints_(kinematics_.legs().size()) {}
@@ -239,7 +240,10 @@ void BaseController::drive_legs(CycleData& data, const Eigen::Vector3d& twist, J
       DriveCommand& d = data.drive[static_cast<std::size_t>(s)];
       d = DriveCommand{};
       d.mode = DriveMode::kPosition;
-      d.position = data.ramp(s, setpoints_[k].steering_angle);
+      // Tracking a trajectory, the steering turns at a fraction of its velocity limit: at the
+      // limit, the drive's own damping costs more than the joint's continuous torque.
+      d.position = data.ramp(s, setpoints_[k].steering_angle,
+                             owner == JointOwner::kTrajectory ? trajectory_steering_rate_ : 1.0);
       d.effort = data.gravity(s);
     }
     if (data.owner[static_cast<std::size_t>(w)] == owner) {
@@ -247,6 +251,11 @@ void BaseController::drive_legs(CycleData& data, const Eigen::Vector3d& twist, J
       d = DriveCommand{};
       d.mode = DriveMode::kVelocity;
       d.velocity = clamp_abs(setpoints_[k].wheel_velocity, data.limits(w).velocity);
+      if (owner == JointOwner::kTrajectory) {
+        // Roll only as fast as the steering points the right way (swerve practice): steering a
+        // rolling loaded wheel scrubs, which costs the steering more than its continuous torque.
+        d.velocity *= std::max(0.0, std::cos(setpoints_[k].steering_angle - data.q(s)));
+      }
       data.follow(w);
     }
   }
@@ -372,11 +381,17 @@ void TrajectoryController::update(CycleData& data) {
     const double eyaw = wrap(q_ref_[c + 2] - data.odometry.yaw);
     base_error = std::hypot(ex, ey);
     const double k = params_.trajectory_base_gain;
-    const double vx = qd_ref_[c] + k * ex;
-    const double vy = qd_ref_[c + 1] + k * ey;
+    double vx = qd_ref_[c] + k * ex;
+    double vy = qd_ref_[c + 1] + k * ey;
+    double wz = qd_ref_[c + 2] + k * eyaw;
+    // Below the deadband the legs keep their steering: tiny feedback corrections in changing
+    // directions would otherwise swing the steering back and forth.
+    const double deadband = params_.trajectory_base_deadband;
+    if (std::hypot(vx, vy) < deadband && std::abs(wz) < deadband) {
+      vx = vy = wz = 0.0;
+    }
     const double co = std::cos(data.odometry.yaw), si = std::sin(data.odometry.yaw);
-    base_->drive_legs(data, Eigen::Vector3d(co * vx + si * vy, -si * vx + co * vy, qd_ref_[c + 2] + k * eyaw),
-                      JointOwner::kTrajectory);
+    base_->drive_legs(data, Eigen::Vector3d(co * vx + si * vy, -si * vx + co * vy, wz), JointOwner::kTrajectory);
   }
   if (joint_error > progress_.max_joint_error) {
     progress_.max_joint_error = joint_error;

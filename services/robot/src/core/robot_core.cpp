@@ -110,7 +110,8 @@ struct RobotCore::Slot {
         cycle(*model, arm.size()),
         joint(model->dof()),
         cartesian(arm),
-        base(leg_list.size() >= 2 ? std::make_unique<BaseController>(leg_list, params.base_command_timeout)
+        base(leg_list.size() >= 2 ? std::make_unique<BaseController>(leg_list, params.base_command_timeout,
+                                                                   params.trajectory_steering_rate)
                                   : nullptr),
         trajectory(model->dof(), params, base.get()),
         commands(make_frame(model->dof())),

@@ -78,6 +78,14 @@ ServiceParams parse_service_params(const std::string& yaml_text, const std::stri
   robot.add("wrench_filter_time_constant", p.robot.wrench_filter_time_constant);
   robot.add("base_command_timeout", p.robot.base_command_timeout);
   robot.add("velocity_guard_gain", p.robot.velocity_guard_gain);
+  robot.add("trajectory_path_tolerance", p.robot.trajectory_path_tolerance);
+  robot.add("trajectory_base_path_tolerance", p.robot.trajectory_base_path_tolerance);
+  robot.add("trajectory_goal_tolerance", p.robot.trajectory_goal_tolerance);
+  robot.add("trajectory_base_goal_tolerance", p.robot.trajectory_base_goal_tolerance);
+  robot.add("trajectory_goal_time", p.robot.trajectory_goal_time);
+  robot.add("trajectory_base_gain", p.robot.trajectory_base_gain);
+  robot.add("trajectory_base_deadband", p.robot.trajectory_base_deadband);
+  robot.add("trajectory_steering_rate", p.robot.trajectory_steering_rate);
   robot.apply(root["robot"]);
 
   Section sim{source, "sim", {}};
