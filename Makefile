@@ -4,7 +4,7 @@ JOBS ?= 2
 BUILD_TYPE ?= RelWithDebInfo
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure build test demo bench clean help
+.PHONY: all deps configure build test demo bench idl-lock clean help
 
 all: build
 
@@ -12,6 +12,7 @@ help:
 	@echo "make demo   install what is missing, build, run the stack in simulation"
 	@echo "make test   install what is missing, build, run every test with ctest"
 	@echo "make bench  build and run the benchmarks (figures go in README.md)"
+	@echo "make idl-lock  rewrite idl/types.lock after changing a message type"
 	@echo "make deps | build | clean"
 
 deps:
@@ -31,6 +32,10 @@ demo: build
 
 bench: build
 	./deploy/bench.sh $(BUILD_DIR)
+
+# After changing a message type: rewrite idl/types.lock (review its diff, commit both).
+idl-lock: configure
+	cmake --build $(BUILD_DIR) -j$(JOBS) --target idl-lock
 
 clean:
 	rm -rf $(BUILD_DIR)

@@ -22,9 +22,6 @@ using topology::ModuleLayout;
 using topology::ModuleTree;
 using topology::PortOrder;
 
-/// ESC type register value the simulated ESCs report (the value CONCERT scans show).
-constexpr int32_t kSimEscType = 50;
-
 std::string line_of(const YAML::Node& node) {
   const YAML::Mark mark = node.Mark();
   return mark.line < 0 ? "" : " (line " + std::to_string(mark.line + 1) + ")";
@@ -62,9 +59,12 @@ Fault parse_fault(const YAML::Node& node, const std::string& context) {
     fault.type = FaultType::kBrokenLink;
   } else if (type == "unknown_identity") {
     fault.type = FaultType::kUnknownIdentity;
+  } else if (type == "wrong_topology") {
+    fault.type = FaultType::kWrongTopology;
   } else {
     throw AssemblyError(context + ".type: '" + type +
-                        "' is not upside_down, broken_link or unknown_identity" + line_of(node));
+                        "' is not upside_down, broken_link, unknown_identity or wrong_topology" +
+                        line_of(node));
   }
   if (!node["module"]) throw AssemblyError(context + ": missing field 'module'" + line_of(node));
   fault.module = to_text(node["module"], context + ".module");
@@ -85,6 +85,25 @@ Fault parse_fault(const YAML::Node& node, const std::string& context) {
     };
     fault.identity = EscIdentity{field("mod_type"), field("mod_id"), field("mod_size"),
                                  field("mod_rev")};
+  }
+  if (const YAML::Node esc = node["esc"]) {
+    if (fault.type != FaultType::kUnknownIdentity && fault.type != FaultType::kWrongTopology) {
+      throw AssemblyError(context + ": esc only applies to unknown_identity and wrong_topology" +
+                          line_of(esc));
+    }
+    fault.esc = to_int32(esc, context + ".esc");
+  }
+  if (const YAML::Node topology = node["topology"]) {
+    if (fault.type != FaultType::kWrongTopology) {
+      throw AssemblyError(context + ": topology only applies to wrong_topology" +
+                          line_of(topology));
+    }
+    fault.topology = to_int32(topology, context + ".topology");
+  } else if (fault.type == FaultType::kWrongTopology) {
+    throw AssemblyError(context +
+                        ": wrong_topology needs 'topology' (the count the master "
+                        "reports)" +
+                        line_of(node));
   }
   return fault;
 }
@@ -184,6 +203,22 @@ Resolved resolve(const Assembly& assembly, const EscCatalog& catalog, PortOrder 
       throw AssemblyError(ctx + ": upstream_port " + std::to_string(*fault.upstream_port) +
                           " is not 1..3");
     }
+    const topology::ModuleLayout& layout = r.layouts[it->second];
+    if (fault.upstream_port && !topology::has_port(layout.escs[0].board, *fault.upstream_port)) {
+      throw AssemblyError(ctx + ": upstream_port " + std::to_string(*fault.upstream_port) +
+                          " but the ESC board of module '" + fault.module +
+                          "' has ports 0 and 1 only");
+    }
+    const auto escs = static_cast<int32_t>(layout.escs.size());
+    if (fault.esc < 0 || fault.esc >= escs) {
+      throw AssemblyError(ctx + ": esc " + std::to_string(fault.esc) + " but module '" +
+                          fault.module + "' has " + std::to_string(escs) + " ESC" +
+                          (escs == 1 ? "" : "s") + " (0.." + std::to_string(escs - 1) + ")");
+    }
+    if (fault.type == FaultType::kWrongTopology && (fault.topology < 0 || fault.topology > 4)) {
+      throw AssemblyError(ctx + ": topology " + std::to_string(fault.topology) +
+                          " is not a port count (0..4)");
+    }
   }
   return r;
 }
@@ -197,7 +232,9 @@ constexpr int32_t kMaster = -2;
 
 struct BusEsc {
   EscIdentity identity;
+  int32_t esc_type = 0;
   int32_t robot_id = -1;
+  std::optional<int32_t> reported_topology;                      // a wrong_topology fault
   std::array<int32_t, 4> peer{kNone, kNone, kNone, kNone};       // ESC index or kMaster
   std::array<int32_t, 4> peer_port{kNone, kNone, kNone, kNone};
 };
@@ -299,10 +336,14 @@ std::string assembly_to_yaml(const Assembly& assembly) {
           out << "  - {type: broken_link, module: " << f.module << "}\n";
           break;
         case FaultType::kUnknownIdentity:
-          out << "  - {type: unknown_identity, module: " << f.module
+          out << "  - {type: unknown_identity, module: " << f.module << ", esc: " << f.esc
               << ", identity: {mod_type: " << f.identity.mod_type
               << ", mod_id: " << f.identity.mod_id << ", mod_size: " << f.identity.mod_size
               << ", mod_rev: " << f.identity.mod_rev << "}}\n";
+          break;
+        case FaultType::kWrongTopology:
+          out << "  - {type: wrong_topology, module: " << f.module << ", esc: " << f.esc
+              << ", topology: " << f.topology << "}\n";
           break;
       }
     }
@@ -327,6 +368,7 @@ EscScan simulate_scan(const Assembly& assembly, const EscCatalog& catalog, PortO
     for (std::size_t e = 0; e < layout.escs.size(); ++e) {
       BusEsc esc;
       esc.identity = layout.escs[e].identity;
+      esc.esc_type = layout.escs[e].esc_type;
       esc.robot_id = robot_id_of(assembly.modules[m], e);
       escs.push_back(esc);
       if (e > 0) {
@@ -356,11 +398,14 @@ EscScan simulate_scan(const Assembly& assembly, const EscCatalog& catalog, PortO
     const std::size_t m = r.by_name.at(f.module);
     const auto index = static_cast<std::size_t>(first_esc[m]);
     if (f.type == FaultType::kUnknownIdentity) {
-      escs[index].identity = f.identity;
+      escs[index + static_cast<std::size_t>(f.esc)].identity = f.identity;
+    } else if (f.type == FaultType::kWrongTopology) {
+      escs[index + static_cast<std::size_t>(f.esc)].reported_topology = f.topology;
     } else if (f.type == FaultType::kUpsideDown) {
       // Mounted the wrong way round: the connector of `port` faces the parent, the input
       // connector (port 0) faces what was mounted on that connector.
-      int32_t port = 3;
+      const topology::EscBoard board = r.layouts[m].escs[0].board;
+      int32_t port = topology::downstream_ports(board, order).ports[0];
       if (f.upstream_port) {
         port = *f.upstream_port;
       } else if (const auto* c = r.layouts[m].connector(1); c && c->esc == 0) {
@@ -417,8 +462,9 @@ EscScan simulate_scan(const Assembly& assembly, const EscCatalog& catalog, PortO
       for (std::size_t p = 0; p < 4; ++p) {
         if (esc.peer[p] != kNone) s.active_ports = static_cast<uint8_t>(s.active_ports | (1U << p));
       }
-      s.topology = std::popcount(static_cast<unsigned>(s.active_ports));
-      s.esc_type = kSimEscType;
+      s.topology =
+          esc.reported_topology.value_or(std::popcount(static_cast<unsigned>(s.active_ports)));
+      s.esc_type = esc.esc_type;
       s.identity = esc.identity;
       s.robot_id = esc.robot_id;
       scan.slaves.push_back(s);
@@ -477,7 +523,7 @@ ModuleTree tree_from_assembly(const Assembly& assembly, const EscCatalog& catalo
 
     topology::SlaveNode slave;
     slave.slave.position = position;
-    slave.slave.esc_type = kSimEscType;
+    slave.slave.esc_type = layout.escs[static_cast<std::size_t>(item.esc)].esc_type;
     slave.slave.identity = layout.escs[static_cast<std::size_t>(item.esc)].identity;
     slave.slave.robot_id = robot_id_of(mounted, static_cast<std::size_t>(item.esc));
     slave.parent_position = item.parent_position;

@@ -119,7 +119,8 @@ TEST(SimBus, PaperRobotScan) {
   // Hub board: connector 1 (front-left) on port 3 first, then 2 (port 1), 3 (port 2).
   const int32_t legs[] = {11, 12, 21, 22, 31, 32, 41, 42};
   for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(scan.slaves[2 + i].robot_id, legs[i]) << i;
-  EXPECT_EQ(scan.slaves[2].active_ports, 0b1001);  // steering: input + wheel on port 3
+  EXPECT_EQ(scan.slaves[2].active_ports, 0b0011);  // steering: input + wheel on port 1
+  EXPECT_EQ(scan.slaves[2].esc_type, 21);
   EXPECT_EQ(scan.slaves[3].active_ports, 0b0001);  // wheel
   EXPECT_EQ(scan.slaves[10].robot_id, 51);         // arm after the rear-right leg
   EXPECT_EQ(scan.slaves[12].robot_id, -1);         // passive link
@@ -169,7 +170,7 @@ TEST(SimBus, UpsideDownElbowComesAfterItsSubtree) {
   for (const auto& s : scan.slaves) ids.push_back(s.robot_id);
   // base (2 ESCs), yaw_1, elbow_1, link_1, then yaw_2 and drill before elbow_2.
   EXPECT_EQ(ids, (std::vector<int32_t>{100, 101, 51, 52, -1, 54, 60, 53}));
-  EXPECT_EQ(scan.slaves[7].active_ports, 0b1001);  // ports 0 and 3, swapped roles
+  EXPECT_EQ(scan.slaves[7].active_ports, 0b0011);  // ports 0 and 1, swapped roles
 }
 
 TEST(SimBus, UpsideDownLeafHasPortZeroClosed) {
@@ -180,7 +181,7 @@ TEST(SimBus, UpsideDownLeafHasPortZeroClosed) {
       "leaf");
   const EscScan scan = simulate_scan(a, catalog);
   ASSERT_EQ(scan.slaves.size(), 2u);
-  EXPECT_EQ(scan.slaves[1].active_ports, 0b1000);
+  EXPECT_EQ(scan.slaves[1].active_ports, 0b0010);  // entered through port 1, port 0 closed
 }
 
 TEST(SimBus, BrokenLinkDropsTheSubtreeAndClosesThePort) {

@@ -210,6 +210,14 @@ EscType parse_module_row(const YAML::Node& node, const std::string& context) {
   if (t.outputs && *t.outputs < 0) {
     throw CatalogError(context + ".outputs: " + std::to_string(*t.outputs) + " is negative");
   }
+  if (const auto ports = opt_int32<CatalogError>(node, "esc_ports", context)) {
+    t.board = board_from_port_count(*ports);
+    if (!t.board) {
+      throw CatalogError(context + ".esc_ports: " + std::to_string(*ports) +
+                         " is not a board's port count (2 or 4)" + where(node));
+    }
+  }
+  t.esc_type = opt_int32<CatalogError>(node, "esc_type", context);
   if (const YAML::Node ports = node["ports"]; ports && !ports.IsNull()) {
     if (!ports.IsSequence()) throw CatalogError(context + ".ports: expected a list" + where(ports));
     for (std::size_t i = 0; i < ports.size(); ++i) {
@@ -240,13 +248,21 @@ void add_esc(const EscCatalog& catalog, const EscType& type, int32_t parent, int
                        " ESCs in one module (hub_board rows form a cycle?)");
   }
   const auto index = static_cast<int32_t>(layout.escs.size());
-  layout.escs.push_back(EscPlacement{type.identity, parent, parent_port});
+  const EscBoard board = type.board.value_or(default_board(type.kind));
+  layout.escs.push_back(EscPlacement{type.identity, board,
+                                     type.esc_type.value_or(default_esc_type(type.kind, index > 0)),
+                                     parent, parent_port});
   if (!type.ports.empty()) {
     std::set<int32_t> seen;
     for (const auto& lead : type.ports) {
       if (lead.port < 1 || lead.port > 3) {
         throw CatalogError(type.origin + ": port " + std::to_string(lead.port) +
                            " is not a downstream ESC port (1..3)");
+      }
+      if (!has_port(board, lead.port)) {
+        throw CatalogError(type.origin + ": port " + std::to_string(lead.port) + " but a " +
+                           to_string(type.kind) + "'s ESC board has ports 0 and 1 only (give " +
+                           "esc_ports: 4 if this board has four)");
       }
       if (!seen.insert(lead.port).second) {
         throw CatalogError(type.origin + ": port " + std::to_string(lead.port) +
@@ -265,13 +281,16 @@ void add_esc(const EscCatalog& catalog, const EscType& type, int32_t parent, int
     }
   } else if (index == 0) {
     const int32_t outputs = type.outputs.value_or(default_outputs(type.kind));
-    if (outputs > 3) {
+    const DownstreamPorts ports = downstream_ports(board, order);
+    if (outputs > ports.count) {
       throw CatalogError(type.origin + ": outputs " + std::to_string(outputs) +
-                         " needs port rows (one ESC has three ports after port 0)");
+                         " needs port rows " + "(its " + std::to_string(port_count(board)) +
+                         "-port ESC board has " + std::to_string(ports.count) + " port" +
+                         (ports.count == 1 ? "" : "s") + " after port 0)");
     }
-    const auto ports = frame_order(order);
     for (int32_t k = 1; k <= outputs; ++k) {
-      layout.connectors.push_back(ConnectorPlacement{k, 0, ports[static_cast<std::size_t>(k)]});
+      layout.connectors.push_back(
+          ConnectorPlacement{k, 0, ports.ports[static_cast<std::size_t>(k - 1)]});
     }
   }
 }
@@ -305,7 +324,9 @@ int32_t default_outputs(ModuleKind kind) {
     case ModuleKind::kLink:
     case ModuleKind::kBaseLink: return 1;
     case ModuleKind::kEndEffector:
-    case ModuleKind::kWheel: return 0;
+    case ModuleKind::kWheel:
+    case ModuleKind::kUnknown:
+      return 0;
     case ModuleKind::kHub: return 3;
   }
   return 0;

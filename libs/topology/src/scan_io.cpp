@@ -192,6 +192,7 @@ nlohmann::json tree_to_json(const ModuleTree& tree) {
   for (const auto& m : tree.modules) {
     modules.push_back(nlohmann::json{{"index", m.index},
                                      {"key", m.key},
+                                     {"known", m.known},
                                      {"kind", to_string(m.kind)},
                                      {"mod_type", m.identity.mod_type},
                                      {"mod_id", m.identity.mod_id},
@@ -202,7 +203,14 @@ nlohmann::json tree_to_json(const ModuleTree& tree) {
                                      {"parent_connector", m.parent_connector},
                                      {"robot_id", m.robot_id}});
   }
-  return nlohmann::json{{"slaves", slaves}, {"modules", modules}};
+  nlohmann::json warnings = nlohmann::json::array();
+  nlohmann::json errors = nlohmann::json::array();
+  for (const auto& issue : tree.issues) {
+    (issue.severity == TreeIssue::Severity::kError ? errors : warnings)
+        .push_back(nlohmann::json{{"position", issue.position}, {"message", issue.message}});
+  }
+  return nlohmann::json{
+      {"slaves", slaves}, {"modules", modules}, {"warnings", warnings}, {"errors", errors}};
 }
 
 std::string tree_to_text(const ModuleTree& tree) {
@@ -222,8 +230,22 @@ std::string tree_to_text(const ModuleTree& tree) {
       [&](std::size_t i, const std::string& indent, bool last, bool root) {
         const ModuleNode& m = tree.modules[i];
         out << indent;
-        if (!root) out << (last ? "`-- " : "|-- ") << "[" << m.parent_connector << "] ";
-        out << "#" << m.index << " " << m.key << " (" << to_string(m.kind) << ") slave";
+        if (!root) {
+          out << (last ? "`-- " : "|-- ") << "[";
+          if (m.parent_connector >= 0) {
+            out << m.parent_connector;
+          } else {
+            out << "?";  // below an unknown module, or on a port that is no connector
+          }
+          out << "] ";
+        }
+        out << "#" << m.index << " ";
+        if (m.known) {
+          out << m.key;
+        } else {
+          out << "UNKNOWN " << to_string(m.identity);
+        }
+        out << " (" << to_string(m.kind) << ") slave";
         if (m.slave_positions.size() > 1) out << "s";
         for (std::size_t k = 0; k < m.slave_positions.size(); ++k) {
           out << (k == 0 ? " " : ",") << m.slave_positions[k];
@@ -236,6 +258,10 @@ std::string tree_to_text(const ModuleTree& tree) {
         }
       };
   for (std::size_t r : roots) print(r, "", true, true);
+  for (const auto& issue : tree.issues) {
+    out << (issue.severity == TreeIssue::Severity::kError ? "error: " : "warning: ") << issue.text()
+        << "\n";
+  }
   return out.str();
 }
 

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 #include "concert/topology/scan_io.hpp"
 
@@ -15,8 +17,8 @@ int32_t int_field(const json& obj, const char* key, const std::string& where) {
 }
 
 ModuleKind kind_from(const std::string& s, const std::string& where) {
-  for (auto k : {ModuleKind::kJoint, ModuleKind::kHub, ModuleKind::kEndEffector,
-                 ModuleKind::kLink, ModuleKind::kWheel, ModuleKind::kBaseLink}) {
+  for (auto k : {ModuleKind::kJoint, ModuleKind::kHub, ModuleKind::kEndEffector, ModuleKind::kLink,
+                 ModuleKind::kWheel, ModuleKind::kBaseLink, ModuleKind::kUnknown}) {
     if (to_string(k) == s) return k;
   }
   throw std::runtime_error(where + ".kind: unknown kind '" + s + "'");
@@ -38,6 +40,11 @@ ModuleTree tree_from_json(const json& doc, const std::string& source) {
     n.index = m.contains("index") ? int_field(m, "index", where) : static_cast<int32_t>(i);
     if (n.index != static_cast<int32_t>(i)) throw std::runtime_error(where + ".index: " + std::to_string(n.index) + " but it is entry " + std::to_string(i));
     n.key = m.value("key", std::string());
+    if (m.contains("known")) {
+      if (!m.at("known").is_boolean())
+        throw std::runtime_error(where + ".known: expected true or false");
+      n.known = m.at("known").get<bool>();
+    }
     if (m.contains("kind") && m.at("kind").is_string()) n.kind = kind_from(m.at("kind").get<std::string>(), where);
     n.identity.mod_type = m.contains("mod_type") ? int_field(m, "mod_type", where) : 0;
     n.identity.mod_id = m.contains("mod_id") ? int_field(m, "mod_id", where) : 0;
@@ -57,7 +64,7 @@ ModuleTree tree_from_json(const json& doc, const std::string& source) {
     }
     n.parent_connector = m.contains("parent_connector") ? int_field(m, "parent_connector", where) : -1;
     n.robot_id = m.contains("robot_id") ? int_field(m, "robot_id", where) : -1;
-    if (n.key.empty() && n.identity == EscIdentity{}) {
+    if (n.known && n.key.empty() && n.identity == EscIdentity{}) {
       throw std::runtime_error(where + ": needs a key or an identity (mod_type, mod_id, mod_size, mod_rev)");
     }
     tree.modules.push_back(std::move(n));
@@ -81,6 +88,24 @@ ModuleTree tree_from_json(const json& doc, const std::string& source) {
       tree.slaves.push_back(node);
     }
   }
+  for (const auto& [field, severity] : {std::pair{"warnings", TreeIssue::Severity::kWarning},
+                                        std::pair{"errors", TreeIssue::Severity::kError}}) {
+    if (!doc.contains(field)) continue;
+    const json& list = doc.at(field);
+    if (!list.is_array()) throw std::runtime_error(source + ": " + field + ": expected a list");
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string where = source + ": " + field + "[" + std::to_string(i) + "]";
+      if (!list[i].is_object() || !list[i].contains("message") ||
+          !list[i].at("message").is_string()) {
+        throw std::runtime_error(where + ": expected {position, message}");
+      }
+      const int32_t position =
+          list[i].contains("position") ? int_field(list[i], "position", where) : 0;
+      tree.issues.push_back({severity, position, list[i].at("message").get<std::string>()});
+    }
+  }
+  std::stable_sort(tree.issues.begin(), tree.issues.end(),
+                   [](const TreeIssue& a, const TreeIssue& b) { return a.position < b.position; });
   return tree;
 }
 

@@ -23,6 +23,8 @@ std::string to_string(ModuleKind kind) {
     case ModuleKind::kLink: return "link";
     case ModuleKind::kWheel: return "wheel";
     case ModuleKind::kBaseLink: return "base_link";
+    case ModuleKind::kUnknown:
+      return "unknown";
   }
   return "unknown";
 }
@@ -31,6 +33,26 @@ std::string to_string(const EscIdentity& identity) {
   return "(mod_type " + std::to_string(identity.mod_type) + ", mod_id " +
          std::to_string(identity.mod_id) + ", mod_size " + std::to_string(identity.mod_size) +
          ", mod_rev " + std::to_string(identity.mod_rev) + ")";
+}
+
+std::string TreeIssue::text() const {
+  return position > 0 ? "slave " + std::to_string(position) + ": " + message : message;
+}
+
+bool ModuleTree::has_errors() const { return count(TreeIssue::Severity::kError) > 0; }
+
+std::size_t ModuleTree::count(TreeIssue::Severity severity) const {
+  std::size_t n = 0;
+  for (const auto& issue : issues) n += issue.severity == severity ? 1 : 0;
+  return n;
+}
+
+std::vector<int32_t> ModuleTree::unknown_modules() const {
+  std::vector<int32_t> out;
+  for (const auto& m : modules) {
+    if (!m.known) out.push_back(m.index);
+  }
+  return out;
 }
 
 std::array<int32_t, 4> frame_order(PortOrder order) {

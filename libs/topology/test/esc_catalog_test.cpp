@@ -58,18 +58,30 @@ TEST(EscCatalog, MobileBaseHubHasTwoEscsAndFiveConnectors) {
   EXPECT_EQ(board.outputs(), 3);
 }
 
-TEST(EscCatalog, DefaultConnectorsFollowTheFrameOrder) {
+TEST(EscCatalog, DefaultConnectorsFollowTheBoards) {
+  // Two-port boards (joints, links) put their output on port 1 whatever the frame order
+  // (real CONCERT scans: active_ports 3); four-port hub boards follow the frame order 3, 1, 2.
   const EscCatalog catalog = EscCatalog::load(kPublicDb);
   const ModuleLayout elbow = catalog.layout(EscIdentity{1, 6, 4, 0}, PortOrder::kReal0312);
   ASSERT_EQ(elbow.outputs(), 1);
-  EXPECT_EQ(elbow.connector(1)->port, 3);
+  EXPECT_EQ(elbow.connector(1)->port, 1);
+  EXPECT_EQ(elbow.escs[0].board, topology::EscBoard::kTwoPort);
+  EXPECT_EQ(elbow.escs[0].esc_type, 21);
   EXPECT_EQ(catalog.layout(EscIdentity{1, 6, 4, 0}, PortOrder::kNumeric0123).connector(1)->port,
             1);
+  EXPECT_EQ(catalog.layout(EscIdentity{4, 6, 4, 0}).connector(1)->port, 1);  // link 0.4 m
+  EXPECT_EQ(catalog.layout(EscIdentity{4, 6, 4, 0}).escs[0].esc_type, 1280);
   const ModuleLayout torso = catalog.layout(EscIdentity{2, 5, 4, 0});
   ASSERT_EQ(torso.outputs(), 3);
   EXPECT_EQ(torso.connector(1)->port, 3);
   EXPECT_EQ(torso.connector(2)->port, 1);
   EXPECT_EQ(torso.connector(3)->port, 2);
+  EXPECT_EQ(torso.escs[0].board, EscBoard::kFourPort);
+  // The Mobile Base Hub: power board (type 50) and hub board (type 256), as the real scan shows.
+  const ModuleLayout base = catalog.layout(EscIdentity{2, 3, 0, 0});
+  ASSERT_EQ(base.escs.size(), 2u);
+  EXPECT_EQ(base.escs[0].esc_type, 50);
+  EXPECT_EQ(base.escs[1].esc_type, 256);
   EXPECT_EQ(catalog.layout(EscIdentity{3, 3, 4, 0}).outputs(), 0);  // drill
   EXPECT_EQ(catalog.layout(EscIdentity{5, 1, 5, 0}).outputs(), 0);  // wheel
   EXPECT_EQ(catalog.layout(EscIdentity{6, 1, 4, 0}).outputs(), 1);  // base link
@@ -84,11 +96,13 @@ modules:
   - {mod_type: 2, mod_id: 8, mod_size: 0, mod_rev: 0, key: wired, ports: [{port: 2, leads_to: 1}, {port: 1, leads_to: 2}]}
   - {mod_type: 2, mod_id: 3, mod_size: 0, mod_rev: 0, key: power}
   - {mod_type: 2, mod_id: 4, mod_size: 0, mod_rev: 0, key: board}
+  - {mod_type: 1, mod_id: 3, mod_size: 0, mod_rev: 0, key: fourport_joint, esc_ports: 4, esc_type: 77, outputs: 2}
 module_ports:
   - {mod_type: 2, mod_id: 3, port: 3, leads_to: hub_board}
   - {mod_type: 2, mod_id: 3, port: 2, leads_to: 2}
   - {mod_type: 2, mod_id: 4, port: 3, leads_to: 1}
-)", "ext.yaml");
+)",
+                                               "ext.yaml");
   EXPECT_EQ(catalog.find(EscIdentity{1, 1, 2, 3})->key, "my_joint");
   EXPECT_EQ(catalog.find(EscIdentity{1, 2, 2, 3})->key, "renamed");
   const ModuleLayout torso = catalog.layout(EscIdentity{2, 9, 0, 0}, PortOrder::kNumeric0123);
@@ -102,6 +116,11 @@ module_ports:
   EXPECT_EQ(power.escs[1].identity, (EscIdentity{2, 4, 0, 0}));
   EXPECT_EQ(power.outputs(), 2);
   EXPECT_EQ(power.connector(1)->esc, 1);
+  const ModuleLayout joint4 = catalog.layout(EscIdentity{1, 3, 0, 0});
+  EXPECT_EQ(joint4.escs[0].board, EscBoard::kFourPort);
+  EXPECT_EQ(joint4.escs[0].esc_type, 77);
+  EXPECT_EQ(joint4.connector(1)->port, 3);
+  EXPECT_EQ(joint4.connector(2)->port, 1);
 }
 
 TEST(EscCatalog, MergeLaterEntriesOverride) {
@@ -148,8 +167,20 @@ TEST(EscCatalog, ErrorsNameTheFileRowAndField) {
                 .find("leads_to: expected a connector number"),
             std::string::npos);
   EXPECT_NE(error_of("modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
+                     "outputs: 2}")
+                .find("outputs 2 needs port rows (its 2-port ESC board has 1 port after port 0)"),
+            std::string::npos);
+  EXPECT_NE(error_of("modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
                      "outputs: 4}")
                 .find("outputs 4 needs port rows"),
+            std::string::npos);
+  EXPECT_NE(error_of("modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
+                     "ports: [{port: 3, leads_to: 1}]}")
+                .find("port 3 but a joint's ESC board has ports 0 and 1 only"),
+            std::string::npos);
+  EXPECT_NE(error_of("modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
+                     "esc_ports: 3}")
+                .find("modules[0].esc_ports: 3 is not a board's port count (2 or 4)"),
             std::string::npos);
   EXPECT_NE(error_of("modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}\n"
                      "module_ports:\n  - {mod_type: 2, mod_id: 7, port: 1, leads_to: 1}")

@@ -32,8 +32,11 @@ class Cli : public ::testing::Test {
     std::ofstream(dir_ / "robot_0123.yaml") << topology::scan_to_yaml(
         simbus::simulate_scan(assembly, catalog, topology::PortOrder::kNumeric0123));
     auto bad = scan;
-    bad.slaves[2].topology = 4;
+    bad.slaves[2].active_ports = 0b0010;  // port 0 closed: the tree is undefined from slave 3 on
     std::ofstream(dir_ / "bad.yaml") << topology::scan_to_yaml(bad);
+    auto lying = scan;
+    lying.slaves[2].topology = 4;  // disagrees with active_ports 0b0011: a warning
+    std::ofstream(dir_ / "lying.yaml") << topology::scan_to_yaml(lying);
     std::ofstream(dir_ / "broken.yaml") << "slaves:\n  - {position: 1, active_ports: 1}\n";
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
@@ -100,9 +103,25 @@ TEST_F(Cli, BadInputGivesOneLineAndNonZero) {
   EXPECT_EQ(run({"--scan", file("robot.yaml"), "--frobnicate"}), 2);
   EXPECT_NE(err_.str().find("unknown argument '--frobnicate'"), std::string::npos);
 
-  EXPECT_EQ(run({"--scan", file("bad.yaml"), "--module-db", kPublicDb}), 1);
+  // An error: the tree rebuilt so far is printed, the error goes to stderr too, exit code 1.
+  EXPECT_EQ(run({"--scan", file("bad.yaml"), "--module-db", kPublicDb, "--json"}), 1);
   EXPECT_EQ(err_.str(), "concert discover: " + file("bad.yaml") +
-                            ": slave 3: active_ports 0b1001 has 2 open ports but topology says 4\n");
+                            ": slave 3: port 0 (upstream) is closed in active_ports 0b0010: every "
+                            "slave is reached through port 0 (module mounted upside down?)\n");
+  {
+    const auto j = nlohmann::json::parse(out_.str());
+    EXPECT_EQ(j["slaves"].size(), 2u);  // the power board and the hub board
+    ASSERT_EQ(j["errors"].size(), 1u);
+    EXPECT_EQ(j["errors"][0]["position"], 3);
+    EXPECT_TRUE(j["warnings"].empty());
+  }
+  // A warning: the whole tree, exit code 0.
+  EXPECT_EQ(run({"--scan", file("lying.yaml"), "--module-db", kPublicDb}), 0) << err_.str();
+  EXPECT_NE(out_.str().find("warning: slave 3: topology says 4 open ports but active_ports "
+                            "0b0011 has 2; using active_ports"),
+            std::string::npos)
+      << out_.str();
+  EXPECT_NE(out_.str().find("18 modules, 19 slaves"), std::string::npos);
   EXPECT_EQ(run({"--scan", file("broken.yaml"), "--module-db", kPublicDb}), 1);
   EXPECT_NE(err_.str().find(file("broken.yaml") + ": slaves[0]: missing field 'mod_type'"),
             std::string::npos)
@@ -112,14 +131,19 @@ TEST_F(Cli, BadInputGivesOneLineAndNonZero) {
   EXPECT_EQ(run({"--scan", file("robot.yaml"), "--module-db", file("nodb")}), 1);
   EXPECT_NE(err_.str().find("nodb: module database folder not found"), std::string::npos);
   EXPECT_TRUE(out_.str().empty());
-  // A database without the base: unknown identity at slave 1.
+  // A database without most modules: the tree is still rebuilt from the ports, with the
+  // unknown modules flagged and one warning each.
   std::filesystem::create_directories(dir_ / "db");
   std::ofstream(dir_ / "db" / "esc_index.yaml")
       << "modules:\n  - {mod_type: 1, mod_id: 4, mod_size: 4, mod_rev: 0, key: yaw}\n";
-  EXPECT_EQ(run({"--scan", file("robot.yaml"), "--module-db", file("db")}), 1);
-  EXPECT_NE(err_.str().find("slave 1: unknown module identity (mod_type 2, mod_id 3"),
+  EXPECT_EQ(run({"--scan", file("robot.yaml"), "--module-db", file("db")}), 0) << err_.str();
+  EXPECT_NE(out_.str().find("#0 UNKNOWN (mod_type 2, mod_id 3, mod_size 0, mod_rev 0) (hub)"),
             std::string::npos)
-      << err_.str();
+      << out_.str();
+  EXPECT_NE(out_.str().find("warning: slave 1: unknown module identity (mod_type 2, mod_id 3"),
+            std::string::npos)
+      << out_.str();
+  EXPECT_NE(out_.str().find("[?] #10 yaw (joint) slave 11"), std::string::npos) << out_.str();
 }
 
 TEST_F(Cli, SeveralDatabasesMerge) {

@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "concert/simbus/assembly.hpp"
+#include "concert/topology/dds/conversions.hpp"
 #include "concert/topology/esc_catalog.hpp"
-#include "dds/conversions.hpp"
 #include "dds/discovery_node.hpp"
 
 namespace concert::discovery {
@@ -22,16 +22,29 @@ TEST(DdsConversions, RoundTrip) {
   const auto catalog = topology::EscCatalog::load(kPublicDb);
   const auto assembly = simbus::load_assembly(kExamples + "/concert_torso_two_arms.yaml");
   const auto scan = simbus::simulate_scan(assembly, catalog);
-  const auto msg_scan = dds::to_msg(scan, 7, 123, "sim");
+  const auto msg_scan = topology::dds::to_msg(scan, 7, 123, "sim");
   EXPECT_EQ(msg_scan.scan_id(), 7u);
   EXPECT_EQ(msg_scan.source(), "sim");
-  EXPECT_EQ(dds::to_core(msg_scan), scan);
+  EXPECT_EQ(topology::dds::to_core(msg_scan), scan);
   const auto tree = simbus::tree_from_assembly(assembly, catalog);
-  const auto msg_tree = dds::to_msg(tree, 3, 7, 456);
+  const auto msg_tree = topology::dds::to_msg(tree, 3, 7, 456);
   EXPECT_EQ(msg_tree.version(), 3u);
   EXPECT_EQ(msg_tree.slaves()[0].parent_port(), -1);
   EXPECT_EQ(msg_tree.modules()[10].kind(), msg::MODULE_HUB);
-  EXPECT_EQ(dds::to_core(msg_tree), tree);
+  EXPECT_EQ(topology::dds::to_core(msg_tree), tree);
+  // Unknown modules and issues travel too.
+  auto odd = tree;
+  odd.modules[3].known = false;
+  odd.modules[3].key.clear();
+  odd.modules[3].kind = topology::ModuleKind::kUnknown;
+  odd.issues = {{topology::TreeIssue::Severity::kWarning, 4, "blank module identity"},
+                {topology::TreeIssue::Severity::kError, 0, "the scan has no slaves"}};
+  const auto msg_odd = topology::dds::to_msg(odd, 4, 8, 789);
+  EXPECT_FALSE(msg_odd.modules()[3].known());
+  EXPECT_EQ(msg_odd.modules()[3].kind(), msg::MODULE_UNKNOWN);
+  ASSERT_EQ(msg_odd.issues().size(), 2u);
+  EXPECT_TRUE(msg_odd.issues()[1].error());
+  EXPECT_EQ(topology::dds::to_core(msg_odd), odd);
 }
 
 /// Waits (bounded) for a status sample of the discovery service in `state`.
@@ -51,7 +64,7 @@ TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
   const auto assembly = simbus::load_assembly(kExamples + "/concert_paper_robot.yaml");
   const auto good = simbus::simulate_scan(assembly, catalog);
   auto bad = good;
-  bad.slaves[4].topology = 3;
+  bad.slaves[4].active_ports = 0b0010;  // port 0 closed: undefined from slave 5 on
 
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "discovery_test"});
   concert::dds::Reader<msg::ServiceStatus> status(participant, concert::dds::topics::status);
@@ -62,7 +75,7 @@ TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
   ASSERT_TRUE(scans.wait_for_readers(1, 10s));
   ASSERT_TRUE(trees.wait_for_writers(1, 10s));
 
-  ASSERT_TRUE(scans.write(dds::to_msg(good, 1, 0, "test")));
+  ASSERT_TRUE(scans.write(topology::dds::to_msg(good, 1, 0, "test")));
   int handled = 0;
   for (int i = 0; i < 50 && handled == 0; ++i) handled = node.spin_once(200ms);
   ASSERT_EQ(handled, 1);
@@ -70,18 +83,19 @@ TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
   ASSERT_TRUE(first);
   EXPECT_EQ(first->version(), 1u);
   EXPECT_EQ(first->scan_id(), 1u);
-  EXPECT_EQ(dds::to_core(*first), simbus::tree_from_assembly(assembly, catalog));
+  EXPECT_EQ(topology::dds::to_core(*first), simbus::tree_from_assembly(assembly, catalog));
   ASSERT_TRUE(wait_status(status, msg::SERVICE_READY));
 
-  ASSERT_TRUE(scans.write(dds::to_msg(bad, 2, 0, "test")));
+  ASSERT_TRUE(scans.write(topology::dds::to_msg(bad, 2, 0, "test")));
   handled = 0;
   for (int i = 0; i < 50 && handled == 0; ++i) handled = node.spin_once(200ms);
   ASSERT_EQ(handled, 1);
   const auto error = wait_status(status, msg::SERVICE_ERROR);
   ASSERT_TRUE(error);
-  EXPECT_EQ(error->message(),
-            "scan 2 rejected: slave 5: active_ports 0b1001 has 2 open ports but topology says 3 "
-            "(keeping tree version 1)");
+  EXPECT_EQ(
+      error->message(),
+      "scan 2 rejected: slave 5: port 0 (upstream) is closed in active_ports 0b0010: every "
+      "slave is reached through port 0 (module mounted upside down?) (keeping tree version 1)");
   EXPECT_NE(log.str().find("scan 2 rejected: slave 5"), std::string::npos);
   EXPECT_FALSE(trees.wait(300ms));
   EXPECT_EQ(node.service().version(), 1u);
@@ -95,13 +109,34 @@ TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
   // A different robot: version 2.
   auto changed = assembly;
   changed.faults.push_back(simbus::Fault{simbus::FaultType::kBrokenLink, "drill", {}, {}});
-  ASSERT_TRUE(scans.write(dds::to_msg(simbus::simulate_scan(changed, catalog), 3, 0, "test")));
+  ASSERT_TRUE(
+      scans.write(topology::dds::to_msg(simbus::simulate_scan(changed, catalog), 3, 0, "test")));
   handled = 0;
   for (int i = 0; i < 50 && handled == 0; ++i) handled = node.spin_once(200ms);
   const auto second = trees.wait(10s);
   ASSERT_TRUE(second);
   EXPECT_EQ(second->version(), 2u);
   EXPECT_EQ(second->modules().size(), 17u);
+
+  // A board with a blank identity: the tree is published with the unknown module flagged and
+  // the warning on the wire (modelgen refuses it, naming the slave); the status stays READY.
+  auto blank = simbus::simulate_scan(assembly, catalog);
+  blank.slaves[11].identity = topology::EscIdentity{};
+  ASSERT_TRUE(scans.write(topology::dds::to_msg(blank, 4, 0, "test")));
+  handled = 0;
+  for (int i = 0; i < 50 && handled == 0; ++i) handled = node.spin_once(200ms);
+  const auto third = trees.wait(10s);
+  ASSERT_TRUE(third);
+  EXPECT_EQ(third->version(), 3u);
+  const auto core = topology::dds::to_core(*third);
+  EXPECT_EQ(core.unknown_modules().size(), 1u);
+  ASSERT_EQ(core.issues.size(), 1u);
+  EXPECT_EQ(core.issues[0].position, 12);
+  const auto ready = wait_status(status, msg::SERVICE_READY);
+  ASSERT_TRUE(ready);
+  EXPECT_NE(ready->message().find("1 unknown; 1 warning: slave 12: blank module identity"),
+            std::string::npos)
+      << ready->message();
 }
 
 }  // namespace

@@ -99,7 +99,8 @@ TEST(Discovery, ScanFileKeyedByPositionAsTheMasterReportsIt) {
   std::string text;
   for (auto it = scan.slaves.rbegin(); it != scan.slaves.rend(); ++it) {
     text += std::to_string(it->position) + ": {active_ports: " + std::to_string(it->active_ports) +
-            ", esc_type: 50, mod_id: " + std::to_string(it->identity.mod_id) +
+            ", esc_type: " + std::to_string(it->esc_type) +
+            ", mod_id: " + std::to_string(it->identity.mod_id) +
             ", mod_rev: 0, mod_size: " + std::to_string(it->identity.mod_size) +
             ", mod_type: " + std::to_string(it->identity.mod_type) +
             ", position: " + std::to_string(it->position) +
@@ -112,7 +113,7 @@ TEST(Discovery, ScanFileKeyedByPositionAsTheMasterReportsIt) {
 
 TEST(Discovery, SlavesMayArriveInAnyOrder) {
   const EscCatalog catalog = simbus::synthetic_catalog();
-  EscScan scan = make_scan({{0b1001, test::kJoint, 1}, {0b0001, test::kTool, 2}});
+  EscScan scan = make_scan({{0b0011, test::kJoint, 1}, {0b0001, test::kTool, 2}});
   std::swap(scan.slaves[0], scan.slaves[1]);
   const ModuleTree tree = discover(scan, catalog);
   EXPECT_EQ(tree.modules[1].key, "tool");
@@ -141,35 +142,42 @@ TEST(Discovery, ThreeEscModule) {
   EXPECT_EQ(tree.slaves[5].parent_port, 2);
 }
 
-TEST(Discovery, UnknownIdentityNamesThePosition) {
+TEST(Discovery, UnknownIdentityIsAnUnknownModuleInTheTree) {
   const EscCatalog catalog = EscCatalog::load(kPublicDb);
   auto assembly = simbus::load_assembly(kExamples + "/concert_paper_robot.yaml");
   assembly.faults.push_back(
       simbus::Fault{simbus::FaultType::kUnknownIdentity, "elbow_1", std::nullopt, {1, 99, 4, 0}});
-  try {
-    (void)discover(simbus::simulate_scan(assembly, catalog), catalog);
-    FAIL() << "no error";
-  } catch (const DiscoveryError& e) {
-    EXPECT_EQ(e.position(), 12);
-    EXPECT_STREQ(e.what(),
-                 "slave 12: unknown module identity (mod_type 1, mod_id 99, mod_size 4, "
-                 "mod_rev 0): not in the ESC catalogue");
-  }
+  const ModuleTree tree = discover(simbus::simulate_scan(assembly, catalog), catalog);
+  ASSERT_EQ(tree.issues.size(), 1u);
+  EXPECT_EQ(tree.issues[0].severity, topology::TreeIssue::Severity::kWarning);
+  EXPECT_EQ(tree.issues[0].text(),
+            "slave 12: unknown module identity (mod_type 1, mod_id 99, mod_size 4, mod_rev 0): "
+            "not in the ESC catalogue; unknown module in the tree");
+  EXPECT_EQ(tree.unknown_modules(), (std::vector<int32_t>{10}));
+  const auto& elbow = tree.modules[10];
+  EXPECT_FALSE(elbow.known);
+  EXPECT_EQ(elbow.key, "");
+  EXPECT_EQ(elbow.kind, ModuleKind::kJoint);  // mod_type 1 still says joint
+  EXPECT_EQ(elbow.parent_connector, 1);
+  EXPECT_EQ(tree.modules[11].parent_module, 10);
+  EXPECT_EQ(tree.modules[11].parent_connector, -1);  // the unknown module's connectors are unknown
+  EXPECT_EQ(tree.modules.size(), 18u);               // everything else as assembled
 }
 
 TEST(Discovery, JointWithTwoChildren) {
   const EscCatalog catalog = simbus::synthetic_catalog();
   const EscScan scan =
       make_scan({{0b1011, test::kJoint}, {0b0001, test::kTool}, {0b0001, test::kTool}});
+  // A two-port board with port 3 open contradicts the joint's single output connector.
   EXPECT_EQ(discovery_error([&] { (void)discover(scan, catalog); }),
             "slave 1: module #0 joint (joint) has 2 child modules but joint has 1 output "
-            "connector (1 on port 3); slave 3 hangs on port 1 of slave 1");
+            "connector (1 on port 1); slave 2 hangs on port 3 of slave 1");
 }
 
 TEST(Discovery, LinkWithTwoChildren) {
   const EscCatalog catalog = simbus::synthetic_catalog();
-  const EscScan scan = make_scan({{0b1001, test::kJoint},
-                                  {0b1101, test::kLink},
+  const EscScan scan = make_scan({{0b0011, test::kJoint},
+                                  {0b1011, test::kLink},
                                   {0b0001, test::kTool},
                                   {0b0001, test::kTool}});
   EXPECT_NE(discovery_error([&] { (void)discover(scan, catalog); })
@@ -179,19 +187,21 @@ TEST(Discovery, LinkWithTwoChildren) {
 
 TEST(Discovery, EndEffectorAndWheelWithAnyChild) {
   const EscCatalog catalog = simbus::synthetic_catalog();
-  EXPECT_EQ(discovery_error([&] {
-              (void)discover(make_scan({{0b1001, test::kJoint}, {0b1001, test::kTool},
-                                        {0b0001, test::kJoint}}),
-                             catalog);
-            }),
-            "slave 2: module #1 tool (end_effector) has 1 child module but tool has no output "
-            "connector; slave 3 hangs on port 3 of slave 2");
-  EXPECT_NE(discovery_error([&] {
-              (void)discover(make_scan({{0b1001, test::kJoint}, {0b1001, test::kWheel},
-                                        {0b0001, test::kTool}}),
-                             catalog);
-            }).find("slave 2: module #1 wheel (wheel) has 1 child module"),
-            std::string::npos);
+  EXPECT_EQ(
+      discovery_error([&] {
+        (void)discover(
+            make_scan({{0b0011, test::kJoint}, {0b0011, test::kTool}, {0b0001, test::kJoint}}),
+            catalog);
+      }),
+      "slave 2: module #1 tool (end_effector) has 1 child module but tool has no output "
+      "connector; slave 3 hangs on port 1 of slave 2");
+  EXPECT_NE(
+      discovery_error([&] {
+        (void)discover(
+            make_scan({{0b0011, test::kJoint}, {0b0011, test::kWheel}, {0b0001, test::kTool}}),
+            catalog);
+      }).find("slave 2: module #1 wheel (wheel) has 1 child module"),
+      std::string::npos);
 }
 
 TEST(Discovery, ChildOnAPortWithoutConnector) {
@@ -223,9 +233,15 @@ TEST(Discovery, ScanChecksComeFirst) {
   const EscCatalog catalog = simbus::synthetic_catalog();
   EXPECT_EQ(discovery_error([&] { (void)discover(EscScan{}, catalog); }),
             "the scan has no slaves");
-  EscScan scan = make_scan({{0b1001, test::kJoint}, {0b0001, test::kTool}});
+  EscScan scan = make_scan({{0b0011, test::kJoint}, {0b0001, test::kTool}});
   scan.slaves[1].topology = 3;
-  EXPECT_NE(discovery_error([&] { (void)discover(scan, catalog); }).find("slave 2: active_ports"),
+  const ModuleTree tree = discover(scan, catalog);  // a warning, not an error
+  ASSERT_EQ(tree.issues.size(), 1u);
+  EXPECT_NE(tree.issues[0].text().find("slave 2: topology says 3"), std::string::npos);
+  scan.slaves[1].active_ports = 0b0010;
+  EXPECT_NE(discovery_error([&] {
+              (void)discover(scan, catalog);
+            }).find("slave 2: port 0 (upstream) is closed"),
             std::string::npos);
 }
 

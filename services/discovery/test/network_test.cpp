@@ -97,13 +97,39 @@ TEST(Network, ErrorsNameThePositionAndTheProblem) {
   shifted.slaves[0].position = 0;
   EXPECT_NE(discovery_error([&] { (void)checked_scan(shifted); }).find("position 0 is outside"),
             std::string::npos);
-  EscScan lying = make_scan({{0b1001}, {0b0001}});
-  lying.slaves[1].topology = 2;
-  EXPECT_EQ(discovery_error([&] { (void)checked_scan(lying); }),
-            "slave 2: active_ports 0b0001 has 1 open ports but topology says 2");
   EXPECT_NE(discovery_error([] { (void)checked_scan(make_scan({{0b1001}, {0b1000}})); })
                 .find("slave 2: port 0 (upstream) is closed"),
             std::string::npos);
+}
+
+TEST(Network, TopologyDisagreeingWithActivePortsIsAWarningResolvedFromActivePorts) {
+  // Real masters report it (../shared/data/README.md): the open-port register decides.
+  EscScan lying = make_scan({{0b0011}, {0b0001}});
+  lying.slaves[1].topology = 2;
+  const ScanCheck check = check_scan(lying);
+  ASSERT_EQ(check.issues.size(), 1u);
+  EXPECT_EQ(check.issues[0].severity, topology::TreeIssue::Severity::kWarning);
+  EXPECT_EQ(
+      check.issues[0].text(),
+      "slave 2: topology says 2 open ports but active_ports 0b0001 has 1; using active_ports");
+  EXPECT_EQ(check.usable, 2u);
+  EXPECT_EQ(checked_scan(lying).slaves.size(), 2u);  // no error
+}
+
+TEST(Network, ErrorsKeepWhatCameBefore) {
+  // Port 0 closed on slave 3: slaves 1 and 2 are still placed.
+  const EscScan scan = make_scan({{0b0011}, {0b0011}, {0b0010}});
+  const ScanCheck check = check_scan(scan);
+  EXPECT_EQ(check.usable, 2u);
+  const Network network = rebuild_network(check.scan, PortOrder::kReal0312, check.usable);
+  EXPECT_EQ(network.links.size(), 2u);
+  EXPECT_FALSE(network.error);  // the scan stopped early: the open port 1 of slave 2 is not blamed
+  // A slave with no free port: the earlier ones are placed, the error names it.
+  const EscScan extra = make_scan({{0b0011}, {0b0001}, {0b0001}, {0b0001}});
+  const Network cut = rebuild_network(extra, PortOrder::kReal0312, extra.slaves.size());
+  EXPECT_EQ(cut.links.size(), 2u);
+  ASSERT_TRUE(cut.error);
+  EXPECT_EQ(cut.error->position, 3);
 }
 
 TEST(Network, MoreChildrenThanOpenPorts) {

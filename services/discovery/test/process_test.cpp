@@ -1,13 +1,15 @@
 // The service as a real process: concert_discovery reads scans from DDS, publishes trees and
 // its status, reports faulty scans on stderr and stops cleanly on SIGTERM.
+#include "process.hpp"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <csignal>
 #include <filesystem>
-#include <optional>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
 #include <tuple>
@@ -15,10 +17,8 @@
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/simbus/assembly.hpp"
+#include "concert/topology/dds/conversions.hpp"
 #include "concert/topology/esc_catalog.hpp"
-#include "dds/conversions.hpp"
-#include "process.hpp"
-
 
 namespace concert::discovery {
 namespace {
@@ -43,13 +43,13 @@ TEST(DiscoveryProcess, ScansInTreesAndStatusOutCleanStop) {
     concert::dds::Reader<msg::ModuleTree> trees(participant, concert::dds::topics::module_tree);
     concert::dds::Reader<msg::ServiceStatus> status(participant, concert::dds::topics::status);
     ASSERT_TRUE(scans.wait_for_readers(1, 20s));
-    ASSERT_TRUE(scans.write(dds::to_msg(scan, 1, 0, "test")));
+    ASSERT_TRUE(scans.write(topology::dds::to_msg(scan, 1, 0, "test")));
     const auto tree = trees.wait(20s);
     ASSERT_TRUE(tree);
     EXPECT_EQ(tree->version(), 1u);
-    EXPECT_EQ(dds::to_core(*tree), simbus::tree_from_assembly(assembly, catalog));
+    EXPECT_EQ(topology::dds::to_core(*tree), simbus::tree_from_assembly(assembly, catalog));
 
-    ASSERT_TRUE(scans.write(dds::to_msg(bad, 2, 0, "test")));
+    ASSERT_TRUE(scans.write(topology::dds::to_msg(bad, 2, 0, "test")));
     bool error_seen = false;
     const auto deadline = std::chrono::steady_clock::now() + 20s;
     while (!error_seen && std::chrono::steady_clock::now() < deadline) {
@@ -66,7 +66,7 @@ TEST(DiscoveryProcess, ScansInTreesAndStatusOutCleanStop) {
   const std::string log = discovery.err();
   EXPECT_NE(log.find("discovery: scan 1: tree version 1 (18 modules, 19 slaves)"), std::string::npos)
       << log;
-  EXPECT_NE(log.find("scan 2 rejected: slave 18: port 3 is open but no slave hangs on it"),
+  EXPECT_NE(log.find("scan 2 rejected: slave 18: port 1 is open but no slave hangs on it"),
             std::string::npos)
       << log;
 }

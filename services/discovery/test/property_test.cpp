@@ -3,6 +3,8 @@
 // with the paper's algorithms.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <random>
 
 #include "concert/simbus/assembly.hpp"
@@ -99,6 +101,105 @@ TEST(Property, ScanFilesRoundTripThroughDiscovery) {
     EXPECT_EQ(
         discover(topology::parse_scan_json(topology::scan_to_json(scan).dump(), "j"), catalog),
         expected);
+  }
+}
+
+}  // namespace
+}  // namespace concert::discovery
+
+namespace concert::discovery {
+namespace {
+
+/// Depth of the deepest chain of hub modules, each mounted below the previous one.
+int hub_depth(const topology::ModuleTree& tree) {
+  std::vector<int> depth(tree.modules.size(), 0);
+  int best = 0;
+  for (const auto& m : tree.modules) {
+    const int above = m.parent_module >= 0 ? depth[static_cast<std::size_t>(m.parent_module)] : 0;
+    depth[static_cast<std::size_t>(m.index)] =
+        above + (m.kind == topology::ModuleKind::kHub ? 1 : 0);
+    best = std::max(best, depth[static_cast<std::size_t>(m.index)]);
+  }
+  return best;
+}
+
+TEST(Property, SeveralHubsChainedOrSideBySideWithTwoAndFourPortBoards) {
+  // Hub-heavy random robots: hub trees of any depth, several hubs per robot, two-port boards
+  // (joints, links, tools, wheels) mixed with four-port hub boards and multi-ESC hubs.
+  const EscCatalog catalog = simbus::synthetic_catalog();
+  std::mt19937 rng(7);
+  int with_three_hubs = 0;
+  int chained_three_deep = 0;
+  for (int trial = 0; trial < 1500; ++trial) {
+    const auto assembly = simbus::random_assembly(catalog, rng, {40, 0.5, 0.45, true});
+    const auto scan = simbus::simulate_scan(assembly, catalog);
+    const auto expected = simbus::tree_from_assembly(assembly, catalog);
+    const auto got = Discovery(catalog).rebuild(scan);
+    ASSERT_TRUE(got.issues.empty()) << "trial " << trial << ": " << topology::tree_to_text(got);
+    ASSERT_EQ(got, expected) << "trial " << trial << "\n" << simbus::assembly_to_yaml(assembly);
+    int hubs = 0;
+    for (const auto& m : got.modules) hubs += m.kind == topology::ModuleKind::kHub ? 1 : 0;
+    with_three_hubs += hubs >= 3 ? 1 : 0;
+    chained_three_deep += hub_depth(got) >= 3 ? 1 : 0;
+    for (const auto& node : got.slaves) {
+      const auto& module = got.modules[static_cast<std::size_t>(node.module_index)];
+      if (module.kind != topology::ModuleKind::kHub) {
+        ASSERT_EQ(node.slave.active_ports & 0b1100, 0)
+            << "trial " << trial << ": a two-port board opened port 2 or 3, slave "
+            << node.slave.position;
+      }
+    }
+  }
+  // The generator really covers what the test claims.
+  EXPECT_GT(with_three_hubs, 500);
+  EXPECT_GT(chained_three_deep, 200);
+}
+
+TEST(Property, BlankIdentitiesAndTopologyDisagreementsGiveTheSameNetworkPlusWarnings) {
+  const EscCatalog catalog =
+      EscCatalog::load(std::string(CONCERT_SHARED_DATA) + "/concert_resources");
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 500; ++trial) {
+    auto assembly = simbus::random_assembly(catalog, rng, {25, 0.6, 0.3, true});
+    const auto clean = Discovery(catalog).rebuild(simbus::simulate_scan(assembly, catalog));
+    ASSERT_TRUE(clean.issues.empty());
+    std::size_t blank_modules = 0;
+    std::size_t warnings = 0;
+    std::vector<bool> touched(assembly.modules.size(), false);
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t m = rng() % assembly.modules.size();
+      if (touched[m]) continue;
+      touched[m] = true;
+      const auto layout = catalog.layout(catalog.find_key(assembly.modules[m].key)->identity);
+      simbus::Fault fault;
+      fault.module = assembly.modules[m].name;
+      fault.esc = static_cast<int32_t>(rng() % layout.escs.size());
+      if (rng() % 2 == 0) {
+        fault.type = simbus::FaultType::kUnknownIdentity;  // all zero
+        blank_modules += fault.esc == 0 ? 1 : 0;
+      } else {
+        fault.type = simbus::FaultType::kWrongTopology;
+        fault.topology = 4;  // never true of a two-port board, rarely of a hub
+      }
+      assembly.faults.push_back(fault);
+    }
+    const auto scan = simbus::simulate_scan(assembly, catalog);
+    for (const auto& s : scan.slaves) {
+      warnings += std::popcount(static_cast<unsigned>(s.active_ports)) != s.topology ? 1 : 0;
+    }
+    const auto tree = Discovery(catalog).rebuild(scan);
+    ASSERT_FALSE(tree.has_errors()) << "trial " << trial << ": " << topology::tree_to_text(tree);
+    ASSERT_EQ(tree.slaves.size(), clean.slaves.size());
+    for (std::size_t i = 0; i < tree.slaves.size(); ++i) {
+      ASSERT_EQ(tree.slaves[i].parent_position, clean.slaves[i].parent_position) << trial;
+      ASSERT_EQ(tree.slaves[i].parent_port, clean.slaves[i].parent_port) << trial;
+    }
+    EXPECT_EQ(tree.unknown_modules().size(), blank_modules) << "trial " << trial;
+    std::size_t topology_warnings = 0;
+    for (const auto& issue : tree.issues) {
+      topology_warnings += issue.message.rfind("topology says", 0) == 0 ? 1 : 0;
+    }
+    EXPECT_EQ(topology_warnings, warnings) << "trial " << trial;
   }
 }
 

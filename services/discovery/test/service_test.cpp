@@ -14,16 +14,17 @@ TEST(DiscoveryService, VersionsGoodTreesAndKeepsThemOnFaultyScans) {
   DiscoveryService service(Discovery(simbus::synthetic_catalog()));
   EXPECT_EQ(service.version(), 0u);
 
-  const auto bad = test::make_scan({{0b1011, test::kJoint}, {0b0001, test::kTool}});
+  // Port 2 of a hub is open with nothing on it.
+  const auto bad = test::make_scan({{0b0111, test::kHub3}, {0b0001, test::kTool}});
   ScanOutcome outcome = service.on_scan(bad, 1);
   EXPECT_EQ(outcome.kind, Kind::kRejected);
   EXPECT_EQ(outcome.version, 0u);
   EXPECT_EQ(outcome.message,
-            "scan 1 rejected: slave 1: port 1 is open but no slave hangs on it (broken link?) "
+            "scan 1 rejected: slave 1: port 2 is open but no slave hangs on it (broken link?) "
             "(no tree yet)");
   EXPECT_FALSE(service.tree());
 
-  const auto one = test::make_scan({{0b1001, test::kJoint}, {0b0001, test::kTool}});
+  const auto one = test::make_scan({{0b0011, test::kJoint}, {0b0001, test::kTool}});
   outcome = service.on_scan(one, 2);
   EXPECT_EQ(outcome.kind, Kind::kPublished);
   EXPECT_EQ(outcome.version, 1u);
@@ -42,12 +43,24 @@ TEST(DiscoveryService, VersionsGoodTreesAndKeepsThemOnFaultyScans) {
   EXPECT_EQ(service.tree_scan_id(), 2u);
   EXPECT_EQ(service.tree()->modules[1].key, "tool");
 
-  const auto two = test::make_scan({{0b1001, test::kJoint}, {0b0001, test::kWheel}});
+  const auto two = test::make_scan({{0b0011, test::kJoint}, {0b0001, test::kWheel}});
   outcome = service.on_scan(two, 5);
   EXPECT_EQ(outcome.kind, Kind::kPublished);
   EXPECT_EQ(outcome.version, 2u);
   EXPECT_EQ(service.tree()->modules[1].key, "wheel");
   EXPECT_EQ(service.tree_scan_id(), 5u);
+
+  // Unknown modules and topology disagreements are warnings: the tree is published with them.
+  auto odd = test::make_scan({{0b0011, test::kJoint}, {0b0001, topology::EscIdentity{}}});
+  odd.slaves[0].topology = 3;
+  outcome = service.on_scan(odd, 6);
+  EXPECT_EQ(outcome.kind, Kind::kPublished);
+  EXPECT_EQ(outcome.version, 3u);
+  EXPECT_EQ(outcome.message,
+            "scan 6: tree version 3 (2 modules, 2 slaves, 1 unknown; 2 warnings: slave 1: "
+            "topology says 3 open ports but active_ports 0b0011 has 2; using active_ports (and 1 "
+            "more))");
+  EXPECT_EQ(service.tree()->unknown_modules(), (std::vector<int32_t>{1}));
 }
 
 }  // namespace

@@ -127,3 +127,30 @@ TEST_F(CliTest, ErrorsAreOneLineAndNonZero) {
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("broken.json: modules[0].parent_module: missing"), std::string::npos) << r.err;
 }
+
+TEST_F(CliTest, RealScanGivesAModelAndBlankBoardsAreNamed) {
+  const std::string real =
+      (fs::path(CONCERT_SHARED_DATA) / "ethercat" / "concert_robot_18slaves.yaml").string();
+  for (const std::string& db : {kPublic, kOwn}) {
+    const std::string out = (dir_ / fs::path(db).filename()).string();
+    const CliRun r = run({"generate", "--scan", real, "--module-db", db, "--out", out});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("17 modules, "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("14 moving joints"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("chain E (arm)"), std::string::npos) << r.out;
+  }
+  // The same scan with the link board at ring position 14 unprogrammed: refused, naming it.
+  topology::EscScan scan = topology::load_scan(real);
+  scan.slaves[13].identity = {};
+  const fs::path blank = dir_ / "blank.yaml";
+  std::ofstream(blank) << topology::scan_to_yaml(scan);
+  const CliRun r = run({"generate", "--scan", blank.string(), "--module-db", kPublic, "--out",
+                        (dir_ / "b").string()});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("1 unknown module, not in the ESC catalogue of the module database: slave "
+                       "14 (mod_type 0, "
+                       "mod_id 0, mod_size 0, mod_rev 0)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "b" / "robot.urdf"));
+}

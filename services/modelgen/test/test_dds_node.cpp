@@ -1,13 +1,14 @@
 // The modelgen node over real DDS (private domain): tree in -> latched RobotModel out, same
 // tree -> no new version, bad tree -> model kept, customisation -> new version, late joiners.
 
-#include <chrono>
-#include <sstream>
-
 #include <gtest/gtest.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include <chrono>
+#include <sstream>
+
 #include "concert/dds/participant.hpp"
+#include "concert/topology/dds/conversions.hpp"
 #include "dds/conversions.hpp"
 #include "dds/modelgen_node.hpp"
 #include "modelgen/cli.hpp"
@@ -20,23 +21,7 @@ using namespace std::chrono_literals;
 namespace {
 
 msg::ModuleTree tree_msg(const topology::ModuleTree& tree, uint32_t version) {
-  msg::ModuleTree m;
-  m.version(version);
-  for (const topology::ModuleNode& n : tree.modules) {
-    msg::ModuleNode w;
-    w.index(n.index);
-    w.key(n.key);
-    w.mod_type(n.identity.mod_type);
-    w.mod_id(n.identity.mod_id);
-    w.mod_size(n.identity.mod_size);
-    w.mod_rev(n.identity.mod_rev);
-    w.slave_positions(n.slave_positions);
-    w.parent_module(n.parent_module);
-    w.parent_connector(n.parent_connector);
-    w.robot_id(n.robot_id);
-    m.modules().push_back(w);
-  }
-  return m;
+  return topology::dds::to_msg(tree, version, 0, 0);
 }
 
 /// Spins the node until `reader` has a sample or 5 s pass.

@@ -1,6 +1,7 @@
 // concert_modelgen as a real process: a tree published by this test comes back as a latched
 // RobotModel; the process deploys the bundle and stops cleanly on SIGTERM.
 
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -9,10 +10,9 @@
 #include <filesystem>
 #include <thread>
 
-#include <gtest/gtest.h>
-
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/participant.hpp"
+#include "concert/topology/dds/conversions.hpp"
 #include "modelgen/bundle.hpp"
 
 namespace fs = std::filesystem;
@@ -34,18 +34,17 @@ TEST(ModelgenProcess, TreeInModelOutCleanStop) {
     concert::dds::Writer<concert::msg::ModuleTree> trees(p, concert::dds::topics::module_tree);
     concert::dds::Reader<concert::msg::RobotModel> models(p, concert::dds::topics::robot_model);
     ASSERT_TRUE(trees.wait_for_readers(1, 20000ms)) << "concert_modelgen did not come up";
-    concert::msg::ModuleTree tree;
-    tree.version(4);
+    concert::topology::ModuleTree tree;
     const char* keys[] = {"mobile_platform_concert", "module_joint_yaw_A_concert", "module_joint_elbow_A_concert", "module_drill_concert"};
     for (int i = 0; i < 4; ++i) {
-      concert::msg::ModuleNode n;
-      n.index(i);
-      n.key(keys[i]);
-      n.parent_module(i - 1);
-      n.parent_connector(i == 0 ? -1 : i == 1 ? 5 : 1);
-      tree.modules().push_back(n);
+      concert::topology::ModuleNode n;
+      n.index = i;
+      n.key = keys[i];
+      n.parent_module = i - 1;
+      n.parent_connector = i == 0 ? -1 : i == 1 ? 5 : 1;
+      tree.modules.push_back(n);
     }
-    ASSERT_TRUE(trees.write(tree));
+    ASSERT_TRUE(trees.write(concert::topology::dds::to_msg(tree, 4, 0, 0)));
     const auto model = models.wait(20000ms);
     ASSERT_TRUE(model.has_value());
     EXPECT_EQ(model->version(), 1u);

@@ -1,12 +1,13 @@
 // assembly -> simulated scan -> discovery -> model equals assembly -> model directly.
 
-#include <filesystem>
-#include <random>
-
 #include <gtest/gtest.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include <filesystem>
+#include <random>
+
 #include "concert/simbus/assembly.hpp"
+#include "concert/topology/scan_io.hpp"
 #include "discovery/discovery.hpp"
 #include "modelgen/model_generator.hpp"
 #include "test_support.hpp"
@@ -49,6 +50,45 @@ TEST(RoundTrip, PublicDatabaseExampleAssemblies) {
   int base_bodies = 0;
   for (const modelgen::PhysicalBody& b : model.tree.bodies) base_bodies += b.module == 0 ? 1 : 0;
   EXPECT_EQ(base_bodies, 1);
+}
+
+TEST(RoundTrip, RealScanGivesTheModelOfItsAssemblyFile) {
+  // The real CONCERT scan -> discovery -> model, against the model of an assembly file of the
+  // same robot (no scan involved): every link at the same place for random postures.
+  const Db d(fs::path(CONCERT_SHARED_DATA) / "concert_resources");
+  const topology::EscScan real = topology::load_scan(fs::path(CONCERT_SHARED_DATA) / "ethercat" /
+                                                     "concert_robot_18slaves.yaml");
+  const topology::ModuleTree tree = discovery::discover(real, d.catalog);
+  ASSERT_TRUE(tree.issues.empty());
+  const simbus::Assembly assembly =
+      simbus::load_assembly(fs::path(SIMBUS_EXAMPLES) / "concert_robot_18slaves.yaml");
+  const modelgen::ModelGenerator gen(d.db);
+  const modelgen::RobotModel from_scan = gen.generate(tree);
+  const modelgen::RobotModel from_assembly =
+      gen.generate(simbus::tree_from_assembly(assembly, d.catalog));
+  const auto scan_urdf = urdf::parseURDF(from_scan.urdf);
+  const auto assembly_urdf = urdf::parseURDF(from_assembly.urdf);
+  ASSERT_TRUE(scan_urdf && assembly_urdf);
+  ASSERT_EQ(from_scan.joints.size(), 14u);  // 4 steering + 4 wheels + 6 arm joints
+  std::vector<std::shared_ptr<urdf::Link>> links;
+  assembly_urdf->getLinks(links);
+  std::mt19937 rng(18);
+  std::uniform_real_distribution<double> angle(-1.5, 1.5);
+  for (int posture = 0; posture < 20; ++posture) {
+    std::map<std::string, double> q;
+    for (const auto& j : from_assembly.joints) q[j.name] = angle(rng);
+    for (const auto& link : links) {
+      ASSERT_TRUE(scan_urdf->getLink(link->name)) << link->name;
+      const Eigen::Isometry3d a = modelgen::test::urdf_fk(*assembly_urdf, link->name, q);
+      const Eigen::Isometry3d b = modelgen::test::urdf_fk(*scan_urdf, link->name, q);
+      EXPECT_LT((a.matrix() - b.matrix()).norm(), 1e-12) << link->name << " posture " << posture;
+    }
+  }
+  // The project database knows the same identities: the real robot gets a model there too.
+  const Db project(fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db");
+  const modelgen::RobotModel own =
+      modelgen::ModelGenerator(project.db).generate(discovery::discover(real, project.catalog));
+  EXPECT_EQ(own.joints.size(), 14u);
 }
 
 TEST(RoundTrip, ProjectDatabaseRobots) {

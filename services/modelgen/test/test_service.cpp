@@ -79,3 +79,42 @@ TEST(Service, BundleVersionsContinueAcrossRestarts) {
   EXPECT_EQ(read_bundle_version(dir).first, 2u);
   fs::remove_all(dir);
 }
+
+TEST(Service, UnknownModulesAreRefusedByPositionAndIdentityAndTheModelStays) {
+  ModelgenService service(public_db());
+  auto tree = test::make_tree(test::public_eighteen_module_robot(), &public_db());
+  for (std::size_t i = 0; i < tree.modules.size(); ++i) {
+    tree.modules[i].slave_positions = {static_cast<int32_t>(i) + 1};
+  }
+  ASSERT_TRUE(service.on_tree(tree, 1).published);
+  const std::string hash = service.current()->content_hash;
+  // Two boards discovery could not identify: one with an all-zero identity, one unknown.
+  auto unknown = tree;
+  unknown.modules[4].known = false;
+  unknown.modules[4].key.clear();
+  unknown.modules[4].identity = {};
+  unknown.modules[12].known = false;
+  unknown.modules[12].key.clear();
+  unknown.modules[12].identity = {1, 99, 4, 0};
+  const Outcome o = service.on_tree(unknown, 2);
+  EXPECT_FALSE(o.published);
+  EXPECT_EQ(o.version, 1u);
+  EXPECT_EQ(
+      o.error,
+      "tree 2: the module tree has 2 unknown modules, not in the ESC catalogue of the module "
+      "database: slave 5 (mod_type 0, mod_id 0, mod_size 0, mod_rev 0); slave 13 (mod_type 1, "
+      "mod_id 99, mod_size 4, mod_rev 0); no model is built until every module is known");
+  EXPECT_EQ(service.current()->content_hash, hash);
+  // A tree with errors (undefined) is refused too, whatever the database.
+  auto undefined = tree;
+  undefined.issues.push_back(
+      {topology::TreeIssue::Severity::kError, 7, "port 1 is open but no slave hangs on it"});
+  EXPECT_NE(service.on_tree(undefined, 3).error.find("1 error (slave 7: port 1 is open"),
+            std::string::npos);
+  // Warnings alone do not stop a model.
+  auto warned = tree;
+  warned.issues.push_back(
+      {topology::TreeIssue::Severity::kWarning, 3, "topology says 3 open ports"});
+  EXPECT_TRUE(service.on_tree(warned, 4).error.empty());
+  EXPECT_EQ(service.current()->content_hash, hash);
+}

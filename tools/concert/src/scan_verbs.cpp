@@ -8,8 +8,8 @@
 #include "args.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/simbus/assembly.hpp"
+#include "concert/topology/dds/conversions.hpp"
 #include "concert/topology/scan_io.hpp"
-#include "dds/conversions.hpp"
 
 namespace concert::cli {
 namespace {
@@ -76,7 +76,7 @@ int run_scan(const std::vector<std::string>& args, std::ostream& out, std::ostre
   std::signal(SIGTERM, on_signal);
   dds::Participant participant({.name = "concert-scan", .domain_id = domain});
   dds::Writer<msg::EscScan> writer(participant, dds::topics::esc_scan);
-  writer.write(discovery::dds::to_msg(scan, static_cast<uint32_t>(scan_id), now_ns(), source));
+  writer.write(topology::dds::to_msg(scan, static_cast<uint32_t>(scan_id), now_ns(), source));
   err << "concert scan publish: published " << scan.slaves.size() << " slaves as scan " << scan_id << " on domain "
       << domain << (hold_ms ? "; holding it for late joiners" : "; holding it until Ctrl-C") << std::endl;
   // The scan is latched: it stays available to late joiners while this writer lives.

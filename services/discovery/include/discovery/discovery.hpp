@@ -43,10 +43,32 @@ struct SlaveLink {
   bool operator==(const SlaveLink&) const = default;
 };
 
-/// The scan sorted by position, after the per-slave checks: at least one slave, positions
-/// exactly 1..n without duplicates, active_ports and topology agree, port 0 open.
-/// Throws DiscoveryError.
+/// The scan sorted by position, after the per-slave checks, and what they found.
+struct ScanCheck {
+  topology::EscScan scan;                   ///< sorted by position
+  std::vector<topology::TreeIssue> issues;  ///< in ring order
+  /// Slaves [0, usable) can be placed in a tree: all of them, or those before the first slave
+  /// with an error (0 when the positions themselves are wrong).
+  std::size_t usable = 0;
+};
+
+/// Checks a scan. Errors (the tree is undefined from there on): no slave, positions not exactly
+/// 1..n, an open-port register over 4 bits, port 0 (upstream) closed. Warnings (resolved): a
+/// `topology` count that disagrees with the bits of `active_ports` (active_ports is used).
+ScanCheck check_scan(const topology::EscScan& scan);
+
+/// check_scan's sorted scan; throws DiscoveryError for its first error (warnings are dropped).
 topology::EscScan checked_scan(const topology::EscScan& scan);
+
+/// Network graph chi of the first `count` slaves of a checked scan, and the error that stopped
+/// it (a slave with no earlier free open port) or that it left (an open port with no slave on
+/// it). links[i] is the slave at position i+1; on an error they stop before that slave.
+struct Network {
+  std::vector<SlaveLink> links;
+  std::optional<topology::TreeIssue> error;
+};
+Network rebuild_network(const topology::EscScan& scan, topology::PortOrder order,
+                        std::size_t count);
 
 /// Network graph chi in linear time: one pass over the ring with a stack of the slaves that
 /// still have free open ports. `scan` must be checked_scan's output. Element i is the slave at
@@ -60,14 +82,25 @@ std::vector<SlaveLink> reconstruct_network_reference(const topology::EscScan& sc
                                                      topology::PortOrder order);
 
 /// Scan -> module tree, with a catalogue of ESC identities. Immutable after construction;
-/// run() may be called from several threads.
+/// rebuild() and run() may be called from several threads.
 class Discovery {
  public:
   /// Throws topology::CatalogError if an entry of the catalogue has an inconsistent layout.
   explicit Discovery(topology::EscCatalog catalog, Params params = {});
 
-  /// Rebuilds slaves (graph chi) and modules in linear time. Throws DiscoveryError naming the
-  /// slave position and what is wrong.
+  /// Rebuilds slaves (graph chi) and modules in linear time, always: the tree holds every slave
+  /// and module that could be placed, and `issues` says what was noticed. Warnings leave the
+  /// tree complete: a module whose identity the catalogue does not know (or an all-zero
+  /// identity) is in the tree as unknown (`known` false, one ESC, children with
+  /// parent_connector -1); a `topology` count that disagrees with `active_ports` is resolved
+  /// from active_ports; a blank ESC where a known module has its further ESC (e.g. a Mobile Base
+  /// Hub's hub board with an unprogrammed EEPROM) is taken as that ESC. Errors are
+  /// contradictions that leave the tree undefined (see check_scan and rebuild_network; a slave on
+  /// a port its known parent module has no connector on; a secondary ESC of another identity or
+  /// missing). Never throws for a bad scan.
+  topology::ModuleTree rebuild(const topology::EscScan& scan) const;
+
+  /// rebuild(), but throws DiscoveryError for the first error (warnings stay in the tree).
   topology::ModuleTree run(const topology::EscScan& scan) const;
 
   const Params& params() const { return params_; }
@@ -79,7 +112,7 @@ class Discovery {
   std::map<topology::EscIdentity, topology::ModuleLayout> layouts_;
 };
 
-/// One-shot convenience: Discovery(catalog, params).run(scan).
+/// One-shot convenience: Discovery(catalog, params).run(scan) (throws on the first error).
 topology::ModuleTree discover(const topology::EscScan& scan, const topology::EscCatalog& catalog,
                               const Params& params = {});
 

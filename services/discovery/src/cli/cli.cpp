@@ -79,15 +79,21 @@ int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostre
     for (const auto& db : options.module_dbs) catalog.merge(topology::EscCatalog::load(db));
     const topology::EscScan scan = topology::load_scan(options.scan);
     const Discovery discovery(std::move(catalog), Params{options.order});
-    const topology::ModuleTree tree = discovery.run(scan);
+    // The tree that could be rebuilt is always printed, with its warnings and errors; errors
+    // (the tree is undefined there) also go to stderr and make the exit code 1.
+    const topology::ModuleTree tree = discovery.rebuild(scan);
     if (options.json) {
       out << topology::tree_to_json(tree).dump(2) << "\n";
     } else {
       out << topology::tree_to_text(tree);
     }
-    return 0;
-  } catch (const DiscoveryError& e) {
-    err << "concert discover: " << options.scan << ": " << e.what() << "\n";
+    if (!tree.has_errors()) return 0;
+    for (const auto& issue : tree.issues) {
+      if (issue.severity == topology::TreeIssue::Severity::kError) {
+        err << "concert discover: " << options.scan << ": " << issue.text() << "\n";
+      }
+    }
+    return 1;
   } catch (const std::exception& e) {
     err << "concert discover: " << e.what() << "\n";
   }

@@ -31,15 +31,21 @@ int32_t downstream_ports(const EscSlave& s, const std::array<int32_t, 4>& order,
   return n;
 }
 
-[[noreturn]] void throw_no_parent(int32_t position) {
-  throw DiscoveryError(position,
-                       "no earlier slave has a free open port for it: an upstream slave has "
-                       "more children than open ports (or a module is mounted upside down)");
+std::string no_parent_message() {
+  return "no earlier slave has a free open port for it: an upstream slave has more children "
+         "than open ports (or a module is mounted upside down)";
 }
 
-[[noreturn]] void throw_dangling(int32_t position, int32_t port) {
-  throw DiscoveryError(position, "port " + std::to_string(port) +
-                                     " is open but no slave hangs on it (broken link?)");
+std::string dangling_message(int32_t port) {
+  return "port " + std::to_string(port) + " is open but no slave hangs on it (broken link?)";
+}
+
+topology::TreeIssue error_at(int32_t position, std::string message) {
+  return {topology::TreeIssue::Severity::kError, position, std::move(message)};
+}
+
+[[noreturn]] void throw_issue(const topology::TreeIssue& issue) {
+  throw DiscoveryError(issue.position, issue.message);
 }
 
 }  // namespace
@@ -50,54 +56,76 @@ DiscoveryError::DiscoveryError(int32_t position, const std::string& message)
       position_(position),
       message_(message) {}
 
-EscScan checked_scan(const EscScan& scan) {
-  if (scan.slaves.empty()) throw DiscoveryError(0, "the scan has no slaves");
-  EscScan sorted = scan;
-  std::stable_sort(sorted.slaves.begin(), sorted.slaves.end(),
+ScanCheck check_scan(const EscScan& scan) {
+  using Severity = topology::TreeIssue::Severity;
+  ScanCheck out;
+  if (scan.slaves.empty()) {
+    out.issues.push_back(error_at(0, "the scan has no slaves"));
+    return out;
+  }
+  out.scan = scan;
+  auto& sorted = out.scan.slaves;
+  std::stable_sort(sorted.begin(), sorted.end(),
                    [](const EscSlave& a, const EscSlave& b) { return a.position < b.position; });
-  const auto n = static_cast<int32_t>(sorted.slaves.size());
+  const auto n = static_cast<int32_t>(sorted.size());
   for (int32_t i = 0; i < n; ++i) {
-    const EscSlave& s = sorted.slaves[static_cast<std::size_t>(i)];
+    const EscSlave& s = sorted[static_cast<std::size_t>(i)];
+    std::string problem;
+    int32_t at = s.position;
     if (s.position < 1 || s.position > n) {
-      throw DiscoveryError(s.position, "position " + std::to_string(s.position) +
-                                           " is outside 1.." + std::to_string(n) +
-                                           " (the scan has " + std::to_string(n) + " slaves)");
+      problem = "position " + std::to_string(s.position) + " is outside 1.." + std::to_string(n) +
+                " (the scan has " + std::to_string(n) + " slaves)";
+    } else if (i > 0 && s.position == sorted[static_cast<std::size_t>(i - 1)].position) {
+      problem = "position " + std::to_string(s.position) + " appears twice in the scan";
+    } else if (s.position != i + 1) {
+      at = i + 1;
+      problem = "position " + std::to_string(i + 1) + " is missing from the scan (" +
+                std::to_string(n) + " slaves)";
     }
-    if (i > 0 && s.position == sorted.slaves[static_cast<std::size_t>(i - 1)].position) {
-      throw DiscoveryError(s.position, "position " + std::to_string(s.position) +
-                                           " appears twice in the scan");
-    }
-    if (s.position != i + 1) {
-      throw DiscoveryError(i + 1, "position " + std::to_string(i + 1) +
-                                      " is missing from the scan (" + std::to_string(n) +
-                                      " slaves)");
+    if (!problem.empty()) {
+      out.issues.push_back(error_at(at, problem));
+      return out;  // positions are the ring order: nothing can be placed
     }
   }
-  for (const EscSlave& s : sorted.slaves) {
+  out.usable = sorted.size();
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    const EscSlave& s = sorted[i];
     if (s.active_ports > 15) {
-      throw DiscoveryError(s.position, "active_ports " + std::to_string(s.active_ports) +
-                                           " is not a 4-bit port mask");
-    }
-    if (open_count(s) != s.topology) {
-      throw DiscoveryError(s.position, "active_ports " + mask_text(s.active_ports) + " has " +
-                                           std::to_string(open_count(s)) +
-                                           " open ports but topology says " +
-                                           std::to_string(s.topology));
+      out.issues.push_back(error_at(s.position, "active_ports " + std::to_string(s.active_ports) +
+                                                    " is not a 4-bit port mask"));
+      out.usable = i;
+      break;
     }
     if ((s.active_ports & 1U) == 0) {
-      throw DiscoveryError(s.position, "port 0 (upstream) is closed in active_ports " +
-                                           mask_text(s.active_ports) +
-                                           ": every slave is reached through port 0 (module "
-                                           "mounted upside down?)");
+      out.issues.push_back(error_at(s.position, "port 0 (upstream) is closed in active_ports " +
+                                                    mask_text(s.active_ports) +
+                                                    ": every slave is reached through port 0 "
+                                                    "(module mounted upside down?)"));
+      out.usable = i;
+      break;
+    }
+    if (open_count(s) != s.topology) {
+      out.issues.push_back({Severity::kWarning, s.position,
+                            "topology says " + std::to_string(s.topology) +
+                                " open ports but active_ports " + mask_text(s.active_ports) +
+                                " has " + std::to_string(open_count(s)) + "; using active_ports"});
     }
   }
-  return sorted;
+  return out;
 }
 
-std::vector<SlaveLink> reconstruct_network(const EscScan& scan, PortOrder order) {
+EscScan checked_scan(const EscScan& scan) {
+  ScanCheck check = check_scan(scan);
+  for (const auto& issue : check.issues) {
+    if (issue.severity == topology::TreeIssue::Severity::kError) throw_issue(issue);
+  }
+  return std::move(check.scan);
+}
+
+Network rebuild_network(const EscScan& scan, PortOrder order, std::size_t count) {
   const auto ports_order = topology::frame_order(order);
-  const std::size_t n = scan.slaves.size();
-  std::vector<SlaveLink> links(n);
+  Network out;
+  out.links.reserve(count);
   // Slaves whose subtree is still open: index and how many of their free ports are used.
   struct Open {
     std::size_t index;
@@ -107,24 +135,36 @@ std::vector<SlaveLink> reconstruct_network(const EscScan& scan, PortOrder order)
   };
   std::vector<Open> stack;
   stack.reserve(64);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < count; ++i) {
     const EscSlave& s = scan.slaves[i];
+    SlaveLink link;
     if (i > 0) {
-      if (stack.empty()) throw_no_parent(s.position);
+      if (stack.empty()) {
+        out.error = error_at(s.position, no_parent_message());
+        return out;
+      }
       Open& top = stack.back();
-      links[i].parent_position = scan.slaves[top.index].position;
-      links[i].parent_port = top.ports[static_cast<std::size_t>(top.used++)];
+      link.parent_position = scan.slaves[top.index].position;
+      link.parent_port = top.ports[static_cast<std::size_t>(top.used++)];
       if (top.used == top.count) stack.pop_back();
     }
+    out.links.push_back(link);
     Open open{i, 0, 0, {}};
     open.count = downstream_ports(s, ports_order, open.ports);
     if (open.count > 0) stack.push_back(open);
   }
-  if (!stack.empty()) {
+  if (!stack.empty() && count == scan.slaves.size()) {
     const Open& top = stack.back();
-    throw_dangling(scan.slaves[top.index].position, top.ports[static_cast<std::size_t>(top.used)]);
+    out.error = error_at(scan.slaves[top.index].position,
+                         dangling_message(top.ports[static_cast<std::size_t>(top.used)]));
   }
-  return links;
+  return out;
+}
+
+std::vector<SlaveLink> reconstruct_network(const EscScan& scan, PortOrder order) {
+  Network network = rebuild_network(scan, order, scan.slaves.size());
+  if (network.error) throw_issue(*network.error);
+  return std::move(network.links);
 }
 
 // Paper Algorithm 1: walk back from the slave, counting end points (-1), link points (0),
@@ -176,14 +216,14 @@ std::vector<SlaveLink> reconstruct_network_reference(const EscScan& scan, PortOr
     }
     if (parent_pos != 0) {
       auto& parent_stack = free_ports_stack[static_cast<std::size_t>(parent_pos - 1)];
-      if (parent_stack.empty()) throw_no_parent(i);
+      if (parent_stack.empty()) throw DiscoveryError(i, no_parent_message());
       links[idx].parent_port = parent_stack.back();
       parent_stack.pop_back();
     }
   }
   for (int32_t i = n; i >= 1; --i) {
     const auto& left = free_ports_stack[static_cast<std::size_t>(i - 1)];
-    if (!left.empty()) throw_dangling(i, left.back());
+    if (!left.empty()) throw DiscoveryError(i, dangling_message(left.back()));
   }
   return links;
 }

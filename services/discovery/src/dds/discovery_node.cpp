@@ -1,6 +1,6 @@
 #include "discovery_node.hpp"
 
-#include "conversions.hpp"
+#include "concert/topology/dds/conversions.hpp"
 
 namespace concert::discovery::dds {
 namespace {
@@ -24,11 +24,12 @@ DiscoveryNode::DiscoveryNode(concert::dds::Participant& participant, DiscoverySe
 }
 
 ScanOutcome DiscoveryNode::handle(const msg::EscScan& scan) {
-  ScanOutcome outcome = service_.on_scan(to_core(scan), scan.scan_id());
+  ScanOutcome outcome = service_.on_scan(topology::dds::to_core(scan), scan.scan_id());
   const std::string line = "discovery: " + outcome.message;
   switch (outcome.kind) {
     case ScanOutcome::Kind::kPublished:
-      if (!trees_.write(to_msg(*service_.tree(), service_.version(), scan.scan_id(), now_ns()))) {
+      if (!trees_.write(topology::dds::to_msg(*service_.tree(), service_.version(), scan.scan_id(),
+                                              now_ns()))) {
         status_.report(msg::SERVICE_ERROR, 0,
                        "could not publish tree version " + std::to_string(outcome.version));
         log_ << "discovery: could not publish tree version " << outcome.version << std::endl;

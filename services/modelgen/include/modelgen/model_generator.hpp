@@ -33,10 +33,11 @@ class ModelGenerator {
   PhysicalTree build_tree(const topology::ModuleTree& tree, const Customisation& custom = {}) const;
 
   /// Builds the whole model (texts, lists, hash); version stays 0. Throws ModelError; the
-  /// caller's current model is not touched. An add-on choice whose `addon` is the key of a
-  /// module without ESC (a passive gripper, which the network cannot see) mounts that module on
-  /// the first free output connector of the module owning body `module_name`, or of the last
-  /// module of chain `module_name` (e.g. "E").
+  /// caller's current model is not touched. A tree with errors (check_modelable) or unknown
+  /// modules is refused, naming each unknown module's slave position and identity. An add-on choice
+  /// whose `addon` is the key of a module without ESC (a passive gripper, which the network cannot
+  /// see) mounts that module on the first free output connector of the module owning body
+  /// `module_name`, or of the last module of chain `module_name` (e.g. "E").
   RobotModel generate(const topology::ModuleTree& tree, const Customisation& custom = {},
                       uint64_t tree_version = 0) const;
 
@@ -53,6 +54,10 @@ class ModelGenerator {
   const module_db::ModuleDatabase& db_;
   Params params_;
 };
+
+/// Throws ModelError if a model cannot be built from `tree` whatever the database: the tree has
+/// errors (it is undefined there), or unknown modules (each named by slave position and identity).
+void check_modelable(const topology::ModuleTree& tree);
 
 /// URDF text of a physical tree (fixed joints kept).
 std::string write_urdf(const PhysicalTree& tree, const std::string& robot_name);

@@ -504,8 +504,39 @@ topology::ModuleTree ModelGenerator::mount_passive_modules(const topology::Modul
   return out;
 }
 
+void check_modelable(const topology::ModuleTree& tree) {
+  std::string errors;
+  std::size_t error_count = 0;
+  for (const auto& issue : tree.issues) {
+    if (issue.severity != topology::TreeIssue::Severity::kError) continue;
+    if (error_count++ > 0) errors += "; ";
+    errors += issue.text();
+  }
+  if (error_count > 0) {
+    throw ModelError("the module tree has " + std::to_string(error_count) + " error" +
+                     (error_count == 1 ? "" : "s") + " (" + errors +
+                     "): no model is built from an undefined tree");
+  }
+  std::string unknown;
+  std::size_t unknown_count = 0;
+  for (const auto& m : tree.modules) {
+    if (m.known) continue;
+    if (unknown_count++ > 0) unknown += "; ";
+    unknown += m.slave_positions.empty() ? "module #" + std::to_string(m.index)
+                                         : "slave " + std::to_string(m.slave_positions.front());
+    unknown += " " + topology::to_string(m.identity);
+  }
+  if (unknown_count > 0) {
+    throw ModelError("the module tree has " + std::to_string(unknown_count) + " unknown module" +
+                     (unknown_count == 1 ? "" : "s") +
+                     ", not in the ESC catalogue of the module database: " + unknown +
+                     "; no model is built until every module is known");
+  }
+}
+
 RobotModel ModelGenerator::generate(const topology::ModuleTree& input_tree, const Customisation& input_custom,
                                     uint64_t tree_version) const {
+  check_modelable(input_tree);
   // Passive modules without ESC (passive grippers) named in the add-ons are mounted first; the
   // remaining add-ons are applied to the built tree.
   const topology::ModuleTree tree = mount_passive_modules(input_tree, input_custom);

@@ -12,9 +12,6 @@
 
 namespace concert::modelgen::dds {
 
-/// Module tree sample -> core tree (parent_port -1 on the wire = none).
-topology::ModuleTree to_core(const msg::ModuleTree& tree);
-
 /// Customisation sample -> request. Throws std::invalid_argument when homing_joints and
 /// homing_positions differ in length or a joint is listed twice.
 CustomisationRequest to_core(const msg::ModelCustomisation& request);

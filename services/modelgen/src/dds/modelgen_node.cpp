@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "concert/topology/dds/conversions.hpp"
 #include "conversions.hpp"
 
 namespace concert::modelgen::dds {
@@ -44,7 +45,7 @@ void ModelgenNode::report(const Outcome& outcome, const std::string& what) {
 }
 
 Outcome ModelgenNode::handle(const msg::ModuleTree& tree) {
-  const Outcome o = service_.on_tree(to_core(tree), tree.version());
+  const Outcome o = service_.on_tree(topology::dds::to_core(tree), tree.version());
   report(o, "tree " + std::to_string(tree.version()));
   return o;
 }

@@ -3,13 +3,12 @@
 #include <chrono>
 #include <cmath>
 
-#include "dds/conversions.hpp"  // discovery's EtherCAT scan conversions
+#include "concert/topology/dds/conversions.hpp"
 #include "robot_conversions.hpp"
 
 namespace concert::robot::dds {
 
 namespace cdds = concert::dds;
-
 
 RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams params)
     : participant_(participant),
@@ -212,7 +211,7 @@ void RobotNode::publish_trajectory(const TrajectoryProgress& p, std::uint64_t mo
 }
 
 void RobotNode::publish_scan(const topology::EscScan& scan, const std::string& source) {
-  scan_.write(discovery::dds::to_msg(scan, ++scan_id_, wall_ns(), source));
+  scan_.write(topology::dds::to_msg(scan, ++scan_id_, wall_ns(), source));
 }
 
 std::string RobotNode::last_error() const {

@@ -36,7 +36,8 @@ struct MountedModule {
 enum class FaultType {
   kUpsideDown,       ///< the module's ESC is entered through `upstream_port`, not port 0
   kBrokenLink,       ///< the link from the module to its parent is cut: it and its subtree vanish
-  kUnknownIdentity,  ///< the module's upstream ESC reports `identity` instead of its own
+  kUnknownIdentity,  ///< ESC `esc` of the module reports `identity` instead of its own
+  kWrongTopology,    ///< the master reports `topology` open ports for ESC `esc` of the module
 };
 
 /// One fault, applied by simulate_scan (never by tree_from_assembly).
@@ -44,10 +45,16 @@ struct Fault {
   FaultType type = FaultType::kBrokenLink;
   std::string module;  ///< name of the module concerned
   /// kUpsideDown: the ESC port facing the parent; empty = the port of the module's connector 1
-  /// (port 3 for a module without connectors). Its port-0 and this port swap roles.
+  /// (for a module without connectors, the board's first downstream port: 1 on a two-port
+  /// board, 3 on a four-port board). Its port 0 and this port swap roles.
   std::optional<int32_t> upstream_port;
-  /// kUnknownIdentity: what the ESC reports.
+  /// kUnknownIdentity: what the ESC reports (default all zero: EEPROM not programmed).
   topology::EscIdentity identity{0, 0, 0, 0};
+  /// kUnknownIdentity, kWrongTopology: which ESC of the module (0 = upstream, as in the
+  /// catalogue's layout, e.g. 1 = the Mobile Base Hub's hub board).
+  int32_t esc = 0;
+  /// kWrongTopology: the count the master reports, whatever the open-port register says.
+  int32_t topology = 0;
   bool operator==(const Fault&) const = default;
 };
 

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "concert/topology/esc_board.hpp"
 #include "concert/topology/port_order.hpp"
 #include "concert/topology/types.hpp"
 
@@ -39,12 +40,16 @@ struct EscType {
   ModuleKind kind = ModuleKind::kLink;
   std::optional<int32_t> outputs;  ///< explicit number of output connectors; empty = default
   std::vector<PortLead> ports;     ///< explicit port rows; empty = default mapping
+  std::optional<EscBoard> board;   ///< `esc_ports: 2|4`; empty = default_board(kind)
+  std::optional<int32_t> esc_type;  ///< ESC type register; empty = default_esc_type(kind, ...)
   std::string origin;              ///< "file: modules[i]", for messages
 };
 
 /// One ESC of a module layout.
 struct EscPlacement {
   EscIdentity identity;
+  EscBoard board = EscBoard::kTwoPort;  ///< ports the board has
+  int32_t esc_type = 0;                 ///< what its ESC type register reads
   int32_t parent_esc = -1;   ///< index into ModuleLayout::escs; -1 for the upstream ESC
   int32_t parent_port = -1;  ///< port of the parent ESC it hangs on; -1 for the upstream ESC
 };
@@ -75,7 +80,9 @@ struct ModuleLayout {
 };
 
 /// Default number of output connectors of a single-ESC module without port rows:
-/// joint, link, base link 1; end-effector, wheel 0; hub 3 (every port after 0).
+/// joint, link, base link 1; end-effector, wheel 0; hub 3 (every port after 0). Without port
+/// rows, connector k sits on the k-th downstream port of the board in frame order (esc_board.hpp):
+/// port 1 on a two-port board; ports 3, 1, 2 on a four-port board (real order).
 int32_t default_outputs(ModuleKind kind);
 
 /// The catalogue of ESC identities of one or more module databases.

@@ -20,18 +20,23 @@ struct EscIdentity {
   auto operator<=>(const EscIdentity&) const = default;
 };
 
-/// Kind of module, as the network can tell it from mod_type.
-enum class ModuleKind { kJoint, kHub, kEndEffector, kLink, kWheel, kBaseLink };
+/// Kind of module, as the network can tell it from mod_type. kUnknown: the ESC reports a
+/// mod_type that is none of these (e.g. an all-zero identity: EEPROM not programmed).
+enum class ModuleKind { kJoint, kHub, kEndEffector, kLink, kWheel, kBaseLink, kUnknown };
 
 /// Kind for an ESC's mod_type register (1 joint, 2 hub, 3 end-effector, 4 link, 5 wheel,
 /// 6 base link); empty for any other value.
 std::optional<ModuleKind> module_kind_from_mod_type(int32_t mod_type);
 
-/// Lower-case name of a kind: "joint", "hub", "end_effector", "link", "wheel", "base_link".
+/// Lower-case name of a kind: "joint", "hub", "end_effector", "link", "wheel", "base_link",
+/// "unknown".
 std::string to_string(ModuleKind kind);
 
 /// "(mod_type 1, mod_id 6, mod_size 4, mod_rev 0)", for messages.
 std::string to_string(const EscIdentity& identity);
+
+/// True for the identity a board reports when its identity EEPROM is not programmed.
+inline bool is_blank(const EscIdentity& identity) { return identity == EscIdentity{}; }
 
 /// One slave as reported by the EtherCAT master after a scan.
 struct EscSlave {
@@ -62,20 +67,49 @@ struct SlaveNode {
 /// A module (one or more ESCs) placed in the module tree.
 struct ModuleNode {
   int32_t index = 0;            ///< 0-based, in ring order of the module's first ESC
-  std::string key;              ///< module-database key of the module description
+  std::string key;              ///< module-database key of the module description; empty if unknown
   ModuleKind kind = ModuleKind::kLink;
   EscIdentity identity;         ///< identity of the module's upstream ESC
   std::vector<int32_t> slave_positions;  ///< ESCs of this module, upstream first
   int32_t parent_module = -1;   ///< -1 for the root module
-  int32_t parent_connector = -1;  ///< output connector number on the parent module (1-based); -1 for root
+  /// Output connector number on the parent module (1-based); -1 for the root and when the
+  /// parent's connectors are unknown (an unknown parent module).
+  int32_t parent_connector = -1;
   int32_t robot_id = -1;
+  /// False: the ESC catalogue does not know the identity (or it is all zero). The module is
+  /// in the tree where its ports put it, with one ESC, and no model can be built from it.
+  bool known = true;
   bool operator==(const ModuleNode&) const = default;
 };
 
-/// Network topology (slaves, graph chi) and the modules they form.
+/// Something discovery noticed while rebuilding a tree.
+///  * kWarning: the tree is defined and complete as far as the network can tell (an unknown or
+///    blank identity, a `topology` count that disagrees with `active_ports`, ...);
+///  * kError: a contradiction that leaves (part of) the tree undefined (no free port for a
+///    slave, an open port with nothing on it, a slave on a port its module has no connector
+///    on, ...). A tree with errors is never used to build a model.
+struct TreeIssue {
+  enum class Severity { kWarning, kError };
+  Severity severity = Severity::kWarning;
+  int32_t position = 0;  ///< ring position of the slave concerned; 0 = the scan as a whole
+  std::string message;   ///< what is wrong, without the position
+  /// "slave 4: message" (or just the message for position 0).
+  std::string text() const;
+  bool operator==(const TreeIssue&) const = default;
+};
+
+/// Network topology (slaves, graph chi), the modules they form, and what discovery noticed.
 struct ModuleTree {
   std::vector<SlaveNode> slaves;    ///< index i = ring position i+1
   std::vector<ModuleNode> modules;  ///< parents come before their children
+  std::vector<TreeIssue> issues;    ///< warnings and errors, in ring order
+
+  /// True if an issue is an error: the tree is (partly) undefined.
+  bool has_errors() const;
+  /// Number of issues of one severity.
+  std::size_t count(TreeIssue::Severity severity) const;
+  /// Indices of the modules whose identity the catalogue does not know.
+  std::vector<int32_t> unknown_modules() const;
   bool operator==(const ModuleTree&) const = default;
 };
 

@@ -1,20 +1,20 @@
-#include "conversions.hpp"
+#include "concert/topology/dds/conversions.hpp"
 
-namespace concert::discovery::dds {
+namespace concert::topology::dds {
 namespace {
 
-topology::EscSlave slave_to_core(const msg::EscSlave& m) {
-  topology::EscSlave s;
+EscSlave slave_to_core(const msg::EscSlave& m) {
+  EscSlave s;
   s.position = m.position();
   s.active_ports = m.active_ports();
   s.topology = m.topology();
   s.esc_type = m.esc_type();
-  s.identity = topology::EscIdentity{m.mod_type(), m.mod_id(), m.mod_size(), m.mod_rev()};
+  s.identity = EscIdentity{m.mod_type(), m.mod_id(), m.mod_size(), m.mod_rev()};
   s.robot_id = m.robot_id();
   return s;
 }
 
-msg::EscSlave slave_to_msg(const topology::EscSlave& s) {
+msg::EscSlave slave_to_msg(const EscSlave& s) {
   msg::EscSlave m;
   m.position(s.position);
   m.active_ports(s.active_ports);
@@ -28,40 +28,56 @@ msg::EscSlave slave_to_msg(const topology::EscSlave& s) {
   return m;
 }
 
-msg::ModuleKind kind_to_msg(topology::ModuleKind kind) {
+msg::ModuleKind kind_to_msg(ModuleKind kind) {
   switch (kind) {
-    case topology::ModuleKind::kJoint: return msg::MODULE_JOINT;
-    case topology::ModuleKind::kHub: return msg::MODULE_HUB;
-    case topology::ModuleKind::kEndEffector: return msg::MODULE_END_EFFECTOR;
-    case topology::ModuleKind::kLink: return msg::MODULE_LINK;
-    case topology::ModuleKind::kWheel: return msg::MODULE_WHEEL;
-    case topology::ModuleKind::kBaseLink: return msg::MODULE_BASE_LINK;
+    case ModuleKind::kJoint:
+      return msg::MODULE_JOINT;
+    case ModuleKind::kHub:
+      return msg::MODULE_HUB;
+    case ModuleKind::kEndEffector:
+      return msg::MODULE_END_EFFECTOR;
+    case ModuleKind::kLink:
+      return msg::MODULE_LINK;
+    case ModuleKind::kWheel:
+      return msg::MODULE_WHEEL;
+    case ModuleKind::kBaseLink:
+      return msg::MODULE_BASE_LINK;
+    case ModuleKind::kUnknown:
+      return msg::MODULE_UNKNOWN;
   }
-  return msg::MODULE_LINK;
+  return msg::MODULE_UNKNOWN;
 }
 
-topology::ModuleKind kind_to_core(msg::ModuleKind kind) {
+ModuleKind kind_to_core(msg::ModuleKind kind) {
   switch (kind) {
-    case msg::MODULE_JOINT: return topology::ModuleKind::kJoint;
-    case msg::MODULE_HUB: return topology::ModuleKind::kHub;
-    case msg::MODULE_END_EFFECTOR: return topology::ModuleKind::kEndEffector;
-    case msg::MODULE_LINK: return topology::ModuleKind::kLink;
-    case msg::MODULE_WHEEL: return topology::ModuleKind::kWheel;
-    case msg::MODULE_BASE_LINK: return topology::ModuleKind::kBaseLink;
+    case msg::MODULE_JOINT:
+      return ModuleKind::kJoint;
+    case msg::MODULE_HUB:
+      return ModuleKind::kHub;
+    case msg::MODULE_END_EFFECTOR:
+      return ModuleKind::kEndEffector;
+    case msg::MODULE_LINK:
+      return ModuleKind::kLink;
+    case msg::MODULE_WHEEL:
+      return ModuleKind::kWheel;
+    case msg::MODULE_BASE_LINK:
+      return ModuleKind::kBaseLink;
+    case msg::MODULE_UNKNOWN:
+      return ModuleKind::kUnknown;
   }
-  return topology::ModuleKind::kLink;
+  return ModuleKind::kUnknown;
 }
 
 }  // namespace
 
-topology::EscScan to_core(const msg::EscScan& scan) {
-  topology::EscScan out;
+EscScan to_core(const msg::EscScan& scan) {
+  EscScan out;
   out.slaves.reserve(scan.slaves().size());
   for (const auto& s : scan.slaves()) out.slaves.push_back(slave_to_core(s));
   return out;
 }
 
-msg::EscScan to_msg(const topology::EscScan& scan, uint32_t scan_id, int64_t stamp_ns,
+msg::EscScan to_msg(const EscScan& scan, uint32_t scan_id, int64_t stamp_ns,
                     const std::string& source) {
   msg::EscScan out;
   out.scan_id(scan_id);
@@ -72,10 +88,10 @@ msg::EscScan to_msg(const topology::EscScan& scan, uint32_t scan_id, int64_t sta
   return out;
 }
 
-topology::ModuleTree to_core(const msg::ModuleTree& tree) {
-  topology::ModuleTree out;
+ModuleTree to_core(const msg::ModuleTree& tree) {
+  ModuleTree out;
   for (const auto& m : tree.slaves()) {
-    topology::SlaveNode node;
+    SlaveNode node;
     node.slave = slave_to_core(m.slave());
     node.parent_position = m.parent_position();
     if (m.parent_port() >= 0) node.parent_port = m.parent_port();
@@ -83,21 +99,26 @@ topology::ModuleTree to_core(const msg::ModuleTree& tree) {
     out.slaves.push_back(node);
   }
   for (const auto& m : tree.modules()) {
-    topology::ModuleNode node;
+    ModuleNode node;
     node.index = m.index();
     node.key = m.key();
+    node.known = m.known();
     node.kind = kind_to_core(m.kind());
-    node.identity = topology::EscIdentity{m.mod_type(), m.mod_id(), m.mod_size(), m.mod_rev()};
+    node.identity = EscIdentity{m.mod_type(), m.mod_id(), m.mod_size(), m.mod_rev()};
     node.slave_positions = m.slave_positions();
     node.parent_module = m.parent_module();
     node.parent_connector = m.parent_connector();
     node.robot_id = m.robot_id();
     out.modules.push_back(std::move(node));
   }
+  for (const auto& i : tree.issues()) {
+    out.issues.push_back({i.error() ? TreeIssue::Severity::kError : TreeIssue::Severity::kWarning,
+                          i.position(), i.message()});
+  }
   return out;
 }
 
-msg::ModuleTree to_msg(const topology::ModuleTree& tree, uint32_t version, uint32_t scan_id,
+msg::ModuleTree to_msg(const ModuleTree& tree, uint32_t version, uint32_t scan_id,
                        int64_t stamp_ns) {
   msg::ModuleTree out;
   out.version(version);
@@ -115,6 +136,7 @@ msg::ModuleTree to_msg(const topology::ModuleTree& tree, uint32_t version, uint3
     msg::ModuleNode node;
     node.index(m.index);
     node.key(m.key);
+    node.known(m.known);
     node.kind(kind_to_msg(m.kind));
     node.mod_type(m.identity.mod_type);
     node.mod_id(m.identity.mod_id);
@@ -126,7 +148,14 @@ msg::ModuleTree to_msg(const topology::ModuleTree& tree, uint32_t version, uint3
     node.robot_id(m.robot_id);
     out.modules().push_back(node);
   }
+  for (const auto& i : tree.issues) {
+    msg::TreeIssue issue;
+    issue.error(i.severity == TreeIssue::Severity::kError);
+    issue.position(i.position);
+    issue.message(i.message);
+    out.issues().push_back(issue);
+  }
   return out;
 }
 
-}  // namespace concert::discovery::dds
+}  // namespace concert::topology::dds
