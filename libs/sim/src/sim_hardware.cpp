@@ -451,6 +451,11 @@ MountedHardware SimHardware::mounted() const {
   return impl_->mounted;
 }
 
+std::uint64_t SimHardware::mounted_generation() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->mounted.generation;
+}
+
 bool SimHardware::switch_prepared() {
   Instance* next = impl_->prepared.take();
   if (next == nullptr) {

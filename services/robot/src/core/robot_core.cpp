@@ -274,7 +274,7 @@ void RobotCore::check_command(std::uint64_t model_version) const {
   if (s == nullptr) {
     throw CommandError("command refused: robot not ready (waiting for a robot model)");
   }
-  if (s->generation != hw_.mounted().generation) {
+  if (s->generation != hw_.mounted_generation()) {
     throw CommandError(
         "command refused: robot not ready (hardware changed: waiting for a model matching the mounted joints)");
   }
@@ -763,7 +763,7 @@ RobotState RobotCore::state() const {
 
 bool RobotCore::ready() const {
   std::lock_guard lock(shared_->mutex);
-  return shared_->accepted != nullptr && shared_->accepted->generation == hw_.mounted().generation;
+  return shared_->accepted != nullptr && shared_->accepted->generation == hw_.mounted_generation();
 }
 
 std::uint64_t RobotCore::model_version() const {

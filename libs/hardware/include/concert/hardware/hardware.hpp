@@ -66,6 +66,8 @@ class Hardware {
   /// prepared (see switch_prepared()). The default (hardware that never changes) is the
   /// running hardware.
   [[nodiscard]] virtual MountedHardware mounted() const { return {generation(), joint_names()}; }
+  /// Any thread: mounted().generation without copying the joint names.
+  [[nodiscard]] virtual std::uint64_t mounted_generation() const { return mounted().generation; }
   /// Control thread, at a cycle boundary: switches to hardware (or a world) another thread
   /// prepared, without allocating; true if it switched. The default has nothing to switch.
   virtual bool switch_prepared() { return false; }

@@ -59,6 +59,7 @@ class SimHardware final : public hardware::Hardware {
   [[nodiscard]] const std::vector<std::string>& joint_names() const override;
   [[nodiscard]] std::uint64_t generation() const override;
   [[nodiscard]] hardware::MountedHardware mounted() const override;
+  [[nodiscard]] std::uint64_t mounted_generation() const override;
   bool switch_prepared() override;
   void read(hardware::HardwareState& state) override;
   void write(const std::vector<hardware::DriveCommand>& commands) override;
