@@ -42,14 +42,20 @@ msg::RobotModel model_msg(const std::string& urdf, uint32_t version) {
   return m;
 }
 
-TEST(RobotNode, ModelCommandsAndStateOverDds) {
-  SimHardware sim(test::read_fixture("mobile_drill.urdf"), World{}, {});
-  RobotCore core(sim);
-  cdds::Participant robot_side({.name = "robot"});
-  dds::RobotNode node(robot_side, core);
+/// The robot side (simulated drill robot, core, node) and a client participant with a model
+/// writer, as each DDS test of the node needs them.
+struct NodeRig : ::testing::Test {
+  SimHardware sim{test::read_fixture("mobile_drill.urdf"), World{}, {}};
+  RobotCore core{sim};
+  cdds::Participant robot_side{{.name = "robot"}};
+  dds::RobotNode node{robot_side, core};
+  cdds::Participant client{{.name = "client"}};
+  cdds::Writer<msg::RobotModel> models{client, cdds::topics::robot_model};
+};
 
-  cdds::Participant client({.name = "client"});
-  cdds::Writer<msg::RobotModel> models(client, cdds::topics::robot_model);
+using RobotNodeDds = NodeRig;
+
+TEST_F(RobotNodeDds, ModelCommandsAndStateOverDds) {
   cdds::Writer<msg::JointCommand> joints(client, cdds::topics::joint_command);
   cdds::Writer<msg::BaseVelocityCommand> base(client, cdds::topics::base_velocity);
   cdds::Reader<msg::JointState> states(client, cdds::topics::joint_state);
@@ -185,13 +191,7 @@ msg::JointTrajectoryCommand ramp(uint32_t request, uint32_t version, const std::
   return c;
 }
 
-TEST(RobotNode, TrajectoriesOverDdsWithProgressResultRefusalAndEstop) {
-  SimHardware sim(test::read_fixture("mobile_drill.urdf"), World{}, {});
-  RobotCore core(sim);
-  cdds::Participant robot_side({.name = "robot"});
-  dds::RobotNode node(robot_side, core);
-  cdds::Participant client({.name = "client"});
-  cdds::Writer<msg::RobotModel> models(client, cdds::topics::robot_model);
+TEST_F(RobotNodeDds, TrajectoriesOverDdsWithProgressResultRefusalAndEstop) {
   cdds::Writer<msg::JointTrajectoryCommand> trajectories(client, cdds::topics::trajectory_command);
   cdds::Writer<msg::SafetyState> safety(client, cdds::topics::safety_state);
   cdds::Reader<msg::TrajectoryStatus> statuses(client, cdds::topics::trajectory_status);
