@@ -76,7 +76,7 @@ void BM_TreeToModel(benchmark::State& state, const topology::ModuleTree& tree) {
   const modelgen::ModelGenerator gen(db());
   size_t bytes = 0;
   for (auto _ : state) {
-    modelgen::RobotModel m = gen.generate(tree);
+    modelgen::GeneratedModel m = gen.generate(tree);
     bytes = m.urdf.size() + m.srdf.size() + m.config_yaml.size();
     benchmark::DoNotOptimize(m.content_hash);
   }
@@ -91,7 +91,7 @@ void BM_ScanToModel18(benchmark::State& state) {
   const discovery::Discovery disc(catalog);
   const modelgen::ModelGenerator gen(db());
   for (auto _ : state) {
-    modelgen::RobotModel m = gen.generate(disc.run(scan));
+    modelgen::GeneratedModel m = gen.generate(disc.run(scan));
     benchmark::DoNotOptimize(m.content_hash);
   }
 }

@@ -95,7 +95,7 @@ TEST_F(CliTest, BothDatabaseFormatsAndSeveralDatabases) {
   const CliRun own = run({"generate", "--tree", (dir_ / "tree.json").string(), "--module-db", kOwn, "--module-db", kPublic, "--out",
                        (dir_ / "own").string()});
   ASSERT_EQ(own.code, 0) << own.err;
-  EXPECT_NE(own.out.find("end-effector gripper_A at tcp_A (concert_passive_gripper_panel)"), std::string::npos) << own.out;
+  EXPECT_NE(own.out.find("end-effector gripper_A (gripper) at tcp_A (concert_passive_gripper_panel)"), std::string::npos) << own.out;
 }
 
 TEST_F(CliTest, ErrorsAreOneLineAndNonZero) {

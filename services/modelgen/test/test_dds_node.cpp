@@ -1,4 +1,4 @@
-// The modelgen node over real DDS (private domain): tree in -> latched RobotModel out, same
+// The modelgen node over real DDS (private domain): tree in -> latched GeneratedModel out, same
 // tree -> no new version, bad tree -> model kept, customisation -> new version, late joiners.
 
 #include <gtest/gtest.h>
@@ -112,7 +112,7 @@ TEST(ModelgenNode, PublishesVersionedModelsOverDds) {
   ASSERT_EQ(modelgen::cli_main({"show", "--timeout", "5"}, out, err), 0) << err.str();
   EXPECT_NE(out.str().find("robot model version 2 (" + service.current()->content_hash + ")"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("  E (arm) base_link -> tcp_E: J1_E J2_E J3_E J4_E J5_E J6_E"), std::string::npos) << out.str();
-  EXPECT_NE(out.str().find("  ee_E chain E frame tcp_E module passive_end_effector_panel"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("  ee_E (other) chain E frame tcp_E module passive_end_effector_panel"), std::string::npos) << out.str();
 }
 
 TEST(ModelShow, NoModelIsAClearError) {

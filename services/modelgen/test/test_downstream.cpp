@@ -16,7 +16,7 @@ using namespace concert;
 TEST(Downstream, KdlLoadsGeneratedModels) {
   const module_db::ModuleDatabase pub = module_db::load_module_database(fs::path(CONCERT_SHARED_DATA) / "concert_resources");
   const topology::ModuleTree tree = modelgen::test::make_tree(modelgen::test::public_eighteen_module_robot(), &pub);
-  const modelgen::RobotModel model = modelgen::ModelGenerator(pub).generate(tree);
+  const modelgen::GeneratedModel model = modelgen::ModelGenerator(pub).generate(tree);
   const kinematics::Model kdl = kinematics::Model::from_urdf_string(model.urdf, {.planar_base = true});
   EXPECT_EQ(kdl.dof(), 3 + static_cast<int>(model.joints.size()));
   EXPECT_NEAR(kdl.total_mass(), model.tree.mass(), 1e-9);

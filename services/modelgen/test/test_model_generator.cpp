@@ -35,7 +35,7 @@ std::string error_of(const std::function<void()>& f) {
 }
 
 /// Checks every end-effector frame of `model` against eq. (1)-(2) at seeded random joint values.
-void expect_fk_matches(const module_db::ModuleDatabase& db, const topology::ModuleTree& tree, const RobotModel& model,
+void expect_fk_matches(const module_db::ModuleDatabase& db, const topology::ModuleTree& tree, const GeneratedModel& model,
                        unsigned seed, int samples) {
   const urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(model.urdf);
   ASSERT_TRUE(urdf_model) << "urdfdom rejected the URDF";
@@ -68,7 +68,7 @@ TEST(PublicRobot, EighteenModulesLoadParseAndKeepTheirMass) {
   const auto& db = public_db();
   const topology::ModuleTree tree = make_tree(test::public_eighteen_module_robot(), &db);
   ASSERT_EQ(tree.modules.size(), 18u);
-  const RobotModel model = ModelGenerator(db).generate(tree);
+  const GeneratedModel model = ModelGenerator(db).generate(tree);
   const urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(model.urdf);
   ASSERT_TRUE(urdf_model);
   double module_mass = 0.0;
@@ -89,14 +89,14 @@ TEST(PublicRobot, EighteenModulesLoadParseAndKeepTheirMass) {
   ASSERT_EQ(model.chains.size(), 5u);
   for (int leg = 0; leg < 4; ++leg) {
     const ChainInfo& c = model.chains[static_cast<size_t>(leg)];
-    EXPECT_EQ(c.role, "leg");
+    EXPECT_EQ(c.role, concert::model::ChainRole::kLeg);
     EXPECT_EQ(c.base_link, "base_link");
     EXPECT_EQ(c.tip_link, "wheel_" + c.name);
     EXPECT_EQ(c.joints, (std::vector<std::string>{"J1_" + c.name, "J2_" + c.name}));
   }
   const ChainInfo& arm = model.chains[4];
   EXPECT_EQ(arm.name, "E");
-  EXPECT_EQ(arm.role, "arm");
+  EXPECT_EQ(arm.role, concert::model::ChainRole::kArm);
   EXPECT_EQ(arm.tip_link, "tcp_E");
   EXPECT_EQ(arm.joints, (std::vector<std::string>{"J1_E", "J2_E", "J3_E", "J4_E", "J5_E", "J6_E"}));
   ASSERT_EQ(model.end_effectors.size(), 5u);
@@ -123,7 +123,7 @@ TEST(PublicRobot, EighteenModulesLoadParseAndKeepTheirMass) {
 TEST(PublicRobot, TcpForwardKinematicsMatchesModuleDescriptions) {
   const auto& db = public_db();
   const topology::ModuleTree tree = make_tree(test::public_eighteen_module_robot(), &db);
-  const RobotModel model = ModelGenerator(db).generate(tree);
+  const GeneratedModel model = ModelGenerator(db).generate(tree);
   expect_fk_matches(db, tree, model, 42u, 25);
 }
 
@@ -140,11 +140,11 @@ TEST(PublicRobot, TorsoHubTwoArmsAndBaseLinkFk) {
                               {"module_joint_yaw_B_concert", 7, 1},
                               {"module_spraying_tool_concert", 8, 1}};
   const topology::ModuleTree tree = make_tree(rows, &db);
-  const RobotModel model = ModelGenerator(db).generate(tree);
+  const GeneratedModel model = ModelGenerator(db).generate(tree);
   ASSERT_TRUE(urdf::parseURDF(model.urdf));
   ASSERT_EQ(model.chains.size(), 3u);
   EXPECT_EQ(model.chains[0].name, "A");
-  EXPECT_EQ(model.chains[0].role, "other");
+  EXPECT_EQ(model.chains[0].role, concert::model::ChainRole::kOther);
   EXPECT_EQ(model.chains[0].tip_link, "L_0_hub_2_A");
   EXPECT_EQ(model.chains[1].name, "B");
   EXPECT_EQ(model.chains[1].base_link, "L_0_hub_2_A");
@@ -162,8 +162,8 @@ TEST(Naming, SameRobotSameNamesWhateverTheModuleOrder) {
   const std::vector<Row> rows = test::public_eighteen_module_robot();
   const topology::ModuleTree tree = make_tree(rows, &db);
   const ModelGenerator gen(db);
-  const RobotModel a = gen.generate(tree);
-  const RobotModel b = gen.generate(tree);
+  const GeneratedModel a = gen.generate(tree);
+  const GeneratedModel b = gen.generate(tree);
   EXPECT_EQ(a.urdf, b.urdf);
   EXPECT_EQ(a.srdf, b.srdf);
   EXPECT_EQ(a.config_yaml, b.config_yaml);
@@ -184,7 +184,7 @@ TEST(Naming, SameRobotSameNamesWhateverTheModuleOrder) {
     if (std::get<1>(r) >= 0) std::get<1>(r) = new_index[static_cast<size_t>(std::get<1>(r))];
     permuted.push_back(r);
   }
-  const RobotModel c = gen.generate(make_tree(permuted, &db));
+  const GeneratedModel c = gen.generate(make_tree(permuted, &db));
   EXPECT_EQ(a.urdf, c.urdf);
   EXPECT_EQ(a.srdf, c.srdf);
   // A different robot gets a different hash.
@@ -263,12 +263,12 @@ TEST(Customisation, HomingAndAddonsMakeANewModel) {
                               {"module_joint_elbow_A_concert", 1, 1},
                               {"module_drill_concert", 2, 1}};
   const topology::ModuleTree tree = make_tree(rows, &db);
-  const RobotModel plain = gen.generate(tree);
+  const GeneratedModel plain = gen.generate(tree);
   Customisation custom;
   custom.home["J2_A"] = 0.5;
   custom.addons.push_back({"drill_A", "drillbit_16_SDSplus"});
   custom.addons.push_back({"drill_A", "drill_handle"});
-  const RobotModel custom_model = gen.generate(tree, custom);
+  const GeneratedModel custom_model = gen.generate(tree, custom);
   EXPECT_NE(custom_model.content_hash, plain.content_hash);
   EXPECT_NE(custom_model.srdf.find("<joint name=\"J2_A\" value=\"0.5\"/>"), std::string::npos);
   EXPECT_NEAR(custom_model.tree.mass(), plain.tree.mass() + 0.8 + 0.33, 1e-9);
@@ -304,7 +304,7 @@ TEST(Bundle, WritesFilesAndManifest) {
   const auto& db = public_db();
   ModelVersioner versioner(3);
   versioner.offer(ModelGenerator(db).generate(make_tree(test::public_eighteen_module_robot(), &db), {}, 11));
-  const RobotModel& model = *versioner.current();
+  const GeneratedModel& model = *versioner.current();
   const fs::path dir = fs::temp_directory_path() / ("concert_modelgen_bundle_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   write_bundle(model, dir / "bundle");
@@ -322,13 +322,13 @@ TEST(Customisation, PassiveGripperWithoutEscIsMountedByHand) {
   const auto& db = public_db();
   const ModelGenerator gen(db);
   std::vector<Row> rows = test::public_eighteen_module_robot();
-  const RobotModel full = gen.generate(make_tree(rows, &db));
+  const GeneratedModel full = gen.generate(make_tree(rows, &db));
   rows.pop_back();
   const topology::ModuleTree seen = make_tree(rows, &db);
   for (const char* where : {"E", "L_6_E"}) {
     Customisation custom;
     custom.addons.push_back({where, "passive_end_effector_panel"});
-    const RobotModel mounted = gen.generate(seen, custom);
+    const GeneratedModel mounted = gen.generate(seen, custom);
     EXPECT_EQ(mounted.urdf, full.urdf) << where;
     EXPECT_EQ(mounted.srdf, full.srdf) << where;
     EXPECT_EQ(mounted.content_hash, full.content_hash) << where;

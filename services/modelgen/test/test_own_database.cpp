@@ -48,7 +48,7 @@ const std::vector<std::string> kMorphologyA{"concert_straight_a", "concert_elbow
 const std::vector<std::string> kMorphologyB{"concert_straight_a", "concert_elbow_a",  "concert_straight_a", "concert_link_400", "concert_elbow_a",
                                             "concert_straight_b", "concert_link_400", "concert_elbow_b",    "concert_drill"};
 
-void check_model(const topology::ModuleTree& tree, const RobotModel& model, unsigned seed) {
+void check_model(const topology::ModuleTree& tree, const GeneratedModel& model, unsigned seed) {
   const auto& db = own_db();
   const urdf::ModelInterfaceSharedPtr u = urdf::parseURDF(model.urdf);
   ASSERT_TRUE(u);
@@ -81,10 +81,10 @@ TEST(OwnDatabase, MorphologiesAandBOfTheDrillingExperiments) {
   const ModelGenerator gen(own_db());
   for (const auto* arm : {&kMorphologyA, &kMorphologyB}) {
     const topology::ModuleTree tree = make_tree(mobile_robot(*arm), &own_db());
-    const RobotModel model = gen.generate(tree);
+    const GeneratedModel model = gen.generate(tree);
     check_model(tree, model, 3u);
     ASSERT_EQ(model.chains.size(), 5u);
-    EXPECT_EQ(model.chains[4].role, "arm");
+    EXPECT_EQ(model.chains[4].role, concert::model::ChainRole::kArm);
     EXPECT_EQ(model.chains[4].joints.size(), 6u);
     EXPECT_EQ(model.chains[4].tip_link, "tcp_E");
     EXPECT_EQ(model.end_effectors.back().name, "drill_E");
@@ -99,9 +99,9 @@ TEST(OwnDatabase, MorphologiesAandBOfTheDrillingExperiments) {
     EXPECT_EQ(model.joints[1].control_mode, "velocity");  // wheel, Small B
   }
   // Morphology B's extra link sits after the third joint: L_3_link_1_E.
-  const RobotModel b = gen.generate(make_tree(mobile_robot(kMorphologyB), &own_db()));
+  const GeneratedModel b = gen.generate(make_tree(mobile_robot(kMorphologyB), &own_db()));
   EXPECT_GE(b.tree.body_index("L_3_link_1_E"), 0);
-  const RobotModel a = gen.generate(make_tree(mobile_robot(kMorphologyA), &own_db()));
+  const GeneratedModel a = gen.generate(make_tree(mobile_robot(kMorphologyA), &own_db()));
   EXPECT_LT(a.tree.body_index("L_3_link_1_E"), 0);
   // The arm is 0.4 m longer when stretched (all joints at zero).
   const auto ua = urdf::parseURDF(a.urdf);
@@ -130,7 +130,7 @@ TEST(OwnDatabase, MorphologyCAndTwoArmTorso) {
   const topology::ModuleTree tree = make_tree(rows, &own_db());
   Customisation custom;
   custom.addons.push_back({"sanding_tool_G", "concert_sanding_force_sensor"});
-  const RobotModel model = gen.generate(tree, custom);
+  const GeneratedModel model = gen.generate(tree, custom);
   check_model(tree, gen.generate(tree), 9u);
   ASSERT_EQ(model.chains.size(), 7u);
   EXPECT_EQ(model.chains[5].base_link, "L_0_hub_2_E");

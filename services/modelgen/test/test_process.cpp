@@ -1,5 +1,5 @@
 // concert_modelgen as a real process: a tree published by this test comes back as a latched
-// RobotModel; the process deploys the bundle and stops cleanly on SIGTERM.
+// GeneratedModel; the process deploys the bundle and stops cleanly on SIGTERM.
 
 #include <gtest/gtest.h>
 #include <signal.h>

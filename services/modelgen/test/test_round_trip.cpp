@@ -28,8 +28,8 @@ void expect_round_trip(const Db& d, const simbus::Assembly& assembly, const std:
   const modelgen::ModelGenerator gen(d.db);
   const topology::ModuleTree direct = simbus::tree_from_assembly(assembly, d.catalog);
   const topology::ModuleTree discovered = discovery::discover(simbus::simulate_scan(assembly, d.catalog), d.catalog);
-  const modelgen::RobotModel a = gen.generate(direct);
-  const modelgen::RobotModel b = gen.generate(discovered);
+  const modelgen::GeneratedModel a = gen.generate(direct);
+  const modelgen::GeneratedModel b = gen.generate(discovered);
   EXPECT_EQ(a.content_hash, b.content_hash) << what;
   EXPECT_EQ(a.urdf, b.urdf) << what;
   EXPECT_EQ(a.modules.size(), assembly.modules.size()) << what;
@@ -46,7 +46,7 @@ TEST(RoundTrip, PublicDatabaseExampleAssemblies) {
   const simbus::Assembly paper = simbus::load_assembly(fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml");
   const topology::ModuleTree tree = discovery::discover(simbus::simulate_scan(paper, d.catalog), d.catalog);
   ASSERT_EQ(tree.modules[0].slave_positions.size(), 2u);
-  const modelgen::RobotModel model = modelgen::ModelGenerator(d.db).generate(tree);
+  const modelgen::GeneratedModel model = modelgen::ModelGenerator(d.db).generate(tree);
   int base_bodies = 0;
   for (const modelgen::PhysicalBody& b : model.tree.bodies) base_bodies += b.module == 0 ? 1 : 0;
   EXPECT_EQ(base_bodies, 1);
@@ -63,8 +63,8 @@ TEST(RoundTrip, RealScanGivesTheModelOfItsAssemblyFile) {
   const simbus::Assembly assembly =
       simbus::load_assembly(fs::path(SIMBUS_EXAMPLES) / "concert_robot_18slaves.yaml");
   const modelgen::ModelGenerator gen(d.db);
-  const modelgen::RobotModel from_scan = gen.generate(tree);
-  const modelgen::RobotModel from_assembly =
+  const modelgen::GeneratedModel from_scan = gen.generate(tree);
+  const modelgen::GeneratedModel from_assembly =
       gen.generate(simbus::tree_from_assembly(assembly, d.catalog));
   const auto scan_urdf = urdf::parseURDF(from_scan.urdf);
   const auto assembly_urdf = urdf::parseURDF(from_assembly.urdf);
@@ -86,7 +86,7 @@ TEST(RoundTrip, RealScanGivesTheModelOfItsAssemblyFile) {
   }
   // The project database knows the same identities: the real robot gets a model there too.
   const Db project(fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db");
-  const modelgen::RobotModel own =
+  const modelgen::GeneratedModel own =
       modelgen::ModelGenerator(project.db).generate(discovery::discover(real, project.catalog));
   EXPECT_EQ(own.joints.size(), 14u);
 }
@@ -158,7 +158,7 @@ TEST(RoundTrip, RandomRobotsOfTheProjectDatabase) {
     const std::string what = "robot " + std::to_string(robot) + ":\n" + simbus::assembly_to_yaml(a);
     expect_round_trip(d, a, what);
     const topology::ModuleTree tree = simbus::tree_from_assembly(a, d.catalog);
-    const modelgen::RobotModel model = modelgen::ModelGenerator(d.db).generate(tree);
+    const modelgen::GeneratedModel model = modelgen::ModelGenerator(d.db).generate(tree);
     const auto u = urdf::parseURDF(model.urdf);
     ASSERT_TRUE(u) << what;
     std::map<std::string, double> qn;

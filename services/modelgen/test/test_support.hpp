@@ -11,7 +11,7 @@
 
 #include "concert/module_db/module_db.hpp"
 #include "concert/topology/types.hpp"
-#include "modelgen/model.hpp"
+#include "modelgen/model_generator.hpp"
 
 namespace concert::modelgen::test {
 

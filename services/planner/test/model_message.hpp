@@ -1,16 +1,16 @@
 #pragma once
-// Test helper: the RobotModel message modelgen publishes for an assembly, with a version.
+// Test helper: the RobotModel message modelgen would publish for an assembly, with a version.
 
 #include <cstdint>
 #include <filesystem>
 
-#include "dds/conversions.hpp"  // modelgen's IDL conversions
+#include "concert/model/dds/conversions.hpp"
 #include "planner/fixtures.hpp"
 
 namespace concert::planner::testing {
 
 inline msg::RobotModel model_message(const std::filesystem::path& assembly, uint32_t version) {
-  msg::RobotModel m = modelgen::dds::to_msg(fixtures::generated_model(assembly), 0);
+  msg::RobotModel m = model::dds::to_msg(fixtures::generated_model(assembly).description(), 0);
   m.version(version);
   return m;
 }

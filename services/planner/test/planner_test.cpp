@@ -305,7 +305,7 @@ TEST(Planner, MirroredHintStandsOnTheAreasOtherSide) {
   const BlockedLowArea s = blocked_low_area(0.0);
   ASSERT_TRUE(s.first.found);
   ASSERT_GT(std::abs(s.first.q[1]), 0.2) << "a low area: the base stands beside it";
-  const EndEffectorSpec& tool = s.model->tool("");
+  const EndEffectorInfo& tool = s.model->tool("");
   // Seeds: the start posture placed and as it is, the hint, its mirror image; nothing else.
   StateChecker checker(s.model, environment_of(s.blocked, s.params), s.params, s.params.environment_padding);
   const Eigen::VectorXd hint = s.first.q.tail(s.first.q.size() - 3);
@@ -326,7 +326,7 @@ TEST(Planner, ResumedPostureSearchGivesAnotherPosture) {
   // one that gave it: a different posture, later seeds, still valid.
   const BlockedLowArea s = blocked_low_area(0.0);
   ASSERT_TRUE(s.first.found);
-  const EndEffectorSpec& tool = s.model->tool("");
+  const EndEffectorInfo& tool = s.model->tool("");
   Params params = s.params;
   params.nspg_time = 60.0;  // the seeds end it, not the clock
   StateChecker checker(s.model, environment_of(s.bare, params), params, params.environment_padding);
@@ -346,7 +346,7 @@ TEST(Planner, ResumedPostureSearchGivesAnotherPosture) {
 TEST(Planner, TurnedHintGetsPastAnObstacleThatBlocksItsBase) {
   const BlockedLowArea s = blocked_low_area(0.3);
   ASSERT_TRUE(s.first.found);
-  const EndEffectorSpec& tool = s.model->tool("");
+  const EndEffectorInfo& tool = s.model->tool("");
   const Eigen::VectorXd hint = s.first.q.tail(s.first.q.size() - 3);
   const Eigen::VectorXd image = *s.model->mirrored_arm(hint);
   // Every seed before the random ones (the start posture placed and as it is, the hint and its

@@ -11,6 +11,7 @@
 #include "planner/trajectory.hpp"
 
 using namespace concert::planner;
+namespace model = concert::model;
 
 namespace {
 
@@ -102,7 +103,15 @@ TEST(PlanningModel, BaseStandsOnTheFloorAndArmGrowsWithMorphology) {
 TEST(PlanningModel, ToolAndCameraFrames) {
   const auto m = morphology('a');
   EXPECT_EQ(m->tool("").name, "drill_E");
+  EXPECT_EQ(m->tool("").kind, model::EndEffectorKind::kDrill);  // by role: the wheels come first
+  EXPECT_EQ(m->description().end_effectors.front().kind, model::EndEffectorKind::kWheel);
   EXPECT_EQ(m->camera_frame(m->tool("drill_E")), "camera_E");
+  try {
+    (void)m->camera_frame(m->tool("wheel_A"));
+    FAIL() << "a wheel has no camera";
+  } catch (const PlannerError& e) {
+    EXPECT_NE(std::string(e.what()).find("'wheel_A' has no camera sensor"), std::string::npos) << e.what();
+  }
   try {
     (void)m->tool("sander_E");
     FAIL() << "unknown end-effector accepted";
@@ -158,8 +167,8 @@ TEST(PlanningModel, MirroredArmReflectsTheCamera) {
   // An oblique joint axis (tilted 30 degrees out of both planes): no mirror image.
   ModelDescription d = fixtures::model_from_assembly(fixtures::data_dir() / "morphology_a.yaml", 1);
   std::string arm_joint;
-  for (const ChainSpec& c : d.chains) {
-    if (c.role == "arm") arm_joint = c.joints.at(1);
+  for (const model::ChainInfo& c : d.chains) {
+    if (c.role == model::ChainRole::kArm) arm_joint = c.joints.at(1);
   }
   const std::size_t at = d.urdf.find("<joint name=\"" + arm_joint + "\"");
   ASSERT_NE(at, std::string::npos);
@@ -174,8 +183,8 @@ TEST(PlanningModel, MirroredArmReflectsTheCamera) {
 TEST(PlanningModel, BadModelsNameTheProblem) {
   ModelDescription d = fixtures::model_from_assembly(fixtures::data_dir() / "morphology_a.yaml", 3);
   ModelDescription no_arm = d;
-  for (ChainSpec& c : no_arm.chains) {
-    if (c.role == "arm") c.role = "other";
+  for (model::ChainInfo& c : no_arm.chains) {
+    if (c.role == model::ChainRole::kArm) c.role = model::ChainRole::kOther;
   }
   EXPECT_THROW((void)PlanningModel::build(no_arm, {}), PlannerError);
   ModelDescription bad_srdf = d;

@@ -241,33 +241,9 @@ TEST_F(RobotNodeDds, TrajectoriesOverDdsWithProgressResultRefusalAndEstop) {
   EXPECT_LT(log.of(43)->progress(), 0.9);
 }
 
-TEST(RobotNode, ToolEndEffectorIsChosenByChainRoleNotListPosition) {
-  msg::RobotModel m;
-  msg::ChainInfo leg, arm;
-  leg.name("A");
-  leg.role("leg");
-  arm.name("E");
-  arm.role("arm");
-  m.chains({leg, arm});
-  msg::EndEffectorInfo wheel, camera, drill;
-  wheel.name("wheel_A");
-  wheel.chain("A");
-  wheel.frame("wheel_A");
-  wheel.module_key("module_wheel_concert");
-  camera.name("cam_E");
-  camera.chain("E");
-  camera.frame("cam_E");
-  camera.module_key("module_camera");
-  drill.name("drill_E");
-  drill.chain("E");
-  drill.frame("tcp_E");
-  drill.module_key("module_drill_concert");
-  m.end_effectors({wheel, camera, drill});
-  EXPECT_EQ(dds::tool_end_effector(m), "tcp_E");
-  m.end_effectors({wheel, camera});
-  EXPECT_EQ(dds::tool_end_effector(m), "cam_E");
-  m.end_effectors({wheel});
-  EXPECT_EQ(dds::tool_end_effector(m), "");  // never a wheel: the core picks its default
+TEST(RobotNode, ToolEndEffectorNeedsAParsableDescription) {
+  // A message with only a URDF (no SRDF, no chains): the core picks its default frame.
+  EXPECT_EQ(dds::tool_end_effector(model_msg(test::read_fixture("mobile_drill.urdf"), 1)), "");
 }
 
 TEST(RobotConversions, JointCommandLengthsAreChecked) {

@@ -9,7 +9,8 @@
 #include "concert/dds/endpoint.hpp"
 #include "concert/module_db/module_db.hpp"
 #include "concert/sim/sim_assembly.hpp"
-#include "modelgen/model_generator.hpp"
+#include "concert/model/dds/conversions.hpp"
+#include "concert/model_generation/generator.hpp"
 #include "robot_node.hpp"
 #include "test_helpers.hpp"
 
@@ -41,36 +42,25 @@ TEST(PaperRobotDds, CartesianImpedanceMovesTheDrillToolFrameNotAWheel) {
   const sim::AssemblyBuilder builder({kPublicDb});
   const sim::SimulatedRobot robot = builder.build(kPaperRobot);
   const module_db::ModuleDatabase db = module_db::load_module_database(kPublicDb);
-  const modelgen::RobotModel generated = modelgen::ModelGenerator(db).generate(robot.tree);
+  const model_generation::GeneratedModel generated = model_generation::ModelGenerator(db).generate(robot.tree);
 
-  msg::RobotModel model;
-  model.version(1);
-  model.urdf(generated.urdf);
+  // The message as modelgen publishes it (libs/model's one conversion).
+  model::ModelDescription description = generated.description();
+  description.version = 1;
+  const msg::RobotModel model = model::dds::to_msg(description, 0);
   std::string drill_frame, wheel_frame;
-  for (const auto& c : generated.chains) {
-    msg::ChainInfo chain;
-    chain.name(c.name);
-    chain.role(c.role);
-    model.chains().push_back(chain);
-  }
   for (const auto& e : generated.end_effectors) {
-    msg::EndEffectorInfo ee;
-    ee.name(e.name);
-    ee.chain(e.chain);
-    ee.frame(e.frame);
-    ee.module_key(e.module_key);
-    model.end_effectors().push_back(ee);
-    if (e.module_key.find("drill") != std::string::npos) {
+    if (e.kind == model::EndEffectorKind::kDrill) {
       drill_frame = e.frame;
     }
-    if (wheel_frame.empty() && e.module_key.find("wheel") != std::string::npos) {
+    if (wheel_frame.empty() && e.kind == model::EndEffectorKind::kWheel) {
       wheel_frame = e.frame;
     }
   }
   ASSERT_FALSE(drill_frame.empty());
   ASSERT_FALSE(wheel_frame.empty());
   // As on the paper's robot: the first end-effector of the message is a wheel.
-  ASSERT_NE(model.end_effectors().front().module_key().find("wheel"), std::string::npos);
+  ASSERT_EQ(model.end_effectors().front().frame(), wheel_frame);
 
   SimHardware sim(robot.urdf, World{}, {});
   RobotCore core(sim);

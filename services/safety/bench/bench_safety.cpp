@@ -41,22 +41,22 @@ void report(const char* what, std::vector<double> v, const char* unit) {
 
 void bench_core() {
   safety::SafetyMonitor monitor(safety::Params{}, safety::Clock::now());
-  std::vector<safety::JointLimits> joints;
+  std::vector<concert::model::JointLimits> joints;
   safety::JointSample sample;
   sample.model_version = 1;
   for (int i = 0; i < 14; ++i) {
-    joints.push_back({"joint_" + std::to_string(i), -2.0, 2.0, 3.0, 100.0});
+    joints.push_back({"joint_" + std::to_string(i), "A", -2.0, 2.0, 3.0, 100.0, 60.0});
     sample.name.push_back("joint_" + std::to_string(i));
     sample.position.push_back(0.1 * i - 0.7);
     sample.velocity.push_back(0.5);
     sample.effort.push_back(20.0);
   }
-  monitor.set_model(1, joints);
+  monitor.set_model(1, concert::model::LimitsTable(joints, "bench"));
   std::vector<double> per_sample;
   for (int round = 0; round < 20; ++round) {
     constexpr int kSamples = 10'000;
     const auto t0 = std::chrono::steady_clock::now();
-    for (int i = 0; i < kSamples; ++i) monitor.on_joint_state(sample);
+    for (int i = 0; i < kSamples; ++i) monitor.on_joint_state(sample, std::chrono::steady_clock::now());
     per_sample.push_back(
         std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() /
         kSamples);

@@ -190,7 +190,8 @@ TEST_F(SafetyNodeTest, JointBeyondModelLimitStops) {
   j.lower(-1.0);
   j.upper(1.0);
   j.velocity(2.0);
-  j.effort(80.0);
+  j.peak_torque(80.0);
+  j.continuous_torque(80.0);
   model.joints({j});
   ASSERT_TRUE(models.write(model));
   ASSERT_TRUE(eventually(
@@ -217,7 +218,7 @@ TEST_F(SafetyNodeTest, JointBeyondModelLimitStops) {
     std::this_thread::sleep_for(5ms);
   }
   ASSERT_EQ(node_->status().mode, Mode::kStopped);
-  EXPECT_EQ(node_->status().causes[0], "limits: joint J1_A effort 95.00 beyond +-88.00 (model v5)");
+  EXPECT_EQ(node_->status().causes[0], "limits: joint J1_A effort 95.00 beyond the peak torque +-88.00 (model v5)");
 }
 
 TEST(SafetyConversions, EStopSourcesRoundTrip) {

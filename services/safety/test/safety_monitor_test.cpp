@@ -194,8 +194,9 @@ TEST(SafetyMonitor, RequiredRobotMustBeHeardAfterStart) {
   EXPECT_TRUE(m.reset("op", kT0 + 1300ms).accepted);
 }
 
-std::vector<JointLimits> two_joints() {
-  return {{"J1_A", -2.0, 2.0, 1.5, 100.0}, {"J2_A", -1.0, 1.0, 2.0, 50.0}};
+// J1_A: 100 N m peak, 60 N m continuous torque.
+model::LimitsTable two_joints() {
+  return model::LimitsTable({{"J1_A", "A", -2.0, 2.0, 1.5, 100.0, 60.0}, {"J2_A", "A", -1.0, 1.0, 2.0, 50.0, 50.0}}, "test");
 }
 
 JointSample sample(uint32_t version, double q1, double qd1, double tau1) {
@@ -205,8 +206,8 @@ JointSample sample(uint32_t version, double q1, double qd1, double tau1) {
 TEST(SafetyMonitor, LimitsWithinBoundsAndTolerancesAreFine) {
   SafetyMonitor m(Params{}, kT0);
   m.set_model(3, two_joints());
-  EXPECT_EQ(m.on_joint_state(sample(3, 2.015, 1.6, 109.0)), SampleOutcome::kChecked);
-  EXPECT_EQ(m.on_joint_state(sample(3, -2.015, -1.6, -109.0)), SampleOutcome::kChecked);
+  EXPECT_EQ(m.on_joint_state(sample(3, 2.015, 1.6, 109.0), kT0), SampleOutcome::kChecked);
+  EXPECT_EQ(m.on_joint_state(sample(3, -2.015, -1.6, -109.0), kT0), SampleOutcome::kChecked);
   EXPECT_EQ(m.status().mode, Mode::kRunning);
 }
 
@@ -214,7 +215,7 @@ TEST(SafetyMonitor, PositionVelocityEffortViolationsStop) {
   {
     SafetyMonitor m(Params{}, kT0);
     m.set_model(3, two_joints());
-    m.on_joint_state(sample(3, 2.1, 0.0, 0.0));
+    m.on_joint_state(sample(3, 2.1, 0.0, 0.0), kT0);
     ASSERT_EQ(m.status().mode, Mode::kStopped);
     EXPECT_EQ(m.status().causes[0],
               "limits: joint J1_A position 2.100 beyond [-2.000, 2.000] (model v3)");
@@ -222,53 +223,105 @@ TEST(SafetyMonitor, PositionVelocityEffortViolationsStop) {
   {
     SafetyMonitor m(Params{}, kT0);
     m.set_model(3, two_joints());
-    m.on_joint_state(sample(3, 0.0, -1.7, 0.0));
+    m.on_joint_state(sample(3, 0.0, -1.7, 0.0), kT0);
     ASSERT_EQ(m.status().mode, Mode::kStopped);
     EXPECT_EQ(m.status().causes[0], "limits: joint J1_A velocity -1.700 beyond +-1.650 (model v3)");
   }
   {
     SafetyMonitor m(Params{}, kT0);
     m.set_model(3, two_joints());
-    m.on_joint_state(sample(3, 0.0, 0.0, 111.0));
+    m.on_joint_state(sample(3, 0.0, 0.0, 111.0), kT0);
     ASSERT_EQ(m.status().mode, Mode::kStopped);
-    EXPECT_EQ(m.status().causes[0], "limits: joint J1_A effort 111.00 beyond +-110.00 (model v3)");
+    EXPECT_EQ(m.status().causes[0], "limits: joint J1_A effort 111.00 beyond the peak torque +-110.00 (model v3)");
   }
   {
     SafetyMonitor m(Params{}, kT0);
     m.set_model(3, two_joints());
-    m.on_joint_state(sample(3, std::nan(""), 0.0, 0.0));
+    m.on_joint_state(sample(3, std::nan(""), 0.0, 0.0), kT0);
     EXPECT_EQ(m.status().mode, Mode::kStopped);
   }
+}
+
+// The limits rule (libs/model): the demo's drilling approach loads J2_E (Large A actuator,
+// 460 N m peak, 160 N m continuous) with transients of ~177 N m; that is no stop. A torque
+// beyond the peak, or a load above the continuous torque held for the thermal window, stops.
+model::LimitsTable elbow() { return model::LimitsTable({{"J2_E", "E", -2.75, 2.75, 2.14, 460.0, 160.0}}, "test"); }
+
+JointSample elbow_sample(double tau) { return {1, {"J2_E"}, {0.5}, {0.2}, {tau}}; }
+
+TEST(SafetyLimitsRule, TransientAboveContinuousButBelowPeakIsNoStop) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_model(1, elbow());
+  // 1 s at 100 Hz of -176.82 N m (the demo's transient), then back to 120 N m for 30 s.
+  auto t = kT0;
+  for (int i = 0; i < 100; ++i, t += 10ms) m.on_joint_state(elbow_sample(-176.82), t);
+  for (int i = 0; i < 3000; ++i, t += 10ms) m.on_joint_state(elbow_sample(120.0), t);
+  EXPECT_EQ(m.status().mode, Mode::kRunning) << m.status().causes.front();
+}
+
+TEST(SafetyLimitsRule, BeyondPeakStopsAtOnce) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_model(1, elbow());
+  m.on_joint_state(elbow_sample(-510.0), kT0);
+  ASSERT_EQ(m.status().mode, Mode::kStopped);
+  EXPECT_EQ(m.status().causes[0], "limits: joint J2_E effort -510.00 beyond the peak torque +-506.00 (model v1)");
+}
+
+TEST(SafetyLimitsRule, SustainedAboveContinuousStops) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_model(1, elbow());
+  // 220 N m (below the peak, above 160 x 1.1 = 176 N m) held: the RMS over the 5 s window
+  // passes 176 N m after 5 s x ln(1 / (1 - (176/220)^2)) = 5.1 s.
+  auto t = kT0;
+  int samples = 0;
+  for (; samples < 2000 && m.status().mode == Mode::kRunning; ++samples, t += 10ms) m.on_joint_state(elbow_sample(220.0), t);
+  ASSERT_EQ(m.status().mode, Mode::kStopped);
+  EXPECT_GT(samples, 450);
+  EXPECT_LT(samples, 560);
+  EXPECT_EQ(m.status().causes[0].rfind("limits: joint J2_E RMS effort 176.", 0), 0u) << m.status().causes[0];
+  EXPECT_NE(m.status().causes[0].find("over the 5.0 s thermal window beyond the continuous torque 176.00 (model v1)"),
+            std::string::npos)
+      << m.status().causes[0];
+}
+
+TEST(SafetyLimitsRule, ANewModelStartsCold) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_model(1, elbow());
+  auto t = kT0;
+  for (int i = 0; i < 400; ++i, t += 10ms) m.on_joint_state(elbow_sample(220.0), t);
+  m.set_model(1, elbow());
+  for (int i = 0; i < 400; ++i, t += 10ms) m.on_joint_state(elbow_sample(220.0), t);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
 }
 
 TEST(SafetyMonitor, RepeatedViolationGivesOneCause) {
   SafetyMonitor m(Params{}, kT0);
   m.set_model(3, two_joints());
-  for (int i = 0; i < 1000; ++i) m.on_joint_state(sample(3, 2.5, 0.0, 0.0));
+  for (int i = 0; i < 1000; ++i) m.on_joint_state(sample(3, 2.5, 0.0, 0.0), kT0);
   EXPECT_EQ(m.status().causes.size(), 1u);
 }
 
 TEST(SafetyMonitor, OtherModelVersionsAndNoModelAreNotChecked) {
   SafetyMonitor m(Params{}, kT0);
-  EXPECT_EQ(m.on_joint_state(sample(3, 9.0, 0.0, 0.0)), SampleOutcome::kNoModel);
+  EXPECT_EQ(m.on_joint_state(sample(3, 9.0, 0.0, 0.0), kT0), SampleOutcome::kNoModel);
   m.set_model(4, two_joints());
-  EXPECT_EQ(m.on_joint_state(sample(3, 9.0, 0.0, 0.0)), SampleOutcome::kOtherModelVersion);
+  EXPECT_EQ(m.on_joint_state(sample(3, 9.0, 0.0, 0.0), kT0), SampleOutcome::kOtherModelVersion);
   EXPECT_EQ(m.status().mode, Mode::kRunning);
-  EXPECT_EQ(m.on_joint_state(sample(4, 9.0, 0.0, 0.0)), SampleOutcome::kChecked);
+  EXPECT_EQ(m.on_joint_state(sample(4, 9.0, 0.0, 0.0), kT0), SampleOutcome::kChecked);
   EXPECT_EQ(m.status().mode, Mode::kStopped);
 }
 
 TEST(SafetyMonitor, InfiniteLimitsOfContinuousJointsNeverTrip) {
   SafetyMonitor m(Params{}, kT0);
-  m.set_model(1, {{"wheel", -1e300, 1e300, 20.0, 50.0}});
-  m.on_joint_state({1, {"wheel"}, {1e6}, {19.0}, {10.0}});
+  m.set_model(1, model::LimitsTable({{"wheel", "A", -1e300, 1e300, 20.0, 50.0, 40.0}}, "test"));
+  m.on_joint_state({1, {"wheel"}, {1e6}, {19.0}, {10.0}}, kT0);
   EXPECT_EQ(m.status().mode, Mode::kRunning);
 }
 
 TEST(SafetyMonitor, MalformedJointStateStops) {
   SafetyMonitor m(Params{}, kT0);
   m.set_model(1, two_joints());
-  m.on_joint_state({1, {"J1_A", "J2_A"}, {0.0}, {}, {}});
+  m.on_joint_state({1, {"J1_A", "J2_A"}, {0.0}, {}, {}}, kT0);
   EXPECT_EQ(m.status().mode, Mode::kStopped);
   EXPECT_EQ(m.status().causes[0],
             "limits: malformed joint state: 2 names, 1 positions, 0 velocities, 0 efforts");
@@ -282,7 +335,7 @@ TEST(SafetyMonitor, RandomSamplesTripExactlyWhenOutsideBounds) {
     SafetyMonitor m(Params{}, kT0);
     m.set_model(1, two_joints());
     const auto s = sample(1, q(rng), qd(rng), tau(rng));
-    m.on_joint_state(s);
+    m.on_joint_state(s, kT0);
     const bool outside = std::abs(s.position[0]) > 2.02 || std::abs(s.velocity[0]) > 1.65 ||
                          std::abs(s.effort[0]) > 110.0;
     EXPECT_EQ(m.status().mode == Mode::kStopped, outside) << i;

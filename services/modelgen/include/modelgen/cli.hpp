@@ -21,7 +21,7 @@ namespace concert::modelgen {
 /// without ESC (passive gripper) it mounts that module on chain/body EE (see ModelGenerator).
 /// Returns 0, or non-zero with a one-line message on `err`.
 ///   show [--timeout S]   prints the live model (version, modules, chains, joints,
-///                        end-effectors) read from the latched RobotModel topic (CONCERT_DOMAIN_ID).
+///                        end-effectors) read from the latched GeneratedModel topic (CONCERT_DOMAIN_ID).
 int cli_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 /// `concert model show` (args[0] == "show").

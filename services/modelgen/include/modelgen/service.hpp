@@ -49,11 +49,11 @@ class ModelgenService {
   Outcome on_customisation(const CustomisationRequest& request);
 
   /// The current model, if any.
-  const std::optional<RobotModel>& current() const { return versioner_.current(); }
+  const std::optional<GeneratedModel>& current() const { return versioner_.current(); }
   const Customisation& customisation() const { return custom_; }
 
  private:
-  Outcome offer(RobotModel model);
+  Outcome offer(GeneratedModel model);
 
   const module_db::ModuleDatabase& db_;
   ServiceParams params_;

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "modelgen/model.hpp"
+#include "modelgen/model_generator.hpp"
 
 namespace concert::modelgen {
 
@@ -28,16 +28,16 @@ class ModelVersioner {
 
   /// Makes `model` current with the next version unless its content hash equals the current
   /// model's (then only tree_version is refreshed and nothing is published).
-  Update offer(RobotModel model);
+  Update offer(GeneratedModel model);
 
   /// The current model, if any.
-  const std::optional<RobotModel>& current() const { return current_; }
+  const std::optional<GeneratedModel>& current() const { return current_; }
 
  private:
   uint64_t next_version_;
   uint64_t resumed_version_ = 0;
   std::string resumed_hash_;
-  std::optional<RobotModel> current_;
+  std::optional<GeneratedModel> current_;
 };
 
 }  // namespace concert::modelgen

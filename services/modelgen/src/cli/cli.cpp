@@ -114,7 +114,7 @@ int generate(const Options& o, std::ostream& out) {
     tree = discovery::discover(simbus::simulate_scan(assembly, catalog, o.order), catalog, {o.order});
     source = o.assembly;
   }
-  RobotModel model = ModelGenerator(db).generate(tree, o.custom);
+  GeneratedModel model = ModelGenerator(db).generate(tree, o.custom);
   const auto [old_version, old_hash] = read_bundle_version(o.out);
   const bool unchanged = old_version > 0 && old_hash == model.content_hash;
   model.version = unchanged ? old_version : old_version + 1;
@@ -124,11 +124,11 @@ int generate(const Options& o, std::ostream& out) {
   out << "  " << model.modules.size() << " modules, " << model.tree.bodies.size() << " links, " << model.joints.size()
       << " moving joints\n";
   for (const ChainInfo& c : model.chains) {
-    out << "  chain " << c.name << " (" << c.role << "): " << c.base_link << " -> " << c.tip_link << ", joints:";
+    out << "  chain " << c.name << " (" << concert::model::to_string(c.role) << "): " << c.base_link << " -> " << c.tip_link << ", joints:";
     for (const std::string& j : c.joints) out << " " << j;
     out << "\n";
   }
-  for (const EndEffectorInfo& e : model.end_effectors) out << "  end-effector " << e.name << " at " << e.frame << " (" << e.module_key << ")\n";
+  for (const EndEffectorInfo& e : model.end_effectors) out << "  end-effector " << e.name << " (" << concert::model::to_string(e.kind) << ") at " << e.frame << " (" << e.module_key << ")\n";
   return 0;
 }
 

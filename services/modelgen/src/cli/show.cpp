@@ -55,11 +55,18 @@ int show_main(const std::vector<std::string>& args, std::ostream& out, std::ostr
       } else {
         out << " position [" << j.lower() << ", " << j.upper() << "] rad";
       }
-      out << ", velocity " << j.velocity() << " rad/s, effort " << j.effort() << " N m\n";
+      out << ", velocity " << j.velocity() << " rad/s, torque peak " << j.peak_torque() << " / continuous "
+          << j.continuous_torque() << " N m\n";
     }
     out << "end-effectors (" << m->end_effectors().size() << "):\n";
     for (const msg::EndEffectorInfo& e : m->end_effectors()) {
-      out << "  " << e.name() << " chain " << e.chain() << " frame " << e.frame() << " module " << e.module_key() << "\n";
+      out << "  " << e.name() << " (" << e.kind() << ") chain " << e.chain() << " frame " << e.frame() << " module "
+          << e.module_key() << "\n";
+    }
+    out << "sensor frames (" << m->sensor_frames().size() << "):\n";
+    for (const msg::SensorFrameInfo& f : m->sensor_frames()) {
+      out << "  " << f.name() << " (" << f.kind() << ") frame " << f.frame() << " on " << (f.end_effector().empty() ? "-" : f.end_effector())
+          << " module " << f.module_key() << "\n";
     }
     return 0;
   } catch (const std::exception& e) {

@@ -17,7 +17,7 @@ ModelVersioner versioner_for(const ServiceParams& p) {
 ModelgenService::ModelgenService(const module_db::ModuleDatabase& db, ServiceParams params)
     : db_(db), params_(std::move(params)), generator_(db_, params_.generator), versioner_(versioner_for(params_)) {}
 
-Outcome ModelgenService::offer(RobotModel model) {
+Outcome ModelgenService::offer(GeneratedModel model) {
   const ModelVersioner::Update u = versioner_.offer(std::move(model));
   Outcome out{u.published, u.version, {}};
   if (u.published && params_.bundle_dir) {
@@ -34,7 +34,7 @@ Outcome ModelgenService::offer(RobotModel model) {
 
 Outcome ModelgenService::on_tree(const topology::ModuleTree& tree, uint64_t tree_version) {
   const uint64_t current = versioner_.current() ? versioner_.current()->version : 0;
-  RobotModel model;
+  GeneratedModel model;
   try {
     model = generator_.generate(tree, custom_, tree_version);
   } catch (const ModelError& e) {
@@ -62,7 +62,7 @@ Outcome ModelgenService::on_customisation(const CustomisationRequest& request) {
             who + ": made for model version " + std::to_string(request.base_version) + " but the current version is " + std::to_string(current)};
   }
   try {
-    RobotModel model = generator_.generate(*tree_, request.customisation, tree_version_);
+    GeneratedModel model = generator_.generate(*tree_, request.customisation, tree_version_);
     custom_ = request.customisation;
     return offer(std::move(model));
   } catch (const ModelError& e) {

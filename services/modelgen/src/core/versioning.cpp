@@ -9,7 +9,7 @@ ModelVersioner ModelVersioner::resume(uint64_t version, std::string hash) {
   return v;
 }
 
-ModelVersioner::Update ModelVersioner::offer(RobotModel model) {
+ModelVersioner::Update ModelVersioner::offer(GeneratedModel model) {
   if (!current_ && resumed_version_ > 0 && model.content_hash == resumed_hash_) {
     model.version = resumed_version_;
     current_ = std::move(model);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "concert/model/dds/conversions.hpp"
 #include "concert/topology/dds/conversions.hpp"
 #include "conversions.hpp"
 
@@ -33,8 +34,8 @@ void ModelgenNode::report(const Outcome& outcome, const std::string& what) {
     return;
   }
   if (outcome.published) {
-    const RobotModel& m = *service_.current();
-    models_.write(to_msg(m, now_ns()));
+    const GeneratedModel& m = *service_.current();
+    models_.write(concert::model::dds::to_msg(m.description(), now_ns()));
     log_ << "modelgen: published model version " << m.version << " (" << m.content_hash << ", " << m.modules.size()
          << " modules, " << m.joints.size() << " joints) from " << what << "\n";
     status_.report(msg::ServiceState::SERVICE_READY, version, "model version " + std::to_string(version));

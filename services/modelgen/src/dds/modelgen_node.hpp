@@ -1,5 +1,5 @@
 #pragma once
-// DDS adapter of the modelgen service: module tree and customisation requests in, RobotModel
+// DDS adapter of the modelgen service: module tree and customisation requests in, GeneratedModel
 // (transient-local, latched) and service status out. Errors keep the current model; they go to
 // the status message and the log.
 

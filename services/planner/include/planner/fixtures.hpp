@@ -1,11 +1,11 @@
 #pragma once
 // Models for tests and benchmarks, built in-process the way the running system builds them:
-// assembly file -> simbus tree -> modelgen (project module database) -> ModelDescription.
+// assembly file -> simbus tree -> model generation (project module database) -> description.
 
 #include <filesystem>
 #include <string>
 
-#include "modelgen/model.hpp"
+#include "concert/model_generation/model.hpp"
 #include "planner/types.hpp"
 
 namespace concert::planner::fixtures {
@@ -14,8 +14,8 @@ namespace concert::planner::fixtures {
 std::filesystem::path data_dir();
 /// Model of an assembly file with the project's module database (data/module_db).
 ModelDescription model_from_assembly(const std::filesystem::path& assembly, uint64_t version);
-/// The model modelgen generates for an assembly (what it would publish), for adapter tests.
-modelgen::RobotModel generated_model(const std::filesystem::path& assembly);
+/// The model generated for an assembly (what modelgen would publish), for adapter tests.
+model_generation::GeneratedModel generated_model(const std::filesystem::path& assembly);
 /// A wall (normal -x, facing the robot at the origin) at x = `wall_x` and a drilling area on it
 /// at height `z` [m] and lateral offset `y` [m]: frame z along the outward normal (-x).
 Eigen::Isometry3d drilling_area(double wall_x, double y, double z);

@@ -36,11 +36,11 @@ struct PostureResult {
 /// `first_seed`: skip the seeds before this index (a previous result's next_seed: another
 /// posture for the same goal, when no path reached the first one).
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
-                               const EndEffectorSpec& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
+                               const EndEffectorInfo& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
                                uint64_t seed, const std::vector<Eigen::VectorXd>& hints = {}, int first_seed = 0);
 
 /// Task error of a full q against a drilling area: (position error [m], axis error [rad]).
-std::pair<double, double> task_error(const PlanningModel& model, const Params& params, const EndEffectorSpec& tool,
+std::pair<double, double> task_error(const PlanningModel& model, const Params& params, const EndEffectorInfo& tool,
                                      const Eigen::VectorXd& q_full, const Eigen::Isometry3d& area);
 
 /// The planner of the planner service. Thread-safe: set_model/set_environment may come from

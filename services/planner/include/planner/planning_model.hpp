@@ -1,7 +1,8 @@
 #pragma once
-// The planner's view of one robot model version: whole-body configuration space (planar base
-// x, y, yaw + the arm joints), link geometry for FCL, SRDF-disabled pairs, torque limits.
-// Immutable once built (Model/Data split: per-thread state lives in StateChecker).
+// The planner's view of one robot model version, built on the parsed model of libs/model:
+// whole-body configuration space (planar base x, y, yaw + the arm joints), link geometry for
+// FCL, SRDF-disabled pairs, limits (with the limits rule: static torques within the continuous
+// torque). Immutable once built (Model/Data split: per-thread state lives in StateChecker).
 
 #include <memory>
 #include <optional>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "concert/kinematics/model.hpp"
+#include "concert/model/robot_model.hpp"
 #include "planner/types.hpp"
 
 namespace concert::planner {
@@ -39,13 +41,17 @@ struct LinkNode {
 /// One model version, ready for planning. Build with PlanningModel::build.
 class PlanningModel {
  public:
-  /// Builds from a model description. Throws PlannerError naming what is wrong (URDF parse
-  /// error, joint listed but absent from the URDF, no arm chain, mesh-only links are reported
-  /// in ignored_shapes()).
+  /// Builds from a parsed model. Throws PlannerError naming what is wrong (no arm chain; mesh
+  /// collision shapes are reported in ignored_shapes()).
+  static std::shared_ptr<const PlanningModel> build(std::shared_ptr<const model::RobotModel> robot, const Params& params);
+  /// Parses `description` (model::RobotModel::build) and builds from it; model errors (URDF
+  /// parse error, joint listed but absent from the URDF...) become PlannerError.
   static std::shared_ptr<const PlanningModel> build(const ModelDescription& description, const Params& params);
 
-  [[nodiscard]] uint64_t version() const { return version_; }
-  [[nodiscard]] const ModelDescription& description() const { return description_; }
+  [[nodiscard]] uint64_t version() const { return robot_->version(); }
+  [[nodiscard]] const ModelDescription& description() const { return robot_->description(); }
+  /// The parsed model it was built on.
+  [[nodiscard]] const model::RobotModel& robot() const { return *robot_; }
   /// orocos-kdl model with a planar base (base_x, base_y, base_yaw first).
   [[nodiscard]] const kinematics::Model& kinematics() const { return kinematics_; }
   /// Size of the full joint vector (kinematics().dof()).
@@ -60,7 +66,8 @@ class PlanningModel {
   [[nodiscard]] const Eigen::VectorXd& upper() const { return upper_; }
   /// Velocity limits of the planned joints [m/s, rad/s] (base from Params).
   [[nodiscard]] const Eigen::VectorXd& velocity_limits() const { return velocity_; }
-  /// Continuous torque limit per full joint [N m]; 0: not limited (virtual, legs).
+  /// Torque limit of the static load per full joint [N m]: the continuous torque
+  /// (model::planning_torque_limit); 0: not limited (virtual, legs).
   [[nodiscard]] const Eigen::VectorXd& torque_limits() const { return torque_; }
   /// World z of the base link [m].
   [[nodiscard]] double base_height() const { return base_height_; }
@@ -70,11 +77,11 @@ class PlanningModel {
   /// Collision elements the model has but the planner ignores (meshes), as "link: reason".
   [[nodiscard]] const std::vector<std::string>& ignored_shapes() const { return ignored_; }
 
-  /// The tool end-effector (`name`, or the first with a camera frame when empty); throws
-  /// PlannerError listing the candidates.
-  [[nodiscard]] const EndEffectorSpec& tool(const std::string& name) const;
-  /// Camera frame of a tool end-effector; throws PlannerError if the model has none.
-  [[nodiscard]] std::string camera_frame(const EndEffectorSpec& tool) const;
+  /// The tool end-effector: `name`, or the arm's tool (model::RobotModel::tool) when empty;
+  /// throws PlannerError listing the candidates.
+  [[nodiscard]] const EndEffectorInfo& tool(const std::string& name) const;
+  /// Frame of the camera sensor on a tool; throws PlannerError naming what the tool carries.
+  [[nodiscard]] std::string camera_frame(const EndEffectorInfo& tool) const;
 
   /// World pose of every link (links() order) for a full q [m, rad].
   void link_poses(const Eigen::VectorXd& q_full, std::vector<Eigen::Isometry3d>& poses) const;
@@ -111,8 +118,7 @@ class PlanningModel {
  private:
   explicit PlanningModel(kinematics::Model kinematics) : kinematics_(std::move(kinematics)) {}
 
-  uint64_t version_ = 0;
-  ModelDescription description_;
+  std::shared_ptr<const model::RobotModel> robot_;
   kinematics::Model kinematics_;
   std::vector<int> planned_;
   std::vector<std::string> planned_names_;
@@ -122,7 +128,6 @@ class PlanningModel {
   Eigen::Vector3d gravity_ = Eigen::Vector3d(0.0, 0.0, -9.81);
   std::vector<std::vector<bool>> disabled_;
   std::vector<std::string> ignored_;
-  std::string camera_prefix_;
   std::optional<Eigen::VectorXd> arm_mirror_;  // per arm joint: +1 or -1 (see mirrored_arm)
 };
 

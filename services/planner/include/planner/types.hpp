@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "concert/model/description.hpp"
+
 namespace concert::planner {
 
 /// A model, request or environment the planner cannot use; what() names the field or item.
@@ -19,46 +21,15 @@ class PlannerError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// One moving joint of the robot model (RobotModel.joints).
-struct JointSpec {
-  std::string name;
-  std::string chain;      ///< chain tag ("A", "B", ...)
-  double lower = 0.0;     ///< [rad] (or [m])
-  double upper = 0.0;     ///< [rad]
-  double velocity = 0.0;  ///< limit [rad/s]
-  double effort = 0.0;    ///< continuous torque limit [N m]
-};
-
-/// A kinematic chain (RobotModel.chains).
-struct ChainSpec {
-  std::string name;                 ///< chain tag
-  std::string role;                 ///< "arm", "leg" or "other"
-  std::vector<std::string> joints;  ///< root to tip
-};
-
-/// An end-effector (RobotModel.end_effectors).
-struct EndEffectorSpec {
-  std::string name;        ///< e.g. "drill_E"
-  std::string chain;
-  std::string frame;       ///< TCP link
-  std::string module_key;  ///< e.g. "concert_drill"
-};
-
-/// What the planner is rebuilt from on every model version.
-struct ModelDescription {
-  uint64_t version = 0;
-  std::string urdf;
-  std::string srdf;
-  std::vector<JointSpec> joints;
-  std::vector<ChainSpec> chains;
-  std::vector<EndEffectorSpec> end_effectors;
-};
+/// The model as received (libs/model): the planner has no model type of its own.
+using ModelDescription = model::ModelDescription;
+/// An end-effector of the model (libs/model), selected by role and kind.
+using EndEffectorInfo = model::EndEffectorInfo;
 
 /// Parameters of the planner core (loaded from YAML by the adapter).
 struct Params {
   // Task (paper section 5.4.2).
   double camera_distance = 0.6;      ///< d: camera frame to wall along the normal [m]
-  std::string camera_frame_prefix = "camera_";  ///< camera frame = prefix + chain tag of the tool
   double contact_force = 200.0;      ///< expected drilling force along the tool axis [N]
   double torque_margin = 1.0;        ///< allowed fraction of the continuous torque [-]
 
@@ -164,7 +135,7 @@ struct Goal {
 struct PlanRequest {
   uint64_t request_id = 0;
   uint64_t model_version = 0;     ///< must equal the planner's model version
-  std::string end_effector;       ///< tool end-effector name; empty: the first with a camera
+  std::string end_effector;       ///< tool end-effector name; empty: the arm's tool (by role)
   std::vector<Goal> goals;
 };
 

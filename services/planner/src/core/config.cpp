@@ -94,8 +94,6 @@ Params parse_params(const std::string& yaml, const std::string& source) {
       const double v = number(kv.second, where);
       if (v < 0) throw PlannerError(where + ": expected a non-negative integer");
       p.seed = static_cast<uint64_t>(v);
-    } else if (key == "camera_frame_prefix") {
-      p.camera_frame_prefix = kv.second.as<std::string>();
     } else {
       throw PlannerError(where + ": unknown parameter");
     }

@@ -54,7 +54,7 @@ constexpr int kTurns = 5;
 
 }  // namespace
 
-std::pair<double, double> task_error(const PlanningModel& model, const Params& params, const EndEffectorSpec& tool,
+std::pair<double, double> task_error(const PlanningModel& model, const Params& params, const EndEffectorInfo& tool,
                                      const Eigen::VectorXd& q_full, const Eigen::Isometry3d& area) {
   const Task task = make_task(params, area);
   const Eigen::Isometry3d pose = model.link_pose(q_full, model.camera_frame(tool));
@@ -63,7 +63,7 @@ std::pair<double, double> task_error(const PlanningModel& model, const Params& p
 }
 
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
-                               const EndEffectorSpec& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
+                               const EndEffectorInfo& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
                                uint64_t seed, const std::vector<Eigen::VectorXd>& hints, int first_seed) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto out_of_time = [&] {

@@ -60,7 +60,7 @@ void Planner::set_model(const ModelDescription& description) {
 int Planner::warm_up(double from, double to, double step, double seconds_per_height, const std::function<bool()>& keep_going) {
   const std::shared_ptr<const PlanningModel> model = this->model();
   if (!model || !(step > 0.0)) return 0;
-  const EndEffectorSpec* tool = nullptr;
+  const EndEffectorInfo* tool = nullptr;
   try {
     tool = &model->tool("");
   } catch (const PlannerError&) {
@@ -244,7 +244,7 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     return fail(Status::kInvalidStart, "start state has " + std::to_string(q_start_full.size()) + " joints, model version " +
                                            std::to_string(model->version()) + " has " + std::to_string(model->full_dof()));
   }
-  const EndEffectorSpec* tool = nullptr;
+  const EndEffectorInfo* tool = nullptr;
   try {
     tool = &model->tool(request.end_effector);
     (void)model->camera_frame(*tool);

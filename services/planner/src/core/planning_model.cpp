@@ -1,47 +1,12 @@
 #include "planner/planning_model.hpp"
 
-#include <tinyxml2.h>
-#include <urdf_parser/urdf_parser.h>
-
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <map>
 #include <set>
 
 namespace concert::planner {
-namespace {
-
-Eigen::Isometry3d to_eigen(const urdf::Pose& p) {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
-  t.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
-  return t;
-}
-
-// SRDF <disable_collisions link1 link2>: the only SRDF content the planner needs, so a small
-// tinyxml2 read instead of a full SRDF model.
-std::vector<std::pair<std::string, std::string>> disabled_pairs(const std::string& srdf) {
-  std::vector<std::pair<std::string, std::string>> out;
-  if (srdf.empty()) return out;
-  tinyxml2::XMLDocument doc;
-  if (doc.Parse(srdf.c_str()) != tinyxml2::XML_SUCCESS) {
-    throw PlannerError(std::string("model SRDF: XML parse error: ") + doc.ErrorStr());
-  }
-  const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
-  if (robot == nullptr) throw PlannerError("model SRDF: no <robot> element");
-  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("disable_collisions"); e != nullptr;
-       e = e->NextSiblingElement("disable_collisions")) {
-    const char* a = e->Attribute("link1");
-    const char* b = e->Attribute("link2");
-    if (a == nullptr || b == nullptr) throw PlannerError("model SRDF: <disable_collisions> without link1/link2");
-    out.emplace_back(a, b);
-  }
-  return out;
-}
-
-}  // namespace
 
 const char* to_string(Constraint constraint) {
   switch (constraint) {
@@ -71,43 +36,33 @@ const char* to_string(Status status) {
 // An axis within this (cosine) of a plane's normal crosses it; within this of 0, lies in it.
 constexpr double kAxisTolerance = 1e-3;
 
-std::shared_ptr<const PlanningModel> PlanningModel::build(const ModelDescription& d, const Params& params) {
-  kinematics::Model kin = [&] {
-    try {
-      return kinematics::Model::from_urdf_string(d.urdf, {.planar_base = true});
-    } catch (const kinematics::ModelError& e) {
-      throw PlannerError("model version " + std::to_string(d.version) + ": URDF: " + e.what());
-    }
-  }();
-  std::shared_ptr<PlanningModel> m(new PlanningModel(std::move(kin)));
-  m->version_ = d.version;
-  m->description_ = d;
-  m->camera_prefix_ = params.camera_frame_prefix;
+std::shared_ptr<const PlanningModel> PlanningModel::build(const ModelDescription& description, const Params& params) {
+  try {
+    return build(model::RobotModel::build(description), params);
+  } catch (const model::ModelError& e) {
+    throw PlannerError(e.what());
+  }
+}
+
+std::shared_ptr<const PlanningModel> PlanningModel::build(std::shared_ptr<const model::RobotModel> robot, const Params& params) {
+  std::shared_ptr<PlanningModel> m(new PlanningModel(robot->planar_kinematics()));
+  m->robot_ = robot;
   const kinematics::Model& k = m->kinematics_;
-  const std::string where = "model version " + std::to_string(d.version);
+  const std::string where = robot->where();
 
   // Planned joints: the virtual base joints, then the joints of every arm chain.
-  std::set<std::string> leg_chains;
   std::vector<std::string> arm_joints;
-  for (const ChainSpec& c : d.chains) {
-    if (c.role == "leg") leg_chains.insert(c.name);
-    if (c.role != "arm") continue;
-    for (const std::string& j : c.joints) arm_joints.push_back(j);
+  for (const model::ChainInfo* c : robot->chains(model::ChainRole::kArm)) {
+    for (const std::string& j : c->joints) arm_joints.push_back(j);
   }
   if (arm_joints.empty()) throw PlannerError(where + ": no chain with role \"arm\" (nothing to plan for)");
   for (int i = 0; i < k.num_virtual_joints(); ++i) m->planned_.push_back(i);
-  for (const std::string& j : arm_joints) {
-    const auto idx = k.joint_index(j);
-    if (!idx) throw PlannerError(where + ": arm joint '" + j + "' is not a moving joint of the URDF");
-    m->planned_.push_back(*idx);
-  }
+  for (const std::string& j : arm_joints) m->planned_.push_back(k.joint_index_or_throw(j));
   const int n = static_cast<int>(m->planned_.size());
   m->lower_.resize(n);
   m->upper_.resize(n);
   m->velocity_.resize(n);
   m->torque_ = Eigen::VectorXd::Zero(k.dof());
-  std::map<std::string, const JointSpec*> spec;
-  for (const JointSpec& j : d.joints) spec[j.name] = &j;
   for (int i = 0; i < n; ++i) {
     const int fi = m->planned_[static_cast<std::size_t>(i)];
     m->planned_names_.push_back(k.joint_names()[static_cast<std::size_t>(fi)]);
@@ -117,84 +72,51 @@ std::shared_ptr<const PlanningModel> PlanningModel::build(const ModelDescription
       m->velocity_[i] = i == 2 ? params.base_angular_velocity : params.base_linear_velocity;
       continue;
     }
-    const kinematics::JointLimits& lim = k.joint_limits()[static_cast<std::size_t>(fi)];
-    m->lower_[i] = lim.has_position_limits ? lim.lower : -M_PI;
-    m->upper_[i] = lim.has_position_limits ? lim.upper : M_PI;
-    double vel = lim.velocity;
-    double eff = lim.effort;
-    if (const auto it = spec.find(m->planned_names_.back()); it != spec.end()) {
-      if (it->second->velocity > 0.0) vel = it->second->velocity;
-      if (it->second->effort > 0.0) eff = it->second->effort;
-    }
-    if (vel <= 0.0) throw PlannerError(where + ": joint '" + m->planned_names_.back() + "' has no velocity limit");
-    m->velocity_[i] = vel;
-    m->torque_[fi] = eff;
+    // The limits table with the limits rule: positions within [lower, upper] (a continuous
+    // joint within one turn), velocities within the limit, static torques within the
+    // continuous torque.
+    const model::JointLimits& lim = robot->limits().at(m->planned_names_.back());
+    m->lower_[i] = std::isfinite(lim.lower) ? lim.lower : -M_PI;
+    m->upper_[i] = std::isfinite(lim.upper) ? lim.upper : M_PI;
+    m->velocity_[i] = lim.velocity;
+    m->torque_[fi] = model::planning_torque_limit(lim);
   }
 
-  // Link tree with collision primitives (urdfdom: the geometry KDL does not keep).
-  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(d.urdf);
-  if (!urdf) throw PlannerError(where + ": URDF cannot be parsed");
-  std::map<std::string, int> index;
-  std::function<void(const urdf::LinkConstSharedPtr&, int, int)> walk = [&](const urdf::LinkConstSharedPtr& link, int parent,
-                                                                          int group) {
+  // Links with their collision primitives (meshes are reported, not used).
+  std::set<std::string> leg_chains;
+  for (const model::ChainInfo* c : robot->chains(model::ChainRole::kLeg)) leg_chains.insert(c->name);
+  for (const model::Link& link : robot->links()) {
     LinkNode node;
-    node.name = link->name;
-    node.parent = parent;
-    if (parent >= 0) {
-      const urdf::JointConstSharedPtr& j = link->parent_joint;
-      node.origin = to_eigen(j->parent_to_joint_origin_transform);
-      node.axis = Eigen::Vector3d(j->axis.x, j->axis.y, j->axis.z);
-      if (j->type != urdf::Joint::FIXED) {
-        const auto fi = k.joint_index(j->name);
-        if (!fi) throw PlannerError(where + ": URDF joint '" + j->name + "' unknown to the kinematic model");
-        node.full_index = *fi;
-        node.prismatic = j->type == urdf::Joint::PRISMATIC;
-        if (std::find(arm_joints.begin(), arm_joints.end(), j->name) != arm_joints.end()) group = *fi;
-        const auto s = spec.find(j->name);
-        if (s != spec.end() && leg_chains.count(s->second->chain) > 0) node.leg = true;
-      }
-      node.leg = node.leg || m->links_[static_cast<std::size_t>(parent)].leg;
+    node.name = link.name;
+    node.parent = link.parent;
+    node.origin = link.origin;
+    node.axis = link.axis;
+    node.prismatic = link.prismatic;
+    node.leg = leg_chains.count(link.chain) > 0;
+    node.mass = link.mass;
+    node.com = link.com;
+    // Rigid group: the nearest planned arm joint at or above the link (-1: the base group).
+    node.rigid_group = link.parent >= 0 ? m->links_[static_cast<std::size_t>(link.parent)].rigid_group : -1;
+    if (link.moving) {
+      node.full_index = k.joint_index_or_throw(link.joint);
+      if (std::find(arm_joints.begin(), arm_joints.end(), link.joint) != arm_joints.end()) node.rigid_group = node.full_index;
     }
-    node.rigid_group = group;
-    if (link->inertial) {
-      node.mass = link->inertial->mass;
-      node.com = to_eigen(link->inertial->origin).translation();
-    }
-    for (const urdf::CollisionSharedPtr& c : link->collision_array) {
-      if (!c || !c->geometry) continue;
+    for (const model::CollisionShape& c : link.shapes) {
       LinkShape s;
-      s.origin = to_eigen(c->origin);
-      switch (c->geometry->type) {
-        case urdf::Geometry::BOX: {
-          const auto* b = static_cast<const urdf::Box*>(c->geometry.get());
-          s.type = LinkShape::Type::kBox;
-          s.size = Eigen::Vector3d(b->dim.x, b->dim.y, b->dim.z);
-          break;
-        }
-        case urdf::Geometry::CYLINDER: {
-          const auto* cy = static_cast<const urdf::Cylinder*>(c->geometry.get());
-          s.type = LinkShape::Type::kCylinder;
-          s.size = Eigen::Vector3d(cy->radius, cy->radius, cy->length);
-          break;
-        }
-        case urdf::Geometry::SPHERE: {
-          const auto* sp = static_cast<const urdf::Sphere*>(c->geometry.get());
-          s.type = LinkShape::Type::kSphere;
-          s.size = Eigen::Vector3d::Constant(sp->radius);
-          break;
-        }
-        default:
-          m->ignored_.push_back(link->name + ": mesh collision geometry (planner uses primitives only)");
+      s.origin = c.origin;
+      s.size = c.size;
+      switch (c.type) {
+        case model::CollisionShape::Type::kBox: s.type = LinkShape::Type::kBox; break;
+        case model::CollisionShape::Type::kCylinder: s.type = LinkShape::Type::kCylinder; break;
+        case model::CollisionShape::Type::kSphere: s.type = LinkShape::Type::kSphere; break;
+        case model::CollisionShape::Type::kMesh:
+          m->ignored_.push_back(link.name + ": mesh collision geometry (planner uses primitives only)");
           continue;
       }
       node.shapes.push_back(s);
     }
-    const int self = static_cast<int>(m->links_.size());
-    index[node.name] = self;
     m->links_.push_back(std::move(node));
-    for (const urdf::LinkSharedPtr& child : link->child_links) walk(child, self, group);
-  };
-  walk(urdf->getRoot(), -1, -1);
+  }
 
   const std::size_t nl = m->links_.size();
   m->disabled_.assign(nl, std::vector<bool>(nl, false));
@@ -203,14 +125,9 @@ std::shared_ptr<const PlanningModel> PlanningModel::build(const ModelDescription
       if (a == b || m->links_[a].rigid_group == m->links_[b].rigid_group) m->disabled_[a][b] = true;
     }
   }
-  for (const auto& [a, b] : disabled_pairs(d.srdf)) {
-    const auto ia = index.find(a);
-    const auto ib = index.find(b);
-    if (ia == index.end() || ib == index.end()) {
-      throw PlannerError(where + ": SRDF disables collisions of unknown link '" + (ia == index.end() ? a : b) + "'");
-    }
-    m->disabled_[static_cast<std::size_t>(ia->second)][static_cast<std::size_t>(ib->second)] = true;
-    m->disabled_[static_cast<std::size_t>(ib->second)][static_cast<std::size_t>(ia->second)] = true;
+  for (const auto& [a, b] : robot->disabled_pairs()) {
+    m->disabled_[static_cast<std::size_t>(a)][static_cast<std::size_t>(b)] = true;
+    m->disabled_[static_cast<std::size_t>(b)][static_cast<std::size_t>(a)] = true;
   }
 
   // Base height: the lowest leg collision point of the zero posture rests on the floor.
@@ -357,7 +274,7 @@ void PlanningModel::static_torques(const std::vector<Eigen::Isometry3d>& poses, 
 
 Eigen::Isometry3d PlanningModel::link_pose(const Eigen::VectorXd& q, const std::string& link) const {
   const int i = link_index(link);
-  if (i < 0) throw PlannerError("model version " + std::to_string(version_) + ": no link '" + link + "'");
+  if (i < 0) throw PlannerError(robot_->where() + ": no link '" + link + "'");
   std::vector<Eigen::Isometry3d> poses;
   link_poses(q, poses);
   return poses[static_cast<std::size_t>(i)];
@@ -370,25 +287,20 @@ int PlanningModel::link_index(const std::string& name) const {
   return -1;
 }
 
-const EndEffectorSpec& PlanningModel::tool(const std::string& name) const {
-  std::string candidates;
-  for (const EndEffectorSpec& e : description_.end_effectors) {
-    const bool has_camera = link_index(camera_prefix_ + e.chain) >= 0;
-    if (name.empty() ? has_camera : e.name == name) return e;
-    candidates += (candidates.empty() ? "" : ", ") + e.name + (has_camera ? " (camera)" : "");
+const EndEffectorInfo& PlanningModel::tool(const std::string& name) const {
+  try {
+    return name.empty() ? robot_->tool() : robot_->end_effector(name);
+  } catch (const model::ModelError& e) {
+    throw PlannerError(e.what());
   }
-  throw PlannerError("model version " + std::to_string(version_) + ": " +
-                     (name.empty() ? std::string("no end-effector with a camera frame") : "no end-effector '" + name + "'") +
-                     "; end-effectors: " + (candidates.empty() ? "none" : candidates));
 }
 
-std::string PlanningModel::camera_frame(const EndEffectorSpec& tool) const {
-  const std::string frame = camera_prefix_ + tool.chain;
-  if (link_index(frame) < 0) {
-    throw PlannerError("model version " + std::to_string(version_) + ": end-effector '" + tool.name + "' has no camera frame '" +
-                       frame + "'");
+std::string PlanningModel::camera_frame(const EndEffectorInfo& tool) const {
+  try {
+    return robot_->sensor(tool, model::SensorKind::kCamera).frame;
+  } catch (const model::ModelError& e) {
+    throw PlannerError(e.what());
   }
-  return frame;
 }
 
 Eigen::VectorXd PlanningModel::to_full(const Eigen::VectorXd& planned, const Eigen::VectorXd& full_template) const {
@@ -413,7 +325,7 @@ Eigen::VectorXd PlanningModel::full_from_named(const std::vector<std::string>& n
   q.head<3>() = base;
   for (std::size_t i = 0; i < names.size(); ++i) {
     const auto idx = kinematics_.joint_index(names[i]);
-    if (!idx) throw PlannerError("joint state: joint '" + names[i] + "' is not in model version " + std::to_string(version_));
+    if (!idx) throw PlannerError("joint state: joint '" + names[i] + "' is not in " + robot_->where());
     q[*idx] = positions[i];
   }
   return q;

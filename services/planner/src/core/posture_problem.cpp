@@ -139,7 +139,7 @@ std::vector<Sphere> sphere_cover(const LinkShape& s) {
 
 }  // namespace
 
-PostureProblem::PostureProblem(const PlanningModel& model, const Params& params, const EndEffectorSpec* tool,
+PostureProblem::PostureProblem(const PlanningModel& model, const Params& params, const EndEffectorInfo* tool,
                  const Eigen::VectorXd& full_template, std::optional<Task> task, std::shared_ptr<const DistanceField> field)
       : model_(model),
         params_(params),

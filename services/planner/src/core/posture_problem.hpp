@@ -51,7 +51,7 @@ enum class Term { kTask, kTorque, kSurface, kFloor, kSelf, kObstacle };
 class PostureProblem {
  public:
   // `tool` and `task` may be absent together (path sampling: no task, no contact force).
-  PostureProblem(const PlanningModel& model, const Params& params, const EndEffectorSpec* tool,
+  PostureProblem(const PlanningModel& model, const Params& params, const EndEffectorInfo* tool,
                  const Eigen::VectorXd& full_template, std::optional<Task> task, std::shared_ptr<const DistanceField> field);
 
   [[nodiscard]] int size() const { return size_; }

@@ -1,5 +1,6 @@
 #include "dds/planner_node.hpp"
 
+#include "concert/model/dds/conversions.hpp"
 #include "concert/world/world_dds.hpp"
 
 #include <sys/resource.h>
@@ -32,19 +33,6 @@ World to_planner_world(const world::World& w) {
   for (const auto& s : w.walls) add(s);
   for (const auto& s : w.obstacles) add(s);
   return out;
-}
-
-ModelDescription to_core(const msg::RobotModel& m) {
-  ModelDescription d;
-  d.version = m.version();
-  d.urdf = m.urdf();
-  d.srdf = m.srdf();
-  for (const msg::JointInfo& j : m.joints())
-    d.joints.push_back({j.name(), j.chain(), j.lower(), j.upper(), j.velocity(), j.effort()});
-  for (const msg::ChainInfo& c : m.chains()) d.chains.push_back({c.name(), c.role(), c.joints()});
-  for (const msg::EndEffectorInfo& e : m.end_effectors())
-    d.end_effectors.push_back({e.name(), e.chain(), e.frame(), e.module_key()});
-  return d;
 }
 
 Eigen::Isometry3d to_core(const msg::Pose& p) {
@@ -202,7 +190,7 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
   status_.report(msg::SERVICE_RECONFIGURING, static_cast<uint32_t>(planner_.model_version()),
                  "reconfiguring to model version " + std::to_string(model.version()));
   try {
-    planner_.set_model(to_core(model));
+    planner_.set_model(concert::model::dds::to_description(model));
     const auto m = planner_.model();
     std::string note = "planning " + std::to_string(m->dof()) + " joints (base x, y, yaw + arm)";
     if (!m->ignored_shapes().empty())

@@ -26,7 +26,6 @@
 namespace concert::planner::dds {
 
 /// Conversions between IDL and core types.
-ModelDescription to_core(const msg::RobotModel& model);
 Eigen::Isometry3d to_core(const msg::Pose& pose);
 /// The planner's boxes and cylinders of the world every service reads (libs/world).
 World to_planner_world(const world::World& world);

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "concert/model/dds/conversions.hpp"
+#include "concert/model/robot_model.hpp"
 #include "concert/topology/dds/conversions.hpp"
 #include "robot_conversions.hpp"
 
@@ -53,35 +55,11 @@ RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams
 }
 
 std::string tool_end_effector(const msg::RobotModel& m) {
-  auto on_arm = [&](const msg::EndEffectorInfo& ee) {
-    for (const auto& chain : m.chains()) {
-      if (chain.name() == ee.chain()) {
-        return chain.role() == "arm";
-      }
-    }
-    return false;
-  };
-  auto is_tool = [](const msg::EndEffectorInfo& ee) {
-    for (const char* kind : {"drill", "sand", "spray", "gripper", "tool"}) {
-      if (ee.module_key().find(kind) != std::string::npos) {
-        return true;
-      }
-    }
-    return false;
-  };
-  const msg::EndEffectorInfo* first_on_arm = nullptr;
-  for (const auto& ee : m.end_effectors()) {
-    if (!on_arm(ee) || ee.module_key().find("wheel") != std::string::npos) {
-      continue;
-    }
-    if (is_tool(ee)) {
-      return ee.frame();
-    }
-    if (first_on_arm == nullptr) {
-      first_on_arm = &ee;
-    }
+  try {
+    return model::RobotModel::build(model::dds::to_description(m))->tool().frame;
+  } catch (const std::exception&) {
+    return "";  // no parsable description or no arm tool: the core's own choice
   }
-  return first_on_arm != nullptr ? first_on_arm->frame() : std::string{};
 }
 
 void RobotNode::on_trajectory(const msg::JointTrajectoryCommand& c) {

@@ -21,9 +21,9 @@ struct NodeParams {
   int trajectory_decimation{100};  ///< trajectory progress every N cycles (10 Hz), and on each change
 };
 
-/// The end-effector a Cartesian command drives, from the model message: the end-effector of an
-/// arm chain whose module is a tool (drill, sander, spraying tool, gripper), else the first
-/// end-effector of an arm chain, else "" (the core's own choice); never a wheel.
+/// The end-effector a Cartesian command drives, from the model message: libs/model's tool (the
+/// end-effector at the tip of an arm chain, never a wheel); "" (the core's own choice: the
+/// deepest tcp link) when the message has no parsable description or no arm tool.
 std::string tool_end_effector(const msg::RobotModel& model);
 
 /// A SAFETY_STOPPED safety state holds the robot, aborts a running trajectory and refuses

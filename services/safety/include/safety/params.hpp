@@ -21,7 +21,8 @@ struct Params {
   double position_tolerance = 0.02;
   /// |velocity| beyond (1 + margin) x the model's velocity limit is a violation (fraction).
   double velocity_margin = 0.10;
-  /// |effort| beyond (1 + margin) x the model's effort limit is a violation (fraction).
+  /// |effort| beyond (1 + margin) x the peak torque, or its RMS over the thermal window beyond
+  /// (1 + margin) x the continuous torque, is a violation (fraction; libs/model limits rule).
   double effort_margin = 0.10;
   /// The adapter re-publishes the safety state at least this often [ms].
   std::chrono::milliseconds publish_period{200};

@@ -1,7 +1,8 @@
 #pragma once
 // The safety layer's logic, free of any middleware: e-stop inputs, liveliness of the robot and
-// task services, and a joint limits watchdog. Any cause stops the robot; the stop is latched
-// until every e-stop input is released AND an explicit reset is accepted.
+// task services, and a joint limits watchdog that applies the model's limits table with the
+// limits rule of libs/model (concert/model/limits.hpp). Any cause stops the robot; the stop is
+// latched until every e-stop input is released AND an explicit reset is accepted.
 //
 // Time is passed in by the caller (steady clock), so the logic is testable without waiting.
 
@@ -10,11 +11,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
+#include "concert/model/limits.hpp"
 #include "safety/params.hpp"
 
 namespace concert::safety {
@@ -36,15 +39,6 @@ inline constexpr std::size_t kEStopSourceCount = 6;
 
 /// "button front left", ..., "wireless", "software".
 std::string_view to_string(EStopSource source);
-
-/// Limits of one joint from the robot model; infinite limits may be +-1e300 or +-inf.
-struct JointLimits {
-  std::string name;
-  double lower = 0.0;     ///< [rad] (or [m])
-  double upper = 0.0;     ///< [rad] (or [m])
-  double velocity = 0.0;  ///< [rad/s]
-  double effort = 0.0;    ///< [N m]
-};
 
 /// One measured joint state; vectors indexed like `name` (velocity/effort may be empty).
 struct JointSample {
@@ -92,13 +86,18 @@ class SafetyMonitor {
   /// with a cause naming it.
   void check_liveliness(TimePoint now);
 
-  /// A new robot model: the joint limits the watchdog enforces from now on.
-  void set_model(uint32_t version, std::vector<JointLimits> joints);
+  /// A new robot model: the limits table the watchdog enforces from now on. The thermal load
+  /// of every joint starts cold.
+  void set_model(uint32_t version, model::LimitsTable limits);
 
-  /// Checks a joint sample against the model's limits. Samples of another model version (a
-  /// reconfiguration in flight) are not checked. A malformed sample (vector lengths differ
-  /// from `name`) stops the robot too.
-  SampleOutcome on_joint_state(const JointSample& sample);
+  /// Checks a joint sample measured at `now` against the model's limits with the limits rule:
+  /// position beyond [lower - position_tolerance, upper + position_tolerance], |velocity|
+  /// beyond velocity x (1 + velocity_margin), |effort| beyond the PEAK torque x
+  /// (1 + effort_margin), or the RMS effort over the thermal window (model::kThermalWindow)
+  /// beyond the CONTINUOUS torque x (1 + effort_margin) stops the robot. Samples of another
+  /// model version (a reconfiguration in flight) are not checked. A malformed sample (vector
+  /// lengths differ from `name`) stops the robot too.
+  SampleOutcome on_joint_state(const JointSample& sample, TimePoint now);
 
   /// Explicit reset of a latched stop. Refused while an e-stop input is engaged, or while the
   /// robot service is silent. Accepting it forgets silent task services (the operator
@@ -125,7 +124,7 @@ class SafetyMonitor {
   bool is_watched(const std::string& service) const;
   /// Adds a cause (once per key) and stops.
   void stop(const std::string& key, const std::string& text);
-  void check_joint(const JointLimits& limits, std::size_t i, const JointSample& sample);
+  void check_joint(std::size_t row, std::size_t i, const JointSample& sample, double dt);
 
   Params params_;
   TimePoint start_;
@@ -134,8 +133,10 @@ class SafetyMonitor {
   bool robot_heard_ = false;
   bool robot_start_cause_ = false;
   uint32_t model_version_ = 0;
-  std::vector<JointLimits> joints_;
+  model::LimitsTable limits_;
   std::map<std::string, std::size_t> joint_index_;
+  std::vector<model::ThermalLoad> thermal_;  // per row of limits_
+  std::optional<TimePoint> last_sample_;
   std::vector<std::string> cause_keys_;
   SafetyStatus status_;
   uint64_t revision_ = 0;

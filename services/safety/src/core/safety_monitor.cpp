@@ -110,44 +110,51 @@ void SafetyMonitor::check_liveliness(TimePoint now) {
   }
 }
 
-void SafetyMonitor::set_model(uint32_t version, std::vector<JointLimits> joints) {
+void SafetyMonitor::set_model(uint32_t version, model::LimitsTable limits) {
   model_version_ = version;
-  joints_ = std::move(joints);
+  limits_ = std::move(limits);
   joint_index_.clear();
-  for (std::size_t i = 0; i < joints_.size(); ++i) joint_index_[joints_[i].name] = i;
+  for (std::size_t i = 0; i < limits_.size(); ++i) joint_index_[limits_.rows()[i].name] = i;
+  thermal_.assign(limits_.size(), model::ThermalLoad{});
+  last_sample_.reset();
 }
 
-void SafetyMonitor::check_joint(const JointLimits& limits, std::size_t i,
-                                const JointSample& sample) {
+void SafetyMonitor::check_joint(std::size_t row, std::size_t i, const JointSample& sample, double dt) {
+  const model::JointLimits& limits = limits_.rows()[row];
   const std::string joint = "joint " + limits.name;
+  const std::string version = " (model v" + std::to_string(model_version_) + ")";
   const double q = sample.position[i];
-  if (!std::isfinite(q) || q < limits.lower - params_.position_tolerance ||
-      q > limits.upper + params_.position_tolerance) {
-    stop("limits:" + limits.name + ":position",
-         "limits: " + joint + " position " + fixed(q, 3) + " beyond [" + fixed(limits.lower, 3) +
-             ", " + fixed(limits.upper, 3) + "] (model v" + std::to_string(model_version_) + ")");
+  if (model::position_violated(limits, q, params_.position_tolerance)) {
+    stop("limits:" + limits.name + ":position", "limits: " + joint + " position " + fixed(q, 3) + " beyond [" +
+                                                    fixed(limits.lower, 3) + ", " + fixed(limits.upper, 3) + "]" + version);
   }
   if (i < sample.velocity.size()) {
     const double qd = sample.velocity[i];
-    const double bound = limits.velocity * (1.0 + params_.velocity_margin);
+    const double bound = model::velocity_bound(limits, params_.velocity_margin);
     if (!std::isfinite(qd) || std::abs(qd) > bound) {
-      stop("limits:" + limits.name + ":velocity", "limits: " + joint + " velocity " + fixed(qd, 3) +
-                                                      " beyond +-" + fixed(bound, 3) + " (model v" +
-                                                      std::to_string(model_version_) + ")");
+      stop("limits:" + limits.name + ":velocity",
+           "limits: " + joint + " velocity " + fixed(qd, 3) + " beyond +-" + fixed(bound, 3) + version);
     }
   }
   if (i < sample.effort.size()) {
     const double tau = sample.effort[i];
-    const double bound = limits.effort * (1.0 + params_.effort_margin);
-    if (!std::isfinite(tau) || std::abs(tau) > bound) {
-      stop("limits:" + limits.name + ":effort", "limits: " + joint + " effort " + fixed(tau, 2) +
-                                                    " beyond +-" + fixed(bound, 2) + " (model v" +
-                                                    std::to_string(model_version_) + ")");
+    const double peak = model::instant_torque_bound(limits, params_.effort_margin);
+    if (!std::isfinite(tau) || std::abs(tau) > peak) {
+      stop("limits:" + limits.name + ":effort",
+           "limits: " + joint + " effort " + fixed(tau, 2) + " beyond the peak torque +-" + fixed(peak, 2) + version);
+      return;
+    }
+    const double rms = thermal_[row].add(tau, dt);
+    const double continuous = model::sustained_torque_bound(limits, params_.effort_margin);
+    if (rms > continuous) {
+      stop("limits:" + limits.name + ":sustained_effort",
+           "limits: " + joint + " RMS effort " + fixed(rms, 2) + " over the " + fixed(model::kThermalWindow, 1) +
+               " s thermal window beyond the continuous torque " + fixed(continuous, 2) + version);
     }
   }
 }
 
-SampleOutcome SafetyMonitor::on_joint_state(const JointSample& sample) {
+SampleOutcome SafetyMonitor::on_joint_state(const JointSample& sample, TimePoint now) {
   if (model_version_ == 0) return SampleOutcome::kNoModel;
   if (sample.model_version != model_version_) return SampleOutcome::kOtherModelVersion;
   const std::size_t n = sample.name.size();
@@ -159,9 +166,11 @@ SampleOutcome SafetyMonitor::on_joint_state(const JointSample& sample) {
                                  std::to_string(sample.effort.size()) + " efforts");
     return SampleOutcome::kChecked;
   }
+  const double dt = last_sample_ ? std::chrono::duration<double>(now - *last_sample_).count() : 0.0;
+  if (!last_sample_ || now > *last_sample_) last_sample_ = now;
   for (std::size_t i = 0; i < n; ++i) {
     const auto it = joint_index_.find(sample.name[i]);
-    if (it != joint_index_.end()) check_joint(joints_[it->second], i, sample);
+    if (it != joint_index_.end()) check_joint(it->second, i, sample, dt);
   }
   return SampleOutcome::kChecked;
 }

@@ -38,14 +38,6 @@ msg::EStopSource to_msg(EStopSource source) {
   return msg::ESTOP_SOFTWARE;
 }
 
-std::vector<JointLimits> joint_limits(const msg::RobotModel& model) {
-  std::vector<JointLimits> out;
-  out.reserve(model.joints().size());
-  for (const auto& j : model.joints())
-    out.push_back({j.name(), j.lower(), j.upper(), j.velocity(), j.effort()});
-  return out;
-}
-
 JointSample to_core(const msg::JointState& state) {
   return {state.model_version(), state.name(), state.position(), state.velocity(), state.effort()};
 }

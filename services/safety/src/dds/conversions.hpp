@@ -1,11 +1,11 @@
 #pragma once
-// IDL <-> core conversions of the safety adapter (idl/system.idl, idl/model.idl, idl/robot.idl).
+// IDL <-> core conversions of the safety adapter (idl/system.idl, idl/robot.idl); the robot model
+// is converted by libs/model (concert_model_dds).
 
 #include <cstdint>
 #include <optional>
 #include <vector>
 
-#include "model.h"
 #include "robot.h"
 #include "safety/safety_monitor.hpp"
 #include "system.h"
@@ -16,7 +16,6 @@ namespace concert::safety::dds {
 std::optional<EStopSource> to_core(msg::EStopSource source);
 msg::EStopSource to_msg(EStopSource source);
 
-std::vector<JointLimits> joint_limits(const msg::RobotModel& model);
 JointSample to_core(const msg::JointState& state);
 msg::SafetyState to_msg(const SafetyStatus& status, int64_t stamp_ns);
 

@@ -2,8 +2,10 @@
 
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 
+#include <optional>
 #include <thread>
 
+#include "concert/model/dds/conversions.hpp"
 #include "dds/conversions.hpp"
 
 namespace concert::safety::dds {
@@ -97,21 +99,37 @@ void SafetyNode::on_status(const msg::ServiceStatus& status) {
   note(text);
 }
 
-void SafetyNode::on_model(const msg::RobotModel& model) {
+void SafetyNode::on_model(const msg::RobotModel& message) {
+  // The limits table only: safety needs no URDF, so a model is not parsed whole here.
+  std::optional<concert::model::LimitsTable> limits;
+  std::string error;
+  try {
+    limits.emplace(concert::model::dds::to_description(message).joints, "model version " + std::to_string(message.version()));
+  } catch (const concert::model::ModelError& e) {
+    error = e.what();
+  }
   std::string text;
   {
     std::lock_guard lock(mutex_);
-    monitor_.set_model(model.version(), joint_limits(model));
-    log_ << "safety: limits of model v" << model.version() << " (" << model.joints().size()
-         << " joints)" << std::endl;
+    if (limits) {
+      monitor_.set_model(message.version(), std::move(*limits));
+      log_ << "safety: limits of model v" << message.version() << " (" << message.joints().size() << " joints)" << std::endl;
+    } else {
+      log_ << "safety: model v" << message.version() << " refused, limits of model v" << monitor_.model_version()
+           << " kept: " << error << std::endl;
+    }
     text = summary(monitor_.status());
   }
-  status_.report(msg::SERVICE_READY, model.version(), text);
+  if (limits) {
+    status_.report(msg::SERVICE_READY, message.version(), text);
+  } else {
+    status_.report(msg::SERVICE_ERROR, monitor_.model_version(), "model v" + std::to_string(message.version()) + " refused: " + error);
+  }
 }
 
 void SafetyNode::on_joint_state(const msg::JointState& state) {
   std::unique_lock lock(mutex_);
-  if (monitor_.on_joint_state(to_core(state)) == SampleOutcome::kChecked) ++checked_samples_;
+  if (monitor_.on_joint_state(to_core(state), Clock::now()) == SampleOutcome::kChecked) ++checked_samples_;
   const auto text = publish_locked(false);
   lock.unlock();
   note(text);

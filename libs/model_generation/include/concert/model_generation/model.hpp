@@ -1,7 +1,8 @@
 #pragma once
 // The robot model generated from a module tree (paper section 4.3.3): the physical tree phi,
-// URDF/SRDF/controller-configuration texts and the joint/chain/end-effector lists carried by the
-// RobotModel message. Plain C++/Eigen; no DDS.
+// URDF/SRDF/controller-configuration texts and the joint/chain/end-effector/sensor lists that
+// become the model description (libs/model) the RobotModel message carries. Plain C++/Eigen;
+// no DDS.
 
 #include <cstdint>
 #include <map>
@@ -10,9 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "concert/model/description.hpp"
 #include "concert/module_db/module_description.hpp"
 
-namespace concert::modelgen {
+namespace concert::model_generation {
 
 using module_db::Pose;
 
@@ -59,7 +61,7 @@ struct PhysicalTree {
   double mass() const;
 };
 
-/// A moving joint as listed in the model (RobotModel.joints).
+/// A moving joint with everything the generator knows of it (the description keeps the limits).
 struct JointInfo {
   std::string name;
   std::string chain;
@@ -77,22 +79,23 @@ struct JointInfo {
   double home = 0.0;               ///< homing position, rad (m)
 };
 
-/// A kinematic chain (RobotModel.chains).
+/// A kinematic chain.
 struct ChainInfo {
   std::string name;                ///< tag "A", "B", ...
-  std::string role;                ///< "arm", "leg" or "other"
+  model::ChainRole role = model::ChainRole::kOther;
   std::string base_link;
   std::string tip_link;
   std::vector<std::string> joints; ///< moving joints, root to tip
   std::vector<int> modules;        ///< module indices in the chain, root to tip
 };
 
-/// An end-effector (RobotModel.end_effectors); wheels count as end-effectors of legs.
+/// An end-effector; wheels count as end-effectors of legs.
 struct EndEffectorInfo {
   std::string name;                ///< e.g. "drill_E"
   std::string chain;
   std::string frame;               ///< TCP or wheel-centre link
   std::string module_key;
+  model::EndEffectorKind kind = model::EndEffectorKind::kOther;  ///< from the module's tags
   int module = -1;
   std::vector<std::string> addons; ///< add-on keys mounted on it
 };
@@ -112,7 +115,7 @@ struct Customisation {
 };
 
 /// A generated model. Texts contain no version or time, so equal content gives an equal hash.
-struct RobotModel {
+struct GeneratedModel {
   uint64_t version = 0;            ///< assigned by ModelVersioner; 0 = not published
   uint64_t tree_version = 0;       ///< version of the module tree it was built from
   std::string content_hash;        ///< "sha256:<hex>" of urdf + '\0' + srdf + '\0' + config_yaml
@@ -123,8 +126,13 @@ struct RobotModel {
   std::vector<JointInfo> joints;
   std::vector<ChainInfo> chains;
   std::vector<EndEffectorInfo> end_effectors;
+  std::vector<model::SensorFrame> sensor_frames;  ///< camera frames of modules, add-on frames
   Customisation customisation;     ///< the customisation applied
   PhysicalTree tree;               ///< phi
+
+  /// What the RobotModel message carries: version, hash, texts and the lists, with the
+  /// limits table (position, velocity, peak and continuous torque per moving joint).
+  [[nodiscard]] model::ModelDescription description() const;
 };
 
 /// Options of the generator.
@@ -138,4 +146,4 @@ struct Params {
   double default_velocity_kp = 5.0;
 };
 
-}  // namespace concert::modelgen
+}  // namespace concert::model_generation

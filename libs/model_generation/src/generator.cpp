@@ -1,6 +1,6 @@
 // chi -> phi (paper section 4.3.3, eq. 1-2) and the model's lists.
 
-#include "modelgen/model_generator.hpp"
+#include "concert/model_generation/generator.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <map>
 #include <set>
 
-namespace concert::modelgen {
+namespace concert::model_generation {
 
 using module_db::ConnectorRole;
 using module_db::JointType;
@@ -83,6 +83,22 @@ std::string end_effector_word(const ModuleDescription& d) {
   return w;
 }
 
+/// Kind of an end-effector module: a wheel module is a wheel, else the first semantic tag that
+/// names a kind (the project database tags "drill", "gripper", "sanding_tool"...; the public
+/// one carries its header type, e.g. "drill", "spraying_tool").
+model::EndEffectorKind end_effector_kind(const ModuleDescription& d) {
+  using model::EndEffectorKind;
+  if (d.type == ModuleType::kWheel) return EndEffectorKind::kWheel;
+  for (const std::string& t : d.tags) {
+    if (t == "drill") return EndEffectorKind::kDrill;
+    if (t == "gripper" || t == "active_gripper" || t == "passive_gripper") return EndEffectorKind::kGripper;
+    if (t == "sanding_tool" || t == "sanding") return EndEffectorKind::kSanding;
+    if (t == "spraying_tool" || t == "spraying") return EndEffectorKind::kSpraying;
+    if (t == "camera") return EndEffectorKind::kCamera;
+  }
+  return EndEffectorKind::kOther;
+}
+
 struct ChainRecord {
   ChainInfo info;
   bool has_wheel = false;
@@ -132,6 +148,7 @@ class Builder {
   PhysicalTree phi;
   std::vector<ChainRecord> chains;
   std::vector<EndEffectorInfo> ees;
+  std::vector<model::SensorFrame> sensors;
   std::vector<const ModuleDescription*> desc_;
 
  private:
@@ -297,6 +314,7 @@ class Builder {
         e.chain = s.tag;
         e.frame = name;
         e.module_key = d.key;
+        e.kind = end_effector_kind(d);
         e.module = m;
         ees.push_back(std::move(e));
         if (ch != nullptr && ch->info.tip_link.empty()) ch->info.tip_link = name;
@@ -304,6 +322,16 @@ class Builder {
     }
     for (const module_db::Frame& f : d.frames) {
       make_frame(m, urdf_of[static_cast<size_t>(f.body)], offset_of[static_cast<size_t>(f.body)] * f.pose, f.name + T, s.tag);
+      if (f.kind == module_db::FrameKind::kCamera) {
+        model::SensorFrame sf;
+        sf.name = f.name + T;
+        sf.kind = model::SensorKind::kCamera;
+        sf.frame = f.name + T;
+        sf.chain = s.tag;
+        if (d.is_end_effector() && !tcps.empty()) sf.end_effector = end_effector_word(d) + T;
+        sf.module_key = d.key;
+        sensors.push_back(std::move(sf));
+      }
     }
     // Children on output connectors, in connector order.
     std::vector<int> kids = children_[static_cast<size_t>(m)];
@@ -351,7 +379,8 @@ class Builder {
 };
 
 void apply_addons(const module_db::ModuleDatabase& db, const Customisation& custom, PhysicalTree& phi,
-                  std::vector<EndEffectorInfo>& ees, const std::vector<const ModuleDescription*>& desc) {
+                  std::vector<EndEffectorInfo>& ees, std::vector<model::SensorFrame>& sensors,
+                  const std::vector<const ModuleDescription*>& desc) {
   std::set<std::pair<int, std::string>> used_types;
   for (size_t i = 0; i < custom.addons.size(); ++i) {
     const AddonChoice& choice = custom.addons[i];
@@ -416,6 +445,14 @@ void apply_addons(const module_db::ModuleDatabase& db, const Customisation& cust
       j.module = module;
       j.chain = ee->chain;
       phi.joints.push_back(j);
+      model::SensorFrame sf;
+      sf.name = fb.name;
+      sf.kind = addon->frame->kind == module_db::FrameKind::kCamera ? model::SensorKind::kCamera : model::SensorKind::kOther;
+      sf.frame = fb.name;
+      sf.chain = ee->chain;
+      sf.end_effector = ee->name;
+      sf.module_key = addon->key;
+      sensors.push_back(std::move(sf));
     }
     ee->addons.push_back(choice.addon);
   }
@@ -444,6 +481,24 @@ const ModuleDescription& ModelGenerator::describe(const topology::ModuleNode& no
                      ", mod_rev " + std::to_string(node.identity.mod_rev) + ")");
   }
   return *d;
+}
+
+model::ModelDescription GeneratedModel::description() const {
+  model::ModelDescription d;
+  d.version = version;
+  d.content_hash = content_hash;
+  d.tree_version = tree_version;
+  d.urdf = urdf;
+  d.srdf = srdf;
+  d.config_yaml = config_yaml;
+  d.modules = modules;
+  for (const JointInfo& j : joints) {
+    d.joints.push_back({j.name, j.chain, j.lower, j.upper, j.velocity, j.peak_torque, j.continuous_torque});
+  }
+  for (const ChainInfo& c : chains) d.chains.push_back({c.name, c.role, c.base_link, c.tip_link, c.joints});
+  for (const EndEffectorInfo& e : end_effectors) d.end_effectors.push_back({e.name, e.chain, e.frame, e.module_key, e.kind});
+  d.sensor_frames = sensor_frames;
+  return d;
 }
 
 PhysicalTree ModelGenerator::build_tree(const topology::ModuleTree& tree, const Customisation& custom) const {
@@ -534,7 +589,7 @@ void check_modelable(const topology::ModuleTree& tree) {
   }
 }
 
-RobotModel ModelGenerator::generate(const topology::ModuleTree& input_tree, const Customisation& input_custom,
+GeneratedModel ModelGenerator::generate(const topology::ModuleTree& input_tree, const Customisation& input_custom,
                                     uint64_t tree_version) const {
   check_modelable(input_tree);
   // Passive modules without ESC (passive grippers) named in the add-ons are mounted first; the
@@ -549,15 +604,17 @@ RobotModel ModelGenerator::generate(const topology::ModuleTree& input_tree, cons
   const Customisation& custom = input_custom;
   Builder b(*this, tree);
   b.run();
-  apply_addons(db_, custom_addons, b.phi, b.ees, b.desc_);
-  RobotModel model;
+  apply_addons(db_, custom_addons, b.phi, b.ees, b.sensors, b.desc_);
+  GeneratedModel model;
   model.tree_version = tree_version;
   model.customisation = custom;
   model.tree = std::move(b.phi);
   model.end_effectors = std::move(b.ees);
+  model.sensor_frames = std::move(b.sensors);
   for (size_t i = 0; i < tree.modules.size(); ++i) model.modules.push_back(b.desc_[i]->key);
   for (ChainRecord& c : b.chains) {
-    c.info.role = c.has_wheel ? "leg" : (c.has_tool || c.has_joint) ? "arm" : "other";
+    using model::ChainRole;
+    c.info.role = c.has_wheel ? ChainRole::kLeg : c.has_joint ? ChainRole::kArm : c.has_tool ? ChainRole::kTool : ChainRole::kOther;
     if (c.info.tip_link.empty()) c.info.tip_link = c.last_body;
     model.chains.push_back(std::move(c.info));
   }
@@ -618,4 +675,4 @@ RobotModel ModelGenerator::generate(const topology::ModuleTree& input_tree, cons
   return model;
 }
 
-}  // namespace concert::modelgen
+}  // namespace concert::model_generation

@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-namespace concert::modelgen::detail {
+namespace concert::model_generation::detail {
 
 /// Shortest round-trip-safe enough text of a double (12 significant digits), never "-0".
 inline std::string num(double v) {
@@ -51,4 +51,4 @@ inline std::string xml_escape(const std::string& s) {
   return out;
 }
 
-}  // namespace concert::modelgen::detail
+}  // namespace concert::model_generation::detail

@@ -1,0 +1,109 @@
+// The paper's robot (mobile base, four steering + wheel legs, 6-DoF arm with a drill) through
+// model generation and the parsed model, with both module databases: the project's
+// (data/module_db, continuous torques from the paper's Table 1) and the public
+// concert_resources (peak torques only).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "concert/model/robot_model.hpp"
+#include "concert/model_generation/generator.hpp"
+#include "concert/module_db/module_db.hpp"
+#include "concert/simbus/assembly.hpp"
+#include "concert/topology/esc_catalog.hpp"
+
+namespace concert::model_generation {
+namespace {
+
+namespace fs = std::filesystem;
+using model::ChainRole;
+using model::EndEffectorKind;
+using model::SensorKind;
+
+struct Database {
+  fs::path dir;
+  fs::path assembly;
+};
+
+GeneratedModel generate(const Database& where) {
+  static std::map<std::string, module_db::ModuleDatabase> dbs;
+  auto [it, fresh] = dbs.try_emplace(where.dir.string());
+  if (fresh) it->second = module_db::load_module_database(where.dir);
+  const topology::EscCatalog catalog = topology::EscCatalog::load(where.dir);
+  const topology::ModuleTree tree =
+      simbus::tree_from_assembly(simbus::load_assembly(where.assembly), catalog);
+  GeneratedModel m = ModelGenerator(it->second).generate(tree);
+  m.version = 1;
+  return m;
+}
+
+class PaperRobot : public ::testing::TestWithParam<Database> {};
+
+TEST_P(PaperRobot, SelectsTheDrillAsTheToolAndTheLegsByRole) {
+  const GeneratedModel generated = generate(GetParam());
+  const auto m = model::RobotModel::build(generated.description());
+  // The first end-effector of the list is a wheel: selection by role must not care.
+  ASSERT_FALSE(m->end_effectors().empty());
+  EXPECT_EQ(m->end_effectors().front().kind, EndEffectorKind::kWheel);
+  EXPECT_EQ(m->tool().kind, EndEffectorKind::kDrill);
+  EXPECT_EQ(m->tool().name, "drill_E");
+  EXPECT_EQ(m->tool().frame, "tcp_E");
+  EXPECT_EQ(&m->tool(EndEffectorKind::kDrill), &m->tool());
+  EXPECT_EQ(m->end_effectors(EndEffectorKind::kWheel).size(), 4u);
+  EXPECT_EQ(m->arm().name, "E");
+  EXPECT_EQ(m->arm().joints.size(), 6u);
+  EXPECT_EQ(m->chains(ChainRole::kLeg).size(), 4u);
+  const std::vector<model::Leg> legs = m->legs();
+  ASSERT_EQ(legs.size(), 4u);
+  for (const model::Leg& leg : legs) {
+    EXPECT_EQ(leg.steering_joint, "J1_" + leg.chain->name);
+    EXPECT_EQ(leg.wheel_joint, "J2_" + leg.chain->name);
+    EXPECT_EQ(leg.wheel_frame, "wheel_" + leg.chain->name);
+    EXPECT_GT(leg.wheel_radius, 0.1);
+    EXPECT_LT(leg.wheel_radius, 0.3);
+  }
+  EXPECT_EQ(m->limits().size(), 6u + 8u);
+  for (const model::JointLimits& j : m->limits().rows()) {
+    EXPECT_GT(j.peak_torque, 0.0) << j.name;
+    EXPECT_LE(j.continuous_torque, j.peak_torque) << j.name;
+  }
+}
+
+TEST(PaperRobotProjectDatabase, LimitsTableKeepsPeakAndContinuousTorqueApart) {
+  const auto m = model::RobotModel::build(
+      generate({fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db",
+                fs::path(CONCERT_SOURCE_DIR) / "deploy/demo/drill_robot.yaml"})
+          .description());
+  // Elbow A (Large A actuator, paper Table 1): 460 N m peak, 160 N m continuous.
+  const model::JointLimits& j2 = m->limits().at("J2_E");
+  EXPECT_DOUBLE_EQ(j2.peak_torque, 460.0);
+  EXPECT_DOUBLE_EQ(j2.continuous_torque, 160.0);
+  for (const model::JointLimits& j : m->limits().rows())
+    EXPECT_LT(j.continuous_torque, j.peak_torque) << j.name;
+  // The drill's camera is a sensor frame of the tool.
+  const model::SensorFrame& camera = m->sensor(m->tool(), SensorKind::kCamera);
+  EXPECT_EQ(camera.frame, "camera_E");
+  EXPECT_EQ(camera.module_key, "concert_drill");
+  EXPECT_TRUE(m->kinematics().has_frame(camera.frame));
+}
+
+TEST(PaperRobotPublicDatabase, ContinuousTorqueIsThePeakWhereTheDatabaseGivesNone) {
+  const fs::path db = fs::path(CONCERT_SHARED_DATA) / "concert_resources";
+  const auto m = model::RobotModel::build(
+      generate({db, fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml"}).description());
+  for (const model::JointLimits& j : m->limits().rows())
+    EXPECT_DOUBLE_EQ(j.continuous_torque, j.peak_torque) << j.name;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BothDatabases, PaperRobot,
+    ::testing::Values(Database{fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db",
+                               fs::path(CONCERT_SOURCE_DIR) / "deploy/demo/drill_robot.yaml"},
+                      Database{fs::path(CONCERT_SHARED_DATA) / "concert_resources",
+                               fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml"}),
+    [](const ::testing::TestParamInfo<Database>& param) {
+      return param.index == 0 ? std::string("Project") : std::string("Public");
+    });
+
+}  // namespace
+}  // namespace concert::model_generation
