@@ -31,6 +31,24 @@ cleanup() {
 }
 trap cleanup EXIT
 
+# The end state decides: safety RUNNING, every service ready at one model (version and hash),
+# nothing stopped or in error, nothing refused. Anything else fails the demo, with the reason.
+fail() {
+  echo "demo: FAILED: $*" >&2
+  exit 1
+}
+check_end_state() {
+  local what=$1 safety
+  safety=$("$concert" safety status --timeout-ms 5000) || fail "$what: no safety state ($safety)"
+  echo "  $safety"
+  case "$safety" in
+    "safety: RUNNING"*) ;;
+    *) fail "$what: the safety service stopped the robot: $safety" ;;
+  esac
+  "$concert" status --check --wait-ms 1500 | sed 's/^/  /' ||
+    fail "$what: a service is stopped or in error, disagrees on the model, or refused input (above)"
+}
+
 stage "concert up: every service on this machine, domain $CONCERT_DOMAIN_ID, drill robot mounted"
 "$concert" up --assembly deploy/demo/drill_robot.yaml > "$log" 2>&1 &
 up_pid=$!
@@ -49,6 +67,9 @@ stage "the live model"
 stage "drilling approach: concert plan drill --at 2.0 0.0 1.2 --execute (area 2 m ahead, 1.2 m high)"
 "$concert" plan drill --at 2.0 0.0 1.2 --execute --timeout 60 | sed 's/^/  /'
 
+stage "after the drilling approach: safety RUNNING, one model everywhere, nothing refused"
+check_end_state "after the drilling approach"
+
 stage "hot swap: concert sim swap deploy/demo/sanding_robot.yaml (drill -> sanding tool)"
 swap=$(date +%s%N)
 "$concert" sim swap deploy/demo/sanding_robot.yaml | sed 's/^/  /'
@@ -59,3 +80,7 @@ stage "model version 2 live in every service (stage times above count from the s
 
 stage "topics on the domain"
 "$concert" topic list --wait-ms 1000 | sed 's/^/  /'
+
+stage "end state: safety RUNNING, every service ready at model version 2, nothing refused"
+check_end_state "at the end"
+echo "demo: OK"

@@ -62,11 +62,31 @@ void StatusReporter::beat() {
   }
 }
 
+void StatusReporter::report(msg::ServiceState state, const ModelId& model,
+                            const std::string& message) {
+  std::lock_guard lock(mutex_);
+  status_.state(state);
+  status_.model_version(model.version);
+  status_.model_hash(model.hash);
+  status_.message(message);
+  status_.stamp_ns(now_ns());
+  writer_.write(status_);
+}
+
 void StatusReporter::report(msg::ServiceState state, uint32_t model_version,
                             const std::string& message) {
   std::lock_guard lock(mutex_);
   status_.state(state);
+  if (status_.model_version() != model_version) status_.model_hash("");
   status_.model_version(model_version);
+  status_.message(message);
+  status_.stamp_ns(now_ns());
+  writer_.write(status_);
+}
+
+void StatusReporter::refused(const std::string& message) {
+  std::lock_guard lock(mutex_);
+  status_.refusals(status_.refusals() + 1);
   status_.message(message);
   status_.stamp_ns(now_ns());
   writer_.write(status_);
@@ -87,6 +107,16 @@ msg::ServiceState StatusReporter::state() const {
 uint32_t StatusReporter::model_version() const {
   std::lock_guard lock(mutex_);
   return status_.model_version();
+}
+
+ModelId StatusReporter::model() const {
+  std::lock_guard lock(mutex_);
+  return {status_.model_version(), status_.model_hash()};
+}
+
+uint32_t StatusReporter::refusals() const {
+  std::lock_guard lock(mutex_);
+  return status_.refusals();
 }
 
 }  // namespace concert::dds

@@ -118,3 +118,35 @@ TEST(Service, UnknownModulesAreRefusedByPositionAndIdentityAndTheModelStays) {
   EXPECT_TRUE(service.on_tree(warned, 4).error.empty());
   EXPECT_EQ(service.current()->content_hash, hash);
 }
+
+TEST(Service, ARestartLearnsTheRunningModelAndNeverReusesAVersion) {
+  const auto big = test::make_tree(test::public_eighteen_module_robot(), &public_db());
+  const auto small = test::make_tree({{"mobile_platform_concert", -1, -1}}, &public_db());
+  // The first incarnation: version 1 (big), version 2 (small).
+  ModelgenService first(public_db());
+  ASSERT_EQ(first.on_tree(big, 1).version, 1u);
+  ASSERT_EQ(first.on_tree(small, 2).version, 2u);
+  const std::string running = first.current()->content_hash;
+
+  // Restarted without a bundle: the services on the wire say they run version 2 with that hash.
+  ModelgenService restarted(public_db());
+  restarted.learn(2, running);
+  EXPECT_EQ(restarted.known_version(), 2u);
+  Outcome o = restarted.on_tree(small, 2);  // the latched tree: the running model again
+  EXPECT_TRUE(o.published);
+  EXPECT_EQ(o.version, 2u);
+  EXPECT_EQ(restarted.current()->content_hash, running);
+  o = restarted.on_tree(big, 3);  // the next hot swap: a new, higher version
+  EXPECT_EQ(o.version, 3u);
+
+  // Restarted, and the latched tree already differs from what runs: never version 2 again.
+  ModelgenService other(public_db());
+  other.learn(2, running);
+  EXPECT_EQ(other.on_tree(big, 3).version, 3u);
+
+  // Older knowledge (a stale bundle, a lagging service) changes nothing.
+  ModelgenService late(public_db());
+  late.learn(2, running);
+  late.learn(1, "sha256:older");
+  EXPECT_EQ(late.on_tree(small, 2).version, 2u);
+}

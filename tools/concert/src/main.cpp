@@ -29,7 +29,9 @@ verbs:
   up [--assembly FILE] [--world FILE] [--module-db DIR ...] [--duration S]
                                                 start every service on this machine (simulated robot),
                                                 restart one that dies, stop all on Ctrl-C
-  status [--json] [--wait-ms MS]                every service: host, state, model version, last message
+  status [--json] [--check] [--wait-ms MS]     every service: host, state, model version and hash, refusals,
+                                                last message; --check: exit 1 if a service is stopped or in
+                                                error, the services disagree on the model, or one refused input
   status --until-version N [--services a,b] [--timeout-ms MS]
                                                 wait until every model consumer is ready at version N
   sim assemble|swap FILE                        mount another assembly on the running simulated robot

@@ -46,13 +46,68 @@ std::vector<ServiceRow> read_statuses(int32_t domain, std::chrono::milliseconds 
   std::vector<ServiceRow> rows;
   const int64_t now = wall_ns();
   for (const auto& [id, s] : latest) {
-    rows.push_back({s.service(), s.host(), state_name(s.state()), s.model_version(), s.message(),
-                    static_cast<double>(now - s.stamp_ns()) / 1e9});
+    rows.push_back({s.service(), s.host(), state_name(s.state()), s.model_version(), s.model_hash(),
+                    s.refusals(), s.message(), static_cast<double>(now - s.stamp_ns()) / 1e9});
   }
   std::sort(rows.begin(), rows.end(), [](const ServiceRow& a, const ServiceRow& b) {
     return std::tie(a.service, a.host) < std::tie(b.service, b.host);
   });
   return rows;
+}
+
+namespace {
+/// "sha256:0123456789ab..." -> "0123456789ab" (the first 12 hex digits), "-" for none.
+std::string short_hash(const std::string& hash) {
+  if (hash.empty()) return "-";
+  const auto colon = hash.find(':');
+  return hash.substr(colon == std::string::npos ? 0 : colon + 1, 12);
+}
+}  // namespace
+
+ModelAgreement model_agreement(const std::vector<ServiceRow>& rows) {
+  ModelAgreement a;
+  for (const auto& r : rows) {
+    if (r.state == "stopped" || r.model_version == 0) continue;
+    if (r.model_version > a.version || (r.model_version == a.version && a.hash.empty())) {
+      a.version = r.model_version;
+      a.hash = r.model_hash;
+    }
+  }
+  for (const auto& r : rows) {
+    if (r.state == "stopped" || r.model_version == 0) continue;
+    const bool other_hash = !r.model_hash.empty() && !a.hash.empty() && r.model_hash != a.hash;
+    if (r.model_version != a.version || other_hash) {
+      a.disagreeing.push_back(r.service + "@" + r.host + " runs " +
+                              std::to_string(r.model_version) + " (" + short_hash(r.model_hash) +
+                              ")");
+    }
+  }
+  return a;
+}
+
+std::vector<std::string> status_problems(const std::vector<ServiceRow>& rows) {
+  std::vector<std::string> problems;
+  for (const auto& r : rows) {
+    if (r.state == "stopped" || r.state == "error") {
+      problems.push_back(r.service + "@" + r.host + " is " + r.state + ": " + r.message);
+    }
+  }
+  const ModelAgreement a = model_agreement(rows);
+  if (!a.disagreeing.empty()) {
+    std::string text = "the services disagree on the model: the newest is version " +
+                       std::to_string(a.version) + " (" + short_hash(a.hash) + ") but";
+    for (const auto& d : a.disagreeing) text += " " + d + ";";
+    text.pop_back();
+    problems.push_back(text);
+  }
+  for (const auto& r : rows) {
+    if (r.refusals > 0) {
+      problems.push_back(r.service + "@" + r.host + " refused " + std::to_string(r.refusals) +
+                         " input" + (r.refusals == 1 ? "" : "s") +
+                         " since it started (its log says which)");
+    }
+  }
+  return problems;
 }
 
 namespace {
@@ -101,7 +156,17 @@ int until_version(int32_t domain, uint32_t version, const std::vector<std::strin
       const bool named_all = only.empty() || std::all_of(only.begin(), only.end(), [&](const std::string& n) {
         return std::any_of(done.begin(), done.end(), [&](const std::string& k) { return k.rfind(n + "@", 0) == 0; });
       });
-      if (consumers > 0 && done.size() == consumers && named_all && Clock::now() - t0 >= kSettle) return 0;
+      // Ready is not enough: every consumer must run the same model (version and hash).
+      std::vector<ServiceRow> rows;
+      for (const auto& [key, s] : latest) {
+        if (consumer(s))
+          rows.push_back(
+              {s.service(), s.host(), state_name(s.state()), s.model_version(), s.model_hash()});
+      }
+      const bool agree = model_agreement(rows).disagreeing.empty();
+      if (consumers > 0 && done.size() == consumers && named_all && agree &&
+          Clock::now() - t0 >= kSettle)
+        return 0;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
@@ -114,6 +179,13 @@ int until_version(int32_t domain, uint32_t version, const std::vector<std::strin
     }
   }
   if (latest.empty()) err << " no service reported";
+  std::vector<ServiceRow> rows;
+  for (const auto& [key, s] : latest) {
+    if (consumer(s))
+      rows.push_back(
+          {s.service(), s.host(), state_name(s.state()), s.model_version(), s.model_hash()});
+  }
+  for (const auto& d : model_agreement(rows).disagreeing) err << "; disagrees: " << d;
   err << "\n";
   return 1;
 }
@@ -132,6 +204,7 @@ std::vector<std::string> split(const std::string& text) {
 int run_status(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   Args a(args);
   const bool json = a.flag("--json");
+  const bool check = a.flag("--check");
   const long wait_ms = a.integer("--wait-ms", 1500, 0, 600000);
   const long until = a.integer("--until-version", 0, 0, 4'000'000'000);
   const long timeout_ms = a.integer("--timeout-ms", 30'000, 1, 86'400'000);
@@ -144,25 +217,49 @@ int run_status(const std::vector<std::string>& args, std::ostream& out, std::ost
   if (json) {
     idl::Json arr = idl::Json::array();
     for (const auto& r : rows) {
-      arr.push_back({{"service", r.service}, {"host", r.host}, {"state", r.state}, {"model_version", r.model_version},
-                     {"message", r.message}, {"age_s", r.age_s}});
+      arr.push_back({{"service", r.service},
+                     {"host", r.host},
+                     {"state", r.state},
+                     {"model_version", r.model_version},
+                     {"model_hash", r.model_hash},
+                     {"refusals", r.refusals},
+                     {"message", r.message},
+                     {"age_s", r.age_s}});
     }
     out << arr.dump(2) << "\n";
-    return 0;
+    return check && !status_problems(rows).empty() ? 1 : 0;
   }
   if (rows.empty()) {
     err << "concert status: no service reported on domain " << domain << " within " << wait_ms << " ms\n";
     return 1;
   }
-  out << std::left << std::setw(16) << "SERVICE" << std::setw(18) << "HOST" << std::setw(15) << "STATE" << std::setw(7)
-      << "MODEL" << std::setw(9) << "AGE" << "MESSAGE\n";
+  out << std::left << std::setw(16) << "SERVICE" << std::setw(18) << "HOST" << std::setw(15)
+      << "STATE" << std::setw(7) << "MODEL" << std::setw(14) << "HASH" << std::setw(9) << "REFUSED"
+      << std::setw(9) << "AGE"
+      << "MESSAGE\n";
+  const ModelAgreement agreement = model_agreement(rows);
   for (const auto& r : rows) {
     std::ostringstream age;
     age << std::fixed << std::setprecision(1) << r.age_s << "s";
-    out << std::setw(16) << r.service << std::setw(18) << r.host << std::setw(15) << r.state << std::setw(7)
-        << r.model_version << std::setw(9) << age.str() << r.message << "\n";
+    const bool odd = std::any_of(
+        agreement.disagreeing.begin(), agreement.disagreeing.end(),
+        [&](const std::string& d) { return d.rfind(r.service + "@" + r.host + " ", 0) == 0; });
+    out << std::setw(16) << r.service << std::setw(18) << r.host << std::setw(15) << r.state
+        << std::setw(7) << (std::to_string(r.model_version) + (odd ? "!" : "")) << std::setw(14)
+        << short_hash(r.model_hash) << std::setw(9) << r.refusals << std::setw(9) << age.str()
+        << r.message << "\n";
   }
-  return 0;
+  if (agreement.version > 0) {
+    out << (agreement.disagreeing.empty() ? "every service runs model version "
+                                          : "DISAGREEMENT: the newest model is version ")
+        << agreement.version << " (" << short_hash(agreement.hash) << ")";
+    for (const auto& d : agreement.disagreeing) out << "; " << d;
+    out << "\n";
+  }
+  if (!check) return 0;
+  const auto problems = status_problems(rows);
+  for (const auto& p : problems) err << "concert status: " << p << "\n";
+  return problems.empty() ? 0 : 1;
 }
 
 }  // namespace concert::cli

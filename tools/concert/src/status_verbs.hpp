@@ -13,6 +13,8 @@ struct ServiceRow {
   std::string host;
   std::string state;        ///< "starting", "ready", "reconfiguring", "error", "stopped"
   uint32_t model_version = 0;
+  std::string model_hash;  ///< content hash of that model; "" = none or unknown
+  uint32_t refusals = 0;   ///< inputs the service refused since it started
   std::string message;
   double age_s = 0;         ///< seconds since the service last reported (heartbeat)
 };
@@ -20,7 +22,21 @@ struct ServiceRow {
 /// Statuses seen on the domain within `wait`, sorted by service then host.
 std::vector<ServiceRow> read_statuses(int32_t domain, std::chrono::milliseconds wait);
 
-/// `concert status [--json] [--wait-ms MS] [--domain N]`; args start after "status".
+/// Which model the services run, and who disagrees: the newest (version, hash) any service
+/// reports is the reference; a service at another version, or at that version with another
+/// hash, disagrees (services that run no model yet are left out).
+struct ModelAgreement {
+  uint32_t version = 0;                  ///< the reference version; 0 = no service runs a model
+  std::string hash;                      ///< its hash ("" if no service reported one)
+  std::vector<std::string> disagreeing;  ///< "service@host runs N (hash)"
+};
+ModelAgreement model_agreement(const std::vector<ServiceRow>& rows);
+
+/// What a scripted check (`concert status --check`) fails on: every service stopped or in
+/// error, a model disagreement, and every service that refused inputs. Empty = all good.
+std::vector<std::string> status_problems(const std::vector<ServiceRow>& rows);
+
+/// `concert status [--json] [--check] [--wait-ms MS] [--domain N]`; args start after "status".
 int run_status(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace concert::cli

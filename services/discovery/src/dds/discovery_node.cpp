@@ -44,6 +44,7 @@ ScanOutcome DiscoveryNode::handle(const msg::EscScan& scan) {
       break;
     case ScanOutcome::Kind::kRejected:
       status_.report(msg::SERVICE_ERROR, 0, outcome.message);
+      status_.refused(outcome.message);
       log_ << line << std::endl;
       break;
   }

@@ -48,8 +48,15 @@ class ModelgenService {
   /// the current model version.
   Outcome on_customisation(const CustomisationRequest& request);
 
+  /// A model that the services on the wire run (read from their status after a restart): see
+  /// ModelVersioner::learn. Call before the first tree, so that a restarted modelgen gives the
+  /// running model its version again and never reuses a version for other content.
+  void learn(uint64_t version, const std::string& hash) { versioner_.learn(version, hash); }
+
   /// The current model, if any.
   const std::optional<GeneratedModel>& current() const { return versioner_.current(); }
+  /// The highest model version known (current, learned from the wire or the bundle).
+  uint64_t known_version() const { return versioner_.known_version(); }
   const Customisation& customisation() const { return custom_; }
 
  private:

@@ -26,9 +26,18 @@ class ModelVersioner {
   /// the next different model gets `version + 1`; a first model with hash `hash` keeps `version`.
   static ModelVersioner resume(uint64_t version, std::string hash);
 
+  /// A model (`version`, `hash`) is known to exist elsewhere (the services on the wire run it, or
+  /// a bundle on disk holds it): versions are never reused for other content, so the next
+  /// different model gets at least `version + 1`, and, before any model is current here, a
+  /// model with `hash` takes `version` again. Lower or equal knowledge changes nothing.
+  void learn(uint64_t version, const std::string& hash);
+
   /// Makes `model` current with the next version unless its content hash equals the current
   /// model's (then only tree_version is refreshed and nothing is published).
   Update offer(GeneratedModel model);
+
+  /// The highest version known (current, learned or resumed); 0 = none.
+  uint64_t known_version() const;
 
   /// The current model, if any.
   const std::optional<GeneratedModel>& current() const { return current_; }

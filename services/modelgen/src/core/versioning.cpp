@@ -1,5 +1,7 @@
 #include "modelgen/versioning.hpp"
 
+#include <algorithm>
+
 namespace concert::modelgen {
 
 ModelVersioner ModelVersioner::resume(uint64_t version, std::string hash) {
@@ -7,6 +9,19 @@ ModelVersioner ModelVersioner::resume(uint64_t version, std::string hash) {
   v.resumed_version_ = version;
   v.resumed_hash_ = std::move(hash);
   return v;
+}
+
+void ModelVersioner::learn(uint64_t version, const std::string& hash) {
+  if (version == 0 || version <= known_version()) return;
+  next_version_ = std::max(next_version_, version + 1);
+  if (!current_) {
+    resumed_version_ = version;
+    resumed_hash_ = hash;
+  }
+}
+
+uint64_t ModelVersioner::known_version() const {
+  return std::max(current_ ? current_->version : 0, std::max(resumed_version_, next_version_ - 1));
 }
 
 ModelVersioner::Update ModelVersioner::offer(GeneratedModel model) {

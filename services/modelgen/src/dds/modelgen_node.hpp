@@ -15,8 +15,16 @@ namespace concert::modelgen::dds {
 
 class ModelgenNode {
  public:
-  /// `participant` and `service` must outlive the node. Reports READY (model version 0) at once.
-  ModelgenNode(concert::dds::Participant& participant, ModelgenService& service, std::ostream& log);
+  /// `participant` and `service` must outlive the node. Reports STARTING at once; the first
+  /// spin learns which model the services on the wire run (up to `resume_wait`), then READY.
+  ModelgenNode(concert::dds::Participant& participant, ModelgenService& service, std::ostream& log,
+               std::chrono::milliseconds resume_wait = std::chrono::milliseconds(1000));
+
+  /// Reads the status of the services on the domain for up to `resume_wait` and tells the
+  /// service the newest model they run (version and hash): a restarted modelgen then gives
+  /// the running model its version again, and never reuses a version for other content. A
+  /// modelgen running alone simply waits that long once. Called by the first spin_once.
+  void resume_from_wire();
 
   /// Handles one tree sample: generate, publish a new version or report the error.
   Outcome handle(const msg::ModuleTree& tree);
@@ -30,8 +38,12 @@ class ModelgenNode {
 
  private:
   void report(const Outcome& outcome, const std::string& what);
+  concert::dds::ModelId current_id() const;
 
   ModelgenService& service_;
+  std::chrono::milliseconds resume_wait_;
+  bool resumed_ = false;
+  concert::dds::Reader<msg::ServiceStatus> statuses_;
   concert::dds::Reader<msg::ModuleTree> trees_;
   concert::dds::Reader<msg::ModelCustomisation> requests_;
   concert::dds::Writer<msg::RobotModel> models_;

@@ -187,6 +187,14 @@ void PlannerNode::warm_up_loop() {
 }
 
 void PlannerNode::on_model(const msg::RobotModel& model) {
+  // The same model again (a restarted modelgen republishes the running one): nothing to do.
+  if (const auto current = planner_.model();
+      current && current->version() == model.version() &&
+      current->robot().content_hash() == model.content_hash()) {
+    log_line("planner: model version " + std::to_string(model.version()) +
+             " again with the same content: kept as it is");
+    return;
+  }
   status_.report(msg::SERVICE_RECONFIGURING, static_cast<uint32_t>(planner_.model_version()),
                  "reconfiguring to model version " + std::to_string(model.version()));
   try {
@@ -195,7 +203,8 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
     std::string note = "planning " + std::to_string(m->dof()) + " joints (base x, y, yaw + arm)";
     if (!m->ignored_shapes().empty())
       note += "; " + std::to_string(m->ignored_shapes().size()) + " mesh collisions ignored";
-    status_.report(msg::SERVICE_READY, model.version(), note);
+    status_.report(msg::SERVICE_READY, concert::dds::ModelId{model.version(), model.content_hash()},
+                   note);
     {
       std::ostringstream line;
       line << "planner: model version " << model.version() << ": " << note;
@@ -208,9 +217,11 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
     wake_.notify_all();
   } catch (const std::exception& e) {
     const uint64_t kept = planner_.model_version();
-    status_.report(
-        kept == 0 ? msg::SERVICE_ERROR : msg::SERVICE_READY, static_cast<uint32_t>(kept),
-        std::string("model version ") + std::to_string(model.version()) + " refused: " + e.what());
+    const std::string refusal =
+        std::string("model version ") + std::to_string(model.version()) + " refused: " + e.what();
+    status_.report(kept == 0 ? msg::SERVICE_ERROR : msg::SERVICE_READY, static_cast<uint32_t>(kept),
+                   refusal);
+    status_.refused(refusal);
     {
       std::ostringstream line;
       line << "planner: model version " << model.version() << " refused (keeping " << kept
@@ -242,6 +253,14 @@ bool PlannerNode::spin_once(std::chrono::milliseconds timeout) {
 }
 
 void PlannerNode::handle(const msg::PlanRequest& request) {
+  // After a hot swap a client may name the new model version before its sample reached us:
+  // wait (bounded) for it instead of answering "no model" or "stale".
+  if (request.model_version() > planner_.model_version()) {
+    std::unique_lock lock(mutex_);
+    wake_.wait_for(lock, options_.model_wait, [&] {
+      return stopping_ || planner_.model_version() >= request.model_version();
+    });
+  }
   msg::PlanResult base;
   base.request_id(request.request_id());
   base.model_version(static_cast<uint32_t>(planner_.model_version()));

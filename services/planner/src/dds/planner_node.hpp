@@ -35,6 +35,9 @@ msg::PlanFailure to_failure(Status status);
 struct NodeOptions {
   /// How long after a trajectory's duration the robot's result may take (its settling time).
   std::chrono::milliseconds result_margin{10000};
+  /// A request for a model version the planner does not have yet (it races the model after a
+  /// hot swap) waits this long for that version before it is answered.
+  std::chrono::milliseconds model_wait{5000};
 };
 
 class PlannerNode {

@@ -107,18 +107,27 @@ template <class F> void RobotNode::guarded(const std::string& what, F&& f) {
       std::lock_guard lock(mutex_);
       last_error_ = e.what();
     }
-    status_.note(what + " refused: " + e.what());
+    status_.refused(what + " refused: " + e.what());
   }
 }
 
-void RobotNode::on_model(const msg::RobotModel& m) { apply_model(m.urdf(), m.version(), tool_end_effector(m)); }
+void RobotNode::on_model(const msg::RobotModel& m) {
+  // The same model again (a restarted modelgen republishes the running one): keep running it.
+  if (core_.ready() && core_.model_version() == m.version() &&
+      status_.model().hash == m.content_hash())
+    return;
+  apply_model(m.urdf(), m.version(), tool_end_effector(m), m.content_hash());
+}
 
-void RobotNode::apply_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame) {
+void RobotNode::apply_model(const std::string& urdf, std::uint64_t version,
+                            const std::string& end_effector_frame,
+                            const std::string& content_hash) {
   try {
     status_.report(msg::SERVICE_RECONFIGURING, status_.model_version(),
                    "reconfiguring to model version " + std::to_string(version));
     core_.set_model(urdf, version, end_effector_frame);
-    status_.report(msg::SERVICE_READY, static_cast<uint32_t>(version),
+    status_.report(msg::SERVICE_READY,
+                   concert::dds::ModelId{static_cast<uint32_t>(version), content_hash},
                    "ready at model version " + std::to_string(version));
   } catch (const std::exception& e) {
     ++refused_;
@@ -129,6 +138,8 @@ void RobotNode::apply_model(const std::string& urdf, std::uint64_t version, cons
     // The last good model keeps running if the hardware still matches it.
     status_.report(core_.ready() ? msg::SERVICE_READY : msg::SERVICE_ERROR,
                    static_cast<uint32_t>(core_.model_version()), e.what());
+    status_.refused(std::string("model version ") + std::to_string(version) +
+                    " refused: " + e.what());
   }
 }
 

@@ -47,7 +47,8 @@ class RobotNode {
 
   /// Reconfigures the core to a model (from the model topic, or the sim's own model in
   /// standalone mode) and reports the outcome on the status topic. Never throws.
-  void apply_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame);
+  void apply_model(const std::string& urdf, std::uint64_t version,
+                   const std::string& end_effector_frame, const std::string& content_hash = "");
 
   /// Counters for tests and diagnostics.
   [[nodiscard]] std::uint64_t refused_commands() const { return refused_.load(); }

@@ -100,6 +100,16 @@ void SafetyNode::on_status(const msg::ServiceStatus& status) {
 }
 
 void SafetyNode::on_model(const msg::RobotModel& message) {
+  {
+    // The same model again (a restarted modelgen republishes the running one): the limits and
+    // the thermal load of every joint stay as they are.
+    std::lock_guard lock(mutex_);
+    if (monitor_.model_version() == message.version() && model_hash_ == message.content_hash()) {
+      log_ << "safety: model v" << message.version() << " again with the same content: kept"
+           << std::endl;
+      return;
+    }
+  }
   // The limits table only: safety needs no URDF, so a model is not parsed whole here.
   std::optional<concert::model::LimitsTable> limits;
   std::string error;
@@ -113,6 +123,7 @@ void SafetyNode::on_model(const msg::RobotModel& message) {
     std::lock_guard lock(mutex_);
     if (limits) {
       monitor_.set_model(message.version(), std::move(*limits));
+      model_hash_ = message.content_hash();
       log_ << "safety: limits of model v" << message.version() << " (" << message.joints().size() << " joints)" << std::endl;
     } else {
       log_ << "safety: model v" << message.version() << " refused, limits of model v" << monitor_.model_version()
@@ -121,9 +132,13 @@ void SafetyNode::on_model(const msg::RobotModel& message) {
     text = summary(monitor_.status());
   }
   if (limits) {
-    status_.report(msg::SERVICE_READY, message.version(), text);
+    status_.report(msg::SERVICE_READY,
+                   concert::dds::ModelId{message.version(), message.content_hash()}, text);
   } else {
-    status_.report(msg::SERVICE_ERROR, monitor_.model_version(), "model v" + std::to_string(message.version()) + " refused: " + error);
+    const std::string refusal =
+        "model v" + std::to_string(message.version()) + " refused: " + error;
+    status_.report(msg::SERVICE_ERROR, monitor_.model_version(), refusal);
+    status_.refused(refusal);
   }
 }
 

@@ -63,6 +63,7 @@ class SafetyNode {
   uint64_t published_revision_ = ~uint64_t{0};
   Clock::time_point last_publish_{};
   uint64_t checked_samples_ = 0;
+  std::string model_hash_;  // content hash of the model whose limits are enforced
   concert::dds::Writer<msg::SafetyState> state_writer_;
   concert::dds::StatusReporter status_;
   // Readers last: destroyed first, so no callback runs on a half-destroyed node.

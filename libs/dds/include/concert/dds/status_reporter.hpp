@@ -23,6 +23,14 @@ std::string host_name();
 /// Default heartbeat period of a StatusReporter [ms].
 inline constexpr std::chrono::milliseconds kDefaultHeartbeat{200};
 
+/// The robot model a service runs: version and content hash (RobotModel.content_hash). Two
+/// services at the same version with different hashes disagree (`concert status` flags it).
+struct ModelId {
+  uint32_t version = 0;  ///< 0 = none yet
+  std::string hash;      ///< "" = none or unknown
+  bool operator==(const ModelId&) const = default;
+};
+
 class StatusReporter {
  public:
   /// `heartbeat`: re-publish period of the status [ms]; zero disables the heartbeat.
@@ -34,12 +42,22 @@ class StatusReporter {
   StatusReporter(const StatusReporter&) = delete;
   StatusReporter& operator=(const StatusReporter&) = delete;
 
+  /// State, the model the service runs, and a message.
+  void report(msg::ServiceState state, const ModelId& model, const std::string& message);
+  /// Same, for a service that knows only the version: the hash is kept while the version stays
+  /// the same, and cleared when it changes.
   void report(msg::ServiceState state, uint32_t model_version, const std::string& message);
-  /// Same state and version as last time, new message (e.g. an error that kept the old state).
+  /// Same state and model as last time, new message (e.g. an error that kept the old state).
   void note(const std::string& message);
+  /// An input was refused (a model, command, request or scan): counts it in `refusals` and
+  /// notes `message`, state and model unchanged.
+  void refused(const std::string& message);
 
   msg::ServiceState state() const;
   uint32_t model_version() const;
+  ModelId model() const;
+  /// Inputs refused since the start.
+  uint32_t refusals() const;
   std::chrono::milliseconds heartbeat() const { return heartbeat_; }
 
  private:
