@@ -173,14 +173,17 @@ TEST_F(PlannerNodeTest, ExecutionGoesThroughTheRobotsTrajectoryCommand) {
     st.source("robot");
     st.state(msg::TRAJECTORY_EXECUTING);
     st.progress(0.5);
-    robot_status.write(st);
-    // The planner relays the progress before the robot finishes (bounded wait).
+    // The planner relays the progress before the robot finishes (bounded wait; the progress is
+    // repeated, as the robot does at 10 Hz, until the planner's reader has it).
+    EXPECT_TRUE(robot_status.wait_for_readers(1, 5s));
     const auto deadline = std::chrono::steady_clock::now() + 10s;
-    while (std::chrono::steady_clock::now() < deadline) {
+    bool relayed = false;
+    while (!relayed && std::chrono::steady_clock::now() < deadline) {
+      robot_status.write(st);
       const auto r = results_->wait(100ms);
       if (!r) continue;
       seen.push_back(*r);
-      if (r->state() == msg::PLAN_EXECUTING && r->progress() == 0.5) break;
+      relayed = r->state() == msg::PLAN_EXECUTING && r->progress() == 0.5;
     }
     st.state(final_state);
     st.progress(final_state == msg::TRAJECTORY_SUCCEEDED ? 1.0 : 0.6);
