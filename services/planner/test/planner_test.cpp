@@ -98,12 +98,22 @@ struct Case {
 
 }  // namespace
 
+/// Parameters with budgets generous enough that a loaded machine (ctest -j2 next to a build)
+/// cannot make a plan fail: searches stop when they succeed, so the budget is only a bound.
+Params generous(uint64_t seed) {
+  Params params;
+  params.seed = seed;
+  params.planning_time = 20.0;
+  params.nspg_time = 10.0;
+  params.path_attempt_time = 6.0;
+  return params;
+}
+
 class MorphologyPlans : public ::testing::TestWithParam<Case> {};
 
 TEST_P(MorphologyPlans, DrillingApproachesAreCollisionFreeAndWithinLimits) {
   const Case c = GetParam();
-  Params params;
-  params.seed = 17;
+  Params params = generous(17);
   Planner planner(params);
   planner.set_model(morphology(c.morphology, 4));
   const World world = site(2.2);
@@ -135,8 +145,7 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<Case>& i) { return std::string("morphology_") + i.param.morphology; });
 
 TEST(Planner, HotSwapRebuildsTheConfigurationSpace) {
-  Params params;
-  params.seed = 23;
+  Params params = generous(23);
   Planner planner(params);
   const World world = site(2.0);
   planner.set_environment(environment_of(world, params));
@@ -208,8 +217,7 @@ TEST(Planner, ClearErrorsForBadRequests) {
 }
 
 TEST(Planner, ObstacleFromAPointCloudIsAvoided) {
-  Params params;
-  params.seed = 31;
+  Params params = generous(31);
   Planner planner(params);
   planner.set_model(morphology('a', 1));
   // A wall seen by a lidar as points (5 cm grid), plus a box of points in front of it.
@@ -238,11 +246,10 @@ TEST(Planner, ObstacleFromAPointCloudIsAvoided) {
 }
 
 TEST(Planner, WarmUpFillsThePostureMemoryAndPlansStayValid) {
-  Params params;
-  params.seed = 23;
+  Params params = generous(23);
   const auto planner = planner_at_site(params, 'a', 9);
   // Mid heights on a bare wall: every one has goal postures.
-  EXPECT_EQ(planner->warm_up(1.0, 1.4, 0.2, 3.0), 3);
+  EXPECT_EQ(planner->warm_up(1.0, 1.4, 0.2, 15.0), 3);
   // No model: nothing to warm up.
   EXPECT_EQ(Planner(params).warm_up(1.0, 1.4, 0.2, 1.0), 0);
   // Goals near the remembered heights plan (seeded from memory) and re-check densely.
@@ -377,11 +384,7 @@ TEST(Planner, LongArmReachesALowAreaAndTheArmOnlyPathsStayValid) {
   // Morphology B (2.15 m arm) at a low area: the shoulder's continuous torque leaves the arm a
   // narrow pocket of folded postures. Budget generous so the test does not depend on the
   // machine's speed; whichever path method succeeds, the plan must re-check densely.
-  Params params;
-  params.seed = 29;
-  params.planning_time = 20.0;
-  params.nspg_time = 10.0;
-  params.path_attempt_time = 6.0;
+  Params params = generous(29);
   const auto planner = planner_at_site(params, 'b', 3);
   const World world = site(2.2);
   const auto model = planner->model();
@@ -399,10 +402,9 @@ TEST(Planner, LongArmReachesALowAreaAndTheArmOnlyPathsStayValid) {
 TEST(Planner, WarmUpRemembersArmPathsThatLaterPlansReplay) {
   // Morphology B: the warm-up stores, with each low posture, the arm's way to it from the
   // parked arm; a later low goal near a box replays it (checked against the map).
-  Params params;
-  params.seed = 31;
+  Params params = generous(31);
   const auto planner = planner_at_site(params, 'b', 5);
-  ASSERT_EQ(planner->warm_up(0.5, 0.7, 0.1, 2.0), 3);
+  ASSERT_EQ(planner->warm_up(0.5, 0.7, 0.1, 20.0), 3);
   const World world = site(2.2);
   const auto model = planner->model();
   const Eigen::VectorXd start = start_state(*model);
