@@ -13,6 +13,7 @@
 #include "robot.h"
 #include "system.h"
 #include "topology.h"
+#include "world.h"
 
 static const struct {
   const char* name;
@@ -34,6 +35,11 @@ static const struct {
     {"concert::msg::SafetyReset", &concert_msg_SafetyReset_desc},
     {"concert::msg::PlanRequest", &concert_msg_PlanRequest_desc},
     {"concert::msg::PlanResult", &concert_msg_PlanResult_desc},
+    {"concert::msg::JointTrajectoryCommand", &concert_msg_JointTrajectoryCommand_desc},
+    {"concert::msg::TrajectoryStatus", &concert_msg_TrajectoryStatus_desc},
+    {"concert::msg::World", &concert_msg_World_desc},
+    {"concert::msg::SimCommand", &concert_msg_SimCommand_desc},
+    {"concert::msg::SimCommandReply", &concert_msg_SimCommandReply_desc},
 };
 
 #define MAX_ENDPOINTS 64

@@ -41,6 +41,16 @@ constexpr std::array kTopics = {
               "tasks/tools: drilling-area goals for whole-body planning (and execution)"},
     TopicInfo{"concert/planner/result", "concert::msg::PlanResult", QosClass::kLatched,
               "planner: progress, trajectory or failure reason, one instance per request"},
+    TopicInfo{"concert/robot/trajectory_command", "concert::msg::JointTrajectoryCommand", QosClass::kCommand,
+              "planner/tasks: a joint trajectory (joints and planar base) for the robot's loop to track"},
+    TopicInfo{"concert/robot/trajectory_status", "concert::msg::TrajectoryStatus", QosClass::kLatched,
+              "robot: progress and result (succeeded, aborted or refused with the reason) per request"},
+    TopicInfo{"concert/world/world", "concert::msg::World", QosClass::kLatched,
+              "simulator (robot service): the world every service reads (walls, obstacles)"},
+    TopicInfo{"concert/sim/command", "concert::msg::SimCommand", QosClass::kCommand,
+              "tools: mount another assembly on the simulated robot, or change the simulated world"},
+    TopicInfo{"concert/sim/reply", "concert::msg::SimCommandReply", QosClass::kLatched,
+              "simulator (robot service): accepted or refused with the reason, one instance per request"},
 };
 
 }  // namespace

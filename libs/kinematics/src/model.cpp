@@ -248,6 +248,34 @@ Eigen::VectorXd Model::inverse_dynamics(Data& data, const Eigen::VectorXd& q, co
   return d.tau.data;
 }
 
+void Model::frame_pose_into(Data& data, const Eigen::VectorXd& q, const std::string& frame,
+                            Eigen::Isometry3d& out) const {
+  auto& d = *data.impl_;
+  d.q.data = q;
+  KDL::Frame f;
+  d.fk.JntToCart(d.q, f, frame);
+  out = to_eigen(f);
+}
+
+void Model::frame_jacobian_into(Data& data, const Eigen::VectorXd& q, const std::string& frame,
+                                Eigen::MatrixXd& out) const {
+  auto& d = *data.impl_;
+  d.q.data = q;
+  d.jac_solver.JntToJac(d.q, d.jac, frame);
+  out = d.jac.data;
+}
+
+void Model::inverse_dynamics_into(Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                                  const Eigen::VectorXd& qdd, Eigen::VectorXd& out) const {
+  auto& d = *data.impl_;
+  d.q.data = q;
+  d.qd.data = qd;
+  d.qdd.data = qdd;
+  d.wrenches.clear();
+  d.id.CartToJnt(d.q, d.qd, d.qdd, d.wrenches, d.tau);
+  out = d.tau.data;
+}
+
 Eigen::MatrixXd Model::mass_matrix(Data& data, const Eigen::VectorXd& q) const {
   const int n = dof();
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);

@@ -2,6 +2,7 @@
 // every RobotModel, plans PlanRequests (NSPG + RRT-Connect) and executes them through the
 // robot service.
 //   concert_planner [--params FILE] [--world FILE]
+// The latched world topic (concert/world/world) replaces the map whenever it changes.
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
 #include <atomic>
 #include <csignal>
@@ -11,6 +12,7 @@
 #include "concert/cli/cli.hpp"
 #include "concert/dds/participant.hpp"
 #include "dds/planner_node.hpp"
+#include "concert/world/world.hpp"
 #include "planner/config.hpp"
 
 namespace {
@@ -29,7 +31,10 @@ int run(const Options& options) {
   planner::Params params;
   planner::World world;
   if (!options.params.empty()) params = planner::load_params(options.params);
-  if (!options.world.empty()) world = planner::load_world(options.world);
+  // The world file (libs/world format) is the map until the world topic brings another.
+  if (!options.world.empty()) {
+    world = planner::dds::to_planner_world(world::load_world_file(options.world));
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   planner::Planner planner(params);

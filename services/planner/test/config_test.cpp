@@ -51,25 +51,3 @@ TEST(Config, ParamErrorsNameFileAndField) {
   EXPECT_DOUBLE_EQ(parse_params("base_height: 0.4", "p.yaml").base_height, 0.4);
   EXPECT_THROW((void)load_params("/nonexistent/planner.yaml"), PlannerError);
 }
-
-TEST(Config, WorldFileLikeTheRobotService) {
-  const World w = parse_world(
-      "floor: {height: 0.0}\n"
-      "walls:\n  - {name: north, size: [4.0, 0.2, 2.5], position: [2.0, 3.0, 1.25], yaw: 0.5}\n"
-      "obstacles:\n  - {name: pillar, shape: cylinder, radius: 0.2, height: 2.0, position: [-3.0, 3.0, 1.0]}\n"
-      "  - {name: crate, size: [0.5, 0.5, 0.5], position: [1.0, -1.0, 0.25]}\n",
-      "w.yaml");
-  ASSERT_EQ(w.boxes.size(), 2u);
-  ASSERT_EQ(w.cylinders.size(), 1u);
-  EXPECT_EQ(w.boxes[0].name, "north");
-  EXPECT_DOUBLE_EQ(w.boxes[0].yaw, 0.5);
-  EXPECT_DOUBLE_EQ(w.cylinders[0].radius, 0.2);
-  try {
-    (void)parse_world("walls:\n  - {size: [1, 2], position: [0, 0, 0]}\n", "w.yaml");
-    FAIL();
-  } catch (const PlannerError& e) {
-    EXPECT_NE(std::string(e.what()).find("w.yaml: walls[0].size: expected a list of 3 numbers"), std::string::npos) << e.what();
-  }
-  EXPECT_THROW((void)parse_world("ceiling: 1\n", "w.yaml"), PlannerError);
-  EXPECT_THROW((void)parse_world("obstacles:\n  - {shape: cone, size: [1,1,1], position: [0,0,0]}\n", "w.yaml"), PlannerError);
-}

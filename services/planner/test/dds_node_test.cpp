@@ -13,6 +13,7 @@
 #include "dds/planner_node.hpp"
 #include "model_message.hpp"
 #include "planner/cli.hpp"
+#include "concert/world/world_dds.hpp"
 #include "planner/fixtures.hpp"
 
 using namespace concert;
@@ -137,9 +138,10 @@ TEST_F(PlannerNodeTest, StaleVersionIsRefusedAndPlansCarryTheTrajectory) {
   EXPECT_TRUE(planned) << "no update with the trajectory";
 }
 
-TEST_F(PlannerNodeTest, ExecutionStreamsPositionCommandsWithProgress) {
+TEST_F(PlannerNodeTest, ExecutionGoesThroughTheRobotsTrajectoryCommand) {
   publish_model('a', 6);
-  concert::dds::Reader<msg::JointCommand> commands(*participant_, concert::dds::topics::joint_command);
+  concert::dds::Reader<msg::JointTrajectoryCommand> commands(*participant_, concert::dds::topics::trajectory_command);
+  concert::dds::Writer<msg::TrajectoryStatus> robot_status(*participant_, concert::dds::topics::trajectory_status);
   concert::dds::Writer<msg::JointState> joint_state(*participant_, concert::dds::topics::joint_state);
   // Without a joint state the request cannot be executed.
   ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
@@ -156,19 +158,118 @@ TEST_F(PlannerNodeTest, ExecutionStreamsPositionCommandsWithProgress) {
     js.position().push_back(0.0);
   }
   joint_state.write(js);
-  std::this_thread::sleep_for(200ms);
+  const auto js_deadline = std::chrono::steady_clock::now() + 5s;
+  while (joint_state.matched_readers() == 0 && std::chrono::steady_clock::now() < js_deadline) {
+    std::this_thread::sleep_for(10ms);
+  }
+  std::this_thread::sleep_for(200ms);  // the joint state reaches the planner's reader
+  // This test plays the robot: the planner hands over one trajectory and relays its status.
   std::vector<msg::PlanResult> seen;
+  auto robot_answers = [&](msg::TrajectoryState final_state, const std::string& reason) {
+    const auto cmd = commands.wait(20s);
+    EXPECT_TRUE(cmd.has_value());
+    if (!cmd) return msg::JointTrajectoryCommand{};
+    msg::TrajectoryStatus st;
+    st.request_id(cmd->request_id());
+    st.model_version(6);
+    st.source("robot");
+    st.state(msg::TRAJECTORY_EXECUTING);
+    st.progress(0.5);
+    // The planner relays the progress before the robot finishes (bounded wait; the progress is
+    // repeated, as the robot does at 10 Hz, until the planner's reader has it).
+    EXPECT_TRUE(robot_status.wait_for_readers(1, 5s));
+    const auto deadline = std::chrono::steady_clock::now() + 10s;
+    bool relayed = false;
+    while (!relayed && std::chrono::steady_clock::now() < deadline) {
+      robot_status.write(st);
+      const auto r = results_->wait(100ms);
+      if (!r) continue;
+      seen.push_back(*r);
+      relayed = r->state() == msg::PLAN_EXECUTING && r->progress() == 0.5;
+    }
+    st.state(final_state);
+    st.progress(final_state == msg::TRAJECTORY_SUCCEEDED ? 1.0 : 0.6);
+    st.reason(reason);
+    robot_status.write(st);
+    return *cmd;
+  };
   requests_->write(request(22, 6, 2.3, true));
+  const msg::JointTrajectoryCommand cmd = robot_answers(msg::TRAJECTORY_SUCCEEDED, "");
   const auto done = wait_final(*results_, 22, &seen);
   ASSERT_TRUE(done.has_value());
   EXPECT_EQ(done->state(), msg::PLAN_SUCCEEDED) << done->reason();
   EXPECT_DOUBLE_EQ(done->progress(), 1.0);
-  const auto cmd = commands.wait(1s);
-  ASSERT_TRUE(cmd.has_value());
-  EXPECT_EQ(cmd->mode(), msg::JOINT_POSITION);
-  EXPECT_EQ(cmd->model_version(), 6u);
-  EXPECT_EQ(cmd->name().size(), 6u);
-  EXPECT_EQ(cmd->position().size(), 6u);
+  EXPECT_EQ(cmd.model_version(), 6u);
+  EXPECT_EQ(cmd.source(), "planner");
+  ASSERT_EQ(cmd.joint_names().size(), 9u);  // base x, y, yaw + 6 arm joints
+  EXPECT_EQ(cmd.joint_names()[0], "base_x");
+  EXPECT_EQ(cmd.joint_names()[2], "base_yaw");
+  ASSERT_GT(cmd.samples().size(), 2u);
+  EXPECT_EQ(cmd.samples().back().position().size(), 9u);
+  EXPECT_EQ(cmd.samples().back().velocity().size(), 9u);
+  bool executing = false;
+  for (const auto& r : seen) executing = executing || (r.state() == msg::PLAN_EXECUTING && r.progress() == 0.5);
+  EXPECT_TRUE(executing) << "the robot's progress was not relayed";
+
+  // The robot aborts (e-stop): the plan fails with the robot's reason.
+  requests_->write(request(23, 6, 2.3, true));
+  robot_answers(msg::TRAJECTORY_ABORTED, "safety stop (estop: front left)");
+  const auto aborted = wait_final(*results_, 23);
+  ASSERT_TRUE(aborted.has_value());
+  EXPECT_EQ(aborted->state(), msg::PLAN_FAILED);
+  EXPECT_EQ(aborted->failure(), msg::PLAN_EXECUTION_ABORTED);
+  EXPECT_NE(aborted->reason().find("aborted by the robot: safety stop (estop: front left)"), std::string::npos)
+      << aborted->reason();
+}
+
+TEST_F(PlannerNodeTest, AnObstacleOnTheWorldTopicChangesThePlan) {
+  publish_model('a', 9);
+  ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
+  // A drilling area 1.6 m to the side: the base drives there.
+  auto plan = [&](uint32_t id) {
+    std::vector<msg::PlanResult> seen;
+    msg::PlanRequest req = request(id, 9, 1.2, false);
+    req.goals()[0] = planner::dds::to_msg(fixtures::drilling_area(2.0, 1.6, 1.2));
+    requests_->write(req);
+    const auto r = wait_final(*results_, id, &seen);
+    EXPECT_TRUE(r.has_value());
+    EXPECT_EQ(r ? r->state() : msg::PLAN_FAILED, msg::PLAN_SUCCEEDED) << (r ? r->reason() : "no result");
+    return r ? *r : msg::PlanResult{};
+  };
+  const msg::PlanResult open = plan(51);
+  ASSERT_GT(open.trajectory().size(), 1u);
+  const double open_y = open.trajectory().back().position()[1];
+  const double open_x = open.trajectory().back().position()[0];
+
+  // The world now has a crate where the base stood to drill: the same wall, plus an obstacle.
+  concert::dds::Writer<msg::World> worlds(*participant_, concert::dds::topics::world);
+  ASSERT_TRUE(worlds.wait_for_readers(1, 5s));
+  world::World w;
+  const WorldBox wall = fixtures::wall_at(2.0);
+  world::WorldShape shape;
+  shape.name = wall.name;
+  shape.size = wall.size;
+  shape.position = wall.position;
+  shape.yaw = wall.yaw;
+  w.walls.push_back(shape);
+  world::WorldShape crate;
+  crate.name = "crate";
+  crate.size = {0.8, 0.8, 0.6};
+  crate.position = {open_x, open_y, 0.3};
+  w.obstacles.push_back(crate);
+  worlds.write(world::to_msg(w, 2, "test"));
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while (log_.str().find("world version 2") == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_NE(log_.str().find("world version 2 from test: 2 boxes"), std::string::npos) << log_.str();
+  const msg::PlanResult blocked = plan(52);
+  ASSERT_GT(blocked.trajectory().size(), 1u);
+  const auto& end = blocked.trajectory().back().position();
+  // The base can no longer stand where it stood: it ends outside the crate.
+  const bool outside = std::abs(end[0] - open_x) > 0.4 || std::abs(end[1] - open_y) > 0.4;
+  EXPECT_TRUE(outside) << "base ends at (" << end[0] << ", " << end[1] << "), the crate is at (" << open_x << ", "
+                       << open_y << ")";
 }
 
 TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {

@@ -2,6 +2,8 @@
 // factor, for the 6-DoF drill arm on the four-legged mobile base (services/robot fixtures).
 //   bench_robot [--seconds S] [--urdf FILE]
 // Plain main (not Google Benchmark): the quantities are loop statistics, not per-call times.
+// Base commands come from another thread (as from DDS in the service); the loop only cycles.
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -9,10 +11,11 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "robot/loop.hpp"
 #include "robot/robot_core.hpp"
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_hardware.hpp"
 
 namespace {
 
@@ -27,7 +30,7 @@ std::string read_file(const std::string& path) {
 }
 
 struct Setup {
-  explicit Setup(const std::string& urdf) : sim(urdf, concert::robot::World{}, {}), core(sim) {
+  explicit Setup(const std::string& urdf) : sim(urdf, concert::world::World{}, {}), core(sim) {
     core.set_model(urdf, 1);
     for (int i = 0; i < 100; ++i) {
       core.cycle();
@@ -38,15 +41,27 @@ struct Setup {
     cart.target_pose = core.state().end_effector_pose;
     core.command_cartesian(cart);
   }
-  void tick() {
-    if (++ticks % 100 == 0) {
-      core.command_base({1, 0.2, 0.0, 0.1});
+  ~Setup() {
+    stop = true;
+    if (commander.joinable()) {
+      commander.join();
     }
-    core.cycle();
   }
-  concert::robot::SimHardware sim;
+  /// Base commands every `period` of wall time from another thread, as the DDS threads send
+  /// them in the service (the loop thread only cycles).
+  void command_from_another_thread(std::chrono::milliseconds period) {
+    commander = std::thread([this, period] {
+      while (!stop) {
+        core.command_base({1, 0.2, 0.0, 0.1});
+        std::this_thread::sleep_for(period);
+      }
+    });
+  }
+  void tick() { core.cycle(); }
+  concert::sim::SimHardware sim;
   concert::robot::RobotCore core;
-  long ticks{0};
+  std::atomic<bool> stop{false};
+  std::thread commander;
 };
 
 }  // namespace
@@ -74,6 +89,7 @@ int main(int argc, char** argv) {
     const auto cycles = static_cast<std::uint64_t>(seconds * 1000.0);
     {
       Setup s(urdf);
+      s.command_from_another_thread(std::chrono::milliseconds(15));  // ~100 ms of simulated time
       concert::robot::Loop loop({0.001, false, false}, [&] { s.tick(); });
       const auto stats = loop.run(cycles);
       std::printf("as fast as possible: %llu cycles of 1 ms, wall %.3f s, real-time factor %.2f, %.1f us/cycle\n",
@@ -82,7 +98,7 @@ int main(int argc, char** argv) {
     }
     {
       // Physics alone (drives holding), to tell simulation cost from controller cost.
-      concert::robot::SimHardware sim(urdf, concert::robot::World{}, {});
+      concert::sim::SimHardware sim(urdf, concert::world::World{}, {});
       const auto start = std::chrono::steady_clock::now();
       for (std::uint64_t k = 0; k < cycles; ++k) {
         sim.step(0.001);
@@ -93,6 +109,7 @@ int main(int argc, char** argv) {
     }
     auto real_time = [&](const char* label, int fifo, double spin) {
       Setup s(urdf);
+      s.command_from_another_thread(std::chrono::milliseconds(100));
       concert::robot::LoopParams params;
       params.record_periods = true;
       params.fifo_priority = fifo;

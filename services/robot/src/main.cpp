@@ -3,31 +3,33 @@
 //                 [--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK]
 //                 [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...] [--params FILE]
 // --params: YAML with sections robot, sim, loop, node (config/robot.yaml); flags override it.
-// The assembly and world files are watched: edit them (hot swap, new walls) while it runs
-// and the simulated bus publishes the new scan. See services/robot/README.md.
-#include <sys/stat.h>
+// --assembly and --world are the initial robot and world; later ones come as SimCommands over
+// DDS (`concert sim swap FILE`, `concert sim world FILE`, from any host), and the world it
+// simulates is published on the latched World topic. See services/robot/README.md.
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <limits>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "concert/cli/cli.hpp"
+#include "concert/common/text.hpp"
 #include "concert/dds/participant.hpp"
+#include "concert/sim/sim_assembly.hpp"
+#include "concert/sim/sim_hardware.hpp"
 #include "robot/loop.hpp"
 #include "robot/robot_core.hpp"
-#include "robot/sim_assembly.hpp"
-#include "robot/sim_hardware.hpp"
 #include "robot_node.hpp"
 #include "robot_params.hpp"
+#include "sim_node.hpp"
 
 namespace {
 
@@ -118,41 +120,22 @@ void check(Options& o) {
   }
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error("cannot open '" + path + "'");
-  }
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::optional<std::filesystem::file_time_type> mtime(const std::string& path) {
-  std::error_code ec;
-  const auto t = std::filesystem::last_write_time(path, ec);
-  if (ec) {
-    return std::nullopt;
-  }
-  return t;
-}
-
 int run(const Options& options) {
   using namespace concert;
   {
-    std::optional<robot::AssemblyBuilder> builder;
-    robot::SimulatedRobot simulated;
+    std::optional<sim::AssemblyBuilder> builder;
+    sim::SimulatedRobot simulated;
     if (!options.assembly.empty()) {
       builder.emplace(options.module_dbs);
       simulated = builder->build(options.assembly);
     } else {
-      simulated.urdf = read_file(options.urdf);
+      simulated.urdf = concert::read_file(options.urdf, "URDF");
       simulated.source = options.urdf;
     }
-    const robot::World world = options.world.empty() ? robot::World{} : robot::load_world_file(options.world);
+    const world::World world = options.world.empty() ? world::World{} : world::load_world_file(options.world);
     robot::dds::ServiceParams service = options.params.empty() ? robot::dds::ServiceParams{}
                                                                 : robot::dds::load_service_params(options.params);
-    robot::SimParams& sim_params = service.sim;
+    sim::SimParams& sim_params = service.sim;
     // Collision meshes: package://NAME/... resolves to a module-database folder named NAME.
     for (const auto& db : options.module_dbs) {
       sim_params.package_paths[std::filesystem::absolute(db).lexically_normal().filename().string()] =
@@ -161,7 +144,7 @@ int run(const Options& options) {
     for (const auto& [name, dir] : options.packages) {
       sim_params.package_paths[name] = dir;
     }
-    robot::SimHardware sim(simulated.urdf, world, sim_params);
+    sim::SimHardware sim(simulated.urdf, world, sim_params);
     robot::RobotParams& params = service.robot;
     if (!options.ee_frame.empty()) {
       params.end_effector_frame = options.ee_frame;
@@ -184,47 +167,31 @@ int run(const Options& options) {
     if (options.fifo > 0) {
       loop_params.fifo_priority = options.fifo;
     }
-    auto watched = options.assembly.empty() ? std::nullopt : mtime(options.assembly);
-    auto world_watched = options.world.empty() ? std::nullopt : mtime(options.world);
-    std::uint64_t ticks = 0;
-    robot::Loop loop(loop_params, [&] {
-      // Hot swap: the assembly file changed (checked every 250 ms of loop time).
-      ++ticks;
-      if (!options.assembly.empty() && ticks % 250 == 0) {
-        const auto now = mtime(options.assembly);
-        if (now && now != watched) {
-          watched = now;
-          try {
-            simulated = builder->build(options.assembly);
-            sim.swap_model(simulated.urdf);
-            core.cycle();  // the core notices the new hardware before anyone sees the scan
-            node.publish_scan(simulated.scan, "sim");
-            std::cerr << "concert_robot: hot swap from '" << options.assembly << "': " << simulated.scan.slaves.size()
-                      << " slaves\n";
-            if (options.standalone) {
-              node.apply_model(simulated.urdf, core.model_version() + 1, options.ee_frame);
-            }
-          } catch (const std::exception& e) {
-            std::cerr << "concert_robot: hot swap refused, the robot keeps its modules: " << e.what() << "\n";
-          }
+    // Off the loop thread: the publisher hands the loop's state to DDS.
+    std::atomic<bool> stopping{false};
+    std::thread publisher([&] {
+      std::uint64_t last = 0;
+      auto next = std::chrono::steady_clock::now();
+      while (!stopping.load()) {
+        const robot::RobotState state = core.state();
+        if (state.cycle != last) {
+          last = state.cycle;
+          node.publish(state);
         }
+        next += std::chrono::microseconds(static_cast<long>(1e6 * params.period));
+        std::this_thread::sleep_until(next);
       }
-      // World edits (walls, obstacles) are picked up the same way.
-      if (!options.world.empty() && ticks % 250 == 125) {
-        const auto now = mtime(options.world);
-        if (now && now != world_watched) {
-          world_watched = now;
-          try {
-            sim.set_world(robot::load_world_file(options.world));
-            std::cerr << "concert_robot: world reloaded from '" << options.world << "'\n";
-          } catch (const std::exception& e) {
-            std::cerr << "concert_robot: world change refused, the old world stays: " << e.what() << "\n";
-          }
-        }
-      }
-      core.cycle();
-      node.publish(core.state());
     });
+    // Hot swaps and world changes come as SimCommands over DDS (`concert sim swap/world`):
+    // prepared on the sim node's worker thread, switched in by the loop at a cycle boundary.
+    robot::dds::SimNode sim_node(
+        participant, sim, builder ? &*builder : nullptr, node, world, options.world.empty() ? "empty world" : options.world,
+        [&](const sim::SimulatedRobot& mounted) {
+          if (options.standalone) {
+            node.apply_model(mounted.urdf, core.model_version() + 1, options.ee_frame);
+          }
+        });
+    robot::Loop loop(loop_params, [&] { core.cycle(); });
     g_loop = &loop;
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
@@ -232,6 +199,8 @@ int run(const Options& options) {
                                                 : std::numeric_limits<std::uint64_t>::max();
     const robot::LoopStats stats = loop.run(cycles);
     g_loop = nullptr;
+    stopping = true;
+    publisher.join();
     std::cerr << "concert_robot: stopped after " << stats.cycles << " cycles (" << stats.overruns
               << " overruns)\n";
   }

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <map>
+#include <optional>
 #include <thread>
 
 #include "concert/dds/endpoint.hpp"
@@ -40,14 +42,20 @@ msg::RobotModel model_msg(const std::string& urdf, uint32_t version) {
   return m;
 }
 
-TEST(RobotNode, ModelCommandsAndStateOverDds) {
-  SimHardware sim(test::read_fixture("mobile_drill.urdf"), World{}, {});
-  RobotCore core(sim);
-  cdds::Participant robot_side({.name = "robot"});
-  dds::RobotNode node(robot_side, core);
+/// The robot side (simulated drill robot, core, node) and a client participant with a model
+/// writer, as each DDS test of the node needs them.
+struct NodeRig : ::testing::Test {
+  SimHardware sim{test::read_fixture("mobile_drill.urdf"), World{}, {}};
+  RobotCore core{sim};
+  cdds::Participant robot_side{{.name = "robot"}};
+  dds::RobotNode node{robot_side, core};
+  cdds::Participant client{{.name = "client"}};
+  cdds::Writer<msg::RobotModel> models{client, cdds::topics::robot_model};
+};
 
-  cdds::Participant client({.name = "client"});
-  cdds::Writer<msg::RobotModel> models(client, cdds::topics::robot_model);
+using RobotNodeDds = NodeRig;
+
+TEST_F(RobotNodeDds, ModelCommandsAndStateOverDds) {
   cdds::Writer<msg::JointCommand> joints(client, cdds::topics::joint_command);
   cdds::Writer<msg::BaseVelocityCommand> base(client, cdds::topics::base_velocity);
   cdds::Reader<msg::JointState> states(client, cdds::topics::joint_state);
@@ -148,6 +156,96 @@ TEST(RobotNode, ModelCommandsAndStateOverDds) {
   EXPECT_TRUE(core.ready());
 }
 
+/// Newest TrajectoryStatus of `request` seen so far (drains the reader).
+struct StatusLog {
+  cdds::Reader<msg::TrajectoryStatus>& reader;
+  std::map<uint32_t, msg::TrajectoryStatus> latest;
+  std::map<uint32_t, int> executing_updates;
+  std::optional<msg::TrajectoryStatus> of(uint32_t request) {
+    while (auto s = reader.take()) {
+      latest[s->request_id()] = *s;
+      if (s->state() == msg::TRAJECTORY_EXECUTING) {
+        ++executing_updates[s->request_id()];
+      }
+    }
+    const auto it = latest.find(request);
+    return it == latest.end() ? std::nullopt : std::optional<msg::TrajectoryStatus>(it->second);
+  }
+};
+
+msg::JointTrajectoryCommand ramp(uint32_t request, uint32_t version, const std::string& joint, double from, double to,
+                                 double duration) {
+  msg::JointTrajectoryCommand c;
+  c.request_id(request);
+  c.model_version(version);
+  c.source("test");
+  c.joint_names({joint});
+  for (int k = 0; k <= 20; ++k) {
+    const double s = k / 20.0;
+    msg::JointTrajectorySample p;
+    p.time(duration * s);
+    p.position({from + (to - from) * (3 * s * s - 2 * s * s * s)});
+    p.velocity({(to - from) * 6 * s * (1 - s) / duration});
+    c.samples().push_back(p);
+  }
+  return c;
+}
+
+TEST_F(RobotNodeDds, TrajectoriesOverDdsWithProgressResultRefusalAndEstop) {
+  cdds::Writer<msg::JointTrajectoryCommand> trajectories(client, cdds::topics::trajectory_command);
+  cdds::Writer<msg::SafetyState> safety(client, cdds::topics::safety_state);
+  cdds::Reader<msg::TrajectoryStatus> statuses(client, cdds::topics::trajectory_status);
+  StatusLog log{statuses, {}, {}};
+  ASSERT_TRUE(models.wait_for_readers(1, 10s));
+  ASSERT_TRUE(trajectories.wait_for_readers(1, 10s));
+  ASSERT_TRUE(safety.wait_for_readers(1, 10s));
+  models.write(model_msg(test::read_fixture("mobile_drill.urdf"), 2));
+  ASSERT_TRUE(run_until(core, node, [&] { return core.ready(); }));
+
+  // Tracked to the end, with progress on the way.
+  trajectories.write(ramp(41, 2, "J2_A", 0.0, 0.6, 1.5));
+  ASSERT_TRUE(run_until(core, node, [&] {
+    const auto s = log.of(41);
+    return s && s->state() != msg::TRAJECTORY_EXECUTING;
+  }));
+  EXPECT_EQ(log.of(41)->state(), msg::TRAJECTORY_SUCCEEDED) << log.of(41)->reason();
+  EXPECT_DOUBLE_EQ(log.of(41)->progress(), 1.0);
+  EXPECT_LT(log.of(41)->max_joint_error(), 0.05);
+  EXPECT_EQ(log.of(41)->source(), "test");
+  EXPECT_GE(log.executing_updates[41], 3);  // 10 Hz progress over 1.5 s
+  const RobotState s = core.state();
+  EXPECT_NEAR(s.position[test::hw_index(s, "J2_A")], 0.6, 0.03);
+
+  // Refused at once with the reason.
+  trajectories.write(ramp(42, 1, "J2_A", 0.6, 0.0, 1.0));
+  ASSERT_TRUE(run_until(core, node, [&] { return log.of(42).has_value(); }));
+  EXPECT_EQ(log.of(42)->state(), msg::TRAJECTORY_REFUSED);
+  EXPECT_NE(log.of(42)->reason().find("current model version is 2"), std::string::npos) << log.of(42)->reason();
+
+  // An e-stop aborts a running trajectory.
+  trajectories.write(ramp(43, 2, "J2_A", 0.6, -0.6, 4.0));
+  ASSERT_TRUE(run_until(core, node, [&] {
+    const auto st = log.of(43);
+    return st && st->state() == msg::TRAJECTORY_EXECUTING && st->progress() > 0.1;
+  }));
+  msg::SafetyState stop;
+  stop.mode(msg::SAFETY_STOPPED);
+  stop.causes({"estop: front left"});
+  safety.write(stop);
+  ASSERT_TRUE(run_until(core, node, [&] {
+    const auto st = log.of(43);
+    return st && st->state() != msg::TRAJECTORY_EXECUTING;
+  }));
+  EXPECT_EQ(log.of(43)->state(), msg::TRAJECTORY_ABORTED);
+  EXPECT_NE(log.of(43)->reason().find("safety stop (estop: front left)"), std::string::npos) << log.of(43)->reason();
+  EXPECT_LT(log.of(43)->progress(), 0.9);
+}
+
+TEST(RobotNode, ToolEndEffectorNeedsAParsableDescription) {
+  // A message with only a URDF (no SRDF, no chains): the core picks its default frame.
+  EXPECT_EQ(dds::tool_end_effector(model_msg(test::read_fixture("mobile_drill.urdf"), 1)), "");
+}
+
 TEST(RobotConversions, JointCommandLengthsAreChecked) {
   msg::JointCommand c;
   c.source("planner");
@@ -202,7 +300,7 @@ TEST(RobotParamsYaml, ShippedConfigListsEveryParameterWithItsDefault) {
   auto doc =
       config::Document::load(std::string(CONCERT_SOURCE_DIR) + "/services/robot/config/robot.yaml");
   (void)dds::read_service_params(doc);
-  EXPECT_EQ(doc.keys().size(), 29u);
+  EXPECT_EQ(doc.keys().size(), 37u);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
 }

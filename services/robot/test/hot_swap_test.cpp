@@ -10,16 +10,18 @@
 #include "concert/module_db/module_db.hpp"
 #include "concert/topology/esc_catalog.hpp"
 #include "discovery/discovery.hpp"
-#include "modelgen/model_generator.hpp"
+#include "concert/model_generation/generator.hpp"
 #include "robot/robot_core.hpp"
-#include "robot/sim_assembly.hpp"
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_assembly.hpp"
+#include "concert/sim/sim_hardware.hpp"
 #include "test_helpers.hpp"
 
 namespace concert::robot {
 namespace {
 
 namespace fs = std::filesystem;
+using sim::AssemblyBuilder;
+using sim::SimulatedRobot;
 const fs::path kPublicDb = fs::path(CONCERT_SHARED_DATA) / "concert_resources";
 const fs::path kPaperRobot = fs::path(CONCERT_SOURCE_DIR) / "libs" / "simbus" / "examples" / "concert_paper_robot.yaml";
 
@@ -40,7 +42,7 @@ std::string replace(std::string text, const std::string& from, const std::string
 std::string model_from_scan(const topology::EscScan& scan) {
   static const module_db::ModuleDatabase db = module_db::load_module_database(kPublicDb);
   const auto tree = discovery::discover(scan, topology::EscCatalog::load(kPublicDb));
-  return modelgen::ModelGenerator(db).generate(tree).urdf;
+  return model_generation::ModelGenerator(db).generate(tree).urdf;
 }
 
 TEST(AssemblyBuilder, PaperRobotGivesScanTreeAndUrdf) {

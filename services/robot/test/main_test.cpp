@@ -1,5 +1,6 @@
-// concert_robot as a process: it publishes the simulated bus scan, and editing the assembly
-// file while it runs (the hot-swap verb) gives a new scan.
+// concert_robot as a process: it publishes the simulated bus scan and the world, and
+// SimCommands over DDS (what `concert sim swap/world` send) hot-swap the assembly or change
+// the world, or are refused with the reason.
 #include <gtest/gtest.h>
 
 #include <signal.h>
@@ -9,6 +10,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -64,31 +66,67 @@ class Process {
   pid_t pid_{-1};
 };
 
-TEST(RobotMain, HotSwapByEditingTheAssemblyGivesANewScan) {
-  const fs::path dir = fs::temp_directory_path() / ("robot_main_test_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  const fs::path assembly = dir / "robot.yaml";
-  const std::string paper = read_text(kPaperRobot);
-  std::ofstream(assembly) << paper;
+/// Sends `command` and waits (bounded) for its reply.
+std::optional<concert::msg::SimCommandReply> send(cdds::Writer<concert::msg::SimCommand>& writer,
+                                                  cdds::Reader<concert::msg::SimCommandReply>& replies,
+                                                  const concert::msg::SimCommand& command) {
+  writer.write(command);
+  for (int i = 0; i < 300; ++i) {
+    if (auto r = replies.wait(100ms); r && r->request_id() == command.request_id()) {
+      return r;
+    }
+  }
+  return std::nullopt;
+}
 
+TEST(RobotMain, SimCommandsSwapTheAssemblyAndChangeTheWorld) {
   cdds::Participant client({.name = "client"});
   cdds::Reader<concert::msg::EscScan> scans(client, cdds::topics::esc_scan);
   cdds::Reader<concert::msg::ServiceStatus> status(client, cdds::topics::status);
-  Process robot({ROBOT_BINARY, "--assembly", assembly.string(), "--module-db", kPublicDb.string(), "--standalone",
+  cdds::Reader<concert::msg::World> worlds(client, cdds::topics::world);
+  cdds::Reader<concert::msg::SimCommandReply> replies(client, cdds::topics::sim_reply);
+  cdds::Writer<concert::msg::SimCommand> commands(client, cdds::topics::sim_command);
+  Process robot({ROBOT_BINARY, "--assembly", kPaperRobot.string(), "--module-db", kPublicDb.string(), "--standalone",
                  "--duration", "60"});
   auto first = scans.wait(20s);
   ASSERT_TRUE(first.has_value());
   EXPECT_EQ(first->slaves().size(), 19u);
   EXPECT_EQ(first->source(), "sim");
+  // The world it simulates is latched on the World topic (empty here: no --world).
+  auto world = worlds.wait(10s);
+  ASSERT_TRUE(world.has_value());
+  EXPECT_EQ(world->version(), 1u);
+  EXPECT_TRUE(world->obstacles().empty());
+  ASSERT_TRUE(commands.wait_for_readers(1, 10s));
 
-  // Remove the rear-right leg while the robot runs.
-  std::string edited = paper;
+  // A bad assembly is refused with the reason; the robot keeps its modules.
+  concert::msg::SimCommand bad;
+  bad.request_id(1);
+  bad.source("test");
+  bad.kind(concert::msg::SIM_SWAP_ASSEMBLY);
+  bad.name("bad.yaml");
+  std::string unknown = read_text(kPaperRobot);
+  unknown.replace(unknown.find("module_drill_concert"), std::string("module_drill_concert").size(), "no_such_module");
+  bad.content(unknown);
+  auto reply = send(commands, replies, bad);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_FALSE(reply->accepted());
+  EXPECT_NE(reply->message().find("keeps its modules"), std::string::npos) << reply->message();
+  EXPECT_NE(reply->message().find("no_such_module"), std::string::npos) << reply->message();
+
+  // Remove the rear-right leg while the robot runs: the content travels over DDS.
+  std::string edited = read_text(kPaperRobot);
   for (const std::string line : {"  - {name: steer_rr, key: module_steering_concert_fl_rr, parent: base, connector: 4, robot_id: 41}\n",
                                  "  - {name: wheel_rr, key: module_wheel_concert, parent: steer_rr, connector: 1, robot_id: 42}\n"}) {
     edited.erase(edited.find(line), line.size());
   }
-  std::this_thread::sleep_for(1100ms);  // file-time granularity
-  std::ofstream(assembly) << edited;
+  concert::msg::SimCommand swap = bad;
+  swap.request_id(2);
+  swap.name("three_legs.yaml");
+  swap.content(edited);
+  reply = send(commands, replies, swap);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_TRUE(reply->accepted()) << reply->message();
   std::optional<concert::msg::EscScan> second;
   for (int i = 0; i < 200 && !(second && second->scan_id() > first->scan_id()); ++i) {
     second = scans.wait(100ms);
@@ -104,7 +142,31 @@ TEST(RobotMain, HotSwapByEditingTheAssemblyGivesANewScan) {
     }
   }
   EXPECT_TRUE(ready_v2);
-  fs::remove_all(dir);
+
+  // A world change: refused when malformed, else simulated and republished.
+  concert::msg::SimCommand w = bad;
+  w.request_id(3);
+  w.kind(concert::msg::SIM_SET_WORLD);
+  w.name("site.yaml");
+  w.content("obstacles:\n  - {name: crate, size: [0.5, -1, 0.5], position: [3, 0, 0.25]}\n");
+  reply = send(commands, replies, w);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_FALSE(reply->accepted());
+  EXPECT_NE(reply->message().find("site.yaml"), std::string::npos) << reply->message();
+  EXPECT_NE(reply->message().find("obstacles[0].size"), std::string::npos) << reply->message();
+  w.request_id(4);
+  w.content("obstacles:\n  - {name: crate, size: [0.5, 0.5, 0.5], position: [3, 0, 0.25]}\n");
+  reply = send(commands, replies, w);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_TRUE(reply->accepted()) << reply->message();
+  for (int i = 0; i < 100 && !(world && world->version() == 2u); ++i) {
+    world = worlds.wait(100ms);
+  }
+  ASSERT_TRUE(world.has_value());
+  EXPECT_EQ(world->version(), 2u);
+  ASSERT_EQ(world->obstacles().size(), 1u);
+  EXPECT_EQ(world->obstacles()[0].name(), "crate");
+  EXPECT_EQ(world->source(), "site.yaml");
 }
 
 }  // namespace

@@ -7,9 +7,9 @@
 #include "concert/module_db/module_db.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/esc_catalog.hpp"
-#include "modelgen/model_generator.hpp"
+#include "concert/model_generation/generator.hpp"
 #include "robot/robot_core.hpp"
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_hardware.hpp"
 #include "test_helpers.hpp"
 
 namespace concert::robot {
@@ -24,7 +24,7 @@ std::string paper_robot_urdf() {
   const auto catalog = topology::EscCatalog::load(kPublicDb);
   const auto assembly = simbus::load_assembly(kExamples / "concert_paper_robot.yaml");
   const auto tree = simbus::tree_from_assembly(assembly, catalog);
-  return modelgen::ModelGenerator(db).generate(tree).urdf;
+  return model_generation::ModelGenerator(db).generate(tree).urdf;
 }
 
 TEST(PaperRobot, GeneratedModelRunsInTheSimulator) {

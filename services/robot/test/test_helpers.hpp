@@ -5,7 +5,16 @@
 #include <string>
 
 #include "robot/robot_core.hpp"
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_hardware.hpp"
+
+namespace concert::robot {
+
+using sim::SimHardware;
+using sim::SimParams;
+using world::World;
+using world::WorldShape;
+
+}  // namespace concert::robot
 
 namespace concert::robot::test {
 

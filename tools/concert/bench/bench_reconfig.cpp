@@ -1,5 +1,6 @@
 // Reconfiguration benchmark: the whole stack runs under `concert up` (simulated robot); the
-// mounted assembly is hot-swapped N times (drill <-> sanding tool) and each stage is timed
+// mounted assembly is hot-swapped N times (drill <-> sanding tool, by SimCommand over DDS, as
+// `concert sim swap` does) and each stage is timed
 // from the swap: new EtherCAT scan, new module tree, new robot model, and every service
 // ready at the new model version.
 // Usage: bench_reconfig [--swaps N]   (domain: CONCERT_DOMAIN_ID, default 198)
@@ -7,6 +8,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -33,6 +36,13 @@ struct Observed {
   std::map<std::string, std::pair<uint32_t, Clock::time_point>> ready;  // service -> version, time
 };
 
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
 double pct(std::vector<double> v, double q) {
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))];
@@ -46,8 +56,6 @@ int bench(int argc, char** argv) {
   if (std::getenv("CONCERT_DOMAIN_ID") == nullptr) setenv("CONCERT_DOMAIN_ID", "198", 1);
   char tmpl[] = "/tmp/concert-bench-XXXXXX";
   const std::string run = mkdtemp(tmpl);
-  const std::string domain = std::getenv("CONCERT_DOMAIN_ID");
-  const fs::path assembly = fs::path(run) / ("concert-d" + domain) / "assembly.yaml";
   const std::string demo = CONCERT_SOURCE_DIR "/deploy/demo/";
 
   Observed o;
@@ -71,6 +79,7 @@ int bench(int argc, char** argv) {
     if (s.model_version() != r.first) r = {s.model_version(), Clock::now()};
   });
 
+  dds::Writer<msg::SimCommand> sim_commands(p, dds::topics::sim_command);
   testing::Process up({CONCERT_BIN, "up", "--assembly", demo + "drill_robot.yaml"}, {"XDG_RUNTIME_DIR=" + run});
   auto wait_all_ready = [&](uint32_t version, std::chrono::seconds timeout) {
     const auto deadline = Clock::now() + timeout;
@@ -103,10 +112,15 @@ int bench(int argc, char** argv) {
       std::lock_guard l(o.m);
       target = o.model + 1;
     }
-    const fs::path tmp = assembly.string() + ".tmp";
-    fs::copy_file(demo + (i % 2 == 0 ? "sanding_robot.yaml" : "drill_robot.yaml"), tmp, fs::copy_options::overwrite_existing);
+    const std::string file = i % 2 == 0 ? "sanding_robot.yaml" : "drill_robot.yaml";
+    msg::SimCommand swap;
+    swap.request_id(static_cast<uint32_t>(i + 1));
+    swap.source("bench_reconfig");
+    swap.kind(msg::SIM_SWAP_ASSEMBLY);
+    swap.name(file);
+    swap.content(read_text(demo + file));
     const auto t0 = Clock::now();
-    fs::rename(tmp, assembly);
+    sim_commands.write(swap);
     if (!wait_all_ready(target, 30s)) {
       std::cerr << "bench_reconfig: swap " << i + 1 << " did not reach model version " << target << "\n";
       return 1;
@@ -129,7 +143,7 @@ int bench(int argc, char** argv) {
   fs::remove_all(run);
 
   std::printf("Reconfiguration after a hot swap in the simulator (%d swaps drill <-> sanding tool, 18-module robot)\n"
-              "times from the swap (assembly file replaced) to the stage, ms:\n",
+              "times from the swap (SimCommand written) to the stage, ms:\n",
               swaps);
   std::printf("  %-28s %10s %10s %10s\n", "stage", "median", "p95", "max");
   std::string json = "{";

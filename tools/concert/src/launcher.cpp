@@ -6,18 +6,23 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <condition_variable>
+#include <fstream>
+#include <mutex>
+#include <optional>
 #include <csignal>
 #include <cstdlib>
 #include <iomanip>
 #include <sstream>
 #include <thread>
 
+#include "concert/common/clock.hpp"
 #include "concert/dds/catalogue.hpp"
+#include "concert/dds/endpoint.hpp"
+#include "concert/idl_schema/cdr.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "scan_verbs.hpp"
-#ifdef CONCERT_HAVE_ROBOT_CORE
-#include "robot/world.hpp"
-#endif
+#include "concert/world/world.hpp"
 
 namespace concert::tool {
 
@@ -188,13 +193,11 @@ void check_assembly(const fs::path& file, const std::vector<std::string>& module
 
 void check_world(const fs::path& file) {
   if (!fs::is_regular_file(file)) throw Failure(file.string() + ": no such file");
-#ifdef CONCERT_HAVE_ROBOT_CORE
   try {
-    robot::load_world_file(file.string());
+    world::load_world_file(file.string());
   } catch (const std::exception& e) {
     throw Failure(std::string("world rejected, nothing changed: ") + e.what());
   }
-#endif
 }
 
 int32_t domain_of(const std::optional<int32_t>& domain) {
@@ -281,28 +284,62 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
 }
 
 int run_sim(const SimOptions& o, std::ostream& out, std::ostream& /*err*/) {
-  const std::string& verb = o.verb;
-  const std::string& file = o.file;
-  const auto& module_dbs = o.module_dbs;
-  const int32_t domain = domain_of(o.domain);
-  const fs::path dir = run_dir(domain);
-  if (!fs::is_directory(dir)) {
-    throw Failure("no stack runs on domain " + std::to_string(domain) + " from this machine (" + dir.string() +
-                  " is missing): start one with `concert up`");
+  if (o.verb != "assemble" && o.verb != "swap" && o.verb != "world") {
+    throw UsageError("unknown sim verb '" + o.verb + "' (assemble, swap, world)");
   }
-  if (verb == "assemble" || verb == "swap") {
-    check_assembly(file, module_dbs);
-    install_file(file, dir / "assembly.yaml");
-    out << "concert sim " << verb << ": " << file << " is now the mounted assembly; the robot service rescans\n";
-    return 0;
+  const bool assembly = o.verb != "world";
+  // Checked here first: a bad file never reaches the simulator (which checks again).
+  if (assembly) {
+    check_assembly(o.file, o.module_dbs);
+  } else {
+    check_world(o.file);
   }
-  if (verb == "world") {
-    check_world(file);
-    install_file(file, dir / "world.yaml");
-    out << "concert sim world: " << file << " is now the simulated world\n";
-    return 0;
+  std::ifstream in(o.file);
+  std::stringstream content;
+  content << in.rdbuf();
+
+  dds::Participant participant({.name = "concert_sim", .domain_id = o.dds.domain_id()});
+  std::mutex m;
+  std::condition_variable cv;
+  std::optional<msg::SimCommandReply> reply;
+  const auto request_id = static_cast<uint32_t>(
+      std::chrono::steady_clock::now().time_since_epoch().count() & 0x7fffffff);
+  dds::Reader<msg::SimCommandReply> replies(participant, dds::topics::sim_reply,
+                                            [&](const msg::SimCommandReply& r, const auto&) {
+                                              if (r.request_id() != request_id) return;
+                                              {
+                                                std::lock_guard lock(m);
+                                                reply = r;
+                                              }
+                                              cv.notify_all();
+                                            });
+  dds::Writer<msg::SimCommand> commands(participant, dds::topics::sim_command);
+  msg::SimCommand c;
+  c.request_id(request_id);
+  c.stamp_ns(now_ns());
+  c.source("concert sim");
+  c.kind(assembly ? msg::SIM_SWAP_ASSEMBLY : msg::SIM_SET_WORLD);
+  c.name(fs::path(o.file).filename().string());
+  c.content(content.str());
+  // The command topic is volatile: wait for the simulator's reader before writing.
+  const auto deadline = std::chrono::steady_clock::now() + o.dds.timeout();
+  if (!commands.wait_for_readers(1, o.dds.timeout())) {
+    throw Failure("no simulator on domain " + std::to_string(participant.domain_id()) +
+                  " (start one with `concert up`)");
   }
-  throw UsageError("unknown sim verb '" + verb + "' (assemble, swap, world)");
+  commands.write(c);
+  std::unique_lock lock(m);
+  if (!cv.wait_until(lock, deadline, [&] { return reply.has_value(); })) {
+    throw Failure("the simulator did not answer within " + std::to_string(o.dds.timeout_s) + " s");
+  }
+  if (!reply->accepted()) throw Failure(reply->message());
+  if (o.dds.json) {
+    out << idl::Json{{"verb", o.verb}, {"file", o.file}, {"accepted", true}, {"message", reply->message()}}.dump()
+        << "\n";
+  } else {
+    out << "concert sim " << o.verb << ": " << o.file << ": " << reply->message() << "\n";
+  }
+  return 0;
 }
 
 void register_launcher_verbs(cli::Cli& concert) {
@@ -353,7 +390,7 @@ void register_launcher_verbs(cli::Cli& concert) {
                       "module database folder to check the assembly against (repeat to merge)")
           ->type_name("DIR");
     }
-    cli::Cli::add_domain_option(verb, o->domain);
+    concert.add_dds_options(verb, o->dds, 10.0, "how long to wait for the simulator and its answer");
   }
 }
 

@@ -83,9 +83,9 @@ struct UpOptions {
 /// `concert sim assemble|swap|world FILE`.
 struct SimOptions {
   std::string verb;  ///< assemble, swap or world
-  std::string file;
-  std::vector<std::string> module_dbs;
-  std::optional<int32_t> domain;
+  std::string file;  ///< assembly or world YAML on this host
+  std::vector<std::string> module_dbs;  ///< extra module databases to check the assembly against
+  cli::DdsOptions dds;  ///< --domain, --timeout (for the simulator and its answer), --json
 };
 
 int run_up(const UpOptions& options, std::ostream& out, std::ostream& err);

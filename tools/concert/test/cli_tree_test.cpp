@@ -106,8 +106,7 @@ std::vector<std::string> required_arguments(const CLI::App& verb) {
 
 /// Verbs that act on a domain without talking DDS themselves (they start processes or write
 /// the run folder); every other verb with --domain must take the DDS options.
-const std::set<std::string> kDomainOnly = {"concert up", "concert sim assemble", "concert sim swap",
-                                           "concert sim world"};
+const std::set<std::string> kDomainOnly = {"concert up"};
 /// Extra arguments for verbs whose rules are checked after parsing.
 const std::map<std::string, std::vector<std::string>> kExtra = {
     {"concert scan publish", {"--scan", "scan.yaml"}}};

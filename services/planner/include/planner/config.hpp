@@ -1,6 +1,6 @@
 #pragma once
-// YAML input of the planner service: parameters (config/planner.yaml) and the world
-// description (walls/obstacles; the robot service's world file format).
+// YAML input of the planner service: its parameters (config/planner.yaml). The world comes
+// from libs/world (one parser, one type, the latched world topic).
 
 #include <filesystem>
 #include <string>
@@ -16,10 +16,5 @@ Params load_params(const std::filesystem::path& file);
 Params parse_params(const std::string& yaml, const std::string& source);
 /// Reads the parameters of `doc`, starting from the defaults (throws config::ConfigError).
 Params read_params(config::Document& doc);
-
-/// Reads walls (boxes) and obstacles (boxes or vertical cylinders) of a world file; `floor`
-/// and `friction` keys are accepted and ignored. Throws PlannerError naming file and field.
-World load_world(const std::filesystem::path& file);
-World parse_world(const std::string& yaml, const std::string& source);
 
 }  // namespace concert::planner

@@ -1,7 +1,5 @@
 #include "planner/config.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include "concert/common/text.hpp"
 
 namespace concert::planner {
@@ -13,27 +11,6 @@ std::string read_file(const std::filesystem::path& file, const char* what) {
   } catch (const std::runtime_error& e) {
     throw PlannerError(e.what());
   }
-}
-
-YAML::Node parse(const std::string& yaml, const std::string& source) {
-  try {
-    return YAML::Load(yaml);
-  } catch (const YAML::Exception& e) {
-    throw PlannerError(source + ": YAML error: " + e.what());
-  }
-}
-
-double number(const YAML::Node& n, const std::string& where) {
-  try {
-    return n.as<double>();
-  } catch (const YAML::Exception&) {
-    throw PlannerError(where + ": expected a number");
-  }
-}
-
-Eigen::Vector3d vec3(const YAML::Node& n, const std::string& where) {
-  if (!n.IsSequence() || n.size() != 3) throw PlannerError(where + ": expected a list of 3 numbers");
-  return {number(n[0], where), number(n[1], where), number(n[2], where)};
 }
 
 }  // namespace
@@ -100,45 +77,5 @@ Params parse_params(const std::string& yaml, const std::string& source) {
 Params load_params(const std::filesystem::path& file) {
   return parse_params(read_file(file, "params"), file.string());
 }
-
-World parse_world(const std::string& yaml, const std::string& source) {
-  World w;
-  const YAML::Node root = parse(yaml, source);
-  if (!root || root.IsNull()) return w;
-  if (!root.IsMap()) throw PlannerError(source + ": expected a map with walls/obstacles");
-  auto read_list = [&](const std::string& key, bool allow_cylinders) {
-    const YAML::Node list = root[key];
-    if (!list) return;
-    if (!list.IsSequence()) throw PlannerError(source + ": " + key + ": expected a list");
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const YAML::Node item = list[i];
-      const std::string where = source + ": " + key + "[" + std::to_string(i) + "]";
-      const std::string name = item["name"] ? item["name"].as<std::string>() : key + std::to_string(i);
-      const std::string shape = item["shape"] ? item["shape"].as<std::string>() : "box";
-      if (shape == "cylinder" && allow_cylinders) {
-        if (!item["radius"] || !item["height"] || !item["position"]) {
-          throw PlannerError(where + ": a cylinder needs radius, height and position");
-        }
-        w.cylinders.push_back({name, number(item["radius"], where + ".radius"), number(item["height"], where + ".height"),
-                               vec3(item["position"], where + ".position")});
-      } else if (shape == "box") {
-        if (!item["size"] || !item["position"]) throw PlannerError(where + ": a box needs size and position");
-        w.boxes.push_back({name, vec3(item["size"], where + ".size"), vec3(item["position"], where + ".position"),
-                           item["yaw"] ? number(item["yaw"], where + ".yaw") : 0.0});
-      } else {
-        throw PlannerError(where + ".shape: unknown shape '" + shape + "' (box" + (allow_cylinders ? " or cylinder)" : ")"));
-      }
-    }
-  };
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    if (key != "walls" && key != "obstacles" && key != "floor") throw PlannerError(source + ": " + key + ": unknown key");
-  }
-  read_list("walls", false);
-  read_list("obstacles", true);
-  return w;
-}
-
-World load_world(const std::filesystem::path& file) { return parse_world(read_file(file, "world"), file.string()); }
 
 }  // namespace concert::planner

@@ -1,6 +1,7 @@
 #include "dds/planner_node.hpp"
 
 #include "concert/model/dds/conversions.hpp"
+#include "concert/world/world_dds.hpp"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -12,22 +13,20 @@
 #include "concert/common/clock.hpp"
 
 namespace concert::planner::dds {
-namespace {
 
-// Linear interpolation of a trajectory at time t [s] (samples are dense, 20 ms by default).
-TrajectoryPoint sample_at(const Trajectory& t, double time) {
-  const auto& p = t.points;
-  if (time <= p.front().time) return p.front();
-  if (time >= p.back().time) return p.back();
-  const auto it = std::upper_bound(p.begin(), p.end(), time,
-                                   [](double v, const TrajectoryPoint& q) { return v < q.time; });
-  const TrajectoryPoint& b = *it;
-  const TrajectoryPoint& a = *(it - 1);
-  const double u = (time - a.time) / (b.time - a.time);
-  return {time, a.q + u * (b.q - a.q), a.qd + u * (b.qd - a.qd)};
+World to_planner_world(const world::World& w) {
+  World out;
+  auto add = [&](const world::WorldShape& s) {
+    if (s.type == world::WorldShape::Type::kCylinder) {
+      out.cylinders.push_back({s.name, s.size.x(), s.size.z(), s.position});
+    } else {
+      out.boxes.push_back({s.name, s.size, s.position, s.yaw});
+    }
+  };
+  for (const auto& s : w.walls) add(s);
+  for (const auto& s : w.obstacles) add(s);
+  return out;
 }
-
-}  // namespace
 
 Eigen::Isometry3d to_core(const msg::Pose& p) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
@@ -78,8 +77,7 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
       options_(options),
       log_(log),
       results_(participant, concert::dds::topics::plan_result),
-      joint_commands_(participant, concert::dds::topics::joint_command),
-      base_commands_(participant, concert::dds::topics::base_velocity),
+      trajectory_commands_(participant, concert::dds::topics::trajectory_command),
       status_(participant, "planner"),
       models_(participant, concert::dds::topics::robot_model,
               [this](const auto& s, const auto&) { on_model(s); }),
@@ -93,6 +91,16 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
                     std::lock_guard lock(mutex_);
                     odometry_ = s;
                   }),
+      trajectory_statuses_(participant, concert::dds::topics::trajectory_status,
+                           [this](const msg::TrajectoryStatus& st, const auto&) {
+                             {
+                               std::lock_guard lock(mutex_);
+                               trajectory_status_[st.request_id()] = st;
+                             }
+                             wake_.notify_all();
+                           }),
+      worlds_(participant, concert::dds::topics::world,
+              [this](const msg::World& w, const auto&) { on_world(w); }),
       request_reader_(participant, concert::dds::topics::plan_request,
                       [this](const auto& s, const auto&) {
                         {
@@ -366,15 +374,15 @@ void PlannerNode::execute_loop() {
     Execution e = std::move(executions_.front());
     executions_.pop_front();
     lock.unlock();
-    const bool ok = execute(e);
+    const std::string error = execute(e);
+    const bool ok = error.empty();
     msg::PlanResult r = e.result;
     r.trajectory().clear();
     r.progress(ok ? 1.0 : r.progress());
     r.state(ok ? (e.last ? msg::PLAN_SUCCEEDED : msg::PLAN_PLANNED) : msg::PLAN_FAILED);
     if (!ok) {
       r.failure(msg::PLAN_EXECUTION_ABORTED);
-      r.reason("execution of goal " + std::to_string(r.goal_index()) +
-               " aborted: the robot model changed");
+      r.reason("execution of goal " + std::to_string(r.goal_index()) + " aborted: " + error);
       std::lock_guard relock(mutex_);
       executions_.clear();
     }
@@ -382,51 +390,81 @@ void PlannerNode::execute_loop() {
   }
 }
 
-bool PlannerNode::execute(Execution& e) {
+std::string PlannerNode::execute(Execution& e) {
+  // The robot's loop tracks the trajectory closed-loop (joints through the drives, the base
+  // from odometry); the planner relays its progress and result.
   const PlanningModel& m = *e.model;
   const Trajectory& t = e.trajectory;
-  msg::JointCommand cmd;
+  msg::JointTrajectoryCommand cmd;
+  const uint32_t id = next_trajectory_id_++;
+  cmd.request_id(id);
   cmd.model_version(static_cast<uint32_t>(m.version()));
+  cmd.stamp_ns(now_ns());
   cmd.source("planner");
-  cmd.mode(msg::JOINT_POSITION);
-  for (std::size_t i = 3; i < t.joint_names.size(); ++i) cmd.name().push_back(t.joint_names[i]);
-  msg::BaseVelocityCommand base;
-  base.model_version(static_cast<uint32_t>(m.version()));
-  base.source("planner");
-  const auto t0 = std::chrono::steady_clock::now();
-  auto last_progress = t0;
+  cmd.joint_names(t.joint_names);
+  for (const TrajectoryPoint& p : t.points) {
+    msg::JointTrajectorySample s;
+    s.time(p.time);
+    s.position(std::vector<double>(p.q.data(), p.q.data() + p.q.size()));
+    s.velocity(std::vector<double>(p.qd.data(), p.qd.data() + p.qd.size()));
+    cmd.samples().push_back(std::move(s));
+  }
   e.result.state(msg::PLAN_EXECUTING);
   e.result.trajectory().clear();
+  trajectory_commands_.write(cmd);
+  // Bounded wait: the trajectory's duration plus the robot's settling time and a margin.
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::milliseconds(static_cast<int64_t>(1e3 * t.duration())) + options_.result_margin;
+  double reported = -1.0;
+  std::unique_lock lock(mutex_);
   while (true) {
-    {
-      std::lock_guard lock(mutex_);
-      if (stopping_) return false;
+    if (stopping_) return "the planner is stopping";
+    const auto it = trajectory_status_.find(id);
+    if (it != trajectory_status_.end()) {
+      const msg::TrajectoryStatus st = it->second;
+      switch (st.state()) {
+        case msg::TRAJECTORY_SUCCEEDED:
+          trajectory_status_.erase(it);
+          return "";
+        case msg::TRAJECTORY_ABORTED:
+        case msg::TRAJECTORY_REFUSED:
+          trajectory_status_.erase(it);
+          return std::string(st.state() == msg::TRAJECTORY_REFUSED ? "refused" : "aborted") + " by the robot: " +
+                 st.reason();
+        case msg::TRAJECTORY_EXECUTING:
+          if (st.progress() >= reported + 0.05 || reported < 0.0) {
+            reported = st.progress();
+            e.result.progress(st.progress());
+            lock.unlock();
+            publish(e.result);
+            lock.lock();
+            // The result may have arrived while the lock was released (its notification is
+            // gone): look again before waiting.
+            continue;
+          }
+          break;
+      }
     }
-    if (planner_.model_version() != m.version()) return false;
-    const double time =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const TrajectoryPoint p = sample_at(t, time);
-    const auto n = static_cast<std::size_t>(p.q.size());
-    cmd.position(std::vector<double>(p.q.data() + 3, p.q.data() + n));
-    cmd.velocity(std::vector<double>(p.qd.data() + 3, p.qd.data() + n));
-    cmd.stamp_ns(now_ns());
-    joint_commands_.write(cmd);
-    // World-frame base velocity into the base frame.
-    const double c = std::cos(p.q[2]);
-    const double s = std::sin(p.q[2]);
-    base.vx(c * p.qd[0] + s * p.qd[1]);
-    base.vy(-s * p.qd[0] + c * p.qd[1]);
-    base.wz(p.qd[2]);
-    base.stamp_ns(now_ns());
-    base_commands_.write(base);
-    if (time >= t.duration()) return true;
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_progress >= options_.progress_period) {
-      e.result.progress(t.duration() > 0 ? std::min(1.0, time / t.duration()) : 1.0);
-      publish(e.result);
-      last_progress = now;
+    if (wake_.wait_until(lock, deadline) == std::cv_status::timeout && std::chrono::steady_clock::now() >= deadline) {
+      return "no result from the robot service within " +
+             std::to_string(static_cast<int>(t.duration() + 1e-3 * static_cast<double>(options_.result_margin.count()))) +
+             " s (is it running?)";
     }
-    std::this_thread::sleep_for(options_.command_period);
+  }
+}
+
+void PlannerNode::on_world(const msg::World& w) {
+  try {
+    const World world = to_planner_world(world::from_msg(w));
+    Environment env(planner_.params().octomap_resolution);
+    env.add_world(world);
+    planner_.set_environment(env);
+    std::ostringstream line;
+    line << "planner: world version " << w.version() << " from " << w.source() << ": " << world.boxes.size()
+         << " boxes, " << world.cylinders.size() << " cylinders, map " << env.occupied_cells() << " occupied cells";
+    log_line(line.str());
+  } catch (const std::exception& e) {
+    log_line(std::string("planner: world version ") + std::to_string(w.version()) + " refused: " + e.what());
   }
 }
 

@@ -2,13 +2,17 @@
 // DDS adapter of the planner service: RobotModel in (reconfigure, status READY at the
 // version), joint state and odometry in (start state), PlanRequest in; PlanResult out per
 // request (planning, planned with the trajectory, executing with progress, succeeded/failed
-// with the reason). Execution streams JointCommand (position mode) for the arm joints and
-// BaseVelocityCommand for the base, while later goals are still being planned (FIFO).
+// with the reason). Execution hands each planned trajectory (base x, y, yaw + arm) to the
+// robot's loop as a JointTrajectoryCommand, which tracks it closed-loop; the robot's
+// TrajectoryStatus becomes the PlanResult's progress and result, while later goals are still
+// being planned (FIFO). The world topic (latched) replaces the planner's map of walls and
+// obstacles whenever it changes.
 
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <ostream>
@@ -16,18 +20,21 @@
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
+#include "concert/world/world.hpp"
 #include "planner/planner.hpp"
 
 namespace concert::planner::dds {
 
 /// Conversions between IDL and core types.
 Eigen::Isometry3d to_core(const msg::Pose& pose);
+/// The planner's boxes and cylinders of the world every service reads (libs/world).
+World to_planner_world(const world::World& world);
 msg::Pose to_msg(const Eigen::Isometry3d& pose);
 msg::PlanFailure to_failure(Status status);
 
 struct NodeOptions {
-  std::chrono::milliseconds command_period{10};   ///< execution command period
-  std::chrono::milliseconds progress_period{100}; ///< progress updates while executing
+  /// How long after a trajectory's duration the robot's result may take (its settling time).
+  std::chrono::milliseconds result_margin{10000};
   /// A request for a model version the planner does not have yet (it races the model after a
   /// hot swap) waits this long for that version before it is answered.
   std::chrono::milliseconds model_wait{5000};
@@ -61,7 +68,9 @@ class PlannerNode {
   void execute_loop();
   void warm_up_loop();
   void log_line(const std::string& line);
-  bool execute(Execution& e);
+  /// Empty on success, else why the robot did not execute it.
+  std::string execute(Execution& e);
+  void on_world(const msg::World& world);
 
   Planner& planner_;
   NodeOptions options_;
@@ -76,12 +85,16 @@ class PlannerNode {
   bool stopping_ = false;
   uint64_t warm_version_ = 0;  // model version the warm-up thread should prepare (0: none)
   concert::dds::Writer<msg::PlanResult> results_;
-  concert::dds::Writer<msg::JointCommand> joint_commands_;
-  concert::dds::Writer<msg::BaseVelocityCommand> base_commands_;
+  concert::dds::Writer<msg::JointTrajectoryCommand> trajectory_commands_;
+  std::map<uint32_t, msg::TrajectoryStatus> trajectory_status_;  // by request id (under mutex_)
+  uint32_t next_trajectory_id_ = static_cast<uint32_t>(
+      std::chrono::steady_clock::now().time_since_epoch().count() & 0x7fffffff);  // executor thread only
   concert::dds::StatusReporter status_;
   concert::dds::Reader<msg::RobotModel> models_;
   concert::dds::Reader<msg::JointState> joint_states_;
   concert::dds::Reader<msg::Odometry> odometries_;
+  concert::dds::Reader<msg::TrajectoryStatus> trajectory_statuses_;
+  concert::dds::Reader<msg::World> worlds_;
   concert::dds::Reader<msg::PlanRequest> request_reader_;
   std::thread executor_;
   std::thread warmer_;

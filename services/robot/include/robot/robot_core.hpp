@@ -5,7 +5,6 @@
 
 #include <cstdint>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -81,8 +80,62 @@ struct BaseCommand {
   double wz{0.0};  ///< [rad/s]
 };
 
-/// Who drives a joint this cycle.
-enum class JointOwner : std::uint8_t { kHold, kJoint, kCartesian, kGravityCompensation, kBase };
+/// Who drives a joint this cycle: the controller that owns it (one owner per joint).
+enum class JointOwner : std::uint8_t { kHold, kJoint, kCartesian, kGravityCompensation, kBase, kTrajectory };
+
+/// Name of the controller behind an owner ("hold", "joint", "cartesian_impedance", ...).
+const char* controller_name(JointOwner owner);
+
+/// Name of the virtual planar-base joints a joint trajectory may carry (odometry frame).
+inline constexpr const char* kBaseX = "base_x";
+inline constexpr const char* kBaseY = "base_y";
+inline constexpr const char* kBaseYaw = "base_yaw";
+
+/// One timed sample of a joint trajectory; vectors are indexed like JointTrajectory::joints.
+struct TrajectorySample {
+  double time{0.0};              ///< [s] from the start of the trajectory
+  std::vector<double> position;  ///< [rad] or [m]
+  std::vector<double> velocity;  ///< [rad/s] or [m/s]
+};
+
+/// A joint trajectory for the robot's loop to track closed-loop: the joints through their
+/// drives (position with velocity feed-forward), the planar base (base_x, base_y, base_yaw,
+/// all three or none, in the odometry frame) through the base controller with odometry
+/// feedback. Samples are linearly interpolated; times strictly increase from >= 0.
+struct JointTrajectory {
+  std::uint32_t request_id{0};
+  std::uint64_t model_version{0};
+  std::string source;
+  std::vector<std::string> joints;
+  std::vector<TrajectorySample> samples;
+};
+
+/// Where the tracked trajectory stands.
+enum class TrajectoryState : std::uint8_t { kIdle, kExecuting, kSucceeded, kAborted };
+
+/// Why a trajectory was aborted.
+enum class TrajectoryAbort : std::uint8_t {
+  kNone,
+  kSafetyStop,      ///< the safety layer stopped the robot
+  kPreempted,       ///< another command took some of its joints (or hold())
+  kModelChanged,    ///< a new model version was switched in
+  kHardwareChanged, ///< the mounted hardware changed (hot swap)
+  kPathTolerance,   ///< tracking error beyond RobotParams::trajectory_path_tolerance
+  kGoalTolerance,   ///< final sample not reached within RobotParams::trajectory_goal_time
+};
+
+/// Progress of the last trajectory the loop took (sampled each cycle).
+struct TrajectoryProgress {
+  std::uint32_t request_id{0};
+  std::uint64_t sequence{0};          ///< increases with each trajectory taken (0: none yet)
+  TrajectoryState state{TrajectoryState::kIdle};
+  TrajectoryAbort abort{TrajectoryAbort::kNone};
+  double progress{0.0};               ///< time along the trajectory / its duration [0, 1]
+  double duration{0.0};               ///< [s]
+  double max_joint_error{0.0};        ///< largest joint tracking error so far [rad] or [m]
+  double max_base_error{0.0};         ///< largest base position error so far [m]
+  int worst_joint{-1};                ///< model index of the joint with max_joint_error (-1: base)
+};
 
 /// Parameters of the robot core (loaded from YAML by the adapter).
 struct RobotParams {
@@ -94,17 +147,28 @@ struct RobotParams {
   double wrench_filter_time_constant{0.02};  ///< low-pass of the wrench estimate [s]
   double base_command_timeout{0.5};      ///< base stops if no base command for this long [s]
   double velocity_guard_gain{20.0};      ///< damping added above the velocity limit [Nm s/rad]
+  double trajectory_path_tolerance{0.3};  ///< joint tracking error that aborts a trajectory [rad] or [m]
+  double trajectory_base_path_tolerance{0.5};  ///< base position error that aborts it [m]
+  double trajectory_goal_tolerance{0.03};  ///< final joint error to succeed [rad] or [m]
+  double trajectory_base_goal_tolerance{0.08};  ///< final base position error to succeed [m]
+  double trajectory_goal_time{3.0};      ///< time after the last sample to get within the goal tolerance [s]
+  double trajectory_base_gain{1.5};      ///< odometry feedback of the base [1/s]
+  double trajectory_base_deadband{0.01};  ///< base twists below this keep the steering [m/s, rad/s]
+  /// Fraction of the steering velocity limit while tracking a trajectory: at the limit the
+  /// drive's damping costs more than the steering's continuous torque (safety's limit).
+  double trajectory_steering_rate{0.35};
 };
 
 /// Everything the robot publishes, sampled at the end of a cycle.
 struct RobotState {
   double time{0.0};                       ///< hardware time [s]
+  std::uint64_t cycle{0};                 ///< loop cycles since start
   bool ready{false};
   std::uint64_t model_version{0};
   std::string message;                    ///< human-readable status
   std::vector<std::string> joint_names;   ///< hardware order
   std::vector<double> position, velocity, effort;
-  std::vector<JointOwner> owners;         ///< hardware order
+  std::vector<JointOwner> owners;         ///< hardware order: the ownership record
   bool has_base{false};
   Odometry odometry;
   std::string end_effector_frame;
@@ -112,26 +176,33 @@ struct RobotState {
   /// Estimated external wrench applied ON the end-effector by the environment, at the frame
   /// origin, world-aligned [N, Nm]; from measured joint torques (quasi-static).
   Vector6d end_effector_wrench{Vector6d::Zero()};
+  TrajectoryProgress trajectory;           ///< the trajectory taken last
+  TrajectoryProgress replaced_trajectory;  ///< the last one a newer one replaced while it ran
 };
 
-/// The robot core (XBot2's role): owns one Hardware, runs the 1 kHz joint-level loop,
-/// turns joint / Cartesian / gravity-compensation / base commands into drive references
-/// with the model's limits enforced, estimates the end-effector wrench, keeps odometry,
-/// and reconfigures on a new model version.
+/// The robot core (XBot2's role): owns one Hardware, runs the 1 kHz joint-level loop with
+/// controllers behind one interface (ros2_control's shape: each controller owns the joints
+/// it claimed; see controllers.hpp), enforces the model's limits, estimates the end-effector
+/// wrench, keeps odometry, tracks joint trajectories, and reconfigures on a new model version.
 ///
-/// Threads: commands and set_model() may come from any thread; cycle() runs on the loop
-/// thread. A mutex guards the shared command/state (held only for copies).
+/// Threads: cycle() runs on the loop thread and never waits for another thread nor
+/// allocates. Commands, set_model() and state() may come from any other thread: commands are
+/// checked there and handed to the loop through a lock-free triple buffer; a new model is
+/// prepared there in full (controllers, KDL scratch, vectors) and switched in by the loop at
+/// the next cycle boundary; the loop hands its state out through another triple buffer.
 class RobotCore {
  public:
   explicit RobotCore(Hardware& hardware, RobotParams params = {});
   ~RobotCore();
+  RobotCore(const RobotCore&) = delete;
+  RobotCore& operator=(const RobotCore&) = delete;
 
-  /// Accepts a new model (URDF text) at `version`: holds every joint, rebuilds
-  /// controllers/limits/legs, reports ready. Throws ModelMismatchError (old model kept) if it
-  /// cannot be parsed, its joints differ from the mounted hardware, or the version is older.
-  /// The mounted hardware is what the last cycle() saw (a hot swap is noticed at the next cycle).
-  /// `end_effector_frame` (e.g. from the model's end-effector list) overrides
-  /// RobotParams::end_effector_frame when not empty.
+  /// Accepts a new model (URDF text) at `version`: prepares its controllers off the loop,
+  /// which switches to it at the next cycle boundary holding every joint, and reports ready.
+  /// Throws ModelMismatchError (old model kept) if it cannot be parsed, its joints differ
+  /// from the mounted hardware (Hardware::mounted(): what the loop runs after its pending
+  /// switch), or the version is older. `end_effector_frame` (e.g. the tool end-effector of
+  /// the model message) overrides RobotParams::end_effector_frame when not empty.
   void set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame = "");
 
   void command_joints(const JointCommandSet& command);
@@ -139,17 +210,24 @@ class RobotCore {
   void command_base(const BaseCommand& command);
   /// Gravity compensation (teaching mode) for `joints` (empty: the end-effector chain).
   void command_gravity_compensation(std::uint64_t model_version, const std::vector<std::string>& joints = {});
-  /// Every joint holds its current position; the base stops.
+  /// Checks a joint trajectory (model version, known and distinct joints, base joints all
+  /// three or none, sample sizes, finite values, strictly increasing times) and hands it to
+  /// the loop, which starts tracking it at the next cycle (aborting the one it replaces).
+  /// Throws CommandError naming the problem.
+  void command_trajectory(const JointTrajectory& trajectory);
+  /// Every joint holds its current position; the base stops; a running trajectory aborts.
   void hold();
-  /// Safety stop (from the safety layer): while stopped every joint holds where it is and
-  /// every command is refused with `reason`; release() lets commands in again (the robot
-  /// keeps holding until commanded).
+  /// Safety stop (from the safety layer): while stopped every joint holds where it is, a
+  /// running trajectory aborts, and every command is refused with `reason`; release() lets
+  /// commands in again (the robot keeps holding until commanded).
   void set_safety_stop(bool stopped, const std::string& reason = "");
   [[nodiscard]] bool safety_stopped() const;
 
-  /// One control period: read the hardware, compute, write, step it by `params.period`.
+  /// One control period: switch what was prepared, read the hardware, run the controllers,
+  /// write, step it by `params.period`. Loop thread only.
   void cycle();
 
+  /// The latest state the loop handed out.
   [[nodiscard]] RobotState state() const;
   [[nodiscard]] bool ready() const;
   [[nodiscard]] std::uint64_t model_version() const;
@@ -159,24 +237,21 @@ class RobotCore {
   [[nodiscard]] std::vector<Leg> legs() const;
   /// Current model (null before the first set_model()).
   [[nodiscard]] std::shared_ptr<const kinematics::Model> model() const;
+  /// The ownership record as the loop last published it: joint -> controller name.
+  [[nodiscard]] std::vector<std::pair<std::string, std::string>> ownership() const;
+  /// Human-readable reason of an aborted trajectory (names the joint for tracking errors).
+  [[nodiscard]] std::string describe(const TrajectoryProgress& progress) const;
 
-  struct Controllers;
+  struct Slot;
+  struct Loop;
 
  private:
+  struct Shared;
   void check_command(std::uint64_t model_version) const;
   Hardware& hw_;
   RobotParams params_;
-  mutable std::mutex mutex_;
-  std::unique_ptr<Controllers> ctl_;
-  RobotState state_;
-  HardwareState hw_state_;
-  std::vector<DriveCommand> drive_;
-  std::vector<std::string> hw_joints_;   // as of the last cycle (the loop thread owns hw_)
-  std::uint64_t hw_generation_{0};       // as of the last cycle
-  std::uint64_t known_generation_{0};    // generation the current model was accepted for
-  bool holding_hw_{false};
-  bool safety_stopped_{false};
-  std::string safety_reason_;
+  std::unique_ptr<Shared> shared_;  // non-real-time side (guarded by its own mutex)
+  std::unique_ptr<Loop> loop_;      // loop-thread side
 };
 
 }  // namespace concert::robot

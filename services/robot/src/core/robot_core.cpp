@@ -5,11 +5,22 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <mutex>
 #include <set>
 
+#include "robot/controllers.hpp"
+#include "concert/hardware/realtime_buffer.hpp"
 
 namespace concert::robot {
+
+using hardware::Handover;
+using hardware::RealtimeBuffer;
+
 namespace {
+
+/// Joint count the loop's hardware-order vectors are reserved for (more is served, with an
+/// allocation at the hardware switch that needs it).
+constexpr std::size_t kReservedJoints = 64;
 
 std::string join(const std::vector<std::string>& names) {
   std::string out;
@@ -20,13 +31,6 @@ std::string join(const std::vector<std::string>& names) {
 }
 
 bool finite(double v) { return std::isfinite(v); }
-
-double clamp_abs(double v, double limit) { return limit > 0.0 ? std::clamp(v, -limit, limit) : v; }
-
-Eigen::Vector3d rotation_error(const Eigen::Matrix3d& target, const Eigen::Matrix3d& current) {
-  const Eigen::AngleAxisd aa(target * current.transpose());
-  return aa.angle() * aa.axis();
-}
 
 // The deepest "tcp"/"tcp_<tag>" frame, else the last deepest link ("" for a model without
 // movable joints). Depth = number of movable joints above the frame.
@@ -56,147 +60,249 @@ std::string default_end_effector(const kinematics::Model& model) {
   return best_tcp.empty() ? best_leaf : best_tcp;
 }
 
+void reserve_state(RobotState& s) {
+  s.message.reserve(256);
+  s.end_effector_frame.reserve(64);
+  s.joint_names.reserve(kReservedJoints);
+  s.position.reserve(kReservedJoints);
+  s.velocity.reserve(kReservedJoints);
+  s.effort.reserve(kReservedJoints);
+  s.owners.reserve(kReservedJoints);
+}
+
+RobotState reserved_state() {
+  RobotState s;
+  reserve_state(s);
+  s.message = "waiting for a robot model";
+  return s;
+}
+
+/// The claim of one joint by a controller; `seq` orders claims and trajectories.
+struct Claim {
+  std::uint64_t seq{0};
+  JointOwner owner{JointOwner::kHold};
+};
+
 }  // namespace
 
-struct RobotCore::Controllers {
+/// Commands as the other threads leave them for the loop: the latest claim of each joint,
+/// the latest reference of each controller, and sequence numbers saying what is new.
+struct CommandFrame {
+  std::vector<Claim> claims;          // model order
+  std::vector<JointSetpoint> joints;  // model order (joint controller)
+  std::uint64_t hold_seq{0};
+  std::uint64_t cartesian_seq{0};
+  CartesianCommand cartesian;
+  bool keep_admittance{false};
+  std::uint64_t base_seq{0};
+  BaseCommand base;
+  std::uint64_t trajectory_seq{0};
+};
+
+/// Everything the loop needs for one model version, prepared off the loop thread.
+struct RobotCore::Slot {
+  Slot(std::shared_ptr<const kinematics::Model> m, const RobotParams& params, std::vector<int> arm_joints,
+       std::vector<Leg> leg_list)
+      : model(std::move(m)),
+        data(model->make_data()),
+        arm(std::move(arm_joints)),
+        legs(leg_list),
+        cycle(*model, arm.size()),
+        joint(model->dof()),
+        cartesian(arm),
+        base(leg_list.size() >= 2 ? std::make_unique<BaseController>(leg_list, params.base_command_timeout,
+                                                                   params.trajectory_steering_rate)
+                                  : nullptr),
+        trajectory(model->dof(), params, base.get()),
+        commands(make_frame(model->dof())),
+        applied_claim(static_cast<std::size_t>(model->dof()), 0) {
+    controllers = {&hold, &joint, &cartesian, &gravity, base.get(), &trajectory};
+  }
+  ~Slot() { delete running; }
+
+  static CommandFrame make_frame(int dof) {
+    CommandFrame f;
+    f.claims.assign(static_cast<std::size_t>(dof), Claim{});
+    f.joints.assign(static_cast<std::size_t>(dof), JointSetpoint{});
+    return f;
+  }
+
   std::shared_ptr<const kinematics::Model> model;
-  kinematics::Data data;
+  kinematics::Data data;  // KDL scratch of the loop
   std::uint64_t version{0};
-  std::vector<int> hw_to_model;  // hw index -> model index
-  std::vector<JointOwner> owner;  // model order
-  std::vector<JointCommand> joint_cmd;
-  std::vector<double> hold_position;
-  std::vector<double> position_ref;  // rate-limited position reference
+  std::uint64_t generation{0};  // hardware generation the model matches
+  std::string ready_message;
   std::string ee_frame;
   std::vector<int> arm;
   std::vector<Leg> legs;
-  std::optional<BaseKinematics> base;
-  BaseCommand base_cmd;
-  double base_cmd_time{-1e9};
-  std::optional<CartesianCommand> cart;
-  double adm_offset{0.0}, adm_rate{0.0};
-  Odometry odometry;
-  Vector6d wrench{Vector6d::Zero()};
+  std::vector<int> hw_to_model;
+  CycleData cycle;
+  HoldController hold;
+  JointController joint;
+  CartesianController cartesian;
+  GravityCompensationController gravity;
+  std::unique_ptr<BaseController> base;
+  TrajectoryController trajectory;
+  std::array<Controller*, 6> controllers{};
+  // Hand-over from the other threads.
+  RealtimeBuffer<CommandFrame> commands;
+  Handover<PreparedTrajectory> trajectories;
+  // Loop side.
+  bool fresh{true};
   bool wrench_initialized{false};
-  Eigen::Isometry3d ee_pose{Eigen::Isometry3d::Identity()};
-
-  explicit Controllers(std::shared_ptr<const kinematics::Model> m) : model(std::move(m)), data(model->make_data()) {}
-  [[nodiscard]] const kinematics::JointLimits& limits(int i) const {
-    return model->joint_limits()[static_cast<std::size_t>(i)];
-  }
+  std::vector<std::uint64_t> applied_claim;
+  std::uint64_t applied_hold{0}, applied_cartesian{0}, applied_base{0}, applied_trajectory{0};
+  PreparedTrajectory* running{nullptr};  // taken from `trajectories`, tracked by `trajectory`
 };
 
-RobotCore::RobotCore(Hardware& hardware, RobotParams params) : hw_(hardware), params_(std::move(params)) {
+/// The non-real-time side: writers serialise on `mutex`; the loop never takes it.
+struct RobotCore::Shared {
+  std::mutex mutex;
+  Handover<Slot> slots;
+  Slot* accepted{nullptr};  // newest model handed to the loop (owned by `slots` or the loop)
+  CommandFrame staged;      // accumulated commands of `accepted`
+  std::uint64_t seq{0};
+  bool safety_stopped{false};
+  std::string safety_reason;
+  bool cartesian_admittance{false};
+  mutable std::mutex state_mutex;  // readers of the loop's state buffer
+};
+
+/// The loop-thread side.
+struct RobotCore::Loop {
+  Loop() : state([] { return reserved_state(); }) {
+    hw_state.position.reserve(kReservedJoints);
+    hw_state.velocity.reserve(kReservedJoints);
+    hw_state.effort.reserve(kReservedJoints);
+    drive.reserve(kReservedJoints);
+  }
+  ~Loop() { delete active; }
+  Slot* active{nullptr};
+  HardwareState hw_state;
+  std::vector<DriveCommand> drive;  // hardware order
+  bool holding_hw{false};
+  std::uint64_t holding_generation{0};
+  bool stop_seen{false};
+  std::uint64_t cycles{0};
+  TrajectoryProgress last_progress;  // of a trajectory that ended with its model
+  std::atomic<bool> safety_stopped{false};
+  RealtimeBuffer<RobotState> state;
+};
+
+RobotCore::RobotCore(Hardware& hardware, RobotParams params)
+    : hw_(hardware), params_(std::move(params)), shared_(std::make_unique<Shared>()), loop_(std::make_unique<Loop>()) {
   if (params_.period <= 0.0) {
     throw std::invalid_argument("robot: period must be positive");
   }
-  hw_.read(hw_state_);
-  hw_joints_ = hw_.joint_names();
-  hw_generation_ = hw_.generation();
-  known_generation_ = hw_generation_;
-  state_.message = "waiting for a robot model";
 }
 
 RobotCore::~RobotCore() = default;
 
 void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame) {
+  const std::string what = "model version " + std::to_string(version);
   std::shared_ptr<const kinematics::Model> model;
   try {
     model = std::make_shared<const kinematics::Model>(kinematics::Model::from_urdf_string(urdf));
   } catch (const kinematics::ModelError& e) {
-    throw ModelMismatchError("model version " + std::to_string(version) + " refused: " + e.what());
+    throw ModelMismatchError(what + " refused: " + e.what());
   }
-  std::lock_guard lock(mutex_);
-  if (ctl_ && version < ctl_->version) {
-    throw ModelMismatchError("model version " + std::to_string(version) + " refused: older than the current version " +
-                             std::to_string(ctl_->version));
+  {
+    std::lock_guard lock(shared_->mutex);
+    if (shared_->accepted != nullptr && version < shared_->accepted->version) {
+      throw ModelMismatchError(what + " refused: older than the current version " +
+                               std::to_string(shared_->accepted->version));
+    }
   }
-  // The hardware belongs to the loop thread: use what the last cycle read.
-  const auto& hw_joints = hw_joints_;
-  const std::set<std::string> mounted(hw_joints.begin(), hw_joints.end());
+  // The hardware the loop runs once its pending switch (if any) is done.
+  const MountedHardware mounted = hw_.mounted();
+  const std::set<std::string> have(mounted.joint_names.begin(), mounted.joint_names.end());
   const std::set<std::string> modelled(model->joint_names().begin(), model->joint_names().end());
   std::vector<std::string> missing, extra;
-  std::set_difference(mounted.begin(), mounted.end(), modelled.begin(), modelled.end(), std::back_inserter(missing));
-  std::set_difference(modelled.begin(), modelled.end(), mounted.begin(), mounted.end(), std::back_inserter(extra));
+  std::set_difference(have.begin(), have.end(), modelled.begin(), modelled.end(), std::back_inserter(missing));
+  std::set_difference(modelled.begin(), modelled.end(), have.begin(), have.end(), std::back_inserter(extra));
   if (!missing.empty() || !extra.empty()) {
-    throw ModelMismatchError("model version " + std::to_string(version) + " '" + model->name() +
+    throw ModelMismatchError(what + " '" + model->name() +
                              "' does not match the mounted hardware: mounted joints missing from the model: " +
                              join(missing) + "; model joints not mounted: " + join(extra));
   }
-  auto ctl = std::make_unique<Controllers>(model);
-  ctl->version = version;
-  const int n = model->dof();
-  for (const auto& name : hw_joints) {
-    ctl->hw_to_model.push_back(model->joint_index_or_throw(name));
+  std::string ee = end_effector_frame.empty() ? params_.end_effector_frame : end_effector_frame;
+  if (ee.empty()) {
+    ee = default_end_effector(*model);
+  } else if (!model->has_frame(ee)) {
+    throw ModelMismatchError(what + ": end-effector frame '" + ee + "' is not a link of the model");
   }
-  // Hold: every joint keeps the position it has now.
-  ctl->hold_position.assign(static_cast<std::size_t>(n), 0.0);
-  for (std::size_t h = 0; h < hw_joints.size(); ++h) {
-    ctl->hold_position[static_cast<std::size_t>(ctl->hw_to_model[h])] = hw_state_.position[h];
-  }
-  ctl->position_ref = ctl->hold_position;
-  ctl->owner.assign(static_cast<std::size_t>(n), JointOwner::kHold);
-  ctl->joint_cmd.assign(static_cast<std::size_t>(n), JointCommand{});
-  // End-effector frame and its chain.
-  ctl->ee_frame = end_effector_frame.empty() ? params_.end_effector_frame : end_effector_frame;
-  if (ctl->ee_frame.empty()) {
-    ctl->ee_frame = default_end_effector(*model);
-  } else if (!model->has_frame(ctl->ee_frame)) {
-    throw ModelMismatchError("model version " + std::to_string(version) + ": end-effector frame '" + ctl->ee_frame +
-                             "' is not a link of the model");
-  }
-  // Legs of the mobile base (never part of the arm chain).
-  ctl->legs = detect_legs(*model, collision_cylinder_radii(urdf), params_.default_wheel_radius);
+  // Legs of the mobile base (never part of the arm chain), then the arm chain.
+  std::vector<Leg> legs = detect_legs(*model, collision_cylinder_radii(urdf), params_.default_wheel_radius);
   std::set<int> leg_joints;
-  for (const auto& leg : ctl->legs) {
+  for (const auto& leg : legs) {
     leg_joints.insert(leg.steering_index);
     leg_joints.insert(leg.wheel_index);
   }
-  if (ctl->legs.size() >= 2) {
-    ctl->base.emplace(ctl->legs);
-  }
-  if (!ctl->ee_frame.empty()) {
-    for (int j = 0; j < n; ++j) {
+  std::vector<int> arm;
+  if (!ee.empty()) {
+    for (int j = 0; j < model->dof(); ++j) {
       const auto sub = model->subtree_links(j);
-      if (leg_joints.count(j) == 0 && std::find(sub.begin(), sub.end(), ctl->ee_frame) != sub.end()) {
-        ctl->arm.push_back(j);
+      if (leg_joints.count(j) == 0 && std::find(sub.begin(), sub.end(), ee) != sub.end()) {
+        arm.push_back(j);
       }
     }
   }
-  if (ctl_) {
-    ctl->odometry = ctl_->odometry;
+  auto slot = std::make_unique<Slot>(model, params_, std::move(arm), std::move(legs));
+  slot->version = version;
+  slot->generation = mounted.generation;
+  slot->ee_frame = ee;
+  slot->ready_message = "ready at model version " + std::to_string(version);
+  for (const auto& name : mounted.joint_names) {
+    slot->hw_to_model.push_back(model->joint_index_or_throw(name));
   }
-  ctl_ = std::move(ctl);
-  known_generation_ = hw_generation_;
-  holding_hw_ = false;
-  state_.ready = true;
-  state_.model_version = version;
-  state_.message = "ready at model version " + std::to_string(version);
+  std::lock_guard lock(shared_->mutex);
+  if (shared_->accepted != nullptr && version < shared_->accepted->version) {
+    throw ModelMismatchError(what + " refused: older than the current version " +
+                             std::to_string(shared_->accepted->version));
+  }
+  shared_->accepted = slot.get();
+  shared_->staged = Slot::make_frame(model->dof());
+  shared_->cartesian_admittance = false;
+  shared_->slots.submit(std::move(slot));
 }
 
 void RobotCore::check_command(std::uint64_t model_version) const {
-  if (safety_stopped_) {
-    throw CommandError("command refused: safety stop (" + safety_reason_ + ")");
+  if (shared_->safety_stopped) {
+    throw CommandError("command refused: safety stop (" + shared_->safety_reason + ")");
   }
-  if (!ctl_ || !state_.ready) {
-    throw CommandError("command refused: robot not ready (" + state_.message + ")");
+  const Slot* s = shared_->accepted;
+  if (s == nullptr) {
+    throw CommandError("command refused: robot not ready (waiting for a robot model)");
   }
-  if (model_version != ctl_->version) {
+  if (s->generation != hw_.mounted_generation()) {
+    throw CommandError(
+        "command refused: robot not ready (hardware changed: waiting for a model matching the mounted joints)");
+  }
+  if (model_version != s->version) {
     throw CommandError("command for model version " + std::to_string(model_version) +
-                       " refused: current model version is " + std::to_string(ctl_->version));
+                       " refused: current model version is " + std::to_string(s->version));
   }
 }
 
+namespace {
+/// Hands the staged frame of `slot` to the loop.
+void publish_frame(RealtimeBuffer<CommandFrame>& buffer, const CommandFrame& staged) {
+  buffer.back() = staged;
+  buffer.publish();
+}
+}  // namespace
+
 void RobotCore::command_joints(const JointCommandSet& command) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(shared_->mutex);
   check_command(command.model_version);
+  Slot& s = *shared_->accepted;
   std::set<int> seen;
-  std::vector<std::pair<int, JointCommand>> accepted;
+  std::vector<std::pair<int, JointSetpoint>> accepted;
   for (const auto& c : command.joints) {
-    const auto index = ctl_->model->joint_index(c.joint);
+    const auto index = s.model->joint_index(c.joint);
     if (!index) {
       throw CommandError("joint command refused: unknown joint '" + c.joint + "' (model version " +
-                         std::to_string(ctl_->version) + " has: " + join(ctl_->model->joint_names()) + ")");
+                         std::to_string(s.version) + " has: " + join(s.model->joint_names()) + ")");
     }
     if (!seen.insert(*index).second) {
       throw CommandError("joint command refused: joint '" + c.joint + "' given twice");
@@ -208,23 +314,26 @@ void RobotCore::command_joints(const JointCommandSet& command) {
     if (c.stiffness < 0.0 || c.damping < 0.0) {
       throw CommandError("joint command refused: negative stiffness or damping for joint '" + c.joint + "'");
     }
-    accepted.emplace_back(*index, c);
+    accepted.emplace_back(*index, JointSetpoint{c.mode, c.position, c.velocity, c.effort, c.stiffness, c.damping});
   }
-  for (const auto& [i, c] : accepted) {
-    ctl_->owner[static_cast<std::size_t>(i)] = JointOwner::kJoint;
-    ctl_->joint_cmd[static_cast<std::size_t>(i)] = c;
+  const std::uint64_t seq = ++shared_->seq;
+  for (const auto& [i, sp] : accepted) {
+    shared_->staged.claims[static_cast<std::size_t>(i)] = {seq, JointOwner::kJoint};
+    shared_->staged.joints[static_cast<std::size_t>(i)] = sp;
   }
+  publish_frame(s.commands, shared_->staged);
 }
 
 void RobotCore::command_cartesian(const CartesianCommand& command) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(shared_->mutex);
   check_command(command.model_version);
-  const std::string frame = command.frame.empty() ? ctl_->ee_frame : command.frame;
-  if (frame != ctl_->ee_frame) {
+  Slot& s = *shared_->accepted;
+  const std::string frame = command.frame.empty() ? s.ee_frame : command.frame;
+  if (frame != s.ee_frame) {
     throw CommandError("Cartesian command refused: frame '" + frame + "' is not the end-effector frame '" +
-                       ctl_->ee_frame + "'");
+                       s.ee_frame + "'");
   }
-  if (ctl_->arm.empty()) {
+  if (s.arm.empty()) {
     throw CommandError("Cartesian command refused: the model has no joints moving '" + frame + "'");
   }
   if ((command.stiffness.array() < 0.0).any() || (command.damping.array() < 0.0).any() ||
@@ -237,64 +346,171 @@ void RobotCore::command_cartesian(const CartesianCommand& command) {
        command.admittance.damping < 0.0)) {
     throw CommandError("Cartesian command refused: admittance needs a unit axis, mass > 0, damping >= 0");
   }
-  const bool keep_admittance = ctl_->cart && ctl_->cart->admittance.enabled && command.admittance.enabled;
-  ctl_->cart = command;
-  ctl_->cart->frame = frame;
-  if (!keep_admittance) {
-    ctl_->adm_offset = 0.0;
-    ctl_->adm_rate = 0.0;
+  const std::uint64_t seq = ++shared_->seq;
+  CommandFrame& f = shared_->staged;
+  f.keep_admittance = shared_->cartesian_admittance && command.admittance.enabled;
+  shared_->cartesian_admittance = command.admittance.enabled;
+  f.cartesian = command;
+  f.cartesian.frame.clear();
+  f.cartesian_seq = seq;
+  for (int j : s.arm) {
+    f.claims[static_cast<std::size_t>(j)] = {seq, JointOwner::kCartesian};
   }
-  for (int j : ctl_->arm) {
-    ctl_->owner[static_cast<std::size_t>(j)] = JointOwner::kCartesian;
-  }
+  publish_frame(s.commands, f);
 }
 
 void RobotCore::command_base(const BaseCommand& command) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(shared_->mutex);
   check_command(command.model_version);
-  if (!ctl_->base) {
-    throw CommandError("base command refused: model version " + std::to_string(ctl_->version) + " has " +
-                       std::to_string(ctl_->legs.size()) + " steering+wheel legs (needs at least 2)");
+  Slot& s = *shared_->accepted;
+  if (!s.base) {
+    throw CommandError("base command refused: model version " + std::to_string(s.version) + " has " +
+                       std::to_string(s.legs.size()) + " steering+wheel legs (needs at least 2)");
   }
   if (!finite(command.vx) || !finite(command.vy) || !finite(command.wz)) {
     throw CommandError("base command refused: non-finite twist");
   }
-  ctl_->base_cmd = command;
-  ctl_->base_cmd_time = hw_state_.time;
-  for (const auto& leg : ctl_->legs) {
+  const std::uint64_t seq = ++shared_->seq;
+  CommandFrame& f = shared_->staged;
+  f.base = command;
+  f.base_seq = seq;
+  for (const auto& leg : s.legs) {
     for (int j : {leg.steering_index, leg.wheel_index}) {
-      ctl_->owner[static_cast<std::size_t>(j)] = JointOwner::kBase;
+      f.claims[static_cast<std::size_t>(j)] = {seq, JointOwner::kBase};
     }
   }
+  publish_frame(s.commands, f);
 }
 
 void RobotCore::command_gravity_compensation(std::uint64_t model_version, const std::vector<std::string>& joints) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(shared_->mutex);
   check_command(model_version);
+  Slot& s = *shared_->accepted;
   std::vector<int> indices;
   if (joints.empty()) {
-    indices = ctl_->arm;
+    indices = s.arm;
   }
   for (const auto& name : joints) {
-    const auto index = ctl_->model->joint_index(name);
+    const auto index = s.model->joint_index(name);
     if (!index) {
       throw CommandError("gravity compensation refused: unknown joint '" + name + "'");
     }
     indices.push_back(*index);
   }
+  const std::uint64_t seq = ++shared_->seq;
   for (int j : indices) {
-    ctl_->owner[static_cast<std::size_t>(j)] = JointOwner::kGravityCompensation;
+    shared_->staged.claims[static_cast<std::size_t>(j)] = {seq, JointOwner::kGravityCompensation};
   }
+  publish_frame(s.commands, shared_->staged);
+}
+
+void RobotCore::command_trajectory(const JointTrajectory& t) {
+  std::lock_guard lock(shared_->mutex);
+  check_command(t.model_version);
+  Slot& s = *shared_->accepted;
+  const std::string what = "trajectory " + std::to_string(t.request_id) + " refused: ";
+  if (t.joints.empty()) {
+    throw CommandError(what + "no joints");
+  }
+  if (t.samples.empty()) {
+    throw CommandError(what + "no samples");
+  }
+  auto prepared = std::make_unique<PreparedTrajectory>();
+  prepared->request_id = t.request_id;
+  std::set<std::string> seen;
+  int base_columns[3] = {-1, -1, -1};
+  std::vector<int> column_of_joint;
+  for (std::size_t k = 0; k < t.joints.size(); ++k) {
+    const std::string& name = t.joints[k];
+    if (!seen.insert(name).second) {
+      throw CommandError(what + "joint '" + name + "' given twice");
+    }
+    const int base_axis = name == kBaseX ? 0 : name == kBaseY ? 1 : name == kBaseYaw ? 2 : -1;
+    if (base_axis >= 0) {
+      base_columns[base_axis] = static_cast<int>(k);
+      continue;
+    }
+    const auto index = s.model->joint_index(name);
+    if (!index) {
+      throw CommandError(what + "unknown joint '" + name + "' (model version " + std::to_string(s.version) +
+                         " has: " + join(s.model->joint_names()) + ")");
+    }
+    prepared->joints.push_back(*index);
+    column_of_joint.push_back(static_cast<int>(k));
+  }
+  const int base_count = (base_columns[0] >= 0) + (base_columns[1] >= 0) + (base_columns[2] >= 0);
+  if (base_count != 0 && base_count != 3) {
+    throw CommandError(what + "the base needs all of base_x, base_y, base_yaw or none of them");
+  }
+  prepared->base = base_count == 3;
+  if (prepared->base && !s.base) {
+    throw CommandError(what + "it moves the base, and model version " + std::to_string(s.version) +
+                       " has no mobile base");
+  }
+  if (prepared->base) {
+    for (const auto& leg : s.legs) {
+      for (int j : {leg.steering_index, leg.wheel_index}) {
+        if (std::find(prepared->joints.begin(), prepared->joints.end(), j) != prepared->joints.end()) {
+          throw CommandError(what + "leg joint '" + s.model->joint_names()[static_cast<std::size_t>(j)] +
+                             "' is driven by the base; give base_x, base_y, base_yaw or the leg joints, not both");
+        }
+      }
+    }
+  }
+  prepared->columns = static_cast<int>(prepared->joints.size()) + (prepared->base ? 3 : 0);
+  const auto cols = static_cast<std::size_t>(prepared->columns);
+  prepared->times.reserve(t.samples.size());
+  prepared->position.reserve(t.samples.size() * cols);
+  prepared->velocity.reserve(t.samples.size() * cols);
+  for (std::size_t n = 0; n < t.samples.size(); ++n) {
+    const TrajectorySample& p = t.samples[n];
+    const std::string at = "sample " + std::to_string(n);
+    if (p.position.size() != t.joints.size() || (!p.velocity.empty() && p.velocity.size() != t.joints.size())) {
+      throw CommandError(what + at + " has " + std::to_string(p.position.size()) + " positions and " +
+                         std::to_string(p.velocity.size()) + " velocities for " + std::to_string(t.joints.size()) +
+                         " joints");
+    }
+    if (!finite(p.time) || p.time < 0.0 || (n > 0 && p.time <= prepared->times.back())) {
+      throw CommandError(what + at + " time " + std::to_string(p.time) +
+                         " s: times must be finite, >= 0 and strictly increasing");
+    }
+    for (std::size_t k = 0; k < t.joints.size(); ++k) {
+      if (!finite(p.position[k]) || (!p.velocity.empty() && !finite(p.velocity[k]))) {
+        throw CommandError(what + at + ": non-finite value for '" + t.joints[k] + "'");
+      }
+    }
+    prepared->times.push_back(p.time);
+    auto add = [&](int column) {
+      const auto c = static_cast<std::size_t>(column);
+      prepared->position.push_back(p.position[c]);
+      prepared->velocity.push_back(p.velocity.empty() ? 0.0 : p.velocity[c]);
+    };
+    for (int c : column_of_joint) {
+      add(c);
+    }
+    if (prepared->base) {
+      for (int c : base_columns) {
+        add(c);
+      }
+    }
+  }
+  const std::uint64_t seq = ++shared_->seq;
+  prepared->sequence = seq;
+  s.trajectories.submit(std::move(prepared));
+  shared_->staged.trajectory_seq = seq;
+  publish_frame(s.commands, shared_->staged);
 }
 
 void RobotCore::set_safety_stop(bool stopped, const std::string& reason) {
   {
-    std::lock_guard lock(mutex_);
-    if (stopped == safety_stopped_ && reason == safety_reason_) {
+    std::lock_guard lock(shared_->mutex);
+    const std::string why = reason.empty() ? std::string("no reason given") : reason;
+    if (stopped == shared_->safety_stopped && why == shared_->safety_reason) {
       return;
     }
-    safety_stopped_ = stopped;
-    safety_reason_ = reason.empty() ? std::string("no reason given") : reason;
+    shared_->safety_stopped = stopped;
+    shared_->safety_reason = why;
+    loop_->safety_stopped.store(stopped, std::memory_order_release);
   }
   if (stopped) {
     hold();
@@ -302,281 +518,323 @@ void RobotCore::set_safety_stop(bool stopped, const std::string& reason) {
 }
 
 bool RobotCore::safety_stopped() const {
-  std::lock_guard lock(mutex_);
-  return safety_stopped_;
+  std::lock_guard lock(shared_->mutex);
+  return shared_->safety_stopped;
 }
 
 void RobotCore::hold() {
-  std::lock_guard lock(mutex_);
-  if (!ctl_) {
+  std::lock_guard lock(shared_->mutex);
+  Slot* s = shared_->accepted;
+  if (s == nullptr) {
     return;
   }
-  for (std::size_t h = 0; h < ctl_->hw_to_model.size() && h < hw_state_.position.size(); ++h) {
-    const auto i = static_cast<std::size_t>(ctl_->hw_to_model[h]);
-    ctl_->hold_position[i] = hw_state_.position[h];
-    ctl_->position_ref[i] = hw_state_.position[h];
-    ctl_->owner[i] = JointOwner::kHold;
+  const std::uint64_t seq = ++shared_->seq;
+  CommandFrame& f = shared_->staged;
+  f.hold_seq = seq;
+  for (auto& claim : f.claims) {
+    claim = {seq, JointOwner::kHold};
   }
-  ctl_->cart.reset();
-  ctl_->base_cmd = BaseCommand{ctl_->version, 0.0, 0.0, 0.0};
+  f.base = BaseCommand{s->version, 0.0, 0.0, 0.0};
+  f.base_seq = seq;
+  shared_->cartesian_admittance = false;
+  publish_frame(s->commands, f);
 }
 
-void RobotCore::cycle() {
-  {
-    std::lock_guard lock(mutex_);
-    hw_.read(hw_state_);
-    if (hw_.generation() != hw_generation_) {
-      hw_generation_ = hw_.generation();
-      hw_joints_ = hw_.joint_names();
-    }
-    const std::size_t nh = hw_state_.position.size();
-    const double dt = params_.period;
-    if (hw_generation_ != known_generation_ || !ctl_) {
-      // Mounted hardware changed (hot swap) or no model yet: hold every drive where it is
-      // until a matching model arrives.
-      if (ctl_ && state_.ready) {
-        state_.ready = false;
-        state_.message = "hardware changed: waiting for a model matching the mounted joints";
-      }
-      if (!holding_hw_ || drive_.size() != nh) {
-        drive_.assign(nh, DriveCommand{});
-        for (std::size_t h = 0; h < nh; ++h) {
-          drive_[h].position = hw_state_.position[h];
-        }
-        holding_hw_ = true;
-      }
-      hw_.write(drive_);
-    } else {
-      Controllers& c = *ctl_;
-      const auto& model = *c.model;
-      const int n = model.dof();
-      Eigen::VectorXd q(n), qd(n), tau_meas(n);
-      for (std::size_t h = 0; h < nh; ++h) {
-        const auto i = c.hw_to_model[h];
-        q(i) = hw_state_.position[h];
-        qd(i) = hw_state_.velocity[h];
-        tau_meas(i) = hw_state_.effort[h];
-      }
-      const Eigen::VectorXd gravity = model.gravity_torques(c.data, q);
-      // Odometry from the legs.
-      if (c.base) {
-        std::vector<double> steer, wheel;
-        for (const auto& leg : c.legs) {
-          steer.push_back(q(leg.steering_index));
-          wheel.push_back(qd(leg.wheel_index));
-        }
-        c.base->integrate(c.odometry, steer, wheel, dt);
-      }
-      // End-effector pose and external wrench (quasi-static: J^T F_env = ID(q, qd, 0) - tau).
-      Eigen::MatrixXd jac_arm;
-      if (!c.arm.empty()) {
-        c.ee_pose = model.frame_pose(c.data, q, c.ee_frame);
-        const Eigen::MatrixXd jac = model.frame_jacobian(c.data, q, c.ee_frame);
-        jac_arm.resize(6, static_cast<Eigen::Index>(c.arm.size()));
-        Eigen::VectorXd residual(static_cast<Eigen::Index>(c.arm.size()));
-        const Eigen::VectorXd id = model.inverse_dynamics(c.data, q, qd, Eigen::VectorXd::Zero(n));
-        for (std::size_t k = 0; k < c.arm.size(); ++k) {
-          jac_arm.col(static_cast<Eigen::Index>(k)) = jac.col(c.arm[k]);
-          residual(static_cast<Eigen::Index>(k)) = id(c.arm[k]) - tau_meas(c.arm[k]);
-        }
-        const Eigen::Matrix<double, 6, 6> jjt = jac_arm * jac_arm.transpose() + 1e-6 * Eigen::Matrix<double, 6, 6>::Identity();
-        const Vector6d raw = jjt.ldlt().solve(jac_arm * residual);
-        const double alpha = params_.wrench_filter_time_constant > 0.0
-                                 ? dt / (params_.wrench_filter_time_constant + dt)
-                                 : 1.0;
-        c.wrench = c.wrench_initialized ? Vector6d(c.wrench + alpha * (raw - c.wrench)) : raw;
-        c.wrench_initialized = true;
-      }
-      // Cartesian impedance torques.
-      Eigen::VectorXd tau_cart = Eigen::VectorXd::Zero(n);
-      if (c.cart && !c.arm.empty()) {
-        const CartesianCommand& cc = *c.cart;
-        Eigen::Isometry3d target = cc.target_pose;
-        if (cc.admittance.enabled) {
-          const double pushed = -c.wrench.head<3>().dot(cc.admittance.axis);
-          const double acc = (cc.admittance.force_setpoint - pushed - cc.admittance.damping * c.adm_rate) /
-                             cc.admittance.mass;
-          c.adm_rate += acc * dt;
-          c.adm_offset += c.adm_rate * dt;
-          if (std::abs(c.adm_offset) > cc.admittance.max_offset) {
-            c.adm_offset = std::copysign(cc.admittance.max_offset, c.adm_offset);
-            c.adm_rate = 0.0;
-          }
-          target.translation() += c.adm_offset * cc.admittance.axis;
-        }
-        Eigen::VectorXd qd_arm(static_cast<Eigen::Index>(c.arm.size()));
-        for (std::size_t k = 0; k < c.arm.size(); ++k) {
-          qd_arm(static_cast<Eigen::Index>(k)) = qd(c.arm[k]);
-        }
-        const Vector6d twist = jac_arm * qd_arm;
-        Vector6d error;
-        error.head<3>() = target.translation() - c.ee_pose.translation();
-        error.tail<3>() = rotation_error(target.linear(), c.ee_pose.linear());
-        const Vector6d force = cc.stiffness.cwiseProduct(error) + cc.damping.cwiseProduct(cc.target_twist - twist) +
-                               cc.feedforward_wrench;
-        const Eigen::VectorXd tau_arm = jac_arm.transpose() * force - cc.nullspace_damping * qd_arm;
-        for (std::size_t k = 0; k < c.arm.size(); ++k) {
-          tau_cart(c.arm[k]) = tau_arm(static_cast<Eigen::Index>(k));
-        }
-      }
-      // Base: leg setpoints (the base stops if commands stop coming).
-      std::map<int, LegSetpoint> leg_sp;
-      if (c.base) {
-        Eigen::Vector3d twist(c.base_cmd.vx, c.base_cmd.vy, c.base_cmd.wz);
-        if (hw_state_.time - c.base_cmd_time > params_.base_command_timeout) {
-          twist.setZero();
-        }
-        std::vector<double> steer;
-        for (const auto& leg : c.legs) {
-          steer.push_back(c.position_ref[static_cast<std::size_t>(leg.steering_index)]);
-        }
-        const auto sp = c.base->leg_setpoints(twist, steer);
-        for (std::size_t k = 0; k < c.legs.size(); ++k) {
-          leg_sp[c.legs[k].steering_index] = sp[k];
-          leg_sp[c.legs[k].wheel_index] = sp[k];
-        }
-      }
-      // Drive references with the model's limits.
-      drive_.assign(nh, DriveCommand{});
-      for (std::size_t h = 0; h < nh; ++h) {
-        const int i = c.hw_to_model[h];
-        const auto iu = static_cast<std::size_t>(i);
-        const auto& lim = c.limits(i);
-        const double vmax = lim.velocity;
-        auto clamp_pos = [&](double p) { return lim.has_position_limits ? std::clamp(p, lim.lower, lim.upper) : p; };
-        // Move the rate-limited reference towards `target` at most vmax * dt.
-        auto ramp = [&](double target) {
-          double& ref = c.position_ref[iu];
-          const double step = vmax > 0.0 ? vmax * dt : 1e9;
-          ref += std::clamp(clamp_pos(target) - ref, -step, step);
-          return ref;
-        };
-        DriveCommand& d = drive_[h];
-        switch (c.owner[iu]) {
-          case JointOwner::kHold:
-            d.mode = DriveMode::kPosition;
-            d.position = ramp(c.hold_position[iu]);
-            d.effort = gravity(i);
-            break;
-          case JointOwner::kJoint: {
-            const JointCommand& jc = c.joint_cmd[iu];
-            d.mode = jc.mode;
-            switch (jc.mode) {
-              case DriveMode::kPosition:
-                d.position = ramp(jc.position);
-                d.effort = gravity(i) + jc.effort;
-                break;
-              case DriveMode::kVelocity:
-                d.velocity = clamp_abs(jc.velocity, vmax);
-                if (lim.has_position_limits &&
-                    ((q(i) >= lim.upper && d.velocity > 0.0) || (q(i) <= lim.lower && d.velocity < 0.0))) {
-                  d.velocity = 0.0;
-                }
-                break;
-              case DriveMode::kEffort:
-                d.effort = jc.effort;
-                break;
-              case DriveMode::kImpedance:
-                d.position = clamp_pos(jc.position);
-                d.velocity = clamp_abs(jc.velocity, vmax);
-                d.effort = jc.effort;
-                d.stiffness = jc.stiffness;
-                d.damping = jc.damping;
-                break;
-            }
-            c.hold_position[iu] = q(i);
-            if (jc.mode != DriveMode::kPosition) {
-              c.position_ref[iu] = q(i);
-            }
-            break;
-          }
-          case JointOwner::kCartesian:
-            d.mode = DriveMode::kEffort;
-            d.effort = tau_cart(i) + gravity(i);
-            c.hold_position[iu] = c.position_ref[iu] = q(i);
-            break;
-          case JointOwner::kGravityCompensation:
-            d.mode = DriveMode::kEffort;
-            d.effort = gravity(i);
-            c.hold_position[iu] = c.position_ref[iu] = q(i);
-            break;
-          case JointOwner::kBase: {
-            const LegSetpoint& sp = leg_sp.at(i);
-            const bool steering = std::any_of(c.legs.begin(), c.legs.end(),
-                                              [&](const Leg& l) { return l.steering_index == i; });
-            if (steering) {
-              d.mode = DriveMode::kPosition;
-              d.position = ramp(sp.steering_angle);
-              d.effort = gravity(i);
-            } else {
-              d.mode = DriveMode::kVelocity;
-              d.velocity = clamp_abs(sp.wheel_velocity, vmax);
-              c.hold_position[iu] = c.position_ref[iu] = q(i);
-            }
-            break;
-          }
-        }
-        // Velocity guard for torque-level modes: damp whatever exceeds the velocity limit.
-        if ((d.mode == DriveMode::kEffort || d.mode == DriveMode::kImpedance) && vmax > 0.0 &&
-            std::abs(qd(i)) > vmax) {
-          d.effort -= params_.velocity_guard_gain * (qd(i) - std::copysign(vmax, qd(i)));
-        }
-        d.effort = clamp_abs(d.effort, lim.effort);
-      }
-      hw_.write(drive_);
-      state_.odometry = c.odometry;
-      state_.end_effector_frame = c.ee_frame;
-      state_.end_effector_pose = c.ee_pose;
-      state_.end_effector_wrench = c.wrench;
-      state_.has_base = c.base.has_value();
-      state_.owners.resize(nh);
-      for (std::size_t h = 0; h < nh; ++h) {
-        state_.owners[h] = c.owner[static_cast<std::size_t>(c.hw_to_model[h])];
-      }
-    }
-    state_.time = hw_state_.time;
-    state_.joint_names = hw_joints_;
-    state_.position = hw_state_.position;
-    state_.velocity = hw_state_.velocity;
-    state_.effort = hw_state_.effort;
+namespace {
+
+/// The loop's half of command hand-over: applies what is new in the slot's frame.
+void apply_commands(RobotCore::Slot& s) {
+  if (!s.commands.update()) {
+    return;
   }
-  hw_.step(params_.period);
+  CycleData& c = s.cycle;
+  const CommandFrame& f = s.commands.front();
+  if (f.trajectory_seq > s.applied_trajectory) {
+    s.applied_trajectory = f.trajectory_seq;
+    if (PreparedTrajectory* next = s.trajectories.take()) {
+      s.trajectory.start(next, c);
+      if (s.running != nullptr && !s.trajectories.retire(s.running)) {
+        delete s.running;  // unreachable in practice: the submitter collects before each hand-over
+      }
+      s.running = next;
+    }
+  }
+  const std::uint64_t tracked = s.trajectory.running() ? s.trajectory.trajectory()->sequence : 0;
+  if (f.hold_seq > s.applied_hold) {
+    s.applied_hold = f.hold_seq;
+    if (f.hold_seq > tracked) {
+      s.trajectory.abort(TrajectoryAbort::kPreempted, c);
+    }
+    for (std::size_t i = 0; i < c.owner.size(); ++i) {
+      if (c.owner[i] != JointOwner::kTrajectory) {
+        c.owner[i] = JointOwner::kHold;
+        c.follow(static_cast<int>(i));
+      }
+    }
+  }
+  for (std::size_t i = 0; i < f.claims.size(); ++i) {
+    const Claim& claim = f.claims[i];
+    if (claim.seq <= s.applied_claim[i]) {
+      continue;
+    }
+    s.applied_claim[i] = claim.seq;
+    if (c.owner[i] == JointOwner::kTrajectory && s.trajectory.running()) {
+      if (claim.seq < tracked) {
+        continue;  // older than the trajectory that took the joint
+      }
+      s.trajectory.abort(TrajectoryAbort::kPreempted, c);
+    }
+    c.owner[i] = claim.owner;
+    if (claim.owner == JointOwner::kJoint) {
+      s.joint.set(static_cast<int>(i), f.joints[i]);
+    }
+  }
+  if (f.cartesian_seq > s.applied_cartesian) {
+    s.applied_cartesian = f.cartesian_seq;
+    s.cartesian.set(f.cartesian, f.keep_admittance);
+  }
+  if (f.base_seq > s.applied_base && s.base) {
+    s.applied_base = f.base_seq;
+    s.base->set(f.base, c.time);
+  }
+}
+
+}  // namespace
+
+void RobotCore::cycle() {
+  Loop& L = *loop_;
+  const double dt = params_.period;
+  // Cycle boundary: switch to a prepared model, then to prepared hardware.
+  if (Slot* next = shared_->slots.take()) {
+    if (Slot* old = L.active) {
+      next->cycle.odometry = old->cycle.odometry;
+      if (old->trajectory.running()) {
+        old->trajectory.abort(TrajectoryAbort::kModelChanged, old->cycle);
+        L.last_progress = old->trajectory.progress();
+      }
+      if (!shared_->slots.retire(old)) {
+        delete old;  // unreachable in practice: set_model() collects before each hand-over
+      }
+    }
+    L.active = next;
+  }
+  hw_.switch_prepared();
+  hw_.read(L.hw_state);
+  const std::size_t nh = L.hw_state.position.size();
+  Slot* s = L.active;
+  const bool stopped = L.safety_stopped.load(std::memory_order_acquire);
+  const bool matching = s != nullptr && s->generation == hw_.generation() && s->hw_to_model.size() == nh;
+  if (!matching) {
+    // No model yet, or the mounted hardware changed (hot swap): hold every drive where it
+    // is until a matching model arrives.
+    if (s != nullptr && s->trajectory.running()) {
+      s->trajectory.abort(TrajectoryAbort::kHardwareChanged, s->cycle);
+    }
+    if (!L.holding_hw || L.holding_generation != hw_.generation() || L.drive.size() != nh) {
+      L.drive.resize(nh);
+      for (std::size_t h = 0; h < nh; ++h) {
+        L.drive[h] = DriveCommand{};
+        L.drive[h].position = L.hw_state.position[h];
+      }
+      L.holding_hw = true;
+      L.holding_generation = hw_.generation();
+    }
+    hw_.write(L.drive);
+  } else {
+    L.holding_hw = false;
+    CycleData& c = s->cycle;
+    const kinematics::Model& model = *s->model;
+    c.time = L.hw_state.time;
+    c.dt = dt;
+    for (std::size_t h = 0; h < nh; ++h) {
+      const int i = s->hw_to_model[h];
+      c.q(i) = L.hw_state.position[h];
+      c.qd(i) = L.hw_state.velocity[h];
+      c.tau(i) = L.hw_state.effort[h];
+    }
+    if (s->fresh) {
+      // First cycle of this model: every joint holds the position it has now.
+      s->fresh = false;
+      for (std::size_t i = 0; i < c.owner.size(); ++i) {
+        c.owner[i] = JointOwner::kHold;
+        c.follow(static_cast<int>(i));
+      }
+    }
+    if (stopped && !L.stop_seen) {
+      s->trajectory.abort(TrajectoryAbort::kSafetyStop, c);
+      for (std::size_t i = 0; i < c.owner.size(); ++i) {
+        c.owner[i] = JointOwner::kHold;
+        c.follow(static_cast<int>(i));
+      }
+    }
+    L.stop_seen = stopped;
+    apply_commands(*s);
+    // Estimation shared by the controllers: gravity, odometry, end-effector pose and wrench
+    // (quasi-static: J^T F_env = ID(q, qd, 0) - tau).
+    model.inverse_dynamics_into(s->data, c.q, c.zero, c.zero, c.gravity);
+    if (s->base) {
+      s->base->estimate(c);
+    }
+    if (!s->arm.empty()) {
+      model.frame_pose_into(s->data, c.q, s->ee_frame, c.ee_pose);
+      model.frame_jacobian_into(s->data, c.q, s->ee_frame, c.jacobian);
+      model.inverse_dynamics_into(s->data, c.q, c.qd, c.zero, c.id_tau);
+      for (std::size_t k = 0; k < s->arm.size(); ++k) {
+        const auto kk = static_cast<Eigen::Index>(k);
+        c.jac_arm.col(kk) = c.jacobian.col(s->arm[k]);
+        c.residual(kk) = c.id_tau(s->arm[k]) - c.tau(s->arm[k]);
+        c.qd_arm(kk) = c.qd(s->arm[k]);
+      }
+      Eigen::Matrix<double, 6, 6> jjt;
+      jjt.noalias() = c.jac_arm.lazyProduct(c.jac_arm.transpose());
+      jjt.diagonal().array() += 1e-6;
+      Vector6d jr;
+      jr.noalias() = c.jac_arm.lazyProduct(c.residual);
+      const Vector6d raw = jjt.ldlt().solve(jr);
+      const double alpha =
+          params_.wrench_filter_time_constant > 0.0 ? dt / (params_.wrench_filter_time_constant + dt) : 1.0;
+      c.wrench = s->wrench_initialized ? Vector6d(c.wrench + alpha * (raw - c.wrench)) : raw;
+      s->wrench_initialized = true;
+    }
+    for (Controller* controller : s->controllers) {
+      if (controller != nullptr) {
+        controller->update(c);
+      }
+    }
+    // Drive references in hardware order, with the model's limits.
+    L.drive.resize(nh);
+    for (std::size_t h = 0; h < nh; ++h) {
+      const int i = s->hw_to_model[h];
+      const auto& lim = c.limits(i);
+      DriveCommand d = c.drive[static_cast<std::size_t>(i)];
+      // Velocity guard for torque-level modes: damp whatever exceeds the velocity limit.
+      const double vmax = lim.velocity;
+      if ((d.mode == DriveMode::kEffort || d.mode == DriveMode::kImpedance) && vmax > 0.0 &&
+          std::abs(c.qd(i)) > vmax) {
+        d.effort -= params_.velocity_guard_gain * (c.qd(i) - std::copysign(vmax, c.qd(i)));
+      }
+      if (lim.effort > 0.0) {
+        d.effort = std::clamp(d.effort, -lim.effort, lim.effort);
+      }
+      L.drive[h] = d;
+    }
+    hw_.write(L.drive);
+  }
+  // Hand the state out.
+  RobotState& out = L.state.back();
+  out.time = L.hw_state.time;
+  out.cycle = ++L.cycles;
+  out.ready = matching;
+  out.joint_names = hw_.joint_names();
+  out.position = L.hw_state.position;
+  out.velocity = L.hw_state.velocity;
+  out.effort = L.hw_state.effort;
+  out.owners.resize(nh);
+  if (matching) {
+    const CycleData& c = s->cycle;
+    out.model_version = s->version;
+    out.message = s->ready_message;
+    out.has_base = s->base != nullptr;
+    out.odometry = c.odometry;
+    out.end_effector_frame = s->ee_frame;
+    out.end_effector_pose = c.ee_pose;
+    out.end_effector_wrench = c.wrench;
+    for (std::size_t h = 0; h < nh; ++h) {
+      out.owners[h] = c.owner[static_cast<std::size_t>(s->hw_to_model[h])];
+    }
+  } else {
+    out.model_version = s != nullptr ? s->version : 0;
+    out.message = s != nullptr ? "hardware changed: waiting for a model matching the mounted joints"
+                               : "waiting for a robot model";
+    std::fill(out.owners.begin(), out.owners.end(), JointOwner::kHold);
+  }
+  const bool own_progress = s != nullptr && s->trajectory.progress().sequence >= L.last_progress.sequence;
+  out.trajectory = own_progress ? s->trajectory.progress() : L.last_progress;
+  out.replaced_trajectory = s != nullptr ? s->trajectory.replaced() : TrajectoryProgress{};
+  L.state.publish();
+  hw_.step(dt);
 }
 
 RobotState RobotCore::state() const {
-  std::lock_guard lock(mutex_);
-  return state_;
+  std::lock_guard lock(shared_->state_mutex);
+  loop_->state.update();
+  return loop_->state.front();
 }
 
 bool RobotCore::ready() const {
-  std::lock_guard lock(mutex_);
-  return state_.ready;
+  std::lock_guard lock(shared_->mutex);
+  return shared_->accepted != nullptr && shared_->accepted->generation == hw_.mounted_generation();
 }
 
 std::uint64_t RobotCore::model_version() const {
-  std::lock_guard lock(mutex_);
-  return ctl_ ? ctl_->version : 0;
+  std::lock_guard lock(shared_->mutex);
+  return shared_->accepted != nullptr ? shared_->accepted->version : 0;
 }
 
 std::vector<std::string> RobotCore::arm_joints() const {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(shared_->mutex);
   std::vector<std::string> out;
-  if (ctl_) {
-    for (int j : ctl_->arm) {
-      out.push_back(ctl_->model->joint_names()[static_cast<std::size_t>(j)]);
+  if (const Slot* s = shared_->accepted) {
+    for (int j : s->arm) {
+      out.push_back(s->model->joint_names()[static_cast<std::size_t>(j)]);
     }
   }
   return out;
 }
 
 std::vector<Leg> RobotCore::legs() const {
-  std::lock_guard lock(mutex_);
-  return ctl_ ? ctl_->legs : std::vector<Leg>{};
+  std::lock_guard lock(shared_->mutex);
+  return shared_->accepted != nullptr ? shared_->accepted->legs : std::vector<Leg>{};
 }
 
 std::shared_ptr<const kinematics::Model> RobotCore::model() const {
-  std::lock_guard lock(mutex_);
-  return ctl_ ? ctl_->model : nullptr;
+  std::lock_guard lock(shared_->mutex);
+  return shared_->accepted != nullptr ? shared_->accepted->model : nullptr;
+}
+
+std::vector<std::pair<std::string, std::string>> RobotCore::ownership() const {
+  const RobotState s = state();
+  std::vector<std::pair<std::string, std::string>> out;
+  for (std::size_t h = 0; h < s.joint_names.size() && h < s.owners.size(); ++h) {
+    out.emplace_back(s.joint_names[h], controller_name(s.owners[h]));
+  }
+  return out;
+}
+
+std::string RobotCore::describe(const TrajectoryProgress& p) const {
+  const auto m = model();
+  auto joint = [&](int i) -> std::string {
+    if (i < 0) {
+      return "the base";
+    }
+    if (m && i < m->dof()) {
+      return "joint '" + m->joint_names()[static_cast<std::size_t>(i)] + "'";
+    }
+    return "joint " + std::to_string(i);
+  };
+  switch (p.abort) {
+    case TrajectoryAbort::kNone:
+      return "";
+    case TrajectoryAbort::kSafetyStop: {
+      std::lock_guard lock(shared_->mutex);
+      return "safety stop (" + shared_->safety_reason + ")";
+    }
+    case TrajectoryAbort::kPreempted:
+      return "preempted by another command on its joints";
+    case TrajectoryAbort::kModelChanged:
+      return "the robot model changed";
+    case TrajectoryAbort::kHardwareChanged:
+      return "the mounted hardware changed";
+    case TrajectoryAbort::kPathTolerance:
+      return "tracking error of " + joint(p.worst_joint) + " beyond the path tolerance (" +
+             std::to_string(p.worst_joint < 0 ? params_.trajectory_base_path_tolerance
+                                              : params_.trajectory_path_tolerance) +
+             ")";
+    case TrajectoryAbort::kGoalTolerance:
+      return joint(p.worst_joint) + " did not reach the final sample within " +
+             std::to_string(params_.trajectory_goal_time) + " s";
+  }
+  return "";
 }
 
 }  // namespace concert::robot

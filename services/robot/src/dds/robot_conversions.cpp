@@ -1,5 +1,6 @@
 #include "robot_conversions.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -103,6 +104,32 @@ CartesianCommand to_core(const msg::CartesianImpedanceCommand& c) {
 }
 
 BaseCommand to_core(const msg::BaseVelocityCommand& c) { return {c.model_version(), c.vx(), c.vy(), c.wz()}; }
+
+JointTrajectory to_core(const msg::JointTrajectoryCommand& c) {
+  JointTrajectory t;
+  t.request_id = c.request_id();
+  t.model_version = c.model_version();
+  t.source = c.source();
+  t.joints = c.joint_names();
+  t.samples.reserve(c.samples().size());
+  for (const auto& p : c.samples()) {
+    t.samples.push_back({p.time(), p.position(), p.velocity()});
+  }
+  return t;
+}
+
+msg::TrajectoryState to_msg(TrajectoryState state) {
+  switch (state) {
+    case TrajectoryState::kSucceeded:
+      return msg::TRAJECTORY_SUCCEEDED;
+    case TrajectoryState::kAborted:
+      return msg::TRAJECTORY_ABORTED;
+    case TrajectoryState::kIdle:
+    case TrajectoryState::kExecuting:
+      break;
+  }
+  return msg::TRAJECTORY_EXECUTING;
+}
 
 int64_t to_stamp_ns(double time) { return static_cast<int64_t>(std::llround(time * 1e9)); }
 

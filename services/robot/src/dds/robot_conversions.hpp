@@ -12,6 +12,10 @@ namespace concert::robot::dds {
 JointCommandSet to_core(const msg::JointCommand& command);
 CartesianCommand to_core(const msg::CartesianImpedanceCommand& command);
 BaseCommand to_core(const msg::BaseVelocityCommand& command);
+JointTrajectory to_core(const msg::JointTrajectoryCommand& command);
+
+/// The trajectory state of the IDL for a core progress (kIdle has none: EXECUTING).
+msg::TrajectoryState to_msg(TrajectoryState state);
 
 msg::JointState to_joint_state(const RobotState& state);
 /// `distance` [m] travelled since start grows the (x, y, yaw) variances (documented in README).

@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "concert/common/clock.hpp"
+#include "concert/model/dds/conversions.hpp"
+#include "concert/model/robot_model.hpp"
 #include "concert/topology/dds/conversions.hpp"
 #include "robot_conversions.hpp"
 
@@ -19,7 +21,8 @@ RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams
       joint_state_(participant, cdds::topics::joint_state),
       odometry_(participant, cdds::topics::odometry),
       wrench_(participant, cdds::topics::ee_wrench),
-      scan_(participant, cdds::topics::esc_scan) {
+      scan_(participant, cdds::topics::esc_scan),
+      trajectory_status_(participant, cdds::topics::trajectory_status) {
   status_.report(msg::SERVICE_STARTING, 0, "waiting for a robot model");
   model_reader_ = std::make_unique<cdds::Reader<msg::RobotModel>>(
       participant, cdds::topics::robot_model, [this](const msg::RobotModel& m, const auto&) { on_model(m); });
@@ -47,10 +50,48 @@ RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams
           status_.note(stopped ? "safety stop: holding (" + causes + ")" : "safety stop released");
         }
       });
+  trajectory_reader_ = std::make_unique<cdds::Reader<msg::JointTrajectoryCommand>>(
+      participant, cdds::topics::trajectory_command,
+      [this](const msg::JointTrajectoryCommand& c, const auto&) { on_trajectory(c); });
+}
+
+std::string tool_end_effector(const msg::RobotModel& m) {
+  try {
+    return model::RobotModel::build(model::dds::to_description(m))->tool().frame;
+  } catch (const std::exception&) {
+    return "";  // no parsable description or no arm tool: the core's own choice
+  }
+}
+
+void RobotNode::on_trajectory(const msg::JointTrajectoryCommand& c) {
+  try {
+    {
+      std::lock_guard lock(mutex_);
+      previous_request_ = last_request_;
+      last_request_ = {c.request_id(), c.model_version(), c.source()};
+    }
+    core_.command_trajectory(to_core(c));
+  } catch (const std::exception& e) {
+    ++refused_;
+    {
+      std::lock_guard lock(mutex_);
+      last_error_ = e.what();
+    }
+    msg::TrajectoryStatus s;
+    s.request_id(c.request_id());
+    s.model_version(static_cast<uint32_t>(core_.model_version()));
+    s.stamp_ns(now_ns());
+    s.source(c.source());
+    s.state(msg::TRAJECTORY_REFUSED);
+    s.reason(e.what());
+    trajectory_status_.write(s);
+    status_.refused(std::string("trajectory refused: ") + e.what());
+  }
 }
 
 RobotNode::~RobotNode() {
   // Readers first: their callbacks use the core and the status writer.
+  trajectory_reader_.reset();
   safety_reader_.reset();
   base_reader_.reset();
   cartesian_reader_.reset();
@@ -76,8 +117,7 @@ void RobotNode::on_model(const msg::RobotModel& m) {
   if (core_.ready() && core_.model_version() == m.version() &&
       status_.model().hash == m.content_hash())
     return;
-  const std::string ee = m.end_effectors().empty() ? std::string{} : m.end_effectors().front().frame();
-  apply_model(m.urdf(), m.version(), ee, m.content_hash());
+  apply_model(m.urdf(), m.version(), tool_end_effector(m), m.content_hash());
 }
 
 void RobotNode::apply_model(const std::string& urdf, std::uint64_t version,
@@ -118,11 +158,46 @@ void RobotNode::publish(const RobotState& s) {
       cycles_ % static_cast<std::uint64_t>(std::max(1, params_.wrench_decimation)) == 0) {
     wrench_.write(to_wrench(s));
   }
+  if (s.replaced_trajectory.sequence != 0 && s.replaced_trajectory.sequence != last_replaced_) {
+    last_replaced_ = s.replaced_trajectory.sequence;
+    publish_trajectory(s.replaced_trajectory, s.model_version);
+  }
+  const TrajectoryProgress& p = s.trajectory;
+  const bool changed = p.sequence != last_sequence_ || p.state != last_state_;
+  if (p.sequence != 0 &&
+      (changed || (p.state == TrajectoryState::kExecuting &&
+                   cycles_ % static_cast<std::uint64_t>(std::max(1, params_.trajectory_decimation)) == 0))) {
+    publish_trajectory(p, s.model_version);
+    last_sequence_ = p.sequence;
+    last_state_ = p.state;
+  }
   if (last_ready_ && !s.ready) {
     status_.report(msg::SERVICE_RECONFIGURING, static_cast<uint32_t>(s.model_version), s.message);
   }
   last_ready_ = s.ready;
   ++cycles_;
+}
+
+void RobotNode::publish_trajectory(const TrajectoryProgress& p, std::uint64_t model_version) {
+  msg::TrajectoryStatus out;
+  {
+    std::lock_guard lock(mutex_);
+    out.source(last_request_.id == p.request_id       ? last_request_.source
+               : previous_request_.id == p.request_id ? previous_request_.source
+                                                      : std::string{});
+  }
+  out.request_id(p.request_id);
+  out.model_version(static_cast<uint32_t>(model_version));
+  out.stamp_ns(now_ns());
+  out.state(to_msg(p.state));
+  out.reason(p.state == TrajectoryState::kAborted ? core_.describe(p) : std::string{});
+  out.progress(p.progress);
+  out.max_joint_error(p.max_joint_error);
+  out.max_base_error(p.max_base_error);
+  trajectory_status_.write(out);
+  if (p.state == TrajectoryState::kAborted) {
+    status_.note("trajectory " + std::to_string(p.request_id) + " aborted: " + out.reason());
+  }
 }
 
 void RobotNode::publish_scan(const topology::EscScan& scan, const std::string& source) {

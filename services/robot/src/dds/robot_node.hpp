@@ -18,11 +18,20 @@ struct NodeParams {
   std::string service_name{"robot"};
   int odometry_decimation{10};  ///< odometry every N cycles (100 Hz at 1 kHz)
   int wrench_decimation{10};    ///< end-effector wrench every N cycles
+  int trajectory_decimation{100};  ///< trajectory progress every N cycles (10 Hz), and on each change
 };
 
-/// A SAFETY_STOPPED safety state holds the robot and refuses commands until SAFETY_RUNNING.
-/// Readers call the core from the DDS listener threads (the core locks); publish() is called
-/// by the loop thread after every cycle. Refused commands and models are reported on the
+/// The end-effector a Cartesian command drives, from the model message: libs/model's tool (the
+/// end-effector at the tip of an arm chain, never a wheel); "" (the core's own choice: the
+/// deepest tcp link) when the message has no parsable description or no arm tool.
+std::string tool_end_effector(const msg::RobotModel& model);
+
+/// A SAFETY_STOPPED safety state holds the robot, aborts a running trajectory and refuses
+/// commands until SAFETY_RUNNING. Readers call the core from the DDS listener threads (the core
+/// checks there and hands over to its loop without locking it); publish() is called by the
+/// service's publisher thread with each new state of the loop, never by the loop itself.
+/// Trajectories: JointTrajectoryCommand in, TrajectoryStatus out (refused at once with the
+/// reason; executing with progress at 10 Hz; succeeded or aborted with the reason). Refused commands and models are reported on the
 /// status topic with the core's message; the last good model stays.
 class RobotNode {
  public:
@@ -62,6 +71,20 @@ class RobotNode {
   std::unique_ptr<concert::dds::Reader<msg::CartesianImpedanceCommand>> cartesian_reader_;
   std::unique_ptr<concert::dds::Reader<msg::BaseVelocityCommand>> base_reader_;
   std::unique_ptr<concert::dds::Reader<msg::SafetyState>> safety_reader_;
+  std::unique_ptr<concert::dds::Reader<msg::JointTrajectoryCommand>> trajectory_reader_;
+  concert::dds::Writer<msg::TrajectoryStatus> trajectory_status_;
+  struct Request {
+    std::uint32_t id{0};
+    std::uint64_t model_version{0};
+    std::string source;
+  };
+  Request last_request_;                 // the last trajectory handed to the core (under mutex_)
+  Request previous_request_;             // the one before it (under mutex_)
+  std::uint64_t last_replaced_{0};       // sequence of the last replaced trajectory published
+  void publish_trajectory(const TrajectoryProgress& progress, std::uint64_t model_version);
+  std::uint64_t last_sequence_{0};       // of the last trajectory progress published
+  TrajectoryState last_state_{TrajectoryState::kIdle};
+  void on_trajectory(const msg::JointTrajectoryCommand& command);
   std::atomic<std::uint64_t> refused_{0};
   mutable std::mutex mutex_;
   std::string last_error_;

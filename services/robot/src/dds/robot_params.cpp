@@ -15,6 +15,14 @@ ServiceParams read_service_params(config::Document& doc) {
   robot.number("wrench_filter_time_constant", p.robot.wrench_filter_time_constant, non_negative);
   robot.number("base_command_timeout", p.robot.base_command_timeout, positive);
   robot.number("velocity_guard_gain", p.robot.velocity_guard_gain, non_negative);
+  robot.number("trajectory_path_tolerance", p.robot.trajectory_path_tolerance, positive);
+  robot.number("trajectory_base_path_tolerance", p.robot.trajectory_base_path_tolerance, positive);
+  robot.number("trajectory_goal_tolerance", p.robot.trajectory_goal_tolerance, positive);
+  robot.number("trajectory_base_goal_tolerance", p.robot.trajectory_base_goal_tolerance, positive);
+  robot.number("trajectory_goal_time", p.robot.trajectory_goal_time, positive);
+  robot.number("trajectory_base_gain", p.robot.trajectory_base_gain, non_negative);
+  robot.number("trajectory_base_deadband", p.robot.trajectory_base_deadband, non_negative);
+  robot.number("trajectory_steering_rate", p.robot.trajectory_steering_rate, positive);
 
   config::Map sim = root.section("sim");
   sim.number("timestep", p.sim.timestep, positive);

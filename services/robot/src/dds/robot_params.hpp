@@ -6,14 +6,14 @@
 #include "concert/config/config.hpp"
 #include "robot/loop.hpp"
 #include "robot/robot_core.hpp"
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_hardware.hpp"
 #include "robot_node.hpp"
 
 namespace concert::robot::dds {
 
 struct ServiceParams {
   RobotParams robot;
-  SimParams sim;
+  sim::SimParams sim;
   LoopParams loop;
   NodeParams node;
 };

@@ -11,6 +11,7 @@
 #include "robotPubSubTypes.h"
 #include "systemPubSubTypes.h"
 #include "topologyPubSubTypes.h"
+#include "worldPubSubTypes.h"
 
 namespace concert::dds {
 
@@ -35,6 +36,11 @@ CONCERT_BIND_PUBSUB(SafetyState);
 CONCERT_BIND_PUBSUB(SafetyReset);
 CONCERT_BIND_PUBSUB(PlanRequest);
 CONCERT_BIND_PUBSUB(PlanResult);
+CONCERT_BIND_PUBSUB(JointTrajectoryCommand);
+CONCERT_BIND_PUBSUB(TrajectoryStatus);
+CONCERT_BIND_PUBSUB(World);
+CONCERT_BIND_PUBSUB(SimCommand);
+CONCERT_BIND_PUBSUB(SimCommandReply);
 #undef CONCERT_BIND_PUBSUB
 
 /// A catalogue topic carrying T.
@@ -60,6 +66,11 @@ inline constexpr TopicHandle<msg::SafetyState> safety_state{"concert/safety/stat
 inline constexpr TopicHandle<msg::SafetyReset> safety_reset{"concert/safety/reset"};
 inline constexpr TopicHandle<msg::PlanRequest> plan_request{"concert/planner/request"};
 inline constexpr TopicHandle<msg::PlanResult> plan_result{"concert/planner/result"};
+inline constexpr TopicHandle<msg::JointTrajectoryCommand> trajectory_command{"concert/robot/trajectory_command"};
+inline constexpr TopicHandle<msg::TrajectoryStatus> trajectory_status{"concert/robot/trajectory_status"};
+inline constexpr TopicHandle<msg::World> world{"concert/world/world"};
+inline constexpr TopicHandle<msg::SimCommand> sim_command{"concert/sim/command"};
+inline constexpr TopicHandle<msg::SimCommandReply> sim_reply{"concert/sim/reply"};
 }  // namespace topics
 
 /// Calls f(handle) for every typed topic handle (e.g. to dispatch on a topic name).
@@ -80,6 +91,11 @@ template <class F> void for_each_topic(F&& f) {
   f(topics::safety_reset);
   f(topics::plan_request);
   f(topics::plan_result);
+  f(topics::trajectory_command);
+  f(topics::trajectory_status);
+  f(topics::world);
+  f(topics::sim_command);
+  f(topics::sim_reply);
 }
 
 }  // namespace concert::dds

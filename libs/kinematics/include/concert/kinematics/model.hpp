@@ -144,6 +144,14 @@ class Model {
   /// targets: check IkResult::converged.
   [[nodiscard]] IkResult inverse_kinematics(Data& data, std::string_view frame, const Eigen::Isometry3d& target,
                                             const Eigen::VectorXd& seed, const IkOptions& options = {}) const;
+  /// Real-time variants for control loops: no allocation and no checks (q, qd, qdd of size
+  /// dof(), `out` already sized: 6 x dof for the Jacobian, dof for torques; `frame` must be a
+  /// frame of the model). Same results as frame_pose(), frame_jacobian(), inverse_dynamics()
+  /// without external wrenches.
+  void frame_pose_into(Data& data, const Eigen::VectorXd& q, const std::string& frame, Eigen::Isometry3d& out) const;
+  void frame_jacobian_into(Data& data, const Eigen::VectorXd& q, const std::string& frame, Eigen::MatrixXd& out) const;
+  void inverse_dynamics_into(Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                             const Eigen::VectorXd& qdd, Eigen::VectorXd& out) const;
   /// Joint-space inertia matrix M(q) (dof x dof) [kg m^2], from dof RNE passes.
   [[nodiscard]] Eigen::MatrixXd mass_matrix(Data& data, const Eigen::VectorXd& q) const;
 

@@ -1,4 +1,4 @@
-#include "robot/base_kinematics.hpp"
+#include "concert/mobile_base/base_kinematics.hpp"
 
 #include <Eigen/Dense>
 #include <urdf_parser/urdf_parser.h>
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace concert::robot {
+namespace concert::mobile_base {
 namespace {
 
 double wrap(double a) {
@@ -109,11 +109,18 @@ BaseKinematics::BaseKinematics(std::vector<Leg> legs) : legs_(std::move(legs)) {
 
 std::vector<LegSetpoint> BaseKinematics::leg_setpoints(const Eigen::Vector3d& twist,
                                                        const std::vector<double>& current_steering) const {
+  std::vector<LegSetpoint> out(legs_.size());
+  leg_setpoints(twist, current_steering, out);
+  return out;
+}
+
+void BaseKinematics::leg_setpoints(const Eigen::Vector3d& twist, const std::vector<double>& current_steering,
+                                   std::vector<LegSetpoint>& out) const {
   if (current_steering.size() != legs_.size()) {
     throw std::invalid_argument("leg_setpoints: " + std::to_string(current_steering.size()) +
                                 " steering angles for " + std::to_string(legs_.size()) + " legs");
   }
-  std::vector<LegSetpoint> out(legs_.size());
+  out.resize(legs_.size());
   for (std::size_t i = 0; i < legs_.size(); ++i) {
     const Leg& leg = legs_[i];
     const double current = current_steering[i];
@@ -145,7 +152,6 @@ std::vector<LegSetpoint> BaseKinematics::leg_setpoints(const Eigen::Vector3d& tw
     }
     out[i] = {angle, direction * speed / leg.wheel_radius};
   }
-  return out;
 }
 
 Eigen::Vector3d BaseKinematics::twist_from_legs(const std::vector<double>& steering,
@@ -177,4 +183,4 @@ void BaseKinematics::integrate(Odometry& odometry, const std::vector<double>& st
   odometry.wz = twist.z();
 }
 
-}  // namespace concert::robot
+}  // namespace concert::mobile_base

@@ -9,11 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "robot/base_kinematics.hpp"
-#include "robot/hardware.hpp"
-#include "robot/world.hpp"
+#include "concert/hardware/hardware.hpp"
+#include "concert/world/world.hpp"
 
-namespace concert::robot {
+namespace concert::sim {
+
+using world::World;
+using hardware::HardwareError;
 
 /// Parameters of the simulated robot (MuJoCo).
 struct SimParams {
@@ -46,7 +48,7 @@ std::string urdf_to_mjcf(const std::string& urdf, const World& world, const SimP
 
 /// The `sim` backend: the robot in MuJoCo. The drives' inner loops (impedance with torque
 /// saturation at the URDF effort limit) run at the physics rate, as real drives do.
-class SimHardware final : public Hardware {
+class SimHardware final : public hardware::Hardware {
  public:
   SimHardware(const std::string& urdf, World world, SimParams params = {});
   ~SimHardware() override;
@@ -56,16 +58,24 @@ class SimHardware final : public Hardware {
   [[nodiscard]] std::string backend() const override { return "sim"; }
   [[nodiscard]] const std::vector<std::string>& joint_names() const override;
   [[nodiscard]] std::uint64_t generation() const override;
-  void read(HardwareState& state) override;
-  void write(const std::vector<DriveCommand>& commands) override;
+  [[nodiscard]] hardware::MountedHardware mounted() const override;
+  [[nodiscard]] std::uint64_t mounted_generation() const override;
+  bool switch_prepared() override;
+  void read(hardware::HardwareState& state) override;
+  void write(const std::vector<hardware::DriveCommand>& commands) override;
   void step(double dt) override;
 
-  /// Hot swap: the robot becomes `urdf` (the base pose and joints with the same name keep
-  /// their state, every drive holds position); generation() increases. The same URDF again
-  /// is no change (nothing happens).
-  void swap_model(const std::string& urdf);
-  /// Replaces the world (keeps the robot state and the hardware generation).
+  /// Hot swap, prepared on the calling thread (any thread but the control thread: URDF ->
+  /// MJCF -> MuJoCo model and data) and switched in by the control thread's next
+  /// switch_prepared(): the robot becomes `urdf` (the base pose and joints with the same name
+  /// keep their state, every drive holds position) and generation() increases; mounted()
+  /// reports it at once. The same URDF again is no change (returns false). Throws
+  /// HardwareError (nothing changes) if the URDF cannot be simulated.
+  bool swap_model(const std::string& urdf);
+  /// Replaces the world the same way (keeps the robot state and the hardware generation).
   void set_world(const World& world);
+  /// The latest world given (any thread).
+  [[nodiscard]] World world() const;
 
   // Ground truth, for tests and benchmarks.
   [[nodiscard]] double time() const;
@@ -83,4 +93,4 @@ class SimHardware final : public Hardware {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace concert::robot
+}  // namespace concert::sim

@@ -1,4 +1,4 @@
-#include "robot/base_kinematics.hpp"
+#include "concert/mobile_base/base_kinematics.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <random>
 
 
-namespace concert::robot {
+namespace concert::mobile_base {
 namespace {
 
 std::string fixture(const std::string& name) { return std::string(ROBOT_FIXTURES) + "/" + name; }
@@ -111,4 +111,4 @@ TEST(BaseKinematics, OdometryRecoversTheCommandedTwist) {
 }
 
 }  // namespace
-}  // namespace concert::robot
+}  // namespace concert::mobile_base

@@ -1,22 +1,37 @@
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_hardware.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
-#include "test_helpers.hpp"
+#include <fstream>
+#include <sstream>
 
-namespace concert::robot {
+namespace concert::sim {
 namespace {
 
-using test::read_fixture;
+using hardware::DriveCommand;
+using hardware::DriveMode;
+using hardware::HardwareError;
+using hardware::HardwareState;
+using world::load_world_file;
+using world::WorldShape;
+
+std::string fixture_path(const std::string& name) { return std::string(ROBOT_FIXTURES) + "/" + name; }
+
+std::string read_fixture(const std::string& name) {
+  std::ifstream in(fixture_path(name));
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
 
 std::size_t index_of(const std::vector<std::string>& names, const std::string& n) {
   return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin());
 }
 
 TEST(SimHardware, MjcfHasActuatorLimitsFrictionWorldAndFreeBase) {
-  World world = load_world_file(test::fixture_path("world_wall.yaml"));
+  World world = load_world_file(std::string(WORLD_FIXTURES) + "/world_wall.yaml");
   const std::string mjcf = urdf_to_mjcf(read_fixture("mobile_drill.urdf"), world, {});
   EXPECT_NE(mjcf.find("<freejoint"), std::string::npos);
   EXPECT_NE(mjcf.find("name=\"floor\""), std::string::npos);
@@ -79,10 +94,15 @@ TEST(SimHardware, HotSwapKeepsStateAndBumpsGeneration) {
     sim.step(0.001);
   }
   const auto gen = sim.generation();
-  sim.swap_model(read_fixture("mobile_drill.urdf"));  // the same robot again: no change
+  EXPECT_FALSE(sim.swap_model(read_fixture("mobile_drill.urdf")));  // the same robot again: no change
+  EXPECT_FALSE(sim.switch_prepared());
   EXPECT_EQ(sim.generation(), gen);
   const double z = sim.base_pose().translation().z();
-  sim.swap_model(read_fixture("mobile_sander.urdf"));
+  EXPECT_TRUE(sim.swap_model(read_fixture("mobile_sander.urdf")));
+  // Prepared off the control thread: announced at once, switched at the next cycle boundary.
+  EXPECT_EQ(sim.mounted().generation, gen + 1);
+  EXPECT_EQ(sim.generation(), gen);
+  EXPECT_TRUE(sim.switch_prepared());
   EXPECT_EQ(sim.generation(), gen + 1);
   EXPECT_NEAR(sim.time(), 0.2, 1e-9);
   HardwareState s;
@@ -92,6 +112,8 @@ TEST(SimHardware, HotSwapKeepsStateAndBumpsGeneration) {
   EXPECT_NO_THROW((void)sim.link_pose("sander"));
   EXPECT_THROW((void)sim.link_pose("drill"), HardwareError);
   sim.swap_model(read_fixture("mobile_three_legs.urdf"));
+  EXPECT_EQ(sim.mounted().joint_names.size(), 12u);
+  sim.switch_prepared();
   EXPECT_EQ(sim.joint_names().size(), 12u);
   EXPECT_EQ(index_of(sim.joint_names(), "J_wheel_rr"), sim.joint_names().size());
 }
@@ -106,6 +128,7 @@ TEST(SimHardware, WorldChangeKeepsTheRobot) {
   box.position = {2.0, 0.0, 0.25};
   world.obstacles.push_back(box);
   sim.set_world(world);
+  EXPECT_TRUE(sim.switch_prepared());
   EXPECT_EQ(sim.generation(), gen);
   EXPECT_NE(sim.mjcf().find("name=\"crate\""), std::string::npos);
 }
@@ -115,4 +138,4 @@ TEST(SimHardware, BadUrdfIsAClearError) {
 }
 
 }  // namespace
-}  // namespace concert::robot
+}  // namespace concert::sim

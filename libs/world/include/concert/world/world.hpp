@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace concert::robot {
+namespace concert::world {
 
 /// Bad world file (names the file and the field).
 class WorldError : public std::runtime_error {
@@ -39,4 +39,4 @@ World parse_world_yaml(const std::string& text, const std::string& source = "<st
 /// Reads a world YAML file.
 World load_world_file(const std::string& path);
 
-}  // namespace concert::robot
+}  // namespace concert::world

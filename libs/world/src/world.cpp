@@ -1,4 +1,4 @@
-#include "robot/world.hpp"
+#include "concert/world/world.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -6,7 +6,7 @@
 #include <set>
 #include <sstream>
 
-namespace concert::robot {
+namespace concert::world {
 namespace {
 
 struct Ctx {
@@ -153,4 +153,4 @@ World load_world_file(const std::string& path) {
   return parse_world_yaml(buffer.str(), path);
 }
 
-}  // namespace concert::robot
+}  // namespace concert::world

@@ -1,4 +1,4 @@
-#include "robot/sim_assembly.hpp"
+#include "concert/sim/sim_assembly.hpp"
 
 #include <fstream>
 #include <sstream>
@@ -7,14 +7,14 @@
 #include "concert/module_db/module_db.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/esc_catalog.hpp"
-#include "modelgen/model_generator.hpp"
+#include "concert/model_generation/generator.hpp"
 
-namespace concert::robot {
+namespace concert::sim {
 
 struct AssemblyBuilder::Impl {
   module_db::ModuleDatabase db;
   topology::EscCatalog catalog;
-  std::unique_ptr<modelgen::ModelGenerator> generator;  // points into db: Impl never moves
+  std::unique_ptr<model_generation::ModelGenerator> generator;  // points into db: Impl never moves
 };
 
 AssemblyBuilder::AssemblyBuilder(const std::vector<std::filesystem::path>& module_db_dirs)
@@ -27,7 +27,7 @@ AssemblyBuilder::AssemblyBuilder(const std::vector<std::filesystem::path>& modul
   for (std::size_t i = 1; i < module_db_dirs.size(); ++i) {
     impl_->catalog.merge(topology::EscCatalog::load(module_db_dirs[i]));
   }
-  impl_->generator = std::make_unique<modelgen::ModelGenerator>(impl_->db);
+  impl_->generator = std::make_unique<model_generation::ModelGenerator>(impl_->db);
 }
 
 AssemblyBuilder::~AssemblyBuilder() = default;
@@ -59,4 +59,4 @@ SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const s
   return out;
 }
 
-}  // namespace concert::robot
+}  // namespace concert::sim

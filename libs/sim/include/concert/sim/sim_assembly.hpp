@@ -7,7 +7,7 @@
 
 #include "concert/topology/types.hpp"
 
-namespace concert::robot {
+namespace concert::sim {
 
 /// What the simulator needs to stand in for an assembled robot.
 struct SimulatedRobot {
@@ -38,4 +38,4 @@ class AssemblyBuilder {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace concert::robot
+}  // namespace concert::sim

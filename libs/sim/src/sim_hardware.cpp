@@ -1,4 +1,4 @@
-#include "robot/sim_hardware.hpp"
+#include "concert/sim/sim_hardware.hpp"
 
 #include <mujoco/mujoco.h>
 #include <urdf_parser/urdf_parser.h>
@@ -11,11 +11,24 @@
 #include <filesystem>
 #include <iomanip>
 #include <random>
+#include <mutex>
 #include <sstream>
 
-#include "robot/base_kinematics.hpp"
+#include "concert/mobile_base/base_kinematics.hpp"
+#include "concert/hardware/realtime_buffer.hpp"
 
-namespace concert::robot {
+namespace concert::sim {
+
+using hardware::DriveCommand;
+using world::WorldShape;
+using hardware::DriveMode;
+using hardware::HardwareError;
+using hardware::HardwareState;
+using hardware::MountedHardware;
+using mobile_base::collision_cylinder_radii;
+using mobile_base::detect_legs;
+using mobile_base::Leg;
+
 namespace {
 
 urdf::ModelInterfaceSharedPtr parse(const std::string& urdf) {
@@ -276,95 +289,118 @@ std::string urdf_to_mjcf(const std::string& urdf, const World& world, const SimP
   return build_mjcf(urdf, world, params).mjcf;
 }
 
-struct SimHardware::Impl {
-  SimParams params;
-  World world;
+/// One MuJoCo robot in one world: what a hot swap or a world change prepares off the control
+/// thread and the control thread switches to.
+struct Instance {
+  Instance() = default;
+  Instance(const Instance&) = delete;
+  Instance& operator=(const Instance&) = delete;
+  ~Instance() {
+    if (d != nullptr) {
+      mj_deleteData(d);
+    }
+    if (m != nullptr) {
+      mj_deleteModel(m);
+    }
+  }
   std::string urdf;
+  World world;
   Built built;
   mjModel* m{nullptr};
   mjData* d{nullptr};
   std::vector<int> qpos_adr, dof_adr;
-  std::vector<double> effort_limit;
   std::vector<DriveCommand> commands;
   std::uint64_t generation{0};
+  /// Only the world changed: the running instance's whole state carries over.
+  bool same_robot{false};
+};
+
+namespace {
+
+std::unique_ptr<Instance> make_instance(const std::string& urdf, const World& world, const SimParams& params) {
+  auto in = std::make_unique<Instance>();
+  in->built = build_mjcf(urdf, world, params);
+  in->urdf = urdf;
+  in->world = world;
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  const char* file = "robot.xml";
+  if (mj_makeEmptyFileVFS(&vfs, file, static_cast<int>(in->built.mjcf.size())) != 0) {
+    throw HardwareError("sim: could not allocate the MuJoCo virtual file");
+  }
+  std::memcpy(vfs.filedata[0], in->built.mjcf.data(), in->built.mjcf.size());
+  char error[1000] = "";
+  in->m = mj_loadXML(file, &vfs, error, sizeof(error));
+  mj_deleteVFS(&vfs);
+  if (in->m == nullptr) {
+    throw HardwareError(std::string("sim: MuJoCo rejected the model built from the URDF: ") + error);
+  }
+  in->d = mj_makeData(in->m);
+  in->commands.assign(in->built.joints.size(), DriveCommand{});
+  for (std::size_t i = 0; i < in->built.joints.size(); ++i) {
+    const int jid = mj_name2id(in->m, mjOBJ_JOINT, in->built.joints[i].c_str());
+    in->qpos_adr.push_back(in->m->jnt_qposadr[jid]);
+    in->dof_adr.push_back(in->m->jnt_dofadr[jid]);
+    double q = 0.0;
+    if (auto p = params.initial_positions.find(in->built.joints[i]); p != params.initial_positions.end()) {
+      q = p->second;
+    }
+    in->d->qpos[in->qpos_adr[i]] = q;
+    in->commands[i].mode = DriveMode::kPosition;
+    in->commands[i].position = q;
+  }
+  mj_forward(in->m, in->d);
+  return in;
+}
+
+/// Carries the state of `from` into `to` (control thread, no allocation): the base pose and
+/// same-named joints for a new robot, everything for a new world around the same robot.
+void carry_state(const Instance& from, Instance& to) {
+  to.d->time = from.d->time;
+  if (to.same_robot && to.m->nq == from.m->nq && to.m->nv == from.m->nv) {
+    std::copy_n(from.d->qpos, from.m->nq, to.d->qpos);
+    std::copy_n(from.d->qvel, from.m->nv, to.d->qvel);
+    std::copy_n(from.d->qacc_warmstart, from.m->nv, to.d->qacc_warmstart);
+    std::copy(from.commands.begin(), from.commands.end(), to.commands.begin());
+  } else {
+    for (std::size_t i = 0; i < to.built.joints.size(); ++i) {
+      for (std::size_t k = 0; k < from.built.joints.size(); ++k) {
+        if (from.built.joints[k] == to.built.joints[i]) {
+          to.d->qpos[to.qpos_adr[i]] = from.d->qpos[from.qpos_adr[k]];
+          to.d->qvel[to.dof_adr[i]] = from.d->qvel[from.dof_adr[k]];
+          to.commands[i].position = from.d->qpos[from.qpos_adr[k]];
+          break;
+        }
+      }
+    }
+    if (from.built.floating && to.built.floating) {
+      std::copy_n(from.d->qpos, 7, to.d->qpos);
+    }
+  }
+  mj_forward(to.m, to.d);
+}
+
+}  // namespace
+
+struct SimHardware::Impl {
+  SimParams params;
+  std::unique_ptr<Instance> active;  // control thread
   std::mt19937 rng;
+  // Preparation side (any thread but the control thread): `preparing` serialises swaps and
+  // world changes; `mutex` guards what they announce.
+  std::mutex preparing;
+  mutable std::mutex mutex;
+  std::string latest_urdf;
+  World latest_world;
+  MountedHardware mounted;
+  hardware::Handover<Instance> prepared;
 
-  ~Impl() { release(); }
-  void release() {
-    if (d != nullptr) {
-      mj_deleteData(d);
-      d = nullptr;
-    }
-    if (m != nullptr) {
-      mj_deleteModel(m);
-      m = nullptr;
-    }
-  }
-
-  void load(const std::string& new_urdf, bool new_hardware) {
-    Built b = build_mjcf(new_urdf, world, params);
-    mjVFS vfs;
-    mj_defaultVFS(&vfs);
-    const char* file = "robot.xml";
-    if (mj_makeEmptyFileVFS(&vfs, file, static_cast<int>(b.mjcf.size())) != 0) {
-      throw HardwareError("sim: could not allocate the MuJoCo virtual file");
-    }
-    std::memcpy(vfs.filedata[0], b.mjcf.data(), b.mjcf.size());
-    char error[1000] = "";
-    mjModel* nm = mj_loadXML(file, &vfs, error, sizeof(error));
-    mj_deleteVFS(&vfs);
-    if (nm == nullptr) {
-      throw HardwareError(std::string("sim: MuJoCo rejected the model built from the URDF: ") + error);
-    }
-    mjData* nd = mj_makeData(nm);
-    // Carry the state over (hot swap): base pose and same-named joints.
-    std::map<std::string, std::pair<double, double>> carried;
-    std::vector<double> base_qpos;
-    if (m != nullptr) {
-      for (std::size_t i = 0; i < built.joints.size(); ++i) {
-        carried[built.joints[i]] = {d->qpos[qpos_adr[i]], d->qvel[dof_adr[i]]};
-      }
-      if (built.floating && b.floating) {
-        base_qpos.assign(d->qpos, d->qpos + 7);
-      }
-      nd->time = d->time;
-    }
-    release();
-    m = nm;
-    d = nd;
-    built = std::move(b);
-    urdf = new_urdf;
-    qpos_adr.clear();
-    dof_adr.clear();
-    effort_limit.clear();
-    commands.assign(built.joints.size(), DriveCommand{});
-    for (std::size_t i = 0; i < built.joints.size(); ++i) {
-      const int jid = mj_name2id(m, mjOBJ_JOINT, built.joints[i].c_str());
-      qpos_adr.push_back(m->jnt_qposadr[jid]);
-      dof_adr.push_back(m->jnt_dofadr[jid]);
-      effort_limit.push_back(m->actuator_forcelimited[i] ? m->actuator_forcerange[2 * i + 1] : 0.0);
-      double q = 0.0;
-      if (auto it = carried.find(built.joints[i]); it != carried.end()) {
-        q = it->second.first;
-      } else if (auto p = params.initial_positions.find(built.joints[i]); p != params.initial_positions.end()) {
-        q = p->second;
-      }
-      d->qpos[qpos_adr[i]] = q;
-      commands[i].mode = DriveMode::kPosition;
-      commands[i].position = q;
-    }
-    if (!base_qpos.empty()) {
-      std::copy(base_qpos.begin(), base_qpos.end(), d->qpos);
-    }
-    mj_forward(m, d);
-    if (new_hardware) {
-      ++generation;
-    }
-  }
+  void submit(std::unique_ptr<Instance> in) { prepared.submit(std::move(in)); }
 
   void apply_drives() {
-    for (std::size_t i = 0; i < commands.size(); ++i) {
-      const DriveCommand& c = commands[i];
+    Instance& in = *active;
+    for (std::size_t i = 0; i < in.commands.size(); ++i) {
+      const DriveCommand& c = in.commands[i];
       double kp = 0.0, kd = 0.0;
       switch (c.mode) {
         case DriveMode::kPosition:
@@ -385,39 +421,67 @@ struct SimHardware::Impl {
       const double pos_term = c.mode == DriveMode::kVelocity ? 0.0 : kp * c.position;
       // General actuator: force = ctrl + biasprm[1] q + biasprm[2] qd, saturated at forcerange.
       // The velocity-dependent part stays inside MuJoCo so the implicit integrator damps it stably.
-      m->actuator_biasprm[i * mjNBIAS + 1] = -kp;
-      m->actuator_biasprm[i * mjNBIAS + 2] = -kd;
-      d->ctrl[i] = pos_term + kd * c.velocity + ff;
+      in.m->actuator_biasprm[i * mjNBIAS + 1] = -kp;
+      in.m->actuator_biasprm[i * mjNBIAS + 2] = -kd;
+      in.d->ctrl[i] = pos_term + kd * c.velocity + ff;
     }
   }
 };
 
 SimHardware::SimHardware(const std::string& urdf, World world, SimParams params) : impl_(std::make_unique<Impl>()) {
   impl_->params = std::move(params);
-  impl_->world = std::move(world);
   impl_->rng.seed(impl_->params.seed);
   if (impl_->params.timestep <= 0.0) {
     throw HardwareError("sim: timestep must be positive");
   }
-  impl_->load(urdf, true);
+  impl_->active = make_instance(urdf, world, impl_->params);
+  impl_->active->generation = 1;
+  impl_->latest_urdf = urdf;
+  impl_->latest_world = std::move(world);
+  impl_->mounted = {1, impl_->active->built.joints};
 }
 
 SimHardware::~SimHardware() = default;
 
-const std::vector<std::string>& SimHardware::joint_names() const { return impl_->built.joints; }
-std::uint64_t SimHardware::generation() const { return impl_->generation; }
+const std::vector<std::string>& SimHardware::joint_names() const { return impl_->active->built.joints; }
+std::uint64_t SimHardware::generation() const { return impl_->active->generation; }
+
+MountedHardware SimHardware::mounted() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->mounted;
+}
+
+std::uint64_t SimHardware::mounted_generation() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->mounted.generation;
+}
+
+bool SimHardware::switch_prepared() {
+  Instance* next = impl_->prepared.take();
+  if (next == nullptr) {
+    return false;
+  }
+  carry_state(*impl_->active, *next);
+  Instance* old = impl_->active.release();
+  impl_->active.reset(next);
+  if (!impl_->prepared.retire(old)) {
+    delete old;  // unreachable in practice: each preparation collects the retired instance first
+  }
+  return true;
+}
 
 void SimHardware::read(HardwareState& state) {
-  const auto n = impl_->built.joints.size();
-  state.time = impl_->d->time;
+  const Instance& in = *impl_->active;
+  const auto n = in.built.joints.size();
+  state.time = in.d->time;
   state.position.resize(n);
   state.velocity.resize(n);
   state.effort.resize(n);
   std::normal_distribution<double> pos_noise(0.0, 1.0);
   for (std::size_t i = 0; i < n; ++i) {
-    state.position[i] = impl_->d->qpos[impl_->qpos_adr[i]];
-    state.velocity[i] = impl_->d->qvel[impl_->dof_adr[i]];
-    state.effort[i] = impl_->d->actuator_force[i];
+    state.position[i] = in.d->qpos[in.qpos_adr[i]];
+    state.velocity[i] = in.d->qvel[in.dof_adr[i]];
+    state.effort[i] = in.d->actuator_force[i];
     if (impl_->params.position_noise > 0.0) {
       state.position[i] += impl_->params.position_noise * pos_noise(impl_->rng);
     }
@@ -428,75 +492,105 @@ void SimHardware::read(HardwareState& state) {
 }
 
 void SimHardware::write(const std::vector<DriveCommand>& commands) {
-  if (commands.size() != impl_->built.joints.size()) {
+  Instance& in = *impl_->active;
+  if (commands.size() != in.built.joints.size()) {
     throw HardwareError("sim: " + std::to_string(commands.size()) + " drive commands for " +
-                        std::to_string(impl_->built.joints.size()) + " joints");
+                        std::to_string(in.built.joints.size()) + " joints");
   }
-  impl_->commands = commands;
+  std::copy(commands.begin(), commands.end(), in.commands.begin());
 }
 
 void SimHardware::step(double dt) {
   const int n = std::max(1, static_cast<int>(std::lround(dt / impl_->params.timestep)));
   for (int k = 0; k < n; ++k) {
     impl_->apply_drives();
-    mj_step(impl_->m, impl_->d);
+    mj_step(impl_->active->m, impl_->active->d);
   }
   // As on real drives, measured efforts and contacts lag the positions by one physics step
   // (mj_step computes forces before integrating); a second mj_forward would double the cost.
 }
 
-void SimHardware::swap_model(const std::string& urdf) {
-  if (urdf == impl_->urdf) {
-    return;  // the same robot was mounted again: no hardware change
+bool SimHardware::swap_model(const std::string& urdf) {
+  // Preparations are serialised (each builds on the latest robot and world); mounted() and
+  // world() stay answerable meanwhile, as they only take `mutex`.
+  std::lock_guard preparing(impl_->preparing);
+  World world;
+  {
+    std::lock_guard lock(impl_->mutex);
+    if (urdf == impl_->latest_urdf) {
+      return false;  // the same robot was mounted again: no hardware change
+    }
+    world = impl_->latest_world;
   }
-  impl_->load(urdf, true);
+  auto next = make_instance(urdf, world, impl_->params);
+  std::lock_guard lock(impl_->mutex);
+  next->generation = impl_->mounted.generation + 1;
+  impl_->latest_urdf = urdf;
+  impl_->mounted = {next->generation, next->built.joints};
+  impl_->submit(std::move(next));
+  return true;
 }
 
 void SimHardware::set_world(const World& world) {
-  impl_->world = world;
-  impl_->load(impl_->urdf, false);  // same robot: no new hardware generation
+  std::lock_guard preparing(impl_->preparing);
+  std::string urdf;
+  {
+    std::lock_guard lock(impl_->mutex);
+    urdf = impl_->latest_urdf;
+  }
+  auto next = make_instance(urdf, world, impl_->params);
+  next->same_robot = true;
+  std::lock_guard lock(impl_->mutex);
+  next->generation = impl_->mounted.generation;  // same robot: no new hardware generation
+  impl_->latest_world = world;
+  impl_->submit(std::move(next));
 }
 
-double SimHardware::time() const { return impl_->d->time; }
+World SimHardware::world() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->latest_world;
+}
+
+double SimHardware::time() const { return impl_->active->d->time; }
 
 Eigen::Isometry3d SimHardware::link_pose(const std::string& link) const {
-  const int id = mj_name2id(impl_->m, mjOBJ_BODY, link.c_str());
+  const int id = mj_name2id(impl_->active->m, mjOBJ_BODY, link.c_str());
   if (id < 0) {
     throw HardwareError("sim: unknown link '" + link + "'");
   }
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   for (int r = 0; r < 3; ++r) {
-    pose.translation()(r) = impl_->d->xpos[3 * id + r];
+    pose.translation()(r) = impl_->active->d->xpos[3 * id + r];
     for (int c = 0; c < 3; ++c) {
-      pose.linear()(r, c) = impl_->d->xmat[9 * id + 3 * r + c];
+      pose.linear()(r, c) = impl_->active->d->xmat[9 * id + 3 * r + c];
     }
   }
   return pose;
 }
 
-Eigen::Isometry3d SimHardware::base_pose() const { return link_pose(mj_id2name(impl_->m, mjOBJ_BODY, 1)); }
+Eigen::Isometry3d SimHardware::base_pose() const { return link_pose(mj_id2name(impl_->active->m, mjOBJ_BODY, 1)); }
 
 Eigen::Vector3d SimHardware::contact_force_on(const std::vector<std::string>& links) const {
   std::vector<int> bodies;
   for (const auto& l : links) {
-    const int id = mj_name2id(impl_->m, mjOBJ_BODY, l.c_str());
+    const int id = mj_name2id(impl_->active->m, mjOBJ_BODY, l.c_str());
     if (id < 0) {
       throw HardwareError("sim: unknown link '" + l + "'");
     }
     bodies.push_back(id);
   }
   auto on_robot = [&](int geom) {
-    return std::find(bodies.begin(), bodies.end(), impl_->m->geom_bodyid[geom]) != bodies.end();
+    return std::find(bodies.begin(), bodies.end(), impl_->active->m->geom_bodyid[geom]) != bodies.end();
   };
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
-  for (int i = 0; i < impl_->d->ncon; ++i) {
-    const mjContact& c = impl_->d->contact[i];
+  for (int i = 0; i < impl_->active->d->ncon; ++i) {
+    const mjContact& c = impl_->active->d->contact[i];
     const bool g1 = on_robot(c.geom1), g2 = on_robot(c.geom2);
     if (g1 == g2) {
       continue;
     }
     mjtNum f[6];
-    mj_contactForce(impl_->m, impl_->d, i, f);
+    mj_contactForce(impl_->active->m, impl_->active->d, i, f);
     // Contact frame rows: normal (from geom1 to geom2), then tangents; the force acts on geom2.
     Eigen::Vector3d world = Eigen::Vector3d::Zero();
     for (int r = 0; r < 3; ++r) {
@@ -507,8 +601,8 @@ Eigen::Vector3d SimHardware::contact_force_on(const std::vector<std::string>& li
   return total;
 }
 
-const std::string& SimHardware::mjcf() const { return impl_->built.mjcf; }
-const std::string& SimHardware::urdf() const { return impl_->urdf; }
-bool SimHardware::floating_base() const { return impl_->built.floating; }
+const std::string& SimHardware::mjcf() const { return impl_->active->built.mjcf; }
+const std::string& SimHardware::urdf() const { return impl_->active->urdf; }
+bool SimHardware::floating_base() const { return impl_->active->built.floating; }
 
-}  // namespace concert::robot
+}  // namespace concert::sim

@@ -1,12 +1,12 @@
-#include "robot/world.hpp"
+#include "concert/world/world.hpp"
 
 #include <gtest/gtest.h>
 
-namespace concert::robot {
+namespace concert::world {
 namespace {
 
 TEST(World, ParsesFloorWallsObstacles) {
-  const World w = load_world_file(std::string(ROBOT_FIXTURES) + "/world_wall.yaml");
+  const World w = load_world_file(std::string(WORLD_FIXTURES) + "/world_wall.yaml");
   EXPECT_TRUE(w.floor);
   EXPECT_DOUBLE_EQ(w.floor_friction, 1.0);
   ASSERT_EQ(w.walls.size(), 1u);
@@ -53,4 +53,4 @@ TEST(World, ClearErrorsNameFileAndField) {
 }
 
 }  // namespace
-}  // namespace concert::robot
+}  // namespace concert::world

@@ -1,0 +1,85 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "concert/kinematics/model.hpp"
+
+namespace concert::mobile_base {
+
+/// One steering + wheel leg of a mobile base, found in the model.
+struct Leg {
+  std::string steering_joint;
+  std::string wheel_joint;
+  int steering_index{-1};                        ///< index in the (fixed-base) model's q
+  int wheel_index{-1};                           ///< index in the (fixed-base) model's q
+  Eigen::Vector2d position{Eigen::Vector2d::Zero()};  ///< steering axis (x, y) in the base frame [m]
+  double wheel_radius{0.0};                      ///< [m]
+  double steering_sign{1.0};                     ///< +1 if the steering axis points up, -1 if down
+  double heading_offset{0.0};  ///< base-frame heading of positive wheel rolling at steering 0 [rad]
+  double wheel_center_height{0.0};               ///< wheel centre z in the base frame at q = 0 [m]
+  double steering_lower{-1e9};                   ///< [rad]
+  double steering_upper{1e9};                    ///< [rad]
+};
+
+/// Steering angle and wheel speed for one leg.
+struct LegSetpoint {
+  double steering_angle{0.0};  ///< [rad]
+  double wheel_velocity{0.0};  ///< [rad/s]
+};
+
+/// Planar base pose and twist (odometry).
+struct Odometry {
+  double x{0.0}, y{0.0}, yaw{0.0};     ///< pose in the odometry frame [m, m, rad]
+  double vx{0.0}, vy{0.0}, wz{0.0};    ///< twist in the base frame [m/s, m/s, rad/s]
+};
+
+/// Cylinder collision radius per link of a URDF (first cylinder collision of each link) [m]
+/// (wheel radii for detect_legs). Throws std::invalid_argument if the URDF cannot be parsed.
+std::map<std::string, double> collision_cylinder_radii(const std::string& urdf);
+
+/// Finds the legs of whatever mobile base the model has: a joint with a vertical axis
+/// (in the base frame at q = 0) and no movable ancestor, whose only movable descendant is a
+/// joint with a horizontal axis (the wheel). Wheel radii come from `wheel_radii`
+/// (link name -> radius, e.g. the wheel link's collision cylinder); legs whose wheel link
+/// has no entry get `default_wheel_radius` [m].
+std::vector<Leg> detect_legs(const kinematics::Model& model, const std::map<std::string, double>& wheel_radii,
+                             double default_wheel_radius = 0.16);
+
+/// Omni-steering kinematics of a base with N >= 2 steering+wheel legs.
+class BaseKinematics {
+ public:
+  /// Throws std::invalid_argument if fewer than two legs are given.
+  explicit BaseKinematics(std::vector<Leg> legs);
+
+  [[nodiscard]] const std::vector<Leg>& legs() const { return legs_; }
+
+  /// Steering angles and wheel speeds for the base twist (vx, vy [m/s], wz [rad/s]).
+  /// Each steering angle is chosen closest to `current_steering`: if the wheel would turn
+  /// by more than 90 degrees, it turns by the supplement and rolls backwards (the 180
+  /// degree flip); steering limits are respected by flipping too. A leg with ~zero
+  /// contact speed keeps its current angle.
+  [[nodiscard]] std::vector<LegSetpoint> leg_setpoints(const Eigen::Vector3d& twist,
+                                                       const std::vector<double>& current_steering) const;
+  /// Same into `out` (resized to the leg count: no allocation once it has that size).
+  void leg_setpoints(const Eigen::Vector3d& twist, const std::vector<double>& current_steering,
+                     std::vector<LegSetpoint>& out) const;
+
+  /// Least-squares base twist (vx, vy, wz) from measured steering angles [rad] and wheel
+  /// speeds [rad/s] (rolling without slip).
+  [[nodiscard]] Eigen::Vector3d twist_from_legs(const std::vector<double>& steering,
+                                                const std::vector<double>& wheel_velocity) const;
+
+  /// Integrates the odometry by `dt` [s] with the twist measured from the legs.
+  void integrate(Odometry& odometry, const std::vector<double>& steering, const std::vector<double>& wheel_velocity,
+                 double dt) const;
+
+ private:
+  std::vector<Leg> legs_;
+  Eigen::Matrix3d normal_inverse_;  // (A^T A)^-1 of the rigid-body constraint matrix
+};
+
+}  // namespace concert::mobile_base

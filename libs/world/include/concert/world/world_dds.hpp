@@ -1,0 +1,17 @@
+#pragma once
+// The one conversion between the world and its latched topic (idl/world.idl).
+
+#include <cstdint>
+#include <string>
+
+#include "concert/world/world.hpp"
+#include "world.h"
+
+namespace concert::world {
+
+/// The World message of `world` at `version`; `source` names where it came from.
+msg::World to_msg(const World& world, std::uint32_t version, const std::string& source);
+/// The world of a World message; throws WorldError naming the shape if a size is not positive.
+World from_msg(const msg::World& message);
+
+}  // namespace concert::world

@@ -1,0 +1,194 @@
+#pragma once
+// The controllers of the robot's loop, behind one interface (ros2_control's shape): each
+// controller owns the joints it claimed (one owner per joint, recorded in CycleData::owner),
+// is built with all its memory when a model is prepared (off the loop thread), and computes
+// the drive references of its joints each cycle without allocating.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "concert/kinematics/model.hpp"
+#include "robot/base_kinematics.hpp"
+#include "robot/hardware.hpp"
+#include "robot/robot_core.hpp"
+
+namespace concert::robot {
+
+/// Joint-level reference of the joint controller (a JointCommand without the name).
+struct JointSetpoint {
+  DriveMode mode{DriveMode::kPosition};
+  double position{0.0};
+  double velocity{0.0};
+  double effort{0.0};
+  double stiffness{0.0};
+  double damping{0.0};
+};
+
+/// What every controller reads and writes in one cycle, in model joint order. Sized when the
+/// model is prepared; the loop only assigns into it.
+struct CycleData {
+  CycleData(const kinematics::Model& model, std::size_t arm_joints);
+
+  const kinematics::Model* model{nullptr};
+  double time{0.0};  ///< hardware time [s]
+  double dt{0.001};  ///< control period [s]
+  Eigen::VectorXd q, qd, tau;  ///< measured [rad, rad/s, Nm]
+  Eigen::VectorXd gravity;     ///< g(q) [Nm]
+  Eigen::VectorXd zero;        ///< zeros (RNE arguments)
+  Odometry odometry;           ///< wheel odometry (odometry frame)
+  // End-effector (only with an arm chain).
+  Eigen::Isometry3d ee_pose{Eigen::Isometry3d::Identity()};
+  Eigen::MatrixXd jacobian;    ///< 6 x dof, world-aligned
+  Eigen::MatrixXd jac_arm;     ///< 6 x arm joints
+  Eigen::VectorXd qd_arm;      ///< arm joint velocities
+  Eigen::VectorXd id_tau;      ///< ID(q, qd, 0)
+  Eigen::VectorXd residual;    ///< arm: ID - measured torque
+  Vector6d wrench{Vector6d::Zero()};  ///< estimated external wrench on the end-effector
+  /// Per joint: who owns it, where a holding joint stays, the rate-limited position
+  /// reference, and the drive reference the owner computed this cycle.
+  std::vector<JointOwner> owner;
+  std::vector<double> hold_position;
+  std::vector<double> position_ref;
+  std::vector<DriveCommand> drive;
+
+  [[nodiscard]] const kinematics::JointLimits& limits(int i) const {
+    return model->joint_limits()[static_cast<std::size_t>(i)];
+  }
+  /// Clamps a position to joint i's limits.
+  [[nodiscard]] double clamp_position(int i, double p) const;
+  /// Moves joint i's rate-limited reference towards `target` (clamped to the limits) by at
+  /// most `rate` times the velocity limit times dt, and returns it.
+  double ramp(int i, double target, double rate = 1.0);
+  /// Joint i leaves torque-level control: its references follow the measurement.
+  void follow(int i);
+};
+
+/// One controller of the loop.
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  /// The owner tag of the joints this controller drives.
+  [[nodiscard]] virtual JointOwner kind() const = 0;
+  /// Computes data.drive[i] for every joint i with data.owner[i] == kind(). No allocation.
+  virtual void update(CycleData& data) = 0;
+};
+
+/// Keeps joints where they were left (position mode, gravity feed-forward).
+class HoldController final : public Controller {
+ public:
+  [[nodiscard]] JointOwner kind() const override { return JointOwner::kHold; }
+  void update(CycleData& data) override;
+};
+
+/// Joint position / velocity / effort / impedance references, per joint.
+class JointController final : public Controller {
+ public:
+  explicit JointController(int dof) : setpoints_(static_cast<std::size_t>(dof)) {}
+  [[nodiscard]] JointOwner kind() const override { return JointOwner::kJoint; }
+  void set(int joint, const JointSetpoint& setpoint) { setpoints_[static_cast<std::size_t>(joint)] = setpoint; }
+  void update(CycleData& data) override;
+
+ private:
+  std::vector<JointSetpoint> setpoints_;
+};
+
+/// Cartesian impedance of the end-effector frame, with admittance along one axis.
+class CartesianController final : public Controller {
+ public:
+  explicit CartesianController(const std::vector<int>& arm);
+  [[nodiscard]] JointOwner kind() const override { return JointOwner::kCartesian; }
+  /// New target; `keep_admittance` keeps the admittance offset (same admittance running).
+  void set(const CartesianCommand& command, bool keep_admittance);
+  void update(CycleData& data) override;
+
+ private:
+  std::vector<int> arm_;
+  CartesianCommand command_;
+  Eigen::VectorXd tau_arm_;
+  double offset_{0.0};
+  double rate_{0.0};
+};
+
+/// Gravity compensation (teaching mode): effort = g(q).
+class GravityCompensationController final : public Controller {
+ public:
+  [[nodiscard]] JointOwner kind() const override { return JointOwner::kGravityCompensation; }
+  void update(CycleData& data) override;
+};
+
+/// Base velocity through the steering+wheel legs; also integrates the odometry.
+class BaseController final : public Controller {
+ public:
+  /// `trajectory_steering_rate`: fraction of the steering velocity limit used while a
+  /// trajectory drives the legs.
+  BaseController(std::vector<Leg> legs, double command_timeout, double trajectory_steering_rate);
+  [[nodiscard]] JointOwner kind() const override { return JointOwner::kBase; }
+  /// New twist (base frame) at hardware time `time`.
+  void set(const BaseCommand& command, double time);
+  /// Integrates the odometry from the measured legs (every cycle, whoever owns the legs).
+  void estimate(CycleData& data);
+  void update(CycleData& data) override;
+  /// Drives the legs owned by `owner` towards `twist` (base frame; vx, vy [m/s], wz [rad/s]).
+  void drive_legs(CycleData& data, const Eigen::Vector3d& twist, JointOwner owner);
+  [[nodiscard]] const std::vector<Leg>& legs() const { return kinematics_.legs(); }
+
+ private:
+  BaseKinematics kinematics_;
+  double timeout_;
+  double trajectory_steering_rate_;
+  Eigen::Vector3d twist_{Eigen::Vector3d::Zero()};
+  double command_time_{-1e9};
+  std::vector<double> steering_, wheel_velocity_;
+  std::vector<LegSetpoint> setpoints_;
+};
+
+/// A trajectory checked and mapped onto the model's joints (made off the loop thread).
+struct PreparedTrajectory {
+  std::uint32_t request_id{0};
+  std::uint64_t sequence{0};
+  std::vector<int> joints;         ///< model indices of the tracked joints
+  bool base{false};                ///< base_x, base_y, base_yaw follow the joints' columns
+  int columns{0};                  ///< joints.size() + 3 if base
+  std::vector<double> times;       ///< [s], strictly increasing
+  std::vector<double> position;    ///< times.size() x columns, row-major
+  std::vector<double> velocity;    ///< same
+  [[nodiscard]] double duration() const { return times.empty() ? 0.0 : times.back(); }
+};
+
+/// Tracks a PreparedTrajectory closed-loop: joints in position mode with velocity
+/// feed-forward through their drives, the base by odometry feedback through the base
+/// controller's legs. Owns the trajectory's joints (and the legs) while it runs; afterwards
+/// they hold the final sample.
+class TrajectoryController final : public Controller {
+ public:
+  TrajectoryController(int dof, const RobotParams& params, BaseController* base);
+  [[nodiscard]] JointOwner kind() const override { return JointOwner::kTrajectory; }
+  /// Starts `trajectory` (the loop keeps it alive until it is replaced): claims its joints.
+  void start(const PreparedTrajectory* trajectory, CycleData& data);
+  /// Stops a running trajectory with `reason`; its joints hold where they are.
+  void abort(TrajectoryAbort reason, CycleData& data);
+  [[nodiscard]] bool running() const { return progress_.state == TrajectoryState::kExecuting; }
+  [[nodiscard]] const PreparedTrajectory* trajectory() const { return trajectory_; }
+  [[nodiscard]] const TrajectoryProgress& progress() const { return progress_; }
+  /// The last trajectory another one replaced while it ran (aborted, preempted).
+  [[nodiscard]] const TrajectoryProgress& replaced() const { return replaced_; }
+  void update(CycleData& data) override;
+
+ private:
+  void sample(double t);
+  void release(CycleData& data, bool to_final);
+  const RobotParams& params_;
+  BaseController* base_;
+  const PreparedTrajectory* trajectory_{nullptr};
+  double start_time_{0.0};
+  TrajectoryProgress progress_;
+  TrajectoryProgress replaced_;
+  std::vector<double> q_ref_, qd_ref_;  // current sample, trajectory columns
+};
+
+}  // namespace concert::robot

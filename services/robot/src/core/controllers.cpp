@@ -1,0 +1,425 @@
+#include "robot/controllers.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+
+namespace concert::robot {
+namespace {
+
+double clamp_abs(double v, double limit) { return limit > 0.0 ? std::clamp(v, -limit, limit) : v; }
+
+double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+Eigen::Vector3d rotation_error(const Eigen::Matrix3d& target, const Eigen::Matrix3d& current) {
+  const Eigen::AngleAxisd aa(target * current.transpose());
+  return aa.angle() * aa.axis();
+}
+
+}  // namespace
+
+const char* controller_name(JointOwner owner) {
+  switch (owner) {
+    case JointOwner::kHold:
+      return "hold";
+    case JointOwner::kJoint:
+      return "joint";
+    case JointOwner::kCartesian:
+      return "cartesian_impedance";
+    case JointOwner::kGravityCompensation:
+      return "gravity_compensation";
+    case JointOwner::kBase:
+      return "base_velocity";
+    case JointOwner::kTrajectory:
+      return "joint_trajectory";
+  }
+  return "unknown";
+}
+
+CycleData::CycleData(const kinematics::Model& m, std::size_t arm_joints) : model(&m) {
+  const auto n = static_cast<Eigen::Index>(m.dof());
+  const auto na = static_cast<Eigen::Index>(arm_joints);
+  q = qd = tau = gravity = zero = id_tau = Eigen::VectorXd::Zero(n);
+  jacobian = Eigen::MatrixXd::Zero(6, n);
+  jac_arm = Eigen::MatrixXd::Zero(6, na);
+  qd_arm = residual = Eigen::VectorXd::Zero(na);
+  const auto nu = static_cast<std::size_t>(n);
+  owner.assign(nu, JointOwner::kHold);
+  hold_position.assign(nu, 0.0);
+  position_ref.assign(nu, 0.0);
+  drive.assign(nu, DriveCommand{});
+}
+
+double CycleData::clamp_position(int i, double p) const {
+  const auto& lim = limits(i);
+  return lim.has_position_limits ? std::clamp(p, lim.lower, lim.upper) : p;
+}
+
+double CycleData::ramp(int i, double target, double rate) {
+  const double vmax = rate * limits(i).velocity;
+  double& ref = position_ref[static_cast<std::size_t>(i)];
+  const double step = vmax > 0.0 ? vmax * dt : 1e9;
+  ref += std::clamp(clamp_position(i, target) - ref, -step, step);
+  return ref;
+}
+
+void CycleData::follow(int i) {
+  const auto iu = static_cast<std::size_t>(i);
+  hold_position[iu] = position_ref[iu] = q(i);
+}
+
+void HoldController::update(CycleData& data) {
+  for (std::size_t iu = 0; iu < data.owner.size(); ++iu) {
+    if (data.owner[iu] != JointOwner::kHold) {
+      continue;
+    }
+    const int i = static_cast<int>(iu);
+    DriveCommand& d = data.drive[iu];
+    d = DriveCommand{};
+    d.mode = DriveMode::kPosition;
+    d.position = data.ramp(i, data.hold_position[iu]);
+    d.effort = data.gravity(i);
+  }
+}
+
+void JointController::update(CycleData& data) {
+  for (std::size_t iu = 0; iu < data.owner.size(); ++iu) {
+    if (data.owner[iu] != JointOwner::kJoint) {
+      continue;
+    }
+    const int i = static_cast<int>(iu);
+    const JointSetpoint& jc = setpoints_[iu];
+    const auto& lim = data.limits(i);
+    DriveCommand& d = data.drive[iu];
+    d = DriveCommand{};
+    d.mode = jc.mode;
+    switch (jc.mode) {
+      case DriveMode::kPosition:
+        d.position = data.ramp(i, jc.position);
+        d.effort = data.gravity(i) + jc.effort;
+        break;
+      case DriveMode::kVelocity:
+        d.velocity = clamp_abs(jc.velocity, lim.velocity);
+        if (lim.has_position_limits && ((data.q(i) >= lim.upper && d.velocity > 0.0) ||
+                                        (data.q(i) <= lim.lower && d.velocity < 0.0))) {
+          d.velocity = 0.0;
+        }
+        break;
+      case DriveMode::kEffort:
+        d.effort = jc.effort;
+        break;
+      case DriveMode::kImpedance:
+        d.position = data.clamp_position(i, jc.position);
+        d.velocity = clamp_abs(jc.velocity, lim.velocity);
+        d.effort = jc.effort;
+        d.stiffness = jc.stiffness;
+        d.damping = jc.damping;
+        break;
+    }
+    data.hold_position[iu] = data.q(i);
+    if (jc.mode != DriveMode::kPosition) {
+      data.position_ref[iu] = data.q(i);
+    }
+  }
+}
+
+CartesianController::CartesianController(const std::vector<int>& arm)
+    : arm_(arm), tau_arm_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(arm.size()))) {}
+
+void CartesianController::set(const CartesianCommand& command, bool keep_admittance) {
+  command_.model_version = command.model_version;
+  command_.target_pose = command.target_pose;
+  command_.target_twist = command.target_twist;
+  command_.stiffness = command.stiffness;
+  command_.damping = command.damping;
+  command_.feedforward_wrench = command.feedforward_wrench;
+  command_.admittance = command.admittance;
+  command_.nullspace_damping = command.nullspace_damping;
+  if (!keep_admittance) {
+    offset_ = 0.0;
+    rate_ = 0.0;
+  }
+}
+
+void CartesianController::update(CycleData& data) {
+  bool owns = false;
+  for (int j : arm_) {
+    owns = owns || data.owner[static_cast<std::size_t>(j)] == JointOwner::kCartesian;
+  }
+  if (!owns || arm_.empty()) {
+    return;
+  }
+  const CartesianCommand& cc = command_;
+  Eigen::Isometry3d target = cc.target_pose;
+  if (cc.admittance.enabled) {
+    const double pushed = -data.wrench.head<3>().dot(cc.admittance.axis);
+    const double acc = (cc.admittance.force_setpoint - pushed - cc.admittance.damping * rate_) / cc.admittance.mass;
+    rate_ += acc * data.dt;
+    offset_ += rate_ * data.dt;
+    if (std::abs(offset_) > cc.admittance.max_offset) {
+      offset_ = std::copysign(cc.admittance.max_offset, offset_);
+      rate_ = 0.0;
+    }
+    target.translation() += offset_ * cc.admittance.axis;
+  }
+  Vector6d twist;
+  twist.noalias() = data.jac_arm.lazyProduct(data.qd_arm);
+  Vector6d error;
+  error.head<3>() = target.translation() - data.ee_pose.translation();
+  error.tail<3>() = rotation_error(target.linear(), data.ee_pose.linear());
+  const Vector6d force =
+      cc.stiffness.cwiseProduct(error) + cc.damping.cwiseProduct(cc.target_twist - twist) + cc.feedforward_wrench;
+  tau_arm_.noalias() = data.jac_arm.transpose().lazyProduct(force);
+  tau_arm_ -= cc.nullspace_damping * data.qd_arm;
+  for (std::size_t k = 0; k < arm_.size(); ++k) {
+    const int i = arm_[k];
+    const auto iu = static_cast<std::size_t>(i);
+    if (data.owner[iu] != JointOwner::kCartesian) {
+      continue;
+    }
+    DriveCommand& d = data.drive[iu];
+    d = DriveCommand{};
+    d.mode = DriveMode::kEffort;
+    d.effort = tau_arm_(static_cast<Eigen::Index>(k)) + data.gravity(i);
+    data.follow(i);
+  }
+}
+
+void GravityCompensationController::update(CycleData& data) {
+  for (std::size_t iu = 0; iu < data.owner.size(); ++iu) {
+    if (data.owner[iu] != JointOwner::kGravityCompensation) {
+      continue;
+    }
+    const int i = static_cast<int>(iu);
+    DriveCommand& d = data.drive[iu];
+    d = DriveCommand{};
+    d.mode = DriveMode::kEffort;
+    d.effort = data.gravity(i);
+    data.follow(i);
+  }
+}
+
+BaseController::BaseController(std::vector<Leg> legs, double command_timeout, double trajectory_steering_rate)
+    : kinematics_(std::move(legs)),
+      timeout_(command_timeout),
+      trajectory_steering_rate_(trajectory_steering_rate),
+      steering_(kinematics_.legs().size(), 0.0),
+      wheel_velocity_(kinematics_.legs().size(), 0.0),
+      setpoints_(kinematics_.legs().size()) {}
+
+void BaseController::set(const BaseCommand& command, double time) {
+  twist_ = {command.vx, command.vy, command.wz};
+  command_time_ = time;
+}
+
+void BaseController::estimate(CycleData& data) {
+  const auto& legs = kinematics_.legs();
+  for (std::size_t k = 0; k < legs.size(); ++k) {
+    steering_[k] = data.q(legs[k].steering_index);
+    wheel_velocity_[k] = data.qd(legs[k].wheel_index);
+  }
+  kinematics_.integrate(data.odometry, steering_, wheel_velocity_, data.dt);
+}
+
+void BaseController::update(CycleData& data) {
+  const Eigen::Vector3d twist = data.time - command_time_ > timeout_ ? Eigen::Vector3d::Zero() : twist_;
+  drive_legs(data, twist, JointOwner::kBase);
+}
+
+void BaseController::drive_legs(CycleData& data, const Eigen::Vector3d& twist, JointOwner owner) {
+  const auto& legs = kinematics_.legs();
+  for (std::size_t k = 0; k < legs.size(); ++k) {
+    steering_[k] = data.position_ref[static_cast<std::size_t>(legs[k].steering_index)];
+  }
+  kinematics_.leg_setpoints(twist, steering_, setpoints_);
+  for (std::size_t k = 0; k < legs.size(); ++k) {
+    const int s = legs[k].steering_index;
+    const int w = legs[k].wheel_index;
+    if (data.owner[static_cast<std::size_t>(s)] == owner) {
+      DriveCommand& d = data.drive[static_cast<std::size_t>(s)];
+      d = DriveCommand{};
+      d.mode = DriveMode::kPosition;
+      // Tracking a trajectory, the steering turns at a fraction of its velocity limit: at the
+      // limit, the drive's own damping costs more than the joint's continuous torque.
+      d.position = data.ramp(s, setpoints_[k].steering_angle,
+                             owner == JointOwner::kTrajectory ? trajectory_steering_rate_ : 1.0);
+      d.effort = data.gravity(s);
+    }
+    if (data.owner[static_cast<std::size_t>(w)] == owner) {
+      DriveCommand& d = data.drive[static_cast<std::size_t>(w)];
+      d = DriveCommand{};
+      d.mode = DriveMode::kVelocity;
+      d.velocity = clamp_abs(setpoints_[k].wheel_velocity, data.limits(w).velocity);
+      if (owner == JointOwner::kTrajectory) {
+        // Roll only as fast as the steering points the right way (swerve practice): steering a
+        // rolling loaded wheel scrubs, which costs the steering more than its continuous torque.
+        d.velocity *= std::max(0.0, std::cos(setpoints_[k].steering_angle - data.q(s)));
+      }
+      data.follow(w);
+    }
+  }
+}
+
+TrajectoryController::TrajectoryController(int dof, const RobotParams& params, BaseController* base)
+    : params_(params),
+      base_(base),
+      q_ref_(static_cast<std::size_t>(dof) + 3, 0.0),
+      qd_ref_(static_cast<std::size_t>(dof) + 3, 0.0) {}
+
+void TrajectoryController::start(const PreparedTrajectory* trajectory, CycleData& data) {
+  if (running()) {
+    abort(TrajectoryAbort::kPreempted, data);
+    replaced_ = progress_;
+  }
+  trajectory_ = trajectory;
+  start_time_ = data.time;
+  progress_ = TrajectoryProgress{};
+  progress_.request_id = trajectory->request_id;
+  progress_.sequence = trajectory->sequence;
+  progress_.state = TrajectoryState::kExecuting;
+  progress_.duration = trajectory->duration();
+  for (int j : trajectory->joints) {
+    data.owner[static_cast<std::size_t>(j)] = JointOwner::kTrajectory;
+  }
+  if (trajectory->base && base_ != nullptr) {
+    for (const Leg& leg : base_->legs()) {
+      data.owner[static_cast<std::size_t>(leg.steering_index)] = JointOwner::kTrajectory;
+      data.owner[static_cast<std::size_t>(leg.wheel_index)] = JointOwner::kTrajectory;
+    }
+  }
+}
+
+void TrajectoryController::release(CycleData& data, bool to_final) {
+  for (std::size_t iu = 0; iu < data.owner.size(); ++iu) {
+    if (data.owner[iu] != JointOwner::kTrajectory) {
+      continue;
+    }
+    data.owner[iu] = JointOwner::kHold;
+    const int i = static_cast<int>(iu);
+    data.hold_position[iu] = data.q(i);
+    data.position_ref[iu] = data.q(i);
+  }
+  if (to_final && trajectory_ != nullptr) {
+    const auto last = trajectory_->times.size() - 1;
+    for (std::size_t k = 0; k < trajectory_->joints.size(); ++k) {
+      const auto iu = static_cast<std::size_t>(trajectory_->joints[k]);
+      data.hold_position[iu] = data.clamp_position(
+          trajectory_->joints[k], trajectory_->position[last * static_cast<std::size_t>(trajectory_->columns) + k]);
+    }
+  }
+}
+
+void TrajectoryController::abort(TrajectoryAbort reason, CycleData& data) {
+  if (!running()) {
+    return;
+  }
+  release(data, false);
+  progress_.state = TrajectoryState::kAborted;
+  progress_.abort = reason;
+}
+
+void TrajectoryController::sample(double t) {
+  const PreparedTrajectory& tr = *trajectory_;
+  const auto cols = static_cast<std::size_t>(tr.columns);
+  const auto n = tr.times.size();
+  if (t <= tr.times.front() || n == 1) {
+    std::copy_n(tr.position.begin(), cols, q_ref_.begin());
+    std::copy_n(tr.velocity.begin(), cols, qd_ref_.begin());
+    return;
+  }
+  if (t >= tr.times.back()) {
+    std::copy_n(tr.position.begin() + static_cast<std::ptrdiff_t>((n - 1) * cols), cols, q_ref_.begin());
+    std::fill_n(qd_ref_.begin(), cols, 0.0);
+    return;
+  }
+  const auto it = std::upper_bound(tr.times.begin(), tr.times.end(), t);
+  const auto b = static_cast<std::size_t>(it - tr.times.begin());
+  const std::size_t a = b - 1;
+  const double s = (t - tr.times[a]) / (tr.times[b] - tr.times[a]);
+  for (std::size_t c = 0; c < cols; ++c) {
+    const double pa = tr.position[a * cols + c], pb = tr.position[b * cols + c];
+    const double va = tr.velocity[a * cols + c], vb = tr.velocity[b * cols + c];
+    q_ref_[c] = pa + s * (pb - pa);
+    qd_ref_[c] = va + s * (vb - va);
+  }
+}
+
+void TrajectoryController::update(CycleData& data) {
+  if (!running()) {
+    return;
+  }
+  const PreparedTrajectory& tr = *trajectory_;
+  const double t = data.time - start_time_;
+  sample(t);
+  double joint_error = 0.0;
+  int worst = -1;
+  for (std::size_t k = 0; k < tr.joints.size(); ++k) {
+    const int i = tr.joints[k];
+    const auto iu = static_cast<std::size_t>(i);
+    const double error = std::abs(q_ref_[k] - data.q(i));
+    if (error > joint_error) {
+      joint_error = error;
+      worst = i;
+    }
+    if (data.owner[iu] != JointOwner::kTrajectory) {
+      continue;
+    }
+    DriveCommand& d = data.drive[iu];
+    d = DriveCommand{};
+    d.mode = DriveMode::kPosition;
+    d.position = data.clamp_position(i, q_ref_[k]);
+    d.velocity = clamp_abs(qd_ref_[k], data.limits(i).velocity);
+    d.effort = data.gravity(i);
+    data.position_ref[iu] = data.hold_position[iu] = d.position;
+  }
+  double base_error = 0.0;
+  if (tr.base && base_ != nullptr) {
+    const std::size_t c = tr.joints.size();
+    const double ex = q_ref_[c] - data.odometry.x;
+    const double ey = q_ref_[c + 1] - data.odometry.y;
+    const double eyaw = wrap(q_ref_[c + 2] - data.odometry.yaw);
+    base_error = std::hypot(ex, ey);
+    const double k = params_.trajectory_base_gain;
+    double vx = qd_ref_[c] + k * ex;
+    double vy = qd_ref_[c + 1] + k * ey;
+    double wz = qd_ref_[c + 2] + k * eyaw;
+    // Below the deadband the legs keep their steering: tiny feedback corrections in changing
+    // directions would otherwise swing the steering back and forth.
+    const double deadband = params_.trajectory_base_deadband;
+    if (std::hypot(vx, vy) < deadband && std::abs(wz) < deadband) {
+      vx = vy = wz = 0.0;
+    }
+    const double co = std::cos(data.odometry.yaw), si = std::sin(data.odometry.yaw);
+    base_->drive_legs(data, Eigen::Vector3d(co * vx + si * vy, -si * vx + co * vy, wz), JointOwner::kTrajectory);
+  }
+  if (joint_error > progress_.max_joint_error) {
+    progress_.max_joint_error = joint_error;
+    progress_.worst_joint = worst;
+  }
+  progress_.max_base_error = std::max(progress_.max_base_error, base_error);
+  progress_.progress = tr.duration() > 0.0 ? std::clamp(t / tr.duration(), 0.0, 1.0) : 1.0;
+  if (joint_error > params_.trajectory_path_tolerance) {
+    progress_.worst_joint = worst;
+    abort(TrajectoryAbort::kPathTolerance, data);
+    return;
+  }
+  if (base_error > params_.trajectory_base_path_tolerance) {
+    progress_.worst_joint = -1;
+    abort(TrajectoryAbort::kPathTolerance, data);
+    return;
+  }
+  if (t < tr.duration()) {
+    return;
+  }
+  if (joint_error <= params_.trajectory_goal_tolerance && base_error <= params_.trajectory_base_goal_tolerance) {
+    release(data, true);
+    progress_.state = TrajectoryState::kSucceeded;
+    progress_.progress = 1.0;
+  } else if (t > tr.duration() + params_.trajectory_goal_time) {
+    progress_.worst_joint = joint_error > params_.trajectory_goal_tolerance ? worst : -1;
+    abort(TrajectoryAbort::kGoalTolerance, data);
+  }
+}
+
+}  // namespace concert::robot

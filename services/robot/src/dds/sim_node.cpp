@@ -1,0 +1,113 @@
+#include "sim_node.hpp"
+
+#include <chrono>
+#include <iostream>
+#include <stdexcept>
+
+#include "concert/common/clock.hpp"
+#include "concert/world/world_dds.hpp"
+#include "robot_conversions.hpp"
+
+namespace concert::robot::dds {
+
+namespace cdds = concert::dds;
+
+
+SimNode::SimNode(cdds::Participant& participant, sim::SimHardware& sim, const sim::AssemblyBuilder* builder,
+                 RobotNode& robot, const world::World& initial_world, const std::string& world_source,
+                 std::function<void(const sim::SimulatedRobot&)> on_swap)
+    : sim_(sim),
+      builder_(builder),
+      robot_(robot),
+      on_swap_(std::move(on_swap)),
+      world_(participant, cdds::topics::world),
+      reply_(participant, cdds::topics::sim_reply) {
+  world_.write(world::to_msg(initial_world, world_version_, world_source));
+  worker_ = std::thread([this] { work(); });
+  commands_ = std::make_unique<cdds::Reader<msg::SimCommand>>(
+      participant, cdds::topics::sim_command, [this](const msg::SimCommand& c, const auto&) {
+        {
+          std::lock_guard lock(mutex_);
+          queue_.push_back(c);
+        }
+        wake_.notify_all();
+      });
+}
+
+SimNode::~SimNode() {
+  commands_.reset();
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  worker_.join();
+}
+
+void SimNode::work() {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+    if (stopping_) {
+      return;
+    }
+    const msg::SimCommand c = std::move(queue_.front());
+    queue_.pop_front();
+    lock.unlock();
+    handle(c);
+    lock.lock();
+  }
+}
+
+void SimNode::handle(const msg::SimCommand& c) {
+  msg::SimCommandReply reply;
+  reply.request_id(c.request_id());
+  const std::string what = c.kind() == msg::SIM_SWAP_ASSEMBLY ? "assembly" : "world";
+  try {
+    reply.message(c.kind() == msg::SIM_SWAP_ASSEMBLY ? swap_assembly(c.content(), c.name())
+                                                     : set_world(c.content(), c.name()));
+    reply.accepted(true);
+    std::cerr << "concert_robot: " << what << " from '" << c.name() << "' (" << c.source() << "): " << reply.message()
+              << "\n";
+  } catch (const std::exception& e) {
+    reply.accepted(false);
+    reply.message(what + " '" + c.name() + "' refused, the simulator keeps its " +
+                  (c.kind() == msg::SIM_SWAP_ASSEMBLY ? "modules" : "world") + ": " + e.what());
+    std::cerr << "concert_robot: " << reply.message() << "\n";
+  }
+  reply.stamp_ns(now_ns());
+  reply_.write(reply);
+}
+
+std::string SimNode::swap_assembly(const std::string& yaml, const std::string& name) {
+  if (builder_ == nullptr) {
+    throw std::runtime_error("the simulated robot is a fixed URDF (--urdf): there is no assembly to swap");
+  }
+  const sim::SimulatedRobot robot = builder_->build_from_text(yaml, name);
+  if (!sim_.swap_model(robot.urdf)) {
+    return "the same robot is mounted again: nothing changed";
+  }
+  // The loop switches at its next cycle boundary; mounted() already names the new joints, so
+  // a model made from this scan is checked against them.
+  robot_.publish_scan(robot.scan, "sim");
+  if (on_swap_) {
+    on_swap_(robot);
+  }
+  return "mounted: " + std::to_string(robot.scan.slaves.size()) + " EtherCAT slaves, " +
+         std::to_string(robot.tree.modules.size()) + " modules";
+}
+
+std::string SimNode::set_world(const std::string& yaml, const std::string& name) {
+  const world::World w = world::parse_world_yaml(yaml, name);
+  sim_.set_world(w);
+  std::uint32_t version = 0;
+  {
+    std::lock_guard lock(mutex_);
+    version = ++world_version_;
+  }
+  world_.write(world::to_msg(w, version, name));
+  return "world version " + std::to_string(version) + ": " + std::to_string(w.walls.size()) + " walls, " +
+         std::to_string(w.obstacles.size()) + " obstacles";
+}
+
+}  // namespace concert::robot::dds

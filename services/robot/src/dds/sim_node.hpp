@@ -1,0 +1,61 @@
+#pragma once
+// DDS face of the simulator (the robot service's sim backend): SimCommand in (mount another
+// assembly, change the world: the content travels, so it works from any host), SimCommandReply
+// out (accepted, or refused with the reason: the robot keeps its modules and world), and the
+// world it simulates on the latched World topic that every service reads.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "concert/dds/endpoint.hpp"
+#include "concert/sim/sim_assembly.hpp"
+#include "concert/sim/sim_hardware.hpp"
+#include "robot_node.hpp"
+
+namespace concert::robot::dds {
+
+class SimNode {
+ public:
+  /// `builder` is null when the simulated robot is a fixed URDF (no assembly to swap).
+  /// `on_swap` runs after each accepted swap (e.g. standalone mode applies the new model).
+  /// Publishes `initial_world` (from `world_source`) as world version 1.
+  SimNode(concert::dds::Participant& participant, sim::SimHardware& sim, const sim::AssemblyBuilder* builder,
+          RobotNode& robot, const world::World& initial_world, const std::string& world_source,
+          std::function<void(const sim::SimulatedRobot&)> on_swap = {});
+  ~SimNode();
+  SimNode(const SimNode&) = delete;
+  SimNode& operator=(const SimNode&) = delete;
+
+  /// Mounts the assembly in `yaml` (named `name` in messages): checks it, prepares the new
+  /// MuJoCo robot off the loop, publishes the new scan. Returns what happened; throws
+  /// std::runtime_error with the reason when refused (nothing changes).
+  std::string swap_assembly(const std::string& yaml, const std::string& name);
+  /// Replaces the world the same way, and publishes it.
+  std::string set_world(const std::string& yaml, const std::string& name);
+
+ private:
+  void work();
+  void handle(const msg::SimCommand& command);
+
+  sim::SimHardware& sim_;
+  const sim::AssemblyBuilder* builder_;
+  RobotNode& robot_;
+  std::function<void(const sim::SimulatedRobot&)> on_swap_;
+  concert::dds::Writer<msg::World> world_;
+  concert::dds::Writer<msg::SimCommandReply> reply_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<msg::SimCommand> queue_;
+  bool stopping_{false};
+  std::uint32_t world_version_{1};
+  std::unique_ptr<concert::dds::Reader<msg::SimCommand>> commands_;
+  std::thread worker_;  // swaps take milliseconds (model generation, MuJoCo): not on a DDS thread
+};
+
+}  // namespace concert::robot::dds
