@@ -5,10 +5,24 @@
 #include <set>
 
 #include "concert/common/clock.hpp"
+#include "concert/common/enum_map.hpp"
 #include "concert/common/text.hpp"
 
 namespace concert {
 namespace {
+
+enum class Colour { kRed, kGreen, kBlue };
+enum Wire : int { WIRE_RED = 10, WIRE_GREEN = 11 };
+
+TEST(EnumMap, BothDirectionsAndMissingRows) {
+  constexpr EnumMap kColours{std::array{std::pair{Colour::kRed, WIRE_RED}, std::pair{Colour::kGreen, WIRE_GREEN}}};
+  static_assert(kColours.to(Colour::kGreen) == WIRE_GREEN);
+  EXPECT_EQ(kColours.to(Colour::kRed), WIRE_RED);
+  EXPECT_EQ(kColours.from(WIRE_GREEN), Colour::kGreen);
+  EXPECT_FALSE(kColours.to(Colour::kBlue).has_value());
+  EXPECT_FALSE(kColours.from(static_cast<Wire>(12)).has_value());
+  EXPECT_EQ(kColours.pairs().size(), 2u);
+}
 
 TEST(Text, JoinAnyRangeOfStrings) {
   EXPECT_EQ(join(std::vector<std::string>{}), "");
