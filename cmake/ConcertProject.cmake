@@ -136,13 +136,11 @@ endfunction()
 
 # No service links another service: what two services share goes into libs/. Every target
 # defined under services/<a>/ is checked against its direct link dependencies; one defined under
-# services/<b>/ (b != a) fails configuration. CONCERT_LAYOUT_EXCEPTIONS lists known violations
-# as "target->dependency" (each reported as a warning until it is removed; a listed exception
-# that no longer occurs is reported too, so the list only shrinks).
+# services/<b>/ (b != a) fails configuration, naming both targets. There is no exception list:
+# a shared piece of code moves to libs/.
 function(concert_check_service_links)
   _concert_all_targets(${CMAKE_SOURCE_DIR} targets)
   set(errors "")
-  set(used_exceptions "")
   foreach(target IN LISTS targets)
     _concert_service_of(${target} service)
     if(service STREQUAL "")
@@ -154,19 +152,8 @@ function(concert_check_service_links)
       if(other STREQUAL "" OR other STREQUAL service)
         continue()
       endif()
-      if("${target}->${dep}" IN_LIST CONCERT_LAYOUT_EXCEPTIONS)
-        list(APPEND used_exceptions "${target}->${dep}")
-        message(WARNING "Layout exception: '${target}' (service ${service}) links '${dep}' (service ${other}); "
-                        "move what they share into libs/ and remove it from CONCERT_LAYOUT_EXCEPTIONS.")
-      else()
-        string(APPEND errors "\n  '${target}' (services/${service}) links '${dep}' (services/${other})")
-      endif()
+      string(APPEND errors "\n  '${target}' (services/${service}) links '${dep}' (services/${other})")
     endforeach()
-  endforeach()
-  foreach(exception IN LISTS CONCERT_LAYOUT_EXCEPTIONS)
-    if(NOT exception IN_LIST used_exceptions)
-      message(WARNING "Layout exception '${exception}' no longer occurs: remove it from CONCERT_LAYOUT_EXCEPTIONS.")
-    endif()
   endforeach()
   if(errors)
     message(FATAL_ERROR "A service links another service:${errors}\n"

@@ -8,11 +8,11 @@
 
 #include "concert/simbus/assembly.hpp"
 #include "concert/simbus/testing.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 
 namespace {
 
-using concert::discovery::Discovery;
+using concert::topology::Discovery;
 using concert::topology::EscCatalog;
 using concert::topology::EscScan;
 using concert::topology::PortOrder;
@@ -84,10 +84,10 @@ void time_network(benchmark::State& state, const EscScan& scan) {
   for (auto _ : state) {
     if constexpr (kReference) {
       benchmark::DoNotOptimize(
-          concert::discovery::reconstruct_network_reference(scan, PortOrder::kReal0312));
+          concert::topology::reconstruct_network_reference(scan, PortOrder::kReal0312));
     } else {
       benchmark::DoNotOptimize(
-          concert::discovery::reconstruct_network(scan, PortOrder::kReal0312));
+          concert::topology::reconstruct_network(scan, PortOrder::kReal0312));
     }
   }
   state.counters["slaves"] = static_cast<double>(scan.slaves.size());
@@ -99,7 +99,7 @@ void BM_Network(benchmark::State& state) {
   // Graph chi only; long chains are the paper algorithm's worst case (it walks back over
   // whole subtrees for each slave hanging on a hub after them).
   const EscScan scan =
-      concert::discovery::checked_scan(synthetic_scan(state.range(0), 0.95));
+      concert::topology::checked_scan(synthetic_scan(state.range(0), 0.95));
   time_network<kReference>(state, scan);
 }
 BENCHMARK(BM_Network<false>)->Name("BM_NetworkLinear")

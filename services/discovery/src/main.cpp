@@ -13,7 +13,7 @@
 #include "concert/dds/participant.hpp"
 #include "dds/discovery_node.hpp"
 #include "dds/service_params.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 
 namespace {
 
@@ -43,8 +43,8 @@ int run(const Options& options) {
   std::signal(SIGTERM, on_signal);
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "discovery"});
   discovery::dds::DiscoveryNode node(participant,
-                                     discovery::DiscoveryService(discovery::Discovery(
-                                         std::move(catalog), discovery::Params{order})),
+                                     discovery::DiscoveryService(topology::Discovery(
+                                         std::move(catalog), topology::DiscoveryParams{order})),
                                      std::cerr);
   std::cerr << "concert_discovery: " << entries << " catalogue entries from "
             << settings.module_dbs.size() << " database(s), port order " << settings.port_order

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include "concert/simbus/testing.hpp"
-#include "scan_builder.hpp"
 
 namespace concert::discovery {
 namespace {
@@ -11,11 +10,11 @@ namespace {
 using Kind = ScanOutcome::Kind;
 
 TEST(DiscoveryService, VersionsGoodTreesAndKeepsThemOnFaultyScans) {
-  DiscoveryService service(Discovery(simbus::synthetic_catalog()));
+  DiscoveryService service(topology::Discovery(simbus::synthetic_catalog()));
   EXPECT_EQ(service.version(), 0u);
 
   // Port 2 of a hub is open with nothing on it.
-  const auto bad = test::make_scan({{0b0111, test::kHub3}, {0b0001, test::kTool}});
+  const auto bad = simbus::testing::make_scan({{0b0111, simbus::testing::kHub3}, {0b0001, simbus::testing::kTool}});
   ScanOutcome outcome = service.on_scan(bad, 1);
   EXPECT_EQ(outcome.kind, Kind::kRejected);
   EXPECT_EQ(outcome.version, 0u);
@@ -24,7 +23,7 @@ TEST(DiscoveryService, VersionsGoodTreesAndKeepsThemOnFaultyScans) {
             "(no tree yet)");
   EXPECT_FALSE(service.tree());
 
-  const auto one = test::make_scan({{0b0011, test::kJoint}, {0b0001, test::kTool}});
+  const auto one = simbus::testing::make_scan({{0b0011, simbus::testing::kJoint}, {0b0001, simbus::testing::kTool}});
   outcome = service.on_scan(one, 2);
   EXPECT_EQ(outcome.kind, Kind::kPublished);
   EXPECT_EQ(outcome.version, 1u);
@@ -43,7 +42,7 @@ TEST(DiscoveryService, VersionsGoodTreesAndKeepsThemOnFaultyScans) {
   EXPECT_EQ(service.tree_scan_id(), 2u);
   EXPECT_EQ(service.tree()->modules[1].key, "tool");
 
-  const auto two = test::make_scan({{0b0011, test::kJoint}, {0b0001, test::kWheel}});
+  const auto two = simbus::testing::make_scan({{0b0011, simbus::testing::kJoint}, {0b0001, simbus::testing::kWheel}});
   outcome = service.on_scan(two, 5);
   EXPECT_EQ(outcome.kind, Kind::kPublished);
   EXPECT_EQ(outcome.version, 2u);
@@ -51,7 +50,7 @@ TEST(DiscoveryService, VersionsGoodTreesAndKeepsThemOnFaultyScans) {
   EXPECT_EQ(service.tree_scan_id(), 5u);
 
   // Unknown modules and topology disagreements are warnings: the tree is published with them.
-  auto odd = test::make_scan({{0b0011, test::kJoint}, {0b0001, topology::EscIdentity{}}});
+  auto odd = simbus::testing::make_scan({{0b0011, simbus::testing::kJoint}, {0b0001, topology::EscIdentity{}}});
   odd.slaves[0].topology = 3;
   outcome = service.on_scan(odd, 6);
   EXPECT_EQ(outcome.kind, Kind::kPublished);

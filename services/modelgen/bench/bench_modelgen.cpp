@@ -7,7 +7,7 @@
 #include <benchmark/benchmark.h>
 
 #include "concert/simbus/assembly.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 #include "modelgen/model_generator.hpp"
 
 namespace fs = std::filesystem;
@@ -88,7 +88,7 @@ void BM_ScanToModel18(benchmark::State& state) {
   const auto catalog = topology::EscCatalog::load(kPublic);
   const simbus::Assembly a = simbus::load_assembly(fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml");
   const topology::EscScan scan = simbus::simulate_scan(a, catalog);
-  const discovery::Discovery disc(catalog);
+  const topology::Discovery disc(catalog);
   const modelgen::ModelGenerator gen(db());
   for (auto _ : state) {
     modelgen::GeneratedModel m = gen.generate(disc.run(scan));

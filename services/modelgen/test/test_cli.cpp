@@ -8,7 +8,7 @@
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/esc_catalog.hpp"
 #include "concert/topology/scan_io.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 #include "modelgen/bundle.hpp"
 #include "modelgen/cli.hpp"
 
@@ -64,7 +64,7 @@ TEST_F(CliTest, AssemblyScanAndTreeGiveTheSameBundle) {
   const auto catalog = topology::EscCatalog::load(kPublic);
   const topology::EscScan scan = simbus::simulate_scan(simbus::load_assembly(kPaperRobot), catalog);
   std::ofstream(dir_ / "scan.yaml") << topology::scan_to_yaml(scan);
-  std::ofstream(dir_ / "tree.json") << topology::tree_to_json(discovery::discover(scan, catalog)).dump(2);
+  std::ofstream(dir_ / "tree.json") << topology::tree_to_json(topology::discover(scan, catalog)).dump(2);
   const CliRun s = run({"generate", "--scan", (dir_ / "scan.yaml").string(), "--module-db", kPublic, "--out", (dir_ / "s").string()});
   ASSERT_EQ(s.code, 0) << s.err;
   const CliRun t = run({"generate", "--tree", (dir_ / "tree.json").string(), "--module-db", kPublic, "--out", (dir_ / "t").string()});

@@ -9,7 +9,7 @@
 
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/scan_io.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 #include "modelgen/model_generator.hpp"
 #include "test_support.hpp"
 
@@ -28,7 +28,7 @@ struct Db {
 void expect_round_trip(const Db& d, const simbus::Assembly& assembly, const std::string& what) {
   const modelgen::ModelGenerator gen(d.db);
   const topology::ModuleTree direct = simbus::tree_from_assembly(assembly, d.catalog);
-  const topology::ModuleTree discovered = discovery::discover(simbus::simulate_scan(assembly, d.catalog), d.catalog);
+  const topology::ModuleTree discovered = topology::discover(simbus::simulate_scan(assembly, d.catalog), d.catalog);
   const modelgen::GeneratedModel a = gen.generate(direct);
   const modelgen::GeneratedModel b = gen.generate(discovered);
   EXPECT_EQ(a.content_hash, b.content_hash) << what;
@@ -45,7 +45,7 @@ TEST(RoundTrip, PublicDatabaseExampleAssemblies) {
   }
   // The Mobile Base Hub's two ESCs are one module and one body.
   const simbus::Assembly paper = simbus::load_assembly(fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml");
-  const topology::ModuleTree tree = discovery::discover(simbus::simulate_scan(paper, d.catalog), d.catalog);
+  const topology::ModuleTree tree = topology::discover(simbus::simulate_scan(paper, d.catalog), d.catalog);
   ASSERT_EQ(tree.modules[0].slave_positions.size(), 2u);
   const modelgen::GeneratedModel model = modelgen::ModelGenerator(d.db).generate(tree);
   int base_bodies = 0;
@@ -59,7 +59,7 @@ TEST(RoundTrip, RealScanGivesTheModelOfItsAssemblyFile) {
   const Db d(fs::path(CONCERT_SHARED_DATA) / "concert_resources");
   const topology::EscScan real = topology::load_scan(fs::path(CONCERT_SHARED_DATA) / "ethercat" /
                                                      "concert_robot_18slaves.yaml");
-  const topology::ModuleTree tree = discovery::discover(real, d.catalog);
+  const topology::ModuleTree tree = topology::discover(real, d.catalog);
   ASSERT_TRUE(tree.issues.empty());
   const simbus::Assembly assembly =
       simbus::load_assembly(fs::path(SIMBUS_EXAMPLES) / "concert_robot_18slaves.yaml");
@@ -88,7 +88,7 @@ TEST(RoundTrip, RealScanGivesTheModelOfItsAssemblyFile) {
   // The project database knows the same identities: the real robot gets a model there too.
   const Db project(fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db");
   const modelgen::GeneratedModel own =
-      modelgen::ModelGenerator(project.db).generate(discovery::discover(real, project.catalog));
+      modelgen::ModelGenerator(project.db).generate(topology::discover(real, project.catalog));
   EXPECT_EQ(own.joints.size(), 14u);
 }
 

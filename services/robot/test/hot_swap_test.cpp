@@ -9,7 +9,7 @@
 
 #include "concert/module_db/module_db.hpp"
 #include "concert/topology/esc_catalog.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 #include "concert/model_generation/generator.hpp"
 #include "robot/robot_core.hpp"
 #include "concert/sim/sim_assembly.hpp"
@@ -41,7 +41,7 @@ std::string replace(std::string text, const std::string& from, const std::string
 // What the discovery and modelgen services do with a scan.
 std::string model_from_scan(const topology::EscScan& scan) {
   static const module_db::ModuleDatabase db = module_db::load_module_database(kPublicDb);
-  const auto tree = discovery::discover(scan, topology::EscCatalog::load(kPublicDb));
+  const auto tree = topology::discover(scan, topology::EscCatalog::load(kPublicDb));
   return model_generation::ModelGenerator(db).generate(tree).urdf;
 }
 

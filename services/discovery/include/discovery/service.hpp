@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 
 namespace concert::discovery {
 
@@ -25,7 +25,7 @@ struct ScanOutcome {
 /// Scan -> versioned tree. Not thread-safe: call from one thread.
 class DiscoveryService {
  public:
-  explicit DiscoveryService(Discovery discovery) : discovery_(std::move(discovery)) {}
+  explicit DiscoveryService(topology::Discovery discovery) : discovery_(std::move(discovery)) {}
 
   /// Rebuilds the tree from `scan` (scan_id names it in messages). Never throws for a bad
   /// scan: the error is in the outcome.
@@ -39,7 +39,7 @@ class DiscoveryService {
   uint32_t tree_scan_id() const { return tree_scan_id_; }
 
  private:
-  Discovery discovery_;
+  topology::Discovery discovery_;
   std::optional<topology::ModuleTree> tree_;
   uint32_t version_ = 0;
   uint32_t tree_scan_id_ = 0;

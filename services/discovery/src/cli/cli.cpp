@@ -6,7 +6,7 @@
 
 #include "concert/topology/esc_catalog.hpp"
 #include "concert/topology/scan_io.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 
 namespace concert::discovery {
 
@@ -24,8 +24,8 @@ int discover(DiscoverOptions options, std::ostream& out, std::ostream& err) {
     topology::EscCatalog catalog;
     for (const auto& db : options.module_dbs) catalog.merge(topology::EscCatalog::load(db));
     const topology::EscScan scan = topology::load_scan(options.scan);
-    const Discovery discovery(std::move(catalog),
-                              Params{*topology::parse_port_order(options.port_order)});
+    const topology::Discovery discovery(std::move(catalog),
+                              topology::DiscoveryParams{*topology::parse_port_order(options.port_order)});
     // The tree that could be rebuilt is always printed, with its warnings and errors; errors
     // (the tree is undefined there) also go to stderr and make the exit code 1.
     const topology::ModuleTree tree = discovery.rebuild(scan);

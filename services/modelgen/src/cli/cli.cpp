@@ -8,7 +8,7 @@
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/esc_catalog.hpp"
 #include "concert/topology/scan_io.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 #include "modelgen/bundle.hpp"
 #include "modelgen/model_generator.hpp"
 
@@ -42,12 +42,12 @@ int generate(const GenerateOptions& o, std::ostream& out) {
     tree = topology::tree_from_json(doc, o.tree);
     source = o.tree;
   } else if (!o.scan.empty()) {
-    tree = discovery::discover(topology::load_scan(o.scan), catalog_of(o.module_dbs), {order});
+    tree = topology::discover(topology::load_scan(o.scan), catalog_of(o.module_dbs), {order});
     source = o.scan;
   } else {
     const topology::EscCatalog catalog = catalog_of(o.module_dbs);
     const simbus::Assembly assembly = simbus::load_assembly(o.assembly);
-    tree = discovery::discover(simbus::simulate_scan(assembly, catalog, order), catalog, {order});
+    tree = topology::discover(simbus::simulate_scan(assembly, catalog, order), catalog, {order});
     source = o.assembly;
   }
   GeneratedModel model = ModelGenerator(db).generate(tree, o.custom);

@@ -1,4 +1,4 @@
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,17 +7,11 @@
 #include "concert/topology/scan_io.hpp"
 #include "scan_builder.hpp"
 
-namespace concert::discovery {
+namespace concert::topology {
 namespace {
 
 using test::discovery_error;
 using test::make_scan;
-using topology::EscCatalog;
-using topology::EscIdentity;
-using topology::EscScan;
-using topology::ModuleKind;
-using topology::ModuleTree;
-using topology::PortOrder;
 
 const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
 const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
@@ -77,7 +71,7 @@ TEST(Discovery, TorsoTwoArmsAndBothPortOrders) {
     const auto assembly = simbus::load_assembly(kExamples + "/" + file);
     for (PortOrder order : {PortOrder::kReal0312, PortOrder::kNumeric0123}) {
       const ModuleTree tree =
-          discover(simbus::simulate_scan(assembly, catalog, order), catalog, Params{order});
+          discover(simbus::simulate_scan(assembly, catalog, order), catalog, DiscoveryParams{order});
       EXPECT_EQ(tree, simbus::tree_from_assembly(assembly, catalog, order))
           << file << " " << to_string(order);
     }
@@ -107,7 +101,7 @@ TEST(Discovery, ScanFileKeyedByPositionAsTheMasterReportsIt) {
             ", robot_id: " + std::to_string(it->robot_id) +
             ", topology: " + std::to_string(it->topology) + "}\n";
   }
-  EXPECT_EQ(discover(topology::parse_scan_yaml(text, "master.yaml"), catalog),
+  EXPECT_EQ(discover(parse_scan_yaml(text, "master.yaml"), catalog),
             simbus::tree_from_assembly(assembly, catalog));
 }
 
@@ -149,7 +143,7 @@ TEST(Discovery, UnknownIdentityIsAnUnknownModuleInTheTree) {
       simbus::Fault{simbus::FaultType::kUnknownIdentity, "elbow_1", std::nullopt, {1, 99, 4, 0}});
   const ModuleTree tree = discover(simbus::simulate_scan(assembly, catalog), catalog);
   ASSERT_EQ(tree.issues.size(), 1u);
-  EXPECT_EQ(tree.issues[0].severity, topology::TreeIssue::Severity::kWarning);
+  EXPECT_EQ(tree.issues[0].severity, TreeIssue::Severity::kWarning);
   EXPECT_EQ(tree.issues[0].text(),
             "slave 12: unknown module identity (mod_type 1, mod_id 99, mod_size 4, mod_rev 0): "
             "not in the ESC catalogue; unknown module in the tree");
@@ -262,7 +256,7 @@ TEST(Discovery, UpsideDownModuleIsCaughtOrChangesTheTree) {
       "ex2");
   EXPECT_NE(discovery_error([&] {
               (void)discover(simbus::simulate_scan(ex2, synthetic, PortOrder::kNumeric0123),
-                             synthetic, Params{PortOrder::kNumeric0123});
+                             synthetic, DiscoveryParams{PortOrder::kNumeric0123});
             }).find("slave 2: no earlier slave has a free open port"),
             std::string::npos);
 }
@@ -279,30 +273,13 @@ TEST(Discovery, BrokenLinkGivesTheSmallerTree) {
 
 TEST(Discovery, InconsistentCatalogueIsRefusedAtConstruction) {
   EscCatalog catalog = simbus::synthetic_catalog();
-  topology::EscType bad;
+  EscType bad;
   bad.identity = EscIdentity{2, 42, 0, 0};
   bad.key = "bad";
   bad.kind = ModuleKind::kHub;
-  bad.ports = {topology::PortLead{1, 1, std::nullopt}, topology::PortLead{2, 1, std::nullopt}};
-  EXPECT_THROW(catalog.add(bad), topology::CatalogError);
+  bad.ports = {PortLead{1, 1, std::nullopt}, PortLead{2, 1, std::nullopt}};
+  EXPECT_THROW(catalog.add(bad), CatalogError);
 }
 
 }  // namespace
-}  // namespace concert::discovery
-
-namespace concert::discovery {
-namespace {
-
-TEST(Discovery, ShippedExampleScansMatchTheirAssemblies) {
-  const EscCatalog catalog = EscCatalog::load(kPublicDb);
-  const std::string dir = std::string(CONCERT_SOURCE_DIR) + "/services/discovery/examples";
-  EXPECT_EQ(discover(topology::load_scan(dir + "/paper_robot_scan.yaml"), catalog),
-            simbus::tree_from_assembly(
-                simbus::load_assembly(kExamples + "/concert_paper_robot.yaml"), catalog));
-  EXPECT_EQ(discover(topology::load_scan(dir + "/torso_two_arms_scan.json"), catalog),
-            simbus::tree_from_assembly(
-                simbus::load_assembly(kExamples + "/concert_torso_two_arms.yaml"), catalog));
-}
-
-}  // namespace
-}  // namespace concert::discovery
+}  // namespace concert::topology

@@ -1,18 +1,13 @@
 // Module tree from the network graph: group the ESCs of multi-ESC modules, name each module
 // from the catalogue and find the output connector each module hangs on.
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 
 #include <algorithm>
 #include <utility>
 
-namespace concert::discovery {
+namespace concert::topology {
 namespace {
 
-using topology::EscScan;
-using topology::ModuleLayout;
-using topology::ModuleNode;
-using topology::ModuleTree;
-using topology::SlaveNode;
 
 std::string module_name(const ModuleNode& m) {
   return "module #" + std::to_string(m.index) + " " + m.key + " (" + to_string(m.kind) + ")";
@@ -33,7 +28,7 @@ std::string connectors_text(const ModuleLayout& layout) {
 
 }  // namespace
 
-Discovery::Discovery(topology::EscCatalog catalog, Params params)
+Discovery::Discovery(EscCatalog catalog, DiscoveryParams params)
     : catalog_(std::move(catalog)), params_(params) {
   for (const auto& entry : catalog_.entries()) {
     layouts_.emplace(entry.identity, catalog_.layout(entry.identity, params_.port_order));
@@ -41,7 +36,7 @@ Discovery::Discovery(topology::EscCatalog catalog, Params params)
 }
 
 ModuleTree Discovery::rebuild(const EscScan& raw_scan) const {
-  using Severity = topology::TreeIssue::Severity;
+  using Severity = TreeIssue::Severity;
   ScanCheck check = check_scan(raw_scan);
   const EscScan& scan = check.scan;
   Network network = rebuild_network(scan, params_.port_order, check.usable);
@@ -88,7 +83,7 @@ ModuleTree Discovery::rebuild(const EscScan& raw_scan) const {
       } else if (const auto esc = layout->esc_at(esc_in_module[p], port)) {
         // Another ESC of the parent's own module (e.g. the Mobile Base Hub's hub board).
         const auto& expected = layout->escs[static_cast<std::size_t>(*esc)].identity;
-        if (slave.identity == expected || topology::is_blank(slave.identity)) {
+        if (slave.identity == expected || is_blank(slave.identity)) {
           if (slave.identity != expected) {
             warn(slave.position,
                  "reports a blank identity (all zero: identity EEPROM not "
@@ -141,10 +136,10 @@ ModuleTree Discovery::rebuild(const EscScan& raw_scan) const {
     const auto found = layouts_.find(slave.identity);
     if (found == layouts_.end()) {
       module.known = false;
-      module.kind = topology::module_kind_from_mod_type(slave.identity.mod_type)
-                        .value_or(topology::ModuleKind::kUnknown);
+      module.kind = module_kind_from_mod_type(slave.identity.mod_type)
+                        .value_or(ModuleKind::kUnknown);
       warn(slave.position,
-           topology::is_blank(slave.identity)
+           is_blank(slave.identity)
                ? "blank module identity (all zero: identity EEPROM not programmed?): unknown "
                  "module in the tree"
                : "unknown module identity " + to_string(slave.identity) +
@@ -189,16 +184,16 @@ ModuleTree Discovery::rebuild(const EscScan& raw_scan) const {
 ModuleTree Discovery::run(const EscScan& scan) const {
   ModuleTree tree = rebuild(scan);
   for (const auto& issue : tree.issues) {
-    if (issue.severity == topology::TreeIssue::Severity::kError) {
+    if (issue.severity == TreeIssue::Severity::kError) {
       throw DiscoveryError(issue.position, issue.message);
     }
   }
   return tree;
 }
 
-ModuleTree discover(const EscScan& scan, const topology::EscCatalog& catalog,
-                    const Params& params) {
+ModuleTree discover(const EscScan& scan, const EscCatalog& catalog,
+                    const DiscoveryParams& params) {
   return Discovery(catalog, params).run(scan);
 }
 
-}  // namespace concert::discovery
+}  // namespace concert::topology

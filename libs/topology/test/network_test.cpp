@@ -4,16 +4,14 @@
 
 #include "concert/simbus/assembly.hpp"
 #include "concert/simbus/testing.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 #include "scan_builder.hpp"
 
-namespace concert::discovery {
+namespace concert::topology {
 namespace {
 
 using test::discovery_error;
 using test::make_scan;
-using topology::EscScan;
-using topology::PortOrder;
 
 /// (parent_position, parent_port or -1) per slave, from both algorithms (which must agree).
 std::vector<std::pair<int32_t, int32_t>> links_of(const EscScan& scan, PortOrder order) {
@@ -108,7 +106,7 @@ TEST(Network, TopologyDisagreeingWithActivePortsIsAWarningResolvedFromActivePort
   lying.slaves[1].topology = 2;
   const ScanCheck check = check_scan(lying);
   ASSERT_EQ(check.issues.size(), 1u);
-  EXPECT_EQ(check.issues[0].severity, topology::TreeIssue::Severity::kWarning);
+  EXPECT_EQ(check.issues[0].severity, TreeIssue::Severity::kWarning);
   EXPECT_EQ(
       check.issues[0].text(),
       "slave 2: topology says 2 open ports but active_ports 0b0001 has 1; using active_ports");
@@ -156,7 +154,7 @@ TEST(Network, LinearEqualsPaperReferenceOnRandomTrees) {
   std::mt19937 rng(2024);
   for (int trial = 0; trial < 400; ++trial) {
     for (PortOrder order : {PortOrder::kReal0312, PortOrder::kNumeric0123}) {
-      const auto frame = topology::frame_order(order);
+      const auto frame = frame_order(order);
       const int n_target = 1 + static_cast<int>(rng() % 150);
       // Build the tree: node -> children (port, child).
       std::vector<std::vector<std::pair<int32_t, int>>> children(1);
@@ -186,7 +184,7 @@ TEST(Network, LinearEqualsPaperReferenceOnRandomTrees) {
       while (!todo.empty()) {
         const auto [node, parent_pos, port] = todo.back();
         todo.pop_back();
-        topology::EscSlave s;
+        EscSlave s;
         s.position = static_cast<int32_t>(scan.slaves.size()) + 1;
         s.active_ports = 1;
         for (const auto& c : children[static_cast<std::size_t>(node)]) {
@@ -215,7 +213,7 @@ TEST(Network, LinearAndReferenceAgreeOnArbitraryMasks) {
     const int n = 1 + static_cast<int>(rng() % 12);
     EscScan scan;
     for (int i = 0; i < n; ++i) {
-      topology::EscSlave s;
+      EscSlave s;
       s.position = i + 1;
       // Leaves are more likely, so that some random scans are valid trees.
       s.active_ports = static_cast<uint8_t>(rng() % 3 == 0 ? (1U | (rng() % 16)) : 1U);
@@ -245,4 +243,4 @@ TEST(Network, LinearAndReferenceAgreeOnArbitraryMasks) {
 }
 
 }  // namespace
-}  // namespace concert::discovery
+}  // namespace concert::topology

@@ -10,19 +10,17 @@
 #include "concert/simbus/assembly.hpp"
 #include "concert/simbus/testing.hpp"
 #include "concert/topology/scan_io.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 
-namespace concert::discovery {
+namespace concert::topology {
 namespace {
 
-using topology::EscCatalog;
-using topology::PortOrder;
 
 void check_round_trips(const EscCatalog& catalog, uint32_t seed, int trials, int max_modules,
                        double chain_bias) {
   std::mt19937 rng(seed);
-  const Discovery real(catalog, Params{PortOrder::kReal0312});
-  const Discovery numeric(catalog, Params{PortOrder::kNumeric0123});
+  const Discovery real(catalog, DiscoveryParams{PortOrder::kReal0312});
+  const Discovery numeric(catalog, DiscoveryParams{PortOrder::kNumeric0123});
   for (int trial = 0; trial < trials; ++trial) {
     simbus::RandomAssemblyParams params;
     params.modules = 1 + static_cast<int32_t>(rng() % static_cast<uint32_t>(max_modules));
@@ -33,7 +31,7 @@ void check_round_trips(const EscCatalog& catalog, uint32_t seed, int trials, int
       const PortOrder order = d->params().port_order;
       const auto scan = simbus::simulate_scan(assembly, catalog, order);
       const auto expected = simbus::tree_from_assembly(assembly, catalog, order);
-      topology::ModuleTree got;
+      ModuleTree got;
       try {
         got = d->run(scan);
       } catch (const DiscoveryError& e) {
@@ -42,7 +40,7 @@ void check_round_trips(const EscCatalog& catalog, uint32_t seed, int trials, int
       }
       ASSERT_EQ(got, expected) << "seed " << seed << " trial " << trial << " order "
                                << to_string(order) << "\n" << simbus::assembly_to_yaml(assembly)
-                               << topology::tree_to_text(got);
+                               << tree_to_text(got);
       const auto checked = checked_scan(scan);
       ASSERT_EQ(reconstruct_network(checked, order), reconstruct_network_reference(checked, order))
           << "seed " << seed << " trial " << trial;
@@ -66,16 +64,16 @@ TEST(Property, PublicCatalogue) {
 TEST(Property, CatalogueBuiltEntryByEntry) {
   // No YAML at all: a joint, a cross-point hub and a tool, added in code.
   EscCatalog catalog;
-  const auto add = [&](topology::EscIdentity id, const char* key, topology::ModuleKind kind) {
-    topology::EscType t;
+  const auto add = [&](EscIdentity id, const char* key, ModuleKind kind) {
+    EscType t;
     t.identity = id;
     t.key = key;
     t.kind = kind;
     catalog.add(t);
   };
-  add({1, 10, 0, 0}, "j", topology::ModuleKind::kJoint);
-  add({2, 10, 0, 0}, "h", topology::ModuleKind::kHub);
-  add({3, 10, 0, 0}, "t", topology::ModuleKind::kEndEffector);
+  add({1, 10, 0, 0}, "j", ModuleKind::kJoint);
+  add({2, 10, 0, 0}, "h", ModuleKind::kHub);
+  add({3, 10, 0, 0}, "t", ModuleKind::kEndEffector);
   check_round_trips(catalog, 6, 500, 60, 0.5);
 }
 
@@ -96,28 +94,28 @@ TEST(Property, ScanFilesRoundTripThroughDiscovery) {
     const auto assembly = simbus::random_assembly(catalog, rng, {30, 0.5, 0.2, true});
     const auto scan = simbus::simulate_scan(assembly, catalog);
     const auto expected = simbus::tree_from_assembly(assembly, catalog);
-    EXPECT_EQ(discover(topology::parse_scan_yaml(topology::scan_to_yaml(scan), "y"), catalog),
+    EXPECT_EQ(discover(parse_scan_yaml(scan_to_yaml(scan), "y"), catalog),
               expected);
     EXPECT_EQ(
-        discover(topology::parse_scan_json(topology::scan_to_json(scan).dump(), "j"), catalog),
+        discover(parse_scan_json(scan_to_json(scan).dump(), "j"), catalog),
         expected);
   }
 }
 
 }  // namespace
-}  // namespace concert::discovery
+}  // namespace concert::topology
 
-namespace concert::discovery {
+namespace concert::topology {
 namespace {
 
 /// Depth of the deepest chain of hub modules, each mounted below the previous one.
-int hub_depth(const topology::ModuleTree& tree) {
+int hub_depth(const ModuleTree& tree) {
   std::vector<int> depth(tree.modules.size(), 0);
   int best = 0;
   for (const auto& m : tree.modules) {
     const int above = m.parent_module >= 0 ? depth[static_cast<std::size_t>(m.parent_module)] : 0;
     depth[static_cast<std::size_t>(m.index)] =
-        above + (m.kind == topology::ModuleKind::kHub ? 1 : 0);
+        above + (m.kind == ModuleKind::kHub ? 1 : 0);
     best = std::max(best, depth[static_cast<std::size_t>(m.index)]);
   }
   return best;
@@ -135,15 +133,15 @@ TEST(Property, SeveralHubsChainedOrSideBySideWithTwoAndFourPortBoards) {
     const auto scan = simbus::simulate_scan(assembly, catalog);
     const auto expected = simbus::tree_from_assembly(assembly, catalog);
     const auto got = Discovery(catalog).rebuild(scan);
-    ASSERT_TRUE(got.issues.empty()) << "trial " << trial << ": " << topology::tree_to_text(got);
+    ASSERT_TRUE(got.issues.empty()) << "trial " << trial << ": " << tree_to_text(got);
     ASSERT_EQ(got, expected) << "trial " << trial << "\n" << simbus::assembly_to_yaml(assembly);
     int hubs = 0;
-    for (const auto& m : got.modules) hubs += m.kind == topology::ModuleKind::kHub ? 1 : 0;
+    for (const auto& m : got.modules) hubs += m.kind == ModuleKind::kHub ? 1 : 0;
     with_three_hubs += hubs >= 3 ? 1 : 0;
     chained_three_deep += hub_depth(got) >= 3 ? 1 : 0;
     for (const auto& node : got.slaves) {
       const auto& module = got.modules[static_cast<std::size_t>(node.module_index)];
-      if (module.kind != topology::ModuleKind::kHub) {
+      if (module.kind != ModuleKind::kHub) {
         ASSERT_EQ(node.slave.active_ports & 0b1100, 0)
             << "trial " << trial << ": a two-port board opened port 2 or 3, slave "
             << node.slave.position;
@@ -188,7 +186,7 @@ TEST(Property, BlankIdentitiesAndTopologyDisagreementsGiveTheSameNetworkPlusWarn
       warnings += std::popcount(static_cast<unsigned>(s.active_ports)) != s.topology ? 1 : 0;
     }
     const auto tree = Discovery(catalog).rebuild(scan);
-    ASSERT_FALSE(tree.has_errors()) << "trial " << trial << ": " << topology::tree_to_text(tree);
+    ASSERT_FALSE(tree.has_errors()) << "trial " << trial << ": " << tree_to_text(tree);
     ASSERT_EQ(tree.slaves.size(), clean.slaves.size());
     for (std::size_t i = 0; i < tree.slaves.size(); ++i) {
       ASSERT_EQ(tree.slaves[i].parent_position, clean.slaves[i].parent_position) << trial;
@@ -204,4 +202,4 @@ TEST(Property, BlankIdentitiesAndTopologyDisagreementsGiveTheSameNetworkPlusWarn
 }
 
 }  // namespace
-}  // namespace concert::discovery
+}  // namespace concert::topology

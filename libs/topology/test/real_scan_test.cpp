@@ -10,17 +10,12 @@
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/esc_catalog.hpp"
 #include "concert/topology/scan_io.hpp"
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 
-namespace concert::discovery {
+namespace concert::topology {
 namespace {
 
-using topology::EscCatalog;
-using topology::EscIdentity;
-using topology::EscScan;
-using topology::ModuleKind;
-using topology::ModuleTree;
-using Severity = topology::TreeIssue::Severity;
+using Severity = TreeIssue::Severity;
 
 const std::string kShared = CONCERT_SHARED_DATA;
 const std::string kRealScan = kShared + "/ethercat/concert_robot_18slaves.yaml";
@@ -56,11 +51,11 @@ const std::vector<Link> kAppendixA = {
 };
 
 TEST(RealScan, RebuildsToTheTreeOfAppendixA) {
-  const EscScan scan = topology::load_scan(kRealScan);
+  const EscScan scan = load_scan(kRealScan);
   ASSERT_EQ(scan.slaves.size(), 18u);
   for (const std::string& db : {kPublicDb, kProjectDb}) {
     const ModuleTree tree = Discovery(EscCatalog::load(db)).rebuild(scan);
-    EXPECT_TRUE(tree.issues.empty()) << db << ": " << topology::tree_to_text(tree);
+    EXPECT_TRUE(tree.issues.empty()) << db << ": " << tree_to_text(tree);
     EXPECT_EQ(links_of(tree), kAppendixA) << db;
     ASSERT_EQ(tree.modules.size(), 17u) << db;  // the two boards of the base are one module
     EXPECT_EQ(tree.modules[0].slave_positions, (std::vector<int32_t>{1, 2}));
@@ -97,7 +92,7 @@ TEST(RealScan, RebuildsToTheTreeOfAppendixA) {
 TEST(RealScan, TheSimulatedBusGivesItFieldForField) {
   const EscCatalog catalog = EscCatalog::load(kPublicDb);
   const auto assembly = simbus::load_assembly(kAssembly);
-  const EscScan real = topology::load_scan(kRealScan);
+  const EscScan real = load_scan(kRealScan);
   const EscScan simulated = simbus::simulate_scan(assembly, catalog);
   ASSERT_EQ(simulated.slaves.size(), real.slaves.size());
   for (std::size_t i = 0; i < real.slaves.size(); ++i) {
@@ -117,7 +112,7 @@ TEST(RealScan, TheSimulatedBusGivesItFieldForField) {
 
 TEST(RealScan, TwoPortBoardsOpenOnlyPortsZeroAndOne) {
   // The fact the simulated bus used to get wrong: joints, wheels and links use ports 0 and 1.
-  for (const auto& s : topology::load_scan(kRealScan).slaves) {
+  for (const auto& s : load_scan(kRealScan).slaves) {
     if (s.identity.mod_type == 2) continue;  // hub boards have four ports
     EXPECT_EQ(s.active_ports & 0b1100, 0) << "slave " << s.position;
   }
@@ -125,7 +120,7 @@ TEST(RealScan, TwoPortBoardsOpenOnlyPortsZeroAndOne) {
 
 TEST(RealScan, BlankIdentitiesGiveTheTreeWithUnknownModulesAndWarnings) {
   const EscCatalog catalog = EscCatalog::load(kPublicDb);
-  const EscScan real = topology::load_scan(kRealScan);
+  const EscScan real = load_scan(kRealScan);
   const ModuleTree reference = Discovery(catalog).rebuild(real);
 
   // A link board (slave 14) with an unprogrammed identity EEPROM: an unknown module where the
@@ -133,7 +128,7 @@ TEST(RealScan, BlankIdentitiesGiveTheTreeWithUnknownModulesAndWarnings) {
   EscScan blank_link = real;
   blank_link.slaves[13].identity = EscIdentity{};
   ModuleTree tree = Discovery(catalog).rebuild(blank_link);
-  EXPECT_FALSE(tree.has_errors()) << topology::tree_to_text(tree);
+  EXPECT_FALSE(tree.has_errors()) << tree_to_text(tree);
   ASSERT_EQ(tree.issues.size(), 1u);
   EXPECT_EQ(tree.issues[0].severity, Severity::kWarning);
   EXPECT_EQ(tree.issues[0].position, 14);
@@ -163,7 +158,7 @@ TEST(RealScan, BlankIdentitiesGiveTheTreeWithUnknownModulesAndWarnings) {
 
 TEST(RealScan, TopologyDisagreementsAreWarningsResolvedFromActivePorts) {
   const EscCatalog catalog = EscCatalog::load(kPublicDb);
-  const EscScan real = topology::load_scan(kRealScan);
+  const EscScan real = load_scan(kRealScan);
   EscScan lying = real;
   lying.slaves[4].topology = 3;   // steering board says 3, active_ports 0b0011 has 2
   lying.slaves[17].topology = 2;  // last elbow says 2, active_ports 0b0001 has 1
@@ -184,7 +179,7 @@ TEST(RealScan, TheSimulatedBusReproducesBlankBoardsAndTopologyDisagreements) {
   simbus::Fault lying{simbus::FaultType::kWrongTopology, "steer_fr", std::nullopt, {}};
   lying.topology = 3;
   assembly.faults = {blank_board, lying};
-  EscScan expected = topology::load_scan(kRealScan);
+  EscScan expected = load_scan(kRealScan);
   expected.slaves[1].identity = EscIdentity{};
   expected.slaves[4].topology = 3;
   EXPECT_EQ(simbus::simulate_scan(assembly, catalog), expected);
@@ -192,7 +187,7 @@ TEST(RealScan, TheSimulatedBusReproducesBlankBoardsAndTopologyDisagreements) {
 
 TEST(RealScan, UndefinedPartsAreErrorsAndTheRestIsKept) {
   const EscCatalog catalog = EscCatalog::load(kPublicDb);
-  EscScan scan = topology::load_scan(kRealScan);
+  EscScan scan = load_scan(kRealScan);
   scan.slaves.pop_back();  // the last elbow is gone, but the link before it says port 1 is open
   const ModuleTree tree = Discovery(catalog).rebuild(scan);
   ASSERT_TRUE(tree.has_errors());
@@ -203,4 +198,4 @@ TEST(RealScan, UndefinedPartsAreErrorsAndTheRestIsKept) {
 }
 
 }  // namespace
-}  // namespace concert::discovery
+}  // namespace concert::topology

@@ -4,14 +4,11 @@
 #include <bit>
 #include <sstream>
 
-#include "discovery/discovery.hpp"
+#include "concert/topology/reconstruction.hpp"
 
-namespace concert::discovery {
+namespace concert::topology {
 namespace {
 
-using topology::EscScan;
-using topology::EscSlave;
-using topology::PortOrder;
 
 std::string mask_text(uint8_t mask) {
   std::string bits = "0b";
@@ -40,11 +37,11 @@ std::string dangling_message(int32_t port) {
   return "port " + std::to_string(port) + " is open but no slave hangs on it (broken link?)";
 }
 
-topology::TreeIssue error_at(int32_t position, std::string message) {
-  return {topology::TreeIssue::Severity::kError, position, std::move(message)};
+TreeIssue error_at(int32_t position, std::string message) {
+  return {TreeIssue::Severity::kError, position, std::move(message)};
 }
 
-[[noreturn]] void throw_issue(const topology::TreeIssue& issue) {
+[[noreturn]] void throw_issue(const TreeIssue& issue) {
   throw DiscoveryError(issue.position, issue.message);
 }
 
@@ -57,7 +54,7 @@ DiscoveryError::DiscoveryError(int32_t position, const std::string& message)
       message_(message) {}
 
 ScanCheck check_scan(const EscScan& scan) {
-  using Severity = topology::TreeIssue::Severity;
+  using Severity = TreeIssue::Severity;
   ScanCheck out;
   if (scan.slaves.empty()) {
     out.issues.push_back(error_at(0, "the scan has no slaves"));
@@ -117,13 +114,13 @@ ScanCheck check_scan(const EscScan& scan) {
 EscScan checked_scan(const EscScan& scan) {
   ScanCheck check = check_scan(scan);
   for (const auto& issue : check.issues) {
-    if (issue.severity == topology::TreeIssue::Severity::kError) throw_issue(issue);
+    if (issue.severity == TreeIssue::Severity::kError) throw_issue(issue);
   }
   return std::move(check.scan);
 }
 
 Network rebuild_network(const EscScan& scan, PortOrder order, std::size_t count) {
-  const auto ports_order = topology::frame_order(order);
+  const auto ports_order = frame_order(order);
   Network out;
   out.links.reserve(count);
   // Slaves whose subtree is still open: index and how many of their free ports are used.
@@ -200,7 +197,7 @@ int32_t find_parent_position(const EscScan& scan, int32_t slave_pos) {
 // Paper Algorithm 2, with the free-port stack holding only downstream ports (1..3, as its set
 // P says) pushed so that the first port in frame order is on top.
 std::vector<SlaveLink> reconstruct_network_reference(const EscScan& scan, PortOrder order) {
-  const auto ports_order = topology::frame_order(order);
+  const auto ports_order = frame_order(order);
   const auto n = static_cast<int32_t>(scan.slaves.size());
   std::vector<SlaveLink> links(static_cast<std::size_t>(n));
   std::vector<std::vector<int32_t>> free_ports_stack(static_cast<std::size_t>(n));
@@ -228,4 +225,4 @@ std::vector<SlaveLink> reconstruct_network_reference(const EscScan& scan, PortOr
   return links;
 }
 
-}  // namespace concert::discovery
+}  // namespace concert::topology

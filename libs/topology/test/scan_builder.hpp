@@ -1,0 +1,24 @@
+#pragma once
+// Helpers of the reconstruction tests (hand-written scans: concert/simbus/testing.hpp).
+
+#include <string>
+
+#include "concert/simbus/testing.hpp"
+#include "concert/topology/reconstruction.hpp"
+
+namespace concert::topology::test {
+
+using namespace concert::simbus::testing;
+
+/// Message of the DiscoveryError `f` throws, or "" if it does not throw one.
+template <class F>
+std::string discovery_error(F&& f) {
+  try {
+    f();
+  } catch (const DiscoveryError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace concert::topology::test
