@@ -183,14 +183,15 @@ function(concert_next_test_domain out_var)
   set(${out_var} ${id} PARENT_SCOPE)
 endfunction()
 
-# Unit/integration test from sources, linked with GoogleTest, registered with ctest.
+# Unit/integration test from sources, linked with GoogleTest and GoogleMock (matchers such as
+# HasSubstr), registered with ctest.
 #   concert_add_test(NAME name SOURCES a.cpp ... LIBS lib ... [LABELS l ...] [TIMEOUT s] [DDS])
 # DDS: the test gets a private CONCERT_DOMAIN_ID and the label "dds".
 function(concert_add_test)
   cmake_parse_arguments(T "DDS" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
   concert_target_defaults(${T_NAME})
-  target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main Threads::Threads)
+  target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gmock GTest::gtest GTest::gtest_main Threads::Threads)
   target_compile_definitions(${T_NAME} PRIVATE
     CONCERT_SHARED_DATA="${CONCERT_SHARED_DATA}"
     CONCERT_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

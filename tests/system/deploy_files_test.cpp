@@ -3,6 +3,7 @@
 // against the compose specification's keys and the three-PC placement; deploy/Dockerfile's
 // sources exist. If a `docker compose` CLI is installed, `docker compose config` must accept
 // the file too (it needs no engine).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -17,6 +18,8 @@
 
 namespace concert::system_test {
 namespace {
+
+using ::testing::HasSubstr;
 
 namespace fs = std::filesystem;
 const fs::path kDeploy = fs::path(CONCERT_SOURCE_DIR) / "deploy";
@@ -168,8 +171,8 @@ TEST(DeployDockerfile, DebianBaseInstallDepsAndSourcesExist) {
   std::stringstream text;
   text << in.rdbuf();
   const auto dockerfile = text.str();
-  EXPECT_NE(dockerfile.find("ARG DEBIAN_IMAGE=debian:12"), std::string::npos);
-  EXPECT_NE(dockerfile.find("RUN /opt/concert/src/deploy/install-deps.sh"), std::string::npos);
+  EXPECT_THAT(dockerfile, HasSubstr("ARG DEBIAN_IMAGE=debian:12"));
+  EXPECT_THAT(dockerfile, HasSubstr("RUN /opt/concert/src/deploy/install-deps.sh"));
   const std::regex copy(R"(^COPY (?!--from)(\S+) )", std::regex::multiline);
   int copies = 0;
   for (auto it = std::sregex_iterator(dockerfile.begin(), dockerfile.end(), copy);
@@ -184,7 +187,7 @@ TEST(DeployDockerfile, DebianBaseInstallDepsAndSourcesExist) {
   const auto compose = load_compose();
   for (const char* rt : {"robot", "safety", "discovery", "modelgen"}) {
     const auto binary = compose["services"][rt]["command"][0].Scalar();
-    EXPECT_NE(dockerfile.find(" " + binary), std::string::npos)
+    EXPECT_THAT(dockerfile, HasSubstr(" " + binary))
         << binary << " is not built by the Dockerfile";
   }
 }

@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -9,6 +10,8 @@
 
 namespace concert::topology {
 namespace {
+
+using ::testing::HasSubstr;
 
 using test::discovery_error;
 using test::make_scan;
@@ -135,8 +138,7 @@ TEST(Network, MoreChildrenThanOpenPorts) {
   const EscScan scan = make_scan({{0b1001}, {0b0001}, {0b0001}});
   for (auto f : {&reconstruct_network, &reconstruct_network_reference}) {
     const std::string error = discovery_error([&] { (void)f(scan, PortOrder::kReal0312); });
-    EXPECT_NE(error.find("slave 3: no earlier slave has a free open port"), std::string::npos)
-        << error;
+    EXPECT_THAT(error, HasSubstr("slave 3: no earlier slave has a free open port"));
   }
 }
 

@@ -1,5 +1,6 @@
 #include "discovery/cli.hpp"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -14,6 +15,8 @@
 
 namespace concert::discovery {
 namespace {
+
+using ::testing::HasSubstr;
 
 const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
 const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
@@ -80,12 +83,8 @@ TEST_F(Cli, JsonOutputHasEverySlaveAndModule) {
 
 TEST_F(Cli, TextOutputAndPortOrder) {
   ASSERT_EQ(run({"--scan", file("robot.yaml"), "--module-db", kPublicDb}), 0) << err_.str();
-  EXPECT_NE(out_.str().find("#0 mobile_platform_concert (hub) slaves 1,2 robot_id 100"),
-            std::string::npos)
-      << out_.str();
-  EXPECT_NE(out_.str().find("[5] #9 module_joint_yaw_A_concert (joint) slave 11"),
-            std::string::npos)
-      << out_.str();
+  EXPECT_THAT(out_.str(), HasSubstr("#0 mobile_platform_concert (hub) slaves 1,2 robot_id 100"));
+  EXPECT_THAT(out_.str(), HasSubstr("[5] #9 module_joint_yaw_A_concert (joint) slave 11"));
   ASSERT_EQ(run({"--scan", file("robot_0123.yaml"), "--port-order", "0123", "--module-db",
                  kPublicDb, "--json"}),
             0)
@@ -98,15 +97,13 @@ TEST_F(Cli, BadInputGivesOneLineAndNonZero) {
   EXPECT_EQ(run({"--module-db", kPublicDb}), 2);
   EXPECT_EQ(err_.str(), "concert discover: --scan is required (see `concert discover --help`)\n");
   EXPECT_EQ(run({"--scan"}), 2);
-  EXPECT_NE(err_.str().find("concert discover: --scan: 1 required FILE missing"), std::string::npos)
-      << err_.str();
+  EXPECT_THAT(err_.str(), HasSubstr("concert discover: --scan: 1 required FILE missing"));
   EXPECT_EQ(run({"--scan", file("robot.yaml"), "--port-order", "0321"}), 2);
-  EXPECT_NE(err_.str().find("--port-order: 0321 not in {0312,0123}"), std::string::npos)
-      << err_.str();
+  EXPECT_THAT(err_.str(), HasSubstr("--port-order: 0321 not in {0312,0123}"));
   EXPECT_EQ(run({"--scan", file("robot.yaml"), "--frobnicate"}), 2);
-  EXPECT_NE(err_.str().find("not expected: --frobnicate"), std::string::npos) << err_.str();
+  EXPECT_THAT(err_.str(), HasSubstr("not expected: --frobnicate"));
   EXPECT_EQ(run({"--help"}), 0);
-  EXPECT_NE(out_.str().find("--port-order"), std::string::npos) << out_.str();
+  EXPECT_THAT(out_.str(), HasSubstr("--port-order"));
 
   // An error: the tree rebuilt so far is printed, the error goes to stderr too, exit code 1.
   EXPECT_EQ(run({"--scan", file("bad.yaml"), "--module-db", kPublicDb, "--json"}), 1);
@@ -126,15 +123,13 @@ TEST_F(Cli, BadInputGivesOneLineAndNonZero) {
                             "0b0011 has 2; using active_ports"),
             std::string::npos)
       << out_.str();
-  EXPECT_NE(out_.str().find("18 modules, 19 slaves"), std::string::npos);
+  EXPECT_THAT(out_.str(), HasSubstr("18 modules, 19 slaves"));
   EXPECT_EQ(run({"--scan", file("broken.yaml"), "--module-db", kPublicDb}), 1);
-  EXPECT_NE(err_.str().find(file("broken.yaml") + ": slaves[0]: missing field 'mod_type'"),
-            std::string::npos)
-      << err_.str();
+  EXPECT_THAT(err_.str(), HasSubstr(file("broken.yaml") + ": slaves[0]: missing field 'mod_type'"));
   EXPECT_EQ(run({"--scan", file("missing.yaml"), "--module-db", kPublicDb}), 1);
-  EXPECT_NE(err_.str().find("missing.yaml: cannot open the scan file"), std::string::npos);
+  EXPECT_THAT(err_.str(), HasSubstr("missing.yaml: cannot open the scan file"));
   EXPECT_EQ(run({"--scan", file("robot.yaml"), "--module-db", file("nodb")}), 1);
-  EXPECT_NE(err_.str().find("nodb: module database folder not found"), std::string::npos);
+  EXPECT_THAT(err_.str(), HasSubstr("nodb: module database folder not found"));
   EXPECT_TRUE(out_.str().empty());
   // A database without most modules: the tree is still rebuilt from the ports, with the
   // unknown modules flagged and one warning each.
@@ -142,13 +137,11 @@ TEST_F(Cli, BadInputGivesOneLineAndNonZero) {
   std::ofstream(dir_ / "db" / "esc_index.yaml")
       << "modules:\n  - {mod_type: 1, mod_id: 4, mod_size: 4, mod_rev: 0, key: yaw}\n";
   EXPECT_EQ(run({"--scan", file("robot.yaml"), "--module-db", file("db")}), 0) << err_.str();
-  EXPECT_NE(out_.str().find("#0 UNKNOWN (mod_type 2, mod_id 3, mod_size 0, mod_rev 0) (hub)"),
-            std::string::npos)
-      << out_.str();
+  EXPECT_THAT(out_.str(), HasSubstr("#0 UNKNOWN (mod_type 2, mod_id 3, mod_size 0, mod_rev 0) (hub)"));
   EXPECT_NE(out_.str().find("warning: slave 1: unknown module identity (mod_type 2, mod_id 3"),
             std::string::npos)
       << out_.str();
-  EXPECT_NE(out_.str().find("[?] #10 yaw (joint) slave 11"), std::string::npos) << out_.str();
+  EXPECT_THAT(out_.str(), HasSubstr("[?] #10 yaw (joint) slave 11"));
 }
 
 TEST_F(Cli, SeveralDatabasesMerge) {

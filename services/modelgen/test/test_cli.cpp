@@ -2,6 +2,7 @@
 #include <fstream>
 #include <sstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -16,6 +17,8 @@ namespace fs = std::filesystem;
 using namespace concert;
 
 namespace {
+
+using ::testing::HasSubstr;
 
 const std::string kPublic = (fs::path(CONCERT_SHARED_DATA) / "concert_resources").string();
 const std::string kOwn = (fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db").string();
@@ -54,8 +57,8 @@ TEST_F(CliTest, AssemblyScanAndTreeGiveTheSameBundle) {
   const std::string out_a = (dir_ / "a").string();
   const CliRun a = run({"generate", "--assembly", kPaperRobot, "--module-db", kPublic, "--out", out_a});
   ASSERT_EQ(a.code, 0) << a.err;
-  EXPECT_NE(a.out.find("wrote model version 1"), std::string::npos) << a.out;
-  EXPECT_NE(a.out.find("chain E (arm)"), std::string::npos) << a.out;
+  EXPECT_THAT(a.out, HasSubstr("wrote model version 1"));
+  EXPECT_THAT(a.out, HasSubstr("chain E (arm)"));
   for (const char* f : {"robot.urdf", "robot.srdf", "controller.yaml", "manifest.yaml"}) EXPECT_TRUE(fs::exists(fs::path(out_a) / f));
   EXPECT_TRUE(urdf::parseURDFFile(out_a + "/robot.urdf"));
   const auto [version_a, hash_a] = modelgen::read_bundle_version(out_a);
@@ -78,14 +81,14 @@ TEST_F(CliTest, VersionsGrowOnlyWhenTheContentChanges) {
   ASSERT_EQ(run({"generate", "--assembly", kPaperRobot, "--module-db", kPublic, "--out", out}).code, 0);
   const CliRun again = run({"generate", "--assembly", kPaperRobot, "--module-db", kPublic, "--out", out});
   ASSERT_EQ(again.code, 0);
-  EXPECT_NE(again.out.find("unchanged model version 1"), std::string::npos) << again.out;
+  EXPECT_THAT(again.out, HasSubstr("unchanged model version 1"));
   const CliRun custom = run({"generate", "--assembly", kPaperRobot, "--module-db", kPublic, "--out", out, "--home", "J2_E=0.5",
                           "--addon", "drill_E=drillbit_12_SDSmax"});
   ASSERT_EQ(custom.code, 0) << custom.err;
-  EXPECT_NE(custom.out.find("wrote model version 2"), std::string::npos) << custom.out;
+  EXPECT_THAT(custom.out, HasSubstr("wrote model version 2"));
   std::ifstream srdf(fs::path(out) / "robot.srdf");
   const std::string text((std::istreambuf_iterator<char>(srdf)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("<joint name=\"J2_E\" value=\"0.5\"/>"), std::string::npos);
+  EXPECT_THAT(text, HasSubstr("<joint name=\"J2_E\" value=\"0.5\"/>"));
 }
 
 TEST_F(CliTest, BothDatabaseFormatsAndSeveralDatabases) {
@@ -97,7 +100,7 @@ TEST_F(CliTest, BothDatabaseFormatsAndSeveralDatabases) {
   const CliRun own = run({"generate", "--tree", (dir_ / "tree.json").string(), "--module-db", kOwn, "--module-db", kPublic, "--out",
                        (dir_ / "own").string()});
   ASSERT_EQ(own.code, 0) << own.err;
-  EXPECT_NE(own.out.find("end-effector gripper_A (gripper) at tcp_A (concert_passive_gripper_panel)"), std::string::npos) << own.out;
+  EXPECT_THAT(own.out, HasSubstr("end-effector gripper_A (gripper) at tcp_A (concert_passive_gripper_panel)"));
 }
 
 TEST_F(CliTest, ErrorsAreOneLineAndNonZero) {
@@ -109,21 +112,19 @@ TEST_F(CliTest, ErrorsAreOneLineAndNonZero) {
       "concert model generate: --module-db is required (see `concert model generate --help`)\n");
   r = run({"generate", "--assembly", kPaperRobot, "--tree", "x.json", "--module-db", kPublic, "--out", out});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--tree excludes --assembly"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--tree excludes --assembly"));
   r = run({"generate", "--module-db", kPublic, "--out", out});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("give exactly one of --scan, --tree, --assembly"), std::string::npos)
-      << r.err;
+  EXPECT_THAT(r.err, HasSubstr("give exactly one of --scan, --tree, --assembly"));
   r = run({"generate", "--assembly", kPaperRobot, "--module-db", kPublic, "--out", out, "--home", "J1_E=abc"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--home: 'J1_E=abc': 'abc' is not a number"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--home: 'J1_E=abc': 'abc' is not a number"));
   r = run({"frobnicate"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("unknown verb 'frobnicate' (one of: generate, show)"), std::string::npos)
-      << r.err;
+  EXPECT_THAT(r.err, HasSubstr("unknown verb 'frobnicate' (one of: generate, show)"));
   r = run({"generate", "--assembly", kPaperRobot, "--module-db", (dir_ / "nowhere").string(), "--out", out});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("module database folder does not exist"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("module database folder does not exist"));
   // A tree the database cannot model: clear error, no bundle written, previous bundle kept.
   ASSERT_EQ(run({"generate", "--assembly", kPaperRobot, "--module-db", kPublic, "--out", out}).code, 0);
   std::ofstream(dir_ / "bad.json") << R"({"modules": [{"index": 0, "key": "mobile_platform_concert", "parent_module": -1},
@@ -135,7 +136,7 @@ TEST_F(CliTest, ErrorsAreOneLineAndNonZero) {
   std::ofstream(dir_ / "broken.json") << R"({"modules": [{"index": 0, "key": "x"}]})";
   r = run({"generate", "--tree", (dir_ / "broken.json").string(), "--module-db", kPublic, "--out", out});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("broken.json: modules[0].parent_module: missing"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("broken.json: modules[0].parent_module: missing"));
 }
 
 TEST_F(CliTest, RealScanGivesAModelAndBlankBoardsAreNamed) {
@@ -145,9 +146,9 @@ TEST_F(CliTest, RealScanGivesAModelAndBlankBoardsAreNamed) {
     const std::string out = (dir_ / fs::path(db).filename()).string();
     const CliRun r = run({"generate", "--scan", real, "--module-db", db, "--out", out});
     ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_NE(r.out.find("17 modules, "), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("14 moving joints"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("chain E (arm)"), std::string::npos) << r.out;
+    EXPECT_THAT(r.out, HasSubstr("17 modules, "));
+    EXPECT_THAT(r.out, HasSubstr("14 moving joints"));
+    EXPECT_THAT(r.out, HasSubstr("chain E (arm)"));
   }
   // The same scan with the link board at ring position 14 unprogrammed: refused, naming it.
   topology::EscScan scan = topology::load_scan(real);
@@ -157,10 +158,8 @@ TEST_F(CliTest, RealScanGivesAModelAndBlankBoardsAreNamed) {
   const CliRun r = run({"generate", "--scan", blank.string(), "--module-db", kPublic, "--out",
                         (dir_ / "b").string()});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("1 unknown module, not in the ESC catalogue of the module database: slave "
+  EXPECT_THAT(r.err, HasSubstr("1 unknown module, not in the ESC catalogue of the module database: slave "
                        "14 (mod_type 0, "
-                       "mod_id 0, mod_size 0, mod_rev 0)"),
-            std::string::npos)
-      << r.err;
+                       "mod_id 0, mod_size 0, mod_rev 0)"));
   EXPECT_FALSE(fs::exists(dir_ / "b" / "robot.urdf"));
 }

@@ -1,6 +1,7 @@
 // The modelgen node over real DDS (private domain): tree in -> latched GeneratedModel out, same
 // tree -> no new version, bad tree -> model kept, customisation -> new version, late joiners.
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -19,6 +20,8 @@ using namespace concert;
 using namespace std::chrono_literals;
 
 namespace {
+
+using ::testing::HasSubstr;
 
 msg::ModuleTree tree_msg(const topology::ModuleTree& tree, uint32_t version) {
   return topology::dds::to_msg(tree, version, 0, 0);
@@ -68,12 +71,12 @@ TEST(ModelgenNode, PublishesVersionedModelsOverDds) {
   // Same tree again: no new version on the wire.
   ASSERT_TRUE(trees.write(tree_msg(big, 2)));
   EXPECT_FALSE(spin_for_model(node, models, 600ms).has_value());
-  EXPECT_NE(log.str().find("not republished"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("not republished"));
 
   // A tree that cannot be modelled: error in the log, model kept.
   ASSERT_TRUE(trees.write(tree_msg(modelgen::test::make_tree({{"mobile_platform_concert", -1, -1}, {"nope", 0, 5}}), 3)));
   EXPECT_FALSE(spin_for_model(node, models, 600ms).has_value());
-  EXPECT_NE(log.str().find("tree 3: module 1 ('nope')"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("tree 3: module 1 ('nope')"));
   EXPECT_EQ(service.current()->version, 1u);
 
   // Customisation: refused as a whole when one add-on does not fit (the panel gripper takes
@@ -89,16 +92,14 @@ TEST(ModelgenNode, PublishesVersionedModelsOverDds) {
   request.addons().push_back(addon);
   ASSERT_TRUE(requests.write(request));
   EXPECT_FALSE(spin_for_model(node, models, 600ms).has_value());
-  EXPECT_NE(log.str().find("customisation request 5: customisation addons[0]: module 'passive_end_effector_panel' accepts no add-ons"),
-            std::string::npos)
-      << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("customisation request 5: customisation addons[0]: module 'passive_end_effector_panel' accepts no add-ons"));
   request.request_id(6);
   request.addons().clear();
   ASSERT_TRUE(requests.write(request));
   const auto m2 = spin_for_model(node, models);
   ASSERT_TRUE(m2.has_value()) << log.str();
   EXPECT_EQ(m2->version(), 2u);
-  EXPECT_NE(m2->srdf().find("<joint name=\"J2_E\" value=\"0.4\"/>"), std::string::npos);
+  EXPECT_THAT(m2->srdf(), HasSubstr("<joint name=\"J2_E\" value=\"0.4\"/>"));
 
   // A late joiner gets the current model at once (transient-local).
   concert::dds::Reader<msg::RobotModel> late(test_participant, concert::dds::topics::robot_model);
@@ -113,9 +114,9 @@ TEST(ModelgenNode, PublishesVersionedModelsOverDds) {
                      out, err),
             0)
       << err.str();
-  EXPECT_NE(out.str().find("robot model version 2 (" + service.current()->content_hash + ")"), std::string::npos) << out.str();
-  EXPECT_NE(out.str().find("  E (arm) base_link -> tcp_E: J1_E J2_E J3_E J4_E J5_E J6_E"), std::string::npos) << out.str();
-  EXPECT_NE(out.str().find("  ee_E (other) chain E frame tcp_E module passive_end_effector_panel"), std::string::npos) << out.str();
+  EXPECT_THAT(out.str(), HasSubstr("robot model version 2 (" + service.current()->content_hash + ")"));
+  EXPECT_THAT(out.str(), HasSubstr("  E (arm) base_link -> tcp_E: J1_E J2_E J3_E J4_E J5_E J6_E"));
+  EXPECT_THAT(out.str(), HasSubstr("  ee_E (other) chain E frame tcp_E module passive_end_effector_panel"));
   std::ostringstream json;
   ASSERT_EQ(cli::run("concert", {modelgen::register_verbs},
                      {"model", "show", "--json", "--timeout", "5"}, json, err),
@@ -134,9 +135,7 @@ TEST(ModelShow, NoModelIsAClearError) {
     return cli::run("concert", {modelgen::register_verbs}, args, out, err);
   };
   EXPECT_EQ(run({"model", "show", "--timeout", "0.3"}), 1);
-  EXPECT_NE(err.str().find("concert model show: no robot model received within 0.3 s"),
-            std::string::npos)
-      << err.str();
+  EXPECT_THAT(err.str(), HasSubstr("concert model show: no robot model received within 0.3 s"));
   EXPECT_EQ(run({"model", "show", "--timeout", "-1"}), 2);
-  EXPECT_NE(err.str().find("--timeout: '-1' is not a number >= 0"), std::string::npos) << err.str();
+  EXPECT_THAT(err.str(), HasSubstr("--timeout: '-1' is not a number >= 0"));
 }

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <random>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -17,6 +18,8 @@ using concert::modelgen::test::make_tree;
 using concert::modelgen::test::Row;
 
 namespace {
+
+using ::testing::HasSubstr;
 
 const fs::path kPublic = fs::path(CONCERT_SHARED_DATA) / "concert_resources";
 
@@ -270,7 +273,7 @@ TEST(Customisation, HomingAndAddonsMakeANewModel) {
   custom.addons.push_back({"drill_A", "drill_handle"});
   const GeneratedModel custom_model = gen.generate(tree, custom);
   EXPECT_NE(custom_model.content_hash, plain.content_hash);
-  EXPECT_NE(custom_model.srdf.find("<joint name=\"J2_A\" value=\"0.5\"/>"), std::string::npos);
+  EXPECT_THAT(custom_model.srdf, HasSubstr("<joint name=\"J2_A\" value=\"0.5\"/>"));
   EXPECT_NEAR(custom_model.tree.mass(), plain.tree.mass() + 0.8 + 0.33, 1e-9);
   EXPECT_EQ(custom_model.end_effectors[0].addons, (std::vector<std::string>{"drillbit_16_SDSplus", "drill_handle"}));
   const auto pu = urdf::parseURDF(plain.urdf);

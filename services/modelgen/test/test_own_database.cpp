@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <random>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -17,6 +18,8 @@ using concert::modelgen::test::make_tree;
 using concert::modelgen::test::Row;
 
 namespace {
+
+using ::testing::HasSubstr;
 
 const module_db::ModuleDatabase& own_db() {
   static const module_db::ModuleDatabase db = module_db::load_module_database(fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db");
@@ -139,6 +142,6 @@ TEST(OwnDatabase, MorphologyCAndTwoArmTorso) {
   EXPECT_EQ(model.end_effectors[4].name, "gripper_F");
   EXPECT_EQ(model.end_effectors[5].name, "sanding_tool_G");
   EXPECT_GE(model.tree.body_index("ft_sensor_G"), 0);
-  EXPECT_NE(model.srdf.find("<end_effector name=\"gripper_F\" parent_link=\"tcp_F\""), std::string::npos);
+  EXPECT_THAT(model.srdf, HasSubstr("<end_effector name=\"gripper_F\" parent_link=\"tcp_F\""));
   EXPECT_TRUE(urdf::parseURDF(model.urdf));
 }

@@ -1,5 +1,6 @@
 #include <filesystem>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "modelgen/bundle.hpp"
@@ -11,6 +12,8 @@ using namespace concert;
 using namespace concert::modelgen;
 
 namespace {
+
+using ::testing::HasSubstr;
 
 const module_db::ModuleDatabase& public_db() {
   static const module_db::ModuleDatabase db = module_db::load_module_database(fs::path(CONCERT_SHARED_DATA) / "concert_resources");
@@ -52,7 +55,7 @@ TEST(Service, TreesCustomisationsAndErrors) {
   o = service.on_customisation(bad);
   EXPECT_FALSE(o.published);
   EXPECT_EQ(o.version, 2u);
-  EXPECT_NE(o.error.find("outside the limits"), std::string::npos);
+  EXPECT_THAT(o.error, HasSubstr("outside the limits"));
   EXPECT_DOUBLE_EQ(service.customisation().home.at("J1_E"), 0.25);
   // A new tree without J1_E drops the customisation instead of failing.
   o = service.on_tree(test::make_tree({{"mobile_platform_concert", -1, -1}}, &public_db()), 10);

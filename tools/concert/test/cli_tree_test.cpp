@@ -1,6 +1,7 @@
 // The whole `concert` command line, walked from its CLI11 tree: every verb and group answers
 // --help with exit 0, a group without its verb exits 2, and every verb that talks DDS accepts
 // the common options. A verb registered later is covered without editing this test.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <set>
@@ -12,6 +13,8 @@
 
 namespace concert {
 namespace {
+
+using ::testing::HasSubstr;
 
 using namespace std::chrono_literals;
 
@@ -67,15 +70,15 @@ TEST(ConcertCli, HelpOnEveryVerbAndGroupExitsZero) {
     path.push_back("--help");
     const Outcome r = run(path);
     EXPECT_EQ(r.code, 0) << name << ": " << r.err;
-    EXPECT_NE(r.out.find("Usage: " + name), std::string::npos) << name << ":\n" << r.out;
+    EXPECT_THAT(r.out, HasSubstr("Usage: " + name)) << name << ":\n" << r.out;
     EXPECT_TRUE(r.err.empty()) << name << ": " << r.err;
   }
   const Outcome top = run({"--help"});
   EXPECT_EQ(top.code, 0);
-  EXPECT_NE(top.out.find("Exit codes: 0 success"), std::string::npos) << top.out;
+  EXPECT_THAT(top.out, HasSubstr("Exit codes: 0 success"));
   const Outcome help = run({"help", "topic", "echo"});
   EXPECT_EQ(help.code, 0) << help.err;
-  EXPECT_NE(help.out.find("Usage: concert topic echo"), std::string::npos) << help.out;
+  EXPECT_THAT(help.out, HasSubstr("Usage: concert topic echo"));
 }
 
 TEST(ConcertCli, AGroupWithoutItsVerbExitsTwoNamingTheVerbs) {
@@ -87,10 +90,10 @@ TEST(ConcertCli, AGroupWithoutItsVerbExitsTwoNamingTheVerbs) {
   }
   const Outcome none = run({});
   EXPECT_EQ(none.code, 2);
-  EXPECT_NE(none.out.find("Usage: concert"), std::string::npos) << "no arguments: the help";
+  EXPECT_THAT(none.out, HasSubstr("Usage: concert")) << "no arguments: the help";
   const Outcome unknown = run({"frobnicate"});
   EXPECT_EQ(unknown.code, 2);
-  EXPECT_NE(unknown.err.find("unknown verb 'frobnicate'"), std::string::npos) << unknown.err;
+  EXPECT_THAT(unknown.err, HasSubstr("unknown verb 'frobnicate'"));
 }
 
 /// Values for a verb's required arguments that pass its checks (numbers where numbers go).
@@ -142,27 +145,22 @@ TEST(ConcertCli, EveryVerbThatTalksDdsAcceptsDomainTimeoutAndJson) {
 TEST(ConcertCli, WrongOptionsExitTwoNamingTheOption) {
   Outcome r = run({"topic", "echo", "a/b", "--domain", "999"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--domain: '999' is not a DDS domain id (an integer from 0 to 232)"), std::string::npos)
-      << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--domain: '999' is not a DDS domain id (an integer from 0 to 232)"));
   r = run({"status", "--timeout", "soon"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("concert status: --timeout: 'soon' is not a number >= 0"), std::string::npos)
-      << r.err;
+  EXPECT_THAT(r.err, HasSubstr("concert status: --timeout: 'soon' is not a number >= 0"));
   r = run({"scan", "show"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("give exactly one of --scan FILE or --assembly FILE"), std::string::npos)
-      << r.err;
+  EXPECT_THAT(r.err, HasSubstr("give exactly one of --scan FILE or --assembly FILE"));
 }
 
 TEST(ConcertCli, TheExecutableUsesTheSameExitCodes) {
   testing::Process help({CONCERT_BIN, "sim", "--help"});
   EXPECT_EQ(help.wait(30s), 0);
-  EXPECT_NE(help.out().find("Usage: concert sim"), std::string::npos) << help.out();
+  EXPECT_THAT(help.out(), HasSubstr("Usage: concert sim"));
   testing::Process missing({CONCERT_BIN, "sim"});
   EXPECT_EQ(missing.wait(30s), 2);
-  EXPECT_NE(missing.err().find("concert sim: missing verb (one of: assemble, swap, world)"),
-            std::string::npos)
-      << missing.err();
+  EXPECT_THAT(missing.err(), HasSubstr("concert sim: missing verb (one of: assemble, swap, world)"));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // `concert topic` verbs against real running writers: a Fast DDS peer publishing every
 // catalogue topic at 100 Hz, and Cyclone's ddsperf as a program that is not ours.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -10,6 +11,8 @@
 
 namespace concert {
 namespace {
+
+using ::testing::HasSubstr;
 
 using namespace std::chrono_literals;
 using testing::Process;
@@ -79,10 +82,10 @@ TEST_F(TopicCli, ListShowsEveryTopicOursAndOthers) {
 TEST_F(TopicCli, InfoShowsTypeQosEndpointsAndShape) {
   const auto r = concert({"topic", "info", "concert/robot/joint_state", "--timeout", "2"});
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("concert::msg::JointState"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("writer"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("best-effort volatile"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("sequence<double> position"), std::string::npos) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("concert::msg::JointState"));
+  EXPECT_THAT(r.out, HasSubstr("writer"));
+  EXPECT_THAT(r.out, HasSubstr("best-effort volatile"));
+  EXPECT_THAT(r.out, HasSubstr("sequence<double> position"));
 }
 
 TEST_F(TopicCli, EchoPrintsSamplesWithFieldNames) {
@@ -112,24 +115,24 @@ TEST_F(TopicCli, HzMeasuresTheRateOfAnyTopic) {
 TEST_F(TopicCli, ClearErrors) {
   auto r = concert({"topic", "echo", "no/such_topic", "--wait", "0.5", "--count", "1"});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("no/such_topic"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("no/such_topic"));
   r = concert({"topic", "echo", "DDSPerfRDataKS", "--count", "1", "--timeout", "5"});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("not in the project's IDL"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("not in the project's IDL"));
   r = concert({"topic", "frob"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("frob"), std::string::npos);
+  EXPECT_THAT(r.err, HasSubstr("frob"));
   r = concert({"topic", "list", "--domain", "999"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--domain"), std::string::npos);
+  EXPECT_THAT(r.err, HasSubstr("--domain"));
   r = concert({"topic", "echo", "concert/robot/odometry", "--count", "x"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--count"), std::string::npos);
+  EXPECT_THAT(r.err, HasSubstr("--count"));
   // A topic without writers times out with a count of what arrived.
   r = concert({"topic", "echo", "concert/robot/ee_wrench", "--domain", "231", "--count", "1",
                "--timeout", "0.5"});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("received 0 of 1"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("received 0 of 1"));
 }
 
 }  // namespace

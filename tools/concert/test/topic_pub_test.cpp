@@ -1,6 +1,7 @@
 // `concert topic pub` through real DDS: a sample given as JSON on a catalogue topic comes back
 // field for field through `concert topic echo` and through a typed reader; bad JSON, unknown
 // fields and wrong types are refused before anything is published.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -11,6 +12,8 @@
 
 namespace concert {
 namespace {
+
+using ::testing::HasSubstr;
 
 using namespace std::chrono_literals;
 using testing::Process;
@@ -57,10 +60,7 @@ TEST(TopicPub, KeyedLatchedSampleReachesATypedReader) {
                                 "model_version": 3, "message": "from the command line"})",
                "--wait", "30"});
   ASSERT_EQ(pub.code, 0) << pub.err;
-  EXPECT_NE(
-      pub.out.find("published 1 sample(s) of concert::msg::ServiceStatus on concert/system/status"),
-      std::string::npos)
-      << pub.out;
+  EXPECT_THAT(pub.out, HasSubstr("published 1 sample(s) of concert::msg::ServiceStatus on concert/system/status"));
   std::optional<msg::ServiceStatus> got;
   const auto deadline = std::chrono::steady_clock::now() + 20s;
   while (!got && std::chrono::steady_clock::now() < deadline) {
@@ -78,24 +78,20 @@ TEST(TopicPub, BadSamplesAreRefusedNamingTheField) {
   const std::string topic = "concert/robot/cartesian_command";
   auto r = concert({"topic", "pub", topic, R"({"end_effector": "tcp_E",)"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("concert topic pub: JSON: "), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("concert topic pub: JSON: "));
   r = concert({"topic", "pub", topic, R"({"target": {"positon": {"x": 1}}})"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(
-      r.err.find(
-          "target.positon: no such field in concert::msg::Pose (fields: position, orientation)"),
-      std::string::npos)
-      << r.err;
+  EXPECT_THAT(r.err, HasSubstr(
+          "target.positon: no such field in concert::msg::Pose (fields: position, orientation)"));
   r = concert({"topic", "pub", topic, R"({"end_effector": 5})"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("end_effector: expected a string"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("end_effector: expected a string"));
   r = concert({"topic", "pub", topic, R"({"target": {"position": {"x": "far"}}})"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("target.position.x: expected a number"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("target.position.x: expected a number"));
   r = concert({"topic", "pub", "no/such_topic", "{}"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("topic 'no/such_topic' is not in the catalogue"), std::string::npos)
-      << r.err;
+  EXPECT_THAT(r.err, HasSubstr("topic 'no/such_topic' is not in the catalogue"));
   EXPECT_TRUE(r.out.empty());
 }
 

@@ -3,6 +3,7 @@
 // service restarted, a clean stop; the planner planning against the world the simulator
 // publishes, `concert sim world` (over DDS) changing the plan, and `concert plan --execute`
 // running through the robot's joint-trajectory command.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <signal.h>
@@ -22,6 +23,8 @@
 
 namespace concert {
 namespace {
+
+using ::testing::HasSubstr;
 
 using namespace std::chrono_literals;
 using testing::Process;
@@ -63,19 +66,19 @@ TEST_F(UpTest, BadInputIsRefusedBeforeAnythingStarts) {
                         "  - {name: x, key: no_such_module, parent: base, connector: 5}\n";
   auto r = concert({"up", "--assembly", bad, "--duration", "5"});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("no_such_module"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("no_such_module"));
+  EXPECT_THAT(r.err, HasSubstr(bad));
   r = concert({"up", "--world", run_ + "/missing.yaml", "--duration", "5"});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("missing.yaml"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("missing.yaml"));
   r = concert({"up", "--backend", "ethercat"});
   EXPECT_EQ(r.code, 2);
   r = concert({"up", "--domain", "300"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("'300' is not a DDS domain id"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("'300' is not a DDS domain id"));
   r = concert({"sim", "swap", CONCERT_SOURCE_DIR "/deploy/demo/sanding_robot.yaml"});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("concert up"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("concert up"));
 }
 
 TEST_F(UpTest, WholeStackSwapRestartAndStop) {
@@ -83,8 +86,8 @@ TEST_F(UpTest, WholeStackSwapRestartAndStop) {
              env_);
   auto r = concert({"status", "--until-version", "1", "--timeout", "60"});
   ASSERT_EQ(r.code, 0) << r.out << r.err << up.out();
-  EXPECT_NE(r.out.find("robot@"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("modelgen@"), std::string::npos) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("robot@"));
+  EXPECT_THAT(r.out, HasSubstr("modelgen@"));
 
   r = concert({"status", "--json", "--timeout", "1.5"});
   ASSERT_EQ(r.code, 0) << r.err;
@@ -102,7 +105,7 @@ TEST_F(UpTest, WholeStackSwapRestartAndStop) {
   std::ofstream(bad) << "modules: [ {name: base, key: concert_mobile_base_hub}, {name: t, key: concert_drill, parent: base, connector: 9} ]\n";
   r = concert({"sim", "swap", bad});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("nothing changed"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("nothing changed"));
 
   r = concert({"sim", "swap", CONCERT_SOURCE_DIR "/deploy/demo/sanding_robot.yaml"});
   ASSERT_EQ(r.code, 0) << r.err;
@@ -130,7 +133,7 @@ TEST_F(UpTest, WholeStackSwapRestartAndStop) {
   EXPECT_TRUE(discovery_back) << r.out << up.out();
 
   EXPECT_EQ(up.stop(20s), 0);
-  EXPECT_NE(up.out().find("stopped robot"), std::string::npos) << up.out();
+  EXPECT_THAT(up.out(), HasSubstr("stopped robot"));
 }
 
 TEST_F(UpTest, WorldFromTheSimulatorChangesThePlanAndExecutionRunsInTheRobot) {
@@ -181,7 +184,7 @@ TEST_F(UpTest, WorldFromTheSimulatorChangesThePlanAndExecutionRunsInTheRobot) {
                                                     std::to_string(x) + ", " + std::to_string(y) + ", 0.3]}\n");
   r = concert({"sim", "world", crate});
   ASSERT_EQ(r.code, 0) << r.out << r.err;
-  EXPECT_NE(r.out.find("world version 2: 1 walls, 1 obstacles"), std::string::npos) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("world version 2: 1 walls, 1 obstacles"));
   // The planner takes the world from the topic; plan again until its answer reflects it
   // (bounded: a few requests at most, the world arrives within milliseconds).
   bool moved = false;
@@ -224,7 +227,7 @@ TEST_F(UpTest, WorldFromTheSimulatorChangesThePlanAndExecutionRunsInTheRobot) {
     EXPECT_EQ(r.code, 1);
     EXPECT_EQ(executed->state(), msg::PLAN_FAILED);
     EXPECT_EQ(executed->failure(), msg::PLAN_EXECUTION_ABORTED);
-    EXPECT_NE(executed->reason().find("aborted by the robot: " + by_robot->reason()), std::string::npos)
+    EXPECT_THAT(executed->reason(), HasSubstr("aborted by the robot: " + by_robot->reason()))
         << executed->reason() << " / " << by_robot->reason();
   }
   EXPECT_EQ(up.stop(20s), 0);
