@@ -187,11 +187,14 @@ endfunction()
 # HasSubstr), registered with ctest.
 #   concert_add_test(NAME name SOURCES a.cpp ... LIBS lib ... [LABELS l ...] [TIMEOUT s] [DDS])
 # DDS: the test gets a private CONCERT_DOMAIN_ID and the label "dds".
+set(CONCERT_TEST_SUPPORT_DIR ${CMAKE_CURRENT_LIST_DIR}/../tests/support)
 function(concert_add_test)
   cmake_parse_arguments(T "DDS" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
   concert_target_defaults(${T_NAME})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gmock GTest::gtest GTest::gtest_main Threads::Threads)
+  # tests/support: header-only helpers every test may include (test_data.hpp).
+  target_include_directories(${T_NAME} PRIVATE ${CONCERT_TEST_SUPPORT_DIR})
   target_compile_definitions(${T_NAME} PRIVATE
     CONCERT_SHARED_DATA="${CONCERT_SHARED_DATA}"
     CONCERT_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -11,18 +11,17 @@
 #include "concert/topology/esc_catalog.hpp"
 #include "concert/topology/scan_io.hpp"
 #include "concert/topology/reconstruction.hpp"
+#include "test_data.hpp"
 
 namespace concert::topology {
 namespace {
 
 using Severity = TreeIssue::Severity;
 
-const std::string kShared = CONCERT_SHARED_DATA;
-const std::string kRealScan = kShared + "/ethercat/concert_robot_18slaves.yaml";
-const std::string kPublicDb = kShared + "/concert_resources";
-const std::string kProjectDb = std::string(CONCERT_SOURCE_DIR) + "/data/module_db";
-const std::string kAssembly =
-    std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples/concert_robot_18slaves.yaml";
+using namespace concert::test_data;
+
+const std::string kRealScan = kRealScans + "/concert_robot_18slaves.yaml";
+const std::string kAssembly = kExamples + "/concert_robot_18slaves.yaml";
 
 struct Link {
   int32_t parent_position;

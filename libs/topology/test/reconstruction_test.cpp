@@ -6,15 +6,16 @@
 #include "concert/simbus/testing.hpp"
 #include "concert/topology/scan_io.hpp"
 #include "scan_builder.hpp"
+#include "test_data.hpp"
 
 namespace concert::topology {
 namespace {
 
+using test::discover_error;
 using test::discovery_error;
 using test::make_scan;
 
-const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
-const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
+using namespace concert::test_data;
 
 TEST(Discovery, PaperRobotFromThePublicDatabase) {
   const EscCatalog catalog = EscCatalog::load(kPublicDb);
@@ -48,12 +49,15 @@ TEST(Discovery, PaperRobotFromThePublicDatabase) {
   EXPECT_EQ(tree.modules[9].key, "module_joint_yaw_A_concert");
   EXPECT_EQ(tree.modules[9].parent_connector, 5);
   EXPECT_EQ(tree.slaves[10].parent_port, 2);
-  const std::vector<std::string> arm = {
-      "module_joint_yaw_A_concert",       "module_joint_elbow_A_concert",
-      "module_link_straight_400_concert", "module_joint_elbow_A_concert",
-      "module_joint_yaw_B_concert",       "module_link_straight_400_concert",
-      "module_joint_elbow_B_concert",     "module_joint_yaw_B_concert",
-      "module_drill_concert"};
+  const std::vector<std::string> arm = {"module_joint_yaw_A_concert",
+                                        "module_joint_elbow_A_concert",
+                                        "module_link_straight_400_concert",
+                                        "module_joint_elbow_A_concert",
+                                        "module_joint_yaw_B_concert",
+                                        "module_link_straight_400_concert",
+                                        "module_joint_elbow_B_concert",
+                                        "module_joint_yaw_B_concert",
+                                        "module_drill_concert"};
   for (std::size_t i = 0; i < arm.size(); ++i) {
     EXPECT_EQ(tree.modules[9 + i].key, arm[i]) << i;
     if (i > 0) {
@@ -70,8 +74,8 @@ TEST(Discovery, TorsoTwoArmsAndBothPortOrders) {
   for (const char* file : {"concert_paper_robot.yaml", "concert_torso_two_arms.yaml"}) {
     const auto assembly = simbus::load_assembly(kExamples + "/" + file);
     for (PortOrder order : {PortOrder::kReal0312, PortOrder::kNumeric0123}) {
-      const ModuleTree tree =
-          discover(simbus::simulate_scan(assembly, catalog, order), catalog, DiscoveryParams{order});
+      const ModuleTree tree = discover(simbus::simulate_scan(assembly, catalog, order), catalog,
+                                       DiscoveryParams{order});
       EXPECT_EQ(tree, simbus::tree_from_assembly(assembly, catalog, order))
           << file << " " << to_string(order);
     }
@@ -120,12 +124,12 @@ TEST(Discovery, ThreeEscModule) {
   const EscCatalog catalog = simbus::synthetic_catalog();
   const EscIdentity tri{2, 5, 1, 0}, tri_b{2, 6, 1, 0}, tri_c{2, 7, 1, 0};
   const EscScan scan = make_scan({{0b1111, tri, 1},
-                                  {0b0001, test::kTool, 2},     // connector 1
+                                  {0b0001, test::kTool, 2},  // connector 1
                                   {0b1101, tri_b, 3},
-                                  {0b0001, test::kTool, 4},     // connector 2
-                                  {0b0001, test::kTool, 5},     // connector 3
+                                  {0b0001, test::kTool, 4},  // connector 2
+                                  {0b0001, test::kTool, 5},  // connector 3
                                   {0b0011, tri_c, 6},
-                                  {0b0001, test::kTool, 7}});   // connector 4
+                                  {0b0001, test::kTool, 7}});  // connector 4
   const ModuleTree tree = discover(scan, catalog);
   ASSERT_EQ(tree.modules.size(), 5u);
   EXPECT_EQ(tree.modules[0].slave_positions, (std::vector<int32_t>{1, 3, 6}));
@@ -163,7 +167,7 @@ TEST(Discovery, JointWithTwoChildren) {
   const EscScan scan =
       make_scan({{0b1011, test::kJoint}, {0b0001, test::kTool}, {0b0001, test::kTool}});
   // A two-port board with port 3 open contradicts the joint's single output connector.
-  EXPECT_EQ(discovery_error([&] { (void)discover(scan, catalog); }),
+  EXPECT_EQ(discover_error(scan, catalog),
             "slave 1: module #0 joint (joint) has 2 child modules but joint has 1 output "
             "connector (1 on port 1); slave 2 hangs on port 3 of slave 1");
 }
@@ -174,68 +178,54 @@ TEST(Discovery, LinkWithTwoChildren) {
                                   {0b1011, test::kLink},
                                   {0b0001, test::kTool},
                                   {0b0001, test::kTool}});
-  EXPECT_NE(discovery_error([&] { (void)discover(scan, catalog); })
-                .find("slave 2: module #1 link (link) has 2 child modules"),
-            std::string::npos);
+  EXPECT_NE(
+      discover_error(scan, catalog).find("slave 2: module #1 link (link) has 2 child modules"),
+      std::string::npos);
 }
 
 TEST(Discovery, EndEffectorAndWheelWithAnyChild) {
   const EscCatalog catalog = simbus::synthetic_catalog();
-  EXPECT_EQ(
-      discovery_error([&] {
-        (void)discover(
-            make_scan({{0b0011, test::kJoint}, {0b0011, test::kTool}, {0b0001, test::kJoint}}),
-            catalog);
-      }),
-      "slave 2: module #1 tool (end_effector) has 1 child module but tool has no output "
-      "connector; slave 3 hangs on port 1 of slave 2");
-  EXPECT_NE(
-      discovery_error([&] {
-        (void)discover(
-            make_scan({{0b0011, test::kJoint}, {0b0011, test::kWheel}, {0b0001, test::kTool}}),
-            catalog);
-      }).find("slave 2: module #1 wheel (wheel) has 1 child module"),
-      std::string::npos);
+  EXPECT_EQ(discover_error(
+                make_scan({{0b0011, test::kJoint}, {0b0011, test::kTool}, {0b0001, test::kJoint}}),
+                catalog),
+            "slave 2: module #1 tool (end_effector) has 1 child module but tool has no output "
+            "connector; slave 3 hangs on port 1 of slave 2");
+  EXPECT_NE(discover_error(
+                make_scan({{0b0011, test::kJoint}, {0b0011, test::kWheel}, {0b0001, test::kTool}}),
+                catalog)
+                .find("slave 2: module #1 wheel (wheel) has 1 child module"),
+            std::string::npos);
 }
 
 TEST(Discovery, ChildOnAPortWithoutConnector) {
   // hub2 has connectors 1, 2 on ports 3, 1; a single child on port 2 is on no connector.
   const EscCatalog catalog = simbus::synthetic_catalog();
-  EXPECT_EQ(discovery_error([&] {
-              (void)discover(make_scan({{0b0101, test::kHub2}, {0b0001, test::kTool}}), catalog);
-            }),
+  EXPECT_EQ(discover_error(make_scan({{0b0101, test::kHub2}, {0b0001, test::kTool}}), catalog),
             "slave 2: hangs on port 2 of slave 1, which is not an output connector of module #0 "
             "hub2 (hub): it has 2 output connectors (1 on port 3, 2 on port 1)");
 }
 
 TEST(Discovery, WrongOrMissingSecondaryEsc) {
   const EscCatalog catalog = simbus::synthetic_catalog();
-  EXPECT_EQ(discovery_error([&] {
-              (void)discover(make_scan({{0b1001, test::kBase}, {0b0001, test::kJoint}}), catalog);
-            }),
+  EXPECT_EQ(discover_error(make_scan({{0b1001, test::kBase}, {0b0001, test::kJoint}}), catalog),
             "slave 2: hangs on port 3 of slave 1, where module #0 base (hub) has its ESC "
             "(mod_type 2, mod_id 4, mod_size 1, mod_rev 0), but reports (mod_type 1, mod_id 1, "
             "mod_size 1, mod_rev 0)");
-  EXPECT_EQ(discovery_error([&] {
-              (void)discover(make_scan({{0b0011, test::kBase}, {0b0001, test::kTool}}), catalog);
-            }),
+  EXPECT_EQ(discover_error(make_scan({{0b0011, test::kBase}, {0b0001, test::kTool}}), catalog),
             "slave 1: module #0 base (hub) lacks its ESC (mod_type 2, mod_id 4, mod_size 1, "
             "mod_rev 0) on port 3 of its ESC 1");
 }
 
 TEST(Discovery, ScanChecksComeFirst) {
   const EscCatalog catalog = simbus::synthetic_catalog();
-  EXPECT_EQ(discovery_error([&] { (void)discover(EscScan{}, catalog); }),
-            "the scan has no slaves");
+  EXPECT_EQ(discover_error(EscScan{}, catalog), "the scan has no slaves");
   EscScan scan = make_scan({{0b0011, test::kJoint}, {0b0001, test::kTool}});
   scan.slaves[1].topology = 3;
   const ModuleTree tree = discover(scan, catalog);  // a warning, not an error
   ASSERT_EQ(tree.issues.size(), 1u);
   EXPECT_NE(tree.issues[0].text().find("slave 2: topology says 3"), std::string::npos);
   scan.slaves[1].active_ports = 0b0010;
-  EXPECT_NE(discovery_error([&] {
-              (void)discover(scan, catalog);
-            }).find("slave 2: port 0 (upstream) is closed"),
+  EXPECT_NE(discover_error(scan, catalog).find("slave 2: port 0 (upstream) is closed"),
             std::string::npos);
 }
 
@@ -244,9 +234,8 @@ TEST(Discovery, UpsideDownModuleIsCaughtOrChangesTheTree) {
   const auto faulty = simbus::load_assembly(kExamples + "/faulty_upside_down_elbow.yaml");
   // The elbow's EPU comes after its subtree (yaw_2, drill take the link's port): nothing is
   // left for it to hang on.
-  EXPECT_NE(discovery_error([&] {
-              (void)discover(simbus::simulate_scan(faulty, catalog), catalog);
-            }).find("slave 8: no earlier slave has a free open port"),
+  EXPECT_NE(discover_error(simbus::simulate_scan(faulty, catalog), catalog)
+                .find("slave 8: no earlier slave has a free open port"),
             std::string::npos);
   // Appendix A Example II: B is seen first and A seems to hang on nothing.
   const EscCatalog synthetic = simbus::synthetic_catalog();
@@ -254,10 +243,9 @@ TEST(Discovery, UpsideDownModuleIsCaughtOrChangesTheTree) {
       "modules:\n  - {name: A, key: hub3}\n  - {name: B, key: joint, parent: A, connector: 2}\n"
       "faults:\n  - {type: upside_down, module: A, upstream_port: 2}\n",
       "ex2");
-  EXPECT_NE(discovery_error([&] {
-              (void)discover(simbus::simulate_scan(ex2, synthetic, PortOrder::kNumeric0123),
-                             synthetic, DiscoveryParams{PortOrder::kNumeric0123});
-            }).find("slave 2: no earlier slave has a free open port"),
+  EXPECT_NE(discover_error(simbus::simulate_scan(ex2, synthetic, PortOrder::kNumeric0123),
+                           synthetic, DiscoveryParams{PortOrder::kNumeric0123})
+                .find("slave 2: no earlier slave has a free open port"),
             std::string::npos);
 }
 

@@ -21,4 +21,10 @@ std::string discovery_error(F&& f) {
   return "";
 }
 
+/// Message of the DiscoveryError that discover(scan, catalog, params) throws, or "".
+inline std::string discover_error(const EscScan& scan, const EscCatalog& catalog,
+                                  const DiscoveryParams& params = {}) {
+  return discovery_error([&] { (void)discover(scan, catalog, params); });
+}
+
 }  // namespace concert::topology::test

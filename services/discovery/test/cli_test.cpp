@@ -12,14 +12,14 @@
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/esc_catalog.hpp"
 #include "concert/topology/scan_io.hpp"
+#include "test_data.hpp"
 
 namespace concert::discovery {
 namespace {
 
 using ::testing::HasSubstr;
 
-const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
-const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
+using namespace concert::test_data;
 
 class Cli : public ::testing::Test {
  protected:

@@ -10,14 +10,14 @@
 #include "concert/topology/esc_catalog.hpp"
 #include "dds/discovery_node.hpp"
 #include "dds/service_params.hpp"
+#include "test_data.hpp"
 
 namespace concert::discovery {
 namespace {
 
 using namespace std::chrono_literals;
 
-const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
-const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
+using namespace concert::test_data;
 
 TEST(DdsConversions, RoundTrip) {
   const auto catalog = topology::EscCatalog::load(kPublicDb);

@@ -19,14 +19,14 @@
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/dds/conversions.hpp"
 #include "concert/topology/esc_catalog.hpp"
+#include "test_data.hpp"
 
 namespace concert::discovery {
 namespace {
 
 using namespace std::chrono_literals;
 
-const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
-const std::string kExamples = std::string(CONCERT_SOURCE_DIR) + "/libs/simbus/examples";
+using namespace concert::test_data;
 
 TEST(DiscoveryProcess, ScansInTreesAndStatusOutCleanStop) {
   concert::testing::Process discovery({DISCOVERY_BINARY, "--module-db", kPublicDb});
