@@ -12,7 +12,6 @@ namespace concert::topology {
 namespace {
 
 using test::discover_error;
-using test::discovery_error;
 using test::make_scan;
 
 using namespace concert::test_data;

@@ -14,28 +14,11 @@
 namespace fs = std::filesystem;
 using namespace concert;
 using namespace concert::modelgen;
-using concert::modelgen::test::make_tree;
-using concert::modelgen::test::Row;
+using namespace concert::modelgen::test;
 
 namespace {
 
 using ::testing::HasSubstr;
-
-const fs::path kPublic = fs::path(CONCERT_SHARED_DATA) / "concert_resources";
-
-const module_db::ModuleDatabase& public_db() {
-  static const module_db::ModuleDatabase db = module_db::load_module_database(kPublic);
-  return db;
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const ModelError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 /// Checks every end-effector frame of `model` against eq. (1)-(2) at seeded random joint values.
 void expect_fk_matches(const module_db::ModuleDatabase& db, const topology::ModuleTree& tree, const GeneratedModel& model,

@@ -1,7 +1,6 @@
 // The project database models the paper's robots (section 6.1 morphologies A, B, C; a torso
 // with two arms) with FK equal to eq. (1)-(2).
 
-#include <filesystem>
 #include <random>
 
 #include <gmock/gmock.h>
@@ -11,45 +10,13 @@
 #include "modelgen/model_generator.hpp"
 #include "test_support.hpp"
 
-namespace fs = std::filesystem;
 using namespace concert;
 using namespace concert::modelgen;
-using concert::modelgen::test::make_tree;
-using concert::modelgen::test::Row;
+using namespace concert::modelgen::test;
 
 namespace {
 
 using ::testing::HasSubstr;
-
-const module_db::ModuleDatabase& own_db() {
-  static const module_db::ModuleDatabase db = module_db::load_module_database(fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db");
-  return db;
-}
-
-/// Mobile base with four legs; then the arm `arm` on connector 5.
-std::vector<Row> mobile_robot(const std::vector<std::string>& arm) {
-  std::vector<Row> r{{"concert_mobile_base_hub", -1, -1}};
-  const char* steering[] = {"concert_steering_fl_rr", "concert_steering_fr_rl", "concert_steering_fr_rl", "concert_steering_fl_rr"};
-  for (int leg = 0; leg < 4; ++leg) {
-    r.emplace_back(steering[leg], 0, leg + 1);
-    r.emplace_back("concert_wheel", static_cast<int>(r.size()) - 1, 1);
-  }
-  int parent = 0;
-  int connector = 5;
-  for (const std::string& key : arm) {
-    r.emplace_back(key, parent, connector);
-    parent = static_cast<int>(r.size()) - 1;
-    connector = 1;
-  }
-  return r;
-}
-
-// Section 6.1: morphology A = Straight A, Elbow A, Straight A, Elbow A, Straight B, link 0.4,
-// Elbow B, Drill; B adds a 0.4 m link after the third joint; C adds the base link in front.
-const std::vector<std::string> kMorphologyA{"concert_straight_a", "concert_elbow_a",  "concert_straight_a", "concert_elbow_a",
-                                            "concert_straight_b", "concert_link_400", "concert_elbow_b",    "concert_drill"};
-const std::vector<std::string> kMorphologyB{"concert_straight_a", "concert_elbow_a",  "concert_straight_a", "concert_link_400", "concert_elbow_a",
-                                            "concert_straight_b", "concert_link_400", "concert_elbow_b",    "concert_drill"};
 
 void check_model(const topology::ModuleTree& tree, const GeneratedModel& model, unsigned seed) {
   const auto& db = own_db();
@@ -121,16 +88,7 @@ TEST(OwnDatabase, MorphologyCAndTwoArmTorso) {
   const topology::ModuleTree tc = make_tree(mobile_robot(c), &own_db());
   check_model(tc, gen.generate(tc), 5u);
 
-  std::vector<Row> rows = mobile_robot({"concert_base_link_600", "concert_torso_hub"});
-  const int torso = static_cast<int>(rows.size()) - 1;
-  rows.emplace_back("concert_elbow_a", torso, 1);
-  rows.emplace_back("concert_link_elbow_90", static_cast<int>(rows.size()) - 1, 1);
-  rows.emplace_back("concert_straight_b", static_cast<int>(rows.size()) - 1, 1);
-  rows.emplace_back("concert_active_gripper_panel", static_cast<int>(rows.size()) - 1, 1);
-  rows.emplace_back("concert_elbow_b", torso, 2);
-  rows.emplace_back("concert_link_elbow_45", static_cast<int>(rows.size()) - 1, 1);
-  rows.emplace_back("concert_sanding_tool", static_cast<int>(rows.size()) - 1, 1);
-  const topology::ModuleTree tree = make_tree(rows, &own_db());
+  const topology::ModuleTree tree = make_tree(two_arm_torso(), &own_db());
   Customisation custom;
   custom.addons.push_back({"sanding_tool_G", "concert_sanding_force_sensor"});
   const GeneratedModel model = gen.generate(tree, custom);

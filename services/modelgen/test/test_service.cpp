@@ -10,15 +10,11 @@
 namespace fs = std::filesystem;
 using namespace concert;
 using namespace concert::modelgen;
+using concert::modelgen::test::public_db;
 
 namespace {
 
 using ::testing::HasSubstr;
-
-const module_db::ModuleDatabase& public_db() {
-  static const module_db::ModuleDatabase db = module_db::load_module_database(fs::path(CONCERT_SHARED_DATA) / "concert_resources");
-  return db;
-}
 
 }  // namespace
 

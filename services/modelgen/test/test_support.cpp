@@ -1,10 +1,35 @@
 #include "test_support.hpp"
 
+#include <array>
+#include <filesystem>
 #include <stdexcept>
+
+#include "modelgen/model_generator.hpp"
 
 namespace concert::modelgen::test {
 
 using module_db::ModuleDescription;
+
+const module_db::ModuleDatabase& public_db() {
+  static const module_db::ModuleDatabase db =
+      module_db::load_module_database(std::filesystem::path(CONCERT_SHARED_DATA) / "concert_resources");
+  return db;
+}
+
+const module_db::ModuleDatabase& own_db() {
+  static const module_db::ModuleDatabase db =
+      module_db::load_module_database(std::filesystem::path(CONCERT_SOURCE_DIR) / "data" / "module_db");
+  return db;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
 
 topology::ModuleTree make_tree(const std::vector<Row>& rows, const module_db::ModuleDatabase* db) {
   topology::ModuleTree tree;
@@ -20,27 +45,6 @@ topology::ModuleTree make_tree(const std::vector<Row>& rows, const module_db::Mo
     tree.modules.push_back(n);
   }
   return tree;
-}
-
-std::vector<Row> public_eighteen_module_robot() {
-  std::vector<Row> r{{"mobile_platform_concert", -1, -1}};
-  const char* steering[] = {"module_steering_concert_fl_rr", "module_steering_concert_fr_rl", "module_steering_concert_fr_rl",
-                            "module_steering_concert_fl_rr"};
-  for (int leg = 0; leg < 4; ++leg) {
-    r.emplace_back(steering[leg], 0, leg + 1);
-    r.emplace_back("module_wheel_concert", static_cast<int>(r.size()) - 1, 1);
-  }
-  const char* arm[] = {"module_joint_yaw_A_concert",       "module_joint_elbow_A_concert",    "module_link_straight_400_concert",
-                       "module_joint_elbow_A_concert",     "module_joint_yaw_B_concert",      "module_link_straight_400_concert",
-                       "module_joint_elbow_B_concert",     "module_joint_yaw_B_concert",      "passive_end_effector_panel"};
-  int parent = 0;
-  int connector = 5;
-  for (const char* key : arm) {
-    r.emplace_back(key, parent, connector);
-    parent = static_cast<int>(r.size()) - 1;
-    connector = 1;
-  }
-  return r;
 }
 
 namespace {
@@ -127,6 +131,81 @@ Eigen::Isometry3d description_fk(const module_db::ModuleDatabase& db, const topo
   const ModuleDescription& d = db.at(tree.modules[static_cast<size_t>(module)].key);
   const module_db::Connector& tcp = d.connectors[static_cast<size_t>(d.tcp_connectors()[static_cast<size_t>(tcp_index)])];
   return root_body * within(d, tcp.body, q_of(module)) * tcp.pose;
+}
+
+namespace {
+
+/// A mobile base (`keys`: base, steering FL/RR, steering FR/RL, wheel) with its four legs on
+/// connectors 1-4, then `arm` in a chain on connector 5.
+std::vector<Row> base_with_arm(const std::array<const char*, 4>& keys, const std::vector<std::string>& arm) {
+  const auto& [base, steering_fl_rr, steering_fr_rl, wheel] = keys;
+  std::vector<Row> r{{base, -1, -1}};
+  int leg_connector = 0;
+  for (const char* steering : {steering_fl_rr, steering_fr_rl, steering_fr_rl, steering_fl_rr}) {
+    r.emplace_back(steering, 0, ++leg_connector);
+    r.emplace_back(wheel, static_cast<int>(r.size()) - 1, 1);
+  }
+  int parent = 0;
+  int connector = 5;
+  for (const std::string& key : arm) {
+    r.emplace_back(key, parent, connector);
+    parent = static_cast<int>(r.size()) - 1;
+    connector = 1;
+  }
+  return r;
+}
+
+}  // namespace
+
+std::vector<Row> public_eighteen_module_robot() {
+  return base_with_arm({"mobile_platform_concert", "module_steering_concert_fl_rr", "module_steering_concert_fr_rl",
+                        "module_wheel_concert"},
+                       {"module_joint_yaw_A_concert", "module_joint_elbow_A_concert", "module_link_straight_400_concert",
+                        "module_joint_elbow_A_concert", "module_joint_yaw_B_concert", "module_link_straight_400_concert",
+                        "module_joint_elbow_B_concert", "module_joint_yaw_B_concert", "passive_end_effector_panel"});
+}
+
+std::vector<Row> mobile_robot(const std::vector<std::string>& arm) {
+  return base_with_arm({"concert_mobile_base_hub", "concert_steering_fl_rr", "concert_steering_fr_rl", "concert_wheel"},
+                       arm);
+}
+
+const std::vector<std::string> kMorphologyA{"concert_straight_a", "concert_elbow_a",  "concert_straight_a",
+                                            "concert_elbow_a",    "concert_straight_b", "concert_link_400",
+                                            "concert_elbow_b",    "concert_drill"};
+const std::vector<std::string> kMorphologyB{"concert_straight_a", "concert_elbow_a",    "concert_straight_a",
+                                            "concert_link_400",   "concert_elbow_a",    "concert_straight_b",
+                                            "concert_link_400",   "concert_elbow_b",    "concert_drill"};
+
+std::vector<Row> two_arm_torso() {
+  std::vector<Row> rows = mobile_robot({"concert_base_link_600", "concert_torso_hub"});
+  const int torso = static_cast<int>(rows.size()) - 1;
+  const auto chain = [&rows](int parent, int connector, const std::vector<std::string>& keys) {
+    for (const std::string& key : keys) {
+      rows.emplace_back(key, parent, connector);
+      parent = static_cast<int>(rows.size()) - 1;
+      connector = 1;
+    }
+  };
+  chain(torso, 1, {"concert_elbow_a", "concert_link_elbow_90", "concert_straight_b", "concert_active_gripper_panel"});
+  chain(torso, 2, {"concert_elbow_b", "concert_link_elbow_45", "concert_sanding_tool"});
+  return rows;
+}
+
+simbus::Assembly to_assembly(const std::vector<Row>& rows) {
+  simbus::Assembly a;
+  a.source = "<test rows>";
+  for (const auto& [key, parent, connector] : rows) {
+    simbus::MountedModule m;
+    m.name = "m" + std::to_string(a.modules.size());
+    m.key = key;
+    if (parent >= 0) {
+      m.parent = "m" + std::to_string(parent);
+      m.connector = connector;
+    }
+    a.modules.push_back(std::move(m));
+  }
+  return a;
 }
 
 }  // namespace concert::modelgen::test
