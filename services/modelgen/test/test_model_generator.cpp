@@ -20,6 +20,15 @@ namespace {
 
 using ::testing::HasSubstr;
 
+/// Message of the ModelError that generating `tree` with the add-ons `addons` throws, or
+/// "(no error)".
+std::string addons_error(const ModelGenerator& gen, const topology::ModuleTree& tree,
+                         const decltype(Customisation::addons)& addons) {
+  Customisation custom;
+  custom.addons = addons;
+  return error_of([&] { gen.generate(tree, custom); });
+}
+
 /// Checks every end-effector frame of `model` against eq. (1)-(2) at seeded random joint values.
 void expect_fk_matches(const module_db::ModuleDatabase& db, const topology::ModuleTree& tree, const GeneratedModel& model,
                        unsigned seed, int samples) {
@@ -273,17 +282,11 @@ TEST(Customisation, HomingAndAddonsMakeANewModel) {
   Customisation no_joint;
   no_joint.home["J9_Z"] = 0.0;
   EXPECT_EQ(error_of([&] { gen.generate(tree, no_joint); }), "customisation home: no moving joint 'J9_Z' in this robot");
-  Customisation bad_addon;
-  bad_addon.addons.push_back({"drill_A", "drillbit_99"});
-  EXPECT_EQ(error_of([&] { gen.generate(tree, bad_addon); }), "customisation addons[0]: unknown add-on 'drillbit_99'");
-  Customisation wrong_module;
-  wrong_module.addons.push_back({"L_1_A", "drillbit_16_SDSplus"});
-  EXPECT_EQ(error_of([&] { gen.generate(tree, wrong_module); }),
+  EXPECT_EQ(addons_error(gen, tree, {{"drill_A", "drillbit_99"}}), "customisation addons[0]: unknown add-on 'drillbit_99'");
+  EXPECT_EQ(addons_error(gen, tree, {{"L_1_A", "drillbit_16_SDSplus"}}),
             "customisation addons[0]: module 'module_joint_yaw_A_concert' accepts no add-ons");
-  Customisation twice;
-  twice.addons.push_back({"drill_A", "drillbit_16_SDSplus"});
-  twice.addons.push_back({"drill_A", "drillbit_6_SDSplus"});
-  EXPECT_NE(error_of([&] { gen.generate(tree, twice); }).find("already has a 'drillbit' add-on"), std::string::npos);
+  EXPECT_THAT(addons_error(gen, tree, {{"drill_A", "drillbit_16_SDSplus"}, {"drill_A", "drillbit_6_SDSplus"}}),
+              HasSubstr("already has a 'drillbit' add-on"));
 }
 
 TEST(Bundle, WritesFilesAndManifest) {
@@ -319,17 +322,11 @@ TEST(Customisation, PassiveGripperWithoutEscIsMountedByHand) {
     EXPECT_EQ(mounted.srdf, full.srdf) << where;
     EXPECT_EQ(mounted.content_hash, full.content_hash) << where;
   }
-  Customisation busy;
-  busy.addons.push_back({"L_5_E", "passive_end_effector_panel"});
-  EXPECT_EQ(error_of([&] { gen.generate(seen, busy); }),
+  EXPECT_EQ(addons_error(gen, seen, {{"L_5_E", "passive_end_effector_panel"}}),
             "customisation addons[0]: module 'module_joint_elbow_B_concert' (L_5_E) has no free output connector for "
             "'passive_end_effector_panel'");
-  Customisation nowhere;
-  nowhere.addons.push_back({"Z", "passive_end_effector_panel"});
-  EXPECT_EQ(error_of([&] { gen.generate(seen, nowhere); }),
+  EXPECT_EQ(addons_error(gen, seen, {{"Z", "passive_end_effector_panel"}}),
             "customisation addons[0].module_name: no body or chain 'Z' to mount 'passive_end_effector_panel' on");
-  Customisation discovered;
-  discovered.addons.push_back({"E", "module_drill_concert"});
-  EXPECT_EQ(error_of([&] { gen.generate(seen, discovered); }),
+  EXPECT_EQ(addons_error(gen, seen, {{"E", "module_drill_concert"}}),
             "customisation addons[0]: module 'module_drill_concert' has an ESC and is discovered, not added by hand");
 }
