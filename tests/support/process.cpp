@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -21,11 +22,19 @@ std::string read_file(const std::string& path) {
 }
 }  // namespace
 
+TempDir::TempDir(const std::string& prefix) {
+  std::string tmpl = "/tmp/" + prefix + "-XXXXXX";
+  if (mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("mkdtemp " + tmpl + " failed");
+  path_ = tmpl;
+}
+
+TempDir::~TempDir() {
+  std::error_code ignored;
+  std::filesystem::remove_all(path_, ignored);
+}
+
 Process::Process(std::vector<std::string> argv, std::vector<std::string> env) {
-  char tmpl[] = "/tmp/concert-proc-XXXXXX";
-  if (mkdtemp(tmpl) == nullptr) throw std::runtime_error("mkdtemp failed");
-  dir_ = tmpl;
-  const std::string out = dir_ + "/stdout", err = dir_ + "/stderr";
+  const std::string out = dir_.path() + "/stdout", err = dir_.path() + "/stderr";
   pid_ = fork();
   if (pid_ < 0) throw std::runtime_error("fork failed");
   if (pid_ == 0) {
@@ -49,8 +58,6 @@ Process::~Process() {
     kill(pid_, SIGKILL);
     waitpid(pid_, nullptr, 0);
   }
-  std::error_code ignored;
-  std::system(("rm -rf '" + dir_ + "'").c_str());
 }
 
 bool Process::running() {
@@ -79,8 +86,8 @@ int Process::stop(std::chrono::milliseconds timeout) {
   return wait(std::chrono::seconds(5)).value_or(-SIGKILL);
 }
 
-std::string Process::out() const { return read_file(dir_ + "/stdout"); }
-std::string Process::err() const { return read_file(dir_ + "/stderr"); }
+std::string Process::out() const { return read_file(dir_.path() + "/stdout"); }
+std::string Process::err() const { return read_file(dir_.path() + "/stderr"); }
 
 bool Process::wait_for_output(const std::string& text, std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;

@@ -11,6 +11,19 @@
 
 namespace concert::testing {
 
+/// A fresh folder /tmp/<prefix>-XXXXXX, removed with its content when this goes.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& prefix);
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
 class Process {
  public:
   /// Starts argv[0] with the arguments; stdout and stderr go to files in a fresh temp folder.
@@ -36,7 +49,7 @@ class Process {
  private:
   pid_t pid_ = -1;
   std::optional<int> status_;
-  std::string dir_;
+  TempDir dir_{"concert-proc"};
 };
 
 /// How a program run to its end went: exit code (-1: it did not end in time and was killed),

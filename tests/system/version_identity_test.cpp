@@ -42,12 +42,6 @@ struct Seen {
 
 class VersionIdentity : public ::testing::Test {
  protected:
-  void SetUp() override {
-    char tmpl[] = "/tmp/concert-version-test-XXXXXX";
-    run_ = mkdtemp(tmpl);
-    env_ = {"XDG_RUNTIME_DIR=" + run_};
-  }
-  void TearDown() override { fs::remove_all(run_); }
 
   Ran concert(std::vector<std::string> args, std::chrono::seconds timeout = 120s) {
     args.insert(args.begin(), CONCERT_BIN);
@@ -69,8 +63,9 @@ class VersionIdentity : public ::testing::Test {
     return out;
   }
 
-  std::string run_;
-  std::vector<std::string> env_;
+  testing::TempDir run_dir_{"concert-version-test"};  ///< XDG_RUNTIME_DIR of this test's stack
+  const std::string run_ = run_dir_.path();
+  const std::vector<std::string> env_{"XDG_RUNTIME_DIR=" + run_};
 };
 
 int last_pid(const std::string& log, const std::string& service) {

@@ -32,12 +32,6 @@ namespace fs = std::filesystem;
 
 class UpTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    char tmpl[] = "/tmp/concert-up-test-XXXXXX";
-    run_ = mkdtemp(tmpl);
-    env_ = {"XDG_RUNTIME_DIR=" + run_};
-  }
-  void TearDown() override { fs::remove_all(run_); }
 
   testing::Outcome concert(std::vector<std::string> args, std::chrono::seconds timeout = 90s) {
     args.insert(args.begin(), CONCERT_BIN);
@@ -52,8 +46,9 @@ class UpTest : public ::testing::Test {
     return path;
   }
 
-  std::string run_;
-  std::vector<std::string> env_;
+  testing::TempDir run_dir_{"concert-up-test"};  ///< XDG_RUNTIME_DIR of this test's stack
+  const std::string run_ = run_dir_.path();
+  const std::vector<std::string> env_{"XDG_RUNTIME_DIR=" + run_};
 };
 
 constexpr const char* kWall =
