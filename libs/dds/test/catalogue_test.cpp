@@ -5,6 +5,7 @@
 #include <cstring>
 #include <set>
 
+#include "concert/dds/json.hpp"
 #include "concert/dds/topics.hpp"
 #include "concert/idl_schema/cdr.hpp"
 #include "concert/idl_schema/schema.hpp"
@@ -15,6 +16,23 @@ namespace {
 template <class T> std::pair<std::string, std::string> bound(TopicHandle<T> h) {
   typename PubSubOf<T>::type pubsub;
   return {std::string(h.name), pubsub.getName()};
+}
+
+TEST(Json, ATypedSampleReadsAsTheIdlSaysWithEnumsByName) {
+  msg::ServiceStatus st;
+  st.id(7);
+  st.service("planner");
+  st.state(msg::SERVICE_READY);
+  st.model_version(3);
+  st.model_hash("abc");
+  st.message("ready");
+  const idl::Json j = to_json(st);
+  EXPECT_EQ(j.at("service"), "planner");
+  EXPECT_EQ(j.at("state"), "SERVICE_READY");
+  EXPECT_EQ(j.at("model_version"), 3);
+  EXPECT_EQ(j.at("model_hash"), "abc");
+  EXPECT_EQ(j.size(), 9u);  // every field of ServiceStatus, in IDL order
+  EXPECT_EQ(j.begin().key(), "id");
 }
 
 TEST(Catalogue, EveryTopicHasATypedHandleWithTheSameType) {

@@ -125,7 +125,11 @@ TEST(ModelgenNode, PublishesVersionedModelsOverDds) {
   const auto j = nlohmann::json::parse(json.str());
   EXPECT_EQ(j.at("version"), 2);
   EXPECT_EQ(j.at("content_hash"), service.current()->content_hash);
-  EXPECT_FALSE(j.at("joints").empty());
+  ASSERT_FALSE(j.at("joints").empty());
+  EXPECT_GT(j.at("joints")[0].at("peak_torque").get<double>(), 0.0);
+  EXPECT_GT(j.at("joints")[0].at("continuous_torque").get<double>(), 0.0);
+  EXPECT_EQ(j.at("chains").size(), service.current()->chains.size());
+  EXPECT_FALSE(j.contains("urdf"));  // the description files are left out
 }
 
 TEST(ModelShow, NoModelIsAClearError) {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "concert/dds/endpoint.hpp"
+#include "concert/dds/json.hpp"
 #include "concert/dds/participant.hpp"
 #include "modelgen/cli.hpp"
 
@@ -23,44 +24,10 @@ int show(const cli::DdsOptions& o, std::ostream& out) {
     throw cli::Failure(what.str());
   }
   if (o.json) {
-    nlohmann::ordered_json j = {{"version", m->version()},
-                                {"content_hash", m->content_hash()},
-                                {"tree_version", m->tree_version()},
-                                {"modules", m->modules()}};
-    j["chains"] = nlohmann::ordered_json::array();
-    for (const msg::ChainInfo& c : m->chains()) {
-      j["chains"].push_back({{"name", c.name()},
-                             {"role", c.role()},
-                             {"base_link", c.base_link()},
-                             {"tip_link", c.tip_link()},
-                             {"joints", c.joints()}});
-    }
-    j["joints"] = nlohmann::ordered_json::array();
-    for (const msg::JointInfo& jt : m->joints()) {
-      j["joints"].push_back({{"name", jt.name()},
-                             {"chain", jt.chain()},
-                             {"lower", jt.lower()},
-                             {"upper", jt.upper()},
-                             {"velocity", jt.velocity()},
-                             {"peak_torque", jt.peak_torque()},
-                             {"continuous_torque", jt.continuous_torque()}});
-    }
-    j["end_effectors"] = nlohmann::ordered_json::array();
-    for (const msg::EndEffectorInfo& e : m->end_effectors()) {
-      j["end_effectors"].push_back({{"name", e.name()},
-                                    {"kind", e.kind()},
-                                    {"chain", e.chain()},
-                                    {"frame", e.frame()},
-                                    {"module_key", e.module_key()}});
-    }
-    j["sensor_frames"] = nlohmann::ordered_json::array();
-    for (const msg::SensorFrameInfo& f : m->sensor_frames()) {
-      j["sensor_frames"].push_back({{"name", f.name()},
-                                    {"kind", f.kind()},
-                                    {"frame", f.frame()},
-                                    {"end_effector", f.end_effector()},
-                                    {"module_key", f.module_key()}});
-    }
+    // Every field as the IDL names it; the description files themselves are left out (they are
+    // `concert topic echo concert/model/robot_model`'s, or the bundle's).
+    idl::Json j = concert::dds::to_json(*m);
+    for (const char* text : {"urdf", "srdf", "config_yaml"}) j.erase(text);
     out << j.dump(2) << "\n";
     return 0;
   }
