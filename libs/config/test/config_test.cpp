@@ -63,6 +63,21 @@ TEST(Config, MissingKeysKeepTheirDefaults) {
   EXPECT_EQ(read("sim: {}\n").decimation, 10);
 }
 
+TEST(Config, ReadWithHandsTheWholeDocumentToTheReader) {
+  const auto reader = [](Document& doc) { return read(doc); };
+  const Params p =
+      Document::parse("name: arm\nsim: {decimation: 5}\n", "arm.yaml").read_with(reader);
+  EXPECT_EQ(p.name, "arm");
+  EXPECT_EQ(p.decimation, 5);
+  try {
+    (void)Document::parse("nmae: arm\n", "arm.yaml").read_with(reader);
+    ADD_FAILURE() << "no error for an unknown key";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("arm.yaml: nmae: unknown key"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Config, EveryTypeIsRead) {
   const Params p = read(
       "name: arm\norder: '0123'\ntimeout: 0.25\nservices: drill\n"

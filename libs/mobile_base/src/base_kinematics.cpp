@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <urdf_parser/urdf_parser.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -36,6 +37,14 @@ std::map<std::string, double> collision_cylinder_radii(const std::string& urdf) 
     }
   }
   return out;
+}
+
+double standing_height(const std::vector<Leg>& legs) {
+  double height = 0.0;
+  for (const auto& leg : legs) {
+    height = std::max(height, leg.wheel_radius - leg.wheel_center_height);
+  }
+  return height;
 }
 
 std::vector<Leg> detect_legs(const kinematics::Model& model, const std::map<std::string, double>& wheel_radii,

@@ -30,6 +30,14 @@ TEST(BaseKinematics, DetectsFourLegsOfTheMobileBase) {
   EXPECT_TRUE(legs_of("arm_drill.urdf").empty());  // arm joints are not legs
 }
 
+TEST(BaseKinematics, StandsOnItsLargestWheelBelowTheBase) {
+  auto legs = legs_of("mobile_drill.urdf");
+  EXPECT_NEAR(standing_height(legs), 0.16 + 0.3, 1e-12);  // wheel centres 0.3 m below the base
+  legs[2].wheel_radius = 0.25;
+  EXPECT_NEAR(standing_height(legs), 0.25 + 0.3, 1e-12);
+  EXPECT_DOUBLE_EQ(standing_height({}), 0.0);
+}
+
 TEST(BaseKinematics, NeedsTwoLegs) {
   auto legs = legs_of("mobile_drill.urdf");
   legs.resize(1);

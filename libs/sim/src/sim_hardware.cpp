@@ -236,12 +236,7 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
   out.floating = params.floating_base.value_or(!legs.empty());
   double z = params.base_position.z();
   if (out.floating && !legs.empty()) {
-    z = world.floor_height;
-    double lift = 0.0;
-    for (const auto& leg : legs) {
-      lift = std::max(lift, leg.wheel_radius - leg.wheel_center_height);
-    }
-    z += lift + 0.002;
+    z = world.floor_height + mobile_base::standing_height(legs) + 0.002;
   }
   MjcfWriter w{params, wheel_links, {}, {}, {}, {}, 0};
   const urdf::Link& root = *parsed->getRoot();

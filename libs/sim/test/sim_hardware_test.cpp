@@ -122,11 +122,8 @@ TEST(SimHardware, WorldChangeKeepsTheRobot) {
   SimHardware sim(read_fixture("arm_drill.urdf"), World{}, {});
   const auto gen = sim.generation();
   World world;
-  WorldShape box;
-  box.name = "crate";
-  box.size = {0.5, 0.5, 0.5};
-  box.position = {2.0, 0.0, 0.25};
-  world.obstacles.push_back(box);
+  world.obstacles.push_back(
+      {.name = "crate", .size = {0.5, 0.5, 0.5}, .position = {2.0, 0.0, 0.25}});
   sim.set_world(world);
   EXPECT_TRUE(sim.switch_prepared());
   EXPECT_EQ(sim.generation(), gen);

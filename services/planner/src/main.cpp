@@ -5,21 +5,17 @@
 // The latched world topic (concert/world/world) replaces the map whenever it changes.
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
 #include <atomic>
-#include <csignal>
 #include <iostream>
 #include <string>
 
 #include "concert/cli/cli.hpp"
+#include "concert/cli/stop_signals.hpp"
 #include "concert/dds/participant.hpp"
 #include "dds/planner_node.hpp"
 #include "concert/world/world.hpp"
 #include "planner/config.hpp"
 
 namespace {
-
-std::atomic<bool> g_stop{false};
-
-void on_signal(int) { g_stop = true; }
 
 struct Options {
   std::string params;
@@ -35,8 +31,7 @@ int run(const Options& options) {
   if (!options.world.empty()) {
     world = planner::dds::to_planner_world(world::load_world_file(options.world));
   }
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  const std::atomic<bool>& stop = concert::cli::stop_on_signals();
   planner::Planner planner(params);
   planner::Environment env(params.octomap_resolution);
   env.add_world(world);
@@ -46,7 +41,7 @@ int run(const Options& options) {
   std::cerr << "concert_planner: domain " << participant.domain_id() << ", map "
             << env.occupied_cells() << " occupied cells"
             << (options.world.empty() ? "" : " from " + options.world) << std::endl;
-  node.spin(g_stop);
+  node.spin(stop);
   return 0;
 }
 

@@ -9,7 +9,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -21,6 +20,7 @@
 #include <vector>
 
 #include "concert/cli/cli.hpp"
+#include "concert/cli/stop_signals.hpp"
 #include "concert/common/text.hpp"
 #include "concert/dds/participant.hpp"
 #include "concert/sim/sim_assembly.hpp"
@@ -193,8 +193,7 @@ int run(const Options& options) {
         });
     robot::Loop loop(loop_params, [&] { core.cycle(); });
     g_loop = &loop;
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
+    concert::cli::on_stop_signals(on_signal);
     const auto cycles = options.duration > 0.0 ? static_cast<std::uint64_t>(options.duration / params.period)
                                                 : std::numeric_limits<std::uint64_t>::max();
     const robot::LoopStats stats = loop.run(cycles);

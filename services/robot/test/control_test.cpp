@@ -19,12 +19,8 @@ using test::run_cycles;
 constexpr double kMaxOvershoot = 0.10;
 
 TEST(JointImpedance, StepResponseSettlesWithBoundedOvershoot) {
-  SimParams params;
-  params.initial_positions = {{"J2_A", 0.3}, {"J3_A", 0.5}};
-  SimHardware sim(read_fixture("arm_drill.urdf"), World{}, params);
-  RobotCore core(sim);
-  core.set_model(read_fixture("arm_drill.urdf"), 1);
-  run_cycles(core, 300);
+  test::SimulatedArm arm({{"J2_A", 0.3}, {"J3_A", 0.5}}, 300);
+  RobotCore& core = arm.core;
   const auto model = core.model();
   auto data = model->make_data();
   RobotState s = core.state();
@@ -166,14 +162,9 @@ class MobileBase : public ::testing::Test {
     core_.set_model(read_fixture("mobile_drill.urdf"), 1);
     run_cycles(core_, 200);
   }
-  // Sends the base command every 100 ms (the core stops the base after 0.5 s of silence).
+  // Drives the base at (vx, vy, wz) for `seconds` of simulated time.
   void drive(double vx, double vy, double wz, double seconds) {
-    for (int k = 0; k < static_cast<int>(seconds * 1000); ++k) {
-      if (k % 100 == 0) {
-        core_.command_base({1, vx, vy, wz});
-      }
-      core_.cycle();
-    }
+    test::drive_base(core_, {1, vx, vy, wz}, static_cast<int>(seconds * 1000));
   }
   SimHardware sim_;
   RobotCore core_;

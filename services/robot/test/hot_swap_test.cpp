@@ -142,17 +142,8 @@ TEST(ProjectDatabase, DemoDrillRobotStandsDrivesAndHoldsItsArm) {
   EXPECT_EQ(core.legs().size(), 4u);
   EXPECT_EQ(core.arm_joints().size(), 6u);
   test::run_cycles(core, 500);
-  double expected_z = 0.0;
-  for (const auto& leg : core.legs()) {
-    expected_z = std::max(expected_z, leg.wheel_radius - leg.wheel_center_height);
-  }
-  EXPECT_NEAR(sim.base_pose().translation().z(), expected_z, 0.02);
-  for (int k = 0; k < 2000; ++k) {
-    if (k % 100 == 0) {
-      core.command_base({1, 0.0, 0.2, 0.0});
-    }
-    core.cycle();
-  }
+  EXPECT_NEAR(sim.base_pose().translation().z(), mobile_base::standing_height(core.legs()), 0.02);
+  test::drive_base(core, {1, 0.0, 0.2, 0.0}, 2000);
   const RobotState s = core.state();
   EXPECT_NEAR(s.odometry.vy, 0.2, 0.02);
   EXPECT_NEAR(s.odometry.y, sim.base_pose().translation().y(), 0.05);

@@ -150,11 +150,8 @@ TEST(NoAllocation, EveryControllerModeAndSwitchCyclesWithoutAllocating) {
   core.set_model(urdf, 2);  // a new version of the same model: switched at a cycle boundary
   EXPECT_EQ(cycles_allocating(core, 500), 0u) << "model switch";
   World world;
-  WorldShape box;
-  box.name = "crate";
-  box.size = {0.5, 0.5, 0.5};
-  box.position = {3.0, 0.0, 0.25};
-  world.obstacles.push_back(box);
+  world.obstacles.push_back(
+      {.name = "crate", .size = {0.5, 0.5, 0.5}, .position = {3.0, 0.0, 0.25}});
   sim.set_world(world);
   EXPECT_EQ(cycles_allocating(core, 500), 0u) << "world switch";
   EXPECT_EQ(core.state().model_version, 2u);

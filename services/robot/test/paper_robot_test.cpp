@@ -41,12 +41,7 @@ TEST(PaperRobot, GeneratedModelRunsInTheSimulator) {
   EXPECT_TRUE(s.has_base);
   EXPECT_EQ(s.end_effector_frame, "tcp_E");  // modelgen's TCP of the arm's last chain
   // Standing on its wheels, arm held (position hold with gravity feed-forward).
-  const auto& legs = core.legs();
-  double expected_z = 0.0;
-  for (const auto& leg : legs) {
-    expected_z = std::max(expected_z, leg.wheel_radius - leg.wheel_center_height);
-  }
-  EXPECT_NEAR(sim.base_pose().translation().z(), expected_z, 0.02);
+  EXPECT_NEAR(sim.base_pose().translation().z(), mobile_base::standing_height(core.legs()), 0.02);
   for (const auto& joint : core.arm_joints()) {
     EXPECT_NEAR(s.position[test::hw_index(s, joint)], 0.0, 0.01) << joint;
   }
@@ -62,11 +57,8 @@ TEST(PaperRobot, CollisionMeshesFromTheModuleDatabase) {
   RobotCore core(sim);
   core.set_model(urdf, 1);
   test::run_cycles(core, 1000);
-  double expected_z = 0.0;
-  for (const auto& leg : core.legs()) {
-    expected_z = std::max(expected_z, leg.wheel_radius - leg.wheel_center_height);
-  }
-  EXPECT_NEAR(sim.base_pose().translation().z(), expected_z, 0.02);  // on its wheels, not on a hull
+  // On its wheels, not on a hull.
+  EXPECT_NEAR(sim.base_pose().translation().z(), mobile_base::standing_height(core.legs()), 0.02);
 }
 
 TEST(PaperRobot, BaseDrivesOnTheGeneratedLegs) {
@@ -75,12 +67,7 @@ TEST(PaperRobot, BaseDrivesOnTheGeneratedLegs) {
   RobotCore core(sim);
   core.set_model(urdf, 1);
   test::run_cycles(core, 300);
-  for (int k = 0; k < 3000; ++k) {
-    if (k % 100 == 0) {
-      core.command_base({1, 0.2, 0.0, 0.0});
-    }
-    core.cycle();
-  }
+  test::drive_base(core, {1, 0.2, 0.0, 0.0}, 3000);
   const RobotState s = core.state();
   EXPECT_NEAR(s.odometry.vx, 0.2, 0.02);
   const Eigen::Vector3d truth = sim.base_pose().translation();

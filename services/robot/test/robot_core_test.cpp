@@ -123,12 +123,8 @@ TEST_F(RobotCoreTest, EffortCommandsSaturateAtTheTorqueLimit) {
 }
 
 TEST_F(RobotCoreTest, GravityCompensationFloatsTheArm) {
-  SimParams params;
-  params.initial_positions = {{"J2_A", 0.5}, {"J3_A", 0.6}};
-  SimHardware sim(read_fixture("arm_drill.urdf"), World{}, params);
-  RobotCore core(sim);
-  core.set_model(read_fixture("arm_drill.urdf"), 1);
-  run_cycles(core, 200);
+  test::SimulatedArm arm({{"J2_A", 0.5}, {"J3_A", 0.6}}, 200);
+  RobotCore& core = arm.core;
   // Position hold has gravity feed-forward: no sag (g / kp would be ~0.02 rad here).
   const RobotState held = core.state();
   EXPECT_NEAR(held.position[hw_index(held, "J2_A")], 0.5, 2e-3);
@@ -145,12 +141,7 @@ TEST_F(RobotCoreTest, GravityCompensationFloatsTheArm) {
 TEST_F(RobotCoreTest, SafetyStopHoldsAndRefusesCommands) {
   core_.set_model(read_fixture("mobile_drill.urdf"), 1);
   core_.command_joints({1, {{"J1_A", DriveMode::kVelocity, 0, 1.0, 0, 0, 0}}});
-  for (int k = 0; k < 400; ++k) {
-    if (k % 100 == 0) {
-      core_.command_base({1, 0.3, 0.0, 0.0});
-    }
-    core_.cycle();
-  }
+  test::drive_base(core_, {1, 0.3, 0.0, 0.0}, 400);
   core_.set_safety_stop(true, "estop: wireless");
   EXPECT_TRUE(core_.safety_stopped());
   const std::string msg = message_of([&] { core_.command_base({1, 0.3, 0, 0}); });
@@ -168,12 +159,8 @@ TEST_F(RobotCoreTest, SafetyStopHoldsAndRefusesCommands) {
 
 TEST(RobotCore, CartesianWithZeroGainsIsGravityCompensation) {
   // What DDS clients use for teaching mode (README): no stiffness, no damping.
-  SimParams params;
-  params.initial_positions = {{"J2_A", 0.5}, {"J3_A", 0.6}};
-  SimHardware sim(read_fixture("arm_drill.urdf"), World{}, params);
-  RobotCore core(sim);
-  core.set_model(read_fixture("arm_drill.urdf"), 1);
-  run_cycles(core, 200);
+  test::SimulatedArm arm({{"J2_A", 0.5}, {"J3_A", 0.6}}, 200);
+  RobotCore& core = arm.core;
   CartesianCommand c;
   c.model_version = 1;
   c.stiffness.setZero();

@@ -4,27 +4,22 @@
 //   concert_safety [--params FILE]
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
 #include <atomic>
-#include <csignal>
 #include <iostream>
 #include <string>
 
 #include "concert/cli/cli.hpp"
+#include "concert/cli/stop_signals.hpp"
 #include "concert/dds/participant.hpp"
 #include "dds/safety_node.hpp"
 #include "safety/params.hpp"
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-
-void on_signal(int) { g_stop = true; }
-
 int run(const std::string& params_file) {
   using namespace concert;
   safety::Params params;
   if (!params_file.empty()) params = safety::load_params(params_file);
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  const std::atomic<bool>& stop = concert::cli::stop_on_signals();
   safety::dds::use_interprocess_delivery_only();
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "safety"});
   safety::dds::SafetyNode node(participant, params, std::cerr);
@@ -32,7 +27,7 @@ int run(const std::string& params_file) {
   for (const auto& s : params.task_services) watched += ", " + s;
   std::cerr << "concert_safety: domain " << participant.domain_id() << ", watching " << watched
             << " (silent > " << params.liveliness_timeout.count() << " ms -> stop)" << std::endl;
-  node.spin(g_stop);
+  node.spin(stop);
   return 0;
 }
 

@@ -11,15 +11,13 @@
 #include "concert/dds/status_reporter.hpp"
 #include "dds/conversions.hpp"
 #include "dds/safety_node.hpp"
+#include "test_helpers.hpp"
 
 namespace concert::safety::dds {
 namespace {
 
 using namespace std::chrono_literals;
-using concert::dds::Participant;
-using concert::dds::Reader;
-using concert::dds::Writer;
-namespace topics = concert::dds::topics;
+using test::wait_state;
 
 /// Polls `done` every 20 ms for at most `timeout`.
 bool eventually(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
@@ -29,17 +27,6 @@ bool eventually(const std::function<bool()>& done, std::chrono::milliseconds tim
     std::this_thread::sleep_for(20ms);
   }
   return done();
-}
-
-/// Reads SafetyState samples until one satisfies `pred` (bounded).
-bool wait_state(Reader<msg::SafetyState>& reader,
-                const std::function<bool(const msg::SafetyState&)>& pred,
-                std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (auto s = reader.wait(100ms); s && pred(*s)) return true;
-  }
-  return false;
 }
 
 msg::EStopInput estop(msg::EStopSource source, bool engaged) {

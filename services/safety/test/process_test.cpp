@@ -14,25 +14,13 @@
 
 #include "concert/dds/endpoint.hpp"
 #include "safety/cli.hpp"
+#include "test_helpers.hpp"
 
 namespace concert::safety {
 namespace {
 
 using namespace std::chrono_literals;
-using concert::dds::Participant;
-using concert::dds::Reader;
-using concert::dds::Writer;
-namespace topics = concert::dds::topics;
-
-bool wait_state(Reader<msg::SafetyState>& reader,
-                const std::function<bool(const msg::SafetyState&)>& pred,
-                std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (auto s = reader.wait(100ms); s && pred(*s)) return true;
-  }
-  return false;
-}
+using test::wait_state;
 
 std::filesystem::path temp_file(const std::string& name, const std::string& text) {
   const auto path =
@@ -162,32 +150,41 @@ TEST(SafetyProcess, OperatorVerbsEStopStatusReset) {
   EXPECT_EQ(safety.stop(15s), 0);
 }
 
-TEST(SafetyCli, UsageErrorsAndNoService) {
-  auto [code, text] = cli({});
-  EXPECT_EQ(code, 2);
-  EXPECT_NE(text.find("concert safety: missing verb (one of: status, estop, reset)"),
-            std::string::npos)
-      << text;
-  std::tie(code, text) = cli({"estop", "--source", "left"});
-  EXPECT_EQ(code, 2);
-  EXPECT_NE(text.find("--source: left not in {front-left,front-right,rear-left,rear-right,"
-                      "software,wireless}"),
-            std::string::npos)
-      << text;
-  std::tie(code, text) = cli({"status", "--timeout", "soon"});
-  EXPECT_EQ(code, 2);
-  EXPECT_NE(text.find("--timeout: 'soon' is not a number >= 0"), std::string::npos) << text;
-  std::tie(code, text) = cli({"status", "--release"});
-  EXPECT_EQ(code, 2);
-  EXPECT_NE(text.find("concert safety status: The following argument was not expected: --release"),
-            std::string::npos)
-      << text;
-  std::tie(code, text) = cli({"reset", "--timeout", "0.3"});  // no safety service running
-  EXPECT_EQ(code, 1);
-  EXPECT_NE(text.find("concert safety reset: no safety service on domain"), std::string::npos)
-      << text;
+/// A command line that must fail: its arguments, the exit code and a text its output names.
+struct Failing {
+  std::vector<std::string> args;
+  int code;
+  std::string text;
+};
+
+/// Runs every command line of `failing` through `run` (which returns the exit code and the
+/// output) and checks how each ends.
+void expect_failures(
+    const std::function<std::pair<int, std::string>(std::vector<std::string>)>& run,
+    const std::vector<Failing>& failing) {
+  for (const auto& f : failing) {
+    const auto [code, text] = run(f.args);
+    EXPECT_EQ(code, f.code) << ::testing::PrintToString(f.args) << ": " << text;
+    EXPECT_NE(text.find(f.text), std::string::npos) << text;
+  }
 }
 
+TEST(SafetyCli, UsageErrorsAndNoService) {
+  expect_failures(
+      cli,
+      {{{}, 2, "concert safety: missing verb (one of: status, estop, reset)"},
+       {{"estop", "--source", "left"},
+        2,
+        "--source: left not in {front-left,front-right,rear-left,rear-right,software,wireless}"},
+       {{"status", "--timeout", "soon"}, 2, "--timeout: 'soon' is not a number >= 0"},
+       {{"status", "--release"},
+        2,
+        "concert safety status: The following argument was not expected: --release"},
+       // No safety service running.
+       {{"reset", "--timeout", "0.3"}, 1, "concert safety reset: no safety service on domain"}});
+}
+
+/// Runs concert_safety with `args`; returns (exit code, stderr).
 std::pair<int, std::string> run(std::vector<std::string> args) {
   args.insert(args.begin(), SAFETY_BINARY);
   testing::Process p(args);
@@ -196,27 +193,17 @@ std::pair<int, std::string> run(std::vector<std::string> args) {
 }
 
 TEST(SafetyProcess, BadArgumentsExitNonZeroWithOneLine) {
-  auto [code, err] = run({"--bogus"});
-  EXPECT_EQ(code, 2);
-  EXPECT_NE(err.find("concert_safety: The following argument was not expected: --bogus"),
-            std::string::npos)
-      << err;
-  std::tie(code, err) = run({"--params"});
-  EXPECT_EQ(code, 2);
-  EXPECT_NE(err.find("--params: 1 required FILE missing"), std::string::npos) << err;
-  std::tie(code, err) = run({"--params", "/nonexistent/safety.yaml"});
-  EXPECT_EQ(code, 1);
-  EXPECT_NE(err.find("parameters file '/nonexistent/safety.yaml' cannot be opened"),
-            std::string::npos)
-      << err;
   const auto bad = temp_file("safety_bad", "liveliness_timeout: soon\n");
-  std::tie(code, err) = run({"--params", bad.string()});
-  EXPECT_EQ(code, 1);
-  EXPECT_NE(err.find(bad.string() +
-                     ": liveliness_timeout: expected a duration in seconds in (0, 3600], got "
-                     "'soon' (line 1)"),
-            std::string::npos)
-      << err;
+  expect_failures(
+      run, {{{"--bogus"}, 2, "concert_safety: The following argument was not expected: --bogus"},
+            {{"--params"}, 2, "--params: 1 required FILE missing"},
+            {{"--params", "/nonexistent/safety.yaml"},
+             1,
+             "parameters file '/nonexistent/safety.yaml' cannot be opened"},
+            {{"--params", bad.string()},
+             1,
+             bad.string() + ": liveliness_timeout: expected a duration in seconds in (0, 3600], "
+                            "got 'soon' (line 1)"}});
   std::filesystem::remove(bad);
 }
 

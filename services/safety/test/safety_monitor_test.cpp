@@ -23,6 +23,13 @@ bool contains(const std::vector<std::string>& causes, const std::string& text) {
   return false;
 }
 
+/// Default parameters but for the liveliness bound.
+Params with_liveliness_timeout(std::chrono::milliseconds timeout) {
+  Params p;
+  p.liveliness_timeout = timeout;
+  return p;
+}
+
 TEST(SafetyMonitor, StartsRunningWithNothingWatched) {
   SafetyMonitor m(Params{}, kT0);
   EXPECT_EQ(m.status().mode, Mode::kRunning);
@@ -109,9 +116,7 @@ TEST(SafetyMonitor, ResetWhileRunningIsHarmless) {
 }
 
 TEST(SafetyMonitor, SilentTaskServiceStopsNamingIt) {
-  Params p;
-  p.liveliness_timeout = 500ms;
-  SafetyMonitor m(p, kT0);
+  SafetyMonitor m(with_liveliness_timeout(500ms), kT0);
   m.on_heartbeat("planner", "manip", false, kT0);
   m.on_heartbeat("robot", "rt", false, kT0);
   for (int i = 1; i <= 10; ++i) {  // robot keeps beating, planner goes silent after 0 ms
@@ -129,9 +134,7 @@ TEST(SafetyMonitor, SilentTaskServiceStopsNamingIt) {
 }
 
 TEST(SafetyMonitor, UnwatchedServicesAreIgnored) {
-  Params p;
-  p.liveliness_timeout = 100ms;
-  SafetyMonitor m(p, kT0);
+  SafetyMonitor m(with_liveliness_timeout(100ms), kT0);
   m.on_heartbeat("modelgen", "rt", false, kT0);
   m.on_heartbeat("discovery", "rt", false, kT0);
   m.check_liveliness(kT0 + 10s);
@@ -139,9 +142,7 @@ TEST(SafetyMonitor, UnwatchedServicesAreIgnored) {
 }
 
 TEST(SafetyMonitor, CleanStopOfATaskIsNotAFaultButOfTheRobotIs) {
-  Params p;
-  p.liveliness_timeout = 100ms;
-  SafetyMonitor m(p, kT0);
+  SafetyMonitor m(with_liveliness_timeout(100ms), kT0);
   m.on_heartbeat("drill", "manip", false, kT0);
   m.on_heartbeat("drill", "manip", true, kT0 + 50ms);
   m.check_liveliness(kT0 + 10s);
@@ -153,9 +154,7 @@ TEST(SafetyMonitor, CleanStopOfATaskIsNotAFaultButOfTheRobotIs) {
 }
 
 TEST(SafetyMonitor, SilentRobotBlocksResetSilentTaskIsForgottenByReset) {
-  Params p;
-  p.liveliness_timeout = 100ms;
-  SafetyMonitor m(p, kT0);
+  SafetyMonitor m(with_liveliness_timeout(100ms), kT0);
   m.on_heartbeat("robot", "rt", false, kT0);
   m.on_heartbeat("nav", "navpc", false, kT0);
   m.check_liveliness(kT0 + 200ms);
@@ -180,8 +179,7 @@ TEST(SafetyMonitor, SilentRobotBlocksResetSilentTaskIsForgottenByReset) {
 }
 
 TEST(SafetyMonitor, RequiredRobotMustBeHeardAfterStart) {
-  Params p;
-  p.liveliness_timeout = 1s;
+  Params p = with_liveliness_timeout(1s);
   p.require_robot = true;
   SafetyMonitor m(p, kT0);
   m.check_liveliness(kT0 + 900ms);
@@ -212,33 +210,21 @@ TEST(SafetyMonitor, LimitsWithinBoundsAndTolerancesAreFine) {
 }
 
 TEST(SafetyMonitor, PositionVelocityEffortViolationsStop) {
-  {
+  const std::pair<JointSample, std::string> violations[] = {
+      {sample(3, 2.1, 0.0, 0.0),
+       "limits: joint J1_A position 2.100 beyond [-2.000, 2.000] (model v3)"},
+      {sample(3, 0.0, -1.7, 0.0), "limits: joint J1_A velocity -1.700 beyond +-1.650 (model v3)"},
+      {sample(3, 0.0, 0.0, 111.0),
+       "limits: joint J1_A effort 111.00 beyond the peak torque +-110.00 (model v3)"},
+      {sample(3, std::nan(""), 0.0, 0.0),
+       "limits: joint J1_A position nan beyond [-2.000, 2.000] (model v3)"},
+  };
+  for (const auto& [s, cause] : violations) {
     SafetyMonitor m(Params{}, kT0);
     m.set_model(3, two_joints());
-    m.on_joint_state(sample(3, 2.1, 0.0, 0.0), kT0);
-    ASSERT_EQ(m.status().mode, Mode::kStopped);
-    EXPECT_EQ(m.status().causes[0],
-              "limits: joint J1_A position 2.100 beyond [-2.000, 2.000] (model v3)");
-  }
-  {
-    SafetyMonitor m(Params{}, kT0);
-    m.set_model(3, two_joints());
-    m.on_joint_state(sample(3, 0.0, -1.7, 0.0), kT0);
-    ASSERT_EQ(m.status().mode, Mode::kStopped);
-    EXPECT_EQ(m.status().causes[0], "limits: joint J1_A velocity -1.700 beyond +-1.650 (model v3)");
-  }
-  {
-    SafetyMonitor m(Params{}, kT0);
-    m.set_model(3, two_joints());
-    m.on_joint_state(sample(3, 0.0, 0.0, 111.0), kT0);
-    ASSERT_EQ(m.status().mode, Mode::kStopped);
-    EXPECT_EQ(m.status().causes[0], "limits: joint J1_A effort 111.00 beyond the peak torque +-110.00 (model v3)");
-  }
-  {
-    SafetyMonitor m(Params{}, kT0);
-    m.set_model(3, two_joints());
-    m.on_joint_state(sample(3, std::nan(""), 0.0, 0.0), kT0);
-    EXPECT_EQ(m.status().mode, Mode::kStopped);
+    m.on_joint_state(s, kT0);
+    ASSERT_EQ(m.status().mode, Mode::kStopped) << cause;
+    EXPECT_EQ(m.status().causes[0], cause);
   }
 }
 

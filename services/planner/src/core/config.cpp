@@ -67,8 +67,7 @@ Params read_params(config::Document& doc) {
 
 Params parse_params(const std::string& yaml, const std::string& source) {
   try {
-    auto doc = config::Document::parse(yaml, source);
-    return read_params(doc);
+    return config::Document::parse(yaml, source).read_with(read_params);
   } catch (const config::ConfigError& e) {
     throw PlannerError(e.what());
   }

@@ -7,10 +7,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "concert/common/clock.hpp"
+#include "concert/common/enum_map.hpp"
 
 namespace concert::planner::dds {
 
@@ -51,25 +54,22 @@ msg::Pose to_msg(const Eigen::Isometry3d& t) {
   return p;
 }
 
-msg::PlanFailure to_failure(Status s) {
-  switch (s) {
-    case Status::kSucceeded:
-      return msg::PLAN_OK;
-    case Status::kNoModel:
-      return msg::PLAN_NO_MODEL;
-    case Status::kStaleModel:
-      return msg::PLAN_STALE_MODEL;
-    case Status::kInvalidRequest:
-      return msg::PLAN_INVALID_REQUEST;
-    case Status::kInvalidStart:
-      return msg::PLAN_INVALID_START;
-    case Status::kUnreachable:
-      return msg::PLAN_UNREACHABLE;
-    case Status::kNoPath:
-      return msg::PLAN_NO_PATH;
-  }
-  return msg::PLAN_NO_PATH;
-}
+namespace {
+
+// Every planning status and the failure the PlanResult reports for it, one row each.
+constexpr EnumMap kFailures{std::array{
+    std::pair{Status::kSucceeded, msg::PLAN_OK},
+    std::pair{Status::kNoModel, msg::PLAN_NO_MODEL},
+    std::pair{Status::kStaleModel, msg::PLAN_STALE_MODEL},
+    std::pair{Status::kInvalidRequest, msg::PLAN_INVALID_REQUEST},
+    std::pair{Status::kInvalidStart, msg::PLAN_INVALID_START},
+    std::pair{Status::kUnreachable, msg::PLAN_UNREACHABLE},
+    std::pair{Status::kNoPath, msg::PLAN_NO_PATH},
+}};
+
+}  // namespace
+
+msg::PlanFailure to_failure(Status s) { return kFailures.to(s).value_or(msg::PLAN_NO_PATH); }
 
 PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planner,
                          NodeOptions options, std::ostream& log)

@@ -66,6 +66,17 @@ struct CycleData {
   double ramp(int i, double target, double rate = 1.0);
   /// Joint i leaves torque-level control: its references follow the measurement.
   void follow(int i);
+  /// Joint i's drive reference, reset to a fresh one in `mode` for its owner to fill in.
+  DriveCommand& new_drive(int i, DriveMode mode);
+  /// Calls `f(i)` for every joint i that `who` owns, in model order. No allocation.
+  template <class F>
+  void for_each_owned_by(JointOwner who, F&& f) {
+    for (std::size_t iu = 0; iu < owner.size(); ++iu) {
+      if (owner[iu] == who) {
+        f(static_cast<int>(iu));
+      }
+    }
+  }
 };
 
 /// One controller of the loop.

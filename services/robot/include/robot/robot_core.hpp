@@ -8,6 +8,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "concert/kinematics/model.hpp"
@@ -84,7 +85,7 @@ struct BaseCommand {
 enum class JointOwner : std::uint8_t { kHold, kJoint, kCartesian, kGravityCompensation, kBase, kTrajectory };
 
 /// Name of the controller behind an owner ("hold", "joint", "cartesian_impedance", ...).
-const char* controller_name(JointOwner owner);
+std::string_view controller_name(JointOwner owner);
 
 /// Name of the virtual planar-base joints a joint trajectory may carry (odometry frame).
 inline constexpr const char* kBaseX = "base_x";

@@ -3,7 +3,12 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <string_view>
+#include <utility>
+
+#include "concert/common/enum_map.hpp"
 
 namespace concert::robot {
 namespace {
@@ -17,24 +22,22 @@ Eigen::Vector3d rotation_error(const Eigen::Matrix3d& target, const Eigen::Matri
   return aa.angle() * aa.axis();
 }
 
+using namespace std::string_view_literals;
+
+// The controller behind each owner, by the name ownership() reports.
+constexpr EnumMap kControllerNames{std::array{
+    std::pair{JointOwner::kHold, "hold"sv},
+    std::pair{JointOwner::kJoint, "joint"sv},
+    std::pair{JointOwner::kCartesian, "cartesian_impedance"sv},
+    std::pair{JointOwner::kGravityCompensation, "gravity_compensation"sv},
+    std::pair{JointOwner::kBase, "base_velocity"sv},
+    std::pair{JointOwner::kTrajectory, "joint_trajectory"sv},
+}};
+
 }  // namespace
 
-const char* controller_name(JointOwner owner) {
-  switch (owner) {
-    case JointOwner::kHold:
-      return "hold";
-    case JointOwner::kJoint:
-      return "joint";
-    case JointOwner::kCartesian:
-      return "cartesian_impedance";
-    case JointOwner::kGravityCompensation:
-      return "gravity_compensation";
-    case JointOwner::kBase:
-      return "base_velocity";
-    case JointOwner::kTrajectory:
-      return "joint_trajectory";
-  }
-  return "unknown";
+std::string_view controller_name(JointOwner owner) {
+  return kControllerNames.to(owner).value_or("unknown");
 }
 
 CycleData::CycleData(const kinematics::Model& m, std::size_t arm_joints) : model(&m) {
@@ -69,31 +72,27 @@ void CycleData::follow(int i) {
   hold_position[iu] = position_ref[iu] = q(i);
 }
 
+DriveCommand& CycleData::new_drive(int i, DriveMode mode) {
+  DriveCommand& d = drive[static_cast<std::size_t>(i)];
+  d = DriveCommand{};
+  d.mode = mode;
+  return d;
+}
+
 void HoldController::update(CycleData& data) {
-  for (std::size_t iu = 0; iu < data.owner.size(); ++iu) {
-    if (data.owner[iu] != JointOwner::kHold) {
-      continue;
-    }
-    const int i = static_cast<int>(iu);
-    DriveCommand& d = data.drive[iu];
-    d = DriveCommand{};
-    d.mode = DriveMode::kPosition;
-    d.position = data.ramp(i, data.hold_position[iu]);
+  data.for_each_owned_by(JointOwner::kHold, [&data](int i) {
+    DriveCommand& d = data.new_drive(i, DriveMode::kPosition);
+    d.position = data.ramp(i, data.hold_position[static_cast<std::size_t>(i)]);
     d.effort = data.gravity(i);
-  }
+  });
 }
 
 void JointController::update(CycleData& data) {
-  for (std::size_t iu = 0; iu < data.owner.size(); ++iu) {
-    if (data.owner[iu] != JointOwner::kJoint) {
-      continue;
-    }
-    const int i = static_cast<int>(iu);
+  data.for_each_owned_by(JointOwner::kJoint, [this, &data](int i) {
+    const auto iu = static_cast<std::size_t>(i);
     const JointSetpoint& jc = setpoints_[iu];
     const auto& lim = data.limits(i);
-    DriveCommand& d = data.drive[iu];
-    d = DriveCommand{};
-    d.mode = jc.mode;
+    DriveCommand& d = data.new_drive(i, jc.mode);
     switch (jc.mode) {
       case DriveMode::kPosition:
         d.position = data.ramp(i, jc.position);
@@ -121,7 +120,7 @@ void JointController::update(CycleData& data) {
     if (jc.mode != DriveMode::kPosition) {
       data.position_ref[iu] = data.q(i);
     }
-  }
+  });
 }
 
 CartesianController::CartesianController(const std::vector<int>& arm)
@@ -178,26 +177,17 @@ void CartesianController::update(CycleData& data) {
     if (data.owner[iu] != JointOwner::kCartesian) {
       continue;
     }
-    DriveCommand& d = data.drive[iu];
-    d = DriveCommand{};
-    d.mode = DriveMode::kEffort;
-    d.effort = tau_arm_(static_cast<Eigen::Index>(k)) + data.gravity(i);
+    data.new_drive(i, DriveMode::kEffort).effort =
+        tau_arm_(static_cast<Eigen::Index>(k)) + data.gravity(i);
     data.follow(i);
   }
 }
 
 void GravityCompensationController::update(CycleData& data) {
-  for (std::size_t iu = 0; iu < data.owner.size(); ++iu) {
-    if (data.owner[iu] != JointOwner::kGravityCompensation) {
-      continue;
-    }
-    const int i = static_cast<int>(iu);
-    DriveCommand& d = data.drive[iu];
-    d = DriveCommand{};
-    d.mode = DriveMode::kEffort;
-    d.effort = data.gravity(i);
+  data.for_each_owned_by(JointOwner::kGravityCompensation, [&data](int i) {
+    data.new_drive(i, DriveMode::kEffort).effort = data.gravity(i);
     data.follow(i);
-  }
+  });
 }
 
 BaseController::BaseController(std::vector<Leg> legs, double command_timeout, double trajectory_steering_rate)
@@ -237,9 +227,7 @@ void BaseController::drive_legs(CycleData& data, const Eigen::Vector3d& twist, J
     const int s = legs[k].steering_index;
     const int w = legs[k].wheel_index;
     if (data.owner[static_cast<std::size_t>(s)] == owner) {
-      DriveCommand& d = data.drive[static_cast<std::size_t>(s)];
-      d = DriveCommand{};
-      d.mode = DriveMode::kPosition;
+      DriveCommand& d = data.new_drive(s, DriveMode::kPosition);
       // Tracking a trajectory, the steering turns at a fraction of its velocity limit: at the
       // limit, the drive's own damping costs more than the joint's continuous torque.
       d.position = data.ramp(s, setpoints_[k].steering_angle,
@@ -247,9 +235,7 @@ void BaseController::drive_legs(CycleData& data, const Eigen::Vector3d& twist, J
       d.effort = data.gravity(s);
     }
     if (data.owner[static_cast<std::size_t>(w)] == owner) {
-      DriveCommand& d = data.drive[static_cast<std::size_t>(w)];
-      d = DriveCommand{};
-      d.mode = DriveMode::kVelocity;
+      DriveCommand& d = data.new_drive(w, DriveMode::kVelocity);
       d.velocity = clamp_abs(setpoints_[k].wheel_velocity, data.limits(w).velocity);
       if (owner == JointOwner::kTrajectory) {
         // Roll only as fast as the steering points the right way (swerve practice): steering a
@@ -365,9 +351,7 @@ void TrajectoryController::update(CycleData& data) {
     if (data.owner[iu] != JointOwner::kTrajectory) {
       continue;
     }
-    DriveCommand& d = data.drive[iu];
-    d = DriveCommand{};
-    d.mode = DriveMode::kPosition;
+    DriveCommand& d = data.new_drive(i, DriveMode::kPosition);
     d.position = data.clamp_position(i, q_ref_[k]);
     d.velocity = clamp_abs(qd_ref_[k], data.limits(i).velocity);
     d.effort = data.gravity(i);

@@ -1,8 +1,14 @@
 #include "robot_conversions.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
+
+#include "concert/common/enum_map.hpp"
 
 namespace concert::robot::dds {
 namespace {
@@ -19,43 +25,64 @@ void check_length(const msg::JointCommand& c, std::size_t size, const char* fiel
 
 double at(const std::vector<double>& v, std::size_t i) { return v.empty() ? 0.0 : v[i]; }
 
+// Every drive mode and its wire twin, one row each.
+constexpr EnumMap kDriveModes{std::array{
+    std::pair{DriveMode::kPosition, msg::JOINT_POSITION},
+    std::pair{DriveMode::kVelocity, msg::JOINT_VELOCITY},
+    std::pair{DriveMode::kEffort, msg::JOINT_EFFORT},
+    std::pair{DriveMode::kImpedance, msg::JOINT_IMPEDANCE},
+}};
+
+// The value fields of a joint command with how many values each carries, in the order their
+// lengths are checked.
+std::array<std::pair<const char*, std::size_t>, 5> value_counts(const msg::JointCommand& c) {
+  return {{{"position", c.position().size()},
+           {"velocity", c.velocity().size()},
+           {"effort", c.effort().size()},
+           {"stiffness", c.stiffness().size()},
+           {"damping", c.damping().size()}}};
+}
+
+// True if a command in `mode` cannot do without `field` (one value per joint).
+bool needs(DriveMode mode, std::string_view field) {
+  switch (mode) {
+    case DriveMode::kPosition:
+      return field == "position";
+    case DriveMode::kVelocity:
+      return field == "velocity";
+    case DriveMode::kEffort:
+      return field == "effort";
+    case DriveMode::kImpedance:
+      return field == "position" || field == "stiffness" || field == "damping";
+  }
+  return false;
+}
+
+// The trajectory states a TrajectoryStatus reports; an idle trajectory is reported as executing.
+constexpr EnumMap kTrajectoryStates{std::array{
+    std::pair{TrajectoryState::kExecuting, msg::TRAJECTORY_EXECUTING},
+    std::pair{TrajectoryState::kIdle, msg::TRAJECTORY_EXECUTING},
+    std::pair{TrajectoryState::kSucceeded, msg::TRAJECTORY_SUCCEEDED},
+    std::pair{TrajectoryState::kAborted, msg::TRAJECTORY_ABORTED},
+}};
+
 }  // namespace
 
 JointCommandSet to_core(const msg::JointCommand& c) {
   JointCommandSet out;
   out.model_version = c.model_version();
-  DriveMode mode = DriveMode::kPosition;
-  switch (c.mode()) {
-    case msg::JOINT_POSITION:
-      mode = DriveMode::kPosition;
-      check_length(c, c.position().size(), "position", true);
-      break;
-    case msg::JOINT_VELOCITY:
-      mode = DriveMode::kVelocity;
-      check_length(c, c.velocity().size(), "velocity", true);
-      break;
-    case msg::JOINT_EFFORT:
-      mode = DriveMode::kEffort;
-      check_length(c, c.effort().size(), "effort", true);
-      break;
-    case msg::JOINT_IMPEDANCE:
-      mode = DriveMode::kImpedance;
-      check_length(c, c.position().size(), "position", true);
-      check_length(c, c.stiffness().size(), "stiffness", true);
-      check_length(c, c.damping().size(), "damping", true);
-      break;
-    default:
-      throw CommandError("joint command from " + from(c.source()) + ": unknown mode " +
-                         std::to_string(static_cast<int>(c.mode())));
+  const std::optional<DriveMode> mode = kDriveModes.from(c.mode());
+  if (!mode) {
+    throw CommandError("joint command from " + from(c.source()) + ": unknown mode " +
+                       std::to_string(static_cast<int>(c.mode())));
   }
-  check_length(c, c.position().size(), "position", false);
-  check_length(c, c.velocity().size(), "velocity", false);
-  check_length(c, c.effort().size(), "effort", false);
-  check_length(c, c.stiffness().size(), "stiffness", false);
-  check_length(c, c.damping().size(), "damping", false);
+  for (const auto& [field, size] : value_counts(c)) {
+    if (needs(*mode, field)) check_length(c, size, field, true);
+  }
+  for (const auto& [field, size] : value_counts(c)) check_length(c, size, field, false);
   for (std::size_t i = 0; i < c.name().size(); ++i) {
-    out.joints.push_back({c.name()[i], mode, at(c.position(), i), at(c.velocity(), i), at(c.effort(), i),
-                          at(c.stiffness(), i), at(c.damping(), i)});
+    out.joints.push_back({c.name()[i], *mode, at(c.position(), i), at(c.velocity(), i),
+                          at(c.effort(), i), at(c.stiffness(), i), at(c.damping(), i)});
   }
   return out;
 }
@@ -119,16 +146,7 @@ JointTrajectory to_core(const msg::JointTrajectoryCommand& c) {
 }
 
 msg::TrajectoryState to_msg(TrajectoryState state) {
-  switch (state) {
-    case TrajectoryState::kSucceeded:
-      return msg::TRAJECTORY_SUCCEEDED;
-    case TrajectoryState::kAborted:
-      return msg::TRAJECTORY_ABORTED;
-    case TrajectoryState::kIdle:
-    case TrajectoryState::kExecuting:
-      break;
-  }
-  return msg::TRAJECTORY_EXECUTING;
+  return kTrajectoryStates.to(state).value_or(msg::TRAJECTORY_EXECUTING);
 }
 
 int64_t to_stamp_ns(double time) { return static_cast<int64_t>(std::llround(time * 1e9)); }

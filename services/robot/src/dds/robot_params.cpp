@@ -61,13 +61,11 @@ ServiceParams read_service_params(config::Document& doc) {
 }
 
 ServiceParams parse_service_params(const std::string& yaml_text, const std::string& source) {
-  auto doc = config::Document::parse(yaml_text, source);
-  return read_service_params(doc);
+  return config::Document::parse(yaml_text, source).read_with(read_service_params);
 }
 
 ServiceParams load_service_params(const std::string& path) {
-  auto doc = config::Document::load(path);
-  return read_service_params(doc);
+  return config::Document::load(path).read_with(read_service_params);
 }
 
 }  // namespace concert::robot::dds

@@ -23,13 +23,11 @@ Params read_params(config::Document& doc) {
 }
 
 Params parse_params(const std::string& yaml, const std::string& origin) {
-  auto doc = config::Document::parse(yaml, origin);
-  return read_params(doc);
+  return config::Document::parse(yaml, origin).read_with(read_params);
 }
 
 Params load_params(const std::string& file) {
-  auto doc = config::Document::load(file);
-  return read_params(doc);
+  return config::Document::load(file).read_with(read_params);
 }
 
 }  // namespace concert::safety

@@ -4,6 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
+
+#include "concert/common/enum_map.hpp"
+#include "concert/model/limit_checks.hpp"
 
 namespace concert::safety {
 namespace {
@@ -18,24 +22,22 @@ std::string seconds(std::chrono::nanoseconds d) {
   return fixed(std::chrono::duration<double>(d).count(), 2) + " s";
 }
 
+using namespace std::string_view_literals;
+
+// What causes and messages call each e-stop input.
+constexpr EnumMap kEStopNames{std::array{
+    std::pair{EStopSource::kButtonFrontLeft, "button front left"sv},
+    std::pair{EStopSource::kButtonFrontRight, "button front right"sv},
+    std::pair{EStopSource::kButtonRearLeft, "button rear left"sv},
+    std::pair{EStopSource::kButtonRearRight, "button rear right"sv},
+    std::pair{EStopSource::kWireless, "wireless"sv},
+    std::pair{EStopSource::kSoftware, "software"sv},
+}};
+
 }  // namespace
 
 std::string_view to_string(EStopSource source) {
-  switch (source) {
-    case EStopSource::kButtonFrontLeft:
-      return "button front left";
-    case EStopSource::kButtonFrontRight:
-      return "button front right";
-    case EStopSource::kButtonRearLeft:
-      return "button rear left";
-    case EStopSource::kButtonRearRight:
-      return "button rear right";
-    case EStopSource::kWireless:
-      return "wireless";
-    case EStopSource::kSoftware:
-      return "software";
-  }
-  return "unknown";
+  return kEStopNames.to(source).value_or("unknown");
 }
 
 SafetyMonitor::SafetyMonitor(Params params, TimePoint start)
@@ -121,35 +123,37 @@ void SafetyMonitor::set_model(uint32_t version, model::LimitsTable limits) {
 
 void SafetyMonitor::check_joint(std::size_t row, std::size_t i, const JointSample& sample, double dt) {
   const model::JointLimits& limits = limits_.rows()[row];
-  const std::string joint = "joint " + limits.name;
-  const std::string version = " (model v" + std::to_string(model_version_) + ")";
+  // Stops with "limits: joint NAME WHAT (model vN)", once per joint and `kind` of limit.
+  const auto violation = [&](const std::string& kind, const std::string& what) {
+    const std::string version = " (model v" + std::to_string(model_version_) + ")";
+    stop("limits:" + limits.name + ":" + kind,
+         "limits: joint " + limits.name + " " + what + version);
+  };
   const double q = sample.position[i];
   if (model::position_violated(limits, q, params_.position_tolerance)) {
-    stop("limits:" + limits.name + ":position", "limits: " + joint + " position " + fixed(q, 3) + " beyond [" +
-                                                    fixed(limits.lower, 3) + ", " + fixed(limits.upper, 3) + "]" + version);
+    violation("position", "position " + fixed(q, 3) + " beyond [" + fixed(limits.lower, 3) + ", " +
+                              fixed(limits.upper, 3) + "]");
   }
   if (i < sample.velocity.size()) {
     const double qd = sample.velocity[i];
-    const double bound = model::velocity_bound(limits, params_.velocity_margin);
-    if (!std::isfinite(qd) || std::abs(qd) > bound) {
-      stop("limits:" + limits.name + ":velocity",
-           "limits: " + joint + " velocity " + fixed(qd, 3) + " beyond +-" + fixed(bound, 3) + version);
+    if (model::velocity_violated(limits, qd, params_.velocity_margin)) {
+      violation("velocity", "velocity " + fixed(qd, 3) + " beyond +-" +
+                                fixed(model::velocity_bound(limits, params_.velocity_margin), 3));
     }
   }
   if (i < sample.effort.size()) {
     const double tau = sample.effort[i];
-    const double peak = model::instant_torque_bound(limits, params_.effort_margin);
-    if (!std::isfinite(tau) || std::abs(tau) > peak) {
-      stop("limits:" + limits.name + ":effort",
-           "limits: " + joint + " effort " + fixed(tau, 2) + " beyond the peak torque +-" + fixed(peak, 2) + version);
+    if (model::torque_violated(limits, tau, params_.effort_margin)) {
+      violation("effort", "effort " + fixed(tau, 2) + " beyond the peak torque +-" +
+                              fixed(model::instant_torque_bound(limits, params_.effort_margin), 2));
       return;
     }
     const double rms = thermal_[row].add(tau, dt);
     const double continuous = model::sustained_torque_bound(limits, params_.effort_margin);
     if (rms > continuous) {
-      stop("limits:" + limits.name + ":sustained_effort",
-           "limits: " + joint + " RMS effort " + fixed(rms, 2) + " over the " + fixed(model::kThermalWindow, 1) +
-               " s thermal window beyond the continuous torque " + fixed(continuous, 2) + version);
+      violation("sustained_effort",
+                "RMS effort " + fixed(rms, 2) + " over the " + fixed(model::kThermalWindow, 1) +
+                    " s thermal window beyond the continuous torque " + fixed(continuous, 2));
     }
   }
 }

@@ -1,41 +1,30 @@
 #include "dds/conversions.hpp"
 
+#include <array>
+#include <utility>
+
+#include "concert/common/enum_map.hpp"
+
 namespace concert::safety::dds {
 
-std::optional<EStopSource> to_core(msg::EStopSource source) {
-  switch (source) {
-    case msg::ESTOP_BUTTON_FRONT_LEFT:
-      return EStopSource::kButtonFrontLeft;
-    case msg::ESTOP_BUTTON_FRONT_RIGHT:
-      return EStopSource::kButtonFrontRight;
-    case msg::ESTOP_BUTTON_REAR_LEFT:
-      return EStopSource::kButtonRearLeft;
-    case msg::ESTOP_BUTTON_REAR_RIGHT:
-      return EStopSource::kButtonRearRight;
-    case msg::ESTOP_WIRELESS:
-      return EStopSource::kWireless;
-    case msg::ESTOP_SOFTWARE:
-      return EStopSource::kSoftware;
-  }
-  return std::nullopt;
-}
+namespace {
+
+// Every e-stop source and its wire twin, one row each; read both ways.
+constexpr EnumMap kEStopSources{std::array{
+    std::pair{EStopSource::kButtonFrontLeft, msg::ESTOP_BUTTON_FRONT_LEFT},
+    std::pair{EStopSource::kButtonFrontRight, msg::ESTOP_BUTTON_FRONT_RIGHT},
+    std::pair{EStopSource::kButtonRearLeft, msg::ESTOP_BUTTON_REAR_LEFT},
+    std::pair{EStopSource::kButtonRearRight, msg::ESTOP_BUTTON_REAR_RIGHT},
+    std::pair{EStopSource::kWireless, msg::ESTOP_WIRELESS},
+    std::pair{EStopSource::kSoftware, msg::ESTOP_SOFTWARE},
+}};
+
+}  // namespace
+
+std::optional<EStopSource> to_core(msg::EStopSource source) { return kEStopSources.from(source); }
 
 msg::EStopSource to_msg(EStopSource source) {
-  switch (source) {
-    case EStopSource::kButtonFrontLeft:
-      return msg::ESTOP_BUTTON_FRONT_LEFT;
-    case EStopSource::kButtonFrontRight:
-      return msg::ESTOP_BUTTON_FRONT_RIGHT;
-    case EStopSource::kButtonRearLeft:
-      return msg::ESTOP_BUTTON_REAR_LEFT;
-    case EStopSource::kButtonRearRight:
-      return msg::ESTOP_BUTTON_REAR_RIGHT;
-    case EStopSource::kWireless:
-      return msg::ESTOP_WIRELESS;
-    case EStopSource::kSoftware:
-      return msg::ESTOP_SOFTWARE;
-  }
-  return msg::ESTOP_SOFTWARE;
+  return kEStopSources.to(source).value_or(msg::ESTOP_SOFTWARE);
 }
 
 JointSample to_core(const msg::JointState& state) {

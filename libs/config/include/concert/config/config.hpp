@@ -25,6 +25,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace concert::config {
@@ -141,6 +142,13 @@ class Document {
 
   /// The top-level mapping (an empty file is an empty mapping).
   Map root();
+  /// Reads this whole document with `reader` (a function of Document&, such as a service's
+  /// read_params) and returns what it returns:
+  ///   return config::Document::load(file).read_with(read_params);
+  template <class Reader>
+  auto read_with(Reader&& reader) {
+    return std::forward<Reader>(reader)(*this);
+  }
   /// Throws ConfigError for the first key of the file no reader asked for, naming it and the
   /// keys that are known at its place; also for a key given twice.
   void finish() const;

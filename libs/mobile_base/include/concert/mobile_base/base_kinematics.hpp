@@ -49,6 +49,10 @@ std::map<std::string, double> collision_cylinder_radii(const std::string& urdf);
 std::vector<Leg> detect_legs(const kinematics::Model& model, const std::map<std::string, double>& wheel_radii,
                              double default_wheel_radius = 0.16);
 
+/// Height of the base frame above the floor when the base stands on its wheels [m]: the
+/// largest wheel radius above its wheel centre's height (0 without legs).
+double standing_height(const std::vector<Leg>& legs);
+
 /// Omni-steering kinematics of a base with N >= 2 steering+wheel legs.
 class BaseKinematics {
  public:
