@@ -3,23 +3,18 @@
 //   concert_discovery [--module-db DIR ...] [--port-order 0312|0123] [--params FILE]
 // --params: config/discovery.yaml lists every key with its default (flags override it).
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
-#include <atomic>
-#include <csignal>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include "concert/cli/cli.hpp"
+#include "concert/cli/stop_signals.hpp"
 #include "concert/dds/participant.hpp"
 #include "dds/discovery_node.hpp"
 #include "dds/service_params.hpp"
 #include "concert/topology/reconstruction.hpp"
 
 namespace {
-
-std::atomic<bool> g_stop{false};
-
-void on_signal(int) { g_stop = true; }
 
 struct Options {
   std::vector<std::string> module_dbs;
@@ -39,8 +34,7 @@ int run(const Options& options) {
   for (const auto& db : settings.module_dbs) catalog.merge(topology::EscCatalog::load(db));
   const std::size_t entries = catalog.entries().size();
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  const std::atomic<bool>& stop = cli::stop_on_signals();
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "discovery"});
   discovery::dds::DiscoveryNode node(participant,
                                      discovery::DiscoveryService(topology::Discovery(
@@ -49,7 +43,7 @@ int run(const Options& options) {
   std::cerr << "concert_discovery: " << entries << " catalogue entries from "
             << settings.module_dbs.size() << " database(s), port order " << settings.port_order
             << ", domain " << participant.domain_id() << "\n";
-  node.spin(g_stop);
+  node.spin(stop);
   return 0;
 }
 

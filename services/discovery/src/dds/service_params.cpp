@@ -12,8 +12,7 @@ ServiceParams read_service_params(config::Document& doc) {
 }
 
 ServiceParams load_service_params(const std::string& file) {
-  auto doc = config::Document::load(file);
-  return read_service_params(doc);
+  return config::Document::load(file).read_with(read_service_params);
 }
 
 }  // namespace concert::discovery::dds
