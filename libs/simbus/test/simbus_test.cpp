@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "concert/common/error_text.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/simbus/testing.hpp"
 
@@ -18,22 +19,20 @@ const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resou
 const std::string kExamples = std::string(SIMBUS_EXAMPLES);
 
 std::string error_of(const std::string& yaml, const EscCatalog& catalog) {
-  try {
-    validate(parse_assembly(yaml, "a.yaml"), catalog);
-  } catch (const AssemblyError& e) {
-    return e.what();
-  }
-  return "";
+  return error_text<AssemblyError>([&] { validate(parse_assembly(yaml, "a.yaml"), catalog); }, "");
+}
+
+/// The scan of the assembly text `yaml` over the synthetic catalogue.
+EscScan synthetic_scan(const std::string& yaml, PortOrder order = PortOrder::kReal0312) {
+  return simulate_scan(parse_assembly(yaml, "test"), synthetic_catalog(), order);
 }
 
 /// Appendix A, Figure A1: slave B on port 2 of slave A (paper's simplified order 0-1-2-3).
 TEST(SimBus, AppendixAExampleOne) {
-  const EscCatalog catalog = synthetic_catalog();
-  const Assembly a = parse_assembly(
+  const EscScan scan = synthetic_scan(
       "modules:\n  - {name: A, key: hub3, robot_id: 1}\n"
       "  - {name: B, key: joint, parent: A, connector: 2, robot_id: 2}\n",
-      "ex1");
-  const EscScan scan = simulate_scan(a, catalog, PortOrder::kNumeric0123);
+      PortOrder::kNumeric0123);
   ASSERT_EQ(scan.slaves.size(), 2u);
   EXPECT_EQ(scan.slaves[0].robot_id, 1);
   EXPECT_EQ(scan.slaves[0].active_ports, 0b0101);  // port 0 (master) and port 2 (B)
@@ -175,12 +174,9 @@ TEST(SimBus, UpsideDownElbowComesAfterItsSubtree) {
 }
 
 TEST(SimBus, UpsideDownLeafHasPortZeroClosed) {
-  const EscCatalog catalog = synthetic_catalog();
-  const Assembly a = parse_assembly(
+  const EscScan scan = synthetic_scan(
       "modules:\n  - {name: j, key: joint}\n  - {name: t, key: tool, parent: j, connector: 1}\n"
-      "faults:\n  - {type: upside_down, module: t}\n",
-      "leaf");
-  const EscScan scan = simulate_scan(a, catalog);
+      "faults:\n  - {type: upside_down, module: t}\n");
   ASSERT_EQ(scan.slaves.size(), 2u);
   EXPECT_EQ(scan.slaves[1].active_ports, 0b0010);  // entered through port 1, port 0 closed
 }
