@@ -322,7 +322,8 @@ std::string assembly_to_yaml(const Assembly& assembly) {
   if (!assembly.faults.empty()) {
     out << "faults:\n";
     for (const auto& f : assembly.faults) {
-      out << "  - {type: " << kFaultTypes.to(f.type).value_or("unknown") << ", module: " << f.module;
+      out << "  - {type: " << kFaultTypes.to(f.type).value_or("unknown")
+          << ", module: " << f.module;
       switch (f.type) {
         case FaultType::kUpsideDown:
           if (f.upstream_port) out << ", upstream_port: " << *f.upstream_port;
