@@ -50,6 +50,18 @@ void delete_reader(Participant& participant, DataReader* reader) {
   }
 }
 
+int32_t matched_count(DataWriter* writer) {
+  PublicationMatchedStatus status;
+  writer->get_publication_matched_status(status);
+  return status.current_count;
+}
+
+int32_t matched_count(DataReader* reader) {
+  SubscriptionMatchedStatus status;
+  reader->get_subscription_matched_status(status);
+  return status.current_count;
+}
+
 bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (!done()) {

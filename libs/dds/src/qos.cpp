@@ -4,29 +4,35 @@ namespace concert::dds {
 
 using namespace eprosima::fastdds::dds;
 
-DataWriterQos writer_qos(QosClass qos) {
-  const QosSpec spec = qos_spec(qos);
-  DataWriterQos q = DATAWRITER_QOS_DEFAULT;
+namespace {
+
+/// The settings writers and readers share: reliability, durability and keep-last depth of the
+/// class, with preallocated (growable) sample memory.
+template <class EndpointQos>
+EndpointQos endpoint_qos(EndpointQos q, const QosSpec& spec) {
   q.reliability().kind = spec.reliable ? RELIABLE_RELIABILITY_QOS : BEST_EFFORT_RELIABILITY_QOS;
-  q.durability().kind = spec.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
+  q.durability().kind =
+      spec.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
   q.history().kind = KEEP_LAST_HISTORY_QOS;
   q.history().depth = spec.history_depth;
-  q.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, kHeartbeatPeriodMs * 1'000'000u);
+  q.endpoint().history_memory_policy =
+      eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+  return q;
+}
+
+}  // namespace
+
+DataWriterQos writer_qos(QosClass qos) {
+  DataWriterQos q = endpoint_qos(DATAWRITER_QOS_DEFAULT, qos_spec(qos));
+  q.reliable_writer_qos().times.heartbeatPeriod =
+      eprosima::fastrtps::Duration_t(0, kHeartbeatPeriodMs * 1'000'000u);
   // Keep-last never blocks, but bound the time a reliable write may wait for a slow reader.
   q.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(0, 1'000'000);
-  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return q;
 }
 
 DataReaderQos reader_qos(QosClass qos) {
-  const QosSpec spec = qos_spec(qos);
-  DataReaderQos q = DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = spec.reliable ? RELIABLE_RELIABILITY_QOS : BEST_EFFORT_RELIABILITY_QOS;
-  q.durability().kind = spec.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
-  q.history().kind = KEEP_LAST_HISTORY_QOS;
-  q.history().depth = spec.history_depth;
-  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
-  return q;
+  return endpoint_qos(DATAREADER_QOS_DEFAULT, qos_spec(qos));
 }
 
 }  // namespace concert::dds

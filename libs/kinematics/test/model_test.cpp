@@ -75,13 +75,18 @@ TEST(KinematicsModel, DepthFirstJointOrderOnTree) {
   EXPECT_NEAR(m.total_mass(), 80.0 + 4 * 7.0 + 2.0 + 3.6 + 3.0 + 2.5 + 1.5 + 1.2 + 0.8 + 2.0, 1e-9);
 }
 
-TEST(KinematicsModel, TwoLinkForwardKinematicsMatchesHandComputation) {
-  const Model m = two_link();
-  Data d = m.make_data();
+/// The two-link arm whose kinematics and dynamics are computed by hand below.
+class TwoLinkArm : public ::testing::Test {
+ protected:
+  const Model model_ = two_link();
+  Data data_ = model_.make_data();
+};
+
+TEST_F(TwoLinkArm, ForwardKinematicsMatchesHandComputation) {
   std::mt19937 rng(7);
   for (int k = 0; k < 20; ++k) {
-    const Eigen::VectorXd q = random_q(m, rng);
-    const Eigen::Isometry3d tip = m.frame_pose(d, q, "tip");
+    const Eigen::VectorXd q = random_q(model_, rng);
+    const Eigen::Isometry3d tip = model_.frame_pose(data_, q, "tip");
     // Rotation about +y turns +x towards -z.
     const double x = kL1 * std::cos(q(0)) + kL2 * std::cos(q(0) + q(1));
     const double z = -(kL1 * std::sin(q(0)) + kL2 * std::sin(q(0) + q(1)));
@@ -90,24 +95,22 @@ TEST(KinematicsModel, TwoLinkForwardKinematicsMatchesHandComputation) {
     EXPECT_NEAR(tip.translation().z(), z, 1e-12);
     const Eigen::Matrix3d expected = Eigen::AngleAxisd(q(0) + q(1), Eigen::Vector3d::UnitY()).toRotationMatrix();
     EXPECT_TRUE(tip.linear().isApprox(expected, 1e-12));
-    const Eigen::Isometry3d rel = m.relative_pose(d, q, "link2", "tip");
+    const Eigen::Isometry3d rel = model_.relative_pose(data_, q, "link2", "tip");
     EXPECT_TRUE(rel.translation().isApprox(Eigen::Vector3d(kL2, 0, 0), 1e-12));
   }
 }
 
-TEST(KinematicsModel, TwoLinkGravityAndDynamicsMatchHandComputation) {
-  const Model m = two_link();
-  Data d = m.make_data();
+TEST_F(TwoLinkArm, GravityAndDynamicsMatchHandComputation) {
   std::mt19937 rng(11);
   for (int k = 0; k < 20; ++k) {
-    const Eigen::VectorXd q = random_q(m, rng);
-    const Eigen::VectorXd qd = random_q(m, rng);
-    const Eigen::VectorXd qdd = random_q(m, rng);
+    const Eigen::VectorXd q = random_q(model_, rng);
+    const Eigen::VectorXd qd = random_q(model_, rng);
+    const Eigen::VectorXd qdd = random_q(model_, rng);
     const double c1 = std::cos(q(0)), c12 = std::cos(q(0) + q(1)), c2 = std::cos(q(1)), s2 = std::sin(q(1));
     Eigen::Vector2d g;
     g << -kG * (kM1 * kL1 * c1 + kM2 * (kL1 * c1 + kL2 * c12)), -kG * kM2 * kL2 * c12;
-    EXPECT_TRUE(m.gravity_torques(d, q).isApprox(g, 1e-6)) << m.gravity_torques(d, q).transpose() << " vs "
-                                                           << g.transpose();
+    EXPECT_TRUE(model_.gravity_torques(data_, q).isApprox(g, 1e-6))
+        << model_.gravity_torques(data_, q).transpose() << " vs " << g.transpose();
     Eigen::Matrix2d mm;
     mm(0, 0) = kM1 * kL1 * kL1 + kM2 * (kL1 * kL1 + kL2 * kL2 + 2 * kL1 * kL2 * c2);
     mm(0, 1) = mm(1, 0) = kM2 * (kL2 * kL2 + kL1 * kL2 * c2);
@@ -115,8 +118,8 @@ TEST(KinematicsModel, TwoLinkGravityAndDynamicsMatchHandComputation) {
     const double h = kM2 * kL1 * kL2 * s2;
     const Eigen::Vector2d c(-h * (2 * qd(0) * qd(1) + qd(1) * qd(1)), h * qd(0) * qd(0));
     const Eigen::Vector2d tau = mm * qdd + c + g;
-    EXPECT_TRUE(m.inverse_dynamics(d, q, qd, qdd).isApprox(tau, 1e-6));
-    EXPECT_TRUE(m.mass_matrix(d, q).isApprox(mm, 1e-6));
+    EXPECT_TRUE(model_.inverse_dynamics(data_, q, qd, qdd).isApprox(tau, 1e-6));
+    EXPECT_TRUE(model_.mass_matrix(data_, q).isApprox(mm, 1e-6));
   }
 }
 

@@ -87,6 +87,29 @@ std::string describe_ee(const EndEffectorInfo& e) {
   return e.name + " (" + std::string(to_string(e.kind)) + ", chain " + e.chain + ")";
 }
 
+std::string describe_chain(const ChainInfo& c) {
+  return c.name + " (" + std::string(to_string(c.role)) + ")";
+}
+
+/// Pointers to the items `keep` accepts, in the description's order.
+template <typename T, typename Keep>
+std::vector<const T*> select(const std::vector<T>& items, Keep keep) {
+  std::vector<const T*> out;
+  for (const T& item : items) {
+    if (keep(item)) out.push_back(&item);
+  }
+  return out;
+}
+
+/// The item called `name`; nullptr if there is none.
+template <typename T>
+const T* find_named(const std::vector<T>& items, std::string_view name) {
+  for (const T& item : items) {
+    if (item.name == name) return &item;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 RobotModel::RobotModel(ModelDescription description, kinematics::Model fixed,
@@ -197,31 +220,19 @@ int RobotModel::link_index(std::string_view name) const {
 }
 
 std::vector<const ChainInfo*> RobotModel::chains(ChainRole role) const {
-  std::vector<const ChainInfo*> out;
-  for (const ChainInfo& c : description_.chains) {
-    if (c.role == role) out.push_back(&c);
-  }
-  return out;
+  return select(description_.chains, [role](const ChainInfo& c) { return c.role == role; });
 }
 
 const ChainInfo& RobotModel::chain(std::string_view name) const {
-  for (const ChainInfo& c : description_.chains) {
-    if (c.name == name) return c;
-  }
-  throw ModelError(where() + ": no chain '" + std::string(name) + "' (chains: " +
-                   list_of(description_.chains,
-                           [](const ChainInfo& c) {
-                             return c.name + " (" + std::string(to_string(c.role)) + ")";
-                           }) +
-                   ")");
+  if (const ChainInfo* c = find_named(description_.chains, name)) return *c;
+  throw ModelError(where() + ": no chain '" + std::string(name) +
+                   "' (chains: " + list_of(description_.chains, describe_chain) + ")");
 }
 
 const ChainInfo& RobotModel::arm() const {
   const std::vector<const ChainInfo*> arms = chains(ChainRole::kArm);
   if (arms.size() == 1) return *arms.front();
-  const std::string all = list_of(description_.chains, [](const ChainInfo& c) {
-    return c.name + " (" + std::string(to_string(c.role)) + ")";
-  });
+  const std::string all = list_of(description_.chains, describe_chain);
   throw ModelError(where() +
                    (arms.empty()
                         ? ": no arm"
@@ -266,17 +277,12 @@ std::vector<Leg> RobotModel::legs() const {
 }
 
 std::vector<const EndEffectorInfo*> RobotModel::end_effectors(EndEffectorKind kind) const {
-  std::vector<const EndEffectorInfo*> out;
-  for (const EndEffectorInfo& e : description_.end_effectors) {
-    if (e.kind == kind) out.push_back(&e);
-  }
-  return out;
+  return select(description_.end_effectors,
+                [kind](const EndEffectorInfo& e) { return e.kind == kind; });
 }
 
 const EndEffectorInfo& RobotModel::end_effector(std::string_view name) const {
-  for (const EndEffectorInfo& e : description_.end_effectors) {
-    if (e.name == name) return e;
-  }
+  if (const EndEffectorInfo* e = find_named(description_.end_effectors, name)) return *e;
   throw ModelError(where() + ": no end-effector '" + std::string(name) +
                    "' (end-effectors: " + list_of(description_.end_effectors, describe_ee) + ")");
 }
@@ -311,11 +317,8 @@ const EndEffectorInfo& RobotModel::tool(EndEffectorKind kind) const {
 }
 
 std::vector<const SensorFrame*> RobotModel::sensor_frames(SensorKind kind) const {
-  std::vector<const SensorFrame*> out;
-  for (const SensorFrame& s : description_.sensor_frames) {
-    if (s.kind == kind) out.push_back(&s);
-  }
-  return out;
+  return select(description_.sensor_frames,
+                [kind](const SensorFrame& s) { return s.kind == kind; });
 }
 
 const SensorFrame* RobotModel::sensor_of(const EndEffectorInfo& ee, SensorKind kind) const {

@@ -46,16 +46,6 @@ void write_shape(std::ostringstream& o, const char* element, const Shape& s, con
   o << "    </" << element << ">\n";
 }
 
-const char* urdf_type(JointType t) {
-  switch (t) {
-    case JointType::kRevolute: return "revolute";
-    case JointType::kContinuous: return "continuous";
-    case JointType::kPrismatic: return "prismatic";
-    case JointType::kFixed: return "fixed";
-  }
-  return "fixed";
-}
-
 std::string yaml_num(double v) {
   if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
   return num(v);
@@ -81,7 +71,7 @@ std::string write_urdf(const PhysicalTree& tree, const std::string& robot_name) 
     o << "  </link>\n";
   }
   for (const PhysicalJoint& j : tree.joints) {
-    o << "  <joint name=\"" << xml_escape(j.name) << "\" type=\"" << urdf_type(j.type) << "\">\n";
+    o << "  <joint name=\"" << xml_escape(j.name) << "\" type=\"" << to_string(j.type) << "\">\n";
     o << "    <parent link=\"" << xml_escape(tree.bodies[static_cast<size_t>(j.parent)].name) << "\"/>\n";
     o << "    <child link=\"" << xml_escape(tree.bodies[static_cast<size_t>(j.child)].name) << "\"/>\n";
     o << "    " << origin(j.origin) << "\n";
@@ -153,7 +143,7 @@ std::string write_config_yaml(const GeneratedModel& model, const std::string& ro
   o << "]\njoints:\n";
   for (const JointInfo& j : model.joints) {
     o << "  - name: " << j.name << "\n    chain: " << j.chain << "\n    module: " << j.module << "\n    module_key: " << j.module_key
-      << "\n    type: " << urdf_type(j.type) << "\n    position_limits: [" << yaml_num(j.lower) << ", " << yaml_num(j.upper)
+      << "\n    type: " << to_string(j.type) << "\n    position_limits: [" << yaml_num(j.lower) << ", " << yaml_num(j.upper)
       << "]\n    velocity_limit: " << num(j.velocity) << "\n    peak_torque: " << num(j.peak_torque)
       << "\n    continuous_torque: " << num(j.continuous_torque) << "\n    gear_ratio: " << num(j.gear_ratio)
       << "\n    control_mode: " << j.control_mode << "\n    gains: {stiffness: " << num(j.gains.stiffness)

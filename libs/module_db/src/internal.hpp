@@ -16,6 +16,10 @@ namespace concert::module_db::detail {
 /// output connectors become TCP connectors). Throws ModuleDbError naming the file and field.
 void validate_and_normalise(ModuleDescription& module, const std::filesystem::path& file);
 
+/// Inverse of to_string(FrameKind) (only the YAML format names frame kinds); throws
+/// std::invalid_argument for an unknown name.
+FrameKind frame_kind_from_string(const std::string& name);
+
 /// Joint limit magnitude from which a revolute joint counts as unbounded (continuous), rad.
 inline constexpr double kUnboundedLimit = 1e6;
 

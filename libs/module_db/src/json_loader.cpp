@@ -191,15 +191,31 @@ std::string control_mode_from_xbot(const std::string& m) {
   return "";
 }
 
+/// The `header` object of a module or add-on file; sets what both share: the key (the file name),
+/// the source file and the label (default: the key).
+template <class Description>
+const json& read_header(const json& doc, const fs::path& file, Description& d) {
+  d.key = file.stem().string();
+  d.source = file.string();
+  const json& header = req(doc, "header", file, "");
+  d.label = str(header, "label", d.key);
+  return header;
+}
+
+/// Calls `read(item, prefix)` for every item of the list at `field`, with the field prefix of the
+/// item ("joints[2].").
+template <class Read>
+void for_each_item(const json& list, const fs::path& file, const std::string& field, Read read) {
+  if (!list.is_array()) fail(file, field, "expected a list");
+  for (size_t i = 0; i < list.size(); ++i) read(list[i], field + "[" + std::to_string(i) + "].");
+}
+
 }  // namespace
 
 ModuleDescription load_json_module(const fs::path& file) {
   const json doc = read_json(file);
   ModuleDescription m;
-  m.key = file.stem().string();
-  m.source = file.string();
-  const json& header = req(doc, "header", file, "");
-  m.label = str(header, "label", m.key);
+  const json& header = read_header(doc, file, m);
   const std::string htype = str(header, "type");
   if (htype.empty()) fail(file, "header.type", "missing");
   m.type = type_from_header(htype, file);
@@ -212,9 +228,8 @@ ModuleDescription load_json_module(const fs::path& file) {
   const json& bodies = req(doc, "bodies", file, "");
   if (!bodies.is_array() || bodies.empty()) fail(file, "bodies", "expected a non-empty list");
   std::map<std::string, int> body_index;
-  for (size_t i = 0; i < bodies.size(); ++i) {
-    const json& b = bodies[i];
-    const std::string p = "bodies[" + std::to_string(i) + "].";
+  for_each_item(bodies, file, "bodies", [&](const json& b, const std::string& p) {
+    const int index = static_cast<int>(m.bodies.size());
     Body body;
     const json& id = req(b, "ID", file, p);
     body.name = id.is_string() ? id.get<std::string>() : id.dump();
@@ -228,17 +243,13 @@ ModuleDescription load_json_module(const fs::path& file) {
     }
     body.visuals = shapes(b.value("visual", json()), file, p + "visual");
     body.collisions = shapes(b.value("collision", json()), file, p + "collision");
-    body_index[body.name] = static_cast<int>(i);
+    body_index[body.name] = index;
     if (b.contains("connectors")) {
-      const json& cons = b.at("connectors");
-      if (!cons.is_array()) fail(file, p + "connectors", "expected a list");
-      for (size_t k = 0; k < cons.size(); ++k) {
-        const json& c = cons[k];
-        const std::string cp = p + "connectors[" + std::to_string(k) + "].";
+      for_each_item(b.at("connectors"), file, p + "connectors", [&](const json& c, const std::string& cp) {
         Connector con;
         const json& cid = req(c, "ID", file, cp);
         con.name = cid.is_string() ? cid.get<std::string>() : cid.dump();
-        con.body = static_cast<int>(i);
+        con.body = index;
         con.pose = pose4(req(c, "pose", file, cp), file, cp + "pose");
         con.type = str(c, "type");
         con.size = str(c, "size");
@@ -256,16 +267,12 @@ ModuleDescription load_json_module(const fs::path& file) {
           fail(file, cp + "gender", "unknown gender '" + gender + "'");
         }
         m.connectors.push_back(std::move(con));
-      }
+      });
     }
     m.bodies.push_back(std::move(body));
-  }
+  });
   if (doc.contains("joints")) {
-    const json& joints = doc.at("joints");
-    if (!joints.is_array()) fail(file, "joints", "expected a list");
-    for (size_t i = 0; i < joints.size(); ++i) {
-      const json& j = joints[i];
-      const std::string p = "joints[" + std::to_string(i) + "].";
+    for_each_item(doc.at("joints"), file, "joints", [&](const json& j, const std::string& p) {
       JointDescription jd;
       const json& jid = req(j, "ID", file, p);
       jd.name = jid.is_string() ? jid.get<std::string>() : jid.dump();
@@ -337,7 +344,7 @@ ModuleDescription load_json_module(const fs::path& file) {
         fail(file, p + "type", "unknown joint type '" + type + "'");
       }
       m.joints.push_back(std::move(jd));
-    }
+    });
   }
   // Semantic tags from the type.
   if (m.type == ModuleType::kWheel) m.tags.push_back("leg");
@@ -349,12 +356,9 @@ ModuleDescription load_json_module(const fs::path& file) {
 AddonDescription load_json_addon(const fs::path& file) {
   const json doc = read_json(file);
   AddonDescription a;
-  a.key = file.stem().string();
-  a.source = file.string();
-  const json& header = req(doc, "header", file, "");
+  const json& header = read_header(doc, file, a);
   a.type = str(header, "type");
   if (a.type.empty()) fail(file, "header.type", "missing");
-  a.label = str(header, "label", a.key);
   const json& params = req(doc, "parameters", file, "");
   if (!params.is_object()) fail(file, "parameters", "expected an object");
   for (auto it = params.begin(); it != params.end(); ++it) {

@@ -1,41 +1,60 @@
 #include "concert/module_db/module_description.hpp"
 
 #include <algorithm>
+#include <array>
+#include <string_view>
+
+#include "internal.hpp"
 
 namespace concert::module_db {
+namespace {
 
-std::string to_string(ModuleType type) {
-  switch (type) {
-    case ModuleType::kJoint: return "joint";
-    case ModuleType::kHub: return "hub";
-    case ModuleType::kMobileBase: return "mobile_base";
-    case ModuleType::kLink: return "link";
-    case ModuleType::kBaseLink: return "base_link";
-    case ModuleType::kEndEffector: return "end_effector";
-    case ModuleType::kWheel: return "wheel";
-  }
-  return "unknown";
+// The names of each enumeration, in the order of its values.
+constexpr std::array<std::string_view, 7> kModuleTypeNames{
+    "joint", "hub", "mobile_base", "link", "base_link", "end_effector", "wheel"};
+constexpr std::array<std::string_view, 4> kJointTypeNames{"revolute", "continuous", "prismatic",
+                                                          "fixed"};
+constexpr std::array<std::string_view, 7> kFrameKindNames{"input", "joint",  "output", "tcp",
+                                                          "wheel", "camera", "other"};
+static_assert(kModuleTypeNames.size() == static_cast<std::size_t>(ModuleType::kWheel) + 1);
+static_assert(kJointTypeNames.size() == static_cast<std::size_t>(JointType::kFixed) + 1);
+static_assert(kFrameKindNames.size() == static_cast<std::size_t>(FrameKind::kOther) + 1);
+
+/// The name of `value`; `fallback` for a value outside the enumeration.
+template <class Enum, std::size_t N>
+std::string name_of(const std::array<std::string_view, N>& names, Enum value,
+                    std::string_view fallback) {
+  const auto index = static_cast<std::size_t>(value);
+  return std::string(index < N ? names[index] : fallback);
 }
+
+/// The value called `name`; throws std::invalid_argument "unknown <what> '<name>'".
+template <class Enum, std::size_t N>
+Enum value_of(const std::array<std::string_view, N>& names, const std::string& name,
+              const std::string& what) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) throw std::invalid_argument("unknown " + what + " '" + name + "'");
+  return static_cast<Enum>(it - names.begin());
+}
+
+}  // namespace
+
+std::string to_string(ModuleType type) { return name_of(kModuleTypeNames, type, "unknown"); }
 
 ModuleType module_type_from_string(const std::string& name) {
-  for (ModuleType t : {ModuleType::kJoint, ModuleType::kHub, ModuleType::kMobileBase, ModuleType::kLink,
-                       ModuleType::kBaseLink, ModuleType::kEndEffector, ModuleType::kWheel}) {
-    if (to_string(t) == name) return t;
-  }
-  throw std::invalid_argument("unknown module type '" + name + "'");
+  return value_of<ModuleType>(kModuleTypeNames, name, "module type");
 }
 
-std::string to_string(FrameKind kind) {
-  switch (kind) {
-    case FrameKind::kInput: return "input";
-    case FrameKind::kJoint: return "joint";
-    case FrameKind::kOutput: return "output";
-    case FrameKind::kTcp: return "tcp";
-    case FrameKind::kWheel: return "wheel";
-    case FrameKind::kCamera: return "camera";
-    case FrameKind::kOther: return "other";
-  }
-  return "other";
+std::string to_string(JointType type) { return name_of(kJointTypeNames, type, "fixed"); }
+
+JointType joint_type_from_string(const std::string& name) {
+  return value_of<JointType>(kJointTypeNames, name, "joint type");
+}
+
+std::string to_string(FrameKind kind) { return name_of(kFrameKindNames, kind, "other"); }
+
+FrameKind detail::frame_kind_from_string(const std::string& name) {
+  return value_of<FrameKind>(kFrameKindNames, name, "frame kind");
 }
 
 int ModuleDescription::input_connector() const {

@@ -135,12 +135,16 @@ ConnectorRole role_from(const std::string& r, const fs::path& file, const std::s
   fail(file, field, "unknown role '" + r + "' (expected input, output, tcp, base)");
 }
 
-FrameKind frame_kind_from(const std::string& k, const fs::path& file, const std::string& field) {
-  for (FrameKind f : {FrameKind::kInput, FrameKind::kJoint, FrameKind::kOutput, FrameKind::kTcp, FrameKind::kWheel,
-                      FrameKind::kCamera, FrameKind::kOther}) {
-    if (to_string(f) == k) return f;
+/// `from_string(name)` (one of the module_db *_from_string functions), its std::invalid_argument
+/// turned into an error naming the file and field.
+template <class Enum>
+Enum enum_from(Enum (*from_string)(const std::string&), const std::string& name, const fs::path& file,
+               const std::string& field) {
+  try {
+    return from_string(name);
+  } catch (const std::invalid_argument& e) {
+    fail(file, field, e.what());
   }
-  fail(file, field, "unknown frame kind '" + k + "'");
 }
 
 std::vector<std::string> string_list(const YAML::Node& v, const fs::path& file, const std::string& field) {
@@ -161,21 +165,33 @@ YAML::Node load_file(const fs::path& file) {
   }
 }
 
+/// The document of a module or add-on file, which must be a mapping; sets what both share: the key
+/// (default: the file name), the source file and the label (default: the key).
+template <class Description>
+YAML::Node read_document(const fs::path& file, Description& d) {
+  YAML::Node doc = load_file(file);
+  if (!doc.IsMap()) fail(file, "(document)", "expected a mapping");
+  d.key = opt_str(doc, "key", file.stem().string());
+  d.source = file.string();
+  d.label = opt_str(doc, "label", d.key);
+  return doc;
+}
+
+/// Calls `read(item, prefix)` for every item of the document-level list `field`, with the field
+/// prefix of the item ("joints[2].").
+template <class Read>
+void for_each_item(const YAML::Node& list, const fs::path& file, const std::string& field,
+                   Read read) {
+  if (!list.IsSequence()) fail(file, field, "expected a list");
+  for (size_t i = 0; i < list.size(); ++i) read(list[i], field + "[" + std::to_string(i) + "].");
+}
+
 }  // namespace
 
 ModuleDescription load_yaml_module(const fs::path& file) {
-  const YAML::Node doc = load_file(file);
-  if (!doc.IsMap()) fail(file, "(document)", "expected a mapping");
   ModuleDescription m;
-  m.key = opt_str(doc, "key", file.stem().string());
-  m.source = file.string();
-  m.label = opt_str(doc, "label", m.key);
-  const std::string type = req_str(doc, "type", file, "");
-  try {
-    m.type = module_type_from_string(type);
-  } catch (const std::invalid_argument& e) {
-    fail(file, "type", e.what());
-  }
+  const YAML::Node doc = read_document(file, m);
+  m.type = enum_from(module_type_from_string, req_str(doc, "type", file, ""), file, "type");
   m.tags = string_list(doc["tags"], file, "tags");
   m.addon_types = string_list(doc["addon_types"], file, "addon_types");
   if (doc["actuator"]) {
@@ -187,9 +203,7 @@ ModuleDescription load_yaml_module(const fs::path& file) {
   const YAML::Node bodies = req(doc, "bodies", file, "");
   if (!bodies.IsSequence() || bodies.size() == 0) fail(file, "bodies", "expected a non-empty list");
   std::map<std::string, int> body_index;
-  for (size_t i = 0; i < bodies.size(); ++i) {
-    const YAML::Node b = bodies[i];
-    const std::string p = "bodies[" + std::to_string(i) + "].";
+  for_each_item(bodies, file, "bodies", [&](const YAML::Node& b, const std::string& p) {
     Body body;
     body.name = req_str(b, "name", file, p);
     body.inertial.mass = req_num(b, "mass", file, p);
@@ -202,20 +216,17 @@ ModuleDescription load_yaml_module(const fs::path& file) {
     body.visuals = shapes(b["visual"], file, p + "visual");
     body.collisions = shapes(b["collision"], file, p + "collision");
     if (body_index.count(body.name)) fail(file, p + "name", "duplicate body name '" + body.name + "'");
-    body_index[body.name] = static_cast<int>(i);
+    body_index[body.name] = static_cast<int>(m.bodies.size());
     m.bodies.push_back(std::move(body));
-  }
+  });
   auto body_ref = [&](const YAML::Node& obj, const std::string& key, const std::string& p) {
     const std::string name = req_str(obj, key, file, p);
     auto it = body_index.find(name);
     if (it == body_index.end()) fail(file, p + key, "no body '" + name + "'");
     return it->second;
   };
-  const YAML::Node cons = req(doc, "connectors", file, "");
-  if (!cons.IsSequence()) fail(file, "connectors", "expected a list");
-  for (size_t i = 0; i < cons.size(); ++i) {
-    const YAML::Node c = cons[i];
-    const std::string p = "connectors[" + std::to_string(i) + "].";
+  const YAML::Node connectors = req(doc, "connectors", file, "");
+  for_each_item(connectors, file, "connectors", [&](const YAML::Node& c, const std::string& p) {
     Connector con;
     con.name = req_str(c, "name", file, p);
     con.role = role_from(req_str(c, "role", file, p), file, p + "role");
@@ -224,29 +235,14 @@ ModuleDescription load_yaml_module(const fs::path& file) {
     con.size = opt_str(c, "size");
     con.pose = pose_xyz_rpy(c["pose"], file, p + "pose");
     m.connectors.push_back(std::move(con));
-  }
+  });
   if (doc["joints"]) {
-    const YAML::Node joints = doc["joints"];
-    if (!joints.IsSequence()) fail(file, "joints", "expected a list");
-    for (size_t i = 0; i < joints.size(); ++i) {
-      const YAML::Node j = joints[i];
-      const std::string p = "joints[" + std::to_string(i) + "].";
+    for_each_item(doc["joints"], file, "joints", [&](const YAML::Node& j, const std::string& p) {
       JointDescription jd;
       jd.name = req_str(j, "name", file, p);
       jd.parent_body = body_ref(j, "parent", p);
       jd.child_body = body_ref(j, "child", p);
-      const std::string jtype = req_str(j, "type", file, p);
-      if (jtype == "revolute") {
-        jd.type = JointType::kRevolute;
-      } else if (jtype == "continuous") {
-        jd.type = JointType::kContinuous;
-      } else if (jtype == "prismatic") {
-        jd.type = JointType::kPrismatic;
-      } else if (jtype == "fixed") {
-        jd.type = JointType::kFixed;
-      } else {
-        fail(file, p + "type", "unknown joint type '" + jtype + "'");
-      }
+      jd.type = enum_from(joint_type_from_string, req_str(j, "type", file, p), file, p + "type");
       jd.pose_parent = pose_xyz_rpy(j["pose_parent"], file, p + "pose_parent");
       jd.pose_child = pose_xyz_rpy(j["pose_child"], file, p + "pose_child");
       if (j["axis"]) jd.axis = vec3(j["axis"], file, p + "axis");
@@ -283,34 +279,26 @@ ModuleDescription load_yaml_module(const fs::path& file) {
         }
       }
       m.joints.push_back(std::move(jd));
-    }
+    });
   }
   if (doc["frames"]) {
-    const YAML::Node frames = doc["frames"];
-    if (!frames.IsSequence()) fail(file, "frames", "expected a list");
-    for (size_t i = 0; i < frames.size(); ++i) {
-      const YAML::Node f = frames[i];
-      const std::string p = "frames[" + std::to_string(i) + "].";
+    for_each_item(doc["frames"], file, "frames", [&](const YAML::Node& f, const std::string& p) {
       Frame fr;
       fr.name = req_str(f, "name", file, p);
-      fr.kind = frame_kind_from(req_str(f, "kind", file, p), file, p + "kind");
+      fr.kind = enum_from(detail::frame_kind_from_string, req_str(f, "kind", file, p), file, p + "kind");
       fr.body = body_ref(f, "body", p);
       fr.pose = pose_xyz_rpy(f["pose"], file, p + "pose");
       m.frames.push_back(std::move(fr));
-    }
+    });
   }
   detail::validate_and_normalise(m, file);
   return m;
 }
 
 AddonDescription load_yaml_addon(const fs::path& file) {
-  const YAML::Node doc = load_file(file);
-  if (!doc.IsMap()) fail(file, "(document)", "expected a mapping");
   AddonDescription a;
-  a.key = opt_str(doc, "key", file.stem().string());
-  a.source = file.string();
+  const YAML::Node doc = read_document(file, a);
   a.type = req_str(doc, "type", file, "");
-  a.label = opt_str(doc, "label", a.key);
   a.mass = req_num(doc, "mass", file, "");
   if (a.mass < 0.0) fail(file, "mass", "must be >= 0");
   if (doc["com"]) a.com = vec3(doc["com"], file, "com");
@@ -319,7 +307,7 @@ AddonDescription load_yaml_addon(const fs::path& file) {
     const YAML::Node f = doc["frame"];
     Frame fr;
     fr.name = req_str(f, "name", file, "frame.");
-    fr.kind = frame_kind_from(req_str(f, "kind", file, "frame."), file, "frame.kind");
+    fr.kind = enum_from(detail::frame_kind_from_string, req_str(f, "kind", file, "frame."), file, "frame.kind");
     fr.pose = pose_xyz_rpy(f["pose"], file, "frame.pose");
     a.frame = fr;
   }

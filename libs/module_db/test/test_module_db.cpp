@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "concert/common/error_text.hpp"
 #include "concert/module_db/module_db.hpp"
 #include "concert/topology/esc_catalog.hpp"
 
@@ -23,14 +24,7 @@ fs::path scratch(const std::string& name) {
   return dir;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const ModuleDbError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string error_of(const std::function<void()>& f) { return concert::error_text<ModuleDbError>(f); }
 
 }  // namespace
 

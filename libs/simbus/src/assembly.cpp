@@ -3,13 +3,15 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
+
+#include "concert/common/enum_map.hpp"
+#include "concert/common/source_text.hpp"
 
 namespace concert::simbus {
 namespace {
@@ -21,6 +23,7 @@ using topology::EscSlave;
 using topology::ModuleLayout;
 using topology::ModuleTree;
 using topology::PortOrder;
+using namespace std::string_view_literals;
 
 std::string line_of(const YAML::Node& node) {
   const YAML::Mark mark = node.Mark();
@@ -48,24 +51,26 @@ std::string to_text(const YAML::Node& node, const std::string& context) {
   return node.Scalar();
 }
 
+/// The `type:` of each fault in assembly files.
+constexpr EnumMap kFaultTypes{std::array{
+    std::pair{FaultType::kUpsideDown, "upside_down"sv},
+    std::pair{FaultType::kBrokenLink, "broken_link"sv},
+    std::pair{FaultType::kUnknownIdentity, "unknown_identity"sv},
+    std::pair{FaultType::kWrongTopology, "wrong_topology"sv},
+}};
+
 Fault parse_fault(const YAML::Node& node, const std::string& context) {
   if (!node.IsMap()) throw AssemblyError(context + ": expected a mapping" + line_of(node));
   Fault fault;
   if (!node["type"]) throw AssemblyError(context + ": missing field 'type'" + line_of(node));
   const std::string type = to_text(node["type"], context + ".type");
-  if (type == "upside_down") {
-    fault.type = FaultType::kUpsideDown;
-  } else if (type == "broken_link") {
-    fault.type = FaultType::kBrokenLink;
-  } else if (type == "unknown_identity") {
-    fault.type = FaultType::kUnknownIdentity;
-  } else if (type == "wrong_topology") {
-    fault.type = FaultType::kWrongTopology;
-  } else {
+  const std::optional<FaultType> fault_type = kFaultTypes.from(type);
+  if (!fault_type) {
     throw AssemblyError(context + ".type: '" + type +
                         "' is not upside_down, broken_link, unknown_identity or wrong_topology" +
                         line_of(node));
   }
+  fault.type = *fault_type;
   if (!node["module"]) throw AssemblyError(context + ": missing field 'module'" + line_of(node));
   fault.module = to_text(node["module"], context + ".module");
   if (const YAML::Node port = node["upstream_port"]) {
@@ -249,12 +254,7 @@ void connect(std::vector<BusEsc>& escs, int32_t a, int32_t port_a, int32_t b, in
 }  // namespace
 
 Assembly parse_assembly(std::string_view yaml_text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml_text));
-  } catch (const YAML::Exception& e) {
-    throw AssemblyError(source + ": not valid YAML: " + e.what());
-  }
+  const YAML::Node root = parse_yaml<AssemblyError>(yaml_text, source);
   if (!root.IsMap() || !root["modules"] || !root["modules"].IsSequence()) {
     throw AssemblyError(source + ": expected a mapping with a 'modules:' list");
   }
@@ -302,11 +302,7 @@ Assembly parse_assembly(std::string_view yaml_text, const std::string& source) {
 }
 
 Assembly load_assembly(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw AssemblyError(file.string() + ": cannot open the assembly file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_assembly(text.str(), file.string());
+  return parse_assembly(read_text<AssemblyError>(file, "the assembly file"), file.string());
 }
 
 std::string assembly_to_yaml(const Assembly& assembly) {
@@ -326,26 +322,24 @@ std::string assembly_to_yaml(const Assembly& assembly) {
   if (!assembly.faults.empty()) {
     out << "faults:\n";
     for (const auto& f : assembly.faults) {
+      out << "  - {type: " << kFaultTypes.to(f.type).value_or("unknown")
+          << ", module: " << f.module;
       switch (f.type) {
         case FaultType::kUpsideDown:
-          out << "  - {type: upside_down, module: " << f.module;
           if (f.upstream_port) out << ", upstream_port: " << *f.upstream_port;
-          out << "}\n";
           break;
         case FaultType::kBrokenLink:
-          out << "  - {type: broken_link, module: " << f.module << "}\n";
           break;
         case FaultType::kUnknownIdentity:
-          out << "  - {type: unknown_identity, module: " << f.module << ", esc: " << f.esc
-              << ", identity: {mod_type: " << f.identity.mod_type
+          out << ", esc: " << f.esc << ", identity: {mod_type: " << f.identity.mod_type
               << ", mod_id: " << f.identity.mod_id << ", mod_size: " << f.identity.mod_size
-              << ", mod_rev: " << f.identity.mod_rev << "}}\n";
+              << ", mod_rev: " << f.identity.mod_rev << "}";
           break;
         case FaultType::kWrongTopology:
-          out << "  - {type: wrong_topology, module: " << f.module << ", esc: " << f.esc
-              << ", topology: " << f.topology << "}\n";
+          out << ", esc: " << f.esc << ", topology: " << f.topology;
           break;
       }
+      out << "}\n";
     }
   }
   return out.str();

@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
+#include "concert/common/error_text.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/simbus/testing.hpp"
 
@@ -17,22 +19,20 @@ const std::string kPublicDb = std::string(CONCERT_SHARED_DATA) + "/concert_resou
 const std::string kExamples = std::string(SIMBUS_EXAMPLES);
 
 std::string error_of(const std::string& yaml, const EscCatalog& catalog) {
-  try {
-    validate(parse_assembly(yaml, "a.yaml"), catalog);
-  } catch (const AssemblyError& e) {
-    return e.what();
-  }
-  return "";
+  return error_text<AssemblyError>([&] { validate(parse_assembly(yaml, "a.yaml"), catalog); }, "");
+}
+
+/// The scan of the assembly text `yaml` over the synthetic catalogue.
+EscScan synthetic_scan(const std::string& yaml, PortOrder order = PortOrder::kReal0312) {
+  return simulate_scan(parse_assembly(yaml, "test"), synthetic_catalog(), order);
 }
 
 /// Appendix A, Figure A1: slave B on port 2 of slave A (paper's simplified order 0-1-2-3).
 TEST(SimBus, AppendixAExampleOne) {
-  const EscCatalog catalog = synthetic_catalog();
-  const Assembly a = parse_assembly(
+  const EscScan scan = synthetic_scan(
       "modules:\n  - {name: A, key: hub3, robot_id: 1}\n"
       "  - {name: B, key: joint, parent: A, connector: 2, robot_id: 2}\n",
-      "ex1");
-  const EscScan scan = simulate_scan(a, catalog, PortOrder::kNumeric0123);
+      PortOrder::kNumeric0123);
   ASSERT_EQ(scan.slaves.size(), 2u);
   EXPECT_EQ(scan.slaves[0].robot_id, 1);
   EXPECT_EQ(scan.slaves[0].active_ports, 0b0101);  // port 0 (master) and port 2 (B)
@@ -174,12 +174,9 @@ TEST(SimBus, UpsideDownElbowComesAfterItsSubtree) {
 }
 
 TEST(SimBus, UpsideDownLeafHasPortZeroClosed) {
-  const EscCatalog catalog = synthetic_catalog();
-  const Assembly a = parse_assembly(
+  const EscScan scan = synthetic_scan(
       "modules:\n  - {name: j, key: joint}\n  - {name: t, key: tool, parent: j, connector: 1}\n"
-      "faults:\n  - {type: upside_down, module: t}\n",
-      "leaf");
-  const EscScan scan = simulate_scan(a, catalog);
+      "faults:\n  - {type: upside_down, module: t}\n");
   ASSERT_EQ(scan.slaves.size(), 2u);
   EXPECT_EQ(scan.slaves[1].active_ports, 0b0010);  // entered through port 1, port 0 closed
 }
@@ -218,54 +215,40 @@ TEST(SimBus, AssemblyYamlRoundTrip) {
 
 TEST(SimBus, AssemblyErrorsNameFileModuleAndField) {
   const EscCatalog catalog = synthetic_catalog();
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: nope}\n", catalog)
-                .find("a.yaml: module 'a': key 'nope' is not in the ESC catalogue"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: joint}\n  - {name: a, key: joint, parent: a, "
-                     "connector: 1}\n",
-                     catalog)
-                .find("module 'a': name used twice"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint, parent: a, "
-                     "connector: 2}\n",
-                     catalog)
-                .find("module 'b': parent 'a' (joint) has no output connector 2 (it has 1)"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint, parent: a, "
-                     "connector: 1}\n  - {name: c, key: joint, parent: a, connector: 1}\n",
-                     catalog)
-                .find("module 'c': connector 1 of 'a' is already taken by 'b'"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint}\n", catalog)
-                .find("2 modules have no parent"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: r, key: joint}\n  - {name: a, key: joint, parent: b, "
-                     "connector: 1}\n  - {name: b, key: joint, parent: a, connector: 1}\n",
-                     catalog)
-                .find("is not connected to the root (parent cycle)"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint, parent: x, "
-                     "connector: 1}\n",
-                     catalog)
-                .find("module 'b': parent 'x' is not a module of the assembly"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint, parent: a}\n",
-                     catalog)
-                .find("modules[1]: module 'b' has a parent but no 'connector'"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: joint}\nfaults:\n  - {type: melted, module: a}\n",
-                     catalog)
-                .find("faults[0].type: 'melted'"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: joint}\nfaults:\n  - {type: broken_link, "
-                     "module: z}\n",
-                     catalog)
-                .find("faults[0]: module 'z' is not in the assembly"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {name: a, key: joint, robot_id: [1, 2]}\n", catalog)
-                .find("2 robot_ids for 1 ESC(s)"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules: [\n", catalog).find("not valid YAML"), std::string::npos);
+  struct Case {
+    std::string assembly;
+    std::string error;  // a part of the expected message
+  };
+  const std::vector<Case> cases = {
+      {"modules:\n  - {name: a, key: nope}\n",
+       "a.yaml: module 'a': key 'nope' is not in the ESC catalogue"},
+      {"modules:\n  - {name: a, key: joint}\n  - {name: a, key: joint, parent: a, connector: 1}\n",
+       "module 'a': name used twice"},
+      {"modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint, parent: a, connector: 2}\n",
+       "module 'b': parent 'a' (joint) has no output connector 2 (it has 1)"},
+      {"modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint, parent: a, connector: 1}\n"
+       "  - {name: c, key: joint, parent: a, connector: 1}\n",
+       "module 'c': connector 1 of 'a' is already taken by 'b'"},
+      {"modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint}\n",
+       "2 modules have no parent"},
+      {"modules:\n  - {name: r, key: joint}\n  - {name: a, key: joint, parent: b, connector: 1}\n"
+       "  - {name: b, key: joint, parent: a, connector: 1}\n",
+       "is not connected to the root (parent cycle)"},
+      {"modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint, parent: x, connector: 1}\n",
+       "module 'b': parent 'x' is not a module of the assembly"},
+      {"modules:\n  - {name: a, key: joint}\n  - {name: b, key: joint, parent: a}\n",
+       "modules[1]: module 'b' has a parent but no 'connector'"},
+      {"modules:\n  - {name: a, key: joint}\nfaults:\n  - {type: melted, module: a}\n",
+       "faults[0].type: 'melted'"},
+      {"modules:\n  - {name: a, key: joint}\nfaults:\n  - {type: broken_link, module: z}\n",
+       "faults[0]: module 'z' is not in the assembly"},
+      {"modules:\n  - {name: a, key: joint, robot_id: [1, 2]}\n", "2 robot_ids for 1 ESC(s)"},
+      {"modules: [\n", "not valid YAML"},
+  };
+  for (const Case& c : cases) {
+    const std::string error = error_of(c.assembly, catalog);
+    EXPECT_NE(error.find(c.error), std::string::npos) << c.assembly << "gave: " << error;
+  }
   EXPECT_THROW((void)load_assembly("/nonexistent.yaml"), AssemblyError);
 }
 

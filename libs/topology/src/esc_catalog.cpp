@@ -1,13 +1,12 @@
 #include "concert/topology/esc_catalog.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <utility>
 
 #include <yaml-cpp/yaml.h>
 
+#include "concert/common/source_text.hpp"
 #include "yaml_util.hpp"
 
 namespace concert::topology {
@@ -20,14 +19,6 @@ using detail::where;
 constexpr const char* kHubBoard = "hub_board";
 // A module with more ESCs than this is taken as a cycle of secondary-ESC rows.
 constexpr std::size_t kMaxEscsPerModule = 16;
-
-std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw CatalogError(file.string() + ": cannot open the ESC catalogue");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 /// A port row of a `mobile_base_ports:` / `module_ports:` section.
 struct SectionRow {
@@ -340,16 +331,11 @@ EscCatalog EscCatalog::load(const std::filesystem::path& folder) {
 }
 
 EscCatalog EscCatalog::load_file(const std::filesystem::path& file) {
-  return parse(read_text(file), file.string());
+  return parse(read_text<CatalogError>(file, "the ESC catalogue"), file.string());
 }
 
 EscCatalog EscCatalog::parse(std::string_view yaml_text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml_text));
-  } catch (const YAML::Exception& e) {
-    throw CatalogError(source + ": not valid YAML: " + e.what());
-  }
+  const YAML::Node root = parse_yaml<CatalogError>(yaml_text, source);
   if (!root.IsMap()) throw CatalogError(source + ": expected a mapping with 'modules:'");
   const YAML::Node modules = root["modules"];
   if (!modules || !modules.IsSequence() || modules.size() == 0) {

@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <bit>
-#include <fstream>
 #include <functional>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
+#include "concert/common/source_text.hpp"
 #include "yaml_util.hpp"
 
 namespace concert::topology {
@@ -16,14 +16,6 @@ namespace {
 using detail::opt_int32;
 using detail::req_int32;
 using detail::where;
-
-std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw ScanFormatError(file.string() + ": cannot open the scan file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 EscSlave parse_slave(const YAML::Node& node, const std::string& context,
                      std::optional<int32_t> key) {
@@ -133,19 +125,13 @@ nlohmann::json slave_fields(const EscSlave& s) {
 }  // namespace
 
 EscScan load_scan(const std::filesystem::path& file) {
-  const std::string text = read_text(file);
+  const std::string text = read_text<ScanFormatError>(file, "the scan file");
   if (file.extension() == ".json") return parse_scan_json(text, file.string());
   return parse_scan_yaml(text, file.string());
 }
 
 EscScan parse_scan_yaml(std::string_view text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    throw ScanFormatError(source + ": not valid YAML: " + e.what());
-  }
-  return parse_scan_node(root, source);
+  return parse_scan_node(parse_yaml<ScanFormatError>(text, source), source);
 }
 
 EscScan parse_scan_json(std::string_view text, const std::string& source) {

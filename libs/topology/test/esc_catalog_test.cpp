@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 namespace concert::topology {
 namespace {
@@ -136,67 +137,57 @@ TEST(EscCatalog, MergeLaterEntriesOverride) {
 }
 
 TEST(EscCatalog, ErrorsNameTheFileRowAndField) {
-  EXPECT_NE(error_of("modules: []").find("non-empty"), std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, file: a.json}")
-                .find("test.yaml: modules[0]: missing field 'mod_rev'"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 9, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}")
-                .find("modules[0].mod_type: 9"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: x, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}")
-                .find("modules[0].mod_type: 'x' is not an integer"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0}")
-                .find("needs 'file' or 'key'"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}\n"
-                     "  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: b}")
-                .find("modules[1]: identity (mod_type 1, mod_id 1, mod_size 0, mod_rev 0) "
-                      "already defined by test.yaml: modules[0]"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
-                     "ports: [{port: 0, leads_to: 1}]}")
-                .find("modules[0].ports[0].port: 0 is not a downstream ESC port"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
-                     "ports: [{port: 1, leads_to: 1}, {port: 2, leads_to: 1}]}")
-                .find("connector 1 is wired to two ports"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
-                     "ports: [{port: 1, leads_to: left}]}")
-                .find("leads_to: expected a connector number"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
-                     "outputs: 2}")
-                .find("outputs 2 needs port rows (its 2-port ESC board has 1 port after port 0)"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
-                     "outputs: 4}")
-                .find("outputs 4 needs port rows"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
-                     "ports: [{port: 3, leads_to: 1}]}")
-                .find("port 3 but a joint's ESC board has ports 0 and 1 only"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
-                     "esc_ports: 3}")
-                .find("modules[0].esc_ports: 3 is not a board's port count (2 or 4)"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}\n"
-                     "module_ports:\n  - {mod_type: 2, mod_id: 7, port: 1, leads_to: 1}")
-                .find("module_ports[0]: no module row has mod_type 2 and mod_id 7"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}\n"
-                     "module_ports:\n  - {mod_type: 2, mod_id: 1, port: 3, leads_to: hub_board}")
-                .find("cannot tell which ESC is the hub board"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, "
-                     "ports: [{port: 3, leads_to: hub_board, secondary: {mod_type: 2, mod_id: 2, "
-                     "mod_size: 0, mod_rev: 0}}]}")
-                .find("hub board ESC (mod_type 2, mod_id 2, mod_size 0, mod_rev 0) on port 3 is "
-                      "not in the catalogue"),
-            std::string::npos);
-  EXPECT_NE(error_of("modules: [\n").find("not valid YAML"), std::string::npos);
+  struct Case {
+    std::string catalogue;
+    std::string error;  // a part of the expected message
+  };
+  const std::vector<Case> cases = {
+      {"modules: []", "non-empty"},
+      {"modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, file: a.json}",
+       "test.yaml: modules[0]: missing field 'mod_rev'"},
+      {"modules:\n  - {mod_type: 9, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}",
+       "modules[0].mod_type: 9"},
+      {"modules:\n  - {mod_type: x, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}",
+       "modules[0].mod_type: 'x' is not an integer"},
+      {"modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0}", "needs 'file' or 'key'"},
+      {"modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}\n"
+       "  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: b}",
+       "modules[1]: identity (mod_type 1, mod_id 1, mod_size 0, "
+       "mod_rev 0) already defined by test.yaml: modules[0]"},
+      {"modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, ports: [{port: 0, "
+       "leads_to: 1}]}",
+       "modules[0].ports[0].port: 0 is not a downstream ESC port"},
+      {"modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, ports: [{port: 1, "
+       "leads_to: 1}, {port: 2, leads_to: 1}]}",
+       "connector 1 is wired to two ports"},
+      {"modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, ports: [{port: 1, "
+       "leads_to: left}]}",
+       "leads_to: expected a connector number"},
+      {"modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, outputs: 2}",
+       "outputs 2 needs port rows (its 2-port ESC board has 1 port after port 0)"},
+      {"modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, outputs: 4}",
+       "outputs 4 needs port rows"},
+      {"modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, ports: [{port: 3, "
+       "leads_to: 1}]}",
+       "port 3 but a joint's ESC board has ports 0 and 1 only"},
+      {"modules:\n  - {mod_type: 1, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, esc_ports: 3}",
+       "modules[0].esc_ports: 3 is not a board's port count (2 or 4)"},
+      {"modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}\nmodule_ports:\n"
+       "  - {mod_type: 2, mod_id: 7, port: 1, leads_to: 1}",
+       "module_ports[0]: no module row has mod_type 2 and mod_id 7"},
+      {"modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a}\nmodule_ports:\n"
+       "  - {mod_type: 2, mod_id: 1, port: 3, leads_to: hub_board}",
+       "cannot tell which ESC is the hub board"},
+      {"modules:\n  - {mod_type: 2, mod_id: 1, mod_size: 0, mod_rev: 0, key: a, ports: [{port: 3, "
+       "leads_to: hub_board, secondary: {mod_type: 2, mod_id: 2, mod_size: 0, mod_rev: 0}}]}",
+       "hub board ESC (mod_type 2, mod_id 2, mod_size 0, "
+       "mod_rev 0) on port 3 is not in the catalogue"},
+      {"modules: [\n", "not valid YAML"},
+  };
+  for (const Case& c : cases) {
+    const std::string error = error_of(c.catalogue);
+    EXPECT_NE(error.find(c.error), std::string::npos) << c.catalogue << "\ngave: " << error;
+  }
   EXPECT_THROW((void)EscCatalog::load("/nonexistent/db"), CatalogError);
   EXPECT_THROW((void)EscCatalog().layout(EscIdentity{1, 1, 1, 1}), CatalogError);
 }

@@ -1,5 +1,10 @@
 #include "concert/topology/dds/conversions.hpp"
 
+#include <array>
+#include <utility>
+
+#include "concert/common/enum_map.hpp"
+
 namespace concert::topology::dds {
 namespace {
 
@@ -28,44 +33,24 @@ msg::EscSlave slave_to_msg(const EscSlave& s) {
   return m;
 }
 
+// Every core kind has its wire twin; a value outside the table (a newer peer's kind) reads as
+// unknown.
+constexpr EnumMap kModuleKinds{std::array{
+    std::pair{ModuleKind::kJoint, msg::MODULE_JOINT},
+    std::pair{ModuleKind::kHub, msg::MODULE_HUB},
+    std::pair{ModuleKind::kEndEffector, msg::MODULE_END_EFFECTOR},
+    std::pair{ModuleKind::kLink, msg::MODULE_LINK},
+    std::pair{ModuleKind::kWheel, msg::MODULE_WHEEL},
+    std::pair{ModuleKind::kBaseLink, msg::MODULE_BASE_LINK},
+    std::pair{ModuleKind::kUnknown, msg::MODULE_UNKNOWN},
+}};
+
 msg::ModuleKind kind_to_msg(ModuleKind kind) {
-  switch (kind) {
-    case ModuleKind::kJoint:
-      return msg::MODULE_JOINT;
-    case ModuleKind::kHub:
-      return msg::MODULE_HUB;
-    case ModuleKind::kEndEffector:
-      return msg::MODULE_END_EFFECTOR;
-    case ModuleKind::kLink:
-      return msg::MODULE_LINK;
-    case ModuleKind::kWheel:
-      return msg::MODULE_WHEEL;
-    case ModuleKind::kBaseLink:
-      return msg::MODULE_BASE_LINK;
-    case ModuleKind::kUnknown:
-      return msg::MODULE_UNKNOWN;
-  }
-  return msg::MODULE_UNKNOWN;
+  return kModuleKinds.to(kind).value_or(msg::MODULE_UNKNOWN);
 }
 
 ModuleKind kind_to_core(msg::ModuleKind kind) {
-  switch (kind) {
-    case msg::MODULE_JOINT:
-      return ModuleKind::kJoint;
-    case msg::MODULE_HUB:
-      return ModuleKind::kHub;
-    case msg::MODULE_END_EFFECTOR:
-      return ModuleKind::kEndEffector;
-    case msg::MODULE_LINK:
-      return ModuleKind::kLink;
-    case msg::MODULE_WHEEL:
-      return ModuleKind::kWheel;
-    case msg::MODULE_BASE_LINK:
-      return ModuleKind::kBaseLink;
-    case msg::MODULE_UNKNOWN:
-      return ModuleKind::kUnknown;
-  }
-  return ModuleKind::kUnknown;
+  return kModuleKinds.from(kind).value_or(ModuleKind::kUnknown);
 }
 
 }  // namespace

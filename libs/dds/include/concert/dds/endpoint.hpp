@@ -27,6 +27,22 @@ eprosima::fastdds::dds::DataReader* create_reader(Participant& participant, std:
 void delete_writer(Participant& participant, eprosima::fastdds::dds::DataWriter* writer);
 void delete_reader(Participant& participant, eprosima::fastdds::dds::DataReader* reader);
 bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout);
+/// Readers matched to `writer` now.
+int32_t matched_count(eprosima::fastdds::dds::DataWriter* writer);
+/// Writers matched to `reader` now.
+int32_t matched_count(eprosima::fastdds::dds::DataReader* reader);
+
+/// Takes samples from `reader` until a valid one (left in `sample` and `info`); false when none
+/// is left.
+template <class T>
+bool take_valid(eprosima::fastdds::dds::DataReader* reader, T& sample,
+                eprosima::fastdds::dds::SampleInfo& info) {
+  while (reader->take_next_sample(&sample, &info) ==
+         eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+    if (info.valid_data) return true;
+  }
+  return false;
+}
 }  // namespace detail
 
 template <class T> class Writer {
@@ -48,11 +64,7 @@ template <class T> class Writer {
            eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
   }
 
-  int32_t matched_readers() const {
-    eprosima::fastdds::dds::PublicationMatchedStatus status;
-    writer_->get_publication_matched_status(status);
-    return status.current_count;
-  }
+  int32_t matched_readers() const { return detail::matched_count(writer_); }
 
   /// Waits until at least `count` readers matched; false on timeout.
   bool wait_for_readers(int32_t count, std::chrono::milliseconds timeout) const {
@@ -86,9 +98,7 @@ template <class T> class Reader : private eprosima::fastdds::dds::DataReaderList
   std::optional<T> take() {
     T sample;
     eprosima::fastdds::dds::SampleInfo info;
-    while (reader_->take_next_sample(&sample, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
-      if (info.valid_data) return sample;
-    }
+    if (detail::take_valid(reader_, sample, info)) return sample;
     return std::nullopt;
   }
 
@@ -105,11 +115,7 @@ template <class T> class Reader : private eprosima::fastdds::dds::DataReaderList
     }
   }
 
-  int32_t matched_writers() const {
-    eprosima::fastdds::dds::SubscriptionMatchedStatus status;
-    reader_->get_subscription_matched_status(status);
-    return status.current_count;
-  }
+  int32_t matched_writers() const { return detail::matched_count(reader_); }
 
   bool wait_for_writers(int32_t count, std::chrono::milliseconds timeout) const {
     return detail::wait_until([&] { return matched_writers() >= count; }, timeout);
@@ -121,9 +127,7 @@ template <class T> class Reader : private eprosima::fastdds::dds::DataReaderList
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     T sample;
     eprosima::fastdds::dds::SampleInfo info;
-    while (reader->take_next_sample(&sample, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
-      if (info.valid_data) callback_(sample, info);
-    }
+    while (detail::take_valid(reader, sample, info)) callback_(sample, info);
   }
 
   Participant& participant_;

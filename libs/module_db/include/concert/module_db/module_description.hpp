@@ -96,6 +96,10 @@ struct ControlParams {
 };
 
 enum class JointType { kRevolute, kContinuous, kPrismatic, kFixed };
+/// URDF name of a joint type ("revolute", "continuous", "prismatic", "fixed").
+std::string to_string(JointType type);
+/// Inverse of to_string; throws std::invalid_argument for an unknown name.
+JointType joint_type_from_string(const std::string& name);
 
 /// A joint between two bodies of the same module. Frames: parent body -> pose_parent -> joint
 /// frame (axis = joint-frame axis, normally z) -> motion(q) -> pose_child -> child body.
