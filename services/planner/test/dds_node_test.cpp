@@ -103,8 +103,13 @@ TEST_F(PlannerNodeTest, ReadyAtModelVersionAndStatusReported) {
   msg::RobotModel bad;
   bad.version(4);
   bad.urdf("<robot name='x'/>");
+  const uint32_t refused_before = node_->refusals();
   models_->write(bad);
-  std::this_thread::sleep_for(300ms);
+  const auto refused_by = std::chrono::steady_clock::now() + 5s;
+  while (node_->refusals() == refused_before && std::chrono::steady_clock::now() < refused_by) {
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_EQ(node_->refusals(), refused_before + 1) << "the broken model was not refused within 5 s";
   EXPECT_EQ(node_->model_version(), 3u);
   EXPECT_NE(log_.str().find("version 4 refused"), std::string::npos) << log_.str();
 }

@@ -54,6 +54,8 @@ class PlannerNode {
   bool spin_once(std::chrono::milliseconds timeout);
   /// Model version the node runs (0: none).
   [[nodiscard]] uint64_t model_version() const { return planner_.model_version(); }
+  /// Inputs refused since start (models, requests), as the service status reports them.
+  [[nodiscard]] uint32_t refusals() const { return status_.refusals(); }
 
  private:
   struct Execution {
