@@ -56,6 +56,11 @@ class PlannerNode {
   [[nodiscard]] uint64_t model_version() const { return planner_.model_version(); }
   /// Inputs refused since start (models, requests), as the service status reports them.
   [[nodiscard]] uint32_t refusals() const { return status_.refusals(); }
+  /// True once a joint state of the robot has arrived (plans start from the latest one).
+  [[nodiscard]] bool has_joint_state() const {
+    std::lock_guard lock(mutex_);
+    return joint_state_.has_value();
+  }
 
  private:
   struct Execution {
@@ -78,7 +83,7 @@ class PlannerNode {
   NodeOptions options_;
   std::ostream& log_;
   std::mutex log_mutex_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<msg::PlanRequest> requests_;
   std::deque<Execution> executions_;
