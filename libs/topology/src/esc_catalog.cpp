@@ -47,17 +47,19 @@ int32_t parse_leads_to(const YAML::Node& row, const std::string& context) {
   const YAML::Node node = row["leads_to"];
   if (!node) throw CatalogError(context + ": missing field 'leads_to'" + where(row));
   if (node.IsScalar() && node.Scalar() == kHubBoard) return 0;
-  std::optional<int32_t> connector;
+  // A plain int with 0 for "no connector number" (an optional reset in the catch trips GCC 12's
+  // -Wmaybe-uninitialized at -Os).
+  int32_t connector = 0;
   try {
-    connector = opt_int32<CatalogError>(row, "leads_to", context);
+    connector = opt_int32<CatalogError>(row, "leads_to", context).value_or(0);
   } catch (const CatalogError&) {
-    connector.reset();
+    connector = 0;
   }
-  if (!connector || *connector < 1) {
+  if (connector < 1) {
     throw CatalogError(context + ".leads_to: expected a connector number >= 1 or '" + kHubBoard +
                        "'" + where(node));
   }
-  return *connector;
+  return connector;
 }
 
 /// Optional `secondary: {mod_type, mod_id[, mod_size, mod_rev]}` of a hub-board row.
