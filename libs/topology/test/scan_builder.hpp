@@ -2,6 +2,9 @@
 // Helpers of the reconstruction tests (hand-written scans: concert/simbus/testing.hpp).
 
 #include <string>
+#include <utility>
+
+#include "concert/common/error_text.hpp"
 
 #include "concert/simbus/testing.hpp"
 #include "concert/topology/reconstruction.hpp"
@@ -13,12 +16,7 @@ using namespace concert::simbus::testing;
 /// Message of the DiscoveryError `f` throws, or "" if it does not throw one.
 template <class F>
 std::string discovery_error(F&& f) {
-  try {
-    f();
-  } catch (const DiscoveryError& e) {
-    return e.what();
-  }
-  return "";
+  return error_text<DiscoveryError>(std::forward<F>(f), "");
 }
 
 /// Message of the DiscoveryError that discover(scan, catalog, params) throws, or "".

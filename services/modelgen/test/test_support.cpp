@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "concert/common/error_text.hpp"
 #include "modelgen/model_generator.hpp"
 
 namespace concert::modelgen::test {
@@ -22,14 +23,7 @@ const module_db::ModuleDatabase& own_db() {
   return db;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const ModelError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string error_of(const std::function<void()>& f) { return error_text<ModelError>(f); }
 
 topology::ModuleTree make_tree(const std::vector<Row>& rows, const module_db::ModuleDatabase* db) {
   topology::ModuleTree tree;
