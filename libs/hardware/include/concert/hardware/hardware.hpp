@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "concert/hardware/sensors.hpp"
+
 namespace concert::hardware {
 
 /// Any hardware-level failure (backend could not be built, wrong command vector size...).
@@ -78,6 +80,13 @@ class Hardware {
   /// Advance one control period `dt` [s]: the sim integrates physics, a real master
   /// exchanges process data with the drives.
   virtual void step(double dt) = 0;
+
+  /// Any thread: where the backend's sensors deliver their data from now on (nullptr:
+  /// nowhere; the sink must outlive the backend or be replaced first). Backends without
+  /// sensors ignore it.
+  virtual void set_sensor_sink(SensorSink* sink) { (void)sink; }
+  /// Any thread: the sensors mounted now (empty for backends without sensors).
+  [[nodiscard]] virtual std::vector<SensorInfo> sensors() const { return {}; }
 };
 
 }  // namespace concert::hardware

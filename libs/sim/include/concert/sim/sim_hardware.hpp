@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "concert/hardware/hardware.hpp"
+#include "concert/sim/sensor_params.hpp"
 #include "concert/world/world.hpp"
 
 namespace concert::sim {
@@ -40,6 +41,7 @@ struct SimParams {
   /// (e.g. {"concert_resources", "/work/shared/data/concert_resources"}). Meshes that do not
   /// resolve to an existing file are skipped; wheel links keep only their primitive shapes.
   std::map<std::string, std::string> package_paths;
+  SensorParams sensors;              ///< simulated sensors (sensor_params.hpp)
 };
 
 /// MJCF text for a URDF placed in a world (exposed for tests and for debugging in MuJoCo's
