@@ -43,8 +43,8 @@ struct CameraParams {
   bool noise{true};
 };
 
-/// Velodyne VLP-16 (datasheet: 16 channels over ±15°, 360°, 0.1–100 m... stated "up to
-/// 100 m", accuracy ±3 cm typical, 5–20 Hz, 0.1°–0.4° horizontal resolution).
+/// Velodyne VLP-16 (datasheet: 16 channels over ±15°, 360°, range up to 100 m, accuracy
+/// ±3 cm typical, 5–20 Hz, 0.1°–0.4° horizontal resolution).
 struct LidarParams {
   double rate{10.0};              ///< [Hz] (datasheet 5–20 Hz)
   std::uint32_t rings{16};
