@@ -16,11 +16,14 @@
 
 #include "concert/mobile_base/base_kinematics.hpp"
 #include "concert/hardware/realtime_buffer.hpp"
+#include "mjcf_text.hpp"
+#include "world_mjcf.hpp"
 
 namespace concert::sim {
 
 using hardware::DriveCommand;
-using world::WorldShape;
+using mjcf::num;
+using mjcf::vec;
 using hardware::DriveMode;
 using hardware::HardwareError;
 using hardware::HardwareState;
@@ -38,14 +41,6 @@ urdf::ModelInterfaceSharedPtr parse(const std::string& urdf) {
   }
   return model;
 }
-
-std::string num(double v) {
-  std::ostringstream s;
-  s << std::setprecision(12) << v;
-  return s.str();
-}
-
-std::string vec(double a, double b, double c) { return num(a) + " " + num(b) + " " + num(c); }
 
 std::string pos_quat(const urdf::Pose& p) {
   return "pos=\"" + vec(p.position.x, p.position.y, p.position.z) + "\" quat=\"" + num(p.rotation.w) + " " +
@@ -191,31 +186,6 @@ struct MjcfWriter {
   }
 };
 
-void world_geoms(std::ostringstream& xml, const World& world) {
-  if (world.floor) {
-    xml << "<geom name=\"floor\" type=\"plane\" size=\"100 100 0.1\" pos=\"0 0 " << num(world.floor_height)
-        << "\" contype=\"0\" conaffinity=\"1\" friction=\"" << num(world.floor_friction) << " 0.005 0.0001\"/>\n";
-  }
-  auto shape = [&](const WorldShape& s) {
-    const std::string where = "pos=\"" + vec(s.position.x(), s.position.y(), s.position.z()) + "\" euler=\"0 0 " +
-                              num(s.yaw) + "\" contype=\"0\" conaffinity=\"1\" friction=\"" + num(s.friction) +
-                              " 0.005 0.0001\"";
-    if (s.type == WorldShape::Type::kBox) {
-      xml << "<geom name=\"" << s.name << "\" type=\"box\" size=\"" << vec(s.size.x() / 2, s.size.y() / 2, s.size.z() / 2)
-          << "\" " << where << "/>\n";
-    } else {
-      xml << "<geom name=\"" << s.name << "\" type=\"cylinder\" size=\"" << num(s.size.x()) << " "
-          << num(s.size.z() / 2) << "\" " << where << "/>\n";
-    }
-  };
-  for (const auto& w : world.walls) {
-    shape(w);
-  }
-  for (const auto& o : world.obstacles) {
-    shape(o);
-  }
-}
-
 struct Built {
   std::string mjcf;
   int meshes{0};
@@ -241,7 +211,8 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
   MjcfWriter w{params, wheel_links, {}, {}, {}, {}, 0};
   const urdf::Link& root = *parsed->getRoot();
   w.xml << "<worldbody>\n";
-  world_geoms(w.xml, world);
+  const WorldMjcf world_xml = world_mjcf(world);
+  w.xml << world_xml.worldbody;
   w.xml << "<body name=\"" << root.name << "\" pos=\"" << vec(params.base_position.x(), params.base_position.y(), z)
         << "\" euler=\"0 0 " << num(params.base_yaw) << "\">\n";
   if (out.floating) {
@@ -265,8 +236,8 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
        << "<compiler angle=\"radian\" inertiafromgeom=\"false\" boundmass=\"0.0001\" boundinertia=\"0.00000001\" "
           "balanceinertia=\"true\"/>\n"
        << "<option timestep=\"" << num(params.timestep) << "\" integrator=\"implicit\" gravity=\"0 0 -9.81\"/>\n";
-  if (!w.assets.empty()) {
-    head << "<asset>\n";
+  if (!w.assets.empty() || !world_xml.assets.empty()) {
+    head << "<asset>\n" << world_xml.assets;
     for (const auto& a : w.assets) {
       head << a << "\n";
     }
