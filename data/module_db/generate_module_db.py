@@ -143,6 +143,79 @@ R = 0.0675  # EMI radius, m (estimate)
 EST_GEOM = ["bodies.*.mass", "bodies.*.com", "bodies.*.inertia", "bodies.*.visual", "bodies.*.collision",
             "connectors.*.pose"]
 
+
+# --- Sensors of the mobile platform -----------------------------------------------------------
+# Mount poses of the real platform (concert_resources/sensors/mobile_platform_sensors.yaml, in the
+# frame of mobile_platform_concert's body, floor at z = -0.747 m there). This hub's chassis box
+# is an estimate, larger than the real chassis and with its floor at z = -0.85 m: each sensor
+# keeps its height above the floor and its orientation, and moves out to this box's faces where
+# the real position lies inside the box (+2 cm clearance).
+REAL_FLOOR, OUR_FLOOR, HALF_BOX = -0.747, -0.85, (0.6, 0.4)
+
+
+def rot(rpy):
+    (r, p, y) = rpy
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return [[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr]]
+
+
+def mul(a, b):
+    return [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+
+
+def rpy_of(m):
+    return tuple(0.0 if abs(a) < 1e-12 else a for a in _rpy_of(m))
+
+
+def _rpy_of(m):
+    pitch = math.atan2(-m[2][0], math.hypot(m[0][0], m[1][0]))
+    if abs(math.cos(pitch)) < 1e-9:  # gimbal lock: put everything in yaw
+        return (0.0, pitch, math.atan2(-m[0][1], m[1][1]))
+    return (math.atan2(m[2][1], m[2][2]), pitch, math.atan2(m[1][0], m[0][0]))
+
+
+def platform_xyz(xyz):
+    x, y, z = xyz
+    if abs(x) < HALF_BOX[0] + 0.02 and abs(y) < HALF_BOX[1] + 0.02:
+        # push out through the nearer face
+        if HALF_BOX[0] - abs(x) < HALF_BOX[1] - abs(y):
+            x = math.copysign(HALF_BOX[0] + 0.02, x)
+        else:
+            y = math.copysign(HALF_BOX[1] + 0.02, y)
+    return (x, y, z - REAL_FLOOR + OUR_FLOOR)
+
+
+# Camera frames are optical frames (z along the optical axis, x right, y down): the real mount
+# (x forward, z up) turned by rpy (-pi/2, 0, -pi/2). Sonar frames: x along the cone axis (the
+# mount, then then_rpy, as the sensor file says).
+OPTICAL = (-PI / 2, 0, -PI / 2)
+REAL_SENSORS = [
+    ("lidar_front", "lidar", (0.5305, 0.315, -0.0627), (PI, 0.0, PI / 2), None),
+    ("lidar_back", "lidar", (-0.5305, -0.315, -0.0627), (PI, 0.0, -PI / 2), None),
+    ("ultrasound_fl_sag", "sonar", (0.5105, 0.315, -0.129), (0.0, 1.963496, 0.0), (0.0, -1.57, 0.0)),
+    ("ultrasound_fr_sag", "sonar", (0.5105, -0.315, -0.129), (0.0, 1.963496, 0.0), (0.0, -1.57, 0.0)),
+    ("ultrasound_rl_sag", "sonar", (-0.5105, 0.315, -0.129), (0.0, 1.963496, PI), (0.0, -1.57, 0.0)),
+    ("ultrasound_rr_sag", "sonar", (-0.5105, -0.315, -0.129), (0.0, 1.963496, PI), (0.0, -1.57, 0.0)),
+    ("ultrasound_fl_lat", "sonar", (0.4515, 0.365, -0.117), (0.0, 1.963496, PI / 2), (0.0, -1.57, 0.0)),
+    ("ultrasound_rl_lat", "sonar", (-0.4515, 0.365, -0.117), (0.0, 1.963496, PI / 2), (0.0, -1.57, 0.0)),
+    ("ultrasound_fr_lat", "sonar", (0.4515, -0.365, -0.117), (0.0, 1.963496, -PI / 2), (0.0, -1.57, 0.0)),
+    ("ultrasound_rr_lat", "sonar", (-0.4515, -0.365, -0.117), (0.0, 1.963496, -PI / 2), (0.0, -1.57, 0.0)),
+    ("d435i_front", "camera", (0.402872, 0.0, -0.078218), (0.0, 0.261799, 0.0), OPTICAL),
+    ("d435i_back", "camera", (-0.402872, 0.0, -0.078218), (0.0, 0.261799, PI), OPTICAL),
+]
+
+
+def platform_sensor_frames():
+    lines = []
+    for name, kind, xyz, rpy, then in REAL_SENSORS:
+        r = rot(rpy) if then is None else mul(rot(rpy), rot(then))
+        lines.append("  - {name: %s, kind: %s, body: base, pose: %s}" % (name, kind, pose(platform_xyz(xyz), rpy_of(r))))
+    # The platform's IMU: the public data gives no pose; at the chassis centre (estimate).
+    lines.append("  - {name: imu, kind: imu, body: base, pose: %s}  # estimate" % pose((0, 0, -0.2)))
+    return lines
+
 # --- Hubs -------------------------------------------------------------------------------------
 base_m = 127.6
 module("concert_mobile_base_hub", "Mobile Base Hub", "mobile_base", ["hub", "mobile_base"],
@@ -154,8 +227,10 @@ module("concert_mobile_base_hub", "Mobile Base Hub", "mobile_base", ["hub", "mob
         connector("leg_rear_right", "output", "base", pose((-0.45, -0.3, -0.4), (PI, 0, 0))),
         connector("arm", "output", "base", pose((0.2, 0.0, 0.0))),
         "  - {name: base, role: base, body: base, type: base, size: large, pose: %s}" % pose((0, 0, -0.4), (PI, 0, 0))],
-       paper=["two ESCs", "connectors 1-4 legs FL FR RL RR, 5 arm", "footprint <= 0.85 x 1.30 m"],
-       estimated=EST_GEOM, identity=(2, 3, 0, 0),
+       frames=platform_sensor_frames(),
+       paper=["two ESCs", "connectors 1-4 legs FL FR RL RR, 5 arm", "footprint <= 0.85 x 1.30 m",
+              "sensor mounts: concert_resources/sensors/mobile_platform_sensors.yaml"],
+       estimated=EST_GEOM + ["frames.*.xyz (moved to this chassis box)", "frames.imu"], identity=(2, 3, 0, 0),
        comment="Connector numbering: output n = n-th output connector below (1 FL, 2 FR, 3 RL, 4 RR, 5 arm).")
 
 torso_m = 4.9
@@ -255,12 +330,12 @@ def tool(key, label, tags, mass, size, tcp_pose, identity, frames=(), addon_type
            [body("tool", mass, (0, 0, c / 2), box_inertia(mass, a, b, c),
                  ["{box: %s, pose: %s}" % (v(size), pose((0, 0, c / 2)))])],
            [connector("input", "input", "tool"), tcp("tcp", "tool", tcp_pose)], frames=frames,
-           addon_types=addon_types, paper=list(paper) or [label], estimated=EST_GEOM + ["tcp pose"],
+           addon_types=addon_types, paper=list(paper) or [label], estimated=EST_GEOM + ["tcp pose"] + (["frames.* pose"] if frames else []),
            identity=identity, project_assigned=project_assigned)
 
 
 tool("concert_drill", "Drill", ["drill", "tool", "arm"], 10.35, (0.35, 0.12, 0.2), pose((0.28, 0, 0.09), (0, PI / 2, 0)),
-     (3, 3, 4, 0), frames=["  - {name: camera, kind: camera, body: tool, pose: %s}  # RealSense D435i"
+     (3, 3, 4, 0), frames=["  - {name: camera, kind: camera, body: tool, pose: %s}  # RealSense D435i, optical frame; pose estimated"
                            % pose((0.12, 0, 0.2), (0, PI / 2, 0))],
      addon_types=["drillbit", "handle"], paper=["Drill with integrated RealSense D435i camera"])
 tool("concert_spraying_tool", "Spraying Tool", ["spraying_tool", "tool", "arm"], 1.8, (0.12, 0.12, 0.2),

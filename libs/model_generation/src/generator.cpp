@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 
 namespace concert::model_generation {
@@ -97,6 +98,22 @@ model::EndEffectorKind end_effector_kind(const ModuleDescription& d) {
     if (t == "camera") return EndEffectorKind::kCamera;
   }
   return EndEffectorKind::kOther;
+}
+
+/// The sensor a module frame carries, if it is a sensor frame.
+std::optional<model::SensorKind> sensor_kind(module_db::FrameKind kind) {
+  switch (kind) {
+    case module_db::FrameKind::kCamera:
+      return model::SensorKind::kCamera;
+    case module_db::FrameKind::kLidar:
+      return model::SensorKind::kLidar;
+    case module_db::FrameKind::kSonar:
+      return model::SensorKind::kSonar;
+    case module_db::FrameKind::kImu:
+      return model::SensorKind::kImu;
+    default:
+      return std::nullopt;
+  }
 }
 
 struct ChainRecord {
@@ -322,10 +339,10 @@ class Builder {
     }
     for (const module_db::Frame& f : d.frames) {
       make_frame(m, urdf_of[static_cast<size_t>(f.body)], offset_of[static_cast<size_t>(f.body)] * f.pose, f.name + T, s.tag);
-      if (f.kind == module_db::FrameKind::kCamera) {
+      if (const auto kind = sensor_kind(f.kind)) {
         model::SensorFrame sf;
         sf.name = f.name + T;
-        sf.kind = model::SensorKind::kCamera;
+        sf.kind = *kind;
         sf.frame = f.name + T;
         sf.chain = s.tag;
         if (d.is_end_effector() && !tcps.empty()) sf.end_effector = end_effector_word(d) + T;
@@ -447,7 +464,7 @@ void apply_addons(const module_db::ModuleDatabase& db, const Customisation& cust
       phi.joints.push_back(j);
       model::SensorFrame sf;
       sf.name = fb.name;
-      sf.kind = addon->frame->kind == module_db::FrameKind::kCamera ? model::SensorKind::kCamera : model::SensorKind::kOther;
+      sf.kind = sensor_kind(addon->frame->kind).value_or(model::SensorKind::kOther);
       sf.frame = fb.name;
       sf.chain = ee->chain;
       sf.end_effector = ee->name;

@@ -4,6 +4,7 @@
 // concert_resources (peak torques only).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "concert/model/robot_model.hpp"
@@ -85,6 +86,49 @@ TEST(PaperRobotProjectDatabase, LimitsTableKeepsPeakAndContinuousTorqueApart) {
   EXPECT_EQ(camera.frame, "camera_E");
   EXPECT_EQ(camera.module_key, "concert_drill");
   EXPECT_TRUE(m->kinematics().has_frame(camera.frame));
+}
+
+TEST(PaperRobotProjectDatabase, MobilePlatformCarriesTheRealPlatformsSensors) {
+  const auto m = model::RobotModel::build(
+      generate({fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db",
+                fs::path(CONCERT_SOURCE_DIR) / "deploy/demo/drill_robot.yaml"})
+          .description());
+  // mobile_platform_sensors.yaml: two lidars, eight ultrasound sensors, front and back
+  // RGB-D cameras; plus the platform's IMU and the drill's camera.
+  EXPECT_EQ(m->sensor_frames(SensorKind::kLidar).size(), 2u);
+  EXPECT_EQ(m->sensor_frames(SensorKind::kSonar).size(), 8u);
+  EXPECT_EQ(m->sensor_frames(SensorKind::kCamera).size(), 3u);
+  EXPECT_EQ(m->sensor_frames(SensorKind::kImu).size(), 1u);
+  const auto& kin = m->kinematics();
+  auto data = kin.make_data();
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(kin.dof());
+  for (const model::SensorFrame* f : m->sensor_frames(SensorKind::kLidar)) {
+    ASSERT_TRUE(kin.has_frame(f->frame)) << f->name;
+    EXPECT_EQ(f->module_key, "concert_mobile_base_hub");
+    EXPECT_TRUE(f->end_effector.empty());
+  }
+  // The sensor file's poses, kept relative to the floor: the lidars' rotation axes point down
+  // (mounted upside down), the front camera's optical axis looks forward and 15 deg down,
+  // every sonar looks outward and 22.5 deg down.
+  for (const model::SensorFrame* f : m->sensor_frames(SensorKind::kLidar)) {
+    const Eigen::Isometry3d pose = kin.frame_pose(data, q, f->frame);
+    EXPECT_NEAR(pose.linear().col(2).z(), -1.0, 1e-9) << f->name;
+  }
+  const model::SensorFrame* front = nullptr;
+  for (const model::SensorFrame* f : m->sensor_frames(SensorKind::kCamera)) {
+    if (f->name.rfind("d435i_front", 0) == 0) front = f;
+  }
+  ASSERT_NE(front, nullptr);
+  const Eigen::Isometry3d camera = kin.frame_pose(data, q, front->frame);
+  EXPECT_NEAR(camera.linear().col(2).x(), std::cos(0.261799), 1e-6);
+  EXPECT_NEAR(camera.linear().col(2).z(), -std::sin(0.261799), 1e-6);
+  EXPECT_NEAR(camera.linear().col(0).y(), -1.0, 1e-6);  // image x to the robot's right
+  for (const model::SensorFrame* f : m->sensor_frames(SensorKind::kSonar)) {
+    const Eigen::Isometry3d pose = kin.frame_pose(data, q, f->frame);
+    const Eigen::Vector3d axis = pose.linear().col(0);
+    EXPECT_NEAR(axis.z(), -std::sin(1.963496 - 1.57), 1e-6) << f->name;
+    EXPECT_GT(axis.head<2>().dot(pose.translation().head<2>()), 0.0) << f->name << " looks inward";
+  }
 }
 
 TEST(PaperRobotPublicDatabase, ContinuousTorqueIsThePeakWhereTheDatabaseGivesNone) {

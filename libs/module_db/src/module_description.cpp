@@ -14,8 +14,8 @@ constexpr std::array<std::string_view, 7> kModuleTypeNames{
     "joint", "hub", "mobile_base", "link", "base_link", "end_effector", "wheel"};
 constexpr std::array<std::string_view, 4> kJointTypeNames{"revolute", "continuous", "prismatic",
                                                           "fixed"};
-constexpr std::array<std::string_view, 7> kFrameKindNames{"input", "joint",  "output", "tcp",
-                                                          "wheel", "camera", "other"};
+constexpr std::array<std::string_view, 10> kFrameKindNames{
+    "input", "joint", "output", "tcp", "wheel", "camera", "lidar", "sonar", "imu", "other"};
 static_assert(kModuleTypeNames.size() == static_cast<std::size_t>(ModuleType::kWheel) + 1);
 static_assert(kJointTypeNames.size() == static_cast<std::size_t>(JointType::kFixed) + 1);
 static_assert(kFrameKindNames.size() == static_cast<std::size_t>(FrameKind::kOther) + 1);

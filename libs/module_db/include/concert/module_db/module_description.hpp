@@ -119,11 +119,14 @@ struct JointDescription {
   bool actuated() const { return type != JointType::kFixed; }
 };
 
-/// Kind of a named frame of a module (paper section 4.3.2).
-enum class FrameKind { kInput, kJoint, kOutput, kTcp, kWheel, kCamera, kOther };
+/// Kind of a named frame of a module (paper section 4.3.2). Sensor frames (camera, lidar,
+/// sonar, imu) become the robot model's sensor frames; camera frames are optical frames (z
+/// along the optical axis, x right, y down), lidar and sonar frames have x along the beam at
+/// azimuth 0 / the cone axis (hardware/sensors.hpp).
+enum class FrameKind { kInput, kJoint, kOutput, kTcp, kWheel, kCamera, kLidar, kSonar, kImu, kOther };
 std::string to_string(FrameKind kind);
 
-/// A named frame fixed to one body, beyond connectors and joints (e.g. a camera).
+/// A named frame fixed to one body, beyond connectors and joints (e.g. a camera, a lidar).
 struct Frame {
   std::string name;
   FrameKind kind = FrameKind::kOther;
