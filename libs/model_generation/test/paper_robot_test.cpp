@@ -139,6 +139,27 @@ TEST(PaperRobotPublicDatabase, ContinuousTorqueIsThePeakWhereTheDatabaseGivesNon
     EXPECT_DOUBLE_EQ(j.continuous_torque, j.peak_torque) << j.name;
 }
 
+TEST(PaperRobotPublicDatabase, MobilePlatformSensorsComeFromThePublicSensorFile) {
+  const fs::path db = fs::path(CONCERT_SHARED_DATA) / "concert_resources";
+  const auto m = model::RobotModel::build(
+      generate({db, fs::path(SIMBUS_EXAMPLES) / "concert_paper_robot.yaml"}).description());
+  EXPECT_EQ(m->sensor_frames(SensorKind::kLidar).size(), 2u);
+  EXPECT_EQ(m->sensor_frames(SensorKind::kSonar).size(), 8u);
+  EXPECT_EQ(m->sensor_frames(SensorKind::kCamera).size(), 2u);  // front, back (the drill has none there)
+  // Poses exactly as mobile_platform_sensors.yaml gives them in the platform's body frame.
+  const auto& kin = m->kinematics();
+  auto data = kin.make_data();
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(kin.dof());
+  const std::string body = m->links().front().name;
+  for (const model::SensorFrame* f : m->sensor_frames(SensorKind::kLidar)) {
+    const Eigen::Isometry3d pose = kin.relative_pose(data, q, body, f->frame);
+    const double side = f->name.rfind("lidar_front", 0) == 0 ? 1.0 : -1.0;
+    EXPECT_NEAR((pose.translation() - Eigen::Vector3d(side * 0.5305, side * 0.315, -0.0627)).norm(), 0.0, 1e-9)
+        << f->name;
+    EXPECT_NEAR(pose.linear().col(2).z(), -1.0, 1e-6) << f->name;  // upside down
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     BothDatabases, PaperRobot,
     ::testing::Values(Database{fs::path(CONCERT_SOURCE_DIR) / "data" / "module_db",

@@ -186,6 +186,9 @@ ModuleDatabase load_module_database(const fs::path& dir) {
   } else {
     for (const fs::path& f : sorted_files(dir / "json", ".json")) modules.push_back(load_json_module(f));
     for (const fs::path& f : sorted_files(dir / "module_addons" / "json", ".json")) db.add_addon(load_json_addon(f));
+    if (fs::is_directory(dir / "sensors")) {
+      for (const fs::path& f : sorted_files(dir / "sensors", ".yaml")) detail::attach_sensor_file(f, modules);
+    }
   }
   const fs::path index_file = dir / "esc_index.yaml";
   if (fs::exists(index_file)) {
