@@ -11,7 +11,7 @@ namespace concert::sim {
 
 namespace {
 
-void require(bool ok, const std::string& what) {
+void require(bool ok, const std::string& what) {  // construction only: may allocate
   if (!ok) {
     throw std::invalid_argument(what);
   }
@@ -48,8 +48,10 @@ Eigen::Vector3d ImuSimulator::gaussian(double sigma) {
 void ImuSimulator::sample(const Eigen::Vector3d& true_angular_velocity,
                           const Eigen::Vector3d& true_specific_force, double dt,
                           hardware::ImuSample& out) {
-  require(non_negative(dt),
-          "ImuSimulator::sample: dt must be finite and >= 0, got " + std::to_string(dt));
+  if (!non_negative(dt)) {
+    throw std::invalid_argument("ImuSimulator::sample: dt must be finite and >= 0, got " +
+                                std::to_string(dt));
+  }
   out.angular_velocity = true_angular_velocity;
   out.linear_acceleration = true_specific_force;
   out.angular_velocity_variance = gyro_sigma_ * gyro_sigma_;

@@ -18,7 +18,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Culling slack in units of a column or ring step: culling must never drop a ray that hits.
 constexpr double kIndexSlack = 1e-6;
 
-void require(bool ok, const std::string& what) {
+// Messages are literals: checks on the per-reading paths must not allocate.
+void require(bool ok, const char* what) {
   if (!ok) {
     throw std::invalid_argument(what);
   }
@@ -311,13 +312,16 @@ void derive_scan2d(const Scan2dParams& params, std::span<const PosedLidarScan> s
   out.stamp = 0.0;
   const Eigen::Isometry3d base_T_world = world_T_base.inverse();
   for (std::size_t i = 0; i < scans.size(); ++i) {
-    require(scans[i].scan != nullptr, "derive_scan2d: scan " + std::to_string(i) + " is null");
+    if (scans[i].scan == nullptr) {
+      throw std::invalid_argument("derive_scan2d: scan " + std::to_string(i) + " is null");
+    }
     const hardware::LidarScan& scan = *scans[i].scan;
-    require(scan.ranges.size() == scan.elevations.size() * scan.columns,
-            "derive_scan2d: lidar scan '" + scan.sensor + "' has " +
-                std::to_string(scan.ranges.size()) + " ranges for " +
-                std::to_string(scan.elevations.size()) + " rings x " +
-                std::to_string(scan.columns) + " columns");
+    if (scan.ranges.size() != scan.elevations.size() * scan.columns) {
+      throw std::invalid_argument("derive_scan2d: lidar scan '" + scan.sensor + "' has " +
+                                  std::to_string(scan.ranges.size()) + " ranges for " +
+                                  std::to_string(scan.elevations.size()) + " rings x " +
+                                  std::to_string(scan.columns) + " columns");
+    }
     out.stamp = i == 0 ? scan.stamp : std::max(out.stamp, scan.stamp);
     const Eigen::Isometry3d& world_T_sensor = scans[i].world_T_sensor;
     const Eigen::Isometry3d base_T_sensor = base_T_world * world_T_sensor;

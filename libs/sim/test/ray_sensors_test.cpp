@@ -8,6 +8,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "allocation_counter.hpp"
 #include "concert/sim/imu_simulator.hpp"
 #include "concert/sim/sim_hardware.hpp"
 #include "mujoco_scene.hpp"
@@ -374,8 +375,9 @@ TEST(LidarSimulator, FastPathEqualsMjRayOnEveryGeomType) {
   world += "<geom type=\"ellipsoid\" size=\"0.3 0.5 0.2\" pos=\"3 -1 0.2\"/>\n";
   world += "<geom type=\"mesh\" mesh=\"tetra\" pos=\"-3 -3 -0.5\"/>\n";
   world += "<geom type=\"hfield\" hfield=\"bumps\" pos=\"3 3 -0.7\"/>\n";
-  world += "<geom type=\"box\" size=\"0.5 0.5 0.5\" pos=\"0 3 0\" rgba=\"1 1 1 0\"/>\n";  // invisible
-                                                                                          // to rays
+  world +=
+      "<geom type=\"box\" size=\"0.5 0.5 0.5\" pos=\"0 3 0\" rgba=\"1 1 1 0\"/>\n";  // invisible
+                                                                                     // to rays
   world +=
       "<body pos=\"0.5 0 0\"><joint type=\"hinge\"/><geom type=\"box\" size=\"0.2 0.2 0.2\" "
       "group=\"1\"/>"
@@ -406,6 +408,36 @@ TEST(LidarSimulator, FastPathEqualsMjRayOnEveryGeomType) {
     EXPECT_EQ(std::count(fast.ranges.begin(), fast.ranges.end(), 0.0f), 0)
         << "trial " << trial << ": a closed room";
   }
+}
+
+TEST(RaySensors, NoAllocationPerReadingAfterTheFirst) {
+  const MujocoScene scene(mjcf_document(floor_plane(-0.7) + box({4.1, 0, 0}, {0.1, 5, 3})));
+  const LidarSimulator lidar(LidarParams{});
+  const SonarSimulator sonar(SonarParams{});
+  ImuSimulator imu(ImuParams{}, 1);
+  std::mt19937_64 rng(1);
+  LidarScan scan;
+  scan.sensor = "lidar_front";
+  LaserScan2d planar;
+  hardware::SonarRange echo;
+  hardware::ImuSample sample;
+  const std::vector<PosedLidarScan> scans{{&scan, Eigen::Isometry3d::Identity()}};
+  auto read_all = [&] {
+    lidar.scan(scene.m(), scene.d(), Eigen::Isometry3d::Identity(), rng, scan);
+    derive_scan2d(Scan2dParams{}, scans, Eigen::Isometry3d::Identity(), -0.7, "mobile_base",
+                  planar);
+    sonar.read(scene.m(), scene.d(), Eigen::Isometry3d::Identity(), rng, echo);
+    imu.sample(Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 9.81), 0.005, sample);
+  };
+  read_all();
+  const concert::test::CountAllocations allocations;
+  for (int i = 0; i < 3; ++i) {
+    read_all();
+  }
+  EXPECT_EQ(allocations.count(), 0u);
+  EXPECT_NEAR(echo.range, 0.7 / std::sin(15.0 * kDeg),
+              0.05);  // the floor, by the cone's lowest rays
+  EXPECT_NEAR(planar.ranges[Scan2dParams{}.bins / 2], 4.0, 0.1);
 }
 
 // ------------------------------------------------------------------------------------------------
