@@ -16,6 +16,7 @@
 
 #include "concert/mobile_base/base_kinematics.hpp"
 #include "concert/hardware/realtime_buffer.hpp"
+#include "concert/sim/geom_groups.hpp"
 #include "mjcf_text.hpp"
 #include "world_mjcf.hpp"
 
@@ -85,7 +86,8 @@ struct MjcfWriter {
         continue;
       }
       const std::string name = "\"" + link.name + "_collision_" + std::to_string(k++) + "\"";
-      const std::string common = " name=" + name + " " + pos_quat(c->origin) + " contype=\"1\" conaffinity=\"0\"" +
+      const std::string common = " name=" + name + " " + pos_quat(c->origin) + " group=\"" +
+                                 std::to_string(kRobotGeomGroup) + "\" contype=\"1\" conaffinity=\"0\"" +
                                  " friction=\"" + num(is_wheel ? params.wheel_friction : params.robot_friction) +
                                  " 0.005 0.0001\"";
       switch (c->geometry->type) {

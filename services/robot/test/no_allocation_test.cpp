@@ -2,64 +2,15 @@
 // malloc/free, counts what the thread running RobotCore::cycle() allocates while it cycles,
 // and drives the core through every controller, a trajectory, a model switch and a world
 // switch from another thread.
-#include <malloc.h>
-
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
-#include <new>
 #include <thread>
 
+#include "allocation_counter.hpp"
 #include "robot/robot_core.hpp"
 #include "test_helpers.hpp"
-
-extern "C" void* __libc_malloc(std::size_t size);
-extern "C" void __libc_free(void* ptr);
-extern "C" void* __libc_calloc(std::size_t n, std::size_t size);
-extern "C" void* __libc_realloc(void* ptr, std::size_t size);
-
-namespace {
-thread_local bool t_counting = false;
-std::atomic<std::uint64_t> g_allocations{0};
-
-/// Where a debugger breaks to see who allocated on the loop thread.
-[[gnu::noinline]] void counted_allocation() { g_allocations.fetch_add(1, std::memory_order_relaxed); }
-
-void note() {
-  if (t_counting) {
-    counted_allocation();
-  }
-}
-}  // namespace
-
-extern "C" void* malloc(std::size_t size) {
-  note();
-  return __libc_malloc(size);
-}
-extern "C" void* calloc(std::size_t n, std::size_t size) {
-  note();
-  return __libc_calloc(n, size);
-}
-extern "C" void* realloc(void* ptr, std::size_t size) {
-  note();
-  return __libc_realloc(ptr, size);
-}
-extern "C" void free(void* ptr) { __libc_free(ptr); }
-
-void* operator new(std::size_t size) {
-  note();
-  if (void* p = __libc_malloc(size == 0 ? 1 : size)) {
-    return p;
-  }
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { __libc_free(p); }
-void operator delete[](void* p) noexcept { __libc_free(p); }
-void operator delete(void* p, std::size_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { __libc_free(p); }
 
 namespace concert::robot {
 namespace {
@@ -70,13 +21,11 @@ using test::read_fixture;
 std::uint64_t cycles_allocating(RobotCore& core, int cycles) {
   std::uint64_t counted = 0;
   std::thread loop([&] {
-    const std::uint64_t before = g_allocations.load();
-    t_counting = true;
+    const concert::test::CountAllocations allocations;
     for (int i = 0; i < cycles; ++i) {
       core.cycle();
     }
-    t_counting = false;
-    counted = g_allocations.load() - before;
+    counted = allocations.count();
   });
   loop.join();
   return counted;
@@ -85,12 +34,14 @@ std::uint64_t cycles_allocating(RobotCore& core, int cycles) {
 TEST(NoAllocation, CountingWorks) {
   std::uint64_t counted = 0;
   std::thread t([&] {
-    const std::uint64_t before = g_allocations.load();
-    t_counting = true;
-    auto* p = new std::vector<double>(100);
-    void* m = std::malloc(64);
-    t_counting = false;
-    counted = g_allocations.load() - before;
+    void* m = nullptr;
+    std::vector<double>* p = nullptr;
+    {
+      const concert::test::CountAllocations allocations;
+      p = new std::vector<double>(100);
+      m = std::malloc(64);
+      counted = allocations.count();
+    }
     std::free(m);
     delete p;
   });
