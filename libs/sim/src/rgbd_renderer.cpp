@@ -195,9 +195,11 @@ CameraIntrinsics camera_intrinsics(const CameraParams& params) {
 
 std::string visual_mjcf(const CameraParams& params) {
   // Lit colour = rgba * (ambient + diffuse * cos(incidence)): 0.4 + 0.6 facing the camera.
+  // Shadow maps of 1024^2 for the model's own lights: MuJoCo's default 4096^2 makes every
+  // render context cost ~100 ms on llvmpipe (~5 ms with this).
   return "<visual>\n<global offwidth=\"" + std::to_string(params.width) + "\" offheight=\"" +
          std::to_string(params.height) +
-         "\"/>\n<quality offsamples=\"0\"/>\n"
+         "\"/>\n<quality offsamples=\"0\" shadowsize=\"1024\"/>\n"
          "<headlight ambient=\"0.4 0.4 0.4\" diffuse=\"0.6 0.6 0.6\" specular=\"0 0 "
          "0\"/>\n</visual>\n";
 }

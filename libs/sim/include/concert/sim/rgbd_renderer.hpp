@@ -62,12 +62,13 @@ hardware::CameraIntrinsics camera_intrinsics(const CameraParams& params);
 
 /// The MJCF `<visual>` element a model needs for this camera: an offscreen buffer of at least
 /// width x height (`<global offwidth offheight>`), no multisampling (`<quality offsamples="0">`:
-/// 3x faster, same corner accuracy), and a headlight without specular highlights that shows a
-/// grey (0.5) surface facing the camera as mid grey (128) and a white one as white (255).
+/// 3x faster, same corner accuracy), 1024^2 shadow maps (`shadowsize`: MuJoCo's 4096^2 default
+/// makes a renderer cost ~100 ms to build), and a headlight without specular highlights that shows
+/// a grey (0.5) surface facing the camera as mid grey (128) and a white one as white (255).
 std::string visual_mjcf(const CameraParams& params);
 
 /// Renders RGB-D frames of one MuJoCo model. Construction makes MuJoCo's render context for
-/// the model (uploads its meshes and textures: a few milliseconds for the robot); a hot swap
+/// the model (uploads its meshes and textures: ~20 ms for the robot); a hot swap
 /// builds a new renderer for the new model. Construct, use and destroy on the thread that owns
 /// `gl`, before `gl` is destroyed; `model` must outlive the renderer.
 class RgbdRenderer {
