@@ -9,12 +9,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
+#include "concert/common/text.hpp"
 #include "concert/sim/rgbd_renderer.hpp"
 #include "concert/sim/sim_hardware.hpp"
 
@@ -24,16 +23,6 @@ using concert::hardware::RgbdFrame;
 using concert::sim::CameraParams;
 using concert::sim::EglContext;
 using concert::sim::RgbdRenderer;
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error("cannot open '" + path + "'");
-  }
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 concert::world::WorldShape box(const std::string& name, const Eigen::Vector3d& size,
                                const Eigen::Vector3d& position) {
@@ -54,9 +43,9 @@ struct Scene {
     concert::world::WorldShape pillar = box("pillar", {0.3, 0.0, 3.0}, {1.8, -1.0, 1.5});
     pillar.type = concert::world::WorldShape::Type::kCylinder;
     world.obstacles = {pillar};
-    const std::string mjcf =
-        concert::sim::urdf_to_mjcf(read_file(std::string(ROBOT_FIXTURES) + "/mobile_drill.urdf"),
-                                   world, concert::sim::SimParams{});
+    const std::string mjcf = concert::sim::urdf_to_mjcf(
+        concert::read_file(std::string(ROBOT_FIXTURES) + "/mobile_drill.urdf", "robot"), world,
+        concert::sim::SimParams{});
     mjVFS vfs;
     mj_defaultVFS(&vfs);
     if (mj_makeEmptyFileVFS(&vfs, "scene.xml", static_cast<int>(mjcf.size())) != 0) {

@@ -95,6 +95,22 @@ std::string mjcf(const std::string& assets, const std::string& worldbody,
          worldbody + "</worldbody>\n</mujoco>\n";
 }
 
+/// A camera looking at a model: its own headless context, the model and a renderer.
+struct Camera {
+  explicit Camera(const std::string& xml, const CameraParams& params = clean_params(),
+                  const std::map<std::string, std::string>& files = {})
+      : model(xml, files), renderer(gl, model.m, params) {}
+  /// The model as seen from `world_T_optical`.
+  RgbdFrame& render(const Eigen::Isometry3d& world_T_optical) {
+    renderer.render(model.d, world_T_optical, frame);
+    return frame;
+  }
+  EglContext gl;
+  Model model;
+  RgbdRenderer renderer;
+  RgbdFrame frame;
+};
+
 /// A 10 m x 10 m grey wall whose face (at world x = `face`) looks down -x.
 std::string wall_at(double face) {
   return "<geom type=\"box\" size=\"0.05 5 5\" pos=\"" + std::to_string(face + 0.05) +
@@ -185,15 +201,12 @@ TEST(RgbdRenderer, IntrinsicsArePinholeWithPixelCentresAtIntegers) {
   EXPECT_DOUBLE_EQ(k.cx, 319.5);
   EXPECT_DOUBLE_EQ(k.cy, 239.5);
 
-  EglContext gl;
-  const Model model(mjcf("", wall_at(0.6)));
-  RgbdRenderer renderer(gl, model.m, p);
-  EXPECT_EQ(renderer.intrinsics(), k);
-  EXPECT_LE(renderer.near_plane(), p.depth_min);
-  EXPECT_GE(renderer.far_plane(), p.depth_max);
-  RgbdFrame frame;
-  frame.sensor = "camera_E";
-  renderer.render(model.d, looking_along_x(Eigen::Vector3d::Zero()), frame);
+  Camera cam(mjcf("", wall_at(0.6)), p);
+  EXPECT_EQ(cam.renderer.intrinsics(), k);
+  EXPECT_LE(cam.renderer.near_plane(), p.depth_min);
+  EXPECT_GE(cam.renderer.far_plane(), p.depth_max);
+  cam.frame.sensor = "camera_E";
+  const RgbdFrame& frame = cam.render(looking_along_x(Eigen::Vector3d::Zero()));
   EXPECT_EQ(frame.intrinsics, k);
   EXPECT_EQ(frame.sensor, "camera_E");
   EXPECT_EQ(frame.rgb.size(), 640U * 480U * 3U);
@@ -204,14 +217,10 @@ TEST(RgbdRenderer, IntrinsicsArePinholeWithPixelCentresAtIntegers) {
 }
 
 TEST(RgbdRenderer, WallAtSixtyCentimetresReadsSixHundredMillimetresInEveryPixel) {
-  EglContext gl;
-  const CameraParams p = clean_params();
-  const Model model(mjcf("", wall_at(0.6)));
-  RgbdRenderer renderer(gl, model.m, p);
-  RgbdFrame frame;
+  Camera cam(mjcf("", wall_at(0.6)));
   // The wall is perpendicular to the optical axis: z (not the range) is 0.6 m everywhere,
   // also in the corners, whatever the camera's position along the wall.
-  renderer.render(model.d, looking_along_x(Eigen::Vector3d(0.0, 0.3, -0.2)), frame);
+  const RgbdFrame& frame = cam.render(looking_along_x(Eigen::Vector3d(0.0, 0.3, -0.2)));
   int off = 0;
   for (const auto z : frame.depth) {
     off += std::abs(static_cast<int>(z) - 600) > 1 ? 1 : 0;
@@ -227,20 +236,16 @@ TEST(RgbdRenderer, WallAtSixtyCentimetresReadsSixHundredMillimetresInEveryPixel)
   // Rendering again reuses the frame's buffers.
   const auto* rgb_data = frame.rgb.data();
   const auto* depth_data = frame.depth.data();
-  renderer.render(model.d, looking_along_x(Eigen::Vector3d(0.1, 0.0, 0.0)), frame);
+  cam.render(looking_along_x(Eigen::Vector3d(0.1, 0.0, 0.0)));
   EXPECT_EQ(frame.rgb.data(), rgb_data);
   EXPECT_EQ(frame.depth.data(), depth_data);
   EXPECT_NEAR(depth_at(frame, 320, 240), 500, 1);
 }
 
 TEST(RgbdRenderer, WhiteIsWhite) {
-  EglContext gl;
-  const Model model(
+  Camera cam(
       mjcf("", "<geom type=\"box\" size=\"0.05 5 5\" pos=\"1.05 0 0\" rgba=\"1 1 1 1\"/>\n"));
-  RgbdRenderer renderer(gl, model.m, clean_params());
-  RgbdFrame frame;
-  renderer.render(model.d, looking_along_x(Eigen::Vector3d::Zero()), frame);
-  const std::uint8_t* c = rgb_at(frame, 320, 240);
+  const std::uint8_t* c = rgb_at(cam.render(looking_along_x(Eigen::Vector3d::Zero())), 320, 240);
   EXPECT_GE(c[0], 250);
   EXPECT_GE(c[1], 250);
   EXPECT_GE(c[2], 250);
@@ -266,15 +271,12 @@ double noise_std(const std::vector<T>& clean, const std::vector<T>& noisy, bool 
 }
 
 TEST(RgbdNoise, DepthNoiseFollowsTheD400RmsModelAndColourNoiseItsStdDev) {
-  EglContext gl;
-  const Model model(mjcf("", wall_at(0.6)));
-  CameraParams p;  // noise on, the D435i's values
+  const CameraParams p;  // noise on, the D435i's values
   ASSERT_TRUE(p.noise);
-  RgbdRenderer renderer(gl, model.m, p);
+  Camera cam(mjcf("", wall_at(0.6)), p);
   std::mt19937_64 rng(7);
   for (const double z : {0.6, 2.0}) {
-    RgbdFrame clean;
-    renderer.render(model.d, looking_along_x(Eigen::Vector3d(0.6 - z, 0.0, 0.0)), clean);
+    const RgbdFrame clean = cam.render(looking_along_x(Eigen::Vector3d(0.6 - z, 0.0, 0.0)));
     ASSERT_NEAR(depth_at(clean, 320, 240), z * 1000.0, 1.0);
     RgbdFrame noisy = clean;
     add_rgbd_noise(noisy, p, rng);
@@ -289,12 +291,9 @@ TEST(RgbdNoise, DepthNoiseFollowsTheD400RmsModelAndColourNoiseItsStdDev) {
 }
 
 TEST(RgbdNoise, IsSeededAndOffWhenDisabled) {
-  EglContext gl;
-  const Model model(mjcf("", wall_at(0.6)));
   CameraParams p;
-  RgbdRenderer renderer(gl, model.m, p);
-  RgbdFrame clean;
-  renderer.render(model.d, looking_along_x(Eigen::Vector3d::Zero()), clean);
+  Camera cam(mjcf("", wall_at(0.6)), p);
+  const RgbdFrame clean = cam.render(looking_along_x(Eigen::Vector3d::Zero()));
   RgbdFrame a = clean;
   RgbdFrame b = clean;
   RgbdFrame c = clean;
@@ -338,16 +337,12 @@ TEST(RgbdNoise, KeepsNoDataPixelsAtZeroAndClampsColour) {
 }
 
 TEST(RgbdRenderer, SphereCentreProjectsWhereThePublishedIntrinsicsSay) {
-  EglContext gl;
   const double radius = 0.02;
-  const Model model(mjcf(kFlatMaterials, "<body mocap=\"true\"><geom type=\"sphere\" size=\"" +
-                                             std::to_string(radius) +
-                                             "\" material=\"red\"/></body>\n"));
-  RgbdRenderer renderer(gl, model.m, clean_params());
-  const auto& k = renderer.intrinsics();
+  Camera cam(mjcf(kFlatMaterials, "<body mocap=\"true\"><geom type=\"sphere\" size=\"" +
+                                      std::to_string(radius) + "\" material=\"red\"/></body>\n"));
+  const auto& k = cam.renderer.intrinsics();
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  RgbdFrame frame;
   for (int trial = 0; trial < 8; ++trial) {
     const Eigen::Isometry3d world_T_optical = random_pose(rng);
     // A point in the field of view, 0.5..1.5 m away, within 80 % of the image.
@@ -356,8 +351,8 @@ TEST(RgbdRenderer, SphereCentreProjectsWhereThePublishedIntrinsicsSay) {
                                     0.8 * unit(rng) * z * k.cy / k.fy, z);
     Eigen::Isometry3d sphere = Eigen::Isometry3d::Identity();
     sphere.translation() = world_T_optical * p_optical;
-    model.place(0, sphere);
-    renderer.render(model.d, world_T_optical, frame);
+    cam.model.place(0, sphere);
+    const RgbdFrame& frame = cam.render(world_T_optical);
     const Eigen::Vector2d expected = project(k, p_optical);
     const Eigen::Vector2d outline_centre = sphere_image_centre(k, p_optical, radius);
     const auto [seen, pixels] = centroid(frame, red);
@@ -375,22 +370,19 @@ TEST(RgbdRenderer, SphereCentreProjectsWhereThePublishedIntrinsicsSay) {
 }
 
 TEST(RgbdRenderer, ImageIsUprightAndNotMirrored) {
-  EglContext gl;
-  const Model model(mjcf(
+  Camera cam(mjcf(
       kFlatMaterials,
       "<body mocap=\"true\"><geom type=\"sphere\" size=\"0.03\" material=\"red\"/></body>\n"
       "<body mocap=\"true\"><geom type=\"sphere\" size=\"0.03\" material=\"green\"/></body>\n"));
-  RgbdRenderer renderer(gl, model.m, clean_params());
   std::mt19937_64 rng(5);
   const Eigen::Isometry3d world_T_optical = random_pose(rng);
   Eigen::Isometry3d above = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d right = Eigen::Isometry3d::Identity();
   above.translation() = world_T_optical * Eigen::Vector3d(0.0, -0.25, 1.0);  // -y optical
   right.translation() = world_T_optical * Eigen::Vector3d(0.3, 0.0, 1.0);    // +x optical
-  model.place(0, above);
-  model.place(1, right);
-  RgbdFrame frame;
-  renderer.render(model.d, world_T_optical, frame);
+  cam.model.place(0, above);
+  cam.model.place(1, right);
+  const RgbdFrame& frame = cam.render(world_T_optical);
   const auto [red_at, red_pixels] = centroid(frame, red);
   const auto [green_at, green_pixels] = centroid(frame, green);
   ASSERT_GT(red_pixels, 100);
@@ -402,13 +394,11 @@ TEST(RgbdRenderer, ImageIsUprightAndNotMirrored) {
 }
 
 TEST(RgbdRenderer, DepthIsZeroOutsideTheDepthRangeWhileColourStillSees) {
-  EglContext gl;
   const CameraParams p = clean_params();
-  const Model model(mjcf("", wall_at(0.0)));
-  RgbdRenderer renderer(gl, model.m, p);
-  RgbdFrame frame;
+  Camera cam(mjcf("", wall_at(0.0)), p);
+  const RgbdFrame& frame = cam.frame;
   auto at = [&](double distance) {
-    renderer.render(model.d, looking_along_x(Eigen::Vector3d(-distance, 0.0, 0.0)), frame);
+    cam.render(looking_along_x(Eigen::Vector3d(-distance, 0.0, 0.0)));
   };
   auto all_zero = [&] {
     return std::count(frame.depth.begin(), frame.depth.end(), 0) == 640 * 480;
@@ -428,7 +418,7 @@ TEST(RgbdRenderer, DepthIsZeroOutsideTheDepthRangeWhileColourStillSees) {
   EXPECT_NEAR(depth_at(frame, 320, 240), 120, 1);
 
   // Nothing in view: no data, black.
-  renderer.render(model.d, looking_along_x(Eigen::Vector3d(1.0, 0.0, 0.0)), frame);
+  cam.render(looking_along_x(Eigen::Vector3d(1.0, 0.0, 0.0)));
   EXPECT_TRUE(all_zero());
   EXPECT_EQ(rgb_at(frame, 320, 240)[0], 0);
 }
@@ -462,14 +452,11 @@ TEST(RgbdRenderer, SeveralModelsShareOneHeadlessContext) {
 }
 
 TEST(RgbdRenderer, RefusesAnotherThread) {
-  EglContext gl;
-  const Model model(mjcf("", wall_at(0.6)));
-  RgbdRenderer renderer(gl, model.m, clean_params());
+  Camera cam(mjcf("", wall_at(0.6)));
   std::string error;
   std::thread other([&] {
-    RgbdFrame frame;
     try {
-      renderer.render(model.d, looking_along_x(Eigen::Vector3d::Zero()), frame);
+      cam.render(looking_along_x(Eigen::Vector3d::Zero()));
     } catch (const HardwareError& e) {
       error = e.what();
     }
@@ -514,16 +501,14 @@ TEST(RgbdRenderer, ArucoCornersDetectedByOpenCvMatchTheProjectionOfTheirPosition
   // along +y (MuJoCo maps the texture's top row to the plane's +y side).
   const double half = 0.1;
   const double corner = half * 200.0 / 300.0;
-  const Model model(
+  Camera cam(
       mjcf("<texture name=\"marker\" type=\"2d\" file=\"marker.png\"/>\n"
            "<material name=\"marker\" texture=\"marker\" texrepeat=\"1 1\" texuniform=\"false\" "
            "specular=\"0\"/>\n",
            "<body mocap=\"true\"><geom type=\"plane\" size=\"" + std::to_string(half) + " " +
                std::to_string(half) + " 0.01\" material=\"marker\"/></body>\n"),
-      {{"marker.png", aruco_png(7, 200, 50)}});
-  EglContext gl;
-  RgbdRenderer renderer(gl, model.m, clean_params());
-  const auto& k = renderer.intrinsics();
+      clean_params(), {{"marker.png", aruco_png(7, 200, 50)}});
+  const auto& k = cam.renderer.intrinsics();
   // The marker's corners in the plane's frame, in ArUco's order: top-left, top-right,
   // bottom-right, bottom-left.
   const std::vector<Eigen::Vector3d> corners = {{-corner, corner, 0.0},
@@ -535,7 +520,6 @@ TEST(RgbdRenderer, ArucoCornersDetectedByOpenCvMatchTheProjectionOfTheirPosition
   detector->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
   std::mt19937_64 rng(23);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  RgbdFrame frame;
   for (int trial = 0; trial < 5; ++trial) {
     const Eigen::Isometry3d world_T_optical = random_pose(rng);
     // The plane 0.5..0.8 m ahead, its normal towards the camera, tilted up to ~25 degrees,
@@ -551,8 +535,8 @@ TEST(RgbdRenderer, ArucoCornersDetectedByOpenCvMatchTheProjectionOfTheirPosition
                                Eigen::AngleAxisd(0.3 * unit(rng), Eigen::Vector3d::UnitZ());
     optical_T_plane.translation() =
         Eigen::Vector3d(0.08 * unit(rng), 0.06 * unit(rng), 0.65 + 0.15 * unit(rng));
-    model.place(0, world_T_optical * optical_T_plane);
-    renderer.render(model.d, world_T_optical, frame);
+    cam.model.place(0, world_T_optical * optical_T_plane);
+    RgbdFrame& frame = cam.render(world_T_optical);
 
     cv::Mat rgb(static_cast<int>(k.height), static_cast<int>(k.width), CV_8UC3, frame.rgb.data());
     cv::Mat grey;
