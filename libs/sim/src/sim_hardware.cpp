@@ -17,6 +17,7 @@
 #include "concert/mobile_base/base_kinematics.hpp"
 #include "concert/hardware/realtime_buffer.hpp"
 #include "concert/sim/geom_groups.hpp"
+#include "concert/sim/rgbd_renderer.hpp"
 #include "mjcf_text.hpp"
 #include "world_mjcf.hpp"
 
@@ -237,6 +238,7 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
   head << "<mujoco model=\"" << parsed->getName() << "\">\n"
        << "<compiler angle=\"radian\" inertiafromgeom=\"false\" boundmass=\"0.0001\" boundinertia=\"0.00000001\" "
           "balanceinertia=\"true\"/>\n"
+       << visual_mjcf(params.sensors.camera)
        << "<option timestep=\"" << num(params.timestep) << "\" integrator=\"implicit\" gravity=\"0 0 -9.81\"/>\n";
   if (!w.assets.empty() || !world_xml.assets.empty()) {
     head << "<asset>\n" << world_xml.assets;
