@@ -11,6 +11,30 @@
 
 namespace concert::sim {
 
+std::vector<SensorMount> sensor_mounts(const std::vector<model::SensorFrame>& frames) {
+  std::vector<SensorMount> out;
+  for (const model::SensorFrame& f : frames) {
+    switch (f.kind) {
+      case model::SensorKind::kCamera:
+        out.push_back({f.name, hardware::SensorType::kRgbd, f.frame});
+        break;
+      case model::SensorKind::kLidar:
+        out.push_back({f.name, hardware::SensorType::kLidar, f.frame});
+        break;
+      case model::SensorKind::kSonar:
+        out.push_back({f.name, hardware::SensorType::kSonar, f.frame});
+        break;
+      case model::SensorKind::kImu:
+        out.push_back({f.name, hardware::SensorType::kImu, f.frame});
+        break;
+      case model::SensorKind::kForceTorque:
+      case model::SensorKind::kOther:
+        break;
+    }
+  }
+  return out;
+}
+
 struct AssemblyBuilder::Impl {
   module_db::ModuleDatabase db;
   topology::EscCatalog catalog;
@@ -52,7 +76,9 @@ SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const s
   out.scan = simbus::simulate_scan(assembly, impl_->catalog);
   out.tree = simbus::tree_from_assembly(assembly, impl_->catalog);
   try {
-    out.urdf = impl_->generator->generate(out.tree).urdf;
+    const model_generation::GeneratedModel model = impl_->generator->generate(out.tree);
+    out.urdf = model.urdf;
+    out.sensors = sensor_mounts(model.sensor_frames);
   } catch (const std::exception& e) {
     throw std::runtime_error("assembly '" + source + "': model generation failed: " + e.what());
   }

@@ -17,8 +17,10 @@
 #include "concert/mobile_base/base_kinematics.hpp"
 #include "concert/hardware/realtime_buffer.hpp"
 #include "concert/sim/geom_groups.hpp"
+#include "concert/sim/imu_simulator.hpp"
 #include "concert/sim/rgbd_renderer.hpp"
 #include "mjcf_text.hpp"
+#include "sensor_runtime.hpp"
 #include "world_mjcf.hpp"
 
 namespace concert::sim {
@@ -53,6 +55,7 @@ Eigen::Matrix3d rotation(const urdf::Rotation& r) { return Eigen::Quaterniond(r.
 
 struct MjcfWriter {
   const SimParams& params;
+  const std::vector<SensorMount>& sensors;
   const std::map<std::string, double>& wheel_radii;
   std::ostringstream xml;
   std::vector<std::string> actuated;  // joint names in depth-first order
@@ -176,11 +179,32 @@ struct MjcfWriter {
     efforts.push_back(j.limits ? j.limits->effort : 0.0);
   }
 
+  /// A site for each IMU mounted at `link` (its MuJoCo gyro and accelerometer read there).
+  void imu_sites(const std::string& link) {
+    for (const auto& s : sensors) {
+      if (s.type == hardware::SensorType::kImu && s.frame == link) {
+        xml << imu_mjcf(imu_site_name(s.name)).site;
+      }
+    }
+  }
+
+  /// The <sensor> section: gyro and accelerometer of each IMU (read by the sensor threads).
+  [[nodiscard]] std::string imu_sensors() const {
+    std::string out;
+    for (const auto& s : sensors) {
+      if (s.type == hardware::SensorType::kImu) {
+        out += imu_mjcf(imu_site_name(s.name)).sensors;
+      }
+    }
+    return out.empty() ? out : "<sensor>\n" + out + "</sensor>\n";
+  }
+
   void body(const urdf::Link& link) {
     for (const auto& child : link.child_links) {
       const urdf::Joint& j = *child->parent_joint;
       xml << "<body name=\"" << child->name << "\" " << pos_quat(j.parent_to_joint_origin_transform) << ">\n";
       inertial(*child);
+      imu_sites(child->name);
       joint(j);
       geoms(*child, wheel_radii.count(child->name) > 0 && j.type != urdf::Joint::FIXED);
       body(*child);
@@ -196,7 +220,8 @@ struct Built {
   bool floating{false};
 };
 
-Built build_mjcf(const std::string& urdf, const World& world, const SimParams& params) {
+Built build_mjcf(const std::string& urdf, const World& world, const SimParams& params,
+                 const std::vector<SensorMount>& sensors) {
   const auto parsed = parse(urdf);
   const auto radii = collision_cylinder_radii(urdf);
   const kinematics::Model model = kinematics::Model::from_urdf_string(urdf);
@@ -211,7 +236,7 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
   if (out.floating && !legs.empty()) {
     z = world.floor_height + mobile_base::standing_height(legs) + 0.002;
   }
-  MjcfWriter w{params, wheel_links, {}, {}, {}, {}, 0};
+  MjcfWriter w{params, sensors, wheel_links, {}, {}, {}, {}, 0};
   const urdf::Link& root = *parsed->getRoot();
   w.xml << "<worldbody>\n";
   const WorldMjcf world_xml = world_mjcf(world);
@@ -222,6 +247,7 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
     w.xml << "<freejoint name=\"__floating_base\"/>\n";
   }
   w.inertial(root);
+  w.imu_sites(root.name);
   w.geoms(root, false);
   w.body(root);
   w.xml << "</body>\n</worldbody>\n<actuator>\n";
@@ -233,7 +259,7 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
     }
     w.xml << "/>\n";
   }
-  w.xml << "</actuator>\n</mujoco>\n";
+  w.xml << "</actuator>\n" << w.imu_sensors() << "</mujoco>\n";
   std::ostringstream head;
   head << "<mujoco model=\"" << parsed->getName() << "\">\n"
        << "<compiler angle=\"radian\" inertiafromgeom=\"false\" boundmass=\"0.0001\" boundinertia=\"0.00000001\" "
@@ -256,7 +282,7 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
 }  // namespace
 
 std::string urdf_to_mjcf(const std::string& urdf, const World& world, const SimParams& params) {
-  return build_mjcf(urdf, world, params).mjcf;
+  return build_mjcf(urdf, world, params, {}).mjcf;
 }
 
 /// One MuJoCo robot in one world: what a hot swap or a world change prepares off the control
@@ -281,15 +307,20 @@ struct Instance {
   std::vector<int> qpos_adr, dof_adr;
   std::vector<DriveCommand> commands;
   std::uint64_t generation{0};
+  std::vector<SensorMount> sensors;
+  /// What the sensor threads read (null when the sensors are off).
+  std::shared_ptr<SensorScene> scene;
   /// Only the world changed: the running instance's whole state carries over.
   bool same_robot{false};
 };
 
 namespace {
 
-std::unique_ptr<Instance> make_instance(const std::string& urdf, const World& world, const SimParams& params) {
+std::unique_ptr<Instance> make_instance(const std::string& urdf, const std::vector<SensorMount>& sensors,
+                                        const World& world, const SimParams& params) {
   auto in = std::make_unique<Instance>();
-  in->built = build_mjcf(urdf, world, params);
+  in->built = build_mjcf(urdf, world, params, sensors);
+  in->sensors = sensors;
   in->urdf = urdf;
   in->world = world;
   mjVFS vfs;
@@ -320,6 +351,9 @@ std::unique_ptr<Instance> make_instance(const std::string& urdf, const World& wo
     in->commands[i].position = q;
   }
   mj_forward(in->m, in->d);
+  if (params.sensors.enabled) {
+    in->scene = std::make_shared<SensorScene>(in->m, sensors, world.floor_height);
+  }
   return in;
 }
 
@@ -361,7 +395,12 @@ struct SimHardware::Impl {
   std::mutex preparing;
   mutable std::mutex mutex;
   std::string latest_urdf;
+  std::vector<SensorMount> latest_sensors;
   World latest_world;
+  // The sensors: the scene of the running instance (published by the control thread at each
+  // switch) and the threads that read it (made on the first sink).
+  std::atomic<std::shared_ptr<SensorScene>> active_scene;
+  std::unique_ptr<SensorRuntime> sensor_runtime;
   MountedHardware mounted;
   hardware::Handover<Instance> prepared;
 
@@ -398,20 +437,46 @@ struct SimHardware::Impl {
   }
 };
 
-SimHardware::SimHardware(const std::string& urdf, World world, SimParams params) : impl_(std::make_unique<Impl>()) {
+SimHardware::SimHardware(const std::string& urdf, World world, SimParams params, std::vector<SensorMount> sensors)
+    : impl_(std::make_unique<Impl>()) {
   impl_->params = std::move(params);
   impl_->rng.seed(impl_->params.seed);
   if (impl_->params.timestep <= 0.0) {
     throw HardwareError("sim: timestep must be positive");
   }
-  impl_->active = make_instance(urdf, world, impl_->params);
+  impl_->active = make_instance(urdf, sensors, world, impl_->params);
   impl_->active->generation = 1;
   impl_->latest_urdf = urdf;
+  impl_->latest_sensors = std::move(sensors);
   impl_->latest_world = std::move(world);
   impl_->mounted = {1, impl_->active->built.joints};
+  impl_->active_scene.store(impl_->active->scene);
+  if (impl_->params.sensors.enabled) {
+    impl_->sensor_runtime = std::make_unique<SensorRuntime>(impl_->params.sensors, impl_->active_scene);
+  }
 }
 
-SimHardware::~SimHardware() = default;
+SimHardware::~SimHardware() {
+  impl_->sensor_runtime.reset();  // joins the sensor threads before the scenes go
+}
+
+void SimHardware::set_sensor_sink(hardware::SensorSink* sink) {
+  if (impl_->sensor_runtime) {
+    impl_->sensor_runtime->set_sink(sink);
+  }
+}
+
+std::vector<hardware::SensorInfo> SimHardware::sensors() const {
+  std::vector<hardware::SensorInfo> out;
+  if (!impl_->params.sensors.enabled) {
+    return out;
+  }
+  std::lock_guard lock(impl_->mutex);
+  for (const SensorMount& m : impl_->latest_sensors) {
+    out.push_back({m.name, m.type, m.frame, sensor_rate(impl_->params.sensors, m.type)});
+  }
+  return out;
+}
 
 const std::vector<std::string>& SimHardware::joint_names() const { return impl_->active->built.joints; }
 std::uint64_t SimHardware::generation() const { return impl_->active->generation; }
@@ -434,6 +499,8 @@ bool SimHardware::switch_prepared() {
   carry_state(*impl_->active, *next);
   Instance* old = impl_->active.release();
   impl_->active.reset(next);
+  // The old scene stays referenced by the retired instance (deleted off this thread).
+  impl_->active_scene.store(next->scene);
   if (!impl_->prepared.retire(old)) {
     delete old;  // unreachable in practice: each preparation collects the retired instance first
   }
@@ -476,11 +543,14 @@ void SimHardware::step(double dt) {
     impl_->apply_drives();
     mj_step(impl_->active->m, impl_->active->d);
   }
+  if (impl_->active->scene) {
+    impl_->active->scene->publish(impl_->active->d);
+  }
   // As on real drives, measured efforts and contacts lag the positions by one physics step
   // (mj_step computes forces before integrating); a second mj_forward would double the cost.
 }
 
-bool SimHardware::swap_model(const std::string& urdf) {
+bool SimHardware::swap_model(const std::string& urdf, std::vector<SensorMount> sensors) {
   // Preparations are serialised (each builds on the latest robot and world); mounted() and
   // world() stay answerable meanwhile, as they only take `mutex`.
   std::lock_guard preparing(impl_->preparing);
@@ -492,10 +562,11 @@ bool SimHardware::swap_model(const std::string& urdf) {
     }
     world = impl_->latest_world;
   }
-  auto next = make_instance(urdf, world, impl_->params);
+  auto next = make_instance(urdf, sensors, world, impl_->params);
   std::lock_guard lock(impl_->mutex);
   next->generation = impl_->mounted.generation + 1;
   impl_->latest_urdf = urdf;
+  impl_->latest_sensors = std::move(sensors);
   impl_->mounted = {next->generation, next->built.joints};
   impl_->submit(std::move(next));
   return true;
@@ -504,11 +575,13 @@ bool SimHardware::swap_model(const std::string& urdf) {
 void SimHardware::set_world(const World& world) {
   std::lock_guard preparing(impl_->preparing);
   std::string urdf;
+  std::vector<SensorMount> sensors;
   {
     std::lock_guard lock(impl_->mutex);
     urdf = impl_->latest_urdf;
+    sensors = impl_->latest_sensors;
   }
-  auto next = make_instance(urdf, world, impl_->params);
+  auto next = make_instance(urdf, sensors, world, impl_->params);
   next->same_robot = true;
   std::lock_guard lock(impl_->mutex);
   next->generation = impl_->mounted.generation;  // same robot: no new hardware generation

@@ -2,6 +2,8 @@
 
 namespace concert::robot::dds {
 
+using sim::SensorParams;
+
 ServiceParams read_service_params(config::Document& doc) {
   ServiceParams p;
   const auto non_negative = config::Range::non_negative();
@@ -44,6 +46,56 @@ ServiceParams read_service_params(config::Document& doc) {
   sim.number("effort_noise", p.sim.effort_noise, non_negative);
   sim.integer("seed", p.sim.seed);
   sim.string_map("package_paths", p.sim.package_paths);
+
+  // Simulated sensors (libs/sim sensor_params.hpp has each value's source).
+  config::Map sensors = root.section("sensors");
+  SensorParams& sp = p.sim.sensors;
+  sensors.boolean("enabled", sp.enabled);
+  sensors.integer("seed", sp.seed);
+  config::Map camera = sensors.section("camera");
+  camera.number("rate", sp.camera.rate, positive);
+  camera.integer("width", sp.camera.width, 16, 4096);
+  camera.integer("height", sp.camera.height, 16, 4096);
+  camera.number("focal", sp.camera.focal, positive);
+  camera.number("depth_min", sp.camera.depth_min, non_negative);
+  camera.number("depth_max", sp.camera.depth_max, positive);
+  camera.number("depth_subpixel", sp.camera.depth_subpixel, non_negative);
+  camera.number("depth_baseline", sp.camera.depth_baseline, positive);
+  camera.number("depth_focal", sp.camera.depth_focal, positive);
+  camera.number("rgb_noise", sp.camera.rgb_noise, non_negative);
+  camera.boolean("noise", sp.camera.noise);
+  config::Map lidar = sensors.section("lidar");
+  lidar.number("rate", sp.lidar.rate, positive);
+  lidar.integer("rings", sp.lidar.rings, 1, 128);
+  lidar.number("elevation_min", sp.lidar.elevation_min);
+  lidar.number("elevation_max", sp.lidar.elevation_max);
+  lidar.integer("columns", sp.lidar.columns, 1, 36000);
+  lidar.number("range_min", sp.lidar.range_min, non_negative);
+  lidar.number("range_max", sp.lidar.range_max, positive);
+  lidar.number("range_noise", sp.lidar.range_noise, non_negative);
+  lidar.boolean("noise", sp.lidar.noise);
+  config::Map scan2d = sensors.section("scan2d");
+  scan2d.integer("bins", sp.scan2d.bins, 1, 36000);
+  scan2d.number("height_min", sp.scan2d.height_min);
+  scan2d.number("height_max", sp.scan2d.height_max);
+  scan2d.number("range_max", sp.scan2d.range_max, positive);
+  config::Map sonar = sensors.section("sonar");
+  sonar.number("rate", sp.sonar.rate, positive);
+  sonar.number("range_min", sp.sonar.range_min, non_negative);
+  sonar.number("range_max", sp.sonar.range_max, positive);
+  sonar.number("field_of_view", sp.sonar.field_of_view, positive);
+  sonar.number("range_noise", sp.sonar.range_noise, non_negative);
+  sonar.integer("rays", sp.sonar.rays, 1, 1000);
+  sonar.boolean("noise", sp.sonar.noise);
+  config::Map imu = sensors.section("imu");
+  imu.number("rate", sp.imu.rate, positive);
+  imu.number("gyro_noise_density", sp.imu.gyro_noise_density, non_negative);
+  imu.number("accel_noise_density", sp.imu.accel_noise_density, non_negative);
+  imu.number("gyro_bias_sigma", sp.imu.gyro_bias_sigma, non_negative);
+  imu.number("accel_bias_sigma", sp.imu.accel_bias_sigma, non_negative);
+  imu.number("gyro_bias_walk", sp.imu.gyro_bias_walk, non_negative);
+  imu.number("accel_bias_walk", sp.imu.accel_bias_walk, non_negative);
+  imu.boolean("noise", sp.imu.noise);
 
   config::Map loop = root.section("loop");
   loop.boolean("real_time", p.loop.real_time);

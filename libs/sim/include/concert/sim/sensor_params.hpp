@@ -104,4 +104,19 @@ struct SensorParams {
   unsigned seed{1};    ///< noise seed (each sensor derives its own stream from it and its name)
 };
 
+/// The rate [Hz] of sensors of `type`.
+constexpr double sensor_rate(const SensorParams& p, hardware::SensorType type) {
+  switch (type) {
+    case hardware::SensorType::kRgbd:
+      return p.camera.rate;
+    case hardware::SensorType::kLidar:
+      return p.lidar.rate;
+    case hardware::SensorType::kSonar:
+      return p.sonar.rate;
+    case hardware::SensorType::kImu:
+      return p.imu.rate;
+  }
+  return 0.0;
+}
+
 }  // namespace concert::sim

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "concert/model/description.hpp"
+#include "concert/sim/sensor_params.hpp"
 #include "concert/topology/types.hpp"
 
 namespace concert::sim {
@@ -15,7 +17,12 @@ struct SimulatedRobot {
   topology::EscScan scan;       ///< the scan the EtherCAT master would report (faults applied)
   topology::ModuleTree tree;    ///< the tree the assembly describes
   std::string source;           ///< assembly file
+  std::vector<SensorMount> sensors;  ///< the sensors its modules carry (sensor frames of its model)
 };
+
+/// The simulated sensors of a model's sensor frames: cameras (RGB-D), lidars, sonars, IMUs;
+/// other sensor kinds (force-torque, ...) are not simulated here and are left out.
+std::vector<SensorMount> sensor_mounts(const std::vector<model::SensorFrame>& frames);
 
 /// Turns an assembly file (libs/simbus format) into the simulated robot, with the module
 /// databases given (EscCatalog + module descriptions). Immutable; build() is const.

@@ -52,7 +52,9 @@ std::string urdf_to_mjcf(const std::string& urdf, const World& world, const SimP
 /// saturation at the URDF effort limit) run at the physics rate, as real drives do.
 class SimHardware final : public hardware::Hardware {
  public:
-  SimHardware(const std::string& urdf, World world, SimParams params = {});
+  /// `sensors`: the sensors the robot carries (SimulatedRobot::sensors), simulated when
+  /// params.sensors.enabled and delivered to the sink given to set_sensor_sink().
+  SimHardware(const std::string& urdf, World world, SimParams params = {}, std::vector<SensorMount> sensors = {});
   ~SimHardware() override;
   SimHardware(const SimHardware&) = delete;
   SimHardware& operator=(const SimHardware&) = delete;
@@ -66,6 +68,11 @@ class SimHardware final : public hardware::Hardware {
   void read(hardware::HardwareState& state) override;
   void write(const std::vector<hardware::DriveCommand>& commands) override;
   void step(double dt) override;
+  /// Sensor threads start with the first sink (sensor_runtime: rendering and ray casting run
+  /// off the control thread, in simulated time, skipping samples rather than delaying it).
+  void set_sensor_sink(hardware::SensorSink* sink) override;
+  /// The sensors of the robot mounted last (as mounted()).
+  [[nodiscard]] std::vector<hardware::SensorInfo> sensors() const override;
 
   /// Hot swap, prepared on the calling thread (any thread but the control thread: URDF ->
   /// MJCF -> MuJoCo model and data) and switched in by the control thread's next
@@ -73,7 +80,8 @@ class SimHardware final : public hardware::Hardware {
   /// keep their state, every drive holds position) and generation() increases; mounted()
   /// reports it at once. The same URDF again is no change (returns false). Throws
   /// HardwareError (nothing changes) if the URDF cannot be simulated.
-  bool swap_model(const std::string& urdf);
+  /// `sensors` are the new robot's (the old robot's sensors stop, the new ones start).
+  bool swap_model(const std::string& urdf, std::vector<SensorMount> sensors = {});
   /// Replaces the world the same way (keeps the robot state and the hardware generation).
   void set_world(const World& world);
   /// The latest world given (any thread).
