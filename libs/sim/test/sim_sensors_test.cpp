@@ -1,0 +1,310 @@
+// The simulated robot's sensors end to end: mounted from the module database (the demo robots
+// of deploy/demo), run by SimHardware's sensor threads, delivered to a SensorSink, measured
+// against the world's ground truth (libs/world geometry) and, for the camera, against OpenCV's
+// ArUco detector.
+#include <gtest/gtest.h>
+
+#include <opencv2/aruco.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <numeric>
+#include <set>
+#include <thread>
+
+#include "concert/sim/sim_assembly.hpp"
+#include "concert/sim/sim_hardware.hpp"
+#include "concert/world/geometry.hpp"
+#include "test_data.hpp"
+
+namespace concert::sim {
+namespace {
+
+using hardware::SensorType;
+
+SimulatedRobot demo_robot(const std::string& file) {
+  const AssemblyBuilder builder({test_data::kProjectDb});
+  return builder.build(std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/" + file);
+}
+
+/// Everything the sensors deliver (called from the sensor threads).
+class Collector : public hardware::SensorSink {
+ public:
+  void on_sensors(const std::vector<hardware::SensorInfo>& mounted) override {
+    std::lock_guard lock(mutex);
+    this->mounted = mounted;
+    ++announcements;
+  }
+  void on_rgbd(const hardware::RgbdFrame& frame) override {
+    std::lock_guard lock(mutex);
+    rgbd[frame.sensor] = frame;
+    ++rgbd_count[frame.sensor];
+  }
+  void on_lidar(const hardware::LidarScan& scan) override {
+    std::lock_guard lock(mutex);
+    lidar[scan.sensor] = scan;
+  }
+  void on_scan2d(const hardware::LaserScan2d& scan) override {
+    std::lock_guard lock(mutex);
+    scan2d = scan;
+    ++scan2d_count;
+  }
+  void on_sonars(const hardware::SonarRanges& ranges) override {
+    std::lock_guard lock(mutex);
+    sonars = ranges;
+    ++sonar_count;
+  }
+  void on_imu(const hardware::ImuSample& sample) override {
+    std::lock_guard lock(mutex);
+    imu.push_back(sample);
+  }
+  [[nodiscard]] std::set<std::string> mounted_names() const {
+    std::set<std::string> out;
+    for (const auto& m : mounted) out.insert(m.name);
+    return out;
+  }
+
+  mutable std::mutex mutex;
+  std::vector<hardware::SensorInfo> mounted;
+  int announcements{0};
+  std::map<std::string, hardware::RgbdFrame> rgbd;
+  std::map<std::string, int> rgbd_count;
+  std::map<std::string, hardware::LidarScan> lidar;
+  hardware::LaserScan2d scan2d;
+  int scan2d_count{0};
+  hardware::SonarRanges sonars;
+  int sonar_count{0};
+  std::vector<hardware::ImuSample> imu;
+};
+
+/// Runs the simulation as the control thread does (switch at the cycle boundary, 1 ms steps),
+/// paced so the sensor threads keep up, until `done` holds (checked under the collector's
+/// lock) or `max_steps` steps (a bound, not a timing assertion).
+bool run_until(SimHardware& sim, Collector& c, const std::function<bool()>& done, int max_steps = 20000) {
+  for (int i = 0; i < max_steps; ++i) {
+    sim.switch_prepared();
+    sim.step(0.001);
+    if (i % 10 == 0) {
+      std::lock_guard lock(c.mutex);
+      if (done()) return true;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(300));
+  }
+  return false;
+}
+
+/// The drill robot with its base fixed level at its standing height, arm upright (q = 0): the
+/// drill camera looks horizontally along world +x (checked).
+SimParams fixed_base_params(bool noise) {
+  SimParams p;
+  p.floating_base = false;
+  p.base_position = {0.0, 0.0, 0.86};  // wheel bottoms 1 cm above the floor
+  p.sensors.camera.noise = noise;
+  p.sensors.lidar.noise = noise;
+  p.sensors.sonar.noise = noise;
+  p.sensors.imu.noise = noise;
+  p.sensors.seed = 7;
+  return p;
+}
+
+TEST(SimSensors, EveryMountedSensorOfTheDemoRobotDelivers) {
+  const SimulatedRobot robot = demo_robot("drill_robot.yaml");
+  ASSERT_EQ(robot.sensors.size(), 14u);  // 2 lidars, 8 sonars, 2 + 1 cameras, 1 IMU
+  world::World world = world::load_world_file(std::string(WORLD_FIXTURES) + "/marks_world.yaml");
+  SimHardware sim(robot.urdf, world, fixed_base_params(true), robot.sensors);
+  ASSERT_EQ(sim.sensors().size(), 14u);
+  Collector c;
+  sim.set_sensor_sink(&c);
+  ASSERT_TRUE(run_until(sim, c, [&] {
+    return c.mounted.size() == 14u && c.rgbd_count.size() == 3u && c.lidar.size() == 2u && c.scan2d_count > 0 &&
+           c.sonar_count > 0 && c.imu.size() >= 50u;
+  })) << "cameras " << c.rgbd_count.size() << " lidars " << c.lidar.size() << " imu " << c.imu.size();
+  sim.set_sensor_sink(nullptr);
+  std::lock_guard lock(c.mutex);
+  EXPECT_EQ(c.mounted_names(), (std::set<std::string>{"lidar_front", "lidar_back", "ultrasound_fl_sag",
+                                                      "ultrasound_fr_sag", "ultrasound_rl_sag", "ultrasound_rr_sag",
+                                                      "ultrasound_fl_lat", "ultrasound_rl_lat", "ultrasound_fr_lat",
+                                                      "ultrasound_rr_lat", "d435i_front", "d435i_back", "imu",
+                                                      "camera_E"}));
+  for (const auto& [name, frame] : c.rgbd) {
+    EXPECT_EQ(frame.intrinsics.width, 640u) << name;
+    EXPECT_EQ(frame.rgb.size(), 640u * 480u * 3u) << name;
+    EXPECT_EQ(frame.depth.size(), 640u * 480u) << name;
+  }
+  // The front lidar (upside down under the front-left corner) sees the wall ahead: the
+  // returns nearest to azimuth "ahead of the robot" lie on the wall's face (x = 0.75 m); the
+  // planar scan's bin straight ahead reads the face's distance from the root link.
+  const hardware::LaserScan2d& s = c.scan2d;
+  ASSERT_EQ(s.ranges.size(), 720u);
+  const auto ahead = static_cast<std::size_t>(std::lround((0.0 - s.angle_min) / s.angle_increment));
+  EXPECT_NEAR(s.ranges[ahead], 0.75, 0.06);  // 4 sigma of the VLP-16 noise
+  // Behind the robot nothing is within range_max but the far side of the marks world.
+  EXPECT_EQ(c.sonars.sonars.size(), 8u);
+  // IMU at rest on the level base: specific force +g up, no rotation (bias within 4 sigma).
+  Eigen::Vector3d acc = Eigen::Vector3d::Zero(), gyro = Eigen::Vector3d::Zero();
+  for (const auto& sample : c.imu) {
+    acc += sample.linear_acceleration;
+    gyro += sample.angular_velocity;
+  }
+  acc /= static_cast<double>(c.imu.size());
+  gyro /= static_cast<double>(c.imu.size());
+  EXPECT_NEAR(acc.z(), 9.81, 4 * 0.23);
+  EXPECT_NEAR(acc.head<2>().norm(), 0.0, 4 * 0.23 * std::sqrt(2.0));
+  EXPECT_LT(gyro.norm(), 4 * 5.8e-3 * std::sqrt(3.0));
+  // Stamps are simulated time and increase.
+  for (std::size_t i = 1; i < c.imu.size(); ++i) {
+    if (c.imu[i].sensor == c.imu[i - 1].sensor) EXPECT_GT(c.imu[i].stamp, c.imu[i - 1].stamp);
+  }
+}
+
+TEST(SimSensors, AfterAHotSwapTheCameraFollowsTheTool) {
+  const SimulatedRobot drill = demo_robot("drill_robot.yaml");
+  const SimulatedRobot sander = demo_robot("sanding_robot.yaml");
+  SimHardware sim(drill.urdf, {}, fixed_base_params(false), drill.sensors);
+  Collector c;
+  sim.set_sensor_sink(&c);
+  ASSERT_TRUE(run_until(sim, c, [&] { return c.rgbd_count.count("camera_E") > 0; }));
+  // Drill -> sanding tool: the drill's camera goes, the platform's cameras stay.
+  ASSERT_TRUE(sim.swap_model(sander.urdf, sander.sensors));
+  ASSERT_TRUE(run_until(sim, c, [&] { return c.mounted_names().count("camera_E") == 0 && !c.mounted.empty(); }));
+  EXPECT_EQ(c.mounted.size(), 13u);
+  run_until(sim, c, [] { return false; }, 100);  // frames rendered before the switch drain
+  {
+    std::lock_guard lock(c.mutex);
+    c.rgbd_count.clear();
+  }
+  ASSERT_TRUE(run_until(sim, c, [&] { return c.rgbd_count["d435i_front"] >= 3; }));
+  {
+    std::lock_guard lock(c.mutex);
+    EXPECT_EQ(c.rgbd_count.count("camera_E"), 0u) << "the old tool's camera still delivers";
+  }
+  // Sanding tool -> drill: its camera is back, at the new tool's pose.
+  ASSERT_TRUE(sim.swap_model(drill.urdf, drill.sensors));
+  ASSERT_TRUE(run_until(sim, c, [&] { return c.mounted_names().count("camera_E") == 1; }));
+  ASSERT_TRUE(run_until(sim, c, [&] { return c.rgbd_count["camera_E"] >= 2; }));
+  sim.set_sensor_sink(nullptr);
+}
+
+/// Pixel of a world point seen by a camera at world_T_optical with intrinsics k.
+Eigen::Vector2d project(const hardware::CameraIntrinsics& k, const Eigen::Isometry3d& world_T_optical,
+                        const Eigen::Vector3d& p_world) {
+  const Eigen::Vector3d p = world_T_optical.inverse() * p_world;
+  return {k.fx * p.x() / p.z() + k.cx, k.fy * p.y() / p.z() + k.cy};
+}
+
+/// A wall 0.6 m in front of the drill camera, facing it, with an ArUco marker on the optical
+/// axis and a blue blob beside it.
+struct WallInFront {
+  world::World world;
+  double distance{0.6};
+};
+
+WallInFront wall_in_front(const Eigen::Isometry3d& camera, double distance) {
+  const Eigen::Vector3d axis = camera.linear().col(2);
+  WallInFront w;
+  w.distance = distance;
+  world::WorldShape wall;
+  wall.name = "wall";
+  wall.size = {0.2, 3.0, 4.0};
+  const double face_x = camera.translation().x() + distance;
+  wall.position = {face_x + 0.1, camera.translation().y(), 2.0};
+  EXPECT_NEAR(axis.x(), 1.0, 1e-3) << "the drill camera should look along +x";
+  w.world.walls.push_back(wall);
+  // On the wall's -x face, u = +y (the viewer's right), at = [u from the face centre, height].
+  world::Mark marker;
+  marker.name = "marker";
+  marker.type = world::Mark::Type::kAruco;
+  marker.wall = "wall";
+  marker.face = world::Face::kMinusX;
+  marker.at = {0.0, camera.translation().z()};
+  marker.size = 0.15;
+  marker.dictionary = "DICT_4X4_50";
+  marker.id = 7;
+  w.world.marks.push_back(marker);
+  world::Mark blob;
+  blob.name = "blob";
+  blob.type = world::Mark::Type::kBlob;
+  blob.wall = "wall";
+  blob.face = world::Face::kMinusX;
+  blob.at = {0.14, camera.translation().z() + 0.16};
+  blob.diameter = 0.05;
+  w.world.marks.push_back(blob);
+  return w;
+}
+
+TEST(SimSensors, DrillCameraSeesTheMarksWhereTheWorldPutsThem) {
+  const SimulatedRobot robot = demo_robot("drill_robot.yaml");
+  SimHardware sim(robot.urdf, {}, fixed_base_params(false), robot.sensors);
+  for (int i = 0; i < 500; ++i) sim.step(0.001);  // settle the arm under its drives
+  const Eigen::Isometry3d camera = sim.link_pose("camera_E");
+  const WallInFront scene = wall_in_front(camera, 0.6);
+  sim.set_world(scene.world);
+  Collector c;
+  sim.set_sensor_sink(&c);
+  ASSERT_TRUE(run_until(sim, c, [&] { return c.rgbd_count["camera_E"] >= 3; }));
+  sim.set_sensor_sink(nullptr);
+  hardware::RgbdFrame frame;
+  {
+    std::lock_guard lock(c.mutex);
+    frame = c.rgbd.at("camera_E");
+  }
+  const Eigen::Isometry3d optical = sim.link_pose("camera_E");
+  EXPECT_LT((optical.translation() - camera.translation()).norm(), 1e-4) << "the arm moved";
+  const auto& k = frame.intrinsics;
+  const auto truth = world::mark_truth(scene.world);
+  ASSERT_EQ(truth.size(), 2u);
+
+  // Depth: wall pixels (away from the marks) read the face's distance along the optical axis.
+  const Eigen::Vector2d wall_px = project(k, optical, world::face_point(scene.world.walls[0], world::Face::kMinusX,
+                                                                       {-0.15, camera.translation().z() - 0.2}));
+  const auto at = [&](const Eigen::Vector2d& px) {
+    return frame.depth[static_cast<std::size_t>(std::lround(px.y())) * k.width +
+                       static_cast<std::size_t>(std::lround(px.x()))];
+  };
+  EXPECT_NEAR(at(wall_px) * frame.depth_scale, 0.6, 0.0011);
+  // The marker's centre is 1 mm in front of the face.
+  EXPECT_NEAR(at(project(k, optical, truth[0].centre)) * frame.depth_scale, 0.599, 0.0011);
+
+  // ArUco: OpenCV finds marker 7 with each corner where the world's truth projects.
+  cv::Mat rgb(static_cast<int>(k.height), static_cast<int>(k.width), CV_8UC3, frame.rgb.data());
+  cv::Mat gray;
+  cv::cvtColor(rgb, gray, cv::COLOR_RGB2GRAY);
+  std::vector<std::vector<cv::Point2f>> corners;
+  std::vector<int> ids;
+  auto params = cv::aruco::DetectorParameters::create();
+  params->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
+  cv::aruco::detectMarkers(gray, cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50), corners, ids, params);
+  ASSERT_EQ(ids.size(), 1u);
+  EXPECT_EQ(ids[0], 7);
+  double worst = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    const Eigen::Vector2d expected = project(k, optical, truth[0].corners[static_cast<std::size_t>(i)]);
+    const double error = std::hypot(corners[0][static_cast<std::size_t>(i)].x - expected.x(),
+                                    corners[0][static_cast<std::size_t>(i)].y - expected.y());
+    worst = std::max(worst, error);
+  }
+  EXPECT_LE(worst, 1.0) << "corner error [px]";
+  std::cout << "[ measured ] ArUco corner error " << worst << " px\n";
+
+  // Blue blob: segmented (HSV hue of blue, saturated) and its centroid at the projected centre.
+  cv::Mat hsv, mask;
+  cv::cvtColor(rgb, hsv, cv::COLOR_RGB2HSV);
+  cv::inRange(hsv, cv::Scalar(100, 120, 40), cv::Scalar(130, 255, 255), mask);
+  const cv::Moments m = cv::moments(mask, true);
+  ASSERT_GT(m.m00, 100.0) << "no blue blob in the image";
+  const Eigen::Vector2d centroid(m.m10 / m.m00, m.m01 / m.m00);
+  const Eigen::Vector2d expected = project(k, optical, truth[1].centre);
+  EXPECT_LT((centroid - expected).norm(), 1.0) << "blob centroid [px]";
+  // The disc's apparent area matches its size at that distance (within 10 %).
+  const double radius_px = k.fx * (truth[1].diameter / 2) / 0.599;
+  EXPECT_NEAR(m.m00, M_PI * radius_px * radius_px, 0.1 * M_PI * radius_px * radius_px);
+}
+
+}  // namespace
+}  // namespace concert::sim
