@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/aruco.hpp>
+
 #include <cmath>
 
 #include "concert/world/aruco.hpp"
@@ -186,6 +188,24 @@ TEST(WorldGeometry, ArucoCellsMatchOpenCvsDictionary) {
   EXPECT_GT(white, 0);
   EXPECT_LT(white, 16);
   EXPECT_NE(aruco_cells("DICT_4X4_50", 8).white, c.white);
+  // OpenCV detects the cells, drawn upright with a white margin, as marker 7 with its first
+  // corner at the top-left.
+  const int px = 20, margin = 40;
+  cv::Mat image(c.side * px + 2 * margin, c.side * px + 2 * margin, CV_8UC1, cv::Scalar(255));
+  for (int r = 0; r < c.side; ++r) {
+    for (int col = 0; col < c.side; ++col) {
+      image(cv::Rect(margin + col * px, margin + r * px, px, px)).setTo(c.at(r, col) ? 255 : 0);
+    }
+  }
+  std::vector<std::vector<cv::Point2f>> found;
+  std::vector<int> ids;
+  cv::aruco::detectMarkers(image, cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50), found, ids);
+  ASSERT_EQ(ids.size(), 1u);
+  EXPECT_EQ(ids[0], 7);
+  EXPECT_NEAR(found[0][0].x, margin, 2.0);
+  EXPECT_NEAR(found[0][0].y, margin, 2.0);
+  EXPECT_NEAR(found[0][1].x, margin + c.side * px, 2.0);
+  EXPECT_NEAR(found[0][1].y, margin, 2.0);
   EXPECT_THROW((void)aruco_cells("DICT_4X4_50", 50), WorldError);
   EXPECT_THROW((void)aruco_cells("DICT_3X3_9", 0), WorldError);
 }
