@@ -1,7 +1,6 @@
 #include "world_mjcf.hpp"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -35,7 +34,8 @@ constexpr double kCellRelief = 0.0001;
 
 std::string pose(const Eigen::Vector3d& p, const Eigen::Matrix3d& r) {
   const Eigen::Quaterniond q(r);
-  return "pos=\"" + vec(p.x(), p.y(), p.z()) + "\" quat=\"" + num(q.w()) + " " + vec(q.x(), q.y(), q.z()) + "\"";
+  return "pos=\"" + vec(p.x(), p.y(), p.z()) + "\" quat=\"" + num(q.w()) + " " +
+         vec(q.x(), q.y(), q.z()) + "\"";
 }
 
 std::string friction(double f) { return "friction=\"" + num(f) + " 0.005 0.0001\""; }
@@ -65,8 +65,8 @@ void shape_geom(std::ostringstream& xml, const WorldShape& s, bool in_place, con
   }
   xml << " group=\"0\"";
   if (in_place) {
-    xml << " pos=\"" << vec(s.position.x(), s.position.y(), s.position.z()) << "\" euler=\"0 0 " << num(s.yaw)
-        << "\"";
+    xml << " pos=\"" << vec(s.position.x(), s.position.y(), s.position.z()) << "\" euler=\"0 0 "
+        << num(s.yaw) << "\"";
   }
   if (rgba != nullptr) {
     xml << " rgba=\"" << rgba << "\"";
@@ -77,13 +77,16 @@ void shape_geom(std::ostringstream& xml, const WorldShape& s, bool in_place, con
 /// A visual box of a mark: half extents (hx, hy) in the mark's plane, from `back` to `front` in
 /// front of the face [m]; (cx, cy) is its centre in the marker's upright frame.
 void mark_box(std::ostringstream& xml, const std::string& name, const Eigen::Isometry3d& face,
-              const Eigen::Vector2d& centre, double angle, double cx, double cy, double hx, double hy, double back,
-              double front, const char* rgba) {
+              const Eigen::Vector2d& centre, double angle, double cx, double cy, double hx,
+              double hy, double back, double front, const char* rgba) {
   const Eigen::Vector2d c = centre + Eigen::Rotation2Dd(angle) * Eigen::Vector2d(cx, cy);
-  const Eigen::Matrix3d r = face.linear() * Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  xml << "<geom name=\"" << name << "\" type=\"box\" group=\"0\" size=\"" << vec(hx, hy, 0.5 * (front - back))
-      << "\" " << pose(face * Eigen::Vector3d(c.x(), c.y(), 0.5 * (front + back)), r)
-      << " contype=\"0\" conaffinity=\"0\" material=\"" << kMatte << "\" rgba=\"" << rgba << "\"/>\n";
+  const Eigen::Matrix3d r =
+      face.linear() * Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  xml << "<geom name=\"" << name << "\" type=\"box\" group=\"0\" size=\""
+      << vec(hx, hy, 0.5 * (front - back)) << "\" "
+      << pose(face * Eigen::Vector3d(c.x(), c.y(), 0.5 * (front + back)), r)
+      << " contype=\"0\" conaffinity=\"0\" material=\"" << kMatte << "\" rgba=\"" << rgba
+      << "\"/>\n";
 }
 
 void mark_geoms(std::ostringstream& xml, const world::World& world, const Mark& m) {
@@ -94,11 +97,12 @@ void mark_geoms(std::ostringstream& xml, const world::World& world, const Mark& 
   const Eigen::Vector2d centre(m.at.x(), m.at.y() - wall.position.z());
   if (m.type == Mark::Type::kBlob) {
     const Eigen::Vector4d& c = m.rgba;
-    xml << "<geom name=\"" << m.name << "\" type=\"cylinder\" group=\"0\" size=\"" << num(0.5 * m.diameter) << " "
-        << num(0.5 * world::kMarkStandoff) << "\" "
-        << pose(face * Eigen::Vector3d(centre.x(), centre.y(), 0.5 * world::kMarkStandoff), face.linear())
-        << " contype=\"0\" conaffinity=\"0\" material=\"" << kMatte << "\" rgba=\"" << num(c[0]) << " "
-        << vec(c[1], c[2], c[3]) << "\"/>\n";
+    xml << "<geom name=\"" << m.name << "\" type=\"cylinder\" group=\"0\" size=\""
+        << num(0.5 * m.diameter) << " " << num(0.5 * world::kMarkStandoff) << "\" "
+        << pose(face * Eigen::Vector3d(centre.x(), centre.y(), 0.5 * world::kMarkStandoff),
+                face.linear())
+        << " contype=\"0\" conaffinity=\"0\" material=\"" << kMatte << "\" rgba=\"" << num(c[0])
+        << " " << vec(c[1], c[2], c[3]) << "\"/>\n";
     return;
   }
   // ArUco as geoms, not as a texture: exact cell edges at any distance (no texture filtering or
@@ -108,7 +112,8 @@ void mark_geoms(std::ostringstream& xml, const world::World& world, const Mark& 
   const world::ArucoCells cells = world::aruco_cells(m.dictionary, m.id);
   const double cell = m.size / cells.side;
   const double half = 0.5 * m.size;
-  mark_box(xml, m.name, face, centre, m.angle, 0.0, 0.0, half, half, 0.0, world::kMarkStandoff, kBlackRgba);
+  mark_box(xml, m.name, face, centre, m.angle, 0.0, 0.0, half, half, 0.0, world::kMarkStandoff,
+           kBlackRgba);
   for (int row = 0; row < cells.side; ++row) {
     for (int col = 0; col < cells.side;) {
       if (!cells.at(row, col)) {
@@ -122,9 +127,9 @@ void mark_geoms(std::ostringstream& xml, const world::World& world, const Mark& 
       // Row 0 is the top, column 0 the left (u) of the upright marker seen from the front.
       const double cx = -half + cell * 0.5 * (col + end);
       const double cy = half - cell * (row + 0.5);
-      mark_box(xml, m.name + "_white_" + std::to_string(row) + "_" + std::to_string(col), face, centre, m.angle, cx,
-               cy, 0.5 * cell * (end - col), 0.5 * cell, world::kMarkStandoff, world::kMarkStandoff + kCellRelief,
-               kWhiteRgba);
+      mark_box(xml, m.name + "_white_" + std::to_string(row) + "_" + std::to_string(col), face,
+               centre, m.angle, cx, cy, 0.5 * cell * (end - col), 0.5 * cell, world::kMarkStandoff,
+               world::kMarkStandoff + kCellRelief, kWhiteRgba);
       col = end;
     }
   }
@@ -137,8 +142,8 @@ WorldMjcf world_mjcf(const world::World& world) {
   std::ostringstream xml;
   if (world.floor) {
     xml << "<geom name=\"floor\" type=\"plane\" group=\"0\" size=\"100 100 0.1\" pos=\"0 0 "
-        << num(world.floor_height) << "\" contype=\"0\" conaffinity=\"1\" " << friction(world.floor_friction)
-        << "/>\n";
+        << num(world.floor_height) << "\" contype=\"0\" conaffinity=\"1\" "
+        << friction(world.floor_friction) << "/>\n";
   }
   for (const auto& w : world.walls) {
     shape_geom(xml, w, true, kWallRgba);
@@ -148,13 +153,15 @@ WorldMjcf world_mjcf(const world::World& world) {
       shape_geom(xml, o, true, nullptr);
       continue;
     }
-    xml << "<body name=\"" << o.name << "\" mocap=\"true\" pos=\"" << vec(o.position.x(), o.position.y(), o.position.z())
-        << "\" euler=\"0 0 " << num(o.yaw) << "\">\n";
+    xml << "<body name=\"" << o.name << "\" mocap=\"true\" pos=\""
+        << vec(o.position.x(), o.position.y(), o.position.z()) << "\" euler=\"0 0 " << num(o.yaw)
+        << "\">\n";
     shape_geom(xml, o, false, nullptr);
     xml << "</body>\n";
   }
   if (!world.marks.empty()) {
-    assets << "<material name=\"" << kMatte << "\" specular=\"0\" shininess=\"0\" reflectance=\"0\"/>\n";
+    assets << "<material name=\"" << kMatte
+           << "\" specular=\"0\" shininess=\"0\" reflectance=\"0\"/>\n";
   }
   for (const auto& m : world.marks) {
     mark_geoms(xml, world, m);
@@ -164,12 +171,14 @@ WorldMjcf world_mjcf(const world::World& world) {
     // z = n; its zero level is the wall face, its base goes `thickness` into the wall.
     const WorldShape& wall = world::find_wall(world, s.wall);
     const HfieldGrid g = grid(s);
-    assets << "<hfield name=\"" << s.name << "\" nrow=\"" << g.nrow << "\" ncol=\"" << g.ncol << "\" size=\""
-           << num(0.5 * s.size.x()) << " " << vec(0.5 * s.size.y(), g.top, s.thickness) << "\"/>\n";
+    assets << "<hfield name=\"" << s.name << "\" nrow=\"" << g.nrow << "\" ncol=\"" << g.ncol
+           << "\" size=\"" << num(0.5 * s.size.x()) << " "
+           << vec(0.5 * s.size.y(), g.top, s.thickness) << "\"/>\n";
     const Eigen::Isometry3d face = world::face_frame(wall, s.face);
-    xml << "<geom name=\"" << s.name << "\" type=\"hfield\" hfield=\"" << s.name << "\" group=\"0\" "
-        << pose(world::face_point(wall, s.face, s.at), face.linear()) << " rgba=\"" << kPlasterRgba
-        << "\" contype=\"0\" conaffinity=\"1\" " << friction(wall.friction) << "/>\n";
+    xml << "<geom name=\"" << s.name << "\" type=\"hfield\" hfield=\"" << s.name
+        << "\" group=\"0\" " << pose(world::face_point(wall, s.face, s.at), face.linear())
+        << " rgba=\"" << kPlasterRgba << "\" contype=\"0\" conaffinity=\"1\" "
+        << friction(wall.friction) << "/>\n";
   }
   return {assets.str(), xml.str()};
 }
@@ -179,8 +188,8 @@ void fill_world_hfields(const world::World& world, mjModel* model) {
     const int id = mj_name2id(model, mjOBJ_HFIELD, s.name.c_str());
     const HfieldGrid g = grid(s);
     if (id < 0 || model->hfield_nrow[id] != g.nrow || model->hfield_ncol[id] != g.ncol) {
-      throw WorldError("sim: the MuJoCo model has no " + std::to_string(g.nrow) + " x " + std::to_string(g.ncol) +
-                       " height field for surface '" + s.name + "'");
+      throw WorldError("sim: the MuJoCo model has no " + std::to_string(g.nrow) + " x " +
+                       std::to_string(g.ncol) + " height field for surface '" + s.name + "'");
     }
     float* data = model->hfield_data + model->hfield_adr[id];
     const double top = model->hfield_size[4 * id + 2];
@@ -189,7 +198,8 @@ void fill_world_hfields(const world::World& world, mjModel* model) {
       const double z = s.at.y() - 0.5 * s.size.y() + s.size.y() * r / (g.nrow - 1);
       for (int c = 0; c < g.ncol; ++c) {
         const double u = s.at.x() - 0.5 * s.size.x() + s.size.x() * c / (g.ncol - 1);
-        data[r * g.ncol + c] = static_cast<float>((s.thickness + world::surface_height(s, u, z)) / top);
+        data[r * g.ncol + c] =
+            static_cast<float>((s.thickness + world::surface_height(s, u, z)) / top);
       }
     }
   }
@@ -202,7 +212,8 @@ ObstacleMotion::ObstacleMotion(const world::World& world, const mjModel* model) 
     }
     const int body = mj_name2id(model, mjOBJ_BODY, o.name.c_str());
     if (body < 0 || model->body_mocapid[body] < 0) {
-      throw WorldError("sim: the MuJoCo model has no mocap body for moving obstacle '" + o.name + "'");
+      throw WorldError("sim: the MuJoCo model has no mocap body for moving obstacle '" + o.name +
+                       "'");
     }
     movers_.push_back({o, model->body_mocapid[body]});
   }

@@ -25,8 +25,8 @@ struct Compiled {
   mjData* d{nullptr};
   explicit Compiled(const World& world) {
     const WorldMjcf w = world_mjcf(world);
-    const std::string xml = "<mujoco>\n<asset>\n" + w.assets + "</asset>\n<worldbody>\n" + w.worldbody +
-                            "</worldbody>\n</mujoco>\n";
+    const std::string xml = "<mujoco>\n<asset>\n" + w.assets + "</asset>\n<worldbody>\n" +
+                            w.worldbody + "</worldbody>\n</mujoco>\n";
     mjVFS vfs;
     mj_defaultVFS(&vfs);
     EXPECT_EQ(mj_makeEmptyFileVFS(&vfs, "world.xml", static_cast<int>(xml.size())), 0);
@@ -54,7 +54,8 @@ struct Compiled {
   Compiled& operator=(const Compiled&) = delete;
 
   /// Distance to the first geom hit from `from` along unit `dir`, and that geom's name.
-  std::pair<double, std::string> ray(const Eigen::Vector3d& from, const Eigen::Vector3d& dir) const {
+  std::pair<double, std::string> ray(const Eigen::Vector3d& from,
+                                     const Eigen::Vector3d& dir) const {
     int geom = -1;
     const double dist = mj_ray(m, d, from.data(), dir.data(), nullptr, 1, -1, &geom);
     return {dist, geom >= 0 ? mj_id2name(m, mjOBJ_GEOM, geom) : ""};
@@ -65,8 +66,8 @@ TEST(WorldMjcf, EveryFeatureCompilesInGroupZeroNamedAfterItsElement) {
   const World world = marks_world();
   Compiled c(world);
   ASSERT_NE(c.m, nullptr);
-  const std::vector<std::string> elements{"floor", "wall_front", "pillar", "cart", "blob_a", "blob_b", "marker_7",
-                                          "plaster"};
+  const std::vector<std::string> elements{"floor",  "wall_front", "pillar",   "cart",
+                                          "blob_a", "blob_b",     "marker_7", "plaster"};
   int aruco_white = 0;
   for (int g = 0; g < c.m->ngeom; ++g) {
     const std::string name = mj_id2name(c.m, mjOBJ_GEOM, g);
@@ -138,9 +139,9 @@ TEST(WorldMjcf, HeightFieldIsTheTrueSurfaceAtTheGridPoints) {
   const Eigen::Vector3d n = world::face_frame(wall, s.face).linear().col(2);
   // Bump top, hole bottom, flat plaster, and the places the bump would be if the grid were
   // mirrored along u or z.
-  for (const Eigen::Vector2d& at : {Eigen::Vector2d(-0.8, 1.1), Eigen::Vector2d(-0.55, 0.9),
-                                   Eigen::Vector2d(-0.6, 1.1), Eigen::Vector2d(-0.8, 0.9),
-                                   Eigen::Vector2d(-0.85, 1.1), Eigen::Vector2d(-0.4, 1.2)}) {
+  for (const Eigen::Vector2d& at :
+       {Eigen::Vector2d(-0.8, 1.1), Eigen::Vector2d(-0.55, 0.9), Eigen::Vector2d(-0.6, 1.1),
+        Eigen::Vector2d(-0.8, 0.9), Eigen::Vector2d(-0.85, 1.1), Eigen::Vector2d(-0.4, 1.2)}) {
     const Eigen::Vector3d truth = world::surface_point(world, s, at.x(), at.y());
     const auto hit = c.ray(truth + 0.3 * n, -n);
     EXPECT_EQ(hit.second, "plaster");
@@ -166,12 +167,14 @@ TEST(WorldMjcf, MovingObstacleFollowsItsPathInTheSimulator) {
   }
   // Each physics step moves the mocap body to where the path is at the step's start.
   const Eigen::Vector3d expected = world::obstacle_position(cart, sim.time() - 0.001);
-  EXPECT_TRUE(sim.link_pose("cart").translation().isApprox(expected, 1e-9)) << sim.link_pose("cart").translation();
+  EXPECT_TRUE(sim.link_pose("cart").translation().isApprox(expected, 1e-9))
+      << sim.link_pose("cart").translation();
   EXPECT_NEAR(sim.link_pose("cart").translation().y(), 1.5, 0.5 * 0.001 + 1e-9);
   // A new world keeps the time: the cart continues where it is.
   sim.set_world(world);
   EXPECT_TRUE(sim.switch_prepared());
-  EXPECT_TRUE(sim.link_pose("cart").translation().isApprox(world::obstacle_position(cart, sim.time()), 1e-9));
+  EXPECT_TRUE(sim.link_pose("cart").translation().isApprox(
+      world::obstacle_position(cart, sim.time()), 1e-9));
 }
 
 TEST(WorldMjcf, AnInvalidWorldIsRefusedAndTheOldOneKept) {

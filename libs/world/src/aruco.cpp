@@ -1,8 +1,7 @@
 #include "concert/world/aruco.hpp"
 
-#include <opencv2/aruco.hpp>
-
 #include <algorithm>
+#include <opencv2/aruco.hpp>
 
 #include "concert/world/world.hpp"
 
@@ -11,11 +10,11 @@ namespace {
 
 // In the order of cv::aruco::PREDEFINED_DICTIONARY_NAME (OpenCV 4.6): the index is the enum value.
 const std::vector<std::string> kNames{
-    "DICT_4X4_50",         "DICT_4X4_100",        "DICT_4X4_250",         "DICT_4X4_1000",
-    "DICT_5X5_50",         "DICT_5X5_100",        "DICT_5X5_250",         "DICT_5X5_1000",
-    "DICT_6X6_50",         "DICT_6X6_100",        "DICT_6X6_250",         "DICT_6X6_1000",
-    "DICT_7X7_50",         "DICT_7X7_100",        "DICT_7X7_250",         "DICT_7X7_1000",
-    "DICT_ARUCO_ORIGINAL", "DICT_APRILTAG_16h5",  "DICT_APRILTAG_25h9",   "DICT_APRILTAG_36h10",
+    "DICT_4X4_50",         "DICT_4X4_100",       "DICT_4X4_250",       "DICT_4X4_1000",
+    "DICT_5X5_50",         "DICT_5X5_100",       "DICT_5X5_250",       "DICT_5X5_1000",
+    "DICT_6X6_50",         "DICT_6X6_100",       "DICT_6X6_250",       "DICT_6X6_1000",
+    "DICT_7X7_50",         "DICT_7X7_100",       "DICT_7X7_250",       "DICT_7X7_1000",
+    "DICT_ARUCO_ORIGINAL", "DICT_APRILTAG_16h5", "DICT_APRILTAG_25h9", "DICT_APRILTAG_36h10",
     "DICT_APRILTAG_36h11"};
 static_assert(cv::aruco::DICT_APRILTAG_36h11 == 20, "dictionary names follow OpenCV's enum");
 
@@ -48,13 +47,15 @@ ArucoCells aruco_cells(const std::string& name, int id) {
                      std::to_string(dict->bytesList.rows - 1) + ")");
   }
   // The same bits cv::aruco::drawMarker draws inside its black border (rotation 0).
-  const cv::Mat bits = cv::aruco::Dictionary::getBitsFromByteList(dict->bytesList.rowRange(id, id + 1), dict->markerSize);
+  const cv::Mat bits = cv::aruco::Dictionary::getBitsFromByteList(
+      dict->bytesList.rowRange(id, id + 1), dict->markerSize);
   ArucoCells cells;
   cells.side = dict->markerSize + 2;
   cells.white.assign(static_cast<std::size_t>(cells.side * cells.side), false);
   for (int r = 0; r < dict->markerSize; ++r) {
     for (int c = 0; c < dict->markerSize; ++c) {
-      cells.white[static_cast<std::size_t>((r + 1) * cells.side + c + 1)] = bits.at<unsigned char>(r, c) != 0;
+      cells.white[static_cast<std::size_t>((r + 1) * cells.side + c + 1)] =
+          bits.at<unsigned char>(r, c) != 0;
     }
   }
   return cells;

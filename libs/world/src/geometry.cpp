@@ -56,7 +56,8 @@ const WorldShape& find_wall(const World& world, const std::string& name) {
 }
 
 Eigen::Isometry3d face_frame(const WorldShape& wall, Face face) {
-  const Eigen::Matrix3d yaw = Eigen::AngleAxisd(wall.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d yaw =
+      Eigen::AngleAxisd(wall.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d axis = local_axis(face);
   const double half_depth = 0.5 * (along_x(face) ? wall.size.x() : wall.size.y());
   const Eigen::Vector3d n = yaw * axis;
@@ -73,7 +74,8 @@ Eigen::Vector2d face_size(const WorldShape& wall, Face face) {
   return {along_x(face) ? wall.size.y() : wall.size.x(), wall.size.z()};
 }
 
-Eigen::Vector3d face_point(const WorldShape& wall, Face face, const Eigen::Vector2d& at, double offset) {
+Eigen::Vector3d face_point(const WorldShape& wall, Face face, const Eigen::Vector2d& at,
+                           double offset) {
   return face_frame(wall, face) * Eigen::Vector3d(at.x(), at.y() - wall.position.z(), offset);
 }
 
@@ -98,7 +100,7 @@ std::vector<MarkTruth> mark_truth(const World& world) {
       const Eigen::Rotation2Dd rot(m.angle);
       const double h = 0.5 * m.size;
       const std::array<Eigen::Vector2d, 4> upright{Eigen::Vector2d(-h, h), Eigen::Vector2d(h, h),
-                                                    Eigen::Vector2d(h, -h), Eigen::Vector2d(-h, -h)};
+                                                   Eigen::Vector2d(h, -h), Eigen::Vector2d(-h, -h)};
       for (std::size_t k = 0; k < 4; ++k) {
         const Eigen::Vector2d c = rot * upright[k];
         t.corners[k] = t.centre + c.x() * t.right + c.y() * Eigen::Vector3d::UnitZ();

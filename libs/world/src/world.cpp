@@ -61,8 +61,8 @@ Eigen::Matrix<double, N, 1> vec(const Ctx& ctx, const YAML::Node& node, const st
   return v;
 }
 
-void only_keys(const Ctx& ctx, const YAML::Node& node, const std::string& field, const std::set<std::string>& keys,
-               const std::string& what) {
+void only_keys(const Ctx& ctx, const YAML::Node& node, const std::string& field,
+               const std::set<std::string>& keys, const std::string& what) {
   if (!node.IsMap()) {
     ctx.fail(field, "expected a map with " + what);
   }
@@ -74,8 +74,8 @@ void only_keys(const Ctx& ctx, const YAML::Node& node, const std::string& field,
   }
 }
 
-YAML::Node required(const Ctx& ctx, const YAML::Node& node, const std::string& field, const std::string& key,
-                    const std::string& why = "") {
+YAML::Node required(const Ctx& ctx, const YAML::Node& node, const std::string& field,
+                    const std::string& key, const std::string& why = "") {
   const YAML::Node child = node[key];
   if (!child) {
     ctx.fail(field + "." + key, "missing" + (why.empty() ? "" : " (" + why + ")"));
@@ -110,9 +110,10 @@ ObstaclePath path(const Ctx& ctx, const YAML::Node& node, const std::string& fie
 }
 
 WorldShape shape(const Ctx& ctx, const YAML::Node& node, const std::string& field, bool obstacle) {
-  static const std::set<std::string> kWallKeys{"name", "shape", "size", "radius", "height", "position", "yaw", "friction"};
-  static const std::set<std::string> kObstacleKeys{"name", "shape",    "size",     "radius", "height",
-                                                   "position", "yaw", "friction", "path"};
+  static const std::set<std::string> kWallKeys{"name",   "shape",    "size", "radius",
+                                               "height", "position", "yaw",  "friction"};
+  static const std::set<std::string> kObstacleKeys{
+      "name", "shape", "size", "radius", "height", "position", "yaw", "friction", "path"};
   only_keys(ctx, node, field, obstacle ? kObstacleKeys : kWallKeys,
             obstacle ? "name, shape, size|radius+height, position, yaw, friction, path"
                      : "name, size, position, yaw, friction");
@@ -120,15 +121,18 @@ WorldShape shape(const Ctx& ctx, const YAML::Node& node, const std::string& fiel
   s.name = text(ctx, required(ctx, node, field, "name"), field + ".name");
   const std::string type = node["shape"] ? text(ctx, node["shape"], field + ".shape") : "box";
   if (type == "box") {
-    s.size = vec<3>(ctx, required(ctx, node, field, "size", "box needs [x, y, z] full extents"), field + ".size");
+    s.size = vec<3>(ctx, required(ctx, node, field, "size", "box needs [x, y, z] full extents"),
+                    field + ".size");
   } else if (type == "cylinder" && obstacle) {
     s.type = WorldShape::Type::kCylinder;
     if (!node["radius"] || !node["height"]) {
       ctx.fail(field, "cylinder needs radius and height");
     }
-    s.size = {number(ctx, node["radius"], field + ".radius"), 0.0, number(ctx, node["height"], field + ".height")};
+    s.size = {number(ctx, node["radius"], field + ".radius"), 0.0,
+              number(ctx, node["height"], field + ".height")};
   } else {
-    ctx.fail(field + ".shape", "unknown shape '" + type + "' (walls: box; obstacles: box or cylinder)");
+    ctx.fail(field + ".shape",
+             "unknown shape '" + type + "' (walls: box; obstacles: box or cylinder)");
   }
   s.position = vec<3>(ctx, required(ctx, node, field, "position"), field + ".position");
   if (node["yaw"]) {
@@ -150,7 +154,8 @@ Face face(const Ctx& ctx, const YAML::Node& node, const std::string& field) {
       return candidate;
     }
   }
-  ctx.fail(field, "unknown face '" + f + "' (expected +x, -x, +y or -y: the wall box's local axes)");
+  ctx.fail(field,
+           "unknown face '" + f + "' (expected +x, -x, +y or -y: the wall box's local axes)");
 }
 
 Mark mark(const Ctx& ctx, const YAML::Node& node, const std::string& field) {
@@ -158,7 +163,8 @@ Mark mark(const Ctx& ctx, const YAML::Node& node, const std::string& field) {
     ctx.fail(field, "expected a map with type, name, wall, face, at, ...");
   }
   Mark m;
-  const std::string type = text(ctx, required(ctx, node, field, "type", "blob or aruco"), field + ".type");
+  const std::string type =
+      text(ctx, required(ctx, node, field, "type", "blob or aruco"), field + ".type");
   if (type == "blob") {
     only_keys(ctx, node, field, {"type", "name", "wall", "face", "at", "diameter", "rgba"},
               "type, name, wall, face, at, diameter, rgba");
@@ -168,11 +174,13 @@ Mark mark(const Ctx& ctx, const YAML::Node& node, const std::string& field) {
       m.rgba = vec<4>(ctx, node["rgba"], field + ".rgba");
     }
   } else if (type == "aruco") {
-    only_keys(ctx, node, field, {"type", "name", "wall", "face", "at", "size", "dictionary", "id", "angle"},
+    only_keys(ctx, node, field,
+              {"type", "name", "wall", "face", "at", "size", "dictionary", "id", "angle"},
               "type, name, wall, face, at, size, dictionary, id, angle");
     m.type = Mark::Type::kAruco;
     m.size = number(ctx, required(ctx, node, field, "size", "outer side [m]"), field + ".size");
-    m.dictionary = text(ctx, required(ctx, node, field, "dictionary", "e.g. DICT_4X4_50"), field + ".dictionary");
+    m.dictionary = text(ctx, required(ctx, node, field, "dictionary", "e.g. DICT_4X4_50"),
+                        field + ".dictionary");
     m.id = integer(ctx, required(ctx, node, field, "id"), field + ".id");
     if (node["angle"]) {
       m.angle = number(ctx, node["angle"], field + ".angle");
@@ -187,8 +195,8 @@ Mark mark(const Ctx& ctx, const YAML::Node& node, const std::string& field) {
   return m;
 }
 
-std::vector<SurfaceFeature> features(const Ctx& ctx, const YAML::Node& node, const std::string& field,
-                                     const char* height_key) {
+std::vector<SurfaceFeature> features(const Ctx& ctx, const YAML::Node& node,
+                                     const std::string& field, const char* height_key) {
   std::vector<SurfaceFeature> out;
   if (!node) {
     return out;
@@ -203,7 +211,8 @@ std::vector<SurfaceFeature> features(const Ctx& ctx, const YAML::Node& node, con
     SurfaceFeature feature;
     feature.at = vec<2>(ctx, required(ctx, node[i], f, "at", "[u, z] [m]"), f + ".at");
     feature.radius = number(ctx, required(ctx, node[i], f, "radius", "[m]"), f + ".radius");
-    feature.height = number(ctx, required(ctx, node[i], f, height_key, "[m]"), f + "." + height_key);
+    feature.height =
+        number(ctx, required(ctx, node[i], f, height_key, "[m]"), f + "." + height_key);
     out.push_back(feature);
   }
   return out;
@@ -265,7 +274,8 @@ struct Validator {
   }
 
   void shape(const WorldShape& s, const std::string& field) const {
-    if (s.size.x() <= 0.0 || s.size.z() <= 0.0 || (s.type == WorldShape::Type::kBox && s.size.y() <= 0.0)) {
+    if (s.size.x() <= 0.0 || s.size.z() <= 0.0 ||
+        (s.type == WorldShape::Type::kBox && s.size.y() <= 0.0)) {
       fail(field + ".size", "dimensions must be positive");
     }
     if (s.friction < 0.0) {
@@ -297,20 +307,21 @@ struct Validator {
     const Eigen::Vector2d size = face_size(w, face);
     constexpr double kEps = 1e-9;
     const double bottom = w.position.z() - 0.5 * size.y(), top = w.position.z() + 0.5 * size.y();
-    if (std::abs(f.centre.x()) + f.half.x() > 0.5 * size.x() + kEps || f.centre.y() - f.half.y() < bottom - kEps ||
-        f.centre.y() + f.half.y() > top + kEps) {
+    if (std::abs(f.centre.x()) + f.half.x() > 0.5 * size.x() + kEps ||
+        f.centre.y() - f.half.y() < bottom - kEps || f.centre.y() + f.half.y() > top + kEps) {
       std::ostringstream why;
-      why << "'" << f.name << "' is not entirely on face " << to_string(face) << " of wall '" << w.name
-          << "' (it spans u " << f.centre.x() - f.half.x() << " .. " << f.centre.x() + f.half.x() << ", z "
-          << f.centre.y() - f.half.y() << " .. " << f.centre.y() + f.half.y() << "; the face spans u "
-          << -0.5 * size.x() << " .. " << 0.5 * size.x() << ", z " << bottom << " .. " << top << ") [m]";
+      why << "'" << f.name << "' is not entirely on face " << to_string(face) << " of wall '"
+          << w.name << "' (it spans u " << f.centre.x() - f.half.x() << " .. "
+          << f.centre.x() + f.half.x() << ", z " << f.centre.y() - f.half.y() << " .. "
+          << f.centre.y() + f.half.y() << "; the face spans u " << -0.5 * size.x() << " .. "
+          << 0.5 * size.x() << ", z " << bottom << " .. " << top << ") [m]";
       fail(f.field + ".at", why.str());
     }
     auto& placed = on_face[w.name + " " + to_string(face)];
     for (const auto& other : placed) {
       if (overlap(f, other)) {
-        fail(f.field + ".at", "'" + f.name + "' overlaps " + other.field + " '" + other.name + "' on face " +
-                                  to_string(face) + " of wall '" + w.name + "'");
+        fail(f.field + ".at", "'" + f.name + "' overlaps " + other.field + " '" + other.name +
+                                  "' on face " + to_string(face) + " of wall '" + w.name + "'");
       }
     }
     placed.push_back(f);
@@ -332,15 +343,17 @@ struct Validator {
         for (const auto& n : aruco_dictionary_names()) {
           all += (all.empty() ? "" : ", ") + n;
         }
-        fail(field + ".dictionary", "unknown ArUco dictionary '" + m.dictionary + "' (accepted: " + all + ")");
+        fail(field + ".dictionary",
+             "unknown ArUco dictionary '" + m.dictionary + "' (accepted: " + all + ")");
       }
       const int count = aruco_dictionary_size(m.dictionary);
       if (m.id < 0 || m.id >= count) {
-        fail(field + ".id", "id " + std::to_string(m.id) + " is not in " + m.dictionary + " (ids 0.." +
-                                std::to_string(count - 1) + ")");
+        fail(field + ".id", "id " + std::to_string(m.id) + " is not in " + m.dictionary +
+                                " (ids 0.." + std::to_string(count - 1) + ")");
       }
       // The rotated square's bounding box.
-      f.half.setConstant(0.5 * m.size * (std::abs(std::cos(m.angle)) + std::abs(std::sin(m.angle))));
+      f.half.setConstant(0.5 * m.size *
+                         (std::abs(std::cos(m.angle)) + std::abs(std::sin(m.angle))));
     }
     place(w, m.face, f);
   }
@@ -363,8 +376,10 @@ struct Validator {
       positive(f.radius, ff + ".radius");
       positive(f.height, ff + "." + height_key);
       const Eigen::Vector2d d = (f.at - s.at).cwiseAbs();
-      if (d.x() + f.radius > 0.5 * s.size.x() + 1e-9 || d.y() + f.radius > 0.5 * s.size.y() + 1e-9) {
-        fail(ff + ".at", "not entirely on the panel '" + s.name + "' (centre and radius must stay inside it)");
+      if (d.x() + f.radius > 0.5 * s.size.x() + 1e-9 ||
+          d.y() + f.radius > 0.5 * s.size.y() + 1e-9) {
+        fail(ff + ".at",
+             "not entirely on the panel '" + s.name + "' (centre and radius must stay inside it)");
       }
       const Footprint fp{ff, "", f.at, {f.radius, f.radius}, true};
       for (const auto& other : features) {
@@ -381,8 +396,9 @@ struct Validator {
       const std::string hf = field + ".holes[" + std::to_string(i) + "]";
       feature(s.holes[i], hf, "depth");
       if (s.holes[i].height >= s.thickness) {
-        fail(hf + ".depth", "a hole must be shallower than the layer (depth " + std::to_string(s.holes[i].height) +
-                                " m, thickness " + std::to_string(s.thickness) + " m)");
+        fail(hf + ".depth", "a hole must be shallower than the layer (depth " +
+                                std::to_string(s.holes[i].height) + " m, thickness " +
+                                std::to_string(s.thickness) + " m)");
       }
     }
     place(w, s.face, {field, s.name, s.at, 0.5 * s.size, false});
@@ -451,8 +467,8 @@ World parse_world_yaml(const std::string& text, const std::string& source) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw WorldError("world file '" + source + "': YAML error at line " + std::to_string(e.mark.line + 1) + ": " +
-                     e.msg);
+    throw WorldError("world file '" + source + "': YAML error at line " +
+                     std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   World world;
   if (root.IsNull()) {
@@ -463,7 +479,8 @@ World parse_world_yaml(const std::string& text, const std::string& source) {
   }
   for (const auto& kv : root) {
     const auto key = kv.first.as<std::string>();
-    if (key != "floor" && key != "walls" && key != "obstacles" && key != "marks" && key != "surfaces") {
+    if (key != "floor" && key != "walls" && key != "obstacles" && key != "marks" &&
+        key != "surfaces") {
       ctx.fail(key, "unknown key (expected floor, walls, obstacles, marks, surfaces)");
     }
   }
@@ -471,7 +488,8 @@ World parse_world_yaml(const std::string& text, const std::string& source) {
     if (floor.IsScalar()) {
       world.floor = floor.as<bool>();
     } else {
-      only_keys(ctx, floor, "floor", {"enabled", "height", "friction"}, "enabled, height, friction");
+      only_keys(ctx, floor, "floor", {"enabled", "height", "friction"},
+                "enabled, height, friction");
       if (floor["enabled"]) {
         world.floor = floor["enabled"].as<bool>();
       }
@@ -495,10 +513,17 @@ World parse_world_yaml(const std::string& text, const std::string& source) {
       parse_one(list[i], std::string(key) + "[" + std::to_string(i) + "]");
     }
   };
-  each("walls", [&](const YAML::Node& n, const std::string& f) { world.walls.push_back(shape(ctx, n, f, false)); });
-  each("obstacles", [&](const YAML::Node& n, const std::string& f) { world.obstacles.push_back(shape(ctx, n, f, true)); });
-  each("marks", [&](const YAML::Node& n, const std::string& f) { world.marks.push_back(mark(ctx, n, f)); });
-  each("surfaces", [&](const YAML::Node& n, const std::string& f) { world.surfaces.push_back(surface(ctx, n, f)); });
+  each("walls", [&](const YAML::Node& n, const std::string& f) {
+    world.walls.push_back(shape(ctx, n, f, false));
+  });
+  each("obstacles", [&](const YAML::Node& n, const std::string& f) {
+    world.obstacles.push_back(shape(ctx, n, f, true));
+  });
+  each("marks",
+       [&](const YAML::Node& n, const std::string& f) { world.marks.push_back(mark(ctx, n, f)); });
+  each("surfaces", [&](const YAML::Node& n, const std::string& f) {
+    world.surfaces.push_back(surface(ctx, n, f));
+  });
   validate_world(world, "world file '" + source + "'");
   return world;
 }

@@ -57,7 +57,8 @@ WorldShape from_msg(const msg::WorldShape& s) {
       path.waypoints.push_back(point(w));
     }
     path.speed = s.path_speed();
-    if (static_cast<int>(s.path_mode()) < 0 || static_cast<int>(s.path_mode()) > msg::WORLD_PATH_ONCE) {
+    if (static_cast<int>(s.path_mode()) < 0 ||
+        static_cast<int>(s.path_mode()) > msg::WORLD_PATH_ONCE) {
       throw WorldError("world message: obstacle '" + s.name() + "': unknown path mode value " +
                        std::to_string(static_cast<int>(s.path_mode())));
     }

@@ -2,9 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/aruco.hpp>
-
 #include <cmath>
+#include <opencv2/aruco.hpp>
 
 #include "concert/world/aruco.hpp"
 
@@ -40,9 +39,12 @@ TEST(WorldGeometry, FaceFrameIsRightHandedWithUToTheViewersRight) {
     }
   }
   // Yaw 0: +x face normal +x, u = +y; -x face normal -x, u = -y.
-  EXPECT_TRUE(face_frame(wall(0.0), Face::kPlusX).linear().col(0).isApprox(Eigen::Vector3d::UnitY()));
-  EXPECT_TRUE(face_frame(wall(0.0), Face::kMinusX).linear().col(0).isApprox(-Eigen::Vector3d::UnitY()));
-  EXPECT_TRUE(face_frame(wall(M_PI / 2), Face::kPlusX).linear().col(2).isApprox(Eigen::Vector3d::UnitY()));
+  EXPECT_TRUE(
+      face_frame(wall(0.0), Face::kPlusX).linear().col(0).isApprox(Eigen::Vector3d::UnitY()));
+  EXPECT_TRUE(
+      face_frame(wall(0.0), Face::kMinusX).linear().col(0).isApprox(-Eigen::Vector3d::UnitY()));
+  EXPECT_TRUE(
+      face_frame(wall(M_PI / 2), Face::kPlusX).linear().col(2).isApprox(Eigen::Vector3d::UnitY()));
   EXPECT_TRUE(face_size(wall(0.0), Face::kPlusY).isApprox(Eigen::Vector2d(0.2, 2.0)));
   EXPECT_TRUE(face_size(wall(0.0), Face::kMinusX).isApprox(Eigen::Vector2d(4.0, 2.0)));
 }
@@ -66,7 +68,8 @@ void expect_marker_geometry(const World& w) {
     }
     // Corners: a square of side `size` on the front plane, around the centre.
     for (std::size_t k = 0; k < 4; ++k) {
-      const Eigen::Vector3d a = t.corners[k], b = t.corners[(k + 1) % 4], c = t.corners[(k + 2) % 4];
+      const Eigen::Vector3d a = t.corners[k], b = t.corners[(k + 1) % 4],
+                            c = t.corners[(k + 2) % 4];
       EXPECT_NEAR((b - a).norm(), m.size, 1e-12);
       EXPECT_NEAR((b - a).dot(c - b), 0.0, 1e-12);
       EXPECT_NEAR((f.inverse() * a).z(), kMarkStandoff, 1e-12);
@@ -76,7 +79,8 @@ void expect_marker_geometry(const World& w) {
     EXPECT_TRUE(((t.corners[0] + t.corners[2]) / 2).isApprox(t.centre, 1e-12));
     // Top edge direction: u rotated by `angle` counter-clockwise (seen from the front) about n.
     const Eigen::Vector3d top = (t.corners[1] - t.corners[0]).normalized();
-    const Eigen::Vector3d expected = std::cos(m.angle) * t.right + std::sin(m.angle) * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d expected =
+        std::cos(m.angle) * t.right + std::sin(m.angle) * Eigen::Vector3d::UnitZ();
     EXPECT_TRUE(top.isApprox(expected, 1e-12)) << top.transpose() << " vs " << expected.transpose();
   }
 }
@@ -124,13 +128,16 @@ TEST(WorldGeometry, SurfaceHeightHasCosineBumpsAndHoles) {
   const World w = fixture();
   const Surface& s = w.surfaces[0];
   EXPECT_DOUBLE_EQ(surface_height(s, -0.8, 1.1), 0.003);
-  EXPECT_NEAR(surface_height(s, -0.8 + 0.025, 1.1), 0.0015, 1e-12);  // half the radius: half the height
+  EXPECT_NEAR(surface_height(s, -0.8 + 0.025, 1.1), 0.0015,
+              1e-12);  // half the radius: half the height
   EXPECT_NEAR(surface_height(s, -0.8, 1.1 - 0.05), 0.0, 1e-12);
   EXPECT_DOUBLE_EQ(surface_height(s, -0.55, 0.9), -0.004);
-  EXPECT_NEAR(surface_height(s, -0.55 + 0.03, 0.9), -0.004 * 0.5 * (1 + std::cos(M_PI * 0.75)), 1e-12);
+  EXPECT_NEAR(surface_height(s, -0.55 + 0.03, 0.9), -0.004 * 0.5 * (1 + std::cos(M_PI * 0.75)),
+              1e-12);
   EXPECT_DOUBLE_EQ(surface_height(s, -0.7, 1.25), 0.0);
   // The bump top is thickness + height in front of the face (x = 0.75, n = -x).
-  EXPECT_TRUE(surface_point(w, s, -0.8, 1.1).isApprox(Eigen::Vector3d(0.75 - 0.013, 0.8, 1.1), 1e-12));
+  EXPECT_TRUE(
+      surface_point(w, s, -0.8, 1.1).isApprox(Eigen::Vector3d(0.75 - 0.013, 0.8, 1.1), 1e-12));
 }
 
 WorldShape mover(ObstaclePath::Mode mode) {
@@ -149,13 +156,15 @@ TEST(WorldGeometry, ObstaclePositionForEachMode) {
   EXPECT_TRUE(obstacle_position(loop, 5.0).isApprox(Eigen::Vector3d(2.0, 0.5, 0.4)));
   // Back towards the start along the closing segment, then round again.
   const double lap = (3.0 + std::sqrt(5.0)) / 0.5;
-  EXPECT_TRUE(obstacle_position(loop, 6.0 + std::sqrt(5.0)).isApprox(Eigen::Vector3d(1.0, 0.5, 0.4), 1e-9));
+  EXPECT_TRUE(
+      obstacle_position(loop, 6.0 + std::sqrt(5.0)).isApprox(Eigen::Vector3d(1.0, 0.5, 0.4), 1e-9));
   EXPECT_TRUE(obstacle_position(loop, lap + 2.0).isApprox(Eigen::Vector3d(1.0, 0.0, 0.4), 1e-9));
 
   const WorldShape ping = mover(ObstaclePath::Mode::kPingPong);
   EXPECT_NEAR(path_length(ping), 3.0, 1e-12);
   EXPECT_TRUE(obstacle_position(ping, 5.0).isApprox(Eigen::Vector3d(2.0, 0.5, 0.4)));
-  EXPECT_TRUE(obstacle_position(ping, 7.0).isApprox(Eigen::Vector3d(2.0, 0.5, 0.4)));  // on its way back
+  EXPECT_TRUE(
+      obstacle_position(ping, 7.0).isApprox(Eigen::Vector3d(2.0, 0.5, 0.4)));  // on its way back
   EXPECT_TRUE(obstacle_position(ping, 10.0).isApprox(Eigen::Vector3d(1.0, 0.0, 0.4)));
   EXPECT_TRUE(obstacle_position(ping, 14.0).isApprox(Eigen::Vector3d(1.0, 0.0, 0.4)));  // out again
 
@@ -199,7 +208,8 @@ TEST(WorldGeometry, ArucoCellsMatchOpenCvsDictionary) {
   }
   std::vector<std::vector<cv::Point2f>> found;
   std::vector<int> ids;
-  cv::aruco::detectMarkers(image, cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50), found, ids);
+  cv::aruco::detectMarkers(image, cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50), found,
+                           ids);
   ASSERT_EQ(ids.size(), 1u);
   EXPECT_EQ(ids[0], 7);
   EXPECT_NEAR(found[0][0].x, margin, 2.0);

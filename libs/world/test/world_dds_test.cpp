@@ -91,7 +91,9 @@ TEST(WorldDds, BadShapeInAMessageIsNamed) {
     (void)from_msg(m);
     FAIL() << "accepted a zero-size box";
   } catch (const WorldError& e) {
-    EXPECT_NE(std::string(e.what()).find("world message 'test': obstacles[0].size"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("world message 'test': obstacles[0].size"),
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -106,7 +108,8 @@ TEST(WorldDds, BadMarkInAMessageIsRefusedAsInAFile) {
     (void)from_msg(m);
     FAIL() << "accepted a hole deeper than its layer";
   } catch (const WorldError& e) {
-    EXPECT_NE(std::string(e.what()).find("surfaces[0].holes[0].depth"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("surfaces[0].holes[0].depth"), std::string::npos)
+        << e.what();
   }
 }
 

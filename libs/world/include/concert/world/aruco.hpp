@@ -21,7 +21,9 @@ int aruco_dictionary_size(const std::string& name);
 struct ArucoCells {
   int side{0};              ///< cells per side, border included
   std::vector<bool> white;  ///< side * side
-  [[nodiscard]] bool at(int row, int col) const { return white[static_cast<std::size_t>(row * side + col)]; }
+  [[nodiscard]] bool at(int row, int col) const {
+    return white[static_cast<std::size_t>(row * side + col)];
+  }
 };
 ArucoCells aruco_cells(const std::string& dictionary, int id);
 

@@ -4,7 +4,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <array>
 #include <string>
 #include <vector>
@@ -24,13 +23,15 @@ Eigen::Isometry3d face_frame(const WorldShape& wall, Face face);
 Eigen::Vector2d face_size(const WorldShape& wall, Face face);
 
 /// World point of face coordinates [u, z] at `offset` along n in front of the face [m].
-Eigen::Vector3d face_point(const WorldShape& wall, Face face, const Eigen::Vector2d& at, double offset = 0.0);
+Eigen::Vector3d face_point(const WorldShape& wall, Face face, const Eigen::Vector2d& at,
+                           double offset = 0.0);
 
 /// A mark as a camera sees it.
 struct MarkTruth {
   std::string name;
   Mark::Type type{Mark::Type::kBlob};
-  Eigen::Vector3d centre{0, 0, 0};  ///< on the front surface (kMarkStandoff in front of the face) [m]
+  Eigen::Vector3d centre{0, 0,
+                         0};  ///< on the front surface (kMarkStandoff in front of the face) [m]
   Eigen::Vector3d normal{0, 0, 0};  ///< outward unit normal of the face
   Eigen::Vector3d right{0, 0, 0};   ///< u: unit, horizontal, the viewer's right
   double diameter{0.0};             ///< blob diameter [m] (0 for ArUco)

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -32,10 +31,12 @@ struct WorldShape {
   enum class Type { kBox, kCylinder };
   std::string name;
   Type type{Type::kBox};
-  Eigen::Vector3d size{1.0, 1.0, 1.0};   ///< box: full extents x y z [m]; cylinder: radius, -, height [m]
-  Eigen::Vector3d position{0, 0, 0};     ///< centre in the world frame [m] (a moving obstacle: at t = 0)
-  double yaw{0.0};                       ///< rotation about world z [rad]
-  double friction{1.0};                  ///< sliding friction coefficient [-]
+  Eigen::Vector3d size{1.0, 1.0,
+                       1.0};  ///< box: full extents x y z [m]; cylinder: radius, -, height [m]
+  Eigen::Vector3d position{0, 0,
+                           0};  ///< centre in the world frame [m] (a moving obstacle: at t = 0)
+  double yaw{0.0};              ///< rotation about world z [rad]
+  double friction{1.0};         ///< sliding friction coefficient [-]
   /// Obstacles only: moves piecewise linearly from `position` through the waypoints (z and yaw
   /// fixed); see obstacle_position() in geometry.hpp.
   std::optional<ObstaclePath> path;
@@ -55,18 +56,18 @@ enum class Face { kPlusX, kMinusX, kPlusY, kMinusY };
 /// geoms (no collision) whose front surface is 1 mm in front of the face (kMarkStandoff).
 struct Mark {
   enum class Type { kBlob, kAruco };
-  std::string name;        ///< unique in the world
+  std::string name;  ///< unique in the world
   Type type{Type::kBlob};
-  std::string wall;        ///< name of the wall it is on
+  std::string wall;  ///< name of the wall it is on
   Face face{Face::kPlusX};
   Eigen::Vector2d at{0, 0};  ///< centre: [u offset from the face centre, world height z] [m]
   // Blob.
-  double diameter{0.1};                          ///< [m]
-  Eigen::Vector4d rgba{0.05, 0.1, 0.9, 1.0};     ///< colour [0..1]
+  double diameter{0.1};                       ///< [m]
+  Eigen::Vector4d rgba{0.05, 0.1, 0.9, 1.0};  ///< colour [0..1]
   // ArUco.
-  double size{0.1};                    ///< full outer side, black border included (OpenCV markerLength) [m]
+  double size{0.1};  ///< full outer side, black border included (OpenCV markerLength) [m]
   std::string dictionary{"DICT_4X4_50"};  ///< OpenCV predefined dictionary name (aruco.hpp)
-  int id{0};                           ///< marker id in the dictionary
+  int id{0};                              ///< marker id in the dictionary
   double angle{0.0};  ///< rotation about n, counter-clockwise as seen from the front [rad]
 };
 
@@ -84,13 +85,13 @@ struct SurfaceFeature {
 /// A plaster layer on a wall face, to be sanded: its nominal surface is `thickness` in front of
 /// the face, bumps stand out of it and holes go into it (surface_height() in geometry.hpp).
 struct Surface {
-  std::string name;          ///< unique in the world
+  std::string name;  ///< unique in the world
   std::string wall;
   Face face{Face::kPlusX};
-  Eigen::Vector2d at{0, 0};  ///< centre [u, z] (as Mark::at) [m]
+  Eigen::Vector2d at{0, 0};        ///< centre [u, z] (as Mark::at) [m]
   Eigen::Vector2d size{1.0, 1.0};  ///< width along u, height along z [m]
-  double thickness{0.01};    ///< nominal layer thickness [m]
-  double resolution{0.005};  ///< height-field grid spacing in the simulator [m]
+  double thickness{0.01};          ///< nominal layer thickness [m]
+  double resolution{0.005};        ///< height-field grid spacing in the simulator [m]
   std::vector<SurfaceFeature> bumps;
   std::vector<SurfaceFeature> holes;  ///< depth < thickness
 };
