@@ -338,15 +338,12 @@ struct Validator {
       f.half.setConstant(0.5 * m.diameter);
     } else {
       positive(m.size, field + ".size");
-      if (!is_aruco_dictionary(m.dictionary)) {
-        std::string all;
-        for (const auto& n : aruco_dictionary_names()) {
-          all += (all.empty() ? "" : ", ") + n;
-        }
-        fail(field + ".dictionary",
-             "unknown ArUco dictionary '" + m.dictionary + "' (accepted: " + all + ")");
+      int count = 0;
+      try {
+        count = aruco_dictionary_size(m.dictionary);  // names the accepted ones if unknown
+      } catch (const WorldError& e) {
+        fail(field + ".dictionary", e.what());
       }
-      const int count = aruco_dictionary_size(m.dictionary);
       if (m.id < 0 || m.id >= count) {
         fail(field + ".id", "id " + std::to_string(m.id) + " is not in " + m.dictionary +
                                 " (ids 0.." + std::to_string(count - 1) + ")");
