@@ -218,6 +218,7 @@ struct Built {
   int meshes{0};
   std::vector<std::string> joints;
   bool floating{false};
+  std::string root;  ///< the root link's body (world bodies, e.g. moving obstacles, come first)
 };
 
 Built build_mjcf(const std::string& urdf, const World& world, const SimParams& params,
@@ -238,6 +239,7 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
   }
   MjcfWriter w{params, sensors, wheel_links, {}, {}, {}, {}, 0};
   const urdf::Link& root = *parsed->getRoot();
+  out.root = root.name;
   w.xml << "<worldbody>\n";
   const WorldMjcf world_xml = world_mjcf(world);
   w.xml << world_xml.worldbody;
@@ -304,6 +306,7 @@ struct Instance {
   Built built;
   mjModel* m{nullptr};
   mjData* d{nullptr};
+  ObstacleMotion obstacles;  ///< moves the world's moving obstacles (mocap bodies)
   std::vector<int> qpos_adr, dof_adr;
   std::vector<DriveCommand> commands;
   std::uint64_t generation{0};
@@ -318,6 +321,7 @@ namespace {
 
 std::unique_ptr<Instance> make_instance(const std::string& urdf, const std::vector<SensorMount>& sensors,
                                         const World& world, const SimParams& params) {
+  world::validate_world(world, "sim world");
   auto in = std::make_unique<Instance>();
   in->built = build_mjcf(urdf, world, params, sensors);
   in->sensors = sensors;
@@ -336,7 +340,10 @@ std::unique_ptr<Instance> make_instance(const std::string& urdf, const std::vect
   if (in->m == nullptr) {
     throw HardwareError(std::string("sim: MuJoCo rejected the model built from the URDF: ") + error);
   }
+  fill_world_hfields(world, in->m);
+  in->obstacles = ObstacleMotion(world, in->m);
   in->d = mj_makeData(in->m);
+  in->obstacles.apply(in->d, 0.0);
   in->commands.assign(in->built.joints.size(), DriveCommand{});
   for (std::size_t i = 0; i < in->built.joints.size(); ++i) {
     const int jid = mj_name2id(in->m, mjOBJ_JOINT, in->built.joints[i].c_str());
@@ -361,6 +368,7 @@ std::unique_ptr<Instance> make_instance(const std::string& urdf, const std::vect
 /// same-named joints for a new robot, everything for a new world around the same robot.
 void carry_state(const Instance& from, Instance& to) {
   to.d->time = from.d->time;
+  to.obstacles.apply(to.d, to.d->time);
   if (to.same_robot && to.m->nq == from.m->nq && to.m->nv == from.m->nv) {
     std::copy_n(from.d->qpos, from.m->nq, to.d->qpos);
     std::copy_n(from.d->qvel, from.m->nv, to.d->qvel);
@@ -541,6 +549,7 @@ void SimHardware::step(double dt) {
   const int n = std::max(1, static_cast<int>(std::lround(dt / impl_->params.timestep)));
   for (int k = 0; k < n; ++k) {
     impl_->apply_drives();
+    impl_->active->obstacles.apply(impl_->active->d, impl_->active->d->time);
     mj_step(impl_->active->m, impl_->active->d);
   }
   if (impl_->active->scene) {
@@ -611,7 +620,7 @@ Eigen::Isometry3d SimHardware::link_pose(const std::string& link) const {
   return pose;
 }
 
-Eigen::Isometry3d SimHardware::base_pose() const { return link_pose(mj_id2name(impl_->active->m, mjOBJ_BODY, 1)); }
+Eigen::Isometry3d SimHardware::base_pose() const { return link_pose(impl_->active->built.root); }
 
 Eigen::Vector3d SimHardware::contact_force_on(const std::vector<std::string>& links) const {
   std::vector<int> bodies;

@@ -154,6 +154,16 @@ TEST(RobotMain, SimCommandsSwapTheAssemblyAndChangeTheWorld) {
   EXPECT_FALSE(reply->accepted());
   EXPECT_NE(reply->message().find("site.yaml"), std::string::npos) << reply->message();
   EXPECT_NE(reply->message().find("obstacles[0].size"), std::string::npos) << reply->message();
+  // ... and when a mark names a dictionary OpenCV does not have (the running world stays:
+  // the next accepted world is version 2).
+  w.request_id(5);
+  w.content("walls:\n  - {name: wall, size: [0.2, 3, 2.5], position: [1, 0, 1.25]}\n"
+            "marks:\n  - {type: aruco, name: m, wall: wall, face: -x, at: [0, 1.2], size: 0.15, "
+            "dictionary: DICT_3X3_9, id: 1}\n");
+  reply = send(commands, replies, w);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_FALSE(reply->accepted());
+  EXPECT_NE(reply->message().find("marks[0].dictionary"), std::string::npos) << reply->message();
   w.request_id(4);
   w.content("obstacles:\n  - {name: crate, size: [0.5, 0.5, 0.5], position: [3, 0, 0.25]}\n");
   reply = send(commands, replies, w);

@@ -103,8 +103,14 @@ TEST(NoAllocation, EveryControllerModeAndSwitchCyclesWithoutAllocating) {
   World world;
   world.obstacles.push_back(
       {.name = "crate", .size = {0.5, 0.5, 0.5}, .position = {3.0, 0.0, 0.25}});
+  // A moving obstacle: the sim moves it from simulated time on the loop thread.
+  world.obstacles.push_back({.name = "cart",
+                             .size = {0.4, 0.4, 0.8},
+                             .position = {-3.0, 0.0, 0.4},
+                             .path = concert::world::ObstaclePath{{{-3.0, 2.0}, {-2.0, 2.0}}, 0.5,
+                                                                  concert::world::ObstaclePath::Mode::kLoop}});
   sim.set_world(world);
-  EXPECT_EQ(cycles_allocating(core, 500), 0u) << "world switch";
+  EXPECT_EQ(cycles_allocating(core, 500), 0u) << "world switch, moving obstacle";
   EXPECT_EQ(core.state().model_version, 2u);
 }
 

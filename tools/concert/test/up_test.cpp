@@ -71,6 +71,11 @@ TEST_F(UpTest, BadInputIsRefusedBeforeAnythingStarts) {
   r = concert({"up", "--domain", "300"});
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, HasSubstr("'300' is not a DDS domain id"));
+  // A world with an unknown ArUco dictionary is refused before anything is sent.
+  r = concert({"sim", "world", CONCERT_SOURCE_DIR "/libs/world/test/fixtures/marks_bad_dictionary.yaml"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.err, HasSubstr("world rejected, nothing changed"));
+  EXPECT_THAT(r.err, HasSubstr("marks[0].dictionary: unknown ArUco dictionary 'DICT_3X3_9'"));
   r = concert({"sim", "swap", CONCERT_SOURCE_DIR "/deploy/demo/sanding_robot.yaml"});
   EXPECT_EQ(r.code, 1);
   EXPECT_THAT(r.err, HasSubstr("concert up"));

@@ -107,7 +107,8 @@ std::string SimNode::set_world(const std::string& yaml, const std::string& name)
   }
   world_.write(world::to_msg(w, version, name));
   return "world version " + std::to_string(version) + ": " + std::to_string(w.walls.size()) + " walls, " +
-         std::to_string(w.obstacles.size()) + " obstacles";
+         std::to_string(w.obstacles.size()) + " obstacles, " + std::to_string(w.marks.size()) + " marks, " +
+         std::to_string(w.surfaces.size()) + " surfaces";
 }
 
 }  // namespace concert::robot::dds
