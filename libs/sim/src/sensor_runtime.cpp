@@ -82,14 +82,20 @@ struct Schedule {
 
 std::string imu_site_name(const std::string& sensor) { return "imu:" + sensor; }
 
-SensorScene::SensorScene(const mjModel* model, std::vector<SensorMount> mounts, double floor_height)
+SensorScene::SensorScene(const mjModel* model, std::vector<SensorMount> mounts, const std::string& root_link,
+                         double floor_height)
     : model_(mj_copyModel(nullptr, model)),
       mounts_(std::move(mounts)),
+      root_body_(mj_name2id(model, mjOBJ_BODY, root_link.c_str())),
       floor_height_(floor_height),
       to_rays_([&] { return make_snapshot(model); }),
       to_cameras_([&] { return make_snapshot(model); }) {
   if (model_ == nullptr) {
     throw HardwareError("sim sensors: could not copy the MuJoCo model");
+  }
+  if (root_body_ < 0) {
+    mj_deleteModel(model_);
+    throw HardwareError("sim sensors: the robot's root link '" + root_link + "' is not a MuJoCo body");
   }
   for (const SensorMount& mount : mounts_) {
     const int body = mj_name2id(model_, mjOBJ_BODY, mount.frame.c_str());

@@ -39,7 +39,9 @@ struct SensorSnapshot {
 class SensorScene {
  public:
   /// Throws hardware::HardwareError naming a mount whose frame is not a link of the model.
-  SensorScene(const mjModel* model, std::vector<SensorMount> mounts, double floor_height);
+  /// `root_link`: the robot's root link (the frame of the derived 2D scan).
+  SensorScene(const mjModel* model, std::vector<SensorMount> mounts, const std::string& root_link,
+              double floor_height);
   ~SensorScene();
   SensorScene(const SensorScene&) = delete;
   SensorScene& operator=(const SensorScene&) = delete;
@@ -56,7 +58,7 @@ class SensorScene {
   [[nodiscard]] int accel_adr(std::size_t i) const { return accel_adr_[i]; }
   [[nodiscard]] double floor_height() const { return floor_height_; }
   /// The robot's root body (the frame of the derived 2D scan).
-  [[nodiscard]] int root_body() const { return 1; }
+  [[nodiscard]] int root_body() const { return root_body_; }
 
   hardware::RealtimeBuffer<SensorSnapshot>& to_rays() { return to_rays_; }
   hardware::RealtimeBuffer<SensorSnapshot>& to_cameras() { return to_cameras_; }
@@ -65,6 +67,7 @@ class SensorScene {
   mjModel* model_{nullptr};
   std::vector<SensorMount> mounts_;
   std::vector<int> bodies_, gyro_adr_, accel_adr_;
+  int root_body_{-1};
   double floor_height_{0.0};
   hardware::RealtimeBuffer<SensorSnapshot> to_rays_;
   hardware::RealtimeBuffer<SensorSnapshot> to_cameras_;

@@ -359,7 +359,7 @@ std::unique_ptr<Instance> make_instance(const std::string& urdf, const std::vect
   }
   mj_forward(in->m, in->d);
   if (params.sensors.enabled) {
-    in->scene = std::make_shared<SensorScene>(in->m, sensors, world.floor_height);
+    in->scene = std::make_shared<SensorScene>(in->m, sensors, in->built.root, world.floor_height);
   }
   return in;
 }
