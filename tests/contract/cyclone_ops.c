@@ -11,6 +11,7 @@
 #include "model.h"
 #include "planning.h"
 #include "robot.h"
+#include "sensors.h"
 #include "system.h"
 #include "topology.h"
 #include "world.h"
@@ -40,6 +41,13 @@ static const struct {
     {"concert::msg::World", &concert_msg_World_desc},
     {"concert::msg::SimCommand", &concert_msg_SimCommand_desc},
     {"concert::msg::SimCommandReply", &concert_msg_SimCommandReply_desc},
+    {"concert::msg::Image", &concert_msg_Image_desc},
+    {"concert::msg::CameraInfo", &concert_msg_CameraInfo_desc},
+    {"concert::msg::LidarScan", &concert_msg_LidarScan_desc},
+    {"concert::msg::LaserScan", &concert_msg_LaserScan_desc},
+    {"concert::msg::SonarRanges", &concert_msg_SonarRanges_desc},
+    {"concert::msg::Imu", &concert_msg_Imu_desc},
+    {"concert::msg::SensorList", &concert_msg_SensorList_desc},
 };
 
 #define MAX_ENDPOINTS 64

@@ -2,6 +2,7 @@
 // Command line and output shared by the Fast DDS and Cyclone contract peers.
 //   peer write|read [--topics all|latched|NAME[,NAME...]] [--seed N] [--timeout-ms T]
 //                   [--linger-ms L] [--wait-readers] [--repeat-ms R] [--stale-first]
+//                   [--full-images]
 // Output: one JSON object per line (event "written", "received", "missing").
 
 #include <algorithm>
@@ -28,16 +29,41 @@ struct PeerArgs {
   bool wait_readers = false;
   int repeat_ms = 0;         ///< writers: write again every repeat_ms while lingering (0 = once)
   bool stale_first = false;  ///< writers: first write an older sample, then the expected one
+  bool full_images = false;  ///< Image samples are full 640x480 frames (see expected_sample)
 };
 
-/// The sample a peer writes on topic `t`: the same on every peer for the same seed.
-inline idl::Json expected_sample(const dds::TopicInfo& t, uint32_t seed) {
+/// Size of the full-size camera images of the contract tests [px].
+inline constexpr uint32_t kFullImageWidth = 640;
+inline constexpr uint32_t kFullImageHeight = 480;
+
+/// The sample a peer writes on topic `t`: the same on every peer for the same seed. With
+/// `full_images`, an Image is a whole 640x480 frame of seeded bytes: RGB8 (921,600 bytes) on
+/// the colour topic, 16UC1 (614,400 bytes) on the others.
+inline idl::Json expected_sample(const dds::TopicInfo& t, uint32_t seed, bool full_images = false) {
   uint32_t index = 0;
   for (const auto& c : dds::catalogue()) {
     if (c.name == t.name) break;
     ++index;
   }
-  return idl::sample_with_every_field_set(idl::Schema::builtin(), t.type_name, seed * 100 + index);
+  idl::Json sample = idl::sample_with_every_field_set(idl::Schema::builtin(), t.type_name, seed * 100 + index);
+  if (full_images && t.type_name == "concert::msg::Image") {
+    const bool rgb = t.name == "concert/sensors/camera/rgb";
+    const uint32_t step = kFullImageWidth * (rgb ? 3 : 2);
+    sample["encoding"] = rgb ? "rgb8" : "16UC1";
+    sample["width"] = kFullImageWidth;
+    sample["height"] = kFullImageHeight;
+    sample["step"] = step;
+    std::vector<uint8_t> data(static_cast<size_t>(step) * kFullImageHeight);
+    uint32_t x = seed * 2654435761u + index;  // xorshift32: the same bytes on every peer
+    for (auto& b : data) {
+      x ^= x << 13;
+      x ^= x >> 17;
+      x ^= x << 5;
+      b = static_cast<uint8_t>(x);
+    }
+    sample["data"] = data;
+  }
+  return sample;
 }
 
 /// An older sample of the same instance (same key fields) as expected_sample.
@@ -71,6 +97,7 @@ inline PeerArgs parse_peer_args(int argc, char** argv) {
   app.add_option("--repeat-ms", a.repeat_ms, "writers: write again every MS while lingering")
       ->type_name("MS");
   app.add_flag("--stale-first", a.stale_first, "writers: first write an older sample");
+  app.add_flag("--full-images", a.full_images, "Image samples are full 640x480 frames");
   bool parsed = false;
   peer.on_run(app, [&parsed] {
     parsed = true;

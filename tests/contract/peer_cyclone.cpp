@@ -46,7 +46,7 @@ int main(int argc, char** argv) try {
         const auto stale = idl::encode(schema, ep.info.type_name, contract::stale_sample(ep.info, args.seed));
         if (cy_write(ep.handle, stale.data(), stale.size()) != 0) return 2;
       }
-      const auto bytes = idl::encode(schema, ep.info.type_name, contract::expected_sample(ep.info, args.seed));
+      const auto bytes = idl::encode(schema, ep.info.type_name, contract::expected_sample(ep.info, args.seed, args.full_images));
       if (cy_write(ep.handle, bytes.data(), bytes.size()) != 0) return 2;
       const auto spec = dds::qos_spec(ep.info.qos);
       idl::Json event = {{"event", "written"}, {"topic", ep.info.name},
@@ -58,7 +58,7 @@ int main(int argc, char** argv) try {
     while (!contract::past(start, args.linger_ms)) {
       if (args.repeat_ms > 0 && contract::past(last, args.repeat_ms)) {
         for (auto& ep : endpoints) {
-          const auto bytes = idl::encode(schema, ep.info.type_name, contract::expected_sample(ep.info, args.seed));
+          const auto bytes = idl::encode(schema, ep.info.type_name, contract::expected_sample(ep.info, args.seed, args.full_images));
           cy_write(ep.handle, bytes.data(), bytes.size());
         }
         last = std::chrono::steady_clock::now();

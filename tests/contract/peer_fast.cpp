@@ -79,7 +79,7 @@ int main(int argc, char** argv) try {
           throw std::runtime_error(std::string("no reader matched on ") + std::string(info.name));
         }
         auto make = [&](uint32_t seed) {
-          return deserialize<T>(idl::encode(schema, info.type_name, contract::expected_sample(info, seed)));
+          return deserialize<T>(idl::encode(schema, info.type_name, contract::expected_sample(info, seed, args.full_images)));
         };
         if (args.stale_first) {
           writer->write(deserialize<T>(idl::encode(schema, info.type_name, contract::stale_sample(info, args.seed))));
@@ -92,9 +92,13 @@ int main(int argc, char** argv) try {
         contract::emit({{"event", "written"}, {"topic", info.name}, {"local_qos", local_qos(q)}});
         ep.keep = writer;
       } else {
-        auto* recording = new Recording<T>();
-        auto* reader = concert::dds::detail::create_reader(participant, handle.name,
-                                                  eprosima::fastdds::dds::TypeSupport(recording), nullptr);
+        // One Recording per type: topics of the same type (the camera images) share the type the
+        // participant registered first, and that one decodes their samples.
+        eprosima::fastdds::dds::TypeSupport type =
+            participant.get()->find_type(typename concert::dds::PubSubOf<T>::type().getName());
+        if (type.empty()) type = eprosima::fastdds::dds::TypeSupport(new Recording<T>());
+        auto* recording = static_cast<Recording<T>*>(type.get());
+        auto* reader = concert::dds::detail::create_reader(participant, handle.name, type, nullptr);
         ep.keep = std::shared_ptr<void>(reader, [&participant](void* r) {
           concert::dds::detail::delete_reader(participant, static_cast<eprosima::fastdds::dds::DataReader*>(r));
         });

@@ -3,6 +3,7 @@
 #include <array>
 #include <charconv>
 #include <cstdlib>
+#include <initializer_list>
 #include <stdexcept>
 
 namespace concert::dds {
@@ -51,6 +52,22 @@ constexpr std::array kTopics = {
               "tools: mount another assembly on the simulated robot, or change the simulated world"},
     TopicInfo{"concert/sim/reply", "concert::msg::SimCommandReply", QosClass::kLatched,
               "simulator (robot service): accepted or refused with the reason, one instance per request"},
+    TopicInfo{"concert/sensors/camera/rgb", "concert::msg::Image", QosClass::kStream,
+              "robot: colour image (rgb8) of each RGB-D camera, one instance per camera"},
+    TopicInfo{"concert/sensors/camera/depth", "concert::msg::Image", QosClass::kStream,
+              "robot: depth image (16UC1, registered to the colour image) of each RGB-D camera"},
+    TopicInfo{"concert/sensors/camera/info", "concert::msg::CameraInfo", QosClass::kStream,
+              "robot: intrinsics and depth range of each camera, with every frame"},
+    TopicInfo{"concert/sensors/lidar", "concert::msg::LidarScan", QosClass::kStream,
+              "robot: one revolution of each 3D lidar (rings x columns), one instance per lidar"},
+    TopicInfo{"concert/sensors/scan", "concert::msg::LaserScan", QosClass::kStream,
+              "robot: planar scan derived from the lidars, for navigation"},
+    TopicInfo{"concert/sensors/sonar", "concert::msg::SonarRanges", QosClass::kStream,
+              "robot: every ultrasound range sensor, read at the same instant"},
+    TopicInfo{"concert/sensors/imu", "concert::msg::Imu", QosClass::kStream,
+              "robot: angular velocity and specific force of each IMU, one instance per IMU"},
+    TopicInfo{"concert/sensors/list", "concert::msg::SensorList", QosClass::kLatched,
+              "robot: the mounted sensors (name, kind, frame, rate) at a model version"},
 };
 
 }  // namespace
@@ -98,18 +115,24 @@ int32_t domain_id_from_env() {
   return parse_domain_id(env, "CONCERT_DOMAIN_ID");
 }
 
-uint32_t status_instance_id(std::string_view service, std::string_view host) {
+namespace {
+/// FNV-1a 32-bit over the concatenation of `parts`.
+uint32_t fnv1a(std::initializer_list<std::string_view> parts) {
   uint32_t h = 2166136261u;
-  auto mix = [&h](std::string_view s) {
+  for (std::string_view s : parts) {
     for (unsigned char c : s) {
       h ^= c;
       h *= 16777619u;
     }
-  };
-  mix(service);
-  mix("@");
-  mix(host);
+  }
   return h;
 }
+}  // namespace
+
+uint32_t status_instance_id(std::string_view service, std::string_view host) {
+  return fnv1a({service, "@", host});
+}
+
+uint32_t sensor_id(std::string_view sensor) { return fnv1a({sensor}); }
 
 }  // namespace concert::dds

@@ -25,7 +25,9 @@ void use_localhost_only(DomainParticipantQos& qos) {
   udp->interfaceWhiteList.emplace_back("127.0.0.1");
   udp->maxInitialPeersRange = kMaxLocalParticipants;
   qos.transport().use_builtin_transports = false;
-  qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  auto shm = std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>();
+  shm->segment_size(kShmSegmentBytes);
+  qos.transport().user_transports.push_back(shm);
   qos.transport().user_transports.push_back(udp);
 
   eprosima::fastrtps::rtps::Locator_t local;
@@ -36,7 +38,11 @@ void use_localhost_only(DomainParticipantQos& qos) {
   // A user-given metatraffic unicast locator keeps Fast DDS from adding its multicast one.
   builtin.metatrafficUnicastLocatorList.push_back(local);
   builtin.metatrafficMulticastLocatorList.clear();
-  qos.wire_protocol().default_unicast_locator_list.push_back(local);
+  // No user-given default unicast locator: Fast DDS then announces both a shared-memory locator
+  // and the (whitelisted) UDP 127.0.0.1 one for user data, and local readers get their samples
+  // through shared memory. With a UDP locator given here, user data went over UDP only, where a
+  // 1 MB best-effort image (16 fragments in one burst) overflows the socket buffer: about half
+  // the camera frames were lost (bench_sensors_dds).
 
   // Announce often: unicast announcements to 48 local ports cost nothing on loopback, and a
   // participant that starts late (a tool, a restarted service) is seen within half a second

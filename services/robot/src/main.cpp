@@ -29,6 +29,7 @@
 #include "robot/robot_core.hpp"
 #include "robot_node.hpp"
 #include "robot_params.hpp"
+#include "sensor_publisher.hpp"
 #include "sim_node.hpp"
 
 namespace {
@@ -49,6 +50,21 @@ struct Options {
 };
 
 std::atomic<concert::robot::Loop*> g_loop{nullptr};
+
+/// Registers a sensor sink with a backend for the registration's lifetime.
+class SensorSinkRegistration {
+ public:
+  SensorSinkRegistration(concert::hardware::Hardware& hardware, concert::hardware::SensorSink& sink)
+      : hardware_(hardware) {
+    hardware_.set_sensor_sink(&sink);
+  }
+  ~SensorSinkRegistration() { hardware_.set_sensor_sink(nullptr); }
+  SensorSinkRegistration(const SensorSinkRegistration&) = delete;
+  SensorSinkRegistration& operator=(const SensorSinkRegistration&) = delete;
+
+ private:
+  concert::hardware::Hardware& hardware_;
+};
 
 void on_signal(int) {
   if (auto* loop = g_loop.load()) {
@@ -153,6 +169,10 @@ int run(const Options& options) {
 
     concert::dds::Participant participant({.name = "robot"});
     robot::dds::RobotNode node(participant, core, service.node);
+    // The backend's sensor threads hand their data to DDS from now on, until the registration
+    // (made after the publisher, so gone before it, also on an exception) unsets it.
+    robot::dds::SensorPublisher sensors(participant, static_cast<std::uint32_t>(core.model_version()));
+    const SensorSinkRegistration registration(sim, sensors);
     if (!options.assembly.empty()) {
       node.publish_scan(simulated.scan, "sim");
     }
@@ -177,6 +197,7 @@ int run(const Options& options) {
         if (state.cycle != last) {
           last = state.cycle;
           node.publish(state);
+          sensors.set_model_version(static_cast<std::uint32_t>(state.model_version));
         }
         next += std::chrono::microseconds(static_cast<long>(1e6 * params.period));
         std::this_thread::sleep_until(next);

@@ -2,6 +2,7 @@
 
 #include <memory>
 
+#include "camera_verbs.hpp"
 #include "launcher.hpp"
 #include "scan_verbs.hpp"
 #include "status_verbs.hpp"
@@ -46,6 +47,7 @@ void register_all(cli::Cli& concert) {
   register_status_verb(concert);
   register_topic_verbs(concert);
   register_scan_verbs(concert);
+  register_camera_verbs(concert);
   register_service_verbs(concert);
   register_help(concert);
 }

@@ -55,4 +55,8 @@ int32_t parse_domain_id(std::string_view text, std::string_view what);
 /// Key of a ServiceStatus instance: FNV-1a 32-bit of "service@host" (keys stay < 16 bytes).
 uint32_t status_instance_id(std::string_view service, std::string_view host);
 
+/// Key of a sensor's instances on the sensor topics (Image, CameraInfo, LidarScan, Imu):
+/// FNV-1a 32-bit of the sensor name, e.g. "camera_E". Writers and readers both use this.
+uint32_t sensor_id(std::string_view sensor);
+
 }  // namespace concert::dds

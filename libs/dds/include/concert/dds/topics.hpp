@@ -9,6 +9,7 @@
 #include "modelPubSubTypes.h"
 #include "planningPubSubTypes.h"
 #include "robotPubSubTypes.h"
+#include "sensorsPubSubTypes.h"
 #include "systemPubSubTypes.h"
 #include "topologyPubSubTypes.h"
 #include "worldPubSubTypes.h"
@@ -41,6 +42,13 @@ CONCERT_BIND_PUBSUB(TrajectoryStatus);
 CONCERT_BIND_PUBSUB(World);
 CONCERT_BIND_PUBSUB(SimCommand);
 CONCERT_BIND_PUBSUB(SimCommandReply);
+CONCERT_BIND_PUBSUB(Image);
+CONCERT_BIND_PUBSUB(CameraInfo);
+CONCERT_BIND_PUBSUB(LidarScan);
+CONCERT_BIND_PUBSUB(LaserScan);
+CONCERT_BIND_PUBSUB(SonarRanges);
+CONCERT_BIND_PUBSUB(Imu);
+CONCERT_BIND_PUBSUB(SensorList);
 #undef CONCERT_BIND_PUBSUB
 
 /// A catalogue topic carrying T.
@@ -71,6 +79,14 @@ inline constexpr TopicHandle<msg::TrajectoryStatus> trajectory_status{"concert/r
 inline constexpr TopicHandle<msg::World> world{"concert/world/world"};
 inline constexpr TopicHandle<msg::SimCommand> sim_command{"concert/sim/command"};
 inline constexpr TopicHandle<msg::SimCommandReply> sim_reply{"concert/sim/reply"};
+inline constexpr TopicHandle<msg::Image> camera_rgb{"concert/sensors/camera/rgb"};
+inline constexpr TopicHandle<msg::Image> camera_depth{"concert/sensors/camera/depth"};
+inline constexpr TopicHandle<msg::CameraInfo> camera_info{"concert/sensors/camera/info"};
+inline constexpr TopicHandle<msg::LidarScan> lidar{"concert/sensors/lidar"};
+inline constexpr TopicHandle<msg::LaserScan> scan{"concert/sensors/scan"};
+inline constexpr TopicHandle<msg::SonarRanges> sonar{"concert/sensors/sonar"};
+inline constexpr TopicHandle<msg::Imu> imu{"concert/sensors/imu"};
+inline constexpr TopicHandle<msg::SensorList> sensor_list{"concert/sensors/list"};
 }  // namespace topics
 
 /// Calls f(handle) for every typed topic handle (e.g. to dispatch on a topic name).
@@ -96,6 +112,14 @@ template <class F> void for_each_topic(F&& f) {
   f(topics::world);
   f(topics::sim_command);
   f(topics::sim_reply);
+  f(topics::camera_rgb);
+  f(topics::camera_depth);
+  f(topics::camera_info);
+  f(topics::lidar);
+  f(topics::scan);
+  f(topics::sonar);
+  f(topics::imu);
+  f(topics::sensor_list);
 }
 
 }  // namespace concert::dds
