@@ -64,6 +64,13 @@ stage "concert status"
 stage "the live model"
 "$concert" model show --timeout 5 | sed -n '1,8p;/^end-effectors/,$p' | sed 's/^/  /'
 
+stage "sensors: what the robot carries, and the drill camera's next RGB-D frame"
+"$concert" camera list --timeout 5 | sed 's/^/  /'
+snapshots=$(mktemp -d /tmp/concert-demo-camera.XXXXXX)
+"$concert" camera snapshot --camera camera_E --out "$snapshots" --timeout 10 | sed 's/^/  /' ||
+  fail "no frame from the drill camera"
+"$concert" topic hz concert/sensors/imu --timeout 3 | sed 's/^/  /' || true
+
 stage "drilling approach: concert plan drill --at 2.0 0.0 1.2 --execute (area 2 m ahead, 1.2 m high)"
 "$concert" plan drill --at 2.0 0.0 1.2 --execute --timeout 60 | sed 's/^/  /'
 
