@@ -52,9 +52,9 @@ constexpr std::array kTopics = {
               "tools: mount another assembly on the simulated robot, or change the simulated world"},
     TopicInfo{"concert/sim/reply", "concert::msg::SimCommandReply", QosClass::kLatched,
               "simulator (robot service): accepted or refused with the reason, one instance per request"},
-    TopicInfo{"concert/sensors/camera/rgb", "concert::msg::Image", QosClass::kStream,
+    TopicInfo{"concert/sensors/camera/rgb", "concert::msg::Image", QosClass::kLargeStream,
               "robot: colour image (rgb8) of each RGB-D camera, one instance per camera"},
-    TopicInfo{"concert/sensors/camera/depth", "concert::msg::Image", QosClass::kStream,
+    TopicInfo{"concert/sensors/camera/depth", "concert::msg::Image", QosClass::kLargeStream,
               "robot: depth image (16UC1, registered to the colour image) of each RGB-D camera"},
     TopicInfo{"concert/sensors/camera/info", "concert::msg::CameraInfo", QosClass::kStream,
               "robot: intrinsics and depth range of each camera, with every frame"},
@@ -77,6 +77,7 @@ QosSpec qos_spec(QosClass qos) {
     case QosClass::kLatched: return {true, true, 1};
     case QosClass::kStream: return {false, false, 1};
     case QosClass::kCommand: return {true, false, 8};
+    case QosClass::kLargeStream: return {false, false, 1, true};
   }
   throw std::logic_error("unknown QosClass");
 }
@@ -86,6 +87,7 @@ std::string_view to_string(QosClass qos) {
     case QosClass::kLatched: return "latched (reliable, transient-local, keep-last 1)";
     case QosClass::kStream: return "stream (best-effort, volatile, keep-last 1)";
     case QosClass::kCommand: return "command (reliable, volatile, keep-last 8)";
+    case QosClass::kLargeStream: return "large stream (best-effort, volatile, keep-last 1, asynchronous writes)";
   }
   return "?";
 }

@@ -28,6 +28,7 @@ DataWriterQos writer_qos(QosClass qos) {
       eprosima::fastrtps::Duration_t(0, kHeartbeatPeriodMs * 1'000'000u);
   // Keep-last never blocks, but bound the time a reliable write may wait for a slow reader.
   q.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(0, 1'000'000);
+  if (qos_spec(qos).asynchronous) q.publish_mode().kind = ASYNCHRONOUS_PUBLISH_MODE;
   return q;
 }
 

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "concert/dds/json.hpp"
+#include "concert/dds/qos.hpp"
 #include "concert/dds/topics.hpp"
 #include "concert/idl_schema/cdr.hpp"
 #include "concert/idl_schema/schema.hpp"
@@ -79,6 +80,14 @@ TEST(Catalogue, QosClasses) {
   EXPECT_EQ(qos_spec(QosClass::kLatched).history_depth, 1);
   EXPECT_FALSE(qos_spec(find_topic("concert/robot/joint_state")->qos).reliable);
   EXPECT_EQ(qos_spec(find_topic("concert/robot/joint_state")->qos).history_depth, 1);
+  // Camera images: a stream whose writers send from a Fast DDS thread.
+  const QosSpec image = qos_spec(find_topic("concert/sensors/camera/rgb")->qos);
+  EXPECT_FALSE(image.reliable);
+  EXPECT_FALSE(image.transient_local);
+  EXPECT_EQ(image.history_depth, 1);
+  EXPECT_TRUE(image.asynchronous);
+  EXPECT_EQ(writer_qos(QosClass::kLargeStream).publish_mode().kind, eprosima::fastdds::dds::ASYNCHRONOUS_PUBLISH_MODE);
+  EXPECT_EQ(writer_qos(QosClass::kStream).publish_mode().kind, eprosima::fastdds::dds::SYNCHRONOUS_PUBLISH_MODE);
 }
 
 TEST(Catalogue, DomainIds) {

@@ -7,7 +7,8 @@
 //  - cost on the writer thread: conversion (copy into the IDL sample) and DataWriter::write.
 // Writers run in Fast DDS's synchronous publish mode (the catalogue's) and, for comparison, in
 // asynchronous mode (a Fast DDS thread sends).
-// Usage: bench_sensors_dds [--frames N] [--mode sync|async|both]   (a table and a JSON line per mode)
+// Usage: bench_sensors_dds [--frames N] [--mode sync|async|both]   (a table and a JSON line per
+// mode)
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -46,7 +47,8 @@ Stats stats(std::vector<double> us) {
   if (us.empty()) return s;
   std::sort(us.begin(), us.end());
   s.median_us = us[us.size() / 2];
-  s.p99_us = us[std::min(us.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(us.size())))];
+  s.p99_us =
+      us[std::min(us.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(us.size())))];
   s.max_us = us.back();
   return s;
 }
@@ -56,8 +58,8 @@ idl::Json to_json(const Stats& s) {
 }
 
 void print(const std::string& what, const Stats& s) {
-  std::printf("  %-34s median %9.1f us   p99 %9.1f us   max %9.1f us   (n=%zu)\n", what.c_str(), s.median_us,
-              s.p99_us, s.max_us, s.n);
+  std::printf("  %-34s median %9.1f us   p99 %9.1f us   max %9.1f us   (n=%zu)\n", what.c_str(),
+              s.median_us, s.p99_us, s.max_us, s.n);
 }
 
 /// Receiving side: latencies of the first `frames` pairs, as a JSON line on stdout.
@@ -71,18 +73,20 @@ int receiver(int frames, int ready_fd) {
     std::lock_guard lock(m);
     rgb_us.push_back(us);
   });
-  dds::Reader<msg::Image> depth(p, dds::topics::camera_depth, [&](const msg::Image& i, const auto&) {
-    const double us = static_cast<double>(now_ns() - i.stamp_ns()) / 1e3;
-    std::lock_guard lock(m);
-    pair_us.push_back(us);
-    ++pairs;
-  });
+  dds::Reader<msg::Image> depth(
+      p, dds::topics::camera_depth, [&](const msg::Image& i, const auto&) {
+        const double us = static_cast<double>(now_ns() - i.stamp_ns()) / 1e3;
+        std::lock_guard lock(m);
+        pair_us.push_back(us);
+        ++pairs;
+      });
   const char ready = 1;
   if (write(ready_fd, &ready, 1) != 1) return 2;
   const auto deadline = Clock::now() + std::chrono::seconds(frames / 15 + 30);
   while (pairs < frames && Clock::now() < deadline) std::this_thread::sleep_for(10ms);
   std::lock_guard lock(m);
-  std::cout << idl::Json{{"rgb", to_json(stats(rgb_us))}, {"pair", to_json(stats(pair_us))}}.dump() << std::endl;
+  std::cout << idl::Json{{"rgb", to_json(stats(rgb_us))}, {"pair", to_json(stats(pair_us))}}.dump()
+            << std::endl;
   return 0;
 }
 
@@ -90,7 +94,8 @@ int receiver(int frames, int ready_fd) {
 edds::DataWriter* make_writer(dds::Participant& p, std::string_view topic, bool async) {
   edds::TypeSupport type(new msg::ImagePubSubType());
   auto qos = dds::writer_qos(dds::find_topic(topic)->qos);
-  qos.publish_mode().kind = async ? edds::ASYNCHRONOUS_PUBLISH_MODE : edds::SYNCHRONOUS_PUBLISH_MODE;
+  qos.publish_mode().kind =
+      async ? edds::ASYNCHRONOUS_PUBLISH_MODE : edds::SYNCHRONOUS_PUBLISH_MODE;
   auto* w = p.publisher()->create_datawriter(p.topic(std::string(topic), type), qos);
   if (w == nullptr) throw std::runtime_error("cannot create a writer on " + std::string(topic));
   return w;
@@ -161,28 +166,27 @@ int run_mode(bool async, int frames) {
   waitpid(pid, &status, 0);
   std::string text;
   char buf[4096];
-  for (ssize_t n; (n = read(out_fds[0], buf, sizeof buf)) > 0;) text.append(buf, static_cast<size_t>(n));
+  for (ssize_t n; (n = read(out_fds[0], buf, sizeof buf)) > 0;)
+    text.append(buf, static_cast<size_t>(n));
   if (text.empty()) {
     std::cerr << "bench_sensors_dds: no result from the reader process\n";
     return 1;
   }
   const auto r = idl::Json::parse(text);
-  const Stats conv = stats(convert_us), rgb_write = stats(rgb_write_us), depth_write = stats(depth_write_us);
-  std::printf("%s publish mode, 640x480 RGB8 + 16UC1 at 15 Hz, %d frames written:\n", async ? "asynchronous" : "synchronous",
-              frames + 5);
-  print("latency colour image", {r.at("rgb").at("median_us"), r.at("rgb").at("p99_us"), r.at("rgb").at("max_us"),
-                                 r.at("rgb").at("n")});
+  const Stats conv = stats(convert_us), rgb_write = stats(rgb_write_us),
+              depth_write = stats(depth_write_us);
+  std::printf("%s publish mode, 640x480 RGB8 + 16UC1 at 15 Hz, %d frames written:\n",
+              async ? "asynchronous" : "synchronous", frames + 5);
+  print("latency colour image", {r.at("rgb").at("median_us"), r.at("rgb").at("p99_us"),
+                                 r.at("rgb").at("max_us"), r.at("rgb").at("n")});
   print("latency pair (depth arrived)", {r.at("pair").at("median_us"), r.at("pair").at("p99_us"),
                                          r.at("pair").at("max_us"), r.at("pair").at("n")});
   print("writer: convert both (2 copies)", conv);
   print("writer: write() colour 921,600 B", rgb_write);
   print("writer: write() depth 614,400 B", depth_write);
-  std::cout << idl::Json{{"mode", async ? "async" : "sync"},
-                         {"frames_written", frames + 5},
-                         {"latency_rgb", r.at("rgb")},
-                         {"latency_pair", r.at("pair")},
-                         {"convert", to_json(conv)},
-                         {"write_rgb", to_json(rgb_write)},
+  std::cout << idl::Json{{"mode", async ? "async" : "sync"},   {"frames_written", frames + 5},
+                         {"latency_rgb", r.at("rgb")},         {"latency_pair", r.at("pair")},
+                         {"convert", to_json(conv)},           {"write_rgb", to_json(rgb_write)},
                          {"write_depth", to_json(depth_write)}}
                    .dump()
             << std::endl;
@@ -196,10 +200,13 @@ int bench_main(int argc, char** argv) {
   std::string mode = "both";
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
-    if (a == "--frames") frames = std::stoi(argv[i + 1]);
-    else if (a == "--mode") mode = argv[i + 1];
+    if (a == "--frames")
+      frames = std::stoi(argv[i + 1]);
+    else if (a == "--mode")
+      mode = argv[i + 1];
     else {
-      std::cerr << "bench_sensors_dds: unknown option " << a << " (--frames N, --mode sync|async|both)\n";
+      std::cerr << "bench_sensors_dds: unknown option " << a
+                << " (--frames N, --mode sync|async|both)\n";
       return 2;
     }
   }

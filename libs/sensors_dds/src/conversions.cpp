@@ -17,8 +17,8 @@ static_assert(std::endian::native == std::endian::little,
 std::string camera(std::string_view sensor) { return "camera '" + std::string(sensor) + "'"; }
 
 /// Header fields every camera image shares.
-void image_header(const hardware::RgbdFrame& frame, uint32_t model_version, std::string_view encoding,
-                  uint32_t bytes_per_pixel, msg::Image& out) {
+void image_header(const hardware::RgbdFrame& frame, uint32_t model_version,
+                  std::string_view encoding, uint32_t bytes_per_pixel, msg::Image& out) {
   out.sensor_id(dds::sensor_id(frame.sensor));
   out.model_version(model_version);
   out.stamp_ns(to_stamp_ns(frame.stamp));
@@ -46,21 +46,29 @@ Eigen::Vector3d from_vector(const msg::Vector3& v) { return {v.x(), v.y(), v.z()
 
 hardware::SensorType from_kind(msg::SensorKind kind, std::string_view sensor) {
   switch (kind) {
-    case msg::SENSOR_RGBD: return hardware::SensorType::kRgbd;
-    case msg::SENSOR_LIDAR: return hardware::SensorType::kLidar;
-    case msg::SENSOR_SONAR: return hardware::SensorType::kSonar;
-    case msg::SENSOR_IMU: return hardware::SensorType::kImu;
+    case msg::SENSOR_RGBD:
+      return hardware::SensorType::kRgbd;
+    case msg::SENSOR_LIDAR:
+      return hardware::SensorType::kLidar;
+    case msg::SENSOR_SONAR:
+      return hardware::SensorType::kSonar;
+    case msg::SENSOR_IMU:
+      return hardware::SensorType::kImu;
   }
-  throw std::invalid_argument("SensorList: sensor '" + std::string(sensor) + "' has an unknown kind " +
-                              std::to_string(static_cast<int>(kind)));
+  throw std::invalid_argument("SensorList: sensor '" + std::string(sensor) +
+                              "' has an unknown kind " + std::to_string(static_cast<int>(kind)));
 }
 
 msg::SensorKind to_kind(hardware::SensorType type) {
   switch (type) {
-    case hardware::SensorType::kRgbd: return msg::SENSOR_RGBD;
-    case hardware::SensorType::kLidar: return msg::SENSOR_LIDAR;
-    case hardware::SensorType::kSonar: return msg::SENSOR_SONAR;
-    case hardware::SensorType::kImu: return msg::SENSOR_IMU;
+    case hardware::SensorType::kRgbd:
+      return msg::SENSOR_RGBD;
+    case hardware::SensorType::kLidar:
+      return msg::SENSOR_LIDAR;
+    case hardware::SensorType::kSonar:
+      return msg::SENSOR_SONAR;
+    case hardware::SensorType::kImu:
+      return msg::SENSOR_IMU;
   }
   throw std::logic_error("unknown hardware::SensorType");
 }
@@ -73,8 +81,9 @@ double from_stamp_ns(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
 void to_rgb_image(const hardware::RgbdFrame& frame, uint32_t model_version, msg::Image& out) {
   if (frame.rgb.size() != pixels(frame) * 3) {
-    throw std::invalid_argument(camera(frame.sensor) + ": colour image has " + std::to_string(frame.rgb.size()) +
-                                " bytes, not width * height * 3 = " + std::to_string(pixels(frame) * 3));
+    throw std::invalid_argument(
+        camera(frame.sensor) + ": colour image has " + std::to_string(frame.rgb.size()) +
+        " bytes, not width * height * 3 = " + std::to_string(pixels(frame) * 3));
   }
   image_header(frame, model_version, kRgb8, 3, out);
   out.depth_scale(0.0);
@@ -83,7 +92,8 @@ void to_rgb_image(const hardware::RgbdFrame& frame, uint32_t model_version, msg:
 
 void to_depth_image(const hardware::RgbdFrame& frame, uint32_t model_version, msg::Image& out) {
   if (frame.depth.size() != pixels(frame)) {
-    throw std::invalid_argument(camera(frame.sensor) + ": depth image has " + std::to_string(frame.depth.size()) +
+    throw std::invalid_argument(camera(frame.sensor) + ": depth image has " +
+                                std::to_string(frame.depth.size()) +
                                 " values, not width * height = " + std::to_string(pixels(frame)));
   }
   image_header(frame, model_version, kDepth16, 2, out);
@@ -121,35 +131,40 @@ void check_image(const msg::Image& image, std::string_view encoding) {
   }
   const uint32_t bytes_per_pixel = encoding == kRgb8 ? 3 : 2;
   if (image.step() < image.width() * bytes_per_pixel) {
-    throw std::invalid_argument(who + ": " + std::string(encoding) + " image step " + std::to_string(image.step()) +
-                                " is shorter than a row of " + std::to_string(image.width()) + " px");
+    throw std::invalid_argument(who + ": " + std::string(encoding) + " image step " +
+                                std::to_string(image.step()) + " is shorter than a row of " +
+                                std::to_string(image.width()) + " px");
   }
   const size_t expected = static_cast<size_t>(image.step()) * image.height();
   if (image.data().size() != expected) {
     throw std::invalid_argument(who + ": " + std::string(encoding) + " image has " +
-                                std::to_string(image.data().size()) + " bytes, not step * height = " +
-                                std::to_string(expected));
+                                std::to_string(image.data().size()) +
+                                " bytes, not step * height = " + std::to_string(expected));
   }
 }
 
-hardware::RgbdFrame to_rgbd_frame(const msg::Image& rgb, const msg::Image& depth, const msg::CameraInfo& info) {
+hardware::RgbdFrame to_rgbd_frame(const msg::Image& rgb, const msg::Image& depth,
+                                  const msg::CameraInfo& info) {
   check_image(rgb, kRgb8);
   check_image(depth, kDepth16);
   const std::string who = camera(rgb.sensor());
   if (depth.sensor() != rgb.sensor() || info.sensor() != rgb.sensor()) {
-    throw std::invalid_argument(who + ": depth image of '" + depth.sensor() + "' and camera info of '" +
-                                info.sensor() + "' are not the same camera's");
+    throw std::invalid_argument(who + ": depth image of '" + depth.sensor() +
+                                "' and camera info of '" + info.sensor() +
+                                "' are not the same camera's");
   }
   if (depth.stamp_ns() != rgb.stamp_ns()) {
     throw std::invalid_argument(who + ": colour stamp " + std::to_string(rgb.stamp_ns()) +
-                                " ns and depth stamp " + std::to_string(depth.stamp_ns()) + " ns differ");
+                                " ns and depth stamp " + std::to_string(depth.stamp_ns()) +
+                                " ns differ");
   }
-  if (depth.width() != rgb.width() || depth.height() != rgb.height() || info.width() != rgb.width() ||
-      info.height() != rgb.height()) {
-    throw std::invalid_argument(who + ": sizes differ: colour " + std::to_string(rgb.width()) + "x" +
-                                std::to_string(rgb.height()) + ", depth " + std::to_string(depth.width()) + "x" +
-                                std::to_string(depth.height()) + ", camera info " + std::to_string(info.width()) +
-                                "x" + std::to_string(info.height()));
+  if (depth.width() != rgb.width() || depth.height() != rgb.height() ||
+      info.width() != rgb.width() || info.height() != rgb.height()) {
+    throw std::invalid_argument(who + ": sizes differ: colour " + std::to_string(rgb.width()) +
+                                "x" + std::to_string(rgb.height()) + ", depth " +
+                                std::to_string(depth.width()) + "x" +
+                                std::to_string(depth.height()) + ", camera info " +
+                                std::to_string(info.width()) + "x" + std::to_string(info.height()));
   }
   hardware::RgbdFrame frame;
   frame.sensor = rgb.sensor();
@@ -193,9 +208,10 @@ msg::LidarScan to_msg(const hardware::LidarScan& scan, uint32_t model_version) {
 hardware::LidarScan from_msg(const msg::LidarScan& scan) {
   const size_t expected = scan.elevations().size() * scan.columns();
   if (scan.ranges().size() != expected) {
-    throw std::invalid_argument("lidar '" + scan.sensor() + "': " + std::to_string(scan.ranges().size()) +
-                                " ranges, not rings * columns = " + std::to_string(scan.elevations().size()) +
-                                " * " + std::to_string(scan.columns()));
+    throw std::invalid_argument(
+        "lidar '" + scan.sensor() + "': " + std::to_string(scan.ranges().size()) +
+        " ranges, not rings * columns = " + std::to_string(scan.elevations().size()) + " * " +
+        std::to_string(scan.columns()));
   }
   hardware::LidarScan out;
   out.sensor = scan.sensor();
@@ -257,7 +273,8 @@ hardware::SonarRanges from_msg(const msg::SonarRanges& ranges) {
   hardware::SonarRanges out;
   out.stamp = from_stamp_ns(ranges.stamp_ns());
   for (const auto& r : ranges.sonars()) {
-    out.sonars.push_back({r.sensor(), r.frame(), r.range(), r.range_min(), r.range_max(), r.field_of_view()});
+    out.sonars.push_back(
+        {r.sensor(), r.frame(), r.range(), r.range_min(), r.range_max(), r.field_of_view()});
   }
   return out;
 }
@@ -288,7 +305,8 @@ hardware::ImuSample from_msg(const msg::Imu& sample) {
   return out;
 }
 
-msg::SensorList to_msg(const std::vector<hardware::SensorInfo>& sensors, uint32_t model_version, int64_t stamp_ns) {
+msg::SensorList to_msg(const std::vector<hardware::SensorInfo>& sensors, uint32_t model_version,
+                       int64_t stamp_ns) {
   msg::SensorList out;
   out.model_version(model_version);
   out.stamp_ns(stamp_ns);

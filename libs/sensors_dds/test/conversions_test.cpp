@@ -122,8 +122,9 @@ TEST(Lidar, RoundTripsAndRefusesRangesOfTheWrongSize) {
 }
 
 TEST(Scan2d, SonarImuAndSensorListRoundTrip) {
-  hardware::LaserScan2d scan{"base_scan", 1.5, -2.0, 0.01, {1.0f, std::numeric_limits<float>::infinity(), 2.5f},
-                             0.1f, 30.0f};
+  hardware::LaserScan2d scan{
+      "base_scan", 1.5,  -2.0, 0.01, {1.0f, std::numeric_limits<float>::infinity(), 2.5f},
+      0.1f,        30.0f};
   const auto scan_back = from_msg(to_msg(scan, 1));
   EXPECT_EQ(scan_back.frame, scan.frame);
   EXPECT_EQ(scan_back.ranges, scan.ranges);
@@ -131,9 +132,10 @@ TEST(Scan2d, SonarImuAndSensorListRoundTrip) {
   EXPECT_DOUBLE_EQ(scan_back.angle_increment, scan.angle_increment);
   EXPECT_EQ(scan_back.range_max, scan.range_max);
 
-  hardware::SonarRanges sonars{2.0, {{"sonar_1", "sonar_1_link", 1.2f, 0.02f, 4.0f, 0.5f},
-                                     {"sonar_2", "sonar_2_link", std::numeric_limits<float>::infinity(), 0.02f,
-                                      4.0f, 0.5f}}};
+  hardware::SonarRanges sonars{
+      2.0,
+      {{"sonar_1", "sonar_1_link", 1.2f, 0.02f, 4.0f, 0.5f},
+       {"sonar_2", "sonar_2_link", std::numeric_limits<float>::infinity(), 0.02f, 4.0f, 0.5f}}};
   const auto sonars_back = from_msg(to_msg(sonars, 1));
   ASSERT_EQ(sonars_back.sonars.size(), 2u);
   EXPECT_EQ(sonars_back.sonars[1].sensor, "sonar_2");
@@ -156,10 +158,11 @@ TEST(Scan2d, SonarImuAndSensorListRoundTrip) {
   EXPECT_EQ(imu_back.linear_acceleration_variance, imu.linear_acceleration_variance);
   EXPECT_EQ(imu_back.stamp, imu.stamp);
 
-  const std::vector<hardware::SensorInfo> mounted = {{"camera_E", hardware::SensorType::kRgbd, "camera_E_optical", 15},
-                                                     {"lidar_A", hardware::SensorType::kLidar, "lidar_A", 10},
-                                                     {"sonar_1", hardware::SensorType::kSonar, "sonar_1_link", 20},
-                                                     {"imu", hardware::SensorType::kImu, "base_link", 200}};
+  const std::vector<hardware::SensorInfo> mounted = {
+      {"camera_E", hardware::SensorType::kRgbd, "camera_E_optical", 15},
+      {"lidar_A", hardware::SensorType::kLidar, "lidar_A", 10},
+      {"sonar_1", hardware::SensorType::kSonar, "sonar_1_link", 20},
+      {"imu", hardware::SensorType::kImu, "base_link", 200}};
   const msg::SensorList list = to_msg(mounted, 3, 42);
   EXPECT_EQ(list.model_version(), 3u);
   EXPECT_EQ(list.sensors()[2].kind(), msg::SENSOR_SONAR);

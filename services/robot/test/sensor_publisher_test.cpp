@@ -19,7 +19,8 @@ using namespace std::chrono_literals;
 namespace cdds = concert::dds;
 namespace topics = concert::dds::topics;
 
-template <class T> void wait_matched(cdds::Reader<T>& reader) {
+template <class T>
+void wait_matched(cdds::Reader<T>& reader) {
   ASSERT_TRUE(reader.wait_for_writers(1, 10s)) << "no writer matched";
 }
 
@@ -92,8 +93,10 @@ TEST(SensorPublisher, LidarScanSonarImuArriveFieldByField) {
   wait_matched(imu);
 
   const auto lidar_in = testing::synthetic_lidar_scan("lidar_front_A", 16, 1800, 5);
-  const hardware::LaserScan2d scan_in{"base_scan", 0.5, -3.1, 0.0087, std::vector<float>(720, 4.5f), 0.1f, 30.0f};
-  const hardware::SonarRanges sonar_in{0.75, {{"sonar_1", "sonar_1_link", 1.25f, 0.02f, 4.0f, 0.5f}}};
+  const hardware::LaserScan2d scan_in{
+      "base_scan", 0.5, -3.1, 0.0087, std::vector<float>(720, 4.5f), 0.1f, 30.0f};
+  const hardware::SonarRanges sonar_in{0.75,
+                                       {{"sonar_1", "sonar_1_link", 1.25f, 0.02f, 4.0f, 0.5f}}};
   hardware::ImuSample imu_in;
   imu_in.sensor = "imu_base";
   imu_in.frame = "base_link";

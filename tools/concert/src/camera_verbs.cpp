@@ -7,12 +7,11 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <optional>
-#include <sstream>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
+#include <sstream>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/idl_schema/cdr.hpp"
@@ -51,23 +50,30 @@ std::string seconds_text(double s) {
 class CameraListener {
  public:
   explicit CameraListener(dds::Participant& participant)
-      : list_reader_(participant, dds::topics::sensor_list,
-                     [this](const msg::SensorList& l, const auto&) { keep([&] { sensor_list = l; }); }),
-        rgb_reader_(participant, dds::topics::camera_rgb,
-                    [this](const msg::Image& i, const auto&) { keep([&] { rgb[i.sensor()] = i; }); }),
-        depth_reader_(participant, dds::topics::camera_depth,
-                      [this](const msg::Image& i, const auto&) { keep([&] { depth[i.sensor()] = i; }); }),
+      : list_reader_(
+            participant, dds::topics::sensor_list,
+            [this](const msg::SensorList& l, const auto&) { keep([&] { sensor_list = l; }); }),
+        rgb_reader_(
+            participant, dds::topics::camera_rgb,
+            [this](const msg::Image& i, const auto&) { keep([&] { rgb[i.sensor()] = i; }); }),
+        depth_reader_(
+            participant, dds::topics::camera_depth,
+            [this](const msg::Image& i, const auto&) { keep([&] { depth[i.sensor()] = i; }); }),
         info_reader_(participant, dds::topics::camera_info,
-                     [this](const msg::CameraInfo& i, const auto&) { keep([&] { info[i.sensor()] = i; }); }) {}
+                     [this](const msg::CameraInfo& i, const auto&) {
+                       keep([&] { info[i.sensor()] = i; });
+                     }) {}
 
   /// Calls f under the lock.
-  template <class F> void with_lock(F&& f) {
+  template <class F>
+  void with_lock(F&& f) {
     std::lock_guard lock(mutex_);
     f();
   }
 
   /// Waits until `done` (called under the lock) returns true or the deadline passes.
-  template <class F> bool wait_until(std::chrono::steady_clock::time_point deadline, F&& done) {
+  template <class F>
+  bool wait_until(std::chrono::steady_clock::time_point deadline, F&& done) {
     std::unique_lock lock(mutex_);
     return changed_.wait_until(lock, deadline, [&] { return done(); });
   }
@@ -78,7 +84,8 @@ class CameraListener {
 
  private:
   /// Stores a sample (f, under the lock) and wakes the waiters.
-  template <class F> void keep(F&& f) {
+  template <class F>
+  void keep(F&& f) {
     {
       std::lock_guard lock(mutex_);
       f();
@@ -103,13 +110,14 @@ int list(const ListOptions& o, std::ostream& out) {
   std::mutex mutex;
   std::condition_variable cv;
   std::optional<msg::SensorList> got;
-  dds::Reader<msg::SensorList> reader(participant, dds::topics::sensor_list, [&](const msg::SensorList& l, const auto&) {
-    {
-      std::lock_guard lock(mutex);
-      got = l;
-    }
-    cv.notify_all();
-  });
+  dds::Reader<msg::SensorList> reader(participant, dds::topics::sensor_list,
+                                      [&](const msg::SensorList& l, const auto&) {
+                                        {
+                                          std::lock_guard lock(mutex);
+                                          got = l;
+                                        }
+                                        cv.notify_all();
+                                      });
   std::unique_lock lock(mutex);
   if (!cv.wait_for(lock, o.dds.timeout(), [&] { return got.has_value(); })) {
     throw Failure("no sensor list on " + std::string(dds::topics::sensor_list.name) + " within " +
@@ -119,7 +127,8 @@ int list(const ListOptions& o, std::ostream& out) {
   const auto cameras = cameras_of(*got);
   if (o.dds.json) {
     idl::Json rows = idl::Json::array();
-    for (const auto& c : cameras) rows.push_back({{"name", c.name()}, {"frame", c.frame()}, {"rate", c.rate()}});
+    for (const auto& c : cameras)
+      rows.push_back({{"name", c.name()}, {"frame", c.frame()}, {"rate", c.rate()}});
     out << idl::Json{{"model_version", got->model_version()}, {"cameras", rows}}.dump() << "\n";
     return 0;
   }
@@ -158,7 +167,8 @@ int snapshot(const SnapshotOptions& o, std::ostream& out) {
     const auto& rgb = l.rgb[name];
     const auto& depth = l.depth[name];
     const auto& info = l.info[name];
-    return rgb && depth && info && rgb->stamp_ns() == depth->stamp_ns() && rgb->stamp_ns() == info->stamp_ns();
+    return rgb && depth && info && rgb->stamp_ns() == depth->stamp_ns() &&
+           rgb->stamp_ns() == info->stamp_ns();
   };
   auto known_cameras = [&] {
     std::vector<std::string> names;
@@ -166,7 +176,8 @@ int snapshot(const SnapshotOptions& o, std::ostream& out) {
       for (const auto& c : cameras_of(*l.sensor_list)) names.push_back(c.name());
     }
     for (const auto& [name, image] : l.rgb) {
-      if (image && std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+      if (image && std::find(names.begin(), names.end(), name) == names.end())
+        names.push_back(name);
     }
     return names;
   };
@@ -183,7 +194,8 @@ int snapshot(const SnapshotOptions& o, std::ostream& out) {
     return complete(camera);
   });
   if (!unknown.empty()) {
-    throw Failure("no camera '" + camera + "' on the robot; its cameras: " + unknown + " (`concert camera list`)");
+    throw Failure("no camera '" + camera + "' on the robot; its cameras: " + unknown +
+                  " (`concert camera list`)");
   }
   if (!got) {
     std::vector<std::string> names;
@@ -192,10 +204,12 @@ int snapshot(const SnapshotOptions& o, std::ostream& out) {
     if (camera.empty()) {
       throw Failure("no camera publishes on " + std::string(dds::topics::camera_rgb.name) + within +
                     " (and no sensor list on " + std::string(dds::topics::sensor_list.name) +
-                    "); is the robot running on domain " + std::to_string(participant.domain_id()) + "?");
+                    "); is the robot running on domain " + std::to_string(participant.domain_id()) +
+                    "?");
     }
-    throw Failure("no complete frame of camera '" + camera + "' (" + std::string(dds::topics::camera_rgb.name) +
-                  ", " + std::string(dds::topics::camera_depth.name) + " and " +
+    throw Failure("no complete frame of camera '" + camera + "' (" +
+                  std::string(dds::topics::camera_rgb.name) + ", " +
+                  std::string(dds::topics::camera_depth.name) + " and " +
                   std::string(dds::topics::camera_info.name) + " with one stamp)" + within +
                   "; cameras seen: " + joined(names));
   }
@@ -215,10 +229,13 @@ int snapshot(const SnapshotOptions& o, std::ostream& out) {
   const fs::path rgb_path = fs::path(o.out_dir) / (file_stem(camera) + "_rgb.png");
   const fs::path depth_path = fs::path(o.out_dir) / (file_stem(camera) + "_depth.png");
   cv::Mat bgr;
-  cv::cvtColor(cv::Mat(height, width, CV_8UC3, const_cast<uint8_t*>(frame.rgb.data())), bgr, cv::COLOR_RGB2BGR);
+  cv::cvtColor(cv::Mat(height, width, CV_8UC3, const_cast<uint8_t*>(frame.rgb.data())), bgr,
+               cv::COLOR_RGB2BGR);
   const cv::Mat depth_mat(height, width, CV_16UC1, const_cast<uint16_t*>(frame.depth.data()));
-  if (!cv::imwrite(rgb_path.string(), bgr)) throw Failure(rgb_path.string() + ": cannot write the PNG");
-  if (!cv::imwrite(depth_path.string(), depth_mat)) throw Failure(depth_path.string() + ": cannot write the PNG");
+  if (!cv::imwrite(rgb_path.string(), bgr))
+    throw Failure(rgb_path.string() + ": cannot write the PNG");
+  if (!cv::imwrite(depth_path.string(), depth_mat))
+    throw Failure(depth_path.string() + ": cannot write the PNG");
 
   // Depth seen: nearest and farthest valid pixel [m], and how many have no data.
   uint16_t nearest = 0, farthest = 0;
@@ -254,13 +271,14 @@ int snapshot(const SnapshotOptions& o, std::ostream& out) {
     return 0;
   }
   out << std::setprecision(6);
-  out << "camera " << camera << " (frame " << frame.frame << ", model version " << rgb.model_version() << ")\n"
+  out << "camera " << camera << " (frame " << frame.frame << ", model version "
+      << rgb.model_version() << ")\n"
       << "  colour  " << rgb_path.string() << "\n"
       << "  depth   " << depth_path.string() << " (16-bit, " << scale * 1000.0 << " mm per unit)\n"
       << "  size    " << width << " x " << height << " px\n"
       << "  stamp   " << rgb.stamp_ns() << " ns (" << frame.stamp << " s)\n"
-      << "  fx fy   " << frame.intrinsics.fx << " " << frame.intrinsics.fy << " px, cx cy " << frame.intrinsics.cx
-      << " " << frame.intrinsics.cy << " px\n"
+      << "  fx fy   " << frame.intrinsics.fx << " " << frame.intrinsics.fy << " px, cx cy "
+      << frame.intrinsics.cx << " " << frame.intrinsics.cy << " px\n"
       << "  depth   " << nearest * scale << " .. " << farthest * scale << " m seen (camera range "
       << frame.depth_min << " .. " << frame.depth_max << " m), " << no_data << " px without data\n";
   return 0;
@@ -269,20 +287,24 @@ int snapshot(const SnapshotOptions& o, std::ostream& out) {
 }  // namespace
 
 void register_camera_verbs(cli::Cli& concert) {
-  CLI::App& camera = concert.group(concert.app(), "camera", "the robot's cameras: list them, take a snapshot");
+  CLI::App& camera =
+      concert.group(concert.app(), "camera", "the robot's cameras: list them, take a snapshot");
 
   auto lo = std::make_shared<ListOptions>();
-  CLI::App& list_verb = concert.verb(camera, "list", "the cameras the robot has mounted (from its sensor list)",
-                                     [&concert, lo] { return list(*lo, concert.out()); });
+  CLI::App& list_verb =
+      concert.verb(camera, "list", "the cameras the robot has mounted (from its sensor list)",
+                   [&concert, lo] { return list(*lo, concert.out()); });
   concert.add_dds_options(list_verb, lo->dds, 3.0, "how long to wait for the robot's sensor list");
 
   auto so = std::make_shared<SnapshotOptions>();
-  CLI::App& snap = concert.verb(
-      camera, "snapshot",
-      "wait for the next colour + depth frame of a camera and write <camera>_rgb.png (8-bit RGB) and "
-      "<camera>_depth.png (16-bit, depth units of the camera, mm by default)",
-      [&concert, so] { return snapshot(*so, concert.out()); });
-  snap.add_option("--camera", so->camera, "the camera (default: the robot's first)")->type_name("NAME");
+  CLI::App& snap =
+      concert.verb(camera, "snapshot",
+                   "wait for the next colour + depth frame of a camera and write <camera>_rgb.png "
+                   "(8-bit RGB) and "
+                   "<camera>_depth.png (16-bit, depth units of the camera, mm by default)",
+                   [&concert, so] { return snapshot(*so, concert.out()); });
+  snap.add_option("--camera", so->camera, "the camera (default: the robot's first)")
+      ->type_name("NAME");
   snap.add_option("--out", so->out_dir, "folder the PNG files go to (made if missing)")
       ->type_name("DIR")
       ->default_str(".");

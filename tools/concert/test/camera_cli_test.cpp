@@ -6,15 +6,14 @@
 
 #include <atomic>
 #include <filesystem>
-#include <thread>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <thread>
 
 #include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
-#include "concert/sensors_dds/conversions.hpp"
 #include "concert/idl_schema/cdr.hpp"
+#include "concert/sensors_dds/conversions.hpp"
 #include "process.hpp"
 #include "synthetic_sensors.hpp"
 
@@ -39,10 +38,11 @@ class CameraPublisher {
         depth_(participant_, topics::camera_depth),
         info_(participant_, topics::camera_info),
         list_(participant_, topics::sensor_list) {
-    list_.write(sensors_dds::to_msg({{"camera_E", hardware::SensorType::kRgbd, "camera_E_optical", 20.0},
-                                     {"lidar_A", hardware::SensorType::kLidar, "lidar_A", 10.0},
-                                     {"camera_F", hardware::SensorType::kRgbd, "camera_F_optical", 20.0}},
-                                    6, now_ns()));
+    list_.write(
+        sensors_dds::to_msg({{"camera_E", hardware::SensorType::kRgbd, "camera_E_optical", 20.0},
+                             {"lidar_A", hardware::SensorType::kLidar, "lidar_A", 10.0},
+                             {"camera_F", hardware::SensorType::kRgbd, "camera_F_optical", 20.0}},
+                            6, now_ns()));
     thread_ = std::thread([this] {
       while (!stop_) {
         for (const auto* f : {&e_, &f_}) {
@@ -78,7 +78,8 @@ class CameraPublisher {
 TEST(CameraCli, SnapshotWritesPngsThatReadBackEqual) {
   CameraPublisher publisher;
   testing::TempDir dir("camera-snapshot");
-  const auto r = concert_cli({"camera", "snapshot", "--out", dir.path() + "/shots", "--timeout", "20"});
+  const auto r =
+      concert_cli({"camera", "snapshot", "--out", dir.path() + "/shots", "--timeout", "20"});
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   // Without --camera: the sensor list's first camera.
   EXPECT_THAT(r.out, HasSubstr("camera camera_E (frame camera_E_optical, model version 6)"));
@@ -109,8 +110,8 @@ TEST(CameraCli, SnapshotWritesPngsThatReadBackEqual) {
   EXPECT_TRUE(std::equal(e.depth.begin(), e.depth.end(), depth.ptr<uint16_t>()))
       << "depth pixels differ from the published frame";
 
-  const auto json = concert_cli({"camera", "snapshot", "--camera", "camera_F", "--out", dir.path(), "--json",
-                                 "--timeout", "20"});
+  const auto json = concert_cli({"camera", "snapshot", "--camera", "camera_F", "--out", dir.path(),
+                                 "--json", "--timeout", "20"});
   ASSERT_EQ(json.code, 0) << json.err;
   const auto j = idl::Json::parse(json.out);
   EXPECT_EQ(j.at("camera"), "camera_F");
@@ -126,7 +127,8 @@ TEST(CameraCli, UnknownCameraFailsListingTheRobotsCameras) {
   CameraPublisher publisher;
   const auto r = concert_cli({"camera", "snapshot", "--camera", "camera_Z", "--timeout", "20"});
   EXPECT_EQ(r.code, 1) << r.out << r.err;
-  EXPECT_THAT(r.err, HasSubstr("no camera 'camera_Z' on the robot; its cameras: camera_E, camera_F"));
+  EXPECT_THAT(r.err,
+              HasSubstr("no camera 'camera_Z' on the robot; its cameras: camera_E, camera_F"));
 }
 
 TEST(CameraCli, ListShowsTheCamerasOfTheSensorList) {
@@ -141,17 +143,17 @@ TEST(CameraCli, ListShowsTheCamerasOfTheSensorList) {
 
 TEST(CameraCli, TopicVerbsHandleTheImageTopics) {
   CameraPublisher publisher;
-  const auto hz = concert_cli({"topic", "hz", "concert/sensors/camera/rgb", "--count", "10", "--timeout", "20",
-                               "--json"});
+  const auto hz = concert_cli(
+      {"topic", "hz", "concert/sensors/camera/rgb", "--count", "10", "--timeout", "20", "--json"});
   ASSERT_EQ(hz.code, 0) << hz.out << hz.err;
   EXPECT_GT(idl::Json::parse(testing::lines(hz.out).back()).at("rate_hz").get<double>(), 0.0);
-  const auto depth_hz = concert_cli({"topic", "hz", "concert/sensors/camera/depth", "--count", "5", "--timeout",
-                                     "20", "--json"});
+  const auto depth_hz = concert_cli(
+      {"topic", "hz", "concert/sensors/camera/depth", "--count", "5", "--timeout", "20", "--json"});
   EXPECT_EQ(depth_hz.code, 0) << depth_hz.err;
   const auto list = concert_cli({"topic", "list", "--timeout", "2"});
   ASSERT_EQ(list.code, 0) << list.err;
-  for (const char* t : {"concert/sensors/camera/rgb", "concert/sensors/camera/depth", "concert/sensors/camera/info",
-                        "concert/sensors/list"}) {
+  for (const char* t : {"concert/sensors/camera/rgb", "concert/sensors/camera/depth",
+                        "concert/sensors/camera/info", "concert/sensors/list"}) {
     EXPECT_THAT(list.out, HasSubstr(t));
   }
 }

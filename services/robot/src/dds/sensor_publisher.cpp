@@ -24,11 +24,13 @@ SensorPublisher::SensorPublisher(concert::dds::Participant& participant, uint32_
 
 /// Runs f on a sensor thread: a malformed sample or a refused write is counted (the first one
 /// reported on stderr), never thrown into the backend.
-template <class F> void SensorPublisher::guarded(F&& f) {
+template <class F>
+void SensorPublisher::guarded(F&& f) {
   try {
     if (!f()) dropped_.fetch_add(1);
   } catch (const std::exception& e) {
-    if (dropped_.fetch_add(1) == 0) std::cerr << "concert_robot: sensor sample dropped: " << e.what() << "\n";
+    if (dropped_.fetch_add(1) == 0)
+      std::cerr << "concert_robot: sensor sample dropped: " << e.what() << "\n";
   }
 }
 

@@ -38,7 +38,8 @@ class SensorPublisher : public hardware::SensorSink {
 
  private:
   void publish_list();
-  template <class F> void guarded(F&& f);
+  template <class F>
+  void guarded(F&& f);
 
   std::atomic<uint32_t> model_version_;
   std::atomic<uint64_t> dropped_{0};

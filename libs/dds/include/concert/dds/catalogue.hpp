@@ -20,12 +20,17 @@ enum class QosClass {
   kStream,
   /// Commands and requests: RELIABLE, VOLATILE, KEEP_LAST 8. Never blocks the writer.
   kCommand,
+  /// Large samples (camera images, ~1 MB): a stream (BEST_EFFORT, VOLATILE, KEEP_LAST 1) whose
+  /// writers publish asynchronously: write() hands the sample to a Fast DDS thread that sends
+  /// its fragments, instead of sending them on the caller's (sensor) thread.
+  kLargeStream,
 };
 
 struct QosSpec {
   bool reliable;
   bool transient_local;
-  int32_t history_depth;  ///< KEEP_LAST depth
+  int32_t history_depth;      ///< KEEP_LAST depth
+  bool asynchronous = false;  ///< writers publish from a Fast DDS thread (not on the wire)
 };
 
 /// The QoS a class stands for.
