@@ -335,8 +335,8 @@ def tool(key, label, tags, mass, size, tcp_pose, identity, frames=(), addon_type
 
 
 tool("concert_drill", "Drill", ["drill", "tool", "arm"], 10.35, (0.35, 0.12, 0.2), pose((0.28, 0, 0.09), (0, PI / 2, 0)),
-     (3, 3, 4, 0), frames=["  - {name: camera, kind: camera, body: tool, pose: %s}  # RealSense D435i on top of the drill, looking along the bit, clear of the drill body; optical frame; pose estimated"
-                           % pose((0.17, 0, 0.24), (0, PI / 2, 0))],
+     (3, 3, 4, 0), frames=["  - {name: camera, kind: camera, body: tool, pose: %s}  # RealSense D435i on the drill, looking along the bit; optical frame; pose estimated"
+                           % pose((0.12, 0, 0.2), (0, PI / 2, 0))],
      addon_types=["drillbit", "handle"], paper=["Drill with integrated RealSense D435i camera"])
 tool("concert_spraying_tool", "Spraying Tool", ["spraying_tool", "tool", "arm"], 1.8, (0.12, 0.12, 0.2),
      pose((-0.086, 0, 0.25)), (3, 5, 4, 0))

@@ -1,5 +1,7 @@
 #include "concert/sim/rgbd_renderer.hpp"
 
+#include "concert/sim/geom_groups.hpp"
+
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <mujoco/mujoco.h>
@@ -268,6 +270,7 @@ RgbdRenderer::RgbdRenderer(EglContext& gl, const mjModel_* model, const CameraPa
   r.znear = static_cast<float>(params.depth_min / 2.0);
   r.zfar = static_cast<float>(std::max(2.0 * params.depth_max, 100.0));
   mjv_defaultOption(&r.option);
+  r.option.geomgroup[kCameraHousingGeomGroup] = 0;  // cameras look past their housing
   std::fill(std::begin(r.option.sitegroup), std::end(r.option.sitegroup), mjtByte{0});
   mjv_defaultCamera(&r.camera);
   mjv_defaultPerturb(&r.perturb);

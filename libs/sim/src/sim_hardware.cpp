@@ -91,7 +91,8 @@ struct MjcfWriter {
       }
       const std::string name = "\"" + link.name + "_collision_" + std::to_string(k++) + "\"";
       const std::string common = " name=" + name + " " + pos_quat(c->origin) + " group=\"" +
-                                 std::to_string(kRobotGeomGroup) + "\" contype=\"1\" conaffinity=\"0\"" +
+                                 std::to_string(houses_camera(link) ? kCameraHousingGeomGroup : kRobotGeomGroup) +
+                                 "\" contype=\"1\" conaffinity=\"0\"" +
                                  " friction=\"" + num(is_wheel ? params.wheel_friction : params.robot_friction) +
                                  " 0.005 0.0001\"";
       switch (c->geometry->type) {
@@ -177,6 +178,21 @@ struct MjcfWriter {
     xml << "/>\n";
     actuated.push_back(j.name);
     efforts.push_back(j.limits ? j.limits->effort : 0.0);
+  }
+
+  /// True if a camera is mounted on a frame fixed to `link` (its geoms are the camera's housing).
+  [[nodiscard]] bool houses_camera(const urdf::Link& link) const {
+    for (const auto& s : sensors) {
+      if (s.type != hardware::SensorType::kRgbd) {
+        continue;
+      }
+      for (const auto& child : link.child_links) {
+        if (child->name == s.frame) {
+          return true;
+        }
+      }
+    }
+    return false;
   }
 
   /// A site for each IMU mounted at `link` (its MuJoCo gyro and accelerometer read there).

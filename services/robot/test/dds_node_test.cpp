@@ -300,7 +300,7 @@ TEST(RobotParamsYaml, ShippedConfigListsEveryParameterWithItsDefault) {
   auto doc =
       config::Document::load(std::string(CONCERT_SOURCE_DIR) + "/services/robot/config/robot.yaml");
   (void)dds::read_service_params(doc);
-  EXPECT_EQ(doc.keys().size(), 37u);
+  EXPECT_EQ(doc.keys().size(), 78u);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
 }
@@ -331,7 +331,7 @@ TEST(RobotParamsYaml, ValuesAndClearErrors) {
             "p.yaml: sim.armature: expected a number >= 0, got 'heavy' (line 1)");
   EXPECT_NE(error_of("sim: {base_position: [1, 2]}").find("sim.base_position"), std::string::npos);
   EXPECT_EQ(error_of("drives: {}"),
-            "p.yaml: drives: unknown key (line 1); known keys: loop, node, robot, sim");
+            "p.yaml: drives: unknown key (line 1); known keys: loop, node, robot, sensors, sim");
   EXPECT_NE(error_of("robot: {period: 0}").find("positive"), std::string::npos);
   EXPECT_NE(error_of("robot: [").find("p.yaml"), std::string::npos);
 }
