@@ -9,6 +9,7 @@
 
 #include "ethercat.h"
 #include "model.h"
+#include "nav.h"
 #include "planning.h"
 #include "robot.h"
 #include "sensors.h"
@@ -48,6 +49,14 @@ static const struct {
     {"concert::msg::SonarRanges", &concert_msg_SonarRanges_desc},
     {"concert::msg::Imu", &concert_msg_Imu_desc},
     {"concert::msg::SensorList", &concert_msg_SensorList_desc},
+    {"concert::msg::NavGoal", &concert_msg_NavGoal_desc},
+    {"concert::msg::NavCancel", &concert_msg_NavCancel_desc},
+    {"concert::msg::NavInitialPose", &concert_msg_NavInitialPose_desc},
+    {"concert::msg::NavStatus", &concert_msg_NavStatus_desc},
+    {"concert::msg::NavPath", &concert_msg_NavPath_desc},
+    {"concert::msg::OccupancyGridMap", &concert_msg_OccupancyGridMap_desc},
+    {"concert::msg::NavLocalisation", &concert_msg_NavLocalisation_desc},
+    {"concert::msg::NavVehicle", &concert_msg_NavVehicle_desc},
 };
 
 #define MAX_ENDPOINTS 64

@@ -7,6 +7,7 @@
 
 #include "ethercatPubSubTypes.h"
 #include "modelPubSubTypes.h"
+#include "navPubSubTypes.h"
 #include "planningPubSubTypes.h"
 #include "robotPubSubTypes.h"
 #include "sensorsPubSubTypes.h"
@@ -49,6 +50,14 @@ CONCERT_BIND_PUBSUB(LaserScan);
 CONCERT_BIND_PUBSUB(SonarRanges);
 CONCERT_BIND_PUBSUB(Imu);
 CONCERT_BIND_PUBSUB(SensorList);
+CONCERT_BIND_PUBSUB(NavGoal);
+CONCERT_BIND_PUBSUB(NavCancel);
+CONCERT_BIND_PUBSUB(NavInitialPose);
+CONCERT_BIND_PUBSUB(NavStatus);
+CONCERT_BIND_PUBSUB(NavPath);
+CONCERT_BIND_PUBSUB(OccupancyGridMap);
+CONCERT_BIND_PUBSUB(NavLocalisation);
+CONCERT_BIND_PUBSUB(NavVehicle);
 #undef CONCERT_BIND_PUBSUB
 
 /// A catalogue topic carrying T.
@@ -87,6 +96,15 @@ inline constexpr TopicHandle<msg::LaserScan> scan{"concert/sensors/scan"};
 inline constexpr TopicHandle<msg::SonarRanges> sonar{"concert/sensors/sonar"};
 inline constexpr TopicHandle<msg::Imu> imu{"concert/sensors/imu"};
 inline constexpr TopicHandle<msg::SensorList> sensor_list{"concert/sensors/list"};
+inline constexpr TopicHandle<msg::NavGoal> nav_goal{"concert/nav/goal"};
+inline constexpr TopicHandle<msg::NavCancel> nav_cancel{"concert/nav/cancel"};
+inline constexpr TopicHandle<msg::NavInitialPose> nav_initial_pose{"concert/nav/initial_pose"};
+inline constexpr TopicHandle<msg::NavStatus> nav_status{"concert/nav/status"};
+inline constexpr TopicHandle<msg::NavPath> nav_path{"concert/nav/path"};
+inline constexpr TopicHandle<msg::OccupancyGridMap> nav_map{"concert/nav/map"};
+inline constexpr TopicHandle<msg::Odometry> nav_odometry{"concert/nav/odometry"};
+inline constexpr TopicHandle<msg::NavLocalisation> nav_localisation{"concert/nav/localisation"};
+inline constexpr TopicHandle<msg::NavVehicle> nav_vehicle{"concert/nav/vehicle"};
 }  // namespace topics
 
 /// Calls f(handle) for every typed topic handle (e.g. to dispatch on a topic name).
@@ -120,6 +138,15 @@ template <class F> void for_each_topic(F&& f) {
   f(topics::sonar);
   f(topics::imu);
   f(topics::sensor_list);
+  f(topics::nav_goal);
+  f(topics::nav_cancel);
+  f(topics::nav_initial_pose);
+  f(topics::nav_status);
+  f(topics::nav_path);
+  f(topics::nav_map);
+  f(topics::nav_odometry);
+  f(topics::nav_localisation);
+  f(topics::nav_vehicle);
 }
 
 }  // namespace concert::dds
