@@ -42,6 +42,7 @@ static const struct {
     {"concert::msg::World", &concert_msg_World_desc},
     {"concert::msg::SimCommand", &concert_msg_SimCommand_desc},
     {"concert::msg::SimCommandReply", &concert_msg_SimCommandReply_desc},
+    {"concert::msg::SimTruth", &concert_msg_SimTruth_desc},
     {"concert::msg::Image", &concert_msg_Image_desc},
     {"concert::msg::CameraInfo", &concert_msg_CameraInfo_desc},
     {"concert::msg::LidarScan", &concert_msg_LidarScan_desc},

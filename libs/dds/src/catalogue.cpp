@@ -52,6 +52,8 @@ constexpr std::array kTopics = {
               "tools: mount another assembly on the simulated robot, or change the simulated world"},
     TopicInfo{"concert/sim/reply", "concert::msg::SimCommandReply", QosClass::kLatched,
               "simulator (robot service): accepted or refused with the reason, one instance per request"},
+    TopicInfo{"concert/sim/truth", "concert::msg::SimTruth", QosClass::kStream,
+              "robot (simulation only): the base's true pose in the world, for tests and benchmarks"},
     TopicInfo{"concert/sensors/camera/rgb", "concert::msg::Image", QosClass::kLargeStream,
               "robot: colour image (rgb8) of each RGB-D camera, one instance per camera"},
     TopicInfo{"concert/sensors/camera/depth", "concert::msg::Image", QosClass::kLargeStream,

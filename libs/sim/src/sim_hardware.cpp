@@ -331,6 +331,7 @@ struct Instance {
   std::shared_ptr<SensorScene> scene;
   /// Only the world changed: the running instance's whole state carries over.
   bool same_robot{false};
+  int root_body{-1};  ///< MuJoCo body of the URDF root
 };
 
 namespace {
@@ -377,6 +378,7 @@ std::unique_ptr<Instance> make_instance(const std::string& urdf, const std::vect
   if (params.sensors.enabled) {
     in->scene = std::make_shared<SensorScene>(in->m, sensors, in->built.root, world.floor_height);
   }
+  in->root_body = mj_name2id(in->m, mjOBJ_BODY, in->built.root.c_str());
   return in;
 }
 
@@ -427,6 +429,9 @@ struct SimHardware::Impl {
   std::unique_ptr<SensorRuntime> sensor_runtime;
   MountedHardware mounted;
   hardware::Handover<Instance> prepared;
+  // Ground truth of the base for other threads (base_truth()); the control thread only try-locks.
+  mutable std::mutex truth_mutex;
+  BaseTruth truth;
 
   void submit(std::unique_ptr<Instance> in) { prepared.submit(std::move(in)); }
 
@@ -571,6 +576,16 @@ void SimHardware::step(double dt) {
   if (impl_->active->scene) {
     impl_->active->scene->publish(impl_->active->d);
   }
+  if (impl_->active->root_body >= 0 && impl_->truth_mutex.try_lock()) {
+    const int root = impl_->active->root_body;
+    const mjData* d = impl_->active->d;
+    impl_->truth.time = d->time;
+    for (int r = 0; r < 3; ++r) {
+      impl_->truth.pose.translation()(r) = d->xpos[3 * root + r];
+      for (int c = 0; c < 3; ++c) impl_->truth.pose.linear()(r, c) = d->xmat[9 * root + 3 * r + c];
+    }
+    impl_->truth_mutex.unlock();
+  }
   // As on real drives, measured efforts and contacts lag the positions by one physics step
   // (mj_step computes forces before integrating); a second mj_forward would double the cost.
 }
@@ -637,6 +652,11 @@ Eigen::Isometry3d SimHardware::link_pose(const std::string& link) const {
 }
 
 Eigen::Isometry3d SimHardware::base_pose() const { return link_pose(impl_->active->built.root); }
+
+SimHardware::BaseTruth SimHardware::base_truth() const {
+  std::lock_guard lock(impl_->truth_mutex);
+  return impl_->truth;
+}
 
 Eigen::Vector3d SimHardware::contact_force_on(const std::vector<std::string>& links) const {
   std::vector<int> bodies;

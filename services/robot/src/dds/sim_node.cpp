@@ -1,6 +1,7 @@
 #include "sim_node.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <iostream>
 #include <stdexcept>
 
@@ -21,9 +22,11 @@ SimNode::SimNode(cdds::Participant& participant, sim::SimHardware& sim, const si
       robot_(robot),
       on_swap_(std::move(on_swap)),
       world_(participant, cdds::topics::world),
-      reply_(participant, cdds::topics::sim_reply) {
+      reply_(participant, cdds::topics::sim_reply),
+      truth_(participant, cdds::topics::sim_truth) {
   world_.write(world::to_msg(initial_world, world_version_, world_source));
   worker_ = std::thread([this] { work(); });
+  truth_thread_ = std::thread([this] { publish_truth(); });
   commands_ = std::make_unique<cdds::Reader<msg::SimCommand>>(
       participant, cdds::topics::sim_command, [this](const msg::SimCommand& c, const auto&) {
         {
@@ -42,6 +45,29 @@ SimNode::~SimNode() {
   }
   wake_.notify_all();
   worker_.join();
+  truth_thread_.join();
+}
+
+void SimNode::publish_truth() {
+  constexpr auto kPeriod = std::chrono::milliseconds(20);
+  std::unique_lock lock(mutex_);
+  double last_time = -1.0;
+  while (!wake_.wait_for(lock, kPeriod, [&] { return stopping_; })) {
+    lock.unlock();
+    const auto truth = sim_.base_truth();
+    if (truth.time != last_time) {  // nothing new while the loop is paused
+      last_time = truth.time;
+      const Eigen::Matrix3d& r = truth.pose.linear();
+      msg::SimTruth t;
+      t.stamp_ns(static_cast<long long>(std::llround(truth.time * 1e9)));
+      t.x(truth.pose.translation().x());
+      t.y(truth.pose.translation().y());
+      t.z(truth.pose.translation().z());
+      t.yaw(std::atan2(r(1, 0), r(0, 0)));
+      truth_.write(t);
+    }
+    lock.lock();
+  }
 }
 
 void SimNode::work() {

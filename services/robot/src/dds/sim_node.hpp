@@ -2,7 +2,8 @@
 // DDS face of the simulator (the robot service's sim backend): SimCommand in (mount another
 // assembly, change the world: the content travels, so it works from any host), SimCommandReply
 // out (accepted, or refused with the reason: the robot keeps its modules and world), and the
-// world it simulates on the latched World topic that every service reads.
+// world it simulates on the latched World topic that every service reads; and the base's true
+// pose (SimTruth, 50 Hz) for tests and benchmarks.
 
 #include <condition_variable>
 #include <cstdint>
@@ -41,6 +42,7 @@ class SimNode {
 
  private:
   void work();
+  void publish_truth();
   void handle(const msg::SimCommand& command);
 
   sim::SimHardware& sim_;
@@ -49,6 +51,7 @@ class SimNode {
   std::function<void(const sim::SimulatedRobot&)> on_swap_;
   concert::dds::Writer<msg::World> world_;
   concert::dds::Writer<msg::SimCommandReply> reply_;
+  concert::dds::Writer<msg::SimTruth> truth_;
   std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<msg::SimCommand> queue_;
@@ -56,6 +59,7 @@ class SimNode {
   std::uint32_t world_version_{1};
   std::unique_ptr<concert::dds::Reader<msg::SimCommand>> commands_;
   std::thread worker_;  // swaps take milliseconds (model generation, MuJoCo): not on a DDS thread
+  std::thread truth_thread_;
 };
 
 }  // namespace concert::robot::dds

@@ -43,6 +43,7 @@ CONCERT_BIND_PUBSUB(TrajectoryStatus);
 CONCERT_BIND_PUBSUB(World);
 CONCERT_BIND_PUBSUB(SimCommand);
 CONCERT_BIND_PUBSUB(SimCommandReply);
+CONCERT_BIND_PUBSUB(SimTruth);
 CONCERT_BIND_PUBSUB(Image);
 CONCERT_BIND_PUBSUB(CameraInfo);
 CONCERT_BIND_PUBSUB(LidarScan);
@@ -88,6 +89,7 @@ inline constexpr TopicHandle<msg::TrajectoryStatus> trajectory_status{"concert/r
 inline constexpr TopicHandle<msg::World> world{"concert/world/world"};
 inline constexpr TopicHandle<msg::SimCommand> sim_command{"concert/sim/command"};
 inline constexpr TopicHandle<msg::SimCommandReply> sim_reply{"concert/sim/reply"};
+inline constexpr TopicHandle<msg::SimTruth> sim_truth{"concert/sim/truth"};
 inline constexpr TopicHandle<msg::Image> camera_rgb{"concert/sensors/camera/rgb"};
 inline constexpr TopicHandle<msg::Image> camera_depth{"concert/sensors/camera/depth"};
 inline constexpr TopicHandle<msg::CameraInfo> camera_info{"concert/sensors/camera/info"};
@@ -130,6 +132,7 @@ template <class F> void for_each_topic(F&& f) {
   f(topics::world);
   f(topics::sim_command);
   f(topics::sim_reply);
+  f(topics::sim_truth);
   f(topics::camera_rgb);
   f(topics::camera_depth);
   f(topics::camera_info);

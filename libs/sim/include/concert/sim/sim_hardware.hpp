@@ -92,6 +92,14 @@ class SimHardware final : public hardware::Hardware {
   [[nodiscard]] Eigen::Isometry3d link_pose(const std::string& link) const;
   /// Pose of the root link in the world.
   [[nodiscard]] Eigen::Isometry3d base_pose() const;
+  /// The root link's pose in the world and the simulated time after the latest step(), safe
+  /// from any thread (the control thread never waits for a reader: a step that finds the
+  /// snapshot being read leaves the previous one). Time 0 and identity before the first step.
+  struct BaseTruth {
+    double time{0.0};                                         ///< simulated time [s]
+    Eigen::Isometry3d pose{Eigen::Isometry3d::Identity()};  ///< world_T_root
+  };
+  [[nodiscard]] BaseTruth base_truth() const;
   /// Total contact force the world exerts on `links` [N], world frame.
   [[nodiscard]] Eigen::Vector3d contact_force_on(const std::vector<std::string>& links) const;
   [[nodiscard]] const std::string& mjcf() const;
