@@ -38,8 +38,8 @@ TEST(CastRay, StopsAtTheFirstOccupiedCellBoundary) {
   for (int row = 0; row < 10; ++row)
     g.at(15, row) = bim::OccupancyGrid::kOccupied;  // x in [1.5, 1.6]
   EXPECT_NEAR(cast_ray(g, {0.25, 0.45}, 0.0, 10.0), 1.25, 1e-9);
-  // At 60 degrees from x the ray meets x = 1.5 after 1.25 / cos(60) = 2.5 m... beyond the top
-  // (y = 1.0, outside counts as occupied) at (1.0 - 0.45) / sin(60).
+  // At 60 degrees the ray leaves through the grid's top edge (y = 1.0; outside counts as
+  // occupied) before it reaches the wall.
   EXPECT_NEAR(cast_ray(g, {0.25, 0.45}, std::numbers::pi / 3, 10.0),
               0.55 / std::sin(std::numbers::pi / 3), 1e-9);
   EXPECT_NEAR(cast_ray(g, {0.25, 0.45}, 0.0, 1.0), 1.0, 1e-12);                // max range
@@ -155,6 +155,8 @@ TEST(Localiser, AKidnappedRobotIsReportedLostAndRecovers) {
     }
     final_error = testing::pose_error(e.pose, where).x();
   }
+  RecordProperty("scans_to_lost", lost_at - static_cast<int>(kidnap));
+  RecordProperty("scans_to_recovered", recovered_at - static_cast<int>(kidnap));
   ASSERT_GE(lost_at, 0) << "the kidnapping was not noticed";
   EXPECT_LE(lost_at - static_cast<int>(kidnap), 3 * LocaliserParams{}.lost_after);
   ASSERT_GE(recovered_at, 0) << "never recovered";

@@ -381,6 +381,13 @@ void Localiser::estimate_pose(const Eigen::Vector3d& odom_pose) {
     c += p.weight * std::cos(p.pose.z());
     s += p.weight * std::sin(p.pose.z());
   }
+  if (!(w > 0.0)) {  // the heaviest bin's particles all lie beyond its mean's radius
+    w = top->weight;
+    x = top->x;
+    y = top->y;
+    c = top->c;
+    s = top->s;
+  }
   const Eigen::Vector3d mean(x / w, y / w, std::atan2(s, c));
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (const Particle& p : particles_) {
