@@ -44,15 +44,20 @@ class Traversability {
       : map_(map), params_(params), start_(start), goal_(goal) {
     const double r = map.shape().circumscribed_radius;
     escape2_ = r * r;
+    // Costs at or above the cost at inscribed radius + margin are too close; with an
+    // inflation radius short of that, the inscribed cost is the only bound.
+    const std::uint8_t bound =
+        map.inflation_cost(map.shape().inscribed_radius + params.clearance_margin);
+    too_close_ = bound > Costmap::kFree ? bound : Costmap::kInscribed;
   }
 
   [[nodiscard]] bool valid(int col, int row) const {
     const std::uint8_t c = map_.cost(col, row);
-    if (c < Costmap::kInscribed) return true;
+    if (c < too_close_) return true;
     if (c == Costmap::kLethal) return false;
     if (c == Costmap::kNoInformation) return params_.allow_unknown;
-    // Within the inscribed radius of an obstacle: only where the robot starts or stops, whose
-    // full footprints were checked.
+    // Too close to an obstacle: only where the robot starts or stops, whose full footprints
+    // were checked.
     const Eigen::Vector2d p = map_.center_of(col, row);
     return (p - start_).squaredNorm() <= escape2_ || (p - goal_).squaredNorm() <= escape2_;
   }
@@ -69,6 +74,7 @@ class Traversability {
   Eigen::Vector2d start_;
   Eigen::Vector2d goal_;
   double escape2_;
+  std::uint8_t too_close_;
 };
 
 // Keeps the points a straight segment may join without crossing an untraversable cell and
@@ -164,6 +170,10 @@ const char* to_string(PlanStatus status) {
 }
 
 GlobalPlanner::GlobalPlanner(const PlannerParams& params) : params_(params) {
+  if (!(params_.clearance_margin >= 0.0)) {
+    throw std::invalid_argument("global planner: clearance_margin " +
+                                std::to_string(params_.clearance_margin) + " m: must be >= 0");
+  }
   if (!(params_.cost_penalty >= 0.0)) {
     throw std::invalid_argument("global planner: cost_penalty " +
                                 std::to_string(params_.cost_penalty) + ": must be >= 0");
