@@ -32,6 +32,11 @@ double quantile(std::vector<double> v, double q) {
   return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
 }
 
+void table_header() {
+  std::printf("| %-28s | %9s | %9s | %9s | %-4s |\n", "", "median", "p95", "max", "unit");
+  std::printf("|------------------------------|-----------|-----------|-----------|------|\n");
+}
+
 void row(const char* name, const std::vector<double>& v, const char* unit) {
   std::printf("| %-28s | %9.2f | %9.2f | %9.2f | %-4s |\n", name, quantile(v, 0.5),
               quantile(v, 0.95), v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()), unit);
@@ -112,8 +117,7 @@ int main(int argc, char** argv) {
   }
   std::printf("\nGlobal planner: %d seeded start/goal pairs >= 5 m apart (seed %u), %d failed\n\n",
               pairs, seed, failed);
-  std::printf("| %-28s | %9s | %9s | %9s | %-4s |\n", "", "median", "p95", "max", "unit");
-  std::printf("|------------------------------|-----------|-----------|-----------|------|\n");
+  table_header();
   row("plan time (search + smooth)", total_ms, "ms");
   row("A* search time", search_ms, "ms");
   row("expansions", expansions, "");
@@ -152,8 +156,7 @@ int main(int argc, char** argv) {
       "\nClosed loop (omni, kinematic sim, 0.5 m/s, unmapped obstacles): %d/%zu reached, "
       "%d collisions\n\n",
       reached, mission_pairs.size(), collided);
-  std::printf("| %-28s | %9s | %9s | %9s | %-4s |\n", "", "median", "p95", "max", "unit");
-  std::printf("|------------------------------|-----------|-----------|-----------|------|\n");
+  table_header();
   row("time to goal (simulated)", time_to_goal, "s");
   row("position error at goal", pos_err, "mm");
   row("heading error at goal", yaw_err, "deg");

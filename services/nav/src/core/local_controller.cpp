@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "pose_text.hpp"
+
 namespace concert::nav {
 
 namespace {
@@ -17,13 +19,6 @@ namespace {
 constexpr double kMaxCheckTime = 5.0;
 
 double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
-
-std::string where(const Eigen::Vector3d& pose) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "(%.3f, %.3f, %.1f deg)", pose.x(), pose.y(),
-                pose.z() * 180.0 / M_PI);
-  return buf;
-}
 
 void require(bool ok, const char* name, double value, const char* what) {
   if (!ok) {
@@ -183,12 +178,12 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
   out.heading_error = wrap(goal.z() - pose.z());
   if (!pose.allFinite()) {
     out.status = ControlStatus::kFailed;
-    out.reason = "the robot pose " + where(pose) + " is not finite";
+    out.reason = "the robot pose " + detail::pose_text(pose) + " is not finite";
     return stop(out);
   }
   if (costmap.in_collision(pose)) {
     out.status = ControlStatus::kFailed;
-    out.reason = "the robot's footprint at " + where(pose) + " covers an obstacle";
+    out.reason = "the robot's footprint at " + detail::pose_text(pose) + " covers an obstacle";
     return stop(out);
   }
 
@@ -211,8 +206,8 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
       out.status = ControlStatus::kFailed;
       char buf[64];
       std::snprintf(buf, sizeof buf, "%.2f m", best);
-      out.reason = "the robot at " + where(pose) + " is " + buf + " from the path (limit " +
-                   std::to_string(params_.max_path_deviation) + " m)";
+      out.reason = "the robot at " + detail::pose_text(pose) + " is " + buf +
+                   " from the path (limit " + std::to_string(params_.max_path_deviation) + " m)";
       return stop(out);
     }
   }
@@ -354,11 +349,11 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
     if (!blocked_since_) blocked_since_ = stamp;
     if (stamp - *blocked_since_ >= params_.blocked_timeout) {
       out.status = ControlStatus::kBlocked;
-      out.reason = "an obstacle in front of the robot at " + where(pose) +
+      out.reason = "an obstacle in front of the robot at " + detail::pose_text(pose) +
                    " has blocked the path for " + std::to_string(stamp - *blocked_since_) + " s";
     } else {
       out.status = ControlStatus::kWaiting;
-      out.reason = "an obstacle in front of the robot at " + where(pose);
+      out.reason = "an obstacle in front of the robot at " + detail::pose_text(pose);
     }
   } else {
     want.vx *= scale;
