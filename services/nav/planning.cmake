@@ -21,3 +21,12 @@ concert_add_test(NAME nav_global_planner_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/test/global_planner_test.cpp
   LIBS concert_nav_planning_fixtures
   LABELS nav)
+concert_add_test(NAME nav_local_controller_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/test/local_controller_test.cpp
+  LIBS concert_nav_planning_fixtures
+  LABELS nav
+  TIMEOUT 300)
+
+add_executable(bench_global_planner ${CMAKE_CURRENT_LIST_DIR}/bench/bench_global_planner.cpp)
+concert_target_defaults(bench_global_planner)
+target_link_libraries(bench_global_planner PRIVATE concert_nav_planning_fixtures)

@@ -215,8 +215,6 @@ RunResult run_mission(const bim::OccupancyGrid& map, const bim::OccupancyGrid& t
     controller.set_path(plan.path);
     return true;
   };
-  costmap.update_obstacles(pose.head<2>(),
-                           cast_scan(truth, pose.head<2>(), config.scan_beams, config.scan_range));
   if (!replan()) return finish(result.failure);
   result.trajectory.push_back(pose);
   for (int step = 0; step * config.dt < config.max_time; ++step) {

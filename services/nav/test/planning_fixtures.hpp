@@ -80,9 +80,9 @@ struct RunResult {
   std::vector<Eigen::Vector3d> trajectory;  ///< every pose [m, rad]
 };
 
-/// Plans on `map`, follows the path while scanning `truth` into the costmap's obstacle layer
-/// and replanning on kBlocked (or kFailed), until the goal is reached, the run fails or
-/// max_time passes. The plant tracks the command with the controller's acceleration limits and
+/// Plans on `map` (before any scan), follows the path while scanning `truth` into the costmap's
+/// obstacle layer and replanning on kBlocked (or kFailed), until the goal is reached, the run fails
+/// or max_time passes. The plant tracks the command with the controller's acceleration limits and
 /// seeded velocity noise; collisions are checked against `truth` with the exact footprint.
 RunResult run_mission(const bim::OccupancyGrid& map, const bim::OccupancyGrid& truth,
                       const Eigen::Vector3d& start, const Eigen::Vector3d& goal,

@@ -17,6 +17,10 @@ struct PlannerParams {
   /// Weight of the cell cost in the traversal cost: a step of length d through a cell of cost
   /// c costs d * (1 + cost_penalty * c / 252).
   double cost_penalty{2.0};
+  /// The robot centre keeps this much more than the inscribed radius from obstacles [m], so
+  /// the footprint fits with room for tracking errors (cells of higher cost are not crossed,
+  /// except within the circumscribed radius of start and goal).
+  double clearance_margin{0.1};
   /// Cross cells the static map marks unknown (only when the costmap keeps them unknown).
   bool allow_unknown{false};
   /// Expansion budget of the A* search (0: unlimited).
@@ -62,9 +66,10 @@ struct PlanResult {
 /// Cost-aware A* on the costmap's cells, 8-connected, octile-distance heuristic (admissible:
 /// every step costs at least its length), at the level of nav2's Smac Planner 2D: the robot
 /// centre stays out of cells of cost >= kInscribed (except near start and goal, where the full
-/// footprint is checked instead), then the path is shortened where a straight segment is not
-/// costlier than what it replaces, resampled at the map resolution, smoothed, and given
-/// orientations: the direction of travel, the goal's heading at the end.
+/// footprint is checked instead; clearance_margin adds to the inscribed radius), then the path is
+/// shortened where a straight segment is not costlier than what it replaces, resampled at the map
+/// resolution, smoothed, and given orientations: the direction of travel, the goal's heading at the
+/// end.
 ///
 /// Keeps its search buffers between calls (not thread-safe; one planner per thread).
 class GlobalPlanner {

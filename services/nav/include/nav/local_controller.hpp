@@ -66,7 +66,7 @@ struct ControllerParams {
   /// Footprint collision check along the forward-simulated command: step [s]; the robot keeps
   /// stop_margin [m] to the first colliding pose.
   double collision_check_step{0.05};
-  double stop_margin{0.08};
+  double stop_margin{0.12};
   /// Stopped for an obstacle for longer than this [s] -> kBlocked (the caller replans).
   double blocked_timeout{2.0};
   /// Farther than this from the path -> kFailed [m].
@@ -102,7 +102,8 @@ struct ControlOutput {
 /// (vx and wz on the pursuit arc; turns in place when the heading error is large). Speed is
 /// regulated by curvature, proximity to obstacles and the approach to the goal, and limited by
 /// the acceleration limits; the footprint is checked along the forward-simulated command and
-/// the speed is cut so the robot can stop stop_margin before the first collision.
+/// the speed is cut so the robot can stop stop_margin before the first collision; when that
+/// stops it, the translation alone (omni) or the turn alone is tried before waiting.
 class LocalController {
  public:
   /// Throws std::invalid_argument naming a bad parameter.
@@ -123,8 +124,10 @@ class LocalController {
 
  private:
   [[nodiscard]] BaseTwist limit_acceleration(const BaseTwist& want, double dt) const;
+  // Scale in [0, 1] of `cmd` that stops stop_margin before its first colliding pose within
+  // max_tau [s at the full command].
   [[nodiscard]] double safe_scale(const Costmap& costmap, const Eigen::Vector3d& pose,
-                                  const BaseTwist& cmd) const;
+                                  const BaseTwist& cmd, double max_tau) const;
   ControlOutput stop(ControlOutput out);
 
   ControllerParams params_;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "grid_line.hpp"
+#include "pose_text.hpp"
 
 namespace concert::nav {
 
@@ -16,13 +17,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-std::string where(const Eigen::Vector3d& pose) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "(%.3f, %.3f, %.1f deg)", pose.x(), pose.y(),
-                pose.z() * 180.0 / M_PI);
-  return buf;
 }
 
 struct QueueEntry {
@@ -44,15 +38,20 @@ class Traversability {
       : map_(map), params_(params), start_(start), goal_(goal) {
     const double r = map.shape().circumscribed_radius;
     escape2_ = r * r;
+    // Costs at or above the cost at inscribed radius + margin are too close; with an
+    // inflation radius short of that, the inscribed cost is the only bound.
+    const std::uint8_t bound =
+        map.inflation_cost(map.shape().inscribed_radius + params.clearance_margin);
+    too_close_ = bound > Costmap::kFree ? bound : Costmap::kInscribed;
   }
 
   [[nodiscard]] bool valid(int col, int row) const {
     const std::uint8_t c = map_.cost(col, row);
-    if (c < Costmap::kInscribed) return true;
+    if (c < too_close_) return true;
     if (c == Costmap::kLethal) return false;
     if (c == Costmap::kNoInformation) return params_.allow_unknown;
-    // Within the inscribed radius of an obstacle: only where the robot starts or stops, whose
-    // full footprints were checked.
+    // Too close to an obstacle: only where the robot starts or stops, whose full footprints
+    // were checked.
     const Eigen::Vector2d p = map_.center_of(col, row);
     return (p - start_).squaredNorm() <= escape2_ || (p - goal_).squaredNorm() <= escape2_;
   }
@@ -69,6 +68,7 @@ class Traversability {
   Eigen::Vector2d start_;
   Eigen::Vector2d goal_;
   double escape2_;
+  std::uint8_t too_close_;
 };
 
 // Keeps the points a straight segment may join without crossing an untraversable cell and
@@ -164,6 +164,10 @@ const char* to_string(PlanStatus status) {
 }
 
 GlobalPlanner::GlobalPlanner(const PlannerParams& params) : params_(params) {
+  if (!(params_.clearance_margin >= 0.0)) {
+    throw std::invalid_argument("global planner: clearance_margin " +
+                                std::to_string(params_.clearance_margin) + " m: must be >= 0");
+  }
   if (!(params_.cost_penalty >= 0.0)) {
     throw std::invalid_argument("global planner: cost_penalty " +
                                 std::to_string(params_.cost_penalty) + ": must be >= 0");
@@ -197,22 +201,26 @@ PlanResult GlobalPlanner::plan(const Costmap& map, const Eigen::Vector3d& start,
   const Eigen::Vector2i s = map.cell_of(start.head<2>());
   const Eigen::Vector2i g = map.cell_of(goal.head<2>());
   if (!start.allFinite() || !map.inside(s.x(), s.y())) {
-    return fail(PlanStatus::kStartOutsideMap, "start " + where(start) + " is outside the map");
+    return fail(PlanStatus::kStartOutsideMap,
+                "start " + detail::pose_text(start) + " is outside the map");
   }
   if (map.in_collision(start)) {
-    return fail(PlanStatus::kStartInCollision,
-                "start " + where(start) + ": the robot's footprint there covers an obstacle");
+    return fail(
+        PlanStatus::kStartInCollision,
+        "start " + detail::pose_text(start) + ": the robot's footprint there covers an obstacle");
   }
   if (!goal.allFinite() || !map.inside(g.x(), g.y())) {
-    return fail(PlanStatus::kGoalOutsideMap, "goal " + where(goal) + " is outside the map");
+    return fail(PlanStatus::kGoalOutsideMap,
+                "goal " + detail::pose_text(goal) + " is outside the map");
   }
   if (map.unknown(g.x(), g.y()) && !(params_.allow_unknown && !map.params().unknown_is_lethal)) {
     return fail(PlanStatus::kGoalUnknown,
-                "goal " + where(goal) + " lies in unknown space of the map");
+                "goal " + detail::pose_text(goal) + " lies in unknown space of the map");
   }
   if (map.in_collision(goal)) {
-    return fail(PlanStatus::kGoalInCollision,
-                "goal " + where(goal) + ": the robot's footprint there covers an obstacle");
+    return fail(
+        PlanStatus::kGoalInCollision,
+        "goal " + detail::pose_text(goal) + ": the robot's footprint there covers an obstacle");
   }
 
   const Traversability trav(map, params_, start.head<2>(), goal.head<2>());
@@ -263,13 +271,15 @@ PlanResult GlobalPlanner::plan(const Costmap& map, const Eigen::Vector3d& start,
     if (params_.max_expansions > 0 && result.expansions >= params_.max_expansions) {
       result.search_time = seconds_since(t0);
       return fail(PlanStatus::kExpansionLimit,
-                  "no path from " + where(start) + " to " + where(goal) + " within the budget of " +
-                      std::to_string(params_.max_expansions) + " expansions");
+                  "no path from " + detail::pose_text(start) + " to " + detail::pose_text(goal) +
+                      " within the budget of " + std::to_string(params_.max_expansions) +
+                      " expansions");
     }
     if ((result.expansions & 1023) == 0 && params_.max_planning_time > 0.0 &&
         seconds_since(t0) > params_.max_planning_time) {
       result.search_time = seconds_since(t0);
-      return fail(PlanStatus::kTimeout, "no path from " + where(start) + " to " + where(goal) +
+      return fail(PlanStatus::kTimeout, "no path from " + detail::pose_text(start) + " to " +
+                                            detail::pose_text(goal) +
                                             " within the planning time of " +
                                             std::to_string(params_.max_planning_time) + " s");
     }
@@ -295,7 +305,7 @@ PlanResult GlobalPlanner::plan(const Costmap& map, const Eigen::Vector3d& start,
   result.search_time = seconds_since(t0);
   if (!found) {
     return fail(PlanStatus::kNoPath,
-                "no path from " + where(start) + " to " + where(goal) +
+                "no path from " + detail::pose_text(start) + " to " + detail::pose_text(goal) +
                     ": the goal is not connected to the start through free space (" +
                     std::to_string(result.expansions) + " cells searched)");
   }

@@ -7,19 +7,18 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
+
+#include "pose_text.hpp"
 
 namespace concert::nav {
 
 namespace {
 
-double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+// Longest stretch of a command checked for collisions [s at the full command].
+constexpr double kMaxCheckTime = 5.0;
 
-std::string where(const Eigen::Vector3d& pose) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "(%.3f, %.3f, %.1f deg)", pose.x(), pose.y(),
-                pose.z() * 180.0 / M_PI);
-  return buf;
-}
+double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 void require(bool ok, const char* name, double value, const char* what) {
   if (!ok) {
@@ -129,7 +128,7 @@ BaseTwist LocalController::limit_acceleration(const BaseTwist& want, double dt) 
 }
 
 double LocalController::safe_scale(const Costmap& costmap, const Eigen::Vector3d& pose,
-                                   const BaseTwist& cmd) const {
+                                   const BaseTwist& cmd, double max_tau) const {
   const ControllerParams::Limits& l = params_.limits;
   // Poses along the command are parametrised by tau: at scale s the robot reaches pose(tau)
   // at time tau / s and can decelerate along it at alpha (tau units per s^2).
@@ -140,8 +139,11 @@ double LocalController::safe_scale(const Costmap& costmap, const Eigen::Vector3d
   if (!std::isfinite(alpha)) return 1.0;
   const double sweep_speed =
       std::max(std::hypot(cmd.vx, cmd.vy), costmap.shape().circumscribed_radius * std::abs(cmd.wz));
+  if (sweep_speed < 1e-4) return 1.0;  // no motion to speak of
   const double tau_margin = params_.stop_margin / sweep_speed + params_.control_period;
-  const double horizon = 1.0 / (2.0 * alpha) + tau_margin + params_.control_period;
+  // A slow command's margin is long in tau: the check ends after kMaxCheckTime in any case.
+  const double horizon =
+      std::min({1.0 / (2.0 * alpha) + tau_margin + params_.control_period, kMaxCheckTime, max_tau});
   for (double tau = params_.collision_check_step; tau <= horizon + 1e-9;
        tau += params_.collision_check_step) {
     if (costmap.in_collision(integrate_twist(pose, cmd, tau))) {
@@ -176,12 +178,12 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
   out.heading_error = wrap(goal.z() - pose.z());
   if (!pose.allFinite()) {
     out.status = ControlStatus::kFailed;
-    out.reason = "the robot pose " + where(pose) + " is not finite";
+    out.reason = "the robot pose " + detail::pose_text(pose) + " is not finite";
     return stop(out);
   }
   if (costmap.in_collision(pose)) {
     out.status = ControlStatus::kFailed;
-    out.reason = "the robot's footprint at " + where(pose) + " covers an obstacle";
+    out.reason = "the robot's footprint at " + detail::pose_text(pose) + " covers an obstacle";
     return stop(out);
   }
 
@@ -204,8 +206,8 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
       out.status = ControlStatus::kFailed;
       char buf[64];
       std::snprintf(buf, sizeof buf, "%.2f m", best);
-      out.reason = "the robot at " + where(pose) + " is " + buf + " from the path (limit " +
-                   std::to_string(params_.max_path_deviation) + " m)";
+      out.reason = "the robot at " + detail::pose_text(pose) + " is " + buf +
+                   " from the path (limit " + std::to_string(params_.max_path_deviation) + " m)";
       return stop(out);
     }
   }
@@ -309,21 +311,49 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
     }
   }
 
-  // Cut the command so the robot can stop before the first colliding pose along it.
-  const double scale = safe_scale(costmap, pose, want);
-  const double lin = scale * std::hypot(want.vx, want.vy);
-  const double rot = scale * std::abs(want.wz);
-  const bool obstructed = scale < 1.0 && lin < 0.5 * params_.min_approach_speed && rot < 0.02;
+  // Cut the command so the robot can stop before the first colliding pose along it. When that
+  // stops it, try its parts alone: the translation (omni), then the turn.
+  auto moving = [&](const BaseTwist& cmd, double scale) {
+    return scale * std::hypot(cmd.vx, cmd.vy) >= 0.5 * params_.min_approach_speed ||
+           scale * std::abs(cmd.wz) >= 0.02;
+  };
+  // Up to the goal, where the command ends: the goal's footprint was checked by the planner.
+  auto until_goal = [&](const BaseTwist& cmd) {
+    double tau = std::numeric_limits<double>::infinity();
+    const double lin = std::hypot(cmd.vx, cmd.vy);
+    if (xy_latched_) {
+      if (std::abs(cmd.wz) > 1e-9) tau = std::abs(out.heading_error) / std::abs(cmd.wz);
+    } else if (out.distance_to_goal < params_.approach_distance && lin > 1e-9) {
+      tau = out.distance_to_goal / lin;
+    }
+    return tau;
+  };
+  double scale = safe_scale(costmap, pose, want, until_goal(want));
+  bool obstructed = scale < 1.0 && !moving(want, scale);
+  if (obstructed) {
+    std::vector<BaseTwist> parts;
+    if (omni) parts.push_back({want.vx, want.vy, 0.0});
+    parts.push_back({0.0, 0.0, want.wz});
+    for (const BaseTwist& part : parts) {
+      const double part_scale = safe_scale(costmap, pose, part, until_goal(part));
+      if (moving(part, part_scale)) {
+        want = part;
+        scale = part_scale;
+        obstructed = false;
+        break;
+      }
+    }
+  }
   if (obstructed) {
     want = {};
     if (!blocked_since_) blocked_since_ = stamp;
     if (stamp - *blocked_since_ >= params_.blocked_timeout) {
       out.status = ControlStatus::kBlocked;
-      out.reason = "an obstacle in front of the robot at " + where(pose) +
+      out.reason = "an obstacle in front of the robot at " + detail::pose_text(pose) +
                    " has blocked the path for " + std::to_string(stamp - *blocked_since_) + " s";
     } else {
       out.status = ControlStatus::kWaiting;
-      out.reason = "an obstacle in front of the robot at " + where(pose);
+      out.reason = "an obstacle in front of the robot at " + detail::pose_text(pose);
     }
   } else {
     want.vx *= scale;
