@@ -1,7 +1,7 @@
 // concert_nav: navigation of the mobile base in the building (paper section 5.3). Reconfigures
 // on every RobotModel (vehicle kinematics, footprint, sensors), localises in the storey map with
 // the lidars, plans and drives to NavGoals (map poses, or in front of a BIM wall).
-//   concert_nav [--params FILE] [--ifc FILE --storey NAME [--resolution M]] [--map MAP.yaml]
+//   concert_nav [--params FILE] [--ifc FILE --storey NAME [--resolution M] [--margin M]] [--map MAP.yaml]
 //               [--initial-pose X Y THETA]
 // The map comes from an IFC file (imported with web-ifc at start: walls, doors, wall goals) or a
 // nav2 map_server file (pose goals only). Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
@@ -25,6 +25,7 @@ struct Options {
   std::string ifc;
   std::string storey;
   double resolution = 0.05;
+  double margin = 3.0;
   std::string map;
   std::vector<double> initial_pose;
   uint64_t seed = 1;
@@ -44,6 +45,7 @@ int run(const Options& o) {
     const bim::Storey& storey = bim->storey(o.storey);
     bim::SliceParams slice;
     slice.resolution = o.resolution;
+    slice.margin = o.margin;
     auto grid = bim::storey_map(*bim, storey, slice);
     std::cerr << "concert_nav: " << o.ifc << " storey '" << storey.name << "': " << grid.width << " x "
               << grid.height << " cells at " << grid.resolution << " m in "
@@ -79,6 +81,8 @@ int main(int argc, char** argv) {
   app.add_option("--storey", o.storey, "with --ifc: the storey to navigate")->type_name("NAME");
   app.add_option("--resolution", o.resolution, "with --ifc: map cell size [m]")
       ->check(concert::cli::number(0.01, 1.0));
+  app.add_option("--margin", o.margin, "with --ifc: free border mapped around the building [m] (room to arrive)")
+      ->check(concert::cli::number(0.0, 50.0));
   app.add_option("--map", o.map, "a nav2 map_server map (map.yaml + image)")->type_name("FILE");
   app.add_option("--initial-pose", o.initial_pose, "the robot's pose in the map at start")
       ->expected(3)

@@ -1,0 +1,158 @@
+// Navigation in a real building: the KIT FZK house (IFC4 from ArchiCAD, ../shared/data/bim) on
+// one machine over loopback DDS. The simulator builds its world from the house's ground floor
+// (libs/bim storey_world), the robot (deploy/demo/drill_robot.yaml: the paper's omni-steering
+// base with two VLP-16s) starts in the garden south of the terrace door, and the nav service -
+// its map sliced from the same IFC file - localises with the lidars, plans through the terrace
+// door around the spiral stair and drives into the living room. Judged against the simulator's
+// ground truth (concert/sim/truth), not against the navigator's own estimate.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "concert/bim/model.hpp"
+#include "concert/bim/storey_world.hpp"
+#include "concert/common/clock.hpp"
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/participant.hpp"
+#include "helpers.hpp"
+#include "process.hpp"
+
+namespace concert::system_test {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+const std::string kHouse = std::string(CONCERT_SHARED_DATA) + "/bim/AC20-FZK-Haus.ifc";
+constexpr const char* kStorey = "Erdgeschoss";
+// In the garden, 2 m south of the terrace door (x 4.95 .. 7.05 m in the south wall at y = 0),
+// facing the house; the goal: the living room's west end, facing west.
+constexpr double kStart[3] = {6.0, -2.2, M_PI / 2};
+constexpr double kGoal[3] = {2.2, 2.2, M_PI};
+
+double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
+  const fs::path dir = fs::temp_directory_path() / ("nav_house_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  {
+    const bim::BimModel house = bim::load_ifc(kHouse);
+    std::ofstream(dir / "world.yaml") << bim::world_yaml(bim::storey_world(house, house.storey(kStorey)));
+  }
+  // The robot at its start pose; cameras at 1 Hz (navigation does not read them: CPU for the
+  // lidars on a 2-core machine).
+  std::ofstream(dir / "robot.yaml") << "sim:\n  base_position: [" << kStart[0] << ", " << kStart[1]
+                                    << ", 0.0]\n  base_yaw: " << kStart[2]
+                                    << "\nsensors:\n  camera:\n    rate: 1.0\n";
+
+  testing::Process discovery(dies_with_test({DISCOVERY_BINARY}));
+  testing::Process modelgen(dies_with_test({MODELGEN_BINARY}));
+  testing::Process robot(dies_with_test({ROBOT_BINARY, "--assembly",
+                                         std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml",
+                                         "--world", (dir / "world.yaml").string(), "--params",
+                                         (dir / "robot.yaml").string()}));
+  testing::Process nav(dies_with_test({NAV_BINARY, "--ifc", kHouse, "--storey", kStorey, "--initial-pose",
+                                       std::to_string(kStart[0]), std::to_string(kStart[1]),
+                                       std::to_string(kStart[2])}));
+  const auto logs = [&] {
+    return "\n--- nav:\n" + nav.err() + "--- robot:\n" + robot.err() + "--- modelgen:\n" + modelgen.err() +
+           "--- discovery:\n" + discovery.err();
+  };
+
+  concert::dds::Participant p({.name = "nav_house_test"});
+  concert::dds::Reader<msg::NavStatus> statuses(p, concert::dds::topics::nav_status);
+  concert::dds::Reader<msg::NavLocalisation> localisations(p, concert::dds::topics::nav_localisation);
+  concert::dds::Reader<msg::SimTruth> truths(p, concert::dds::topics::sim_truth);
+  concert::dds::Reader<msg::RobotModel> models(p, concert::dds::topics::robot_model);
+  concert::dds::Writer<msg::NavGoal> goals(p, concert::dds::topics::nav_goal);
+
+  // The model reaches nav, and the lidars have localised the robot at its start.
+  ASSERT_TRUE(wait_for_err(nav, "nav: model version 1: omni_steering drive", 90s)) << logs();
+  const auto model = models.wait(10s);
+  ASSERT_TRUE(model) << logs();
+  bool tracking = false;
+  for (const auto until = std::chrono::steady_clock::now() + 30s; !tracking && std::chrono::steady_clock::now() < until;) {
+    const auto l = localisations.wait(200ms);
+    tracking = l && l->state() == msg::LOCALISATION_TRACKING;
+  }
+  ASSERT_TRUE(tracking) << "not localised at the start" << logs();
+  ASSERT_TRUE(goals.wait_for_readers(1, 10s)) << logs();
+
+  auto send = [&](uint32_t id, double x, double y, double yaw) {
+    msg::NavGoal g;
+    g.request_id(id);
+    g.model_version(model->version());
+    g.stamp_ns(now_ns());
+    g.source("nav_house_test");
+    g.kind(msg::NAV_GOAL_POSE);
+    g.pose().x(x);
+    g.pose().y(y);
+    g.pose().yaw(yaw);
+    goals.write(g);
+  };
+  auto final_status = [&](uint32_t id, std::chrono::seconds timeout, std::vector<msg::SimTruth>* track) {
+    std::optional<msg::NavStatus> last;
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < until) {
+      if (track) {
+        while (auto t = truths.take()) track->push_back(*t);
+      }
+      const auto s = statuses.wait(100ms);
+      if (!s || s->request_id() != id) continue;
+      last = s;
+      if (s->state() == msg::NAV_REACHED || s->state() == msg::NAV_FAILED || s->state() == msg::NAV_CANCELLED ||
+          s->state() == msg::NAV_REFUSED) {
+        break;
+      }
+    }
+    return last;
+  };
+
+  // A goal in the middle of the west wall is refused with the reason.
+  send(1, 0.05, 5.0, 0.0);
+  const auto refused = final_status(1, 10s, nullptr);
+  ASSERT_TRUE(refused) << logs();
+  EXPECT_EQ(refused->state(), msg::NAV_REFUSED);
+  EXPECT_NE(refused->reason().find("in collision"), std::string::npos) << refused->reason();
+
+  // Garden -> terrace door -> living room.
+  std::vector<msg::SimTruth> track;
+  send(2, kGoal[0], kGoal[1], kGoal[2]);
+  const auto done = final_status(2, 240s, &track);
+  ASSERT_TRUE(done) << logs();
+  ASSERT_EQ(done->state(), msg::NAV_REACHED) << done->reason() << logs();
+  std::this_thread::sleep_for(500ms);
+  while (auto t = truths.take()) track.push_back(*t);
+  ASSERT_FALSE(track.empty());
+  const msg::SimTruth& end = track.back();
+  const double position_error = std::hypot(end.x() - kGoal[0], end.y() - kGoal[1]);
+  const double heading_error = std::abs(wrap(end.yaw() - kGoal[2]));
+  std::cout << "nav house run: true final pose (" << end.x() << ", " << end.y() << ", " << end.yaw()
+            << "), error " << position_error << " m, " << heading_error * 180.0 / M_PI << " deg; nav says "
+            << done->position_error() << " m, replans " << done->replans() << std::endl;
+  EXPECT_LT(position_error, 0.10);
+  EXPECT_LT(heading_error, 3.0 * M_PI / 180.0);
+  // It went through the terrace door: the base crossed the south wall's line within the door.
+  bool through_door = false;
+  for (std::size_t i = 1; i < track.size(); ++i) {
+    if (track[i - 1].y() < 0.1 && track[i].y() >= 0.1) through_door |= track[i].x() > 4.95 && track[i].x() < 7.05;
+  }
+  EXPECT_TRUE(through_door) << logs();
+  EXPECT_TRUE(robot.running()) << logs();
+  EXPECT_TRUE(nav.running()) << logs();
+
+  nav.stop(10s);
+  robot.stop(10s);
+  modelgen.stop(10s);
+  discovery.stop(10s);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace concert::system_test
