@@ -77,7 +77,7 @@ void save_map(const OccupancyGrid& grid, const std::string& dir, const std::stri
       << "origin: [" << grid.origin.x() << ", " << grid.origin.y() << ", 0.0]\n"
       << "negate: 0\n"
       << "occupied_thresh: 0.65\n"
-      << "free_thresh: 0.25\n";
+      << "free_thresh: 0.196\n";
   if (!out) throw MapError("save_map: cannot write '" + yaml.string() + "'");
 }
 

@@ -61,7 +61,8 @@ struct MapMetadata {
 
 /// Writes `grid` as nav2 map_server files: `<dir>/<stem>.pgm` (binary P5, 8 bit: occupied 0,
 /// free 254, unknown 205, top row first) and `<dir>/<stem>.yaml` (image, resolution, origin,
-/// negate 0, occupied_thresh 0.65, free_thresh 0.25, mode trinary). Creates `dir`.
+/// negate 0, occupied_thresh 0.65, free_thresh 0.196 (ROS map_saver's value: unknown 205 reads back
+/// as unknown, with 0.25 it would read as free), mode trinary). Creates `dir`.
 /// Throws MapError naming the file on a write failure.
 void save_map(const OccupancyGrid& grid, const std::string& dir, const std::string& stem = "map");
 
