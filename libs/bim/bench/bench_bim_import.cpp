@@ -12,7 +12,9 @@ namespace {
 
 using concert::bim::BimModel;
 
-std::string bim_file(const std::string& name) { return std::string(CONCERT_SHARED_DATA) + "/bim/" + name; }
+std::string bim_file(const std::string& name) {
+  return std::string(CONCERT_SHARED_DATA) + "/bim/" + name;
+}
 
 void import_file(benchmark::State& state, const std::string& name) {
   std::size_t elements = 0;
@@ -36,12 +38,17 @@ void rasterise(benchmark::State& state, const std::string& name, const std::stri
   state.counters["cells"] = static_cast<double>(cells);
 }
 
-BENCHMARK_CAPTURE(import_file, fzk_haus, std::string("AC20-FZK-Haus.ifc"))->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK_CAPTURE(import_file, duplex, std::string("duplex.ifc"))->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK_CAPTURE(import_file, fzk_haus, std::string("AC20-FZK-Haus.ifc"))
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+BENCHMARK_CAPTURE(import_file, duplex, std::string("duplex.ifc"))
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
 BENCHMARK_CAPTURE(import_file, ifc_open_house, std::string("IfcOpenHouse_IFC4.ifc"))
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
-BENCHMARK_CAPTURE(rasterise, fzk_erdgeschoss, std::string("AC20-FZK-Haus.ifc"), std::string("Erdgeschoss"))
+BENCHMARK_CAPTURE(rasterise, fzk_erdgeschoss, std::string("AC20-FZK-Haus.ifc"),
+                  std::string("Erdgeschoss"))
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(rasterise, duplex_level_1, std::string("duplex.ifc"), std::string("Level 1"))
     ->Unit(benchmark::kMillisecond);

@@ -1,9 +1,8 @@
 #include "concert/bim/geometry.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 namespace concert::bim {
 
@@ -41,10 +40,8 @@ Json vec(const Eigen::Vector2d& v) { return Json::array({v.x(), v.y()}); }
 Json box_json(const OrientedBox2& b) {
   Json corners = Json::array();
   for (const auto& c : b.corners()) corners.push_back(vec(c));
-  return Json{{"center", vec(b.center)},
-              {"size", vec(2 * b.half)},
-              {"yaw", b.yaw},
-              {"corners", corners}};
+  return Json{
+      {"center", vec(b.center)}, {"size", vec(2 * b.half)}, {"yaw", b.yaw}, {"corners", corners}};
 }
 
 }  // namespace
@@ -115,7 +112,8 @@ WallGeometry wall_geometry(const Element& wall) {
   const Eigen::Vector2d left(-d.y(), d.x());
   for (int k = 0; k < 2; ++k) {
     const Eigen::Vector2d n = k == 0 ? left : -left;
-    g.faces[static_cast<std::size_t>(k)] = {n, g.start + n * box.half.y(), g.end + n * box.half.y()};
+    g.faces[static_cast<std::size_t>(k)] = {n, g.start + n * box.half.y(),
+                                            g.end + n * box.half.y()};
   }
   return g;
 }
@@ -124,11 +122,14 @@ std::string geometry_json(const BimModel& model, const Storey& storey) {
   Json elements = Json::array();
   for (const Element* e : model.elements_of(storey)) {
     const Category c = e->category;
-    if (c != Category::kWall && c != Category::kDoor && c != Category::kWindow && c != Category::kColumn &&
-        c != Category::kSlab) {
+    if (c != Category::kWall && c != Category::kDoor && c != Category::kWindow &&
+        c != Category::kColumn && c != Category::kSlab) {
       continue;
     }
-    Json j{{"global_id", e->global_id}, {"type", e->ifc_type}, {"category", to_string(c)}, {"name", e->name}};
+    Json j{{"global_id", e->global_id},
+           {"type", e->ifc_type},
+           {"category", to_string(c)},
+           {"name", e->name}};
     if (e->mesh.vertices.empty()) {
       j["footprint"] = nullptr;
       j["z"] = nullptr;
@@ -143,7 +144,8 @@ std::string geometry_json(const BimModel& model, const Storey& storey) {
       const WallGeometry w = wall_geometry(*e);
       Json faces = Json::array();
       for (const auto& f : w.faces) {
-        faces.push_back(Json{{"normal", vec(f.normal)}, {"start", vec(f.start)}, {"end", vec(f.end)}});
+        faces.push_back(
+            Json{{"normal", vec(f.normal)}, {"start", vec(f.start)}, {"end", vec(f.end)}});
       }
       j["axis"] = Json{{"start", vec(w.start)}, {"end", vec(w.end)}, {"length", w.length()}};
       j["thickness"] = w.thickness;
@@ -155,7 +157,9 @@ std::string geometry_json(const BimModel& model, const Storey& storey) {
                  {"version", 1},
                  {"source", model.source},
                  {"frame", "IFC world frame: x y z [m], z up; map.yaml shares x y"},
-                 {"storey", Json{{"name", storey.name}, {"global_id", storey.global_id}, {"elevation", storey.elevation}}},
+                 {"storey", Json{{"name", storey.name},
+                                 {"global_id", storey.global_id},
+                                 {"elevation", storey.elevation}}},
                  {"elements", elements}};
   return out.dump(1);
 }

@@ -5,8 +5,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -14,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 extern char** environ;
@@ -47,8 +46,8 @@ class TempDir {
   TempDir() {
     std::string pattern = (fs::temp_directory_path() / "concert-bim-XXXXXX").string();
     if (mkdtemp(pattern.data()) == nullptr) {
-      throw BimError("cannot create a temporary folder in " + fs::temp_directory_path().string() + ": " +
-                     std::strerror(errno));
+      throw BimError("cannot create a temporary folder in " + fs::temp_directory_path().string() +
+                     ": " + std::strerror(errno));
     }
     path_ = pattern;
   }
@@ -83,8 +82,8 @@ int run_child(const std::vector<std::string>& argv, const fs::path& err_file) {
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0644);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_file.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
   std::vector<char*> args;
   std::vector<std::string> copy = argv;
   for (auto& a : copy) args.push_back(a.data());
@@ -98,7 +97,8 @@ int run_child(const std::vector<std::string>& argv, const fs::path& err_file) {
   }
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw BimError(std::string("waiting for the IFC import step: ") + std::strerror(errno));
+    if (errno != EINTR)
+      throw BimError(std::string("waiting for the IFC import step: ") + std::strerror(errno));
   }
   return status;
 }
@@ -137,7 +137,8 @@ Category category_from_string(const std::string& name) {
 }
 
 bool is_obstacle(Category category) {
-  return category != Category::kDoor && category != Category::kSlab && category != Category::kCovering;
+  return category != Category::kDoor && category != Category::kSlab &&
+         category != Category::kCovering;
 }
 
 const Storey& BimModel::storey(const std::string& name_or_id) const {
@@ -149,8 +150,8 @@ const Storey& BimModel::storey(const std::string& name_or_id) const {
   }
   std::string names;
   for (const auto& s : storeys) names += (names.empty() ? "" : ", ") + s.name;
-  throw BimError("storey '" + name_or_id + "' not found in " + source + "; storeys: " +
-                 (names.empty() ? "none" : names));
+  throw BimError("storey '" + name_or_id + "' not found in " + source +
+                 "; storeys: " + (names.empty() ? "none" : names));
 }
 
 const Element& BimModel::element(const std::string& global_id) const {
@@ -177,7 +178,8 @@ double BimModel::storey_height(const Storey& storey, double fallback) const {
 }
 
 std::string default_import_script() {
-  if (const char* env = std::getenv("CONCERT_IFC_IMPORT"); env != nullptr && *env != '\0') return env;
+  if (const char* env = std::getenv("CONCERT_IFC_IMPORT"); env != nullptr && *env != '\0')
+    return env;
   return CONCERT_IFC_IMPORT_SCRIPT;
 }
 
@@ -191,7 +193,8 @@ BimModel read_import(const std::string& json_path) {
   } catch (const Json::exception& e) {
     throw BimError(where + ": not JSON: " + e.what());
   }
-  if (field<std::string>(j, "format", where) != "concert-ifc-import" || field<int>(j, "version", where) != 1) {
+  if (field<std::string>(j, "format", where) != "concert-ifc-import" ||
+      field<int>(j, "version", where) != 1) {
     throw BimError(where + ": not format concert-ifc-import version 1");
   }
   BimModel m;
@@ -200,7 +203,8 @@ BimModel read_import(const std::string& json_path) {
   m.length_unit_m = field<double>(j, "length_unit_m", where);
 
   const Json& binary = j.at("binary");
-  const fs::path bin = fs::path(json_path).parent_path() / field<std::string>(binary, "file", where + ": binary");
+  const fs::path bin =
+      fs::path(json_path).parent_path() / field<std::string>(binary, "file", where + ": binary");
   const auto vertex_count = field<std::size_t>(binary, "vertex_count", where + ": binary");
   const auto index_count = field<std::size_t>(binary, "index_count", where + ": binary");
   std::vector<float> vertices(vertex_count * 3);
@@ -209,12 +213,13 @@ BimModel read_import(const std::string& json_path) {
     std::ifstream b(bin, std::ios::binary);
     if (!b) throw BimError(where + ": its binary file '" + bin.string() + "' cannot be opened");
     const auto expected = vertices.size() * sizeof(float) + indices.size() * sizeof(std::uint32_t);
-    b.read(reinterpret_cast<char*>(vertices.data()), static_cast<std::streamsize>(vertices.size() * sizeof(float)));
+    b.read(reinterpret_cast<char*>(vertices.data()),
+           static_cast<std::streamsize>(vertices.size() * sizeof(float)));
     b.read(reinterpret_cast<char*>(indices.data()),
            static_cast<std::streamsize>(indices.size() * sizeof(std::uint32_t)));
     if (!b || static_cast<std::uintmax_t>(fs::file_size(bin)) != expected) {
-      throw BimError(where + ": binary file '" + bin.string() + "' is not " + std::to_string(expected) +
-                     " bytes long");
+      throw BimError(where + ": binary file '" + bin.string() + "' is not " +
+                     std::to_string(expected) + " bytes long");
     }
   }
 
@@ -253,8 +258,10 @@ BimModel read_import(const std::string& json_path) {
     }
     for (std::size_t k = 0; k < ni; k += 3) {
       const std::uint32_t* t = &indices[i0 + k];
-      if (t[0] >= nv || t[1] >= nv || t[2] >= nv) throw BimError(w + ": triangle index beyond its vertices");
-      el.mesh.triangles.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2]));
+      if (t[0] >= nv || t[1] >= nv || t[2] >= nv)
+        throw BimError(w + ": triangle index beyond its vertices");
+      el.mesh.triangles.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]),
+                                     static_cast<int>(t[2]));
     }
     m.elements.push_back(std::move(el));
   }
@@ -280,8 +287,9 @@ BimModel load_ifc(const std::string& ifc_path, const ImportOptions& options) {
     if (ec) throw BimError("cannot create '" + out_dir.string() + "': " + ec.message());
   }
   const fs::path err_file = out_dir / "import.stderr";
-  const int status =
-      run_child({options.node, script, fs::absolute(ifc_path).string(), (out_dir / "model").string()}, err_file);
+  const int status = run_child(
+      {options.node, script, fs::absolute(ifc_path).string(), (out_dir / "model").string()},
+      err_file);
   std::string err = trimmed(read_text(err_file));
   std::error_code ec;
   fs::remove(err_file, ec);
@@ -291,17 +299,19 @@ BimModel load_ifc(const std::string& ifc_path, const ImportOptions& options) {
     const std::string how = WIFEXITED(status) ? "exit code " + std::to_string(WEXITSTATUS(status))
                                               : "signal " + std::to_string(WTERMSIG(status));
     if (WIFEXITED(status) && WEXITSTATUS(status) == 127 && err.empty()) {
-      throw BimError("IFC file '" + ifc_path + "': cannot run '" + options.node + "' (install Node.js)");
+      throw BimError("IFC file '" + ifc_path + "': cannot run '" + options.node +
+                     "' (install Node.js)");
     }
-    throw BimError("IFC file '" + ifc_path + "': " + (err.empty() ? "the import step failed" : err) + " (" +
-                   how + ")");
+    throw BimError("IFC file '" + ifc_path +
+                   "': " + (err.empty() ? "the import step failed" : err) + " (" + how + ")");
   }
   BimModel model = read_import((out_dir / "model.json").string());
   model.source = ifc_path;
-  const bool walls = std::any_of(model.elements.begin(), model.elements.end(), [](const Element& e) {
-    return e.category == Category::kWall && !e.mesh.triangles.empty();
-  });
-  if (!walls) throw BimError("IFC file '" + ifc_path + "': no walls with geometry (nothing to map)");
+  const bool walls = std::any_of(
+      model.elements.begin(), model.elements.end(),
+      [](const Element& e) { return e.category == Category::kWall && !e.mesh.triangles.empty(); });
+  if (!walls)
+    throw BimError("IFC file '" + ifc_path + "': no walls with geometry (nothing to map)");
   if (model.storeys.empty()) throw BimError("IFC file '" + ifc_path + "': no IfcBuildingStorey");
   return model;
 }

@@ -56,18 +56,24 @@ bool overlaps(const Polygon& poly, const Eigen::Vector2d& lo, const Eigen::Vecto
 class Mask {
  public:
   Mask(const OccupancyGrid& grid, int c0, int r0, int c1, int r1)
-      : grid_(grid), c0_(c0), r0_(r0), w_(c1 - c0 + 1), h_(r1 - r0 + 1),
-        bits_(static_cast<std::size_t>(std::max(0, w_)) * static_cast<std::size_t>(std::max(0, h_)), false) {}
+      : grid_(grid),
+        c0_(c0),
+        r0_(r0),
+        w_(c1 - c0 + 1),
+        h_(r1 - r0 + 1),
+        bits_(static_cast<std::size_t>(std::max(0, w_)) * static_cast<std::size_t>(std::max(0, h_)),
+              false) {}
   void set(int col, int row) {
     if (col < c0_ || row < r0_ || col >= c0_ + w_ || row >= r0_ + h_) return;
-    bits_[static_cast<std::size_t>(row - r0_) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(col - c0_)] =
-        true;
+    bits_[static_cast<std::size_t>(row - r0_) * static_cast<std::size_t>(w_) +
+          static_cast<std::size_t>(col - c0_)] = true;
   }
   [[nodiscard]] std::vector<Eigen::Vector2i> cells() const {
     std::vector<Eigen::Vector2i> out;
     for (int r = 0; r < h_; ++r) {
       for (int c = 0; c < w_; ++c) {
-        if (bits_[static_cast<std::size_t>(r) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(c)]) {
+        if (bits_[static_cast<std::size_t>(r) * static_cast<std::size_t>(w_) +
+                  static_cast<std::size_t>(c)]) {
           out.emplace_back(c0_ + c, r0_ + r);
         }
       }
@@ -90,7 +96,8 @@ class Mask {
 void mark_surface(const Mesh& mesh, double z_min, double z_max, Mask& mask) {
   const OccupancyGrid& g = mask.grid();
   for (const auto& t : mesh.triangles) {
-    Polygon p{mesh.vertices[static_cast<std::size_t>(t[0])], mesh.vertices[static_cast<std::size_t>(t[1])],
+    Polygon p{mesh.vertices[static_cast<std::size_t>(t[0])],
+              mesh.vertices[static_cast<std::size_t>(t[1])],
               mesh.vertices[static_cast<std::size_t>(t[2])]};
     p = clip_z(p, z_min, 1.0);
     if (p.empty()) continue;
@@ -102,15 +109,20 @@ void mark_surface(const Mesh& mesh, double z_min, double z_max, Mask& mask) {
       lo = lo.cwiseMin(v.head<2>());
       hi = hi.cwiseMax(v.head<2>());
     }
-    const int ca = std::max(mask.c0(), static_cast<int>(std::floor((lo.x() - g.origin.x() + kEps) / g.resolution)));
-    const int cb = std::min(mask.c1(), static_cast<int>(std::floor((hi.x() - g.origin.x() - kEps) / g.resolution)));
-    const int ra = std::max(mask.r0(), static_cast<int>(std::floor((lo.y() - g.origin.y() + kEps) / g.resolution)));
-    const int rb = std::min(mask.r1(), static_cast<int>(std::floor((hi.y() - g.origin.y() - kEps) / g.resolution)));
+    const int ca = std::max(
+        mask.c0(), static_cast<int>(std::floor((lo.x() - g.origin.x() + kEps) / g.resolution)));
+    const int cb = std::min(
+        mask.c1(), static_cast<int>(std::floor((hi.x() - g.origin.x() - kEps) / g.resolution)));
+    const int ra = std::max(
+        mask.r0(), static_cast<int>(std::floor((lo.y() - g.origin.y() + kEps) / g.resolution)));
+    const int rb = std::min(
+        mask.r1(), static_cast<int>(std::floor((hi.y() - g.origin.y() - kEps) / g.resolution)));
     for (int r = ra; r <= rb; ++r) {
       for (int c = ca; c <= cb; ++c) {
-        const Eigen::Vector2d cell_lo = g.origin + g.resolution * Eigen::Vector2d(c, r) + Eigen::Vector2d::Constant(kEps);
-        const Eigen::Vector2d cell_hi =
-            g.origin + g.resolution * Eigen::Vector2d(c + 1, r + 1) - Eigen::Vector2d::Constant(kEps);
+        const Eigen::Vector2d cell_lo =
+            g.origin + g.resolution * Eigen::Vector2d(c, r) + Eigen::Vector2d::Constant(kEps);
+        const Eigen::Vector2d cell_hi = g.origin + g.resolution * Eigen::Vector2d(c + 1, r + 1) -
+                                        Eigen::Vector2d::Constant(kEps);
         if (overlaps(p, cell_lo, cell_hi)) mask.set(c, r);
       }
     }
@@ -130,7 +142,8 @@ void mark_section(const Mesh& mesh, double z, Mask& mask) {
       const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(t[k])];
       const Eigen::Vector3d& b = mesh.vertices[static_cast<std::size_t>(t[(k + 1) % 3])];
       if ((a.z() >= z) != (b.z() >= z)) {
-        ends[static_cast<std::size_t>(n++)] = (a + (b - a) * ((z - a.z()) / (b.z() - a.z()))).head<2>();
+        ends[static_cast<std::size_t>(n++)] =
+            (a + (b - a) * ((z - a.z()) / (b.z() - a.z()))).head<2>();
       }
     }
     if (n == 2) segments.emplace_back(ends[0], ends[1]);
@@ -141,14 +154,16 @@ void mark_section(const Mesh& mesh, double z, Mask& mask) {
     const double y = g.origin.y() + (r + 0.5) * g.resolution;
     xs.clear();
     for (const auto& [a, b] : segments) {
-      if ((a.y() <= y) != (b.y() <= y)) xs.push_back(a.x() + (b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()));
+      if ((a.y() <= y) != (b.y() <= y))
+        xs.push_back(a.x() + (b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()));
     }
     if (xs.size() < 2 || xs.size() % 2 != 0) continue;
     std::sort(xs.begin(), xs.end());
     for (std::size_t i = 0; i + 1 < xs.size(); i += 2) {
-      const int ca = std::max(mask.c0(), static_cast<int>(std::ceil((xs[i] - g.origin.x()) / g.resolution - 0.5)));
-      const int cb =
-          std::min(mask.c1(), static_cast<int>(std::floor((xs[i + 1] - g.origin.x()) / g.resolution - 0.5)));
+      const int ca = std::max(
+          mask.c0(), static_cast<int>(std::ceil((xs[i] - g.origin.x()) / g.resolution - 0.5)));
+      const int cb = std::min(
+          mask.c1(), static_cast<int>(std::floor((xs[i + 1] - g.origin.x()) / g.resolution - 0.5)));
       for (int c = ca; c <= cb; ++c) mask.set(c, r);
     }
   }
@@ -156,8 +171,8 @@ void mark_section(const Mesh& mesh, double z, Mask& mask) {
 
 }  // namespace
 
-std::vector<Eigen::Vector2i> element_cells(const Element& element, const OccupancyGrid& grid, double z_min,
-                                           double z_max) {
+std::vector<Eigen::Vector2i> element_cells(const Element& element, const OccupancyGrid& grid,
+                                           double z_min, double z_max) {
   if (element.mesh.triangles.empty() || element.bounds.isEmpty()) return {};
   if (element.bounds.max().z() < z_min || element.bounds.min().z() > z_max) return {};
   const Eigen::Vector2i lo = grid.cell_of(element.bounds.min().head<2>());
@@ -182,12 +197,15 @@ std::vector<Eigen::Vector2i> element_cells(const Element& element, const Occupan
 OccupancyGrid storey_map(const BimModel& model, const Storey& storey, const SliceParams& params) {
   std::ostringstream where;
   where << "storey '" << storey.name << "' of " << model.source;
-  if (!(params.band_max > params.band_min) || !std::isfinite(params.band_min) || !std::isfinite(params.band_max)) {
+  if (!(params.band_max > params.band_min) || !std::isfinite(params.band_min) ||
+      !std::isfinite(params.band_max)) {
     throw BimError(where.str() + ": slice band " + std::to_string(params.band_min) + " .. " +
-                   std::to_string(params.band_max) + " m: the upper edge must be above the lower one");
+                   std::to_string(params.band_max) +
+                   " m: the upper edge must be above the lower one");
   }
   if (!(params.resolution > 0) || !std::isfinite(params.resolution)) {
-    throw BimError(where.str() + ": resolution " + std::to_string(params.resolution) + " m: must be > 0");
+    throw BimError(where.str() + ": resolution " + std::to_string(params.resolution) +
+                   " m: must be > 0");
   }
   if (!(params.margin >= 0)) throw BimError(where.str() + ": margin must be >= 0 m");
   Eigen::AlignedBox3d extent;
@@ -201,16 +219,17 @@ OccupancyGrid storey_map(const BimModel& model, const Storey& storey, const Slic
   const Eigen::Vector2d cells = ((hi - lo) / res).array().ceil();
   if (cells.x() * cells.y() > 2e8) {
     throw BimError(where.str() + ": " + std::to_string(static_cast<long>(cells.x())) + " x " +
-                   std::to_string(static_cast<long>(cells.y())) + " cells at " + std::to_string(res) +
-                   " m: too large a map (use a coarser resolution)");
+                   std::to_string(static_cast<long>(cells.y())) + " cells at " +
+                   std::to_string(res) + " m: too large a map (use a coarser resolution)");
   }
-  OccupancyGrid grid = OccupancyGrid::filled(static_cast<int>(cells.x()), static_cast<int>(cells.y()), res, lo,
-                                             OccupancyGrid::kFree);
+  OccupancyGrid grid = OccupancyGrid::filled(
+      static_cast<int>(cells.x()), static_cast<int>(cells.y()), res, lo, OccupancyGrid::kFree);
   const double z_min = storey.elevation + params.band_min;
   const double z_max = storey.elevation + params.band_max;
   for (const auto& e : model.elements) {
     if (!is_obstacle(e.category)) continue;
-    for (const auto& c : element_cells(e, grid, z_min, z_max)) grid.at(c.x(), c.y()) = OccupancyGrid::kOccupied;
+    for (const auto& c : element_cells(e, grid, z_min, z_max))
+      grid.at(c.x(), c.y()) = OccupancyGrid::kOccupied;
   }
   return grid;
 }

@@ -27,12 +27,14 @@ std::vector<Rect> rectangles(std::vector<Eigen::Vector2i> cells) {
     }
   }
   std::vector<Rect> out;
-  std::map<std::pair<int, int>, std::size_t> open;  // (c0, c1) -> index in out of the rectangle ending on the last row
+  std::map<std::pair<int, int>, std::size_t>
+      open;  // (c0, c1) -> index in out of the rectangle ending on the last row
   int last_row = std::numeric_limits<int>::min();
   std::map<std::pair<int, int>, std::size_t> next;
   for (const auto& run : runs) {
     if (run.r0 != last_row) {
-      open = run.r0 == last_row + 1 ? std::move(next) : std::map<std::pair<int, int>, std::size_t>{};
+      open =
+          run.r0 == last_row + 1 ? std::move(next) : std::map<std::pair<int, int>, std::size_t>{};
       next.clear();
       last_row = run.r0;
     }
@@ -58,8 +60,8 @@ YAML::Node vec3(const Eigen::Vector3d& v) {
 
 }  // namespace
 
-concert::world::World storey_world(const BimModel& model, const Storey& storey, const SliceParams& params,
-                                   double max_height) {
+concert::world::World storey_world(const BimModel& model, const Storey& storey,
+                                   const SliceParams& params, double max_height) {
   if (!(max_height > 0)) throw BimError("storey world: maximum box height must be > 0 m");
   const OccupancyGrid grid = storey_map(model, storey, params);
   concert::world::World w;
@@ -80,7 +82,8 @@ concert::world::World storey_world(const BimModel& model, const Storey& storey, 
       box.type = concert::world::WorldShape::Type::kBox;
       box.size = {(r.c1 - r.c0 + 1) * grid.resolution, (r.r1 - r.r0 + 1) * grid.resolution, top};
       const Eigen::Vector2d centre =
-          grid.origin + grid.resolution * Eigen::Vector2d((r.c0 + r.c1 + 1) / 2.0, (r.r0 + r.r1 + 1) / 2.0);
+          grid.origin +
+          grid.resolution * Eigen::Vector2d((r.c0 + r.c1 + 1) / 2.0, (r.r0 + r.r1 + 1) / 2.0);
       box.position = {centre.x(), centre.y(), top / 2};
       (e.category == Category::kWall ? w.walls : w.obstacles).push_back(std::move(box));
     }
@@ -99,7 +102,8 @@ std::string world_yaml(const concert::world::World& world) {
   auto shapes = [&](const std::vector<concert::world::WorldShape>& list, const char* key) {
     for (const auto& s : list) {
       if (s.type != concert::world::WorldShape::Type::kBox || s.path) {
-        throw BimError("world_yaml: " + std::string(key) + " '" + s.name + "': only static boxes are written");
+        throw BimError("world_yaml: " + std::string(key) + " '" + s.name +
+                       "': only static boxes are written");
       }
       YAML::Node n;
       n["name"] = s.name;

@@ -39,7 +39,8 @@ bool segment_hits(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eige
 
 bool has_material(const Mesh& mesh, const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
   for (const auto& t : mesh.triangles) {
-    if (segment_hits(p, q, mesh.vertices[static_cast<std::size_t>(t[0])], mesh.vertices[static_cast<std::size_t>(t[1])],
+    if (segment_hits(p, q, mesh.vertices[static_cast<std::size_t>(t[0])],
+                     mesh.vertices[static_cast<std::size_t>(t[1])],
                      mesh.vertices[static_cast<std::size_t>(t[2])])) {
       return true;
     }
@@ -77,14 +78,16 @@ std::vector<bool> free_space(const OccupancyGrid& grid, double radius) {
   const int n = static_cast<int>(std::ceil(radius / grid.resolution - 0.5));
   for (int r = 0; r < grid.height; ++r) {
     for (int c = 0; c < grid.width; ++c) {
-      if (c < n || r < n || c >= grid.width - n || r >= grid.height - n) free[grid.index(c, r)] = false;
+      if (c < n || r < n || c >= grid.width - n || r >= grid.height - n)
+        free[grid.index(c, r)] = false;
     }
   }
   return free;
 }
 
 /// Area of the 4-connected region of `free` holding `start` [m^2].
-double region_area(const OccupancyGrid& grid, const std::vector<bool>& free, const Eigen::Vector2i& start) {
+double region_area(const OccupancyGrid& grid, const std::vector<bool>& free,
+                   const Eigen::Vector2i& start) {
   std::vector<bool> seen(free.size(), false);
   std::deque<Eigen::Vector2i> queue{start};
   seen[grid.index(start.x(), start.y())] = true;
@@ -93,8 +96,8 @@ double region_area(const OccupancyGrid& grid, const std::vector<bool>& free, con
     const Eigen::Vector2i c = queue.front();
     queue.pop_front();
     ++count;
-    for (const Eigen::Vector2i& d : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0), Eigen::Vector2i(0, 1),
-                                    Eigen::Vector2i(0, -1)}) {
+    for (const Eigen::Vector2i& d : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
+                                     Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)}) {
       const Eigen::Vector2i n = c + d;
       if (!grid.inside(n.x(), n.y())) continue;
       const std::size_t i = grid.index(n.x(), n.y());
@@ -109,8 +112,9 @@ double region_area(const OccupancyGrid& grid, const std::vector<bool>& free, con
 
 }  // namespace
 
-WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid, const std::string& wall_global_id, double s,
-                   double h, double standoff, double robot_radius, const GoalOptions& options) {
+WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid,
+                   const std::string& wall_global_id, double s, double h, double standoff,
+                   double robot_radius, const GoalOptions& options) {
   const Element& wall = model.element(wall_global_id);
   const std::string what = "wall '" + wall_global_id + "'";
   if (wall.category != Category::kWall) {
@@ -121,13 +125,14 @@ WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid, const std::
   const WallGeometry g = wall_geometry(wall);
   const Storey& storey = model.storey(wall.storey);
   if (!(s >= 0 && s <= g.length())) {
-    throw BimError("s = " + fmt(s) + " m is off " + what + ": its axis is " + fmt(g.length()) + " m long (0 .. " +
-                   fmt(g.length()) + ")");
+    throw BimError("s = " + fmt(s) + " m is off " + what + ": its axis is " + fmt(g.length()) +
+                   " m long (0 .. " + fmt(g.length()) + ")");
   }
   const double z = storey.elevation + h;
   if (!(z >= g.z_min && z <= g.z_max)) {
-    throw BimError("h = " + fmt(h) + " m is off " + what + ": it spans " + fmt(g.z_min - storey.elevation) + " .. " +
-                   fmt(g.z_max - storey.elevation) + " m above storey '" + storey.name + "'");
+    throw BimError("h = " + fmt(h) + " m is off " + what + ": it spans " +
+                   fmt(g.z_min - storey.elevation) + " .. " + fmt(g.z_max - storey.elevation) +
+                   " m above storey '" + storey.name + "'");
   }
   const Eigen::Vector2d d = g.direction();
   const Eigen::Vector2d on_axis = g.start + s * d;
@@ -141,7 +146,8 @@ WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid, const std::
       if (e.host != wall_global_id || e.bounds.isEmpty()) continue;
       const Eigen::Vector3d pt(on_axis.x(), on_axis.y(), z);
       if (e.bounds.exteriorDistance(pt) < g.thickness / 2 + 0.05) {
-        filler = " (" + e.ifc_type + " '" + e.global_id + "'" + (e.name.empty() ? "" : " \"" + e.name + "\"") + ")";
+        filler = " (" + e.ifc_type + " '" + e.global_id + "'" +
+                 (e.name.empty() ? "" : " \"" + e.name + "\"") + ")";
         break;
       }
     }
@@ -158,7 +164,9 @@ WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid, const std::
   std::vector<Candidate> ok;
   std::string reasons;
   for (int k = 0; k < 2; ++k) {
-    if ((options.face == FaceChoice::kLeft && k != 0) || (options.face == FaceChoice::kRight && k != 1)) continue;
+    if ((options.face == FaceChoice::kLeft && k != 0) ||
+        (options.face == FaceChoice::kRight && k != 1))
+      continue;
     const Eigen::Vector2d n = g.faces[static_cast<std::size_t>(k)].normal;
     const Eigen::Vector2d base = on_axis + n * (g.thickness / 2 + standoff);
     const std::string name = k == 0 ? "left face" : "right face";
@@ -174,15 +182,17 @@ WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid, const std::
           const int c = cell.x() + dx;
           const int r = cell.y() + dy;
           const Eigen::Vector2d lo = grid.origin + grid.resolution * Eigen::Vector2d(c, r);
-          const Eigen::Vector2d closest = base.cwiseMax(lo).cwiseMin(lo + Eigen::Vector2d::Constant(grid.resolution));
+          const Eigen::Vector2d closest =
+              base.cwiseMax(lo).cwiseMin(lo + Eigen::Vector2d::Constant(grid.resolution));
           if ((closest - base).norm() >= robot_radius) continue;
           if (!grid.inside(c, r)) {
-            why = "the robot (radius " + fmt(robot_radius, 2) + " m) at (" + fmt(base.x()) + ", " + fmt(base.y()) +
-                  ") reaches beyond the map";
+            why = "the robot (radius " + fmt(robot_radius, 2) + " m) at (" + fmt(base.x()) + ", " +
+                  fmt(base.y()) + ") reaches beyond the map";
           } else if (grid.at(c, r) != OccupancyGrid::kFree) {
             const Eigen::Vector2d at = grid.center_of(c, r);
-            why = "the robot (radius " + fmt(robot_radius, 2) + " m) at (" + fmt(base.x()) + ", " + fmt(base.y()) +
-                  ") overlaps the " + (grid.at(c, r) == OccupancyGrid::kOccupied ? "occupied" : "unknown") +
+            why = "the robot (radius " + fmt(robot_radius, 2) + " m) at (" + fmt(base.x()) + ", " +
+                  fmt(base.y()) + ") overlaps the " +
+                  (grid.at(c, r) == OccupancyGrid::kOccupied ? "occupied" : "unknown") +
                   " cell at (" + fmt(at.x()) + ", " + fmt(at.y()) + ")";
           }
         }
@@ -204,8 +214,8 @@ WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid, const std::
     if (!why.empty()) reasons += (reasons.empty() ? "" : "; ") + name + ": " + why;
   }
   if (ok.empty()) {
-    throw BimError("no face of " + what + " is reachable at s = " + fmt(s) + " m, h = " + fmt(h) + " m (standoff " +
-                   fmt(standoff, 2) + " m): " + reasons);
+    throw BimError("no face of " + what + " is reachable at s = " + fmt(s) + " m, h = " + fmt(h) +
+                   " m (standoff " + fmt(standoff, 2) + " m): " + reasons);
   }
   const Candidate& best = ok.size() == 2 && ok[1].area > ok[0].area ? ok[1] : ok[0];
   const Eigen::Vector2d n = g.faces[static_cast<std::size_t>(best.face)].normal;

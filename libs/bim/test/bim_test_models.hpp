@@ -11,7 +11,9 @@
 
 namespace concert::bim::test_models {
 
-inline std::string bim_file(const std::string& name) { return std::string(CONCERT_SHARED_DATA) + "/bim/" + name; }
+inline std::string bim_file(const std::string& name) {
+  return std::string(CONCERT_SHARED_DATA) + "/bim/" + name;
+}
 
 inline const BimModel& shared_model(const std::string& name) {
   static std::map<std::string, BimModel> models;
@@ -31,7 +33,8 @@ inline std::string file_text(const std::string& path) {
 /// the truth the import is checked against.
 inline int count_entities(const std::string& text, const std::string& upper_type) {
   const std::regex re("=\\s*" + upper_type + "\\(");
-  return static_cast<int>(std::distance(std::sregex_iterator(text.begin(), text.end(), re), std::sregex_iterator()));
+  return static_cast<int>(
+      std::distance(std::sregex_iterator(text.begin(), text.end(), re), std::sregex_iterator()));
 }
 
 }  // namespace concert::bim::test_models

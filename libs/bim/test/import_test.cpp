@@ -17,12 +17,27 @@ using ::testing::HasSubstr;
 using namespace concert::bim::test_models;
 
 /// Every IFC type the import knows, as the file spells it.
-const std::vector<std::string> kTypes = {
-    "IFCWALL",          "IFCWALLSTANDARDCASE", "IFCWALLELEMENTEDCASE", "IFCCURTAINWALL", "IFCDOOR",
-    "IFCWINDOW",        "IFCCOLUMN",           "IFCSLAB",              "IFCSTAIR",       "IFCSTAIRFLIGHT",
-    "IFCRAMP",          "IFCRAMPFLIGHT",       "IFCRAILING",           "IFCCOVERING",    "IFCFURNISHINGELEMENT",
-    "IFCFURNITURE",     "IFCBEAM",             "IFCMEMBER",            "IFCPLATE",       "IFCROOF",
-    "IFCBUILDINGELEMENTPROXY"};
+const std::vector<std::string> kTypes = {"IFCWALL",
+                                         "IFCWALLSTANDARDCASE",
+                                         "IFCWALLELEMENTEDCASE",
+                                         "IFCCURTAINWALL",
+                                         "IFCDOOR",
+                                         "IFCWINDOW",
+                                         "IFCCOLUMN",
+                                         "IFCSLAB",
+                                         "IFCSTAIR",
+                                         "IFCSTAIRFLIGHT",
+                                         "IFCRAMP",
+                                         "IFCRAMPFLIGHT",
+                                         "IFCRAILING",
+                                         "IFCCOVERING",
+                                         "IFCFURNISHINGELEMENT",
+                                         "IFCFURNITURE",
+                                         "IFCBEAM",
+                                         "IFCMEMBER",
+                                         "IFCPLATE",
+                                         "IFCROOF",
+                                         "IFCBUILDINGELEMENTPROXY"};
 
 std::map<std::string, int> imported_counts(const BimModel& m) {
   std::map<std::string, int> counts;
@@ -68,7 +83,8 @@ TEST_P(SharedFiles, EveryElementHasAStoreyAndEveryWallAMeshInMetres) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Bim, SharedFiles,
-                         ::testing::Values("AC20-FZK-Haus.ifc", "duplex.ifc", "IfcOpenHouse_IFC4.ifc"),
+                         ::testing::Values("AC20-FZK-Haus.ifc", "duplex.ifc",
+                                           "IfcOpenHouse_IFC4.ifc"),
                          [](const auto& p) {
                            std::string n = p.param.substr(0, p.param.find('.'));
                            std::replace(n.begin(), n.end(), '-', '_');
@@ -147,7 +163,8 @@ TEST(Import, DoorsFillOpeningsOfTheirHostWall) {
       const double s = dir.dot(v.head<2>() - g.start);
       const Eigen::Vector2d half = d.bounds.sizes().head<2>() / 2;
       const double half_width = std::abs(dir.x()) * half.x() + std::abs(dir.y()) * half.y();
-      EXPECT_FALSE(std::abs(s - along) < half_width - 0.15) << d.global_id << " in " << wall.global_id;
+      EXPECT_FALSE(std::abs(s - along) < half_width - 0.15)
+          << d.global_id << " in " << wall.global_id;
     }
   }
   EXPECT_EQ(doors, 5);
@@ -201,12 +218,14 @@ TEST_F(BadInput, BuildingWithoutWalls) {
   // The same house with its walls turned into proxies.
   text = std::regex_replace(text, std::regex("IFCWALLSTANDARDCASE\\("), "IFCBUILDINGELEMENTPROXY(");
   const std::string path = write("no_walls.ifc", text);
-  EXPECT_THAT([&] { (void)load_ifc(path); }, ::testing::ThrowsMessage<BimError>(HasSubstr("no walls")));
+  EXPECT_THAT([&] { (void)load_ifc(path); },
+              ::testing::ThrowsMessage<BimError>(HasSubstr("no walls")));
 }
 
 TEST_F(BadInput, MissingImportStepIsNamed) {
-  EXPECT_THAT([&] { (void)load_ifc(bim_file("duplex.ifc"), {.script = (dir_ / "nope.mjs").string()}); },
-              ::testing::ThrowsMessage<BimError>(HasSubstr("nope.mjs")));
+  EXPECT_THAT(
+      [&] { (void)load_ifc(bim_file("duplex.ifc"), {.script = (dir_ / "nope.mjs").string()}); },
+      ::testing::ThrowsMessage<BimError>(HasSubstr("nope.mjs")));
 }
 
 TEST(Lookup, UnknownStoreyListsTheStoreys) {
@@ -220,7 +239,8 @@ TEST(Lookup, UnknownStoreyListsTheStoreys) {
 TEST(Lookup, UnknownGlobalId) {
   const BimModel& m = shared_model("duplex.ifc");
   EXPECT_THAT([&] { (void)m.element("0000000000000000000000"); },
-              ::testing::ThrowsMessage<BimError>(HasSubstr("no element with GlobalId '0000000000000000000000'")));
+              ::testing::ThrowsMessage<BimError>(
+                  HasSubstr("no element with GlobalId '0000000000000000000000'")));
 }
 
 TEST(Slug, FileNameSafe) {

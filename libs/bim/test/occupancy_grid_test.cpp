@@ -1,11 +1,11 @@
+#include "concert/bim/occupancy_grid.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <random>
-
-#include "concert/bim/occupancy_grid.hpp"
 
 namespace concert::bim {
 namespace {

@@ -1,3 +1,5 @@
+#include "concert/bim/storey_map.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -5,7 +7,6 @@
 
 #include "bim_test_models.hpp"
 #include "concert/bim/geometry.hpp"
-#include "concert/bim/storey_map.hpp"
 
 namespace concert::bim {
 namespace {
@@ -34,7 +35,9 @@ bool clear_of_obstacles(const BimModel& m, const Storey& s, const Eigen::Vector2
   const SliceParams band;
   for (const auto& e : m.elements) {
     if (!is_obstacle(e.category) || e.bounds.isEmpty()) continue;
-    if (e.bounds.max().z() < s.elevation + band.band_min || e.bounds.min().z() > s.elevation + band.band_max) continue;
+    if (e.bounds.max().z() < s.elevation + band.band_min ||
+        e.bounds.min().z() > s.elevation + band.band_max)
+      continue;
     const Eigen::Vector2d lo = e.bounds.min().head<2>().array() - grow;
     const Eigen::Vector2d hi = e.bounds.max().head<2>().array() + grow;
     if ((p.array() >= lo.array()).all() && (p.array() <= hi.array()).all()) return false;
@@ -64,13 +67,14 @@ TEST_P(StoreyMaps, WallAxesAreOccupiedAndRoomsBesideThemFree) {
   for (const Element* e : m.elements_of(s)) {
     if (e->category != Category::kWall || e->mesh.triangles.empty()) continue;
     // Walls through the middle of the band (not parapets, knee walls or foundations).
-    if (e->bounds.min().z() > s.elevation + 0.5 || e->bounds.max().z() < s.elevation + 1.5) continue;
+    if (e->bounds.min().z() > s.elevation + 0.5 || e->bounds.max().z() < s.elevation + 1.5)
+      continue;
     const WallGeometry g = wall_geometry(*e);
     for (double f = 0.1; f <= 0.9 + 1e-9; f += 0.1) {
       const Eigen::Vector2d p = g.start + f * (g.end - g.start);
       if (on_door(m, *e, p, 0.1)) continue;
-      EXPECT_TRUE(grid.occupied(p)) << e->global_id << " \"" << e->name << "\" at " << f << " of its axis ("
-                                    << p.transpose() << ")";
+      EXPECT_TRUE(grid.occupied(p)) << e->global_id << " \"" << e->name << "\" at " << f
+                                    << " of its axis (" << p.transpose() << ")";
       ++occupied_samples;
       for (const auto& face : g.faces) {
         const Eigen::Vector2d q = p + face.normal * (g.thickness / 2 + 0.5);
@@ -91,8 +95,10 @@ TEST_P(StoreyMaps, GridCoversTheStoreyWithAMargin) {
   EXPECT_DOUBLE_EQ(grid.resolution, 0.05);
   for (const Element* e : m.elements_of(s)) {
     if (e->bounds.isEmpty()) continue;
-    EXPECT_TRUE(grid.inside(grid.cell_of(e->bounds.min().head<2>()).x(), grid.cell_of(e->bounds.min().head<2>()).y()));
-    EXPECT_TRUE(grid.inside(grid.cell_of(e->bounds.max().head<2>()).x(), grid.cell_of(e->bounds.max().head<2>()).y()));
+    EXPECT_TRUE(grid.inside(grid.cell_of(e->bounds.min().head<2>()).x(),
+                            grid.cell_of(e->bounds.min().head<2>()).y()));
+    EXPECT_TRUE(grid.inside(grid.cell_of(e->bounds.max().head<2>()).x(),
+                            grid.cell_of(e->bounds.max().head<2>()).y()));
   }
   // The margin is free: the border row and column.
   for (int c = 0; c < grid.width; ++c) EXPECT_EQ(grid.at(c, 0), OccupancyGrid::kFree);
@@ -100,9 +106,10 @@ TEST_P(StoreyMaps, GridCoversTheStoreyWithAMargin) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Bim, StoreyMaps,
-                         ::testing::Values(Case{"AC20-FZK-Haus.ifc", "Erdgeschoss"}, Case{"duplex.ifc", "Level 1"},
-                                           Case{"duplex.ifc", "Level 2"}, Case{"IfcOpenHouse_IFC4.ifc",
-                                                                               "38aOKO8_DDkBd1FHm_lVXz"}),
+                         ::testing::Values(Case{"AC20-FZK-Haus.ifc", "Erdgeschoss"},
+                                           Case{"duplex.ifc", "Level 1"},
+                                           Case{"duplex.ifc", "Level 2"},
+                                           Case{"IfcOpenHouse_IFC4.ifc", "38aOKO8_DDkBd1FHm_lVXz"}),
                          [](const auto& p) {
                            std::string n = p.param.file.substr(0, 5) + "_" + slug(p.param.storey);
                            for (char& ch : n) {
@@ -141,11 +148,14 @@ TEST(DoorPassable, EveryDoorOfTheFzkGroundFloor) {
       const Eigen::Vector2i cell = queue.front();
       queue.pop_front();
       reached = cell == to;
-      for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0), Eigen::Vector2i(0, 1),
-                                          Eigen::Vector2i(0, -1)}) {
+      for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
+                                          Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)}) {
         const Eigen::Vector2i nb = cell + step;
-        if ((nb.array() < lo.array()).any() || (nb.array() > hi.array()).any() || !grid.inside(nb.x(), nb.y())) continue;
-        if (grid.at(nb.x(), nb.y()) != OccupancyGrid::kFree || seen[grid.index(nb.x(), nb.y())]) continue;
+        if ((nb.array() < lo.array()).any() || (nb.array() > hi.array()).any() ||
+            !grid.inside(nb.x(), nb.y()))
+          continue;
+        if (grid.at(nb.x(), nb.y()) != OccupancyGrid::kFree || seen[grid.index(nb.x(), nb.y())])
+          continue;
         seen[grid.index(nb.x(), nb.y())] = true;
         queue.push_back(nb);
       }

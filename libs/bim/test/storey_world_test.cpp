@@ -1,8 +1,9 @@
+#include "concert/bim/storey_world.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "bim_test_models.hpp"
-#include "concert/bim/storey_world.hpp"
 
 namespace concert::bim {
 namespace {
@@ -27,7 +28,8 @@ TEST(StoreyWorld, BoxesStandOnTheFloorWhereTheMapIsOccupied) {
       EXPECT_GT(b.size.z(), 0.0) << b.name;
       EXPECT_EQ(b.name.rfind("door_", 0), std::string::npos) << b.name;
       EXPECT_TRUE(grid.occupied(b.position.head<2>())) << b.name;
-      cells += static_cast<std::size_t>(std::lround(b.size.x() / grid.resolution * b.size.y() / grid.resolution));
+      cells += static_cast<std::size_t>(
+          std::lround(b.size.x() / grid.resolution * b.size.y() / grid.resolution));
     }
   }
   // Every occupied cell is under some box (boxes of different elements may overlap).
@@ -57,7 +59,8 @@ TEST(StoreyWorld, YamlRefusesWhatItDoesNotWrite) {
   c.name = "pillar";
   c.type = world::WorldShape::Type::kCylinder;
   w.obstacles.push_back(c);
-  EXPECT_THAT([&] { (void)world_yaml(w); }, ::testing::ThrowsMessage<BimError>(::testing::HasSubstr("pillar")));
+  EXPECT_THAT([&] { (void)world_yaml(w); },
+              ::testing::ThrowsMessage<BimError>(::testing::HasSubstr("pillar")));
 }
 
 }  // namespace

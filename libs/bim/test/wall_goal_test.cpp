@@ -1,10 +1,11 @@
+#include "concert/bim/wall_goal.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "bim_test_models.hpp"
 #include "concert/bim/geometry.hpp"
 #include "concert/bim/storey_map.hpp"
-#include "concert/bim/wall_goal.hpp"
 
 namespace concert::bim {
 namespace {
@@ -13,8 +14,8 @@ using ::testing::HasSubstr;
 using namespace concert::bim::test_models;
 
 constexpr const char* kInteriorWall = "2ptk1k7qn8_Qk22vjh$0DE";  // Wand-Int-ERDG-1, no opening
-constexpr const char* kDoorWall = "3PfS__Y_DBAfq5naM6zD2Z";      // Wand-Int-ERDG-2, door Innentuer-1
-constexpr const char* kDoor = "1Oms875aH3Wg$9l65H2ZGw";          // Innentuer-1
+constexpr const char* kDoorWall = "3PfS__Y_DBAfq5naM6zD2Z";  // Wand-Int-ERDG-2, door Innentuer-1
+constexpr const char* kDoor = "1Oms875aH3Wg$9l65H2ZGw";      // Innentuer-1
 
 class WallGoalTest : public ::testing::Test {
  protected:
@@ -61,9 +62,10 @@ TEST_F(WallGoalTest, FrameOnTheFaceAndBaseAtTheStandoffFacingIt) {
 
 TEST_F(WallGoalTest, BothFacesOfAnInteriorWallCanBeAsked) {
   const WallGeometry g = wall_geometry(model().element(kInteriorWall));
-  const WallGoal left = wall_goal(model(), *grid_, kInteriorWall, g.length() / 2, 1.0, 0.7, 0.3, {FaceChoice::kLeft});
-  const WallGoal right =
-      wall_goal(model(), *grid_, kInteriorWall, g.length() / 2, 1.0, 0.7, 0.3, {FaceChoice::kRight});
+  const WallGoal left =
+      wall_goal(model(), *grid_, kInteriorWall, g.length() / 2, 1.0, 0.7, 0.3, {FaceChoice::kLeft});
+  const WallGoal right = wall_goal(model(), *grid_, kInteriorWall, g.length() / 2, 1.0, 0.7, 0.3,
+                                   {FaceChoice::kRight});
   EXPECT_EQ(left.face, 0);
   EXPECT_EQ(right.face, 1);
   EXPECT_NEAR((left.area_frame.linear().col(2) + right.area_frame.linear().col(2)).norm(), 0, 1e-9);
@@ -74,8 +76,8 @@ TEST_F(WallGoalTest, PointOnADoorOpeningIsRefusedNamingTheDoor) {
   const WallGeometry g = wall_geometry(model().element(kDoorWall));
   const double s = g.direction().dot(door.bounds.center().head<2>() - g.start);
   EXPECT_THAT([&] { (void)wall_goal(model(), *grid_, kDoorWall, s, 1.0, 0.7, 0.3); },
-              ::testing::ThrowsMessage<BimError>(::testing::AllOf(HasSubstr("on an opening"), HasSubstr("IfcDoor"),
-                                                                  HasSubstr(kDoor))));
+              ::testing::ThrowsMessage<BimError>(::testing::AllOf(
+                  HasSubstr("on an opening"), HasSubstr("IfcDoor"), HasSubstr(kDoor))));
 }
 
 TEST_F(WallGoalTest, OffTheWallIsRefused) {
@@ -86,8 +88,10 @@ TEST_F(WallGoalTest, OffTheWallIsRefused) {
 }
 
 TEST_F(WallGoalTest, UnknownGlobalIdAndNonWallAreRefused) {
-  EXPECT_THAT([&] { (void)wall_goal(model(), *grid_, "3xxxxxxxxxxxxxxxxxxxxx", 1.0, 1.0, 0.7, 0.3); },
-              ::testing::ThrowsMessage<BimError>(HasSubstr("no element with GlobalId '3xxxxxxxxxxxxxxxxxxxxx'")));
+  EXPECT_THAT(
+      [&] { (void)wall_goal(model(), *grid_, "3xxxxxxxxxxxxxxxxxxxxx", 1.0, 1.0, 0.7, 0.3); },
+      ::testing::ThrowsMessage<BimError>(
+          HasSubstr("no element with GlobalId '3xxxxxxxxxxxxxxxxxxxxx'")));
   EXPECT_THAT([&] { (void)wall_goal(model(), *grid_, kDoor, 1.0, 1.0, 0.7, 0.3); },
               ::testing::ThrowsMessage<BimError>(HasSubstr("is an IfcDoor, not a wall")));
 }

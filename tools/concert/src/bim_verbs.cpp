@@ -1,7 +1,5 @@
 #include "bim_verbs.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -9,6 +7,7 @@
 #include <iomanip>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
@@ -80,7 +79,8 @@ int run_import(const ImportOptions& o, std::ostream& out) {
   } catch (const bim::BimError& e) {
     throw Failure(e.what());
   }
-  const bim::SliceParams params{.band_min = o.band[0], .band_max = o.band[1], .resolution = o.resolution};
+  const bim::SliceParams params{
+      .band_min = o.band[0], .band_max = o.band[1], .resolution = o.resolution};
   Json index_storeys = Json::array();
   Json report_storeys = Json::array();
   std::set<std::string> used;
@@ -91,11 +91,12 @@ int run_import(const ImportOptions& o, std::ostream& out) {
     used.insert(dir);
     std::map<std::string, int> counts;
     for (const bim::Element* e : model.elements_of(*s)) ++counts[e->ifc_type];
-    Json entry{{"name", s->name}, {"global_id", s->global_id}, {"elevation", s->elevation}, {"dir", dir}};
+    Json entry{
+        {"name", s->name}, {"global_id", s->global_id}, {"elevation", s->elevation}, {"dir", dir}};
     Json report = entry;
     report["elements"] = counts;
-    text << "storey '" << s->name << "' (elevation " << std::fixed << std::setprecision(3) << s->elevation
-         << " m) -> " << (fs::path(o.out) / dir).string() << "\n  elements:";
+    text << "storey '" << s->name << "' (elevation " << std::fixed << std::setprecision(3)
+         << s->elevation << " m) -> " << (fs::path(o.out) / dir).string() << "\n  elements:";
     for (const auto& [type, n] : counts) text << " " << type << " " << n;
     if (counts.empty()) text << " none";
     text << "\n";
@@ -108,17 +109,18 @@ int run_import(const ImportOptions& o, std::ostream& out) {
       write_text(fs::path(o.out) / dir / "geometry.json", bim::geometry_json(model, *s) + "\n");
       std::size_t occupied = 0;
       for (const auto c : grid.cells) occupied += c == bim::OccupancyGrid::kOccupied ? 1 : 0;
-      report["map"] = Json{{"width", grid.width},
-                           {"height", grid.height},
-                           {"resolution", grid.resolution},
-                           {"size_m", {grid.width * grid.resolution, grid.height * grid.resolution}},
-                           {"origin", {grid.origin.x(), grid.origin.y()}},
-                           {"occupied_cells", occupied},
-                           {"time_s", map_s}};
+      report["map"] =
+          Json{{"width", grid.width},
+               {"height", grid.height},
+               {"resolution", grid.resolution},
+               {"size_m", {grid.width * grid.resolution, grid.height * grid.resolution}},
+               {"origin", {grid.origin.x(), grid.origin.y()}},
+               {"occupied_cells", occupied},
+               {"time_s", map_s}};
       text << "  map: " << grid.width << " x " << grid.height << " cells, " << std::setprecision(2)
-           << grid.width * grid.resolution << " x " << grid.height * grid.resolution << " m at " << grid.resolution
-           << " m, origin (" << grid.origin.x() << ", " << grid.origin.y() << "), " << occupied
-           << " occupied cells, " << std::setprecision(3) << map_s << " s\n";
+           << grid.width * grid.resolution << " x " << grid.height * grid.resolution << " m at "
+           << grid.resolution << " m, origin (" << grid.origin.x() << ", " << grid.origin.y()
+           << "), " << occupied << " occupied cells, " << std::setprecision(3) << map_s << " s\n";
     } catch (const bim::BimError& e) {
       // A storey without geometry (e.g. a roof level holding nothing) gets no map; others do.
       report["map"] = nullptr;
@@ -129,31 +131,33 @@ int run_import(const ImportOptions& o, std::ostream& out) {
     index_storeys.push_back(entry);
     report_storeys.push_back(report);
   }
-  const Json index{{"format", "concert-bim-import"}, {"version", 1},         {"source", model.source},
-                   {"model", "model.json"},           {"band", o.band},       {"resolution", o.resolution},
+  const Json index{{"format", "concert-bim-import"}, {"version", 1},   {"source", model.source},
+                   {"model", "model.json"},          {"band", o.band}, {"resolution", o.resolution},
                    {"storeys", index_storeys}};
   write_text(fs::path(o.out) / kIndex, index.dump(1) + "\n");
   const double total_s = seconds_since(t0);
   if (o.json) {
-    out << Json{{"source", model.source},   {"schema", model.schema}, {"out", o.out},
-                {"import_s", import_s},     {"total_s", total_s},     {"storeys", report_storeys}}
+    out << Json{{"source", model.source}, {"schema", model.schema}, {"out", o.out},
+                {"import_s", import_s},   {"total_s", total_s},     {"storeys", report_storeys}}
                .dump()
         << "\n";
   } else {
-    out << "concert bim import: " << model.source << " (" << model.schema << ", " << model.storeys.size()
-        << " storeys, " << model.elements.size() << " elements), IFC import " << std::fixed << std::setprecision(2)
-        << import_s << " s\n"
+    out << "concert bim import: " << model.source << " (" << model.schema << ", "
+        << model.storeys.size() << " storeys, " << model.elements.size()
+        << " elements), IFC import " << std::fixed << std::setprecision(2) << import_s << " s\n"
         << text.str() << "total " << std::setprecision(2) << total_s << " s\n";
   }
   return 0;
 }
 
 int run_goal(const GoalOptions& o, std::ostream& out) {
-  if (o.at.size() != 2) throw UsageError("--at S H: axis distance from the wall's start and height [m]");
+  if (o.at.size() != 2)
+    throw UsageError("--at S H: axis distance from the wall's start and height [m]");
   const fs::path dir(o.bim_dir);
   const fs::path index_file = dir / kIndex;
   std::ifstream in(index_file);
-  if (!in) throw Failure("--bim " + o.bim_dir + ": no " + kIndex + " (make it with `concert bim import`)");
+  if (!in)
+    throw Failure("--bim " + o.bim_dir + ": no " + kIndex + " (make it with `concert bim import`)");
   Json index;
   try {
     index = Json::parse(in);
@@ -161,7 +165,8 @@ int run_goal(const GoalOptions& o, std::ostream& out) {
     throw Failure(index_file.string() + ": not JSON: " + e.what());
   }
   try {
-    const bim::BimModel model = bim::read_import((dir / index.at("model").get<std::string>()).string());
+    const bim::BimModel model =
+        bim::read_import((dir / index.at("model").get<std::string>()).string());
     const bim::Element& wall = model.element(o.wall);
     const bim::Storey& storey = model.storey(o.storey.empty() ? wall.storey : o.storey);
     std::string map_dir;
@@ -174,10 +179,11 @@ int run_goal(const GoalOptions& o, std::ostream& out) {
     }
     const bim::OccupancyGrid grid = bim::load_map((dir / map_dir / "map.yaml").string());
     bim::GoalOptions options;
-    options.face = o.face == "left" ? bim::FaceChoice::kLeft
+    options.face = o.face == "left"    ? bim::FaceChoice::kLeft
                    : o.face == "right" ? bim::FaceChoice::kRight
                                        : bim::FaceChoice::kAuto;
-    const bim::WallGoal g = bim::wall_goal(model, grid, o.wall, o.at[0], o.at[1], o.standoff, o.robot_radius, options);
+    const bim::WallGoal g =
+        bim::wall_goal(model, grid, o.wall, o.at[0], o.at[1], o.standoff, o.robot_radius, options);
     const Eigen::Vector3d p = g.area_frame.translation();
     const Eigen::Matrix3d r = g.area_frame.linear();
     const Eigen::Quaterniond q(r);
@@ -192,18 +198,22 @@ int run_goal(const GoalOptions& o, std::ostream& out) {
                     {"y", v3(r.col(1))},
                     {"z", v3(r.col(2))},
                     {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}}},
-                  {"base_pose", {{"x", g.base_pose.x()}, {"y", g.base_pose.y()}, {"theta", g.base_pose.z()}}},
+                  {"base_pose",
+                   {{"x", g.base_pose.x()}, {"y", g.base_pose.y()}, {"theta", g.base_pose.z()}}},
                   {"free_area_m2", g.free_area}}
                  .dump()
           << "\n";
     } else {
-      out << std::fixed << std::setprecision(3) << "wall " << o.wall << " (" << wall.ifc_type << " \"" << wall.name
-          << "\"), storey '" << g.storey << "', " << (g.face == 0 ? "left" : "right") << " face\n"
-          << "area frame: origin (" << p.x() << ", " << p.y() << ", " << p.z() << ") m, x (" << r(0, 0) << ", "
-          << r(1, 0) << ", " << r(2, 0) << "), z = face normal (" << r(0, 2) << ", " << r(1, 2) << ", " << r(2, 2)
-          << "), quaternion xyzw (" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w() << ")\n"
-          << "base pose: x " << g.base_pose.x() << " m, y " << g.base_pose.y() << " m, theta " << g.base_pose.z()
-          << " rad (" << std::setprecision(1) << g.base_pose.z() * 180 / M_PI << " deg)\n";
+      out << std::fixed << std::setprecision(3) << "wall " << o.wall << " (" << wall.ifc_type
+          << " \"" << wall.name << "\"), storey '" << g.storey << "', "
+          << (g.face == 0 ? "left" : "right") << " face\n"
+          << "area frame: origin (" << p.x() << ", " << p.y() << ", " << p.z() << ") m, x ("
+          << r(0, 0) << ", " << r(1, 0) << ", " << r(2, 0) << "), z = face normal (" << r(0, 2)
+          << ", " << r(1, 2) << ", " << r(2, 2) << "), quaternion xyzw (" << q.x() << ", " << q.y()
+          << ", " << q.z() << ", " << q.w() << ")\n"
+          << "base pose: x " << g.base_pose.x() << " m, y " << g.base_pose.y() << " m, theta "
+          << g.base_pose.z() << " rad (" << std::setprecision(1) << g.base_pose.z() * 180 / M_PI
+          << " deg)\n";
     }
   } catch (const bim::BimError& e) {
     throw Failure(e.what());
@@ -218,15 +228,21 @@ int run_goal(const GoalOptions& o, std::ostream& out) {
 }  // namespace
 
 void register_bim_verbs(cli::Cli& concert) {
-  CLI::App& bim = concert.group(concert.app(), "bim", "the building's IFC model: maps, geometry, wall goals");
+  CLI::App& bim =
+      concert.group(concert.app(), "bim", "the building's IFC model: maps, geometry, wall goals");
 
   auto im = std::make_shared<ImportOptions>();
   CLI::App& import = concert.verb(
-      bim, "import", "IFC file -> per storey an occupancy map (nav2 map.yaml + map.pgm) and geometry.json",
+      bim, "import",
+      "IFC file -> per storey an occupancy map (nav2 map.yaml + map.pgm) and geometry.json",
       [&concert, im] { return run_import(*im, concert.out()); });
   import.add_option("FILE", im->file, "an IFC2x3 or IFC4 file")->required();
-  import.add_option("--out", im->out, "output folder (one sub-folder per storey)")->required()->type_name("DIR");
-  import.add_option("--storey", im->storey, "only this storey (name or GlobalId; default: every storey)")
+  import.add_option("--out", im->out, "output folder (one sub-folder per storey)")
+      ->required()
+      ->type_name("DIR");
+  import
+      .add_option("--storey", im->storey,
+                  "only this storey (name or GlobalId; default: every storey)")
       ->type_name("NAME");
   import.add_option("--resolution", im->resolution, "map cell side [m]")
       ->check(cli::number(0.001, 10))
@@ -243,13 +259,17 @@ void register_bim_verbs(cli::Cli& concert) {
       bim, "goal", "area frame on a wall face at (S, H) and the base pose in front of it",
       [&concert, go] { return run_goal(*go, concert.out()); });
   goal.add_option("--wall", go->wall, "the wall's IFC GlobalId")->required()->type_name("GLOBALID");
-  goal.add_option("--at", go->at, "axis distance from the wall's start, height above its storey [m]")
+  goal.add_option("--at", go->at,
+                  "axis distance from the wall's start, height above its storey [m]")
       ->required()
       ->expected(2)
       ->type_name("S H")
       ->check(cli::real());
-  goal.add_option("--bim", go->bim_dir, "a folder written by `concert bim import`")->required()->type_name("DIR");
-  goal.add_option("--storey", go->storey, "the storey whose map to use (default: the wall's)")->type_name("NAME");
+  goal.add_option("--bim", go->bim_dir, "a folder written by `concert bim import`")
+      ->required()
+      ->type_name("DIR");
+  goal.add_option("--storey", go->storey, "the storey whose map to use (default: the wall's)")
+      ->type_name("NAME");
   goal.add_option("--standoff", go->standoff, "distance from the face to the base's centre [m]")
       ->check(cli::number(0, 1e3, false, true))
       ->default_str("0.8");

@@ -3,19 +3,18 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <nlohmann/json.hpp>
-
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "process.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-using ::testing::HasSubstr;
 using concert::testing::run;
 using concert::testing::TempDir;
+using ::testing::HasSubstr;
 using Json = nlohmann::json;
 
 const std::string kFzk = std::string(CONCERT_SHARED_DATA) + "/bim/AC20-FZK-Haus.ifc";
@@ -23,7 +22,8 @@ constexpr auto kTimeout = std::chrono::seconds(120);
 
 TEST(BimCli, ImportWritesMapsAndGeometryPerStoreyThenGoalReadsThem) {
   TempDir dir("bim-cli");
-  const auto imported = run({CONCERT_BIN, "bim", "import", kFzk, "--out", dir.path(), "--resolution", "0.1"}, kTimeout);
+  const auto imported = run(
+      {CONCERT_BIN, "bim", "import", kFzk, "--out", dir.path(), "--resolution", "0.1"}, kTimeout);
   ASSERT_EQ(imported.code, 0) << imported.err;
   EXPECT_THAT(imported.out, HasSubstr("storey 'Erdgeschoss' (elevation 0.000 m)"));
   EXPECT_THAT(imported.out, HasSubstr("IfcWallStandardCase 9"));
@@ -31,7 +31,8 @@ TEST(BimCli, ImportWritesMapsAndGeometryPerStoreyThenGoalReadsThem) {
   EXPECT_THAT(imported.out, HasSubstr("at 0.10 m"));
   for (const char* storey : {"erdgeschoss", "dachgeschoss"}) {
     for (const char* file : {"map.yaml", "map.pgm", "geometry.json"}) {
-      EXPECT_TRUE(fs::is_regular_file(fs::path(dir.path()) / storey / file)) << storey << "/" << file;
+      EXPECT_TRUE(fs::is_regular_file(fs::path(dir.path()) / storey / file))
+          << storey << "/" << file;
     }
   }
   std::ifstream in(fs::path(dir.path()) / "erdgeschoss" / "geometry.json");
@@ -45,9 +46,10 @@ TEST(BimCli, ImportWritesMapsAndGeometryPerStoreyThenGoalReadsThem) {
   }
   EXPECT_EQ(walls, 9);
 
-  const auto goal = run({CONCERT_BIN, "bim", "goal", "--wall", "2ptk1k7qn8_Qk22vjh$0DE", "--at", "2", "1.2", "--bim",
-                         dir.path(), "--robot-radius", "0.3", "--standoff", "0.7", "--json"},
-                        kTimeout);
+  const auto goal =
+      run({CONCERT_BIN, "bim", "goal", "--wall", "2ptk1k7qn8_Qk22vjh$0DE", "--at", "2", "1.2",
+           "--bim", dir.path(), "--robot-radius", "0.3", "--standoff", "0.7", "--json"},
+          kTimeout);
   ASSERT_EQ(goal.code, 0) << goal.err;
   const Json g = Json::parse(goal.out);
   EXPECT_EQ(g.at("storey"), "Erdgeschoss");
@@ -59,15 +61,17 @@ TEST(BimCli, ImportWritesMapsAndGeometryPerStoreyThenGoalReadsThem) {
   EXPECT_NEAR(base.at("x").get<double>(), origin[0].get<double>() + 0.7 * nx, 1e-6);
   EXPECT_NEAR(base.at("y").get<double>(), origin[1].get<double>() + 0.7 * ny, 1e-6);
 
-  const auto refused = run({CONCERT_BIN, "bim", "goal", "--wall", "nope", "--at", "2", "1.2", "--bim", dir.path()},
-                           kTimeout);
+  const auto refused =
+      run({CONCERT_BIN, "bim", "goal", "--wall", "nope", "--at", "2", "1.2", "--bim", dir.path()},
+          kTimeout);
   EXPECT_EQ(refused.code, 1);
   EXPECT_THAT(refused.err, HasSubstr("no element with GlobalId 'nope'"));
 }
 
 TEST(BimCli, BadInputIsNamed) {
   TempDir dir("bim-cli");
-  const auto storey = run({CONCERT_BIN, "bim", "import", kFzk, "--out", dir.path(), "--storey", "Keller"}, kTimeout);
+  const auto storey = run(
+      {CONCERT_BIN, "bim", "import", kFzk, "--out", dir.path(), "--storey", "Keller"}, kTimeout);
   EXPECT_EQ(storey.code, 1);
   EXPECT_THAT(storey.err, HasSubstr("storey 'Keller' not found"));
   EXPECT_THAT(storey.err, HasSubstr("storeys: Erdgeschoss, Dachgeschoss"));
@@ -76,19 +80,23 @@ TEST(BimCli, BadInputIsNamed) {
   const auto not_ifc = run({CONCERT_BIN, "bim", "import", junk, "--out", dir.path()}, kTimeout);
   EXPECT_EQ(not_ifc.code, 1);
   EXPECT_THAT(not_ifc.err, HasSubstr("not an IFC file"));
-  const auto band = run({CONCERT_BIN, "bim", "import", kFzk, "--out", dir.path(), "--band", "1.5", "0.5"}, kTimeout);
+  const auto band = run(
+      {CONCERT_BIN, "bim", "import", kFzk, "--out", dir.path(), "--band", "1.5", "0.5"}, kTimeout);
   EXPECT_EQ(band.code, 2);
   EXPECT_THAT(band.err, HasSubstr("--band"));
 }
 
 TEST(BimCli, SimWorldFromIfcChecksItsArgumentsBeforeTalkingToTheSimulator) {
-  const auto both = run({CONCERT_BIN, "sim", "world", "some.yaml", "--ifc", kFzk, "--storey", "Erdgeschoss"}, kTimeout);
+  const auto both =
+      run({CONCERT_BIN, "sim", "world", "some.yaml", "--ifc", kFzk, "--storey", "Erdgeschoss"},
+          kTimeout);
   EXPECT_EQ(both.code, 2);
   EXPECT_THAT(both.err, HasSubstr("one of them"));
   const auto no_storey = run({CONCERT_BIN, "sim", "world", "--ifc", kFzk}, kTimeout);
   EXPECT_EQ(no_storey.code, 2);
   EXPECT_THAT(no_storey.err, HasSubstr("--storey"));
-  const auto unknown = run({CONCERT_BIN, "sim", "world", "--ifc", kFzk, "--storey", "Keller"}, kTimeout);
+  const auto unknown =
+      run({CONCERT_BIN, "sim", "world", "--ifc", kFzk, "--storey", "Keller"}, kTimeout);
   EXPECT_EQ(unknown.code, 1);
   EXPECT_THAT(unknown.err, HasSubstr("world rejected, nothing changed: storey 'Keller' not found"));
 }

@@ -2,7 +2,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -53,10 +52,10 @@ struct Element {
   std::string global_id;  ///< IFC GlobalId (22 characters)
   std::string ifc_type;   ///< e.g. "IfcWallStandardCase"
   Category category{Category::kWall};
-  std::string name;    ///< IFC Name ("" when the file has none)
-  std::string storey;  ///< GlobalId of its storey
+  std::string name;              ///< IFC Name ("" when the file has none)
+  std::string storey;            ///< GlobalId of its storey
   bool storey_by_height{false};  ///< in no storey in the file: assigned by its lowest point
-  std::string host;    ///< doors and windows: GlobalId of the element whose opening they fill
+  std::string host;  ///< doors and windows: GlobalId of the element whose opening they fill
   /// Origin and unit x axis of the element's mesh placement (world frame, Z up) [m]: for a wall,
   /// the start of its axis and the axis direction; unset when the element has no mesh.
   std::optional<Eigen::Vector3d> placement_origin;
@@ -67,15 +66,15 @@ struct Element {
 
 /// An IfcBuildingStorey.
 struct Storey {
-  std::string name;       ///< IFC Name (the GlobalId when the file has none)
+  std::string name;  ///< IFC Name (the GlobalId when the file has none)
   std::string global_id;
   double elevation{0.0};  ///< world z of the storey's placement (its floor level) [m]
 };
 
 /// A building read from an IFC file: storeys from the lowest up, elements in file-type order.
 struct BimModel {
-  std::string source;  ///< the IFC file
-  std::string schema;  ///< "IFC2X3", "IFC4", ...
+  std::string source;         ///< the IFC file
+  std::string schema;         ///< "IFC2X3", "IFC4", ...
   double length_unit_m{1.0};  ///< the file's length unit [m] (everything here is in metres)
   std::vector<Storey> storeys;
   std::vector<Element> elements;
@@ -93,10 +92,10 @@ struct BimModel {
 
 /// How load_ifc runs the import step (tools/ifc_import/ifc_import.mjs on Node.js).
 struct ImportOptions {
-  std::string script;      ///< "" = default_import_script()
+  std::string script;        ///< "" = default_import_script()
   std::string node{"node"};  ///< the Node.js executable (looked up in PATH)
-  std::string keep_dir;    ///< "" = a temporary folder, removed; else the import output is kept
-                           ///< there as model.json + model.bin (read_import reads it back)
+  std::string keep_dir;      ///< "" = a temporary folder, removed; else the import output is kept
+                             ///< there as model.json + model.bin (read_import reads it back)
 };
 
 /// The import step's script: $CONCERT_IFC_IMPORT when set, else the path compiled in

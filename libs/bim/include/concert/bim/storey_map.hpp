@@ -26,11 +26,12 @@ struct SliceParams {
 /// covers the storey's elements (all categories) plus `margin`; every cell not occupied is free
 /// (outside the building too). Throws BimError for a bad band or resolution, or a storey without
 /// geometry.
-OccupancyGrid storey_map(const BimModel& model, const Storey& storey, const SliceParams& params = {});
+OccupancyGrid storey_map(const BimModel& model, const Storey& storey,
+                         const SliceParams& params = {});
 
 /// The cells (col, row) of `grid` that `element`'s material in the world z band [z_min, z_max]
 /// occupies, by the rule of storey_map (any cell outside the grid is left out).
-std::vector<Eigen::Vector2i> element_cells(const Element& element, const OccupancyGrid& grid, double z_min,
-                                           double z_max);
+std::vector<Eigen::Vector2i> element_cells(const Element& element, const OccupancyGrid& grid,
+                                           double z_min, double z_max);
 
 }  // namespace concert::bim

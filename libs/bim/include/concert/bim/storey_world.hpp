@@ -17,8 +17,8 @@ namespace concert::bim {
 /// rectangles, each a box from the floor (z = 0) up to the element's top, capped at `max_height`.
 /// Walls go to World::walls, the other obstacles to World::obstacles; doors are left out (open).
 /// Box names: "<category>_<GlobalId>_<k>". The floor is on, at z = 0.
-concert::world::World storey_world(const BimModel& model, const Storey& storey, const SliceParams& params = {},
-                                   double max_height = 3.0);
+concert::world::World storey_world(const BimModel& model, const Storey& storey,
+                                   const SliceParams& params = {}, double max_height = 3.0);
 
 /// The world file text (libs/world README "World file") of a world made of a floor and static
 /// boxes, as storey_world() makes. Throws BimError for what it does not write (marks, surfaces,

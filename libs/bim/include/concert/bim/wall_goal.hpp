@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Geometry>
-
 #include <string>
 
 #include "concert/bim/model.hpp"
@@ -44,7 +43,8 @@ struct WallGoal {
 /// and reachable (GoalOptions::min_free_area). Throws BimError with the reason: unknown GlobalId,
 /// not a wall, s or h off the wall, the point on an opening (naming the door or window), or no
 /// face reachable (the reason for each face).
-WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid, const std::string& wall_global_id, double s,
-                   double h, double standoff, double robot_radius, const GoalOptions& options = {});
+WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid,
+                   const std::string& wall_global_id, double s, double h, double standoff,
+                   double robot_radius, const GoalOptions& options = {});
 
 }  // namespace concert::bim
