@@ -2,6 +2,9 @@
 # Installs every Debian package the project needs (Debian 12). Idempotent and non-interactive:
 # packages already installed are skipped, so a second run does nothing and takes a second.
 # The lists live in deploy/packages/*.txt (one package a line, '#' comments), one file per area.
+# Then the npm packages of the project's Node.js steps (tools/ifc_import: the IFC engine web-ifc)
+# are installed from their committed lockfiles with `npm ci`, when node_modules is missing or
+# older than the lockfile; nothing is fetched at run time.
 # Usage: deploy/install-deps.sh [--check]   (--check: only report what is missing; exit 1 if any)
 set -euo pipefail
 
@@ -24,18 +27,42 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#wanted[@]} packages already installed"
-  exit 0
-fi
-echo "install-deps: missing ${#missing[@]} of ${#wanted[@]} packages: ${missing[*]}"
-[ "$check_only" -eq 1 ] && exit 1
+else
+  echo "install-deps: missing ${#missing[@]} of ${#wanted[@]} packages: ${missing[*]}"
+  [ "$check_only" -eq 1 ] && exit 1
 
-sudo=""
-if [ "$(id -u)" -ne 0 ]; then
-  command -v sudo >/dev/null || { echo "install-deps: not root and no sudo; install as root: ${missing[*]}" >&2; exit 1; }
-  sudo="sudo"
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || { echo "install-deps: not root and no sudo; install as root: ${missing[*]}" >&2; exit 1; }
+    sudo="sudo"
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  # A fresh machine has no package lists yet; refresh them once (cheap when already recent).
+  $sudo apt-get update -q
+  $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+  echo "install-deps: done"
 fi
-export DEBIAN_FRONTEND=noninteractive
-# A fresh machine has no package lists yet; refresh them once (cheap when already recent).
-$sudo apt-get update -q
-$sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
-echo "install-deps: done"
+
+# npm packages, one folder per Node.js step, from its committed package-lock.json. Quiet when
+# node_modules is already newer than the lockfile.
+for dir in "$here/../tools/ifc_import"; do
+  dir=$(cd "$dir" && pwd)
+  lock="$dir/package-lock.json"
+  [ -f "$lock" ] || continue
+  stamp="$dir/node_modules/.package-lock.json"
+  if [ -f "$stamp" ] && [ "$stamp" -nt "$lock" ]; then
+    continue
+  fi
+  if [ "$check_only" -eq 1 ]; then
+    echo "install-deps: npm packages of $dir are missing or older than its lockfile" >&2
+    exit 1
+  fi
+  if ! command -v npm >/dev/null; then
+    echo "install-deps: npm not found; installing Debian's npm package"
+    sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends npm
+  fi
+  echo "install-deps: npm ci in $dir"
+  (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+done

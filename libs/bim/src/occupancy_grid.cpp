@@ -11,11 +11,11 @@ namespace concert::bim {
 
 namespace fs = std::filesystem;
 
-OccupancyGrid OccupancyGrid::filled(int width, int height, double resolution, const Eigen::Vector2d& origin,
-                                    std::int8_t fill) {
+OccupancyGrid OccupancyGrid::filled(int width, int height, double resolution,
+                                    const Eigen::Vector2d& origin, std::int8_t fill) {
   if (width <= 0 || height <= 0) {
-    throw MapError("occupancy grid: size " + std::to_string(width) + " x " + std::to_string(height) +
-                   " cells: both must be > 0");
+    throw MapError("occupancy grid: size " + std::to_string(width) + " x " +
+                   std::to_string(height) + " cells: both must be > 0");
   }
   if (!(resolution > 0.0) || !std::isfinite(resolution)) {
     throw MapError("occupancy grid: resolution " + std::to_string(resolution) + " m: must be > 0");
@@ -45,9 +45,10 @@ bool OccupancyGrid::occupied(const Eigen::Vector2d& p) const {
 
 void save_map(const OccupancyGrid& grid, const std::string& dir, const std::string& stem) {
   if (grid.width <= 0 || grid.height <= 0 ||
-      grid.cells.size() != static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height)) {
-    throw MapError("save_map: the grid's cells do not match its size " + std::to_string(grid.width) + " x " +
-                   std::to_string(grid.height));
+      grid.cells.size() !=
+          static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height)) {
+    throw MapError("save_map: the grid's cells do not match its size " +
+                   std::to_string(grid.width) + " x " + std::to_string(grid.height));
   }
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -61,8 +62,8 @@ void save_map(const OccupancyGrid& grid, const std::string& dir, const std::stri
       for (int c = 0; c < grid.width; ++c) {
         const std::int8_t v = grid.at(c, r);
         row[static_cast<std::size_t>(c)] = static_cast<char>(v == OccupancyGrid::kOccupied ? 0
-                                                             : v == OccupancyGrid::kFree ? 254
-                                                                                         : 205);
+                                                             : v == OccupancyGrid::kFree   ? 254
+                                                                                           : 205);
       }
       out.write(row.data(), static_cast<std::streamsize>(row.size()));
     }
@@ -77,7 +78,7 @@ void save_map(const OccupancyGrid& grid, const std::string& dir, const std::stri
       << "origin: [" << grid.origin.x() << ", " << grid.origin.y() << ", 0.0]\n"
       << "negate: 0\n"
       << "occupied_thresh: 0.65\n"
-      << "free_thresh: 0.25\n";
+      << "free_thresh: 0.196\n";
   if (!out) throw MapError("save_map: cannot write '" + yaml.string() + "'");
 }
 
@@ -126,7 +127,8 @@ OccupancyGrid load_map(const std::string& yaml_path) {
     throw MapError("map file '" + yaml_path + "': " + e.what());
   }
   auto field = [&](const char* name) {
-    if (!root.IsMap() || !root[name]) throw MapError("map file '" + yaml_path + "': missing field '" + name + "'");
+    if (!root.IsMap() || !root[name])
+      throw MapError("map file '" + yaml_path + "': missing field '" + name + "'");
     return root[name];
   };
   MapMetadata meta;
@@ -134,7 +136,8 @@ OccupancyGrid load_map(const std::string& yaml_path) {
     meta.image = field("image").as<std::string>();
     meta.resolution = field("resolution").as<double>();
     const auto o = field("origin");
-    if (!o.IsSequence() || o.size() != 3) throw MapError("map file '" + yaml_path + "': origin: expected [x, y, yaw]");
+    if (!o.IsSequence() || o.size() != 3)
+      throw MapError("map file '" + yaml_path + "': origin: expected [x, y, yaw]");
     meta.origin = {o[0].as<double>(), o[1].as<double>(), o[2].as<double>()};
     if (root["negate"]) meta.negate = root["negate"].as<int>() != 0;
     if (root["occupied_thresh"]) meta.occupied_thresh = root["occupied_thresh"].as<double>();
@@ -145,17 +148,21 @@ OccupancyGrid load_map(const std::string& yaml_path) {
   } catch (const std::exception& e) {
     throw MapError("map file '" + yaml_path + "': " + e.what());
   }
-  if (!(meta.resolution > 0.0)) throw MapError("map file '" + yaml_path + "': resolution: must be > 0");
+  if (!(meta.resolution > 0.0))
+    throw MapError("map file '" + yaml_path + "': resolution: must be > 0");
   if (meta.mode != "trinary") {
-    throw MapError("map file '" + yaml_path + "': mode '" + meta.mode + "': only trinary maps are read");
+    throw MapError("map file '" + yaml_path + "': mode '" + meta.mode +
+                   "': only trinary maps are read");
   }
   if (std::abs(meta.origin.z()) > 1e-9) {
-    throw MapError("map file '" + yaml_path + "': origin: a rotated map (yaw != 0) is not supported");
+    throw MapError("map file '" + yaml_path +
+                   "': origin: a rotated map (yaw != 0) is not supported");
   }
   fs::path image = meta.image;
   if (image.is_relative()) image = fs::path(yaml_path).parent_path() / image;
   std::ifstream in(image, std::ios::binary);
-  if (!in) throw MapError("map file '" + yaml_path + "': image '" + image.string() + "' cannot be opened");
+  if (!in)
+    throw MapError("map file '" + yaml_path + "': image '" + image.string() + "' cannot be opened");
   const std::string file = image.string();
   const std::string magic = pgm_token(in, file);
   if (magic != "P5" && magic != "P2") {
@@ -165,27 +172,30 @@ OccupancyGrid load_map(const std::string& yaml_path) {
   const int h = pgm_int(in, file, "height");
   const int maxval = pgm_int(in, file, "maxval");
   if (maxval > 255) throw MapError("map image '" + file + "': 16-bit PGM images are not supported");
-  OccupancyGrid grid = OccupancyGrid::filled(w, h, meta.resolution, meta.origin.head<2>(), OccupancyGrid::kUnknown);
+  OccupancyGrid grid =
+      OccupancyGrid::filled(w, h, meta.resolution, meta.origin.head<2>(), OccupancyGrid::kUnknown);
   for (int r = h - 1; r >= 0; --r) {
     for (int c = 0; c < w; ++c) {
       int v = 0;
       if (magic == "P5") {
         const int ch = in.get();
         if (ch == EOF) {
-          throw MapError("map image '" + file + "': truncated: " + std::to_string(w * h) + " pixels expected");
+          throw MapError("map image '" + file + "': truncated: " + std::to_string(w * h) +
+                         " pixels expected");
         }
         v = ch;
       } else {
         if (!(in >> v)) {
-          throw MapError("map image '" + file + "': truncated: " + std::to_string(w * h) + " pixels expected");
+          throw MapError("map image '" + file + "': truncated: " + std::to_string(w * h) +
+                         " pixels expected");
         }
       }
       // map_server: occupancy = (255 - v) / 255 unless negated.
       const double occ = meta.negate ? v / static_cast<double>(maxval)
                                      : (maxval - v) / static_cast<double>(maxval);
       grid.at(c, r) = occ > meta.occupied_thresh ? OccupancyGrid::kOccupied
-                      : occ < meta.free_thresh  ? OccupancyGrid::kFree
-                                                : OccupancyGrid::kUnknown;
+                      : occ < meta.free_thresh   ? OccupancyGrid::kFree
+                                                 : OccupancyGrid::kUnknown;
     }
   }
   return grid;

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "concert/bim/storey_world.hpp"
 #include "concert/common/clock.hpp"
 #include "concert/dds/catalogue.hpp"
 #include "concert/dds/endpoint.hpp"
@@ -288,15 +289,33 @@ int run_sim(const SimOptions& o, std::ostream& out, std::ostream& /*err*/) {
     throw UsageError("unknown sim verb '" + o.verb + "' (assemble, swap, world)");
   }
   const bool assembly = o.verb != "world";
-  // Checked here first: a bad file never reaches the simulator (which checks again).
-  if (assembly) {
-    check_assembly(o.file, o.module_dbs);
-  } else {
-    check_world(o.file);
+  const bool from_ifc = !assembly && !o.ifc.empty();
+  if (!assembly && o.file.empty() == o.ifc.empty()) {
+    throw UsageError("sim world: give a world FILE or --ifc FILE --storey NAME (one of them)");
   }
-  std::ifstream in(o.file);
+  if (from_ifc && o.storey.empty()) throw UsageError("sim world --ifc: --storey NAME is required");
   std::stringstream content;
-  content << in.rdbuf();
+  std::string name = fs::path(o.file).filename().string();
+  if (from_ifc) {
+    // The storey's world (bim::storey_world), checked by the world parser like a file.
+    try {
+      const bim::BimModel model = bim::load_ifc(o.ifc);
+      content << bim::world_yaml(bim::storey_world(model, model.storey(o.storey)));
+      name = fs::path(o.ifc).filename().string() + " storey " + o.storey;
+      world::parse_world_yaml(content.str(), name);
+    } catch (const std::exception& e) {
+      throw Failure(std::string("world rejected, nothing changed: ") + e.what());
+    }
+  } else {
+    // Checked here first: a bad file never reaches the simulator (which checks again).
+    if (assembly) {
+      check_assembly(o.file, o.module_dbs);
+    } else {
+      check_world(o.file);
+    }
+    std::ifstream in(o.file);
+    content << in.rdbuf();
+  }
 
   dds::Participant participant({.name = "concert_sim", .domain_id = o.dds.domain_id()});
   std::mutex m;
@@ -319,7 +338,7 @@ int run_sim(const SimOptions& o, std::ostream& out, std::ostream& /*err*/) {
   c.stamp_ns(now_ns());
   c.source("concert sim");
   c.kind(assembly ? msg::SIM_SWAP_ASSEMBLY : msg::SIM_SET_WORLD);
-  c.name(fs::path(o.file).filename().string());
+  c.name(name);
   c.content(content.str());
   // The command topic is volatile: wait for the simulator's reader before writing.
   const auto deadline = std::chrono::steady_clock::now() + o.dds.timeout();
@@ -334,10 +353,12 @@ int run_sim(const SimOptions& o, std::ostream& out, std::ostream& /*err*/) {
   }
   if (!reply->accepted()) throw Failure(reply->message());
   if (o.dds.json) {
-    out << idl::Json{{"verb", o.verb}, {"file", o.file}, {"accepted", true}, {"message", reply->message()}}.dump()
+    out << idl::Json{{"verb", o.verb}, {"file", from_ifc ? o.ifc : o.file}, {"accepted", true},
+                     {"message", reply->message()}}
+               .dump()
         << "\n";
   } else {
-    out << "concert sim " << o.verb << ": " << o.file << ": " << reply->message() << "\n";
+    out << "concert sim " << o.verb << ": " << (from_ifc ? name : o.file) << ": " << reply->message() << "\n";
   }
   return 0;
 }
@@ -383,8 +404,14 @@ void register_launcher_verbs(cli::Cli& concert) {
     o->verb = name;
     CLI::App& verb = concert.verb(
         sim, name, what, [&concert, o] { return run_sim(*o, concert.out(), concert.err()); });
-    verb.add_option("FILE", o->file, name == "world" ? "a world file" : "an assembly file")
-        ->required();
+    if (name == "world") {
+      verb.add_option("FILE", o->file, "a world file (or --ifc)");
+      verb.add_option("--ifc", o->ifc, "build the world from a storey of this IFC file (bim::storey_world)")
+          ->type_name("FILE");
+      verb.add_option("--storey", o->storey, "with --ifc: the storey (name or GlobalId)")->type_name("NAME");
+    } else {
+      verb.add_option("FILE", o->file, "an assembly file")->required();
+    }
     if (name != "world") {
       verb.add_option("--module-db", o->module_dbs,
                       "module database folder to check the assembly against (repeat to merge)")

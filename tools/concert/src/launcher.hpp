@@ -84,6 +84,8 @@ struct UpOptions {
 struct SimOptions {
   std::string verb;  ///< assemble, swap or world
   std::string file;  ///< assembly or world YAML on this host
+  std::string ifc;     ///< world only: build the world from this IFC file's storey instead
+  std::string storey;  ///< with ifc: the storey (name or GlobalId)
   std::vector<std::string> module_dbs;  ///< extra module databases to check the assembly against
   cli::DdsOptions dds;  ///< --domain, --timeout (for the simulator and its answer), --json
 };

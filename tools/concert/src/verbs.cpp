@@ -2,6 +2,7 @@
 
 #include <memory>
 
+#include "bim_verbs.hpp"
 #include "camera_verbs.hpp"
 #include "launcher.hpp"
 #include "scan_verbs.hpp"
@@ -48,6 +49,7 @@ void register_all(cli::Cli& concert) {
   register_topic_verbs(concert);
   register_scan_verbs(concert);
   register_camera_verbs(concert);
+  register_bim_verbs(concert);
   register_service_verbs(concert);
   register_help(concert);
 }

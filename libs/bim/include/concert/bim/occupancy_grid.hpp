@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -27,16 +26,20 @@ struct OccupancyGrid {
   int width{0};             ///< columns (x)
   int height{0};            ///< rows (y)
   double resolution{0.05};  ///< cell side [m]
-  Eigen::Vector2d origin{0.0, 0.0};  ///< map-frame position of the lower-left corner of cell (0, 0) [m]
-  std::vector<std::int8_t> cells;    ///< row-major, width * height, row 0 at the bottom
+  Eigen::Vector2d origin{0.0,
+                         0.0};  ///< map-frame position of the lower-left corner of cell (0, 0) [m]
+  std::vector<std::int8_t> cells;  ///< row-major, width * height, row 0 at the bottom
 
   /// An all-`fill` grid. Throws MapError unless width, height > 0 and resolution > 0.
-  static OccupancyGrid filled(int width, int height, double resolution, const Eigen::Vector2d& origin,
-                              std::int8_t fill = kFree);
+  static OccupancyGrid filled(int width, int height, double resolution,
+                              const Eigen::Vector2d& origin, std::int8_t fill = kFree);
 
-  [[nodiscard]] bool inside(int col, int row) const { return col >= 0 && row >= 0 && col < width && row < height; }
+  [[nodiscard]] bool inside(int col, int row) const {
+    return col >= 0 && row >= 0 && col < width && row < height;
+  }
   [[nodiscard]] std::size_t index(int col, int row) const {
-    return static_cast<std::size_t>(row) * static_cast<std::size_t>(width) + static_cast<std::size_t>(col);
+    return static_cast<std::size_t>(row) * static_cast<std::size_t>(width) +
+           static_cast<std::size_t>(col);
   }
   [[nodiscard]] std::int8_t at(int col, int row) const { return cells[index(col, row)]; }
   std::int8_t& at(int col, int row) { return cells[index(col, row)]; }
@@ -50,8 +53,8 @@ struct OccupancyGrid {
 
 /// Map metadata of nav2's map_server YAML (map.yaml).
 struct MapMetadata {
-  std::string image;          ///< image file, relative to the YAML file's folder
-  double resolution{0.05};    ///< [m/cell]
+  std::string image;                ///< image file, relative to the YAML file's folder
+  double resolution{0.05};          ///< [m/cell]
   Eigen::Vector3d origin{0, 0, 0};  ///< x, y [m], yaw [rad] of the image's lower-left pixel
   bool negate{false};
   double occupied_thresh{0.65};
@@ -61,7 +64,8 @@ struct MapMetadata {
 
 /// Writes `grid` as nav2 map_server files: `<dir>/<stem>.pgm` (binary P5, 8 bit: occupied 0,
 /// free 254, unknown 205, top row first) and `<dir>/<stem>.yaml` (image, resolution, origin,
-/// negate 0, occupied_thresh 0.65, free_thresh 0.25, mode trinary). Creates `dir`.
+/// negate 0, occupied_thresh 0.65, free_thresh 0.196 (ROS map_saver's value: unknown 205 reads back
+/// as unknown, with 0.25 it would read as free), mode trinary). Creates `dir`.
 /// Throws MapError naming the file on a write failure.
 void save_map(const OccupancyGrid& grid, const std::string& dir, const std::string& stem = "map");
 
