@@ -174,7 +174,7 @@ TEST_F(NavigatorTest, RefusesWhatItCannotDoWithAReason) {
   // Each refusal was reported.
   int refused = 0;
   for (const auto& u : nav_.take_updates()) refused += u.state == GoalState::kRefused;
-  EXPECT_EQ(refused, 6);
+  EXPECT_EQ(refused, 5);
 }
 
 TEST_F(NavigatorTest, SafetyStopCancelsAndGoalsWaitForTheReset) {

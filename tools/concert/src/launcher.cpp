@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "concert/bim/model.hpp"
 #include "concert/bim/storey_world.hpp"
 #include "concert/common/clock.hpp"
 #include "concert/dds/catalogue.hpp"
@@ -226,11 +227,34 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
   }
   check_assembly(assembly, module_dbs);
   if (world) check_world(*world);
+  if (!o.ifc.empty() && world) throw UsageError("give --world or --ifc, not both");
+  if (!o.ifc.empty() && o.storey.empty()) throw UsageError("--ifc needs --storey NAME");
+  if (o.ifc.empty() && !o.storey.empty()) throw UsageError("--storey goes with --ifc");
+  // The building's storey: the simulator's world (bim::storey_world) and nav's map, one file.
+  std::string ifc_world;
+  if (!o.ifc.empty()) {
+    out << "concert up: importing " << o.ifc << " (storey " << o.storey << ")" << std::endl;
+    try {
+      const bim::BimModel model = bim::load_ifc(o.ifc);
+      ifc_world = bim::world_yaml(bim::storey_world(model, model.storey(o.storey)));
+      world::parse_world_yaml(ifc_world, o.ifc);
+    } catch (const std::exception& e) {
+      throw Failure(std::string("--ifc: nothing started: ") + e.what());
+    }
+  }
+  const std::vector<double> start = o.start.empty() ? std::vector<double>{0.0, 0.0, 0.0} : o.start;
 
   const fs::path dir = run_dir(domain);
   fs::create_directories(dir / "logs");
   install_file(assembly, dir / "assembly.yaml");
   if (world) install_file(*world, dir / "world.yaml");
+  if (!ifc_world.empty()) std::ofstream(dir / "world.yaml") << ifc_world;
+  // The simulated robot's start pose (robot.yaml's sim section; the rest stays the default).
+  {
+    std::ofstream params(dir / "robot_params.yaml");
+    params << std::setprecision(17) << "sim:\n  base_position: [" << start[0] << ", " << start[1]
+           << ", 0.0]\n  base_yaw: " << start[2] << "\n";
+  }
 
   std::vector<std::string> db_args;
   for (const auto& db : module_dbs) {
@@ -242,15 +266,27 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
     std::vector<std::string> args;
     bool required;
   };
-  std::vector<std::string> robot_args = {"--assembly", (dir / "assembly.yaml").string()};
-  if (world) robot_args.insert(robot_args.end(), {"--world", (dir / "world.yaml").string()});
+  std::vector<std::string> robot_args = {"--assembly", (dir / "assembly.yaml").string(), "--params",
+                                         (dir / "robot_params.yaml").string()};
+  if (world || !ifc_world.empty()) robot_args.insert(robot_args.end(), {"--world", (dir / "world.yaml").string()});
   robot_args.insert(robot_args.end(), db_args.begin(), db_args.end());
+  // nav: the building's map when there is one, localised at the start pose.
+  std::vector<std::string> nav_args;
+  if (!o.ifc.empty()) {
+    std::ostringstream x, y, yaw;
+    x << std::setprecision(17) << start[0];
+    y << std::setprecision(17) << start[1];
+    yaw << std::setprecision(17) << start[2];
+    nav_args = {"--ifc", fs::absolute(o.ifc).string(), "--storey", o.storey, "--initial-pose", x.str(), y.str(),
+                yaw.str()};
+  }
   const std::vector<Plan> plan = {
       {"safety", "concert_safety", {}, false},
       {"discovery", "concert_discovery", db_args, true},
       {"modelgen", "concert_modelgen", db_args, true},
       {"robot", "concert_robot", robot_args, true},
       {"planner", "concert_planner", {}, false},
+      {"nav", "concert_nav", nav_args, false},
   };
   std::vector<ServiceSpec> services;
   for (const auto& p : plan) {
@@ -375,6 +411,13 @@ void register_launcher_verbs(cli::Cli& concert) {
       ->default_str(up->assembly);
   up_verb.add_option("--world", up->world, "the simulated world (walls, obstacles)")
       ->type_name("FILE");
+  up_verb.add_option("--ifc", up->ifc, "a building: the simulated world and nav's map from one IFC storey")
+      ->type_name("FILE");
+  up_verb.add_option("--storey", up->storey, "with --ifc: the storey (name or GlobalId)")->type_name("NAME");
+  up_verb.add_option("--start", up->start, "the robot's start pose in the world (nav starts localised there)")
+      ->expected(3)
+      ->type_name("X Y THETA")
+      ->check(cli::real());
   up_verb
       .add_option("--module-db", up->module_dbs,
                   "module database folder (repeat to merge; default: the project's)")

@@ -74,6 +74,9 @@ struct UpOptions {
   std::string backend = "sim";
   std::string assembly = CONCERT_DEFAULT_ASSEMBLY;
   std::string world;                    ///< "" = none
+  std::string ifc;                      ///< a building: the world of its storey and nav's map ("" = none)
+  std::string storey;                   ///< with ifc: the storey (name or GlobalId)
+  std::vector<double> start;            ///< the robot's start pose x, y, yaw in the world (empty: 0 0 0)
   std::vector<std::string> module_dbs;  ///< "" = the project's
   std::string bin_dir;                  ///< "" = CONCERT_BIN_DIR, the build tree, PATH
   double duration_s = 0.0;              ///< 0 = until Ctrl-C
