@@ -60,7 +60,7 @@ int run(const Options& o) {
     navigator.set_initial_pose({o.initial_pose[0], o.initial_pose[1], o.initial_pose[2]}, 0.0, 0.0);
   }
   const std::atomic<bool>& stop = cli::stop_on_signals();
-  dds::Participant participant(dds::ParticipantOptions{.name = "nav"});
+  concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "nav"});
   nav::dds::NavNode node(participant, navigator, source, std::cerr);
   std::cerr << "concert_nav: domain " << participant.domain_id()
             << (navigator.has_map() ? ", map '" + navigator.map_name() + "'" : ", no map (goals refused until one is given)")
