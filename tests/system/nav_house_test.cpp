@@ -21,6 +21,7 @@
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/participant.hpp"
 #include "helpers.hpp"
+#include "nav/cli.hpp"
 #include "process.hpp"
 
 namespace concert::system_test {
@@ -144,6 +145,14 @@ TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
     if (track[i - 1].y() < 0.1 && track[i].y() >= 0.1) through_door |= track[i].x() > 4.95 && track[i].x() < 7.05;
   }
   EXPECT_TRUE(through_door) << logs();
+  // What an operator sees: `concert nav status`.
+  {
+    std::ostringstream out, err;
+    ASSERT_EQ(cli::run("concert", {nav::register_verbs}, {"nav", "status", "--json"}, out, err), 0) << err.str();
+    EXPECT_NE(out.str().find("\"drive\":\"omni_steering\""), std::string::npos) << out.str();
+    EXPECT_NE(out.str().find("\"name\":\"Erdgeschoss\""), std::string::npos) << out.str();
+    EXPECT_NE(out.str().find("\"state\":\"reached\""), std::string::npos) << out.str();
+  }
   EXPECT_TRUE(robot.running()) << logs();
   EXPECT_TRUE(nav.running()) << logs();
 
