@@ -45,10 +45,11 @@ fi
 
 # npm packages, one folder per Node.js step, from its committed package-lock.json. Quiet when
 # node_modules is already newer than the lockfile.
+# (A folder that is not there, as in the Docker build's first layer, is skipped.)
 for dir in "$here/../tools/ifc_import"; do
+  [ -f "$dir/package-lock.json" ] || continue
   dir=$(cd "$dir" && pwd)
   lock="$dir/package-lock.json"
-  [ -f "$lock" ] || continue
   stamp="$dir/node_modules/.package-lock.json"
   if [ -f "$stamp" ] && [ "$stamp" -nt "$lock" ]; then
     continue

@@ -8,6 +8,7 @@
 
 #include "bim_test_models.hpp"
 #include "concert/bim/geometry.hpp"
+#include "process.hpp"
 
 namespace concert::bim {
 namespace {
@@ -172,46 +173,30 @@ TEST(Import, DoorsFillOpeningsOfTheirHostWall) {
 
 class BadInput : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("bim-test-" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string write(const std::string& name, const std::string& content) {
-    const fs::path p = dir_ / name;
+    const fs::path p = fs::path(dir_.path()) / name;
     std::ofstream(p, std::ios::binary) << content;
     return p.string();
   }
-  fs::path dir_;
+  /// load_ifc(path) fails with a message naming the file and saying `what`.
+  static void expect_refused(const std::string& path, const std::string& what) {
+    EXPECT_THAT([&] { (void)load_ifc(path); }, ::testing::ThrowsMessage<BimError>(::testing::AllOf(
+                                                   HasSubstr(path), HasSubstr(what))));
+  }
+  concert::testing::TempDir dir_{"bim-test"};
 };
 
 TEST_F(BadInput, TruncatedFileIsNamed) {
   const std::string text = file_text(bim_file("duplex.ifc"));
-  const std::string path = write("truncated.ifc", text.substr(0, text.size() / 2));
-  try {
-    (void)load_ifc(path);
-    FAIL() << "no error";
-  } catch (const BimError& e) {
-    EXPECT_THAT(e.what(), HasSubstr(path));
-    EXPECT_THAT(e.what(), HasSubstr("truncated"));
-  }
+  expect_refused(write("truncated.ifc", text.substr(0, text.size() / 2)), "truncated");
 }
 
 TEST_F(BadInput, NonIfcFileIsNamed) {
-  const std::string path = write("notes.ifc", "these are not the walls you are looking for\n");
-  try {
-    (void)load_ifc(path);
-    FAIL() << "no error";
-  } catch (const BimError& e) {
-    EXPECT_THAT(e.what(), HasSubstr(path));
-    EXPECT_THAT(e.what(), HasSubstr("not an IFC file"));
-  }
+  expect_refused(write("notes.ifc", "these are not the walls you are looking for\n"),
+                 "not an IFC file");
 }
 
-TEST_F(BadInput, MissingFile) {
-  EXPECT_THAT([&] { (void)load_ifc((dir_ / "none.ifc").string()); },
-              ::testing::ThrowsMessage<BimError>(HasSubstr("no such file")));
-}
+TEST_F(BadInput, MissingFile) { expect_refused(dir_.path() + "/none.ifc", "no such file"); }
 
 TEST_F(BadInput, BuildingWithoutWalls) {
   std::string text = file_text(bim_file("IfcOpenHouse_IFC4.ifc"));
@@ -224,7 +209,7 @@ TEST_F(BadInput, BuildingWithoutWalls) {
 
 TEST_F(BadInput, MissingImportStepIsNamed) {
   EXPECT_THAT(
-      [&] { (void)load_ifc(bim_file("duplex.ifc"), {.script = (dir_ / "nope.mjs").string()}); },
+      [&] { (void)load_ifc(bim_file("duplex.ifc"), {.script = dir_.path() + "/nope.mjs"}); },
       ::testing::ThrowsMessage<BimError>(HasSubstr("nope.mjs")));
 }
 

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <random>
 
+#include "process.hpp"
+
 namespace concert::bim {
 namespace {
 
@@ -15,12 +17,8 @@ using ::testing::HasSubstr;
 
 class MapFiles : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("bim-map-test-" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  concert::testing::TempDir tmp_{"bim-map-test"};
+  fs::path dir_{tmp_.path()};
 };
 
 TEST_F(MapFiles, RoundTripKeepsEveryCellAndTheFrame) {

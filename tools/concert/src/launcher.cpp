@@ -394,7 +394,8 @@ int run_sim(const SimOptions& o, std::ostream& out, std::ostream& /*err*/) {
                .dump()
         << "\n";
   } else {
-    out << "concert sim " << o.verb << ": " << (from_ifc ? name : o.file) << ": " << reply->message() << "\n";
+    out << "concert sim " << o.verb << ": " << (from_ifc ? name : o.file) << ": "
+        << reply->message() << "\n";
   }
   return 0;
 }
@@ -449,9 +450,11 @@ void register_launcher_verbs(cli::Cli& concert) {
         sim, name, what, [&concert, o] { return run_sim(*o, concert.out(), concert.err()); });
     if (name == "world") {
       verb.add_option("FILE", o->file, "a world file (or --ifc)");
-      verb.add_option("--ifc", o->ifc, "build the world from a storey of this IFC file (bim::storey_world)")
+      verb.add_option("--ifc", o->ifc,
+                      "build the world from a storey of this IFC file (bim::storey_world)")
           ->type_name("FILE");
-      verb.add_option("--storey", o->storey, "with --ifc: the storey (name or GlobalId)")->type_name("NAME");
+      verb.add_option("--storey", o->storey, "with --ifc: the storey (name or GlobalId)")
+          ->type_name("NAME");
     } else {
       verb.add_option("FILE", o->file, "an assembly file")->required();
     }
