@@ -47,6 +47,22 @@ bool contains(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d
   return true;
 }
 
+// Assembly YAML: the Mobile Base Hub with its first `legs` steering + wheel legs (FL, FR, RL, RR).
+std::string base_with_legs(int legs) {
+  const char* sides[4][2] = {{"fl", "concert_steering_fl_rr"},
+                             {"fr", "concert_steering_fr_rl"},
+                             {"rl", "concert_steering_fr_rl"},
+                             {"rr", "concert_steering_fl_rr"}};
+  std::string yaml = "modules:\n  - {name: base, key: concert_mobile_base_hub}\n";
+  for (int i = 0; i < legs; ++i) {
+    const std::string side = sides[i][0];
+    yaml += "  - {name: steer_" + side + ", key: " + sides[i][1] +
+            ", parent: base, connector: " + std::to_string(i + 1) + "}\n  - {name: wheel_" + side +
+            ", key: concert_wheel, parent: steer_" + side + ", connector: 1}\n";
+  }
+  return yaml;
+}
+
 // recognise_vehicle(model) throws a VehicleError whose message holds every one of `parts`.
 void expect_refused(const model::RobotModel& model, std::initializer_list<std::string> parts) {
   try {
@@ -243,28 +259,12 @@ modules:
 }
 
 TEST(Vehicle, TwoSteeredLegsAreRefused) {
-  const auto model = model_from_yaml(R"(
-modules:
-  - {name: base, key: concert_mobile_base_hub}
-  - {name: steer_fl, key: concert_steering_fl_rr, parent: base, connector: 1}
-  - {name: wheel_fl, key: concert_wheel, parent: steer_fl, connector: 1}
-  - {name: steer_fr, key: concert_steering_fr_rl, parent: base, connector: 2}
-  - {name: wheel_fr, key: concert_wheel, parent: steer_fr, connector: 1}
-)");
+  const auto model = model_from_yaml(base_with_legs(2));
   expect_refused(*model, {"2 steered legs (chains A, B)", "at least 3"});
 }
 
 TEST(Vehicle, ThreeSteeredLegsAreEnough) {
-  const auto model = model_from_yaml(R"(
-modules:
-  - {name: base, key: concert_mobile_base_hub}
-  - {name: steer_fl, key: concert_steering_fl_rr, parent: base, connector: 1}
-  - {name: wheel_fl, key: concert_wheel, parent: steer_fl, connector: 1}
-  - {name: steer_fr, key: concert_steering_fr_rl, parent: base, connector: 2}
-  - {name: wheel_fr, key: concert_wheel, parent: steer_fr, connector: 1}
-  - {name: steer_rl, key: concert_steering_fr_rl, parent: base, connector: 3}
-  - {name: wheel_rl, key: concert_wheel, parent: steer_rl, connector: 1}
-)");
+  const auto model = model_from_yaml(base_with_legs(3));
   const VehicleConfig v = recognise_vehicle(*model);
   EXPECT_EQ(v.drive, DriveType::kOmniSteering);
   EXPECT_EQ(v.wheels.size(), 3u);
