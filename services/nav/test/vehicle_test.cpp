@@ -47,6 +47,32 @@ bool contains(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d
   return true;
 }
 
+// Assembly YAML: the Mobile Base Hub with its first `legs` steering + wheel legs (FL, FR, RL, RR).
+std::string base_with_legs(int legs) {
+  const char* sides[4][2] = {{"fl", "concert_steering_fl_rr"},
+                             {"fr", "concert_steering_fr_rl"},
+                             {"rl", "concert_steering_fr_rl"},
+                             {"rr", "concert_steering_fl_rr"}};
+  std::string yaml = "modules:\n  - {name: base, key: concert_mobile_base_hub}\n";
+  for (int i = 0; i < legs; ++i) {
+    const std::string side = sides[i][0];
+    yaml += "  - {name: steer_" + side + ", key: " + sides[i][1] +
+            ", parent: base, connector: " + std::to_string(i + 1) + "}\n  - {name: wheel_" + side +
+            ", key: concert_wheel, parent: steer_" + side + ", connector: 1}\n";
+  }
+  return yaml;
+}
+
+// recognise_vehicle(model) throws a VehicleError whose message holds every one of `parts`.
+void expect_refused(const model::RobotModel& model, std::initializer_list<std::string> parts) {
+  try {
+    recognise_vehicle(model);
+    ADD_FAILURE() << model.where() << " was given a vehicle";
+  } catch (const VehicleError& e) {
+    for (const std::string& part : parts) EXPECT_THAT(e.what(), HasSubstr(part));
+  }
+}
+
 const SensorPose* find_sensor(const std::vector<SensorPose>& list, const std::string& name) {
   const auto it = std::find_if(list.begin(), list.end(),
                                [&](const SensorPose& s) { return s.name.find(name) == 0; });
@@ -218,13 +244,7 @@ TEST(Vehicle, WheelsThatAreNotCoaxialAreRefused) {
   const std::string from = "<origin xyz=\"0 -0.25 0\"";
   d.urdf.replace(d.urdf.find(from), from.size(), "<origin xyz=\"0.2 -0.25 0\"");
   const auto model = model::RobotModel::build(d);
-  try {
-    recognise_vehicle(*model);
-    FAIL() << "offset wheels accepted";
-  } catch (const VehicleError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("model version 3"));
-    EXPECT_THAT(e.what(), HasSubstr("not coaxial"));
-  }
+  expect_refused(*model, {"model version 3", "not coaxial"});
 }
 
 TEST(Vehicle, AnArmWithoutWheelsCannotNavigate) {
@@ -235,44 +255,16 @@ modules:
   - {name: elbow_1, key: concert_elbow_a, parent: yaw_1, connector: 1}
   - {name: tool, key: concert_drill, parent: elbow_1, connector: 1}
 )");
-  try {
-    recognise_vehicle(*model);
-    FAIL() << "a fixed-base arm was given a vehicle";
-  } catch (const VehicleError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("model version 1"));
-    EXPECT_THAT(e.what(), HasSubstr("no wheels: a fixed-base arm cannot navigate"));
-  }
+  expect_refused(*model, {"model version 1", "no wheels: a fixed-base arm cannot navigate"});
 }
 
 TEST(Vehicle, TwoSteeredLegsAreRefused) {
-  const auto model = model_from_yaml(R"(
-modules:
-  - {name: base, key: concert_mobile_base_hub}
-  - {name: steer_fl, key: concert_steering_fl_rr, parent: base, connector: 1}
-  - {name: wheel_fl, key: concert_wheel, parent: steer_fl, connector: 1}
-  - {name: steer_fr, key: concert_steering_fr_rl, parent: base, connector: 2}
-  - {name: wheel_fr, key: concert_wheel, parent: steer_fr, connector: 1}
-)");
-  try {
-    recognise_vehicle(*model);
-    FAIL() << "two steered legs accepted";
-  } catch (const VehicleError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("2 steered legs (chains A, B)"));
-    EXPECT_THAT(e.what(), HasSubstr("at least 3"));
-  }
+  const auto model = model_from_yaml(base_with_legs(2));
+  expect_refused(*model, {"2 steered legs (chains A, B)", "at least 3"});
 }
 
 TEST(Vehicle, ThreeSteeredLegsAreEnough) {
-  const auto model = model_from_yaml(R"(
-modules:
-  - {name: base, key: concert_mobile_base_hub}
-  - {name: steer_fl, key: concert_steering_fl_rr, parent: base, connector: 1}
-  - {name: wheel_fl, key: concert_wheel, parent: steer_fl, connector: 1}
-  - {name: steer_fr, key: concert_steering_fr_rl, parent: base, connector: 2}
-  - {name: wheel_fr, key: concert_wheel, parent: steer_fr, connector: 1}
-  - {name: steer_rl, key: concert_steering_fr_rl, parent: base, connector: 3}
-  - {name: wheel_rl, key: concert_wheel, parent: steer_rl, connector: 1}
-)");
+  const auto model = model_from_yaml(base_with_legs(3));
   const VehicleConfig v = recognise_vehicle(*model);
   EXPECT_EQ(v.drive, DriveType::kOmniSteering);
   EXPECT_EQ(v.wheels.size(), 3u);

@@ -93,8 +93,10 @@ struct LocaliserParams {
   double update_min_distance{0.03};
   double update_min_angle{0.03};
   double resample_ratio{0.5};  ///< resample when N_eff < ratio * N
-  double cluster_radius{0.5};  ///< particles within this of the best one form the estimate [m]
-  double cluster_angle{0.5};   ///< ... and this in yaw [rad]
+  /// The estimate: the mean of the particles within cluster_radius [m] and cluster_angle [rad]
+  /// of the heaviest cell of a (cluster_radius, cluster_radius, cluster_angle) histogram.
+  double cluster_radius{0.5};
+  double cluster_angle{0.5};
   /// Gauss-Newton refinement of the estimate against the distance field.
   bool refine{true};
   int refine_beams{240};
@@ -105,7 +107,9 @@ struct LocaliserParams {
   /// A beam within this distance of the map matches [m]; the match ratio is the fraction of
   /// returns that match at the estimate.
   double match_distance{0.15};
-  double lost_match_ratio{0.3};  ///< below this for lost_after scans: lost, particles spread
+  /// Below this for lost_after scans: lost, particles spread (again while lost: a wrong
+  /// cluster is dropped).
+  double lost_match_ratio{0.3};
   int lost_after{10};
   /// lost -> tracking after converged_after consecutive weighed scans with the match ratio
   /// above converged_match_ratio, the estimate refined, and the cluster's spread below:

@@ -123,24 +123,18 @@ LikelihoodField::LikelihoodField(OccupancyGrid grid, double max_distance)
   std::vector<double> f(static_cast<std::size_t>(n)), d(static_cast<std::size_t>(n));
   std::vector<int> v(static_cast<std::size_t>(n));
   std::vector<double> z(static_cast<std::size_t>(n) + 1);
-  f.resize(static_cast<std::size_t>(h));
-  d.resize(static_cast<std::size_t>(h));
-  for (int col = 0; col < w; ++col) {
-    for (int row = 0; row < h; ++row)
-      f[static_cast<std::size_t>(row)] = squared[grid_.index(col, row)];
-    distance_transform_1d(f, d, v, z);
-    for (int row = 0; row < h; ++row)
-      squared[grid_.index(col, row)] = d[static_cast<std::size_t>(row)];
-  }
-  f.resize(static_cast<std::size_t>(w));
-  d.resize(static_cast<std::size_t>(w));
-  for (int row = 0; row < h; ++row) {
-    for (int col = 0; col < w; ++col)
-      f[static_cast<std::size_t>(col)] = squared[grid_.index(col, row)];
-    distance_transform_1d(f, d, v, z);
-    for (int col = 0; col < w; ++col)
-      squared[grid_.index(col, row)] = d[static_cast<std::size_t>(col)];
-  }
+  // Separable: along every column, then along every row of the column pass's result.
+  auto transform_lines = [&](int lines, int length, auto index) {
+    f.resize(static_cast<std::size_t>(length));
+    d.resize(static_cast<std::size_t>(length));
+    for (int a = 0; a < lines; ++a) {
+      for (int b = 0; b < length; ++b) f[static_cast<std::size_t>(b)] = squared[index(a, b)];
+      distance_transform_1d(f, d, v, z);
+      for (int b = 0; b < length; ++b) squared[index(a, b)] = d[static_cast<std::size_t>(b)];
+    }
+  };
+  transform_lines(w, h, [&](int col, int row) { return grid_.index(col, row); });
+  transform_lines(h, w, [&](int row, int col) { return grid_.index(col, row); });
   centre_distance_.resize(squared.size());
   for (std::size_t i = 0; i < squared.size(); ++i) {
     centre_distance_[i] = static_cast<float>(
