@@ -1,4 +1,5 @@
 #include "concert/model/dds/conversions.hpp"
+#include "concert/model/dds/pose.hpp"
 
 #include <cmath>
 #include <limits>
@@ -110,6 +111,31 @@ msg::RobotModel to_msg(const ModelDescription& d, int64_t stamp_ns) {
     m.sensor_frames().push_back(std::move(w));
   }
   return m;
+}
+
+}  // namespace concert::model::dds
+
+namespace concert::model::dds {
+
+Eigen::Isometry3d to_isometry(const msg::Pose& p) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(p.position().x(), p.position().y(), p.position().z());
+  const Eigen::Quaterniond q(p.orientation().w(), p.orientation().x(), p.orientation().y(), p.orientation().z());
+  t.linear() = q.norm() > 1e-9 ? q.normalized().toRotationMatrix() : Eigen::Matrix3d::Zero();
+  return t;
+}
+
+msg::Pose to_pose_msg(const Eigen::Isometry3d& t) {
+  msg::Pose p;
+  p.position().x(t.translation().x());
+  p.position().y(t.translation().y());
+  p.position().z(t.translation().z());
+  const Eigen::Quaterniond q(t.linear());
+  p.orientation().x(q.x());
+  p.orientation().y(q.y());
+  p.orientation().z(q.z());
+  p.orientation().w(q.w());
+  return p;
 }
 
 }  // namespace concert::model::dds

@@ -6,6 +6,7 @@
 
 #include "concert/common/clock.hpp"
 #include "concert/model/dds/conversions.hpp"
+#include "concert/model/dds/pose.hpp"
 
 namespace concert::nav::dds {
 
@@ -57,19 +58,6 @@ msg::LocalisationState to_msg(const LocalisationStatus& l) {
   return msg::LOCALISATION_NONE;
 }
 
-msg::Pose to_pose_msg(const Eigen::Isometry3d& t) {
-  msg::Pose p;
-  p.position().x(t.translation().x());
-  p.position().y(t.translation().y());
-  p.position().z(t.translation().z());
-  const Eigen::Quaterniond q(t.linear());
-  p.orientation().x(q.x());
-  p.orientation().y(q.y());
-  p.orientation().z(q.z());
-  p.orientation().w(q.w());
-  return p;
-}
-
 std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 double to_s(std::int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
@@ -83,7 +71,7 @@ msg::NavStatus to_msg(const GoalStatus& s, std::int64_t stamp_ns) {
   out.state(to_msg(s.state));
   out.reason(s.reason);
   out.goal(to_msg(s.goal));
-  if (s.area) out.goal_area(to_pose_msg(*s.area));
+  if (s.area) out.goal_area(model::dds::to_pose_msg(*s.area));
   out.pose(to_msg(s.pose));
   out.distance_remaining(s.distance_remaining);
   out.replans(s.replans);

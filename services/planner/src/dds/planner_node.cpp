@@ -1,6 +1,7 @@
 #include "dds/planner_node.hpp"
 
 #include "concert/model/dds/conversions.hpp"
+#include "concert/model/dds/pose.hpp"
 #include "concert/world/world_dds.hpp"
 
 #include <sys/resource.h>
@@ -31,28 +32,9 @@ World to_planner_world(const world::World& w) {
   return out;
 }
 
-Eigen::Isometry3d to_core(const msg::Pose& p) {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = Eigen::Vector3d(p.position().x(), p.position().y(), p.position().z());
-  const Eigen::Quaterniond q(p.orientation().w(), p.orientation().x(), p.orientation().y(),
-                             p.orientation().z());
-  // A zero quaternion stays zero so the planner rejects it (not a rigid transform).
-  t.linear() = q.norm() > 1e-9 ? q.normalized().toRotationMatrix() : Eigen::Matrix3d::Zero();
-  return t;
-}
+Eigen::Isometry3d to_core(const msg::Pose& p) { return model::dds::to_isometry(p); }
 
-msg::Pose to_msg(const Eigen::Isometry3d& t) {
-  msg::Pose p;
-  p.position().x(t.translation().x());
-  p.position().y(t.translation().y());
-  p.position().z(t.translation().z());
-  const Eigen::Quaterniond q(t.linear());
-  p.orientation().x(q.x());
-  p.orientation().y(q.y());
-  p.orientation().z(q.z());
-  p.orientation().w(q.w());
-  return p;
-}
+msg::Pose to_msg(const Eigen::Isometry3d& t) { return model::dds::to_pose_msg(t); }
 
 namespace {
 

@@ -1,0 +1,16 @@
+#pragma once
+// The one conversion between the Pose message (idl/robot.idl) and Eigen, for every adapter.
+
+#include <Eigen/Geometry>
+
+#include "robot.h"
+
+namespace concert::model::dds {
+
+/// Pose sample -> rigid transform. A zero quaternion stays a zero rotation (not a rigid
+/// transform), so that whoever checks the request refuses it rather than a silent identity.
+Eigen::Isometry3d to_isometry(const msg::Pose& pose);
+/// Rigid transform -> Pose sample.
+msg::Pose to_pose_msg(const Eigen::Isometry3d& pose);
+
+}  // namespace concert::model::dds
