@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <algorithm>
 #include <map>
+#include <optional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -15,6 +17,8 @@
 #include "concert/bim/model.hpp"
 #include "concert/bim/storey_map.hpp"
 #include "concert/bim/wall_goal.hpp"
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/participant.hpp"
 
 namespace concert::tool {
 namespace {
@@ -41,11 +45,47 @@ struct GoalOptions {
   std::vector<double> at;
   std::string bim_dir;
   std::string storey;
-  double standoff{0.8};
-  double robot_radius{0.4};
+  double standoff{0.0};      ///< 0: from the running nav service's vehicle, else kDefaultStandoff
+  double robot_radius{0.0};  ///< 0: likewise, else kDefaultRobotRadius
   std::string face{"auto"};
   bool json{false};
+  std::optional<int32_t> domain;
 };
+
+// Without a running nav service (and without --standoff / --robot-radius): a base of about the
+// CONCERT platform's size.
+constexpr double kDefaultStandoff = 0.8;
+constexpr double kDefaultRobotRadius = 0.4;
+// Footprint front edge to the wall face: nav's default wall_clearance (services/nav/config/nav.yaml).
+constexpr double kWallClearance = 0.25;
+
+// The standoff and robot radius of the mounted model, as the nav service recognised it
+// (concert/nav/vehicle, latched): the footprint's front edge + kWallClearance, and its
+// inscribed radius. Empty when no nav service answers or the model cannot navigate.
+std::optional<std::pair<double, double>> live_vehicle(const std::optional<int32_t>& domain, std::string& source) {
+  cli::DdsOptions dds;
+  dds.domain = domain;
+  dds::Participant participant({.name = "concert_bim", .domain_id = dds.domain_id()});
+  dds::Reader<msg::NavVehicle> vehicles(participant, dds::topics::nav_vehicle);
+  const auto v = vehicles.wait(std::chrono::milliseconds(1500));
+  if (!v || v->drive().empty() || v->footprint().empty()) return std::nullopt;
+  double front = 0.0;
+  std::vector<Eigen::Vector2d> polygon;
+  for (const auto& p : v->footprint()) {
+    front = std::max(front, p.x());
+    polygon.emplace_back(p.x(), p.y());
+  }
+  // Inscribed radius about the base origin: the nearest polygon edge.
+  double inscribed = 1e9;
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2d a = polygon[i], b = polygon[(i + 1) % polygon.size()];
+    const Eigen::Vector2d e = b - a;
+    const double t = std::clamp(-a.dot(e) / std::max(1e-12, e.squaredNorm()), 0.0, 1.0);
+    inscribed = std::min(inscribed, (a + t * e).norm());
+  }
+  source = "model version " + std::to_string(v->model_version()) + " (" + v->drive() + ")";
+  return std::make_pair(front + kWallClearance, inscribed);
+}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -182,8 +222,17 @@ int run_goal(const GoalOptions& o, std::ostream& out) {
     options.face = o.face == "left"    ? bim::FaceChoice::kLeft
                    : o.face == "right" ? bim::FaceChoice::kRight
                                        : bim::FaceChoice::kAuto;
+    double standoff = o.standoff, robot_radius = o.robot_radius;
+    std::string sizes = "given";
+    if (standoff <= 0.0 || robot_radius <= 0.0) {
+      std::string source;
+      const auto live = live_vehicle(o.domain, source);
+      sizes = live ? "from the running " + source : "defaults (no nav service running)";
+      if (standoff <= 0.0) standoff = live ? live->first : kDefaultStandoff;
+      if (robot_radius <= 0.0) robot_radius = live ? live->second : kDefaultRobotRadius;
+    }
     const bim::WallGoal g =
-        bim::wall_goal(model, grid, o.wall, o.at[0], o.at[1], o.standoff, o.robot_radius, options);
+        bim::wall_goal(model, grid, o.wall, o.at[0], o.at[1], standoff, robot_radius, options);
     const Eigen::Vector3d p = g.area_frame.translation();
     const Eigen::Matrix3d r = g.area_frame.linear();
     const Eigen::Quaterniond q(r);
@@ -200,7 +249,10 @@ int run_goal(const GoalOptions& o, std::ostream& out) {
                     {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}}},
                   {"base_pose",
                    {{"x", g.base_pose.x()}, {"y", g.base_pose.y()}, {"theta", g.base_pose.z()}}},
-                  {"free_area_m2", g.free_area}}
+                  {"free_area_m2", g.free_area},
+                  {"standoff", standoff},
+                  {"robot_radius", robot_radius},
+                  {"sizes", sizes}}
                  .dump()
           << "\n";
     } else {
@@ -270,12 +322,15 @@ void register_bim_verbs(cli::Cli& concert) {
       ->type_name("DIR");
   goal.add_option("--storey", go->storey, "the storey whose map to use (default: the wall's)")
       ->type_name("NAME");
-  goal.add_option("--standoff", go->standoff, "distance from the face to the base's centre [m]")
-      ->check(cli::number(0, 1e3, false, true))
-      ->default_str("0.8");
-  goal.add_option("--robot-radius", go->robot_radius, "radius of the base's footprint disc [m]")
-      ->check(cli::number(0, 1e3, false, true))
-      ->default_str("0.4");
+  goal.add_option("--standoff", go->standoff,
+                  "distance from the face to the base's centre [m] (default: the running robot's "
+                  "footprint front + 0.25 m, as nav computes it; 0.8 without a nav service)")
+      ->check(cli::number(0, 1e3, false, true));
+  goal.add_option("--robot-radius", go->robot_radius,
+                  "radius of the base's footprint disc [m] (default: the running robot's inscribed "
+                  "radius; 0.4 without a nav service)")
+      ->check(cli::number(0, 1e3, false, true));
+  cli::Cli::add_domain_option(goal, go->domain);
   cli::Cli::add_choice(goal, "--face", go->face, {"auto", "left", "right"},
                        "which face (left/right of the wall's axis; auto: the reachable one)");
   goal.add_flag("--json", go->json, "machine-readable output");
