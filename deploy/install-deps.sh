@@ -62,6 +62,7 @@ for dir in "$here/../tools/ifc_import"; do
     echo "install-deps: npm not found; installing Debian's npm package"
     sudo=""
     [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    $sudo apt-get update -q  # the lists may be gone (the Docker image removes them)
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends npm
   fi
   echo "install-deps: npm ci in $dir"
