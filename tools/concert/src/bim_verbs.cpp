@@ -48,8 +48,7 @@ struct GoalOptions {
   double standoff{0.0};      ///< 0: from the running nav service's vehicle, else kDefaultStandoff
   double robot_radius{0.0};  ///< 0: likewise, else kDefaultRobotRadius
   std::string face{"auto"};
-  bool json{false};
-  std::optional<int32_t> domain;
+  cli::DdsOptions dds;  ///< --domain/--timeout: where to ask nav for the vehicle; --json
 };
 
 // Without a running nav service (and without --standoff / --robot-radius): a base of about the
@@ -62,12 +61,10 @@ constexpr double kWallClearance = 0.25;
 // The standoff and robot radius of the mounted model, as the nav service recognised it
 // (concert/nav/vehicle, latched): the footprint's front edge + kWallClearance, and its
 // inscribed radius. Empty when no nav service answers or the model cannot navigate.
-std::optional<std::pair<double, double>> live_vehicle(const std::optional<int32_t>& domain, std::string& source) {
-  cli::DdsOptions dds;
-  dds.domain = domain;
+std::optional<std::pair<double, double>> live_vehicle(const cli::DdsOptions& dds, std::string& source) {
   dds::Participant participant({.name = "concert_bim", .domain_id = dds.domain_id()});
   dds::Reader<msg::NavVehicle> vehicles(participant, dds::topics::nav_vehicle);
-  const auto v = vehicles.wait(std::chrono::milliseconds(1500));
+  const auto v = vehicles.wait(dds.timeout());
   if (!v || v->drive().empty() || v->footprint().empty()) return std::nullopt;
   double front = 0.0;
   std::vector<Eigen::Vector2d> polygon;
@@ -226,7 +223,7 @@ int run_goal(const GoalOptions& o, std::ostream& out) {
     std::string sizes = "given";
     if (standoff <= 0.0 || robot_radius <= 0.0) {
       std::string source;
-      const auto live = live_vehicle(o.domain, source);
+      const auto live = live_vehicle(o.dds, source);
       sizes = live ? "from the running " + source : "defaults (no nav service running)";
       if (standoff <= 0.0) standoff = live ? live->first : kDefaultStandoff;
       if (robot_radius <= 0.0) robot_radius = live ? live->second : kDefaultRobotRadius;
@@ -236,7 +233,7 @@ int run_goal(const GoalOptions& o, std::ostream& out) {
     const Eigen::Vector3d p = g.area_frame.translation();
     const Eigen::Matrix3d r = g.area_frame.linear();
     const Eigen::Quaterniond q(r);
-    if (o.json) {
+    if (o.dds.json) {
       auto v3 = [](const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); };
       out << Json{{"wall", o.wall},
                   {"storey", g.storey},
@@ -330,10 +327,10 @@ void register_bim_verbs(cli::Cli& concert) {
                   "radius of the base's footprint disc [m] (default: the running robot's inscribed "
                   "radius; 0.4 without a nav service)")
       ->check(cli::number(0, 1e3, false, true));
-  cli::Cli::add_domain_option(goal, go->domain);
   cli::Cli::add_choice(goal, "--face", go->face, {"auto", "left", "right"},
                        "which face (left/right of the wall's axis; auto: the reachable one)");
-  goal.add_flag("--json", go->json, "machine-readable output");
+  concert.add_dds_options(goal, go->dds, 1.5,
+                          "how long to wait for the nav service's vehicle (sizes not given)");
 }
 
 }  // namespace concert::tool

@@ -102,7 +102,7 @@ std::vector<std::string> required_arguments(const CLI::App& verb) {
   for (const CLI::Option* o : verb.get_options()) {
     if (!o->get_required()) continue;
     if (!o->get_positional()) args.push_back(o->get_name());
-    for (int i = 0; i < std::max(1, o->get_type_size_min()); ++i) args.push_back("1");
+    for (int i = 0; i < std::max(1, o->get_items_expected_min()); ++i) args.push_back("1");
   }
   return args;
 }
