@@ -15,6 +15,8 @@
 #include <string>
 #include <thread>
 
+#include <Eigen/Geometry>
+
 #include "concert/bim/model.hpp"
 #include "concert/bim/storey_world.hpp"
 #include "concert/common/clock.hpp"
@@ -145,6 +147,46 @@ TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
     if (track[i - 1].y() < 0.1 && track[i].y() >= 0.1) through_door |= track[i].x() > 4.95 && track[i].x() < 7.05;
   }
   EXPECT_TRUE(through_door) << logs();
+
+  // Then a BIM wall goal: 1.2 m high on the living room's face of the interior wall north of it
+  // (Wand-Int-ERDG-5, y = 4.13 m, 0.24 m thick, x 0.3 .. 3.8 m), 1.75 m along its axis: the base
+  // stands south of it facing north, the area frame's z points out of the wall (south).
+  {
+    msg::NavGoal g;
+    g.request_id(3);
+    g.model_version(model->version());
+    g.stamp_ns(now_ns());
+    g.source("nav_house_test");
+    g.kind(msg::NAV_GOAL_WALL);
+    g.wall("1$wmdwWPjDYuku_ghVkynE");
+    g.s(1.75);
+    g.h(1.2);
+    goals.write(g);
+  }
+  std::vector<msg::SimTruth> wall_track;
+  const auto at_wall = final_status(3, 120s, &wall_track);
+  ASSERT_TRUE(at_wall) << logs();
+  ASSERT_EQ(at_wall->state(), msg::NAV_REACHED) << at_wall->reason() << logs();
+  const auto& area = at_wall->goal_area();
+  EXPECT_NEAR(area.position().x(), 0.30 + 1.75, 0.02);
+  EXPECT_NEAR(area.position().y(), 4.13 - 0.12, 0.02);
+  EXPECT_NEAR(area.position().z(), 1.2, 1e-6);
+  const Eigen::Quaterniond q(area.orientation().w(), area.orientation().x(), area.orientation().y(),
+                             area.orientation().z());
+  EXPECT_LT((q * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, -1, 0)).norm(), 1e-3);
+  EXPECT_NEAR(at_wall->goal().yaw(), M_PI / 2, 1e-3);                 // facing the wall
+  EXPECT_LT(at_wall->goal().y(), area.position().y() - 0.5);          // in front of it
+  std::this_thread::sleep_for(500ms);
+  while (auto t = truths.take()) wall_track.push_back(*t);
+  ASSERT_FALSE(wall_track.empty());
+  const msg::SimTruth& stand = wall_track.back();
+  const double wall_error = std::hypot(stand.x() - at_wall->goal().x(), stand.y() - at_wall->goal().y());
+  std::cout << "nav house wall goal: base goal (" << at_wall->goal().x() << ", " << at_wall->goal().y()
+            << "), true error " << wall_error << " m, "
+            << std::abs(wrap(stand.yaw() - at_wall->goal().yaw())) * 180.0 / M_PI << " deg" << std::endl;
+  EXPECT_LT(wall_error, 0.10);
+  EXPECT_LT(std::abs(wrap(stand.yaw() - at_wall->goal().yaw())), 3.0 * M_PI / 180.0);
+
   // What an operator sees: `concert nav status`.
   {
     std::ostringstream out, err;

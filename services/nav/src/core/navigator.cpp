@@ -275,9 +275,28 @@ GoalStatus Navigator::submit(const GoalRequest& goal) {
   if (goal.kind == GoalRequest::Kind::kWall) {
     if (!bim_) return refuse("wall goals need the building's IFC model (the map came from a map file)");
     if (!std::isfinite(goal.s) || !std::isfinite(goal.h)) return refuse("wall goal: s and h must be numbers");
+    // wall_goal places a disc of the inscribed radius; the footprint itself must fit too. The
+    // face wall_goal prefers first, then the other one.
+    std::string why;
     try {
-      const bim::WallGoal w = bim::wall_goal(*bim_, *map_, goal.wall, goal.s, goal.h, wall_standoff(),
-                                             vehicle_->footprint.inscribed_radius);
+      bim::WallGoal w = bim::wall_goal(*bim_, *map_, goal.wall, goal.s, goal.h, wall_standoff(),
+                                       vehicle_->footprint.inscribed_radius);
+      if (costmap_->in_collision(w.base_pose)) {
+        why = "the footprint does not fit in front of the " + std::string(w.face == 0 ? "left" : "right") +
+              " face at (" + fixed(w.base_pose.x()) + ", " + fixed(w.base_pose.y()) + ")";
+        bim::GoalOptions other;
+        other.face = w.face == 0 ? bim::FaceChoice::kRight : bim::FaceChoice::kLeft;
+        try {
+          w = bim::wall_goal(*bim_, *map_, goal.wall, goal.s, goal.h, wall_standoff(),
+                             vehicle_->footprint.inscribed_radius, other);
+        } catch (const std::exception& e) {
+          return refuse(why + "; the other face: " + e.what());
+        }
+        if (costmap_->in_collision(w.base_pose)) {
+          return refuse(why + ", nor in front of the other face at (" + fixed(w.base_pose.x()) + ", " +
+                        fixed(w.base_pose.y()) + ")");
+        }
+      }
       target = {w.base_pose.x(), w.base_pose.y(), w.base_pose.z()};
       area = w.area_frame;
     } catch (const std::exception& e) {
