@@ -222,7 +222,7 @@ TEST(Vehicle, TwoCoaxialWheelsAndACasterAreADifferentialDrive) {
   EXPECT_NEAR(v.wheels[1].position.y(), -0.25, 1e-9);
   EXPECT_NEAR(v.limits.linear, 0.5, 1e-9);  // 5 rad/s x 0.1 m
   EXPECT_EQ(v.limits.lateral, 0.0);
-  EXPECT_NEAR(v.limits.angular, 1.0, 1e-9);  // 2 x 0.5 / 0.5 = 2 rad/s, capped at 1
+  EXPECT_NEAR(v.limits.angular, VehicleParams{}.max_angular_speed, 1e-9);  // 2 x 0.5 / 0.5 = 2 rad/s, capped
   EXPECT_EQ(v.limits.steering_rate, 0.0);
   // No SRDF: q = 0; the box, the wheels and the caster.
   EXPECT_EQ(v.footprint.posture, "q = 0");

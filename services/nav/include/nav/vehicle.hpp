@@ -107,7 +107,7 @@ struct VehicleConfig {
 /// Options of recognise_vehicle().
 struct VehicleParams {
   double max_linear_speed{1.0};   ///< cap [m/s], whatever the wheels allow
-  double max_angular_speed{1.0};  ///< cap [rad/s]
+  double max_angular_speed{0.5};  ///< cap [rad/s]
   /// |cos| tolerance of the axis tests (vertical steering, horizontal and coaxial wheels) [-].
   double axis_tolerance{0.02};
   int circle_segments{16};   ///< polygon sides of cylinders and spheres (circumscribed)
