@@ -7,6 +7,7 @@
 // ground truth (concert/sim/truth), not against the navigator's own estimate.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -14,8 +15,6 @@
 #include <sstream>
 #include <string>
 #include <thread>
-
-#include <Eigen/Geometry>
 
 #include "concert/bim/model.hpp"
 #include "concert/bim/storey_world.hpp"
@@ -46,31 +45,36 @@ TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
   fs::create_directories(dir);
   {
     const bim::BimModel house = bim::load_ifc(kHouse);
-    std::ofstream(dir / "world.yaml") << bim::world_yaml(bim::storey_world(house, house.storey(kStorey)));
+    std::ofstream(dir / "world.yaml")
+        << bim::world_yaml(bim::storey_world(house, house.storey(kStorey)));
   }
   // The robot at its start pose; cameras at 1 Hz (navigation does not read them: CPU for the
   // lidars on a 2-core machine).
-  std::ofstream(dir / "robot.yaml") << "sim:\n  base_position: [" << kStart[0] << ", " << kStart[1]
-                                    << ", 0.0]\n  base_yaw: " << kStart[2]
-                                    << "\nsensors:\n  camera:\n    rate: 1.0\n";
+  std::ofstream(dir / "robot.yaml")
+      << "sim:\n  base_position: [" << kStart[0] << ", " << kStart[1]
+      << ", 0.0]\n  base_yaw: " << kStart[2] << "\nsensors:\n  camera:\n    rate: 1.0\n";
 
+  // The safety layer watches the whole run: driving must not trip it (e.g. the arm's first joint
+  // holding the arm's yaw inertia while the base turns).
+  testing::Process safety(dies_with_test({SAFETY_BINARY}));
   testing::Process discovery(dies_with_test({DISCOVERY_BINARY}));
   testing::Process modelgen(dies_with_test({MODELGEN_BINARY}));
-  testing::Process robot(dies_with_test({ROBOT_BINARY, "--assembly",
-                                         std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml",
-                                         "--world", (dir / "world.yaml").string(), "--params",
-                                         (dir / "robot.yaml").string()}));
-  testing::Process nav(dies_with_test({NAV_BINARY, "--ifc", kHouse, "--storey", kStorey, "--initial-pose",
-                                       std::to_string(kStart[0]), std::to_string(kStart[1]),
-                                       std::to_string(kStart[2])}));
+  testing::Process robot(
+      dies_with_test({ROBOT_BINARY, "--assembly",
+                      std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml", "--world",
+                      (dir / "world.yaml").string(), "--params", (dir / "robot.yaml").string()}));
+  testing::Process nav(dies_with_test({NAV_BINARY, "--ifc", kHouse, "--storey", kStorey,
+                                       "--initial-pose", std::to_string(kStart[0]),
+                                       std::to_string(kStart[1]), std::to_string(kStart[2])}));
   const auto logs = [&] {
-    return "\n--- nav:\n" + nav.err() + "--- robot:\n" + robot.err() + "--- modelgen:\n" + modelgen.err() +
-           "--- discovery:\n" + discovery.err();
+    return "\n--- nav:\n" + nav.err() + "--- safety:\n" + safety.err() + "--- robot:\n" +
+           robot.err() + "--- modelgen:\n" + modelgen.err() + "--- discovery:\n" + discovery.err();
   };
 
   concert::dds::Participant p({.name = "nav_house_test"});
   concert::dds::Reader<msg::NavStatus> statuses(p, concert::dds::topics::nav_status);
-  concert::dds::Reader<msg::NavLocalisation> localisations(p, concert::dds::topics::nav_localisation);
+  concert::dds::Reader<msg::NavLocalisation> localisations(p,
+                                                           concert::dds::topics::nav_localisation);
   concert::dds::Reader<msg::SimTruth> truths(p, concert::dds::topics::sim_truth);
   concert::dds::Reader<msg::RobotModel> models(p, concert::dds::topics::robot_model);
   concert::dds::Writer<msg::NavGoal> goals(p, concert::dds::topics::nav_goal);
@@ -80,7 +84,8 @@ TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
   const auto model = models.wait(10s);
   ASSERT_TRUE(model) << logs();
   bool tracking = false;
-  for (const auto until = std::chrono::steady_clock::now() + 30s; !tracking && std::chrono::steady_clock::now() < until;) {
+  for (const auto until = std::chrono::steady_clock::now() + 30s;
+       !tracking && std::chrono::steady_clock::now() < until;) {
     const auto l = localisations.wait(200ms);
     tracking = l && l->state() == msg::LOCALISATION_TRACKING;
   }
@@ -99,7 +104,8 @@ TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
     g.pose().yaw(yaw);
     goals.write(g);
   };
-  auto final_status = [&](uint32_t id, std::chrono::seconds timeout, std::vector<msg::SimTruth>* track) {
+  auto final_status = [&](uint32_t id, std::chrono::seconds timeout,
+                          std::vector<msg::SimTruth>* track) {
     std::optional<msg::NavStatus> last;
     const auto until = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < until) {
@@ -109,8 +115,8 @@ TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
       const auto s = statuses.wait(100ms);
       if (!s || s->request_id() != id) continue;
       last = s;
-      if (s->state() == msg::NAV_REACHED || s->state() == msg::NAV_FAILED || s->state() == msg::NAV_CANCELLED ||
-          s->state() == msg::NAV_REFUSED) {
+      if (s->state() == msg::NAV_REACHED || s->state() == msg::NAV_FAILED ||
+          s->state() == msg::NAV_CANCELLED || s->state() == msg::NAV_REFUSED) {
         break;
       }
     }
@@ -137,14 +143,16 @@ TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
   const double position_error = std::hypot(end.x() - kGoal[0], end.y() - kGoal[1]);
   const double heading_error = std::abs(wrap(end.yaw() - kGoal[2]));
   std::cout << "nav house run: true final pose (" << end.x() << ", " << end.y() << ", " << end.yaw()
-            << "), error " << position_error << " m, " << heading_error * 180.0 / M_PI << " deg; nav says "
-            << done->position_error() << " m, replans " << done->replans() << std::endl;
+            << "), error " << position_error << " m, " << heading_error * 180.0 / M_PI
+            << " deg; nav says " << done->position_error() << " m, replans " << done->replans()
+            << std::endl;
   EXPECT_LT(position_error, 0.10);
   EXPECT_LT(heading_error, 3.0 * M_PI / 180.0);
   // It went through the terrace door: the base crossed the south wall's line within the door.
   bool through_door = false;
   for (std::size_t i = 1; i < track.size(); ++i) {
-    if (track[i - 1].y() < 0.1 && track[i].y() >= 0.1) through_door |= track[i].x() > 4.95 && track[i].x() < 7.05;
+    if (track[i - 1].y() < 0.1 && track[i].y() >= 0.1)
+      through_door |= track[i].x() > 4.95 && track[i].x() < 7.05;
   }
   EXPECT_TRUE(through_door) << logs();
 
@@ -174,29 +182,41 @@ TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
   const Eigen::Quaterniond q(area.orientation().w(), area.orientation().x(), area.orientation().y(),
                              area.orientation().z());
   EXPECT_LT((q * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, -1, 0)).norm(), 1e-3);
-  EXPECT_NEAR(at_wall->goal().yaw(), M_PI / 2, 1e-3);                 // facing the wall
-  EXPECT_LT(at_wall->goal().y(), area.position().y() - 0.5);          // in front of it
+  EXPECT_NEAR(at_wall->goal().yaw(), M_PI / 2, 1e-3);         // facing the wall
+  EXPECT_LT(at_wall->goal().y(), area.position().y() - 0.5);  // in front of it
   std::this_thread::sleep_for(500ms);
   while (auto t = truths.take()) wall_track.push_back(*t);
   ASSERT_FALSE(wall_track.empty());
   const msg::SimTruth& stand = wall_track.back();
-  const double wall_error = std::hypot(stand.x() - at_wall->goal().x(), stand.y() - at_wall->goal().y());
-  std::cout << "nav house wall goal: base goal (" << at_wall->goal().x() << ", " << at_wall->goal().y()
-            << "), true error " << wall_error << " m, "
-            << std::abs(wrap(stand.yaw() - at_wall->goal().yaw())) * 180.0 / M_PI << " deg" << std::endl;
+  const double wall_error =
+      std::hypot(stand.x() - at_wall->goal().x(), stand.y() - at_wall->goal().y());
+  std::cout << "nav house wall goal: base goal (" << at_wall->goal().x() << ", "
+            << at_wall->goal().y() << "), true error " << wall_error << " m, "
+            << std::abs(wrap(stand.yaw() - at_wall->goal().yaw())) * 180.0 / M_PI << " deg"
+            << std::endl;
   EXPECT_LT(wall_error, 0.10);
   EXPECT_LT(std::abs(wrap(stand.yaw() - at_wall->goal().yaw())), 3.0 * M_PI / 180.0);
 
   // What an operator sees: `concert nav status`.
   {
     std::ostringstream out, err;
-    ASSERT_EQ(cli::run("concert", {nav::register_verbs}, {"nav", "status", "--json"}, out, err), 0) << err.str();
+    ASSERT_EQ(cli::run("concert", {nav::register_verbs}, {"nav", "status", "--json"}, out, err), 0)
+        << err.str();
     EXPECT_NE(out.str().find("\"drive\":\"omni_steering\""), std::string::npos) << out.str();
     EXPECT_NE(out.str().find("\"name\":\"Erdgeschoss\""), std::string::npos) << out.str();
     EXPECT_NE(out.str().find("\"state\":\"reached\""), std::string::npos) << out.str();
   }
   EXPECT_TRUE(robot.running()) << logs();
   EXPECT_TRUE(nav.running()) << logs();
+  // End state: the safety layer never stopped the robot.
+  EXPECT_EQ(safety.err().find("STOPPED"), std::string::npos) << logs();
+  {
+    concert::dds::Reader<msg::SafetyState> safety_state(p, concert::dds::topics::safety_state);
+    const auto state = safety_state.wait(5s);
+    ASSERT_TRUE(state) << logs();
+    EXPECT_EQ(state->mode(), msg::SAFETY_RUNNING) << logs();
+  }
+  safety.stop(10s);
 
   nav.stop(10s);
   robot.stop(10s);

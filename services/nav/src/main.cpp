@@ -1,7 +1,8 @@
 // concert_nav: navigation of the mobile base in the building (paper section 5.3). Reconfigures
 // on every RobotModel (vehicle kinematics, footprint, sensors), localises in the storey map with
 // the lidars, plans and drives to NavGoals (map poses, or in front of a BIM wall).
-//   concert_nav [--params FILE] [--ifc FILE --storey NAME [--resolution M] [--margin M]] [--map MAP.yaml]
+//   concert_nav [--params FILE] [--ifc FILE --storey NAME [--resolution M] [--margin M]] [--map
+//   MAP.yaml]
 //               [--initial-pose X Y THETA]
 // The map comes from an IFC file (imported with web-ifc at start: walls, doors, wall goals) or a
 // nav2 map_server file (pose goals only). Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
@@ -47,9 +48,10 @@ int run(const Options& o) {
     slice.resolution = o.resolution;
     slice.margin = o.margin;
     auto grid = bim::storey_map(*bim, storey, slice);
-    std::cerr << "concert_nav: " << o.ifc << " storey '" << storey.name << "': " << grid.width << " x "
-              << grid.height << " cells at " << grid.resolution << " m in "
-              << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() << " s" << std::endl;
+    std::cerr << "concert_nav: " << o.ifc << " storey '" << storey.name << "': " << grid.width
+              << " x " << grid.height << " cells at " << grid.resolution << " m in "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
+              << " s" << std::endl;
     navigator.set_map(std::move(grid), storey.name, bim, storey.name);
     source = o.ifc;
   } else if (!o.map.empty()) {
@@ -63,7 +65,8 @@ int run(const Options& o) {
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "nav"});
   nav::dds::NavNode node(participant, navigator, source, std::cerr);
   std::cerr << "concert_nav: domain " << participant.domain_id()
-            << (navigator.has_map() ? ", map '" + navigator.map_name() + "'" : ", no map (goals refused until one is given)")
+            << (navigator.has_map() ? ", map '" + navigator.map_name() + "'"
+                                    : ", no map (goals refused until one is given)")
             << std::endl;
   node.spin(stop);
   return 0;
@@ -72,16 +75,20 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  concert::cli::Cli cli("concert_nav", "Navigation of the mobile base in the building (BIM map, lidars).",
+  concert::cli::Cli cli("concert_nav",
+                        "Navigation of the mobile base in the building (BIM map, lidars).",
                         std::cout, std::cerr);
   Options o;
   auto& app = cli.app();
-  app.add_option("--params", o.params, "parameters file (config/nav.yaml lists every key)")->type_name("FILE");
-  app.add_option("--ifc", o.ifc, "the building's IFC file (walls, doors; wall goals)")->type_name("FILE");
+  app.add_option("--params", o.params, "parameters file (config/nav.yaml lists every key)")
+      ->type_name("FILE");
+  app.add_option("--ifc", o.ifc, "the building's IFC file (walls, doors; wall goals)")
+      ->type_name("FILE");
   app.add_option("--storey", o.storey, "with --ifc: the storey to navigate")->type_name("NAME");
   app.add_option("--resolution", o.resolution, "with --ifc: map cell size [m]")
       ->check(concert::cli::number(0.01, 1.0));
-  app.add_option("--margin", o.margin, "with --ifc: free border mapped around the building [m] (room to arrive)")
+  app.add_option("--margin", o.margin,
+                 "with --ifc: free border mapped around the building [m] (room to arrive)")
       ->check(concert::cli::number(0.0, 50.0));
   app.add_option("--map", o.map, "a nav2 map_server map (map.yaml + image)")->type_name("FILE");
   app.add_option("--initial-pose", o.initial_pose, "the robot's pose in the map at start")

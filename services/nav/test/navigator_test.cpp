@@ -45,21 +45,23 @@ bim::OccupancyGrid two_rooms() {
     for (int r = 0; r < g.height; ++r) {
       for (int c = 0; c < g.width; ++c) {
         const Eigen::Vector2d p = g.center_of(c, r);
-        if (p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1) g.at(c, r) = bim::OccupancyGrid::kOccupied;
+        if (p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1)
+          g.at(c, r) = bim::OccupancyGrid::kOccupied;
       }
     }
   };
-  wall(-0.2, -0.2, 14.4, 0.0);   // south
-  wall(-0.2, 5.0, 14.4, 5.2);    // north
-  wall(-0.2, -0.2, 0.0, 5.2);    // west
-  wall(14.2, -0.2, 14.4, 5.2);   // east
-  wall(7.0, -0.2, 7.2, 1.5);     // the middle wall, below the door
-  wall(7.0, 3.5, 7.2, 5.2);      // ... and above it
+  wall(-0.2, -0.2, 14.4, 0.0);  // south
+  wall(-0.2, 5.0, 14.4, 5.2);   // north
+  wall(-0.2, -0.2, 0.0, 5.2);   // west
+  wall(14.2, -0.2, 14.4, 5.2);  // east
+  wall(7.0, -0.2, 7.2, 1.5);    // the middle wall, below the door
+  wall(7.0, 3.5, 7.2, 5.2);     // ... and above it
   return g;
 }
 
 // A planar scan of the demo robot's derived scan: 720 beams, 0.1..30 m, in the true map.
-PlanarScan scan_at(const bim::OccupancyGrid& truth, const Eigen::Vector3d& pose, std::mt19937& rng) {
+PlanarScan scan_at(const bim::OccupancyGrid& truth, const Eigen::Vector3d& pose,
+                   std::mt19937& rng) {
   std::normal_distribution<double> noise(0.0, 0.01);
   PlanarScan s;
   s.range_min = 0.1;
@@ -74,14 +76,15 @@ PlanarScan scan_at(const bim::OccupancyGrid& truth, const Eigen::Vector3d& pose,
 }
 
 struct Drive {
-  Eigen::Vector3d truth;       // map frame
+  Eigen::Vector3d truth;          // map frame
   Eigen::Vector3d odom{0, 0, 0};  // wheel odometry (drifts)
 };
 
 // Runs the navigator closed-loop for up to `seconds` of simulated time at 100 Hz odometry, 10 Hz
 // scans and the control rate; the base follows the command with a first-order lag and its wheels
 // slip 2 % in speed. Returns the final status.
-GoalStatus run(Navigator& nav, Drive& d, const bim::OccupancyGrid& truth, double seconds, std::mt19937& rng) {
+GoalStatus run(Navigator& nav, Drive& d, const bim::OccupancyGrid& truth, double seconds,
+               std::mt19937& rng) {
   const double dt = 0.01;
   BaseTwist cmd;
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
@@ -145,10 +148,12 @@ TEST_F(NavigatorTest, DrivesThroughTheDoorAndStopsWithinTolerance) {
   // Against the truth, not the navigator's own estimate.
   EXPECT_LT(std::hypot(drive_.truth.x() - 11.5, drive_.truth.y() - 3.0), 0.05)
       << "true final pose " << drive_.truth.transpose();
-  EXPECT_LT(std::abs(std::remainder(drive_.truth.z() - M_PI / 2, 2 * M_PI)), 2.0 * M_PI / 180.0 + 0.01);
+  EXPECT_LT(std::abs(std::remainder(drive_.truth.z() - M_PI / 2, 2 * M_PI)),
+            2.0 * M_PI / 180.0 + 0.01);
   // The path went through the door.
   bool through_door = false;
-  for (const auto& p : nav_.path()) through_door |= p.x() > 6.9 && p.x() < 7.3 && p.y() > 1.5 && p.y() < 3.5;
+  for (const auto& p : nav_.path())
+    through_door |= p.x() > 6.9 && p.x() < 7.3 && p.y() > 1.5 && p.y() < 3.5;
   EXPECT_TRUE(through_door);
 }
 

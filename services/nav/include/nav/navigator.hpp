@@ -37,16 +37,18 @@ struct NavParams {
   CostmapParams costmap;
   PlannerParams planner;
   ControllerParams controller;
-  double control_rate{20.0};      ///< control loop [Hz]
-  double cruise_speed{0.5};       ///< along the path, capped by the vehicle's limits [m/s]
-  double max_acceleration{0.5};   ///< [m/s^2]
-  double max_angular_acceleration{1.0};  ///< [rad/s^2]
-  int max_replans{10};            ///< blocked this often -> the goal fails
-  double initial_std_xy{0.2};     ///< default spread of an initial pose [m]
-  double initial_std_yaw{0.1};    ///< [rad]
-  double wall_standoff{0.0};      ///< base centre to wall face for wall goals [m]; 0: from the model
-  double wall_clearance{0.25};    ///< with wall_standoff 0: footprint front edge to the face [m]
-  double scan_period{0.1};        ///< localise at most this often [s]
+  double control_rate{20.0};     ///< control loop [Hz]
+  double cruise_speed{0.5};      ///< along the path, capped by the vehicle's limits [m/s]
+  double max_acceleration{0.5};  ///< [m/s^2]
+  /// [rad/s^2]; low: the arm rides on the base, and its first joint holds the arm's yaw inertia
+  /// (the demo arm at 1 rad/s^2 exceeds its continuous torque: a safety stop)
+  double max_angular_acceleration{0.3};
+  int max_replans{10};          ///< blocked this often -> the goal fails
+  double initial_std_xy{0.2};   ///< default spread of an initial pose [m]
+  double initial_std_yaw{0.1};  ///< [rad]
+  double wall_standoff{0.0};    ///< base centre to wall face for wall goals [m]; 0: from the model
+  double wall_clearance{0.25};  ///< with wall_standoff 0: footprint front edge to the face [m]
+  double scan_period{0.1};      ///< localise at most this often [s]
 };
 
 /// Loads config/nav.yaml-style parameters. Throws std::runtime_error naming the file and key.
@@ -77,20 +79,20 @@ struct GoalStatus {
   std::uint64_t model_version{0};
   GoalState state{GoalState::kIdle};
   std::string reason;
-  Pose2 goal;                                 ///< the base goal in the map frame
-  std::optional<Eigen::Isometry3d> area;      ///< wall goals: the area frame (map frame)
-  Pose2 pose;                                 ///< current estimate
-  double distance_remaining{0.0};             ///< [m]
+  Pose2 goal;                             ///< the base goal in the map frame
+  std::optional<Eigen::Isometry3d> area;  ///< wall goals: the area frame (map frame)
+  Pose2 pose;                             ///< current estimate
+  double distance_remaining{0.0};         ///< [m]
   std::uint32_t replans{0};
-  double position_error{0.0};                 ///< [m] from the goal
-  double heading_error{0.0};                  ///< [rad]
+  double position_error{0.0};  ///< [m] from the goal
+  double heading_error{0.0};   ///< [rad]
 };
 
 /// The localisation as published.
 struct LocalisationStatus {
   LocaliserStatus state{LocaliserStatus::kUninitialised};
   bool converging{false};  ///< tracking, but the particles are still spread (covariance large)
-  Pose2 pose;                                  ///< base in the map
+  Pose2 pose;              ///< base in the map
   Eigen::Matrix3d covariance{Eigen::Matrix3d::Zero()};
   Pose2 map_to_odom;
 };
@@ -114,8 +116,8 @@ class Navigator {
   const VehicleConfig& set_model(const model::RobotModel& model);
   /// The storey map (and the BIM model with its walls for wall goals; null: pose goals only).
   /// The running goal is cancelled; localisation restarts from its last pose estimate.
-  void set_map(bim::OccupancyGrid grid, std::string name, std::shared_ptr<const bim::BimModel> bim = nullptr,
-               std::string storey = {});
+  void set_map(bim::OccupancyGrid grid, std::string name,
+               std::shared_ptr<const bim::BimModel> bim = nullptr, std::string storey = {});
   /// Restarts localisation around `pose` (std <= 0: the defaults).
   void set_initial_pose(const Pose2& pose, double std_xy, double std_yaw);
   /// Wheel odometry from the robot service: pose in the odom frame and base twist; `stamp` [s].

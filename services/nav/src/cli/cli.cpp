@@ -22,35 +22,47 @@ using Clock = std::chrono::steady_clock;
 
 const char* state_name(msg::NavState s) {
   switch (s) {
-    case msg::NAV_IDLE: return "idle";
-    case msg::NAV_PLANNING: return "planning";
-    case msg::NAV_FOLLOWING: return "following";
-    case msg::NAV_REACHED: return "reached";
-    case msg::NAV_FAILED: return "failed";
-    case msg::NAV_CANCELLED: return "cancelled";
-    case msg::NAV_REFUSED: return "refused";
+    case msg::NAV_IDLE:
+      return "idle";
+    case msg::NAV_PLANNING:
+      return "planning";
+    case msg::NAV_FOLLOWING:
+      return "following";
+    case msg::NAV_REACHED:
+      return "reached";
+    case msg::NAV_FAILED:
+      return "failed";
+    case msg::NAV_CANCELLED:
+      return "cancelled";
+    case msg::NAV_REFUSED:
+      return "refused";
   }
   return "?";
 }
 
 const char* localisation_name(msg::LocalisationState s) {
   switch (s) {
-    case msg::LOCALISATION_NONE: return "none";
-    case msg::LOCALISATION_CONVERGING: return "converging";
-    case msg::LOCALISATION_TRACKING: return "tracking";
-    case msg::LOCALISATION_LOST: return "lost";
+    case msg::LOCALISATION_NONE:
+      return "none";
+    case msg::LOCALISATION_CONVERGING:
+      return "converging";
+    case msg::LOCALISATION_TRACKING:
+      return "tracking";
+    case msg::LOCALISATION_LOST:
+      return "lost";
   }
   return "?";
 }
 
 bool final_state(msg::NavState s) {
-  return s == msg::NAV_REACHED || s == msg::NAV_FAILED || s == msg::NAV_CANCELLED || s == msg::NAV_REFUSED;
+  return s == msg::NAV_REACHED || s == msg::NAV_FAILED || s == msg::NAV_CANCELLED ||
+         s == msg::NAV_REFUSED;
 }
 
 std::string pose_text(const msg::Pose2D& p) {
   std::ostringstream s;
-  s << std::fixed << std::setprecision(3) << "(" << p.x() << ", " << p.y() << ", " << std::setprecision(1)
-    << p.yaw() * 180.0 / M_PI << " deg)";
+  s << std::fixed << std::setprecision(3) << "(" << p.x() << ", " << p.y() << ", "
+    << std::setprecision(1) << p.yaw() * 180.0 / M_PI << " deg)";
   return s.str();
 }
 
@@ -71,8 +83,10 @@ nlohmann::ordered_json status_json(const msg::NavStatus& s) {
           {"heading_error", s.heading_error()}};
 }
 
-template <class T> bool acknowledged(cdds::Writer<T>& writer) {
-  return writer.get()->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2, 0)) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
+template <class T>
+bool acknowledged(cdds::Writer<T>& writer) {
+  return writer.get()->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2, 0)) ==
+         eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
 }
 
 std::chrono::milliseconds left_until(Clock::time_point deadline) {
@@ -91,7 +105,8 @@ struct GotoOptions {
 
 int run_goto(const GotoOptions& o, std::ostream& out, std::ostream& err) {
   const bool wall = !o.wall.empty();
-  if (wall == !o.pose.empty()) throw cli::UsageError("give either X Y THETA or --wall GLOBALID --at S H");
+  if (wall == !o.pose.empty())
+    throw cli::UsageError("give either X Y THETA or --wall GLOBALID --at S H");
   if (wall && o.at.size() != 2) throw cli::UsageError("--wall needs --at S H");
   if (!wall && !o.at.empty()) throw cli::UsageError("--at goes with --wall");
   cdds::Participant participant({.name = "concert_nav", .domain_id = o.dds.domain_id()});
@@ -128,7 +143,8 @@ int run_goto(const GotoOptions& o, std::ostream& out, std::ostream& err) {
   }
   goals.write(g);
   if (o.dds.json) {
-    out << nlohmann::ordered_json{{"request_id", o.request_id}, {"model_version", model->version()}}.dump()
+    out << nlohmann::ordered_json{{"request_id", o.request_id}, {"model_version", model->version()}}
+               .dump()
         << std::endl;
   } else {
     out << "goal " << o.request_id << " sent for model version " << model->version() << "\n";
@@ -167,16 +183,19 @@ int run_goto(const GotoOptions& o, std::ostream& out, std::ostream& err) {
       return 1;
     }
   }
-  err << "concert nav goto: no final result within " << o.dds.timeout_s << " s (the goal keeps running; "
+  err << "concert nav goto: no final result within " << o.dds.timeout_s
+      << " s (the goal keeps running; "
       << "concert nav cancel stops it)\n";
   return 1;
 }
 
-int run_cancel(uint32_t request_id, const cli::DdsOptions& dds, std::ostream& out, std::ostream& err) {
+int run_cancel(uint32_t request_id, const cli::DdsOptions& dds, std::ostream& out,
+               std::ostream& err) {
   cdds::Participant participant({.name = "concert_nav", .domain_id = dds.domain_id()});
   cdds::Writer<msg::NavCancel> cancels(participant, cdds::topics::nav_cancel);
   if (!cancels.wait_for_readers(1, std::min(dds.timeout(), std::chrono::milliseconds(5000)))) {
-    err << "concert nav cancel: no nav service listening on domain " << participant.domain_id() << "\n";
+    err << "concert nav cancel: no nav service listening on domain " << participant.domain_id()
+        << "\n";
     return 1;
   }
   msg::NavCancel c;
@@ -189,7 +208,8 @@ int run_cancel(uint32_t request_id, const cli::DdsOptions& dds, std::ostream& ou
     err << "concert nav cancel: the nav service did not acknowledge the cancel\n";
     return 1;
   }
-  out << "cancel sent" << (request_id ? " for goal " + std::to_string(request_id) : std::string()) << "\n";
+  out << "cancel sent" << (request_id ? " for goal " + std::to_string(request_id) : std::string())
+      << "\n";
   return 0;
 }
 
@@ -204,7 +224,8 @@ int run_init(const InitOptions& o, std::ostream& out, std::ostream& err) {
   cdds::Participant participant({.name = "concert_nav", .domain_id = o.dds.domain_id()});
   cdds::Writer<msg::NavInitialPose> poses(participant, cdds::topics::nav_initial_pose);
   if (!poses.wait_for_readers(1, std::min(o.dds.timeout(), std::chrono::milliseconds(5000)))) {
-    err << "concert nav init: no nav service listening on domain " << participant.domain_id() << "\n";
+    err << "concert nav init: no nav service listening on domain " << participant.domain_id()
+        << "\n";
     return 1;
   }
   msg::NavInitialPose p;
@@ -253,9 +274,14 @@ int run_status(const cli::DdsOptions& dds, std::ostream& out, std::ostream& err)
     j["sonars"] = vehicle->sonars();
     j["imu"] = vehicle->imu();
     j["max_speed"] = vehicle->max_speed();
-    if (map) j["map"] = {{"name", map->name()}, {"width", map->width()}, {"height", map->height()},
-                         {"resolution", map->resolution()}};
-    if (loc) j["localisation"] = {{"state", localisation_name(loc->state())}, {"pose", pose_json(loc->pose())}};
+    if (map)
+      j["map"] = {{"name", map->name()},
+                  {"width", map->width()},
+                  {"height", map->height()},
+                  {"resolution", map->resolution()}};
+    if (loc)
+      j["localisation"] = {{"state", localisation_name(loc->state())},
+                           {"pose", pose_json(loc->pose())}};
     if (latest) j["goal"] = status_json(*latest);
     out << j.dump() << std::endl;
     return 0;
@@ -264,9 +290,10 @@ int run_status(const cli::DdsOptions& dds, std::ostream& out, std::ostream& err)
   if (vehicle->drive().empty()) {
     out << "cannot navigate: " << vehicle->reason() << "\n";
   } else {
-    out << vehicle->drive() << " drive, " << vehicle->footprint().size() << "-corner footprint, max "
-        << vehicle->max_speed() << " m/s; lidars " << vehicle->lidars().size() << ", sonars "
-        << vehicle->sonars().size() << ", imu " << (vehicle->imu().empty() ? "none" : vehicle->imu()) << "\n";
+    out << vehicle->drive() << " drive, " << vehicle->footprint().size()
+        << "-corner footprint, max " << vehicle->max_speed() << " m/s; lidars "
+        << vehicle->lidars().size() << ", sonars " << vehicle->sonars().size() << ", imu "
+        << (vehicle->imu().empty() ? "none" : vehicle->imu()) << "\n";
   }
   if (map) {
     out << "map '" << map->name() << "': " << map->width() << " x " << map->height() << " cells at "
@@ -274,7 +301,9 @@ int run_status(const cli::DdsOptions& dds, std::ostream& out, std::ostream& err)
   } else {
     out << "map: none\n";
   }
-  if (loc) out << "localisation: " << localisation_name(loc->state()) << " at " << pose_text(loc->pose()) << "\n";
+  if (loc)
+    out << "localisation: " << localisation_name(loc->state()) << " at " << pose_text(loc->pose())
+        << "\n";
   if (latest) {
     out << "goal " << latest->request_id() << ": " << state_name(latest->state()) << " "
         << pose_text(latest->goal());
@@ -289,17 +318,21 @@ int run_status(const cli::DdsOptions& dds, std::ostream& out, std::ostream& err)
 }  // namespace
 
 void register_verbs(cli::Cli& concert) {
-  CLI::App& nav = concert.group(concert.app(), "nav", "navigation of the mobile base (nav service)");
+  CLI::App& nav =
+      concert.group(concert.app(), "nav", "navigation of the mobile base (nav service)");
   {
     auto o = std::make_shared<GotoOptions>();
-    CLI::App& verb = concert.verb(nav, "goto", "drive to a map pose, or in front of a BIM wall",
-                                  [&concert, o] { return run_goto(*o, concert.out(), concert.err()); });
+    CLI::App& verb =
+        concert.verb(nav, "goto", "drive to a map pose, or in front of a BIM wall",
+                     [&concert, o] { return run_goto(*o, concert.out(), concert.err()); });
     verb.add_option("POSE", o->pose, "goal in the map frame: x [m], y [m], heading [rad]")
         ->expected(3)
         ->type_name("X Y THETA")
         ->check(cli::real());
-    verb.add_option("--wall", o->wall, "stand in front of this wall (its IFC GlobalId)")->type_name("GLOBALID");
-    verb.add_option("--at", o->at, "with --wall: distance along the wall from its start, height [m]")
+    verb.add_option("--wall", o->wall, "stand in front of this wall (its IFC GlobalId)")
+        ->type_name("GLOBALID");
+    verb.add_option("--at", o->at,
+                    "with --wall: distance along the wall from its start, height [m]")
         ->expected(2)
         ->type_name("S H")
         ->check(cli::real());
@@ -312,8 +345,9 @@ void register_verbs(cli::Cli& concert) {
   {
     auto id = std::make_shared<uint32_t>(0);
     auto dds = std::make_shared<cli::DdsOptions>();
-    CLI::App& verb = concert.verb(nav, "cancel", "cancel a navigation goal",
-                                  [&concert, id, dds] { return run_cancel(*id, *dds, concert.out(), concert.err()); });
+    CLI::App& verb = concert.verb(nav, "cancel", "cancel a navigation goal", [&concert, id, dds] {
+      return run_cancel(*id, *dds, concert.out(), concert.err());
+    });
     verb.add_option("--request-id", *id, "the goal to cancel (default: whatever runs)")
         ->type_name("N")
         ->check(cli::number(0, 4294967295.0, true));
@@ -321,8 +355,9 @@ void register_verbs(cli::Cli& concert) {
   }
   {
     auto o = std::make_shared<InitOptions>();
-    CLI::App& verb = concert.verb(nav, "init", "(re)start localisation from a pose in the map",
-                                  [&concert, o] { return run_init(*o, concert.out(), concert.err()); });
+    CLI::App& verb =
+        concert.verb(nav, "init", "(re)start localisation from a pose in the map",
+                     [&concert, o] { return run_init(*o, concert.out(), concert.err()); });
     verb.add_option("POSE", o->pose, "the robot's pose in the map: x [m], y [m], heading [rad]")
         ->expected(3)
         ->required()
@@ -336,8 +371,9 @@ void register_verbs(cli::Cli& concert) {
   }
   {
     auto dds = std::make_shared<cli::DdsOptions>();
-    CLI::App& verb = concert.verb(nav, "status", "vehicle set-up, map, localisation and the latest goal",
-                                  [&concert, dds] { return run_status(*dds, concert.out(), concert.err()); });
+    CLI::App& verb =
+        concert.verb(nav, "status", "vehicle set-up, map, localisation and the latest goal",
+                     [&concert, dds] { return run_status(*dds, concert.out(), concert.err()); });
     concert.add_dds_options(verb, *dds, 3.0, "how long to wait for the nav service");
   }
 }

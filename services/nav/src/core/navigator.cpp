@@ -44,19 +44,29 @@ constexpr double kLostTimeout = 10.0;    // [s] lost while driving -> the goal f
 
 const char* to_string(GoalState s) {
   switch (s) {
-    case GoalState::kIdle: return "idle";
-    case GoalState::kPlanning: return "planning";
-    case GoalState::kFollowing: return "following";
-    case GoalState::kReached: return "reached";
-    case GoalState::kFailed: return "failed";
-    case GoalState::kCancelled: return "cancelled";
-    case GoalState::kRefused: return "refused";
+    case GoalState::kIdle:
+      return "idle";
+    case GoalState::kPlanning:
+      return "planning";
+    case GoalState::kFollowing:
+      return "following";
+    case GoalState::kReached:
+      return "reached";
+    case GoalState::kFailed:
+      return "failed";
+    case GoalState::kCancelled:
+      return "cancelled";
+    case GoalState::kRefused:
+      return "refused";
   }
   return "?";
 }
 
 Navigator::Navigator(NavParams params, std::uint64_t seed)
-    : params_(std::move(params)), seed_(seed), planner_(params_.planner), filter_(params_.odometry) {
+    : params_(std::move(params)),
+      seed_(seed),
+      planner_(params_.planner),
+      filter_(params_.odometry) {
   if (!(params_.control_rate > 0.0)) throw std::invalid_argument("nav: control_rate must be > 0");
   if (!(params_.cruise_speed > 0.0)) throw std::invalid_argument("nav: cruise_speed must be > 0");
   if (params_.max_replans < 0) throw std::invalid_argument("nav: max_replans must be >= 0");
@@ -65,7 +75,8 @@ Navigator::Navigator(NavParams params, std::uint64_t seed)
 
 const VehicleConfig& Navigator::set_model(const model::RobotModel& model) {
   if (running(status_.state)) {
-    set_state(GoalState::kCancelled, "the robot model changed to version " + std::to_string(model.version()));
+    set_state(GoalState::kCancelled,
+              "the robot model changed to version " + std::to_string(model.version()));
   }
   model_version_ = model.version();
   try {
@@ -81,12 +92,14 @@ const VehicleConfig& Navigator::set_model(const model::RobotModel& model) {
   return *vehicle_;
 }
 
-void Navigator::set_map(bim::OccupancyGrid grid, std::string name, std::shared_ptr<const bim::BimModel> bim,
-                        std::string storey) {
+void Navigator::set_map(bim::OccupancyGrid grid, std::string name,
+                        std::shared_ptr<const bim::BimModel> bim, std::string storey) {
   auto field = std::make_shared<const LikelihoodField>(grid);  // throws on a map without walls
   if (running(status_.state)) set_state(GoalState::kCancelled, "the map changed to '" + name + "'");
-  const bool was_localised = localiser_ && localiser_->estimate().status == LocaliserStatus::kTracking;
-  const Eigen::Vector3d last = was_localised ? localiser_->estimate().pose : Eigen::Vector3d::Zero();
+  const bool was_localised =
+      localiser_ && localiser_->estimate().status == LocaliserStatus::kTracking;
+  const Eigen::Vector3d last =
+      was_localised ? localiser_->estimate().pose : Eigen::Vector3d::Zero();
   map_ = std::make_shared<const bim::OccupancyGrid>(std::move(grid));
   field_ = std::move(field);
   map_name_ = std::move(name);
@@ -98,7 +111,8 @@ void Navigator::set_map(bim::OccupancyGrid grid, std::string name, std::shared_p
     map_to_odom_ = localiser_->estimate().map_T_odom;
     pending_initial_.reset();
   } else if (was_localised) {
-    localiser_->set_pose(last, {params_.initial_std_xy, params_.initial_std_xy, params_.initial_std_yaw},
+    localiser_->set_pose(last,
+                         {params_.initial_std_xy, params_.initial_std_xy, params_.initial_std_yaw},
                          filter_.estimate().pose);
   }
   rebuild();
@@ -113,7 +127,9 @@ void Navigator::rebuild() {
                                                          : ControllerParams::Drive::kOmni;
   const double linear = std::min(params_.cruise_speed, vehicle_->limits.linear);
   cp.limits.max_vx = linear;
-  cp.limits.max_vy = vehicle_->drive == DriveType::kDifferential ? 0.0 : std::min(linear, vehicle_->limits.lateral);
+  cp.limits.max_vy = vehicle_->drive == DriveType::kDifferential
+                         ? 0.0
+                         : std::min(linear, vehicle_->limits.lateral);
   cp.limits.max_wz = vehicle_->limits.angular;
   cp.limits.max_ax = params_.max_acceleration;
   cp.limits.max_ay = params_.max_acceleration;
@@ -122,8 +138,8 @@ void Navigator::rebuild() {
   cp.control_period = 1.0 / params_.control_rate;
   controller_ = std::make_unique<LocalController>(cp);
   if (!map_) return;
-  costmap_ = std::make_unique<Costmap>(*map_, RobotShape::from_footprint(vehicle_->footprint.polygon),
-                                       params_.costmap);
+  costmap_ = std::make_unique<Costmap>(
+      *map_, RobotShape::from_footprint(vehicle_->footprint.polygon), params_.costmap);
 }
 
 void Navigator::set_initial_pose(const Pose2& pose, double std_xy, double std_yaw) {
@@ -138,7 +154,8 @@ void Navigator::set_initial_pose(const Pose2& pose, double std_xy, double std_ya
   map_to_odom_ = localiser_->estimate().map_T_odom;
 }
 
-void Navigator::on_wheel_odometry(double stamp, const Pose2& /*odom_pose*/, const Eigen::Vector3d& twist) {
+void Navigator::on_wheel_odometry(double stamp, const Pose2& /*odom_pose*/,
+                                  const Eigen::Vector3d& twist) {
   if (!have_odometry_) {
     filter_.reset(stamp);
     have_odometry_ = true;
@@ -171,7 +188,9 @@ Eigen::Vector3d Navigator::odom_at(double stamp) const {
   return p;
 }
 
-Eigen::Vector3d Navigator::map_pose_of(const Eigen::Vector3d& odom) const { return compose(map_to_odom_, odom); }
+Eigen::Vector3d Navigator::map_pose_of(const Eigen::Vector3d& odom) const {
+  return compose(map_to_odom_, odom);
+}
 
 Pose2 Navigator::pose() const { return pose2(map_pose_of(filter_.estimate().pose)); }
 
@@ -209,7 +228,8 @@ void Navigator::localise() {
     const double d = hit ? r : scan.beams.range_max;
     const double a = scan.beams.angles[i];
     const Eigen::Vector2d p(d * std::cos(a), d * std::sin(a));
-    beams.push_back({Eigen::Vector2d(base.x() + c * p.x() - s * p.y(), base.y() + s * p.x() + c * p.y()), hit});
+    beams.push_back(
+        {Eigen::Vector2d(base.x() + c * p.x() - s * p.y(), base.y() + s * p.x() + c * p.y()), hit});
   }
   costmap_->update_obstacles(base.head<2>(), beams);
 }
@@ -226,7 +246,8 @@ void Navigator::set_state(GoalState state, std::string reason) {
   status_.state = state;
   status_.reason = std::move(reason);
   status_.pose = pose();
-  if (state == GoalState::kReached || state == GoalState::kFailed || state == GoalState::kCancelled) {
+  if (state == GoalState::kReached || state == GoalState::kFailed ||
+      state == GoalState::kCancelled) {
     const Pose2 p = status_.pose;
     status_.position_error = std::hypot(p.x - status_.goal.x, p.y - status_.goal.y);
     status_.heading_error = std::abs(wrap(p.yaw - status_.goal.yaw));
@@ -256,16 +277,19 @@ GoalStatus Navigator::submit(const GoalRequest& goal) {
     return refused;
   };
   if (goal.id == 0) return refuse("request id 0 is reserved (cancel: whatever runs)");
-  if (safety_stop_) return refuse("the robot is in a safety stop: reset it first (concert safety reset)");
+  if (safety_stop_)
+    return refuse("the robot is in a safety stop: reset it first (concert safety reset)");
   if (model_version_ == 0) return refuse("no robot model yet");
   if (goal.model_version != model_version_) {
     return refuse("stale goal: made for model version " + std::to_string(goal.model_version) +
                   ", the robot runs version " + std::to_string(model_version_));
   }
   if (!vehicle_) {
-    return refuse("model version " + std::to_string(model_version_) + " cannot navigate: " + vehicle_error_);
+    return refuse("model version " + std::to_string(model_version_) +
+                  " cannot navigate: " + vehicle_error_);
   }
-  if (!map_ || !costmap_) return refuse("no map (start concert_nav with --ifc FILE --storey NAME or --map FILE)");
+  if (!map_ || !costmap_)
+    return refuse("no map (start concert_nav with --ifc FILE --storey NAME or --map FILE)");
   if (!have_odometry_) return refuse("no odometry from the robot service yet");
   if (!localiser_ || localiser_->estimate().status != LocaliserStatus::kTracking) {
     return refuse("not localised (give the robot's pose: concert nav init X Y THETA)");
@@ -273,8 +297,10 @@ GoalStatus Navigator::submit(const GoalRequest& goal) {
   Pose2 target = goal.pose;
   std::optional<Eigen::Isometry3d> area;
   if (goal.kind == GoalRequest::Kind::kWall) {
-    if (!bim_) return refuse("wall goals need the building's IFC model (the map came from a map file)");
-    if (!std::isfinite(goal.s) || !std::isfinite(goal.h)) return refuse("wall goal: s and h must be numbers");
+    if (!bim_)
+      return refuse("wall goals need the building's IFC model (the map came from a map file)");
+    if (!std::isfinite(goal.s) || !std::isfinite(goal.h))
+      return refuse("wall goal: s and h must be numbers");
     // wall_goal places a disc of the inscribed radius; the footprint itself must fit too. The
     // face wall_goal prefers first, then the other one.
     std::string why;
@@ -282,8 +308,9 @@ GoalStatus Navigator::submit(const GoalRequest& goal) {
       bim::WallGoal w = bim::wall_goal(*bim_, *map_, goal.wall, goal.s, goal.h, wall_standoff(),
                                        vehicle_->footprint.inscribed_radius);
       if (costmap_->in_collision(w.base_pose)) {
-        why = "the footprint does not fit in front of the " + std::string(w.face == 0 ? "left" : "right") +
-              " face at (" + fixed(w.base_pose.x()) + ", " + fixed(w.base_pose.y()) + ")";
+        why = "the footprint does not fit in front of the " +
+              std::string(w.face == 0 ? "left" : "right") + " face at (" + fixed(w.base_pose.x()) +
+              ", " + fixed(w.base_pose.y()) + ")";
         bim::GoalOptions other;
         other.face = w.face == 0 ? bim::FaceChoice::kRight : bim::FaceChoice::kLeft;
         try {
@@ -293,8 +320,8 @@ GoalStatus Navigator::submit(const GoalRequest& goal) {
           return refuse(why + "; the other face: " + e.what());
         }
         if (costmap_->in_collision(w.base_pose)) {
-          return refuse(why + ", nor in front of the other face at (" + fixed(w.base_pose.x()) + ", " +
-                        fixed(w.base_pose.y()) + ")");
+          return refuse(why + ", nor in front of the other face at (" + fixed(w.base_pose.x()) +
+                        ", " + fixed(w.base_pose.y()) + ")");
         }
       }
       target = {w.base_pose.x(), w.base_pose.y(), w.base_pose.z()};
@@ -315,7 +342,8 @@ GoalStatus Navigator::submit(const GoalRequest& goal) {
     return refuse("goal " + where(target) +
                   " is in collision: the robot's footprint there overlaps a wall or obstacle");
   }
-  if (running(status_.state)) set_state(GoalState::kCancelled, "replaced by goal " + std::to_string(goal.id));
+  if (running(status_.state))
+    set_state(GoalState::kCancelled, "replaced by goal " + std::to_string(goal.id));
   goal_ = goal;
   goal_->pose = target;
   status_ = GoalStatus{};
@@ -343,7 +371,8 @@ void Navigator::set_safety_stop(bool stopped, const std::string& reason) {
 void Navigator::plan_path(double /*stamp*/) {
   const PlanResult r = planner_.plan(*costmap_, vec(pose()), vec(goal_->pose));
   if (!r.ok()) {
-    set_state(GoalState::kFailed, std::string("no path: ") + to_string(r.status) + ": " + r.message);
+    set_state(GoalState::kFailed,
+              std::string("no path: ") + to_string(r.status) + ": " + r.message);
     return;
   }
   path_ = r.path;
@@ -357,7 +386,8 @@ StepOutput Navigator::step(double stamp) {
   now_ = stamp;
   StepOutput out;
   localise();
-  if (goal_ && (!costmap_ || !controller_)) set_state(GoalState::kFailed, "the map or the vehicle went away");
+  if (goal_ && (!costmap_ || !controller_))
+    set_state(GoalState::kFailed, "the map or the vehicle went away");
   if (goal_ && status_.state == GoalState::kPlanning) plan_path(stamp);
   if (goal_ && status_.state == GoalState::kFollowing) {
     out.drive = true;
@@ -384,8 +414,8 @@ StepOutput Navigator::step(double stamp) {
         case ControlStatus::kBlocked:
           out.command = {};
           if (status_.replans >= static_cast<std::uint32_t>(params_.max_replans)) {
-            set_state(GoalState::kFailed,
-                      "blocked: " + c.reason + " (after " + std::to_string(status_.replans) + " replans)");
+            set_state(GoalState::kFailed, "blocked: " + c.reason + " (after " +
+                                              std::to_string(status_.replans) + " replans)");
           } else {
             ++status_.replans;
             set_state(GoalState::kPlanning, "blocked: " + c.reason + "; replanning");

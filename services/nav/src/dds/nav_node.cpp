@@ -38,22 +38,32 @@ namespace {
 
 msg::NavState to_msg(GoalState s) {
   switch (s) {
-    case GoalState::kIdle: return msg::NAV_IDLE;
-    case GoalState::kPlanning: return msg::NAV_PLANNING;
-    case GoalState::kFollowing: return msg::NAV_FOLLOWING;
-    case GoalState::kReached: return msg::NAV_REACHED;
-    case GoalState::kFailed: return msg::NAV_FAILED;
-    case GoalState::kCancelled: return msg::NAV_CANCELLED;
-    case GoalState::kRefused: return msg::NAV_REFUSED;
+    case GoalState::kIdle:
+      return msg::NAV_IDLE;
+    case GoalState::kPlanning:
+      return msg::NAV_PLANNING;
+    case GoalState::kFollowing:
+      return msg::NAV_FOLLOWING;
+    case GoalState::kReached:
+      return msg::NAV_REACHED;
+    case GoalState::kFailed:
+      return msg::NAV_FAILED;
+    case GoalState::kCancelled:
+      return msg::NAV_CANCELLED;
+    case GoalState::kRefused:
+      return msg::NAV_REFUSED;
   }
   return msg::NAV_FAILED;
 }
 
 msg::LocalisationState to_msg(const LocalisationStatus& l) {
   switch (l.state) {
-    case LocaliserStatus::kUninitialised: return msg::LOCALISATION_NONE;
-    case LocaliserStatus::kTracking: return l.converging ? msg::LOCALISATION_CONVERGING : msg::LOCALISATION_TRACKING;
-    case LocaliserStatus::kLost: return msg::LOCALISATION_LOST;
+    case LocaliserStatus::kUninitialised:
+      return msg::LOCALISATION_NONE;
+    case LocaliserStatus::kTracking:
+      return l.converging ? msg::LOCALISATION_CONVERGING : msg::LOCALISATION_TRACKING;
+    case LocaliserStatus::kLost:
+      return msg::LOCALISATION_LOST;
   }
   return msg::LOCALISATION_NONE;
 }
@@ -80,7 +90,8 @@ msg::NavStatus to_msg(const GoalStatus& s, std::int64_t stamp_ns) {
   return out;
 }
 
-msg::OccupancyGridMap to_msg(const bim::OccupancyGrid& g, const std::string& name, const std::string& source) {
+msg::OccupancyGridMap to_msg(const bim::OccupancyGrid& g, const std::string& name,
+                             const std::string& source) {
   msg::OccupancyGridMap out;
   out.stamp_ns(now_ns());
   out.name(name);
@@ -91,7 +102,8 @@ msg::OccupancyGridMap to_msg(const bim::OccupancyGrid& g, const std::string& nam
   out.width(static_cast<uint32_t>(g.width));
   out.height(static_cast<uint32_t>(g.height));
   out.cells().resize(g.cells.size());
-  for (std::size_t i = 0; i < g.cells.size(); ++i) out.cells()[i] = static_cast<uint8_t>(g.cells[i]);
+  for (std::size_t i = 0; i < g.cells.size(); ++i)
+    out.cells()[i] = static_cast<uint8_t>(g.cells[i]);
   return out;
 }
 
@@ -101,11 +113,13 @@ bim::OccupancyGrid to_core(const msg::OccupancyGridMap& m) {
   }
   if (m.cells().size() != static_cast<std::size_t>(m.width()) * m.height()) {
     throw std::invalid_argument("map '" + m.name() + "': " + std::to_string(m.cells().size()) +
-                                " cells for " + std::to_string(m.width()) + " x " + std::to_string(m.height()));
+                                " cells for " + std::to_string(m.width()) + " x " +
+                                std::to_string(m.height()));
   }
-  auto g = bim::OccupancyGrid::filled(static_cast<int>(m.width()), static_cast<int>(m.height()), m.resolution(),
-                                      {m.origin_x(), m.origin_y()});
-  for (std::size_t i = 0; i < g.cells.size(); ++i) g.cells[i] = static_cast<std::int8_t>(m.cells()[i]);
+  auto g = bim::OccupancyGrid::filled(static_cast<int>(m.width()), static_cast<int>(m.height()),
+                                      m.resolution(), {m.origin_x(), m.origin_y()});
+  for (std::size_t i = 0; i < g.cells.size(); ++i)
+    g.cells[i] = static_cast<std::int8_t>(m.cells()[i]);
   return g;
 }
 
@@ -142,7 +156,8 @@ PlanarScan to_core(const msg::LaserScan& scan) {
   return out;
 }
 
-NavNode::NavNode(cdds::Participant& participant, Navigator& navigator, std::string map_source, std::ostream& log)
+NavNode::NavNode(cdds::Participant& participant, Navigator& navigator, std::string map_source,
+                 std::ostream& log)
     : navigator_(navigator),
       map_source_(std::move(map_source)),
       log_(log),
@@ -206,7 +221,8 @@ void NavNode::log_line(const std::string& line) {
 }
 
 void NavNode::publish_map() {
-  if (const auto* map = navigator_.map()) maps_.write(to_msg(*map, navigator_.map_name(), map_source_));
+  if (const auto* map = navigator_.map())
+    maps_.write(to_msg(*map, navigator_.map_name(), map_source_));
 }
 
 void NavNode::apply_model(const msg::RobotModel& m) {
@@ -218,8 +234,10 @@ void NavNode::apply_model(const msg::RobotModel& m) {
     robot = model::RobotModel::build(concert::model::dds::to_description(m));
   } catch (const std::exception& e) {
     status_.refused("model version " + std::to_string(m.version()) + " refused: " + e.what());
-    status_.report(model_version_ ? msg::SERVICE_READY : msg::SERVICE_ERROR, static_cast<uint32_t>(model_version_),
-                   std::string("model version ") + std::to_string(m.version()) + " refused: " + e.what());
+    status_.report(
+        model_version_ ? msg::SERVICE_READY : msg::SERVICE_ERROR,
+        static_cast<uint32_t>(model_version_),
+        std::string("model version ") + std::to_string(m.version()) + " refused: " + e.what());
     log_line("nav: " + std::string(e.what()));
     return;
   }
@@ -254,16 +272,18 @@ void NavNode::apply_model(const msg::RobotModel& m) {
 void NavNode::publish_status() {
   for (const GoalStatus& s : navigator_.take_updates()) {
     statuses_.write(to_msg(s, last_stamp_ns_));
-    if (s.state == GoalState::kReached || s.state == GoalState::kFailed || s.state == GoalState::kCancelled ||
-        s.state == GoalState::kRefused) {
+    if (s.state == GoalState::kReached || s.state == GoalState::kFailed ||
+        s.state == GoalState::kCancelled || s.state == GoalState::kRefused) {
       std::ostringstream line;
       line << "nav: goal " << s.id << " " << to_string(s.state);
       if (s.state == GoalState::kReached) {
-        line << " (" << s.position_error << " m, " << s.heading_error * 180.0 / M_PI << " deg from the goal)";
+        line << " (" << s.position_error << " m, " << s.heading_error * 180.0 / M_PI
+             << " deg from the goal)";
       }
       if (!s.reason.empty()) line << ": " << s.reason;
       log_line(line.str());
-      if (s.state == GoalState::kRefused) status_.refused("goal " + std::to_string(s.id) + " refused: " + s.reason);
+      if (s.state == GoalState::kRefused)
+        status_.refused("goal " + std::to_string(s.id) + " refused: " + s.reason);
     }
   }
 }
@@ -289,7 +309,8 @@ void NavNode::tick() {
   for (const auto& o : in.odometry) {
     last_stamp_ns_ = std::max(last_stamp_ns_, static_cast<std::int64_t>(o.stamp_ns()));
     try {
-      navigator_.on_wheel_odometry(to_s(o.stamp_ns()), {o.x(), o.y(), o.yaw()}, {o.vx(), o.vy(), o.wz()});
+      navigator_.on_wheel_odometry(to_s(o.stamp_ns()), {o.x(), o.y(), o.yaw()},
+                                   {o.vx(), o.vy(), o.wz()});
     } catch (const std::exception& e) {
       status_.refused(std::string("odometry refused: ") + e.what());
     }
@@ -300,11 +321,13 @@ void NavNode::tick() {
       Eigen::Matrix3d base_R_imu = Eigen::Matrix3d::Identity();
       if (v) {
         for (const auto& imu : v->perception.imus) {
-          if (imu.frame == s.frame() || imu.name == s.sensor()) base_R_imu = imu.base_T_sensor.linear();
+          if (imu.frame == s.frame() || imu.name == s.sensor())
+            base_R_imu = imu.base_T_sensor.linear();
         }
       }
-      const Eigen::Vector3d w = base_R_imu * Eigen::Vector3d(s.angular_velocity().x(), s.angular_velocity().y(),
-                                                             s.angular_velocity().z());
+      const Eigen::Vector3d w =
+          base_R_imu * Eigen::Vector3d(s.angular_velocity().x(), s.angular_velocity().y(),
+                                       s.angular_velocity().z());
       navigator_.on_gyro(to_s(s.stamp_ns()), w.z());
     } catch (const std::exception& e) {
       status_.refused(std::string("IMU sample refused: ") + e.what());
@@ -315,8 +338,9 @@ void NavNode::tick() {
   for (const auto& g : in.goals) {
     const GoalStatus s = navigator_.submit(to_core(g));
     if (s.state != GoalState::kRefused) {
-      log_line("nav: goal " + std::to_string(g.request_id()) + " from " + g.source() + " accepted: to (" +
-               std::to_string(s.goal.x) + ", " + std::to_string(s.goal.y) + ", " + std::to_string(s.goal.yaw) + ")");
+      log_line("nav: goal " + std::to_string(g.request_id()) + " from " + g.source() +
+               " accepted: to (" + std::to_string(s.goal.x) + ", " + std::to_string(s.goal.y) +
+               ", " + std::to_string(s.goal.yaw) + ")");
     }
   }
   if (last_stamp_ns_ == 0) {  // no robot clock yet
@@ -390,7 +414,8 @@ void NavNode::spin(const std::atomic<bool>& stop) {
     if (next < now) next = now;
     std::this_thread::sleep_until(next);
   }
-  if (navigator_.status().state == GoalState::kFollowing || navigator_.status().state == GoalState::kPlanning) {
+  if (navigator_.status().state == GoalState::kFollowing ||
+      navigator_.status().state == GoalState::kPlanning) {
     navigator_.cancel(0, "nav service stopping");
     publish_status();
     msg::BaseVelocityCommand c;

@@ -29,7 +29,8 @@ msg::Pose2D to_msg(const Pose2& pose);
 Pose2 to_core(const msg::Pose2D& pose);
 GoalRequest to_core(const msg::NavGoal& goal);
 msg::NavStatus to_msg(const GoalStatus& status, std::int64_t stamp_ns);
-msg::OccupancyGridMap to_msg(const bim::OccupancyGrid& grid, const std::string& name, const std::string& source);
+msg::OccupancyGridMap to_msg(const bim::OccupancyGrid& grid, const std::string& name,
+                             const std::string& source);
 /// The grid of a map message; throws std::invalid_argument naming what is inconsistent.
 bim::OccupancyGrid to_core(const msg::OccupancyGridMap& map);
 msg::NavVehicle to_msg(const VehicleConfig& vehicle);
@@ -40,7 +41,8 @@ class NavNode {
  public:
   /// `participant` and `navigator` must outlive the node. `map_source` names where the map
   /// came from (published with it).
-  NavNode(concert::dds::Participant& participant, Navigator& navigator, std::string map_source, std::ostream& log);
+  NavNode(concert::dds::Participant& participant, Navigator& navigator, std::string map_source,
+          std::ostream& log);
   ~NavNode();
   NavNode(const NavNode&) = delete;
   NavNode& operator=(const NavNode&) = delete;
