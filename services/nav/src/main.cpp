@@ -52,7 +52,7 @@ int run(const Options& o) {
               << " x " << grid.height << " cells at " << grid.resolution << " m in "
               << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
               << " s" << std::endl;
-    navigator.set_map(std::move(grid), storey.name, bim, storey.name);
+    navigator.set_map(std::move(grid), storey.name, bim);
     source = o.ifc;
   } else if (!o.map.empty()) {
     navigator.set_map(bim::load_map(o.map), o.map);

@@ -77,7 +77,6 @@ PlanarScan scan_at(const bim::OccupancyGrid& truth, const Eigen::Vector3d& pose,
 
 struct Drive {
   Eigen::Vector3d truth;          // map frame
-  Eigen::Vector3d odom{0, 0, 0};  // wheel odometry (drifts)
 };
 
 // Runs the navigator closed-loop for up to `seconds` of simulated time at 100 Hz odometry, 10 Hz
@@ -94,8 +93,7 @@ GoalStatus run(Navigator& nav, Drive& d, const bim::OccupancyGrid& truth, double
     v += (Eigen::Vector3d(cmd.vx, cmd.vy, cmd.wz) - v) * (dt / 0.1);
     d.truth = integrate_twist(d.truth, {v.x(), v.y(), v.z()}, dt);
     const Eigen::Vector3d measured = v.cwiseProduct(Eigen::Vector3d(1.02, 1.02, 0.98));  // slip
-    d.odom = integrate_twist(d.odom, {measured.x(), measured.y(), measured.z()}, dt);
-    nav.on_wheel_odometry(t, {d.odom.x(), d.odom.y(), d.odom.z()}, measured);
+    nav.on_wheel_odometry(t, measured);
     nav.on_gyro(t, v.z() + 0.002);  // a small gyro bias
     if (k % 10 == 0) nav.on_scan(t, scan_at(truth, d.truth, rng));
     if (k % 5 == 0) {
@@ -118,7 +116,7 @@ class NavigatorTest : public ::testing::Test {
   // Odometry and a first scan at the start, then the user's initial pose (off by 10 cm, 3 deg).
   void start(const Eigen::Vector3d& truth) {
     drive_.truth = truth;
-    nav_.on_wheel_odometry(9.99, {0, 0, 0}, Eigen::Vector3d::Zero());
+    nav_.on_wheel_odometry(9.99, Eigen::Vector3d::Zero());
     nav_.set_initial_pose({truth.x() + 0.1, truth.y() - 0.05, truth.z() + 0.05}, 0.0, 0.0);
     for (int i = 0; i < 5; ++i) {
       nav_.on_scan(9.99, scan_at(map_, truth, rng_));
@@ -159,7 +157,7 @@ TEST_F(NavigatorTest, DrivesThroughTheDoorAndStopsWithinTolerance) {
 
 TEST_F(NavigatorTest, RefusesWhatItCannotDoWithAReason) {
   // Not localised yet.
-  nav_.on_wheel_odometry(1.0, {0, 0, 0}, Eigen::Vector3d::Zero());
+  nav_.on_wheel_odometry(1.0, Eigen::Vector3d::Zero());
   EXPECT_THAT(nav_.submit(goal(3, 3, 0)).reason, HasSubstr("not localised"));
   start({2.0, 2.5, 0.0});
   // A goal for another model version.

@@ -117,11 +117,13 @@ class Navigator {
   /// The storey map (and the BIM model with its walls for wall goals; null: pose goals only).
   /// The running goal is cancelled; localisation restarts from its last pose estimate.
   void set_map(bim::OccupancyGrid grid, std::string name,
-               std::shared_ptr<const bim::BimModel> bim = nullptr, std::string storey = {});
+               std::shared_ptr<const bim::BimModel> bim = nullptr);
   /// Restarts localisation around `pose` (std <= 0: the defaults).
   void set_initial_pose(const Pose2& pose, double std_xy, double std_yaw);
-  /// Wheel odometry from the robot service: pose in the odom frame and base twist; `stamp` [s].
-  void on_wheel_odometry(double stamp, const Pose2& odom_pose, const Eigen::Vector3d& twist);
+  /// Wheel odometry from the robot service: the base twist (vx, vy [m/s], wz [rad/s]) at
+  /// `stamp` [s]. The odometry filter integrates it (with the gyro); the robot's own
+  /// integrated pose is not needed.
+  void on_wheel_odometry(double stamp, const Eigen::Vector3d& twist);
   /// IMU angular rate about the base z axis [rad/s].
   void on_gyro(double stamp, double yaw_rate);
   /// A planar scan in the base frame, taken at `stamp` [s].
@@ -181,7 +183,6 @@ class Navigator {
   std::shared_ptr<const LikelihoodField> field_;
   std::string map_name_;
   std::shared_ptr<const bim::BimModel> bim_;
-  std::string storey_;
   std::unique_ptr<Costmap> costmap_;
   std::unique_ptr<Localiser> localiser_;
   GlobalPlanner planner_;

@@ -93,7 +93,7 @@ const VehicleConfig& Navigator::set_model(const model::RobotModel& model) {
 }
 
 void Navigator::set_map(bim::OccupancyGrid grid, std::string name,
-                        std::shared_ptr<const bim::BimModel> bim, std::string storey) {
+                        std::shared_ptr<const bim::BimModel> bim) {
   auto field = std::make_shared<const LikelihoodField>(grid);  // throws on a map without walls
   if (running(status_.state)) set_state(GoalState::kCancelled, "the map changed to '" + name + "'");
   const bool was_localised =
@@ -104,7 +104,6 @@ void Navigator::set_map(bim::OccupancyGrid grid, std::string name,
   field_ = std::move(field);
   map_name_ = std::move(name);
   bim_ = std::move(bim);
-  storey_ = std::move(storey);
   localiser_ = std::make_unique<Localiser>(field_, params_.localiser);
   if (pending_initial_) {
     localiser_->set_pose(*pending_initial_, pending_sigma_, filter_.estimate().pose);
@@ -154,8 +153,7 @@ void Navigator::set_initial_pose(const Pose2& pose, double std_xy, double std_ya
   map_to_odom_ = localiser_->estimate().map_T_odom;
 }
 
-void Navigator::on_wheel_odometry(double stamp, const Pose2& /*odom_pose*/,
-                                  const Eigen::Vector3d& twist) {
+void Navigator::on_wheel_odometry(double stamp, const Eigen::Vector3d& twist) {
   if (!have_odometry_) {
     filter_.reset(stamp);
     have_odometry_ = true;

@@ -107,22 +107,6 @@ msg::OccupancyGridMap to_msg(const bim::OccupancyGrid& g, const std::string& nam
   return out;
 }
 
-bim::OccupancyGrid to_core(const msg::OccupancyGridMap& m) {
-  if (m.width() == 0 || m.height() == 0 || !(m.resolution() > 0.0)) {
-    throw std::invalid_argument("map '" + m.name() + "': empty grid or resolution <= 0");
-  }
-  if (m.cells().size() != static_cast<std::size_t>(m.width()) * m.height()) {
-    throw std::invalid_argument("map '" + m.name() + "': " + std::to_string(m.cells().size()) +
-                                " cells for " + std::to_string(m.width()) + " x " +
-                                std::to_string(m.height()));
-  }
-  auto g = bim::OccupancyGrid::filled(static_cast<int>(m.width()), static_cast<int>(m.height()),
-                                      m.resolution(), {m.origin_x(), m.origin_y()});
-  for (std::size_t i = 0; i < g.cells.size(); ++i)
-    g.cells[i] = static_cast<std::int8_t>(m.cells()[i]);
-  return g;
-}
-
 msg::NavVehicle to_msg(const VehicleConfig& v) {
   msg::NavVehicle out;
   out.model_version(static_cast<uint32_t>(v.model_version));
@@ -309,8 +293,7 @@ void NavNode::tick() {
   for (const auto& o : in.odometry) {
     last_stamp_ns_ = std::max(last_stamp_ns_, static_cast<std::int64_t>(o.stamp_ns()));
     try {
-      navigator_.on_wheel_odometry(to_s(o.stamp_ns()), {o.x(), o.y(), o.yaw()},
-                                   {o.vx(), o.vy(), o.wz()});
+      navigator_.on_wheel_odometry(to_s(o.stamp_ns()), {o.vx(), o.vy(), o.wz()});
     } catch (const std::exception& e) {
       status_.refused(std::string("odometry refused: ") + e.what());
     }

@@ -31,8 +31,6 @@ GoalRequest to_core(const msg::NavGoal& goal);
 msg::NavStatus to_msg(const GoalStatus& status, std::int64_t stamp_ns);
 msg::OccupancyGridMap to_msg(const bim::OccupancyGrid& grid, const std::string& name,
                              const std::string& source);
-/// The grid of a map message; throws std::invalid_argument naming what is inconsistent.
-bim::OccupancyGrid to_core(const msg::OccupancyGridMap& map);
 msg::NavVehicle to_msg(const VehicleConfig& vehicle);
 /// The planar scan (base frame) of a LaserScan.
 PlanarScan to_core(const msg::LaserScan& scan);
