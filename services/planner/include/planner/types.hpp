@@ -42,9 +42,10 @@ struct Params {
   double floor_clearance = 0.02;     ///< non-leg shapes stay this far above the floor [m]
   double base_range = 3.0;           ///< base x, y sampled within start +- this [m]
 
-  // Planning.
-  double planning_time = 2.0;        ///< per goal, NSPG included [s]
-  double path_attempt_time = 0.5;    ///< path search per goal posture before another posture is tried [s]
+  // Planning. Time budgets are CPU seconds of the planning thread, not wall seconds, so a plan
+  // does not depend on what else loads the machine.
+  double planning_time = 2.0;        ///< per goal, NSPG included [s CPU]
+  double path_attempt_time = 0.5;    ///< path search per goal posture before another posture is tried [s CPU]
   double check_resolution = 0.02;    ///< largest step between checked states [rad or m]
   int simplify_iterations = 50;      ///< shortcutting attempts after RRT-Connect
   int sample_iterations = 4;         ///< Gauss-Newton steps pulling every other RRT sample toward feasibility (0: uniform)
@@ -54,7 +55,7 @@ struct Params {
   int nspg_seeds = 256;              ///< seeds tried per goal at most (start posture first; nspg_time usually ends it first)
   int nspg_screen = 24;              ///< random arm postures drawn per random seed (closest kept)
   int nspg_iterations = 40;          ///< Levenberg-Marquardt iterations per seed
-  double nspg_time = 1.6;            ///< NSPG time budget per goal [s] (of planning_time)
+  double nspg_time = 1.6;            ///< NSPG time budget per goal [s CPU] (of planning_time)
   int nspg_enough = 1;               ///< stop after this many valid postures
   double warm_up_time = 2.0;         ///< service: per height of the background warm-up after each model [s] (0: none)
   int nspg_memory = 128;             ///< goal postures remembered per model version as seeds for similar heights (0: off)

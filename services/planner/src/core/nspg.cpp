@@ -6,8 +6,9 @@
 // links and the map's obstacles). Seeds: the start posture with the base placed for it, the
 // start posture as it is, the hints (remembered postures) and their mirror images, the start
 // posture, the hints and their images with the first arm joint turned, then random arm
-// postures (the best of a few draws, base placed for each). Every converged posture is judged by the exact StateChecker; the valid
-// one of least cost (distance to the start, inverse manipulability) is kept.
+// postures (the best of a few draws, base placed for each). Every converged posture is judged by
+// the exact StateChecker; the valid one of least cost (distance to the start, inverse
+// manipulability) is kept.
 //
 // The solver is hand-written instead of a library's (Ipopt is in Debian): 9-12 variables and
 // a few hundred cheap residual rows, a dense two-priority Gauss-Newton step with a
@@ -15,7 +16,6 @@
 // residuals plus derivatives and a problem adapter without being faster at this size.
 
 #include <Eigen/Dense>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -24,25 +24,28 @@
 #include <optional>
 #include <random>
 
+#include "cpu_clock.hpp"
 #include "planner/planner.hpp"
 #include "posture_problem.hpp"
 
 namespace concert::planner {
 namespace {
 
-using detail::PostureProblem;
-using detail::Task;
-using detail::Term;
 using detail::kTaskWeight;
 using detail::make_task;
+using detail::PostureProblem;
 using detail::solve;
+using detail::Task;
+using detail::Term;
 
 // Yoshikawa manipulability of the arm joints for the camera frame.
-double manipulability(const PlanningModel& model, kinematics::Data& data, const Eigen::VectorXd& full, const std::string& camera) {
+double manipulability(const PlanningModel& model, kinematics::Data& data,
+                      const Eigen::VectorXd& full, const std::string& camera) {
   const Eigen::MatrixXd j_full = model.kinematics().frame_jacobian(data, full, camera);
   const auto& idx = model.planned_indices();
   Eigen::MatrixXd j(6, static_cast<Eigen::Index>(idx.size()) - 3);
-  for (std::size_t i = 3; i < idx.size(); ++i) j.col(static_cast<Eigen::Index>(i) - 3) = j_full.col(idx[i]);
+  for (std::size_t i = 3; i < idx.size(); ++i)
+    j.col(static_cast<Eigen::Index>(i) - 3) = j_full.col(idx[i]);
   return std::sqrt(std::max(0.0, (j * j.transpose()).determinant()));
 }
 
@@ -54,21 +57,22 @@ constexpr int kTurns = 5;
 
 }  // namespace
 
-std::pair<double, double> task_error(const PlanningModel& model, const Params& params, const EndEffectorInfo& tool,
-                                     const Eigen::VectorXd& q_full, const Eigen::Isometry3d& area) {
+std::pair<double, double> task_error(const PlanningModel& model, const Params& params,
+                                     const EndEffectorInfo& tool, const Eigen::VectorXd& q_full,
+                                     const Eigen::Isometry3d& area) {
   const Task task = make_task(params, area);
   const Eigen::Isometry3d pose = model.link_pose(q_full, model.camera_frame(tool));
   const double angle = std::acos(std::clamp(pose.linear().col(2).dot(task.axis), -1.0, 1.0));
   return {(pose.translation() - task.position).norm(), angle};
 }
 
-PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
-                               const EndEffectorInfo& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
-                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints, int first_seed) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const auto out_of_time = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > params.nspg_time;
-  };
+PostureResult generate_posture(const PlanningModel& model, StateChecker& checker,
+                               const Params& params, const EndEffectorInfo& tool,
+                               const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
+                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints,
+                               int first_seed) {
+  const auto t0 = detail::ThreadCpuClock::now();
+  const auto out_of_time = [&] { return detail::cpu_seconds_since(t0) > params.nspg_time; };
   const Task task = make_task(params, area);
   const int n = model.dof();
   const Eigen::VectorXd start = model.to_planned(q_start_full);
@@ -110,7 +114,8 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   PostureResult out;
   std::map<std::string, int> rejections;
   auto reject = [&](const std::string& key, const std::string& detail) {
-    if (rejections[key]++ == 0 && out.reason.empty()) out.reason = key + (detail.empty() ? "" : ": " + detail);
+    if (rejections[key]++ == 0 && out.reason.empty())
+      out.reason = key + (detail.empty() ? "" : ": " + detail);
   };
   // Seeds in order: the start posture with the base placed for it, the start posture as it
   // is, the hints and their mirror images (the base then stands on the area's other side), then
@@ -125,7 +130,8 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   // of random seeds.
   std::vector<Eigen::VectorXd> mirrored;
   for (const Eigen::VectorXd& arm : hints) {
-    if (std::optional<Eigen::VectorXd> m = model.mirrored_arm(arm)) mirrored.push_back(std::move(*m));
+    if (std::optional<Eigen::VectorXd> m = model.mirrored_arm(arm))
+      mirrored.push_back(std::move(*m));
   }
   arms.insert(arms.end(), mirrored.begin(), mirrored.end());
   std::vector<Eigen::VectorXd> turned;
@@ -144,11 +150,11 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   for (; k < params.nspg_seeds && valid_found < params.nspg_enough && !out_of_time(); ++k) {
     const auto hint = static_cast<std::size_t>(k - 2);  // index into arms[1...]
     const std::size_t turn = hint - (arms.size() - 1);
-    Eigen::VectorXd q = k == 0                      ? problem.place(arms[0], yaw_hint)
-                        : k == 1                    ? start
-                        : hint + 1 < arms.size()    ? problem.place(arms[hint + 1], yaw_hint)
-                        : turn < turned.size()      ? problem.place(turned[turn], yaw_hint)
-                                                    : random_seed();
+    Eigen::VectorXd q = k == 0                   ? problem.place(arms[0], yaw_hint)
+                        : k == 1                 ? start
+                        : hint + 1 < arms.size() ? problem.place(arms[hint + 1], yaw_hint)
+                        : turn < turned.size()   ? problem.place(turned[turn], yaw_hint)
+                                                 : random_seed();
     solve(problem, q, lo, hi, params.nspg_iterations, params.nspg_tolerance, r);
     out.candidates += 1;
     if (r.head<6>().norm() >= kTaskWeight * params.nspg_tolerance) {
@@ -156,12 +162,26 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
       Eigen::Index row = 0;
       if (r.tail(r.size() - 6).maxCoeff(&row) > 0.0) {
         switch (problem.term_of_row(static_cast<int>(row) + 6)) {
-          case Term::kTorque: reject(to_string(Constraint::kTorqueLimit), "torques kept the camera off the task"); break;
-          case Term::kSurface: reject(to_string(Constraint::kEnvironmentCollision), "the drilled surface kept the camera off the task"); break;
-          case Term::kFloor: reject(to_string(Constraint::kFloor), "the floor kept the camera off the task"); break;
-          case Term::kSelf: reject(to_string(Constraint::kSelfCollision), "the robot's own links kept the camera off the task"); break;
-          case Term::kObstacle: reject(to_string(Constraint::kEnvironmentCollision), "obstacles kept the camera off the task"); break;
-          case Term::kTask: break;
+          case Term::kTorque:
+            reject(to_string(Constraint::kTorqueLimit), "torques kept the camera off the task");
+            break;
+          case Term::kSurface:
+            reject(to_string(Constraint::kEnvironmentCollision),
+                   "the drilled surface kept the camera off the task");
+            break;
+          case Term::kFloor:
+            reject(to_string(Constraint::kFloor), "the floor kept the camera off the task");
+            break;
+          case Term::kSelf:
+            reject(to_string(Constraint::kSelfCollision),
+                   "the robot's own links kept the camera off the task");
+            break;
+          case Term::kObstacle:
+            reject(to_string(Constraint::kEnvironmentCollision),
+                   "obstacles kept the camera off the task");
+            break;
+          case Term::kTask:
+            break;
         }
       } else {
         reject("off the task", "");
@@ -179,8 +199,9 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
     }
     valid_found += 1;
     out.valid.push_back(q);
-    const double cost = params.nspg_distance_weight * (q - start).norm() +
-                        params.nspg_singularity_weight / (manipulability(model, data, full, camera) + 1e-3);
+    const double cost =
+        params.nspg_distance_weight * (q - start).norm() +
+        params.nspg_singularity_weight / (manipulability(model, data, full, camera) + 1e-3);
     if (!out.found || cost < out.cost) {
       out.found = true;
       out.cost = cost;
@@ -194,7 +215,8 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
     out.reason = "camera frame cannot reach the task pose (kinematically unreachable)";
   } else {
     std::string counts;
-    for (const auto& [what, count] : rejections) counts += (counts.empty() ? "" : ", ") + what + " x" + std::to_string(count);
+    for (const auto& [what, count] : rejections)
+      counts += (counts.empty() ? "" : ", ") + what + " x" + std::to_string(count);
     out.reason = "rejected: " + counts + "; first: " + out.reason;
   }
   return out;

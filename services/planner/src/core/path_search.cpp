@@ -17,15 +17,13 @@ namespace {
 
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
-using Clock = std::chrono::steady_clock;
+using Clock = ThreadCpuClock;
 
 // Largest joint change [rad or m] between the states of a projected straight line.
 constexpr double kLineStep = 0.15;
 // Share of a path attempt's remaining time for each order of the arm-alone-and-drive search
 // (arm first, then drive first, each of what is left); the rest is whole-body RRT-Connect's.
 constexpr double kArmShare = 0.5;
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 Eigen::VectorXd to_eigen(const ob::State* s, int n) {
   const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
@@ -46,12 +44,18 @@ void from_eigen(const Eigen::VectorXd& q, ob::State* s) {
 // rarely land in it, so RRT-Connect's trees stop growing (morphology B).
 class SeededSampler : public ob::RealVectorStateSampler {
  public:
-  SeededSampler(const ob::StateSpace* space, uint64_t seed, PostureProblem* feasible, int iterations, const bool* active)
-      : ob::RealVectorStateSampler(space), feasible_(feasible), iterations_(iterations), active_(active) {
+  SeededSampler(const ob::StateSpace* space, uint64_t seed, PostureProblem* feasible,
+                int iterations, const bool* active)
+      : ob::RealVectorStateSampler(space),
+        feasible_(feasible),
+        iterations_(iterations),
+        active_(active) {
     rng_.setLocalSeed(static_cast<std::uint_fast32_t>(seed));
     const auto& bounds = space->as<ob::RealVectorStateSpace>()->getBounds();
-    lo_ = Eigen::Map<const Eigen::VectorXd>(bounds.low.data(), static_cast<Eigen::Index>(bounds.low.size()));
-    hi_ = Eigen::Map<const Eigen::VectorXd>(bounds.high.data(), static_cast<Eigen::Index>(bounds.high.size()));
+    lo_ = Eigen::Map<const Eigen::VectorXd>(bounds.low.data(),
+                                            static_cast<Eigen::Index>(bounds.low.size()));
+    hi_ = Eigen::Map<const Eigen::VectorXd>(bounds.high.data(),
+                                            static_cast<Eigen::Index>(bounds.high.size()));
   }
   void sampleUniform(ob::State* state) override {
     ob::RealVectorStateSampler::sampleUniform(state);
@@ -71,23 +75,29 @@ class SeededSampler : public ob::RealVectorStateSampler {
   unsigned long count_ = 0;
 };
 
-// RRT-Connect from `a` to `b` within `budget` [s]: the path, or none.
-std::optional<og::PathGeometric> rrt_connect(const ob::SpaceInformationPtr& si, const ob::ScopedState<>& a, const ob::ScopedState<>& b,
+// RRT-Connect from `a` to `b` within `budget` [s of this thread's CPU time]: the path, or none.
+std::optional<og::PathGeometric> rrt_connect(const ob::SpaceInformationPtr& si,
+                                             const ob::ScopedState<>& a, const ob::ScopedState<>& b,
                                              double budget) {
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
   pdef->setStartAndGoalStates(a, b);
   og::RRTConnect rrt(si);
   rrt.setProblemDefinition(pdef);
   rrt.setup();
-  if (rrt.solve(ob::timedPlannerTerminationCondition(budget)) != ob::PlannerStatus::EXACT_SOLUTION) return std::nullopt;
+  const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                        std::chrono::duration<double>(budget));
+  const ob::PlannerTerminationCondition out_of_time([deadline] { return Clock::now() > deadline; });
+  if (rrt.solve(out_of_time) != ob::PlannerStatus::EXACT_SOLUTION) return std::nullopt;
   return *pdef->getSolutionPath()->as<og::PathGeometric>();
 }
 
 }  // namespace
 
-std::vector<Eigen::VectorXd> subspace_rrt(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& full_template,
-                                          double check_resolution, int first, int count, const Eigen::VectorXd& lo,
-                                          const Eigen::VectorXd& hi, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+std::vector<Eigen::VectorXd> subspace_rrt(const PlanningModel& model, StateChecker& checker,
+                                          const Eigen::VectorXd& full_template,
+                                          double check_resolution, int first, int count,
+                                          const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
+                                          const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                                           double budget, uint64_t seed, Validity* last_rejection) {
   // Both ends must be valid (e.g. the goal's arm posture where the base stands at the start
   // may hit the wall); OMPL would otherwise report it as an error and search in vain.
@@ -106,8 +116,9 @@ std::vector<Eigen::VectorXd> subspace_rrt(const PlanningModel& model, StateCheck
     sub_bounds.setHigh(static_cast<unsigned>(i), hi[first + i]);
   }
   sub->setBounds(sub_bounds);
-  sub->setStateSamplerAllocator(
-      [seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed, nullptr, 0, &kActive); });
+  sub->setStateSamplerAllocator([seed](const ob::StateSpace* s) {
+    return std::make_shared<SeededSampler>(s, seed, nullptr, 0, &kActive);
+  });
   auto sub_si = std::make_shared<ob::SpaceInformation>(sub);
   Eigen::VectorXd q = from;
   sub_si->setStateValidityChecker([&](const ob::State* s) {
@@ -131,8 +142,9 @@ std::vector<Eigen::VectorXd> subspace_rrt(const PlanningModel& model, StateCheck
   return out;
 }
 
-PathSearch::PathSearch(const PlanningModel& model, StateChecker& checker, const Params& params, const Eigen::VectorXd& q_start_full,
-                       const Eigen::VectorXd& q_goal, uint64_t seed, RememberedArmPath remembered)
+PathSearch::PathSearch(const PlanningModel& model, StateChecker& checker, const Params& params,
+                       const Eigen::VectorXd& q_start_full, const Eigen::VectorXd& q_goal,
+                       uint64_t seed, RememberedArmPath remembered)
     : model_(model),
       checker_(checker),
       params_(params),
@@ -191,13 +203,15 @@ bool PathSearch::motion_ok(const Eigen::VectorXd& from, const Eigen::VectorXd& t
 // point on the line, by the inequality rows): for a long arm the straight joint-space line
 // usually swings the arm out past its torque limits, and a slight fold on the way is all it
 // needs. Cheap compared with RRT-Connect, so it is tried first.
-PathSearch::Path PathSearch::projected_line(const Eigen::VectorXd& from, const Eigen::VectorXd& target) {
+PathSearch::Path PathSearch::projected_line(const Eigen::VectorXd& from,
+                                            const Eigen::VectorXd& target) {
   if (params_.sample_iterations <= 0) return {};
   Eigen::VectorXd residual;
   Path line{from};
   // Appends a feasible chain from line.back() to `to`: the direct motion, else a projected
   // midpoint and the two halves (bounded depth).
-  std::function<bool(const Eigen::VectorXd&, int)> reach = [&](const Eigen::VectorXd& to, int depth) {
+  std::function<bool(const Eigen::VectorXd&, int)> reach = [&](const Eigen::VectorXd& to,
+                                                               int depth) {
     if (motion_ok(line.back(), to)) {
       line.push_back(to);
       return true;
@@ -208,12 +222,14 @@ PathSearch::Path PathSearch::projected_line(const Eigen::VectorXd& from, const E
     return reach(mid, depth - 1) && reach(to, depth - 1);
   };
   const Eigen::VectorXd delta = target - from;
-  const int segments = std::max(2, static_cast<int>(std::ceil(delta.cwiseAbs().maxCoeff() / kLineStep)));
+  const int segments =
+      std::max(2, static_cast<int>(std::ceil(delta.cwiseAbs().maxCoeff() / kLineStep)));
   for (int k = 1; k <= segments; ++k) {
     // From the previous state moved by one step of the line, so a fold made on the way is
     // kept; the last segments steer back onto the target.
     const double left = static_cast<double>(segments - k + 1);
-    Eigen::VectorXd q = k == segments ? target : Eigen::VectorXd(line.back() + (target - line.back()) / left);
+    Eigen::VectorXd q =
+        k == segments ? target : Eigen::VectorXd(line.back() + (target - line.back()) / left);
     if (k < segments) solve(feasible_, q, lo_, hi_, 3 * params_.sample_iterations, 1.0, residual);
     if (!reach(q, 3)) return {};
   }
@@ -221,14 +237,16 @@ PathSearch::Path PathSearch::projected_line(const Eigen::VectorXd& from, const E
 }
 
 // RRT-Connect over the joints [first, first + count) with the others held.
-PathSearch::Path PathSearch::subspace(int first, int count, const Eigen::VectorXd& from, const Eigen::VectorXd& to, double budget) {
-  return subspace_rrt(model_, checker_, q_start_full_, params_.check_resolution, first, count, lo_, hi_, from, to, budget, seed_,
-                      &last_rejection_);
+PathSearch::Path PathSearch::subspace(int first, int count, const Eigen::VectorXd& from,
+                                      const Eigen::VectorXd& to, double budget) {
+  return subspace_rrt(model_, checker_, q_start_full_, params_.check_resolution, first, count, lo_,
+                      hi_, from, to, budget, seed_, &last_rejection_);
 }
 
 // The arm's moves with the base held: a path remembered by the warm-up for a posture like the
 // goal's (checked here against the map), else RRT-Connect over the arm's joints.
-PathSearch::Path PathSearch::arm_path(const Eigen::VectorXd& from, const Eigen::VectorXd& to, double budget) {
+PathSearch::Path PathSearch::arm_path(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                      double budget) {
   const Path known = remembered_ ? remembered_(to.tail(n_ - 3)) : Path{};
   if (!known.empty()) {
     Path chain{from};
@@ -250,7 +268,8 @@ PathSearch::Path PathSearch::arm_path(const Eigen::VectorXd& from, const Eigen::
 
 // The drive alone (x, y, yaw; the arm held): the projected line, else RRT-Connect over the
 // base's three joints around the obstacles.
-PathSearch::Path PathSearch::drive(const Eigen::VectorXd& from, const Eigen::VectorXd& to, double budget) {
+PathSearch::Path PathSearch::drive(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                   double budget) {
   Path line = projected_line(from, to);
   return line.empty() ? subspace(0, 3, from, to, budget) : line;
 }
@@ -266,12 +285,13 @@ PathSearch::Path PathSearch::drive(const Eigen::VectorXd& from, const Eigen::Vec
 PathSearch::Path PathSearch::arm_and_drive(bool reach_first, double budget) {
   replayed_ = false;
   const auto t_order = Clock::now();
-  const auto rest = [&] { return std::max(0.0, budget - seconds_since(t_order)); };
+  const auto rest = [&] { return std::max(0.0, budget - cpu_seconds_since(t_order)); };
   Eigen::VectorXd turn = q_start_;  // where the arm moves: the start's or the goal's base pose
   if (!reach_first) turn.head<3>() = q_goal_.head<3>();
   Eigen::VectorXd turned = turn;
   turned.tail(n_ - 3) = q_goal_.tail(n_ - 3);
-  Path first = reach_first ? arm_path(q_start_, turned, 0.5 * budget) : drive(q_start_, turn, 0.5 * budget);
+  Path first =
+      reach_first ? arm_path(q_start_, turned, 0.5 * budget) : drive(q_start_, turn, 0.5 * budget);
   if (first.empty()) return {};
   Path second = reach_first ? drive(turned, q_goal_, rest()) : arm_path(turn, q_goal_, rest());
   if (second.empty()) return {};
@@ -296,7 +316,8 @@ PathSearch::Path PathSearch::simplified(og::PathGeometric& path) {
   simplifier.reduceVertices(path, steps);
   simplifier.collapseCloseVertices(path);
   Path out;
-  for (std::size_t i = 0; i < path.getStateCount(); ++i) out.push_back(to_eigen(path.getState(static_cast<unsigned>(i)), n_));
+  for (std::size_t i = 0; i < path.getStateCount(); ++i)
+    out.push_back(to_eigen(path.getState(static_cast<unsigned>(i)), n_));
   return out;
 }
 
@@ -333,9 +354,12 @@ std::vector<Eigen::VectorXd> PathSearch::run(Clock::time_point deadline) {
   const double budget = seconds_left();
   if (line = whole_body_rrt(budget); !line.empty()) return line;
   std::ostringstream s;
-  s << "no collision-free path (direct, projected line, arm alone before or after driving, then RRT-Connect for " << budget
-    << " s)";
-  if (!last_rejection_.valid()) s << " (last rejection: " << to_string(last_rejection_.constraint) << ": " << last_rejection_.detail << ")";
+  s << "no collision-free path (direct, projected line, arm alone before or after driving, then "
+       "RRT-Connect for "
+    << budget << " s)";
+  if (!last_rejection_.valid())
+    s << " (last rejection: " << to_string(last_rejection_.constraint) << ": "
+      << last_rejection_.detail << ")";
   reason_ = s.str();
   return {};
 }

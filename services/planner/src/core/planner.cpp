@@ -15,7 +15,9 @@
 namespace concert::planner {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Clock = std::chrono::steady_clock;  // what results report (wall time)
+using detail::cpu_seconds_since;
+using detail::ThreadCpuClock;  // what budgets are measured in (see cpu_clock.hpp)
 
 // Remembered postures whose camera height is within this of a new goal's seed it [m], at most
 // kHints of them (nearest first).
@@ -38,11 +40,14 @@ double shape_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return (a.tail(a.size() - 1) - b.tail(b.size() - 1)).cwiseAbs().maxCoeff();
 }
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 }  // namespace
 
-Planner::Planner(Params params) : params_(std::move(params)), environment_(params_.octomap_resolution) {
+Planner::Planner(Params params)
+    : params_(std::move(params)), environment_(params_.octomap_resolution) {
   static std::once_flag once;
   std::call_once(once, [&] {
     ompl::msg::setLogLevel(ompl::msg::LOG_ERROR);
@@ -57,7 +62,8 @@ void Planner::set_model(const ModelDescription& description) {
   memory_.clear();
 }
 
-int Planner::warm_up(double from, double to, double step, double seconds_per_height, const std::function<bool()>& keep_going) {
+int Planner::warm_up(double from, double to, double step, double seconds_per_height,
+                     const std::function<bool()>& keep_going) {
   const std::shared_ptr<const PlanningModel> model = this->model();
   if (!model || !(step > 0.0)) return 0;
   const EndEffectorInfo* tool = nullptr;
@@ -87,15 +93,17 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
     for (const bool seeded : {true, false}) {
       params.nspg_enough = seeded ? 1 : 2;
       const uint64_t seed = params.seed + 31u * static_cast<uint64_t>(index) + (seeded ? 0u : 17u);
-      const PostureResult p = generate_posture(*model, checker, params, *tool, start, area, seed,
-                                               seeded ? hints_for(*model, height) : std::vector<Eigen::VectorXd>{});
+      const PostureResult p =
+          generate_posture(*model, checker, params, *tool, start, area, seed,
+                           seeded ? hints_for(*model, height) : std::vector<Eigen::VectorXd>{});
       for (const Eigen::VectorXd& q : p.valid) {
         // The arm's way from the start posture to it, where the map cannot interfere: later
         // plans replay it (checked against their map) instead of searching for it.
         Eigen::VectorXd parked = model->to_planned(start);
         parked.head<3>() = q.head<3>();
-        std::vector<Eigen::VectorXd> path = detail::subspace_rrt(*model, checker, start, params.check_resolution, 3, model->dof() - 3, model->lower(),
-                                                         model->upper(), parked, q, kWarmUpPathTime, seed, nullptr);
+        std::vector<Eigen::VectorXd> path = detail::subspace_rrt(
+            *model, checker, start, params.check_resolution, 3, model->dof() - 3, model->lower(),
+            model->upper(), parked, q, kWarmUpPathTime, seed, nullptr);
         std::vector<Eigen::VectorXd> arms;
         for (const Eigen::VectorXd& w : path) arms.push_back(w.tail(w.size() - 3));
         remember(*model, height, q, std::move(arms));
@@ -113,23 +121,28 @@ std::vector<Eigen::VectorXd> Planner::hints_for(const PlanningModel& model, doub
     std::lock_guard lock(mutex_);
     if (model_.get() != &model) return {};
     for (const Remembered& m : memory_) {
-      if (std::abs(m.height - height) <= kHintHeight) near.emplace_back(std::abs(m.height - height), m.arm);
+      if (std::abs(m.height - height) <= kHintHeight)
+        near.emplace_back(std::abs(m.height - height), m.arm);
     }
   }
-  std::sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(near.begin(), near.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<Eigen::VectorXd> out;
-  for (std::size_t i = 0; i < near.size() && out.size() < kHints; ++i) out.push_back(near[i].second);
+  for (std::size_t i = 0; i < near.size() && out.size() < kHints; ++i)
+    out.push_back(near[i].second);
   return out;
 }
 
-void Planner::remember(const PlanningModel& model, double height, const Eigen::VectorXd& q, std::vector<Eigen::VectorXd> arm_path) {
+void Planner::remember(const PlanningModel& model, double height, const Eigen::VectorXd& q,
+                       std::vector<Eigen::VectorXd> arm_path) {
   if (params_.nspg_memory <= 0) return;
   std::lock_guard lock(mutex_);
   if (model_.get() != &model) return;
   const Eigen::VectorXd arm = q.tail(q.size() - 3);
   for (Remembered& m : memory_) {
     // The same posture again (both warm-up passes, or a plan that started from it): one entry.
-    if (std::abs(m.height - height) < kSamePosture && (m.arm - arm).cwiseAbs().maxCoeff() < kSamePosture) {
+    if (std::abs(m.height - height) < kSamePosture &&
+        (m.arm - arm).cwiseAbs().maxCoeff() < kSamePosture) {
       if (m.arm_path.empty()) m.arm_path = std::move(arm_path);
       return;
     }
@@ -138,7 +151,8 @@ void Planner::remember(const PlanningModel& model, double height, const Eigen::V
   memory_.push_back({height, arm, std::move(arm_path)});
 }
 
-std::vector<Eigen::VectorXd> Planner::arm_path_to(const PlanningModel& model, const Eigen::VectorXd& arm) const {
+std::vector<Eigen::VectorXd> Planner::arm_path_to(const PlanningModel& model,
+                                                  const Eigen::VectorXd& arm) const {
   std::lock_guard lock(mutex_);
   if (model_.get() != &model) return {};
   // The goal's arm is compared with each remembered posture and with its mirror image (the
@@ -167,7 +181,8 @@ std::vector<Eigen::VectorXd> Planner::arm_path_to(const PlanningModel& model, co
     if (!w) return {};  // the image leaves the joint limits
     out.push_back(std::move(*w));
   }
-  const double turn = arm[0] - out.back()[0];  // the path ends at the remembered posture (or its image)
+  const double turn =
+      arm[0] - out.back()[0];  // the path ends at the remembered posture (or its image)
   for (Eigen::VectorXd& a : out) a[0] += turn;
   return out;
 }
@@ -194,21 +209,25 @@ Environment Planner::environment() const {
   return environment_;
 }
 
-GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& q_start_full,
-                              const Eigen::VectorXd& q_goal, double time_budget, uint64_t seed) const {
+GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
+                              const Eigen::VectorXd& q_start_full, const Eigen::VectorXd& q_goal,
+                              double time_budget, uint64_t seed) const {
   const auto t0 = Clock::now();
+  const auto cpu0 = ThreadCpuClock::now();
   GoalResult r;
   const Validity vs = checker.check(q_start_full);
   if (!vs.valid()) {
     r.goal_q = q_goal;
     r.status = Status::kInvalidStart;
-    r.reason = std::string("start state rejected by ") + to_string(vs.constraint) + ": " + vs.detail;
+    r.reason =
+        std::string("start state rejected by ") + to_string(vs.constraint) + ": " + vs.detail;
     return r;
   }
   detail::PathSearch search(model, checker, params_, q_start_full, q_goal, seed,
                             [&](const Eigen::VectorXd& arm) { return arm_path_to(model, arm); });
   const std::vector<Eigen::VectorXd> waypoints =
-      search.run(t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(time_budget)));
+      search.run(cpu0 + std::chrono::duration_cast<ThreadCpuClock::duration>(
+                            std::chrono::duration<double>(time_budget)));
   r.goal_q = search.goal();
   r.path_method = search.method();
   r.plan_seconds = seconds_since(t0);
@@ -217,13 +236,15 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
     r.reason = search.reason();
     return r;
   }
-  r.trajectory = time_parameterize(waypoints, model.joint_names(), motion_limits(model, params_), params_.sample_period);
+  r.trajectory = time_parameterize(waypoints, model.joint_names(), motion_limits(model, params_),
+                                   params_.sample_period);
   r.status = Status::kSucceeded;
   r.plan_seconds = seconds_since(t0);
   return r;
 }
 
-PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_start_full, const GoalCallback& on_goal) {
+PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_start_full,
+                         const GoalCallback& on_goal) {
   PlanResult out;
   out.request_id = request.request_id;
   const std::shared_ptr<const PlanningModel> model = this->model();
@@ -236,13 +257,16 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   };
   if (!model) return fail(Status::kNoModel, "no robot model received yet");
   if (request.model_version != model->version()) {
-    return fail(Status::kStaleModel, "request made for model version " + std::to_string(request.model_version) +
-                                         " but the planner runs model version " + std::to_string(model->version()));
+    return fail(Status::kStaleModel,
+                "request made for model version " + std::to_string(request.model_version) +
+                    " but the planner runs model version " + std::to_string(model->version()));
   }
   if (request.goals.empty()) return fail(Status::kInvalidRequest, "request has no goals");
   if (q_start_full.size() != model->full_dof() || !q_start_full.allFinite()) {
-    return fail(Status::kInvalidStart, "start state has " + std::to_string(q_start_full.size()) + " joints, model version " +
-                                           std::to_string(model->version()) + " has " + std::to_string(model->full_dof()));
+    return fail(Status::kInvalidStart, "start state has " + std::to_string(q_start_full.size()) +
+                                           " joints, model version " +
+                                           std::to_string(model->version()) + " has " +
+                                           std::to_string(model->full_dof()));
   }
   const EndEffectorInfo* tool = nullptr;
   try {
@@ -254,20 +278,22 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   for (std::size_t g = 0; g < request.goals.size(); ++g) {
     const Eigen::Isometry3d& a = request.goals[g].area;
     if (!a.matrix().allFinite() || std::abs(a.linear().determinant() - 1.0) > 1e-3) {
-      return fail(Status::kInvalidRequest, "goal " + std::to_string(g) + ": drilling area frame is not a finite rigid transform");
+      return fail(
+          Status::kInvalidRequest,
+          "goal " + std::to_string(g) + ": drilling area frame is not a finite rigid transform");
     }
   }
 
   StateChecker checker(model, env, params_, params_.environment_padding);
   const Validity start_ok = checker.check(q_start_full);
   if (!start_ok.valid()) {
-    return fail(Status::kInvalidStart,
-                std::string("start state rejected by ") + to_string(start_ok.constraint) + ": " + start_ok.detail);
+    return fail(Status::kInvalidStart, std::string("start state rejected by ") +
+                                           to_string(start_ok.constraint) + ": " + start_ok.detail);
   }
   Eigen::VectorXd current = q_start_full;
   out.status = Status::kSucceeded;
   for (std::size_t g = 0; g < request.goals.size(); ++g) {
-    const auto t0 = Clock::now();
+    const auto t0 = ThreadCpuClock::now();
     const uint64_t seed = params_.seed + 7919u * request.request_id + 104729u * g;
     // Goal posture, then a path to it; when no path is found within the attempt's share of
     // the budget, another goal posture is tried while time remains (the posture search goes on
@@ -275,7 +301,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     // postures sit in torque-feasible pockets no path reaches.
     GoalResult r;
     double nspg = 0.0;
-    const double height = (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, params_.camera_distance)).z();
+    const double height =
+        (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, params_.camera_distance)).z();
     const std::vector<Eigen::VectorXd> hints = hints_for(*model, height);
     int next_seed = 0;
     // The arm shapes no path reached: the posture search's next seeds are often the same
@@ -284,33 +311,40 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     std::vector<Eigen::VectorXd> unreached;
     const auto like_unreached = [&](const Eigen::VectorXd& q) {
       const Eigen::VectorXd arm = q.tail(q.size() - 3);
-      return std::any_of(unreached.begin(), unreached.end(), [&](const Eigen::VectorXd& u) { return shape_distance(u, arm) < kSameShape; });
+      return std::any_of(unreached.begin(), unreached.end(), [&](const Eigen::VectorXd& u) {
+        return shape_distance(u, arm) < kSameShape;
+      });
     };
     for (int attempt = 0;; ++attempt) {
       const auto t_posture = Clock::now();
       Params attempt_params = params_;
       PostureResult posture;
       do {
-        attempt_params.nspg_time = std::min(params_.nspg_time, params_.planning_time - seconds_since(t0));
-        posture = generate_posture(*model, checker, attempt_params, *tool, current, request.goals[g].area,
-                                   seed + 7777u * static_cast<uint64_t>(attempt), hints, next_seed);
+        attempt_params.nspg_time =
+            std::min(params_.nspg_time, params_.planning_time - cpu_seconds_since(t0));
+        posture =
+            generate_posture(*model, checker, attempt_params, *tool, current, request.goals[g].area,
+                             seed + 7777u * static_cast<uint64_t>(attempt), hints, next_seed);
         next_seed = posture.next_seed;
-      } while (posture.found && like_unreached(posture.q) && params_.planning_time - seconds_since(t0) > 0.05);
+      } while (posture.found && like_unreached(posture.q) &&
+               params_.planning_time - cpu_seconds_since(t0) > 0.05);
       nspg += seconds_since(t_posture);
       if (!posture.found) {
         if (attempt > 0) break;  // keep the previous attempt's "no path"
         r.status = Status::kUnreachable;
         r.reason = "no feasible posture puts camera '" + model->camera_frame(*tool) + "' " +
-                   std::to_string(params_.camera_distance) + " m in front of the drilling area (" + std::to_string(posture.candidates) +
-                   " seeds solved; " + posture.reason + ")";
+                   std::to_string(params_.camera_distance) + " m in front of the drilling area (" +
+                   std::to_string(posture.candidates) + " seeds solved; " + posture.reason + ")";
         break;
       }
-      const double remaining = params_.planning_time - seconds_since(t0);
-      r = plan_path(*model, checker, current, posture.q, std::min(remaining, params_.path_attempt_time), seed);
+      const double remaining = params_.planning_time - cpu_seconds_since(t0);
+      r = plan_path(*model, checker, current, posture.q,
+                    std::min(remaining, params_.path_attempt_time), seed);
       r.nspg_seconds = nspg;
       if (r.status == Status::kSucceeded) remember(*model, height, posture.q);
       if (r.status == Status::kNoPath) unreached.push_back(posture.q.tail(posture.q.size() - 3));
-      if (r.status != Status::kNoPath || params_.planning_time - seconds_since(t0) < 0.05) break;
+      if (r.status != Status::kNoPath || params_.planning_time - cpu_seconds_since(t0) < 0.05)
+        break;
     }
     if (r.status != Status::kSucceeded) r.reason = "goal " + std::to_string(g) + ": " + r.reason;
     r.index = g;
