@@ -1,0 +1,1 @@
+# concert_drill_perception (see ../CMakeLists.txt)

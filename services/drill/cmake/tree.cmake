@@ -1,0 +1,1 @@
+# concert_drill_tree (see ../CMakeLists.txt)

@@ -1,0 +1,105 @@
+#pragma once
+// What the drilling mission's behaviour tree asks of the rest of the robot. Every call returns
+// at once: long work (navigation, planning, a trajectory, a hole) is started by one call and
+// polled on later ticks. The DDS adapter implements it with the other services' topics; the
+// tests implement it with fakes. Plain C++, no DDS.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drill/mission.hpp"
+
+namespace concert::drill {
+
+/// State of a started operation.
+enum class Progress { kRunning, kSucceeded, kFailed };
+
+/// A polled operation's state and, when it failed, why ("no blob visible in area 'a2'").
+struct Outcome {
+  Progress progress{Progress::kRunning};
+  std::string reason;
+  static Outcome running() { return {}; }
+  static Outcome succeeded() { return {Progress::kSucceeded, {}}; }
+  static Outcome failed(std::string why) { return {Progress::kFailed, std::move(why)}; }
+};
+
+/// Base pose in the map frame: x, y [m], theta [rad].
+struct BasePose {
+  double x{0.0};
+  double y{0.0};
+  double theta{0.0};
+};
+
+/// A drilling area once located: its frame (world/map frame, origin on the wall surface, z
+/// along the outward normal, x horizontal to the right seen from the front, y up) and, for
+/// a BIM wall area, where the base stands to reach it.
+struct ResolvedArea {
+  Eigen::Isometry3d frame{Eigen::Isometry3d::Identity()};
+  std::optional<BasePose> base;
+};
+
+/// One hole to drill: its frame on the wall (origin where the hole starts, z along the outward
+/// normal) and how it was found.
+struct DrillPoint {
+  Eigen::Isometry3d frame{Eigen::Isometry3d::Identity()};
+  std::string label;   ///< "blob 1", "aruco 7 hole 3"
+  bool servo{false};   ///< visual servoing on the blob while drilling (blobs), else kinematics alone
+};
+
+/// The robot as the mission's tree sees it.
+class MissionPorts {
+ public:
+  virtual ~MissionPorts() = default;
+
+  /// Whether the robot may move: succeeded when safety is RUNNING and every service the
+  /// mission uses is alive; failed with the reason otherwise (e-stop, a lost service). Never
+  /// kRunning.
+  virtual Outcome health() = 0;
+
+  /// Locates an area (a BIM wall: frame + base pose; a point or a pixel: the normal from the
+  /// point cloud). May stay kRunning while it waits for sensor data.
+  virtual void resolve(std::size_t area, const AreaSpec& spec) = 0;
+  virtual Outcome resolution(std::size_t area, ResolvedArea& out) = 0;
+
+  /// Drives the base to a pose (autonomous navigation).
+  virtual void navigate(const BasePose& goal) = 0;
+  virtual Outcome navigation() = 0;
+
+  /// Plans the whole-body approach to an area frame (camera at the working distance along
+  /// the normal). `after` is the area whose approach posture the plan starts from (the arm
+  /// retracts there after drilling), or none to start from the robot's current state. Several
+  /// areas may be planned while another executes.
+  virtual void plan(std::size_t area, const Eigen::Isometry3d& frame, std::optional<std::size_t> after) = 0;
+  virtual Outcome planning(std::size_t area) = 0;
+
+  /// Executes a planned approach (the robot must stand where the plan started).
+  virtual void execute(std::size_t area) = 0;
+  virtual Outcome execution() = 0;
+
+  /// Detects the area's drilling points in the drill camera's images (blobs, or the ArUco
+  /// marker and its pattern).
+  virtual void detect(std::size_t area, const AreaSpec& spec, const ResolvedArea& located) = 0;
+  virtual Outcome detection(std::vector<DrillPoint>& points) = 0;
+
+  /// Moves the bit in front of a point, along its normal (Cartesian impedance).
+  virtual void align(const DrillPoint& point) = 0;
+  virtual Outcome alignment() = 0;
+
+  /// Drills the point to `depth` [m] (eq. 3; visual servoing if point.servo).
+  virtual void drill(const DrillPoint& point, double depth) = 0;
+  virtual Outcome drilling() = 0;
+
+  /// Pulls the bit out and returns the arm to the area's approach posture.
+  virtual void retract() = 0;
+  virtual Outcome retraction() = 0;
+
+  /// Stops every motion at once (aborting): cancels navigation, holds the arm where it is.
+  virtual void stop() = 0;
+};
+
+}  // namespace concert::drill
