@@ -88,6 +88,14 @@ constexpr std::array kTopics = {
               "nav: the base pose in the map and map -> odom, from the lidars"},
     TopicInfo{"concert/nav/vehicle", "concert::msg::NavVehicle", QosClass::kLatched,
               "nav: drive type, footprint and sensors recognised in the current model"},
+    TopicInfo{"concert/sim/holes", "concert::msg::SimHoles", QosClass::kLatched,
+              "robot (simulation only): every hole the drill bits cut, for tests and benchmarks"},
+    TopicInfo{"concert/drill/mission", "concert::msg::DrillMission", QosClass::kCommand,
+              "tools: a drilling mission (the mission file's YAML) for the drill service"},
+    TopicInfo{"concert/drill/abort", "concert::msg::DrillAbort", QosClass::kCommand,
+              "tools/operator: stop the running drilling mission"},
+    TopicInfo{"concert/drill/status", "concert::msg::DrillStatus", QosClass::kLatched,
+              "drill: the mission's active behaviour-tree node, areas, holes and time split, per mission"},
 };
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "concert/sim/sim_assembly.hpp"
 
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -10,6 +11,26 @@
 #include "concert/model_generation/generator.hpp"
 
 namespace concert::sim {
+namespace {
+
+/// The bits of the drill end-effectors: the TCP link, and the diameter from a "drillbit_<mm>_..."
+/// add-on when one is mounted (the public database's keys, e.g. drillbit_12_SDSmax), else 12 mm.
+std::vector<DrillBit> drill_bits(const std::vector<model_generation::EndEffectorInfo>& end_effectors) {
+  static const std::regex kBit(R"(^drillbit_([0-9]+)_)");
+  std::vector<DrillBit> bits;
+  for (const auto& ee : end_effectors) {
+    if (ee.kind != model::EndEffectorKind::kDrill) continue;
+    DrillBit bit{ee.frame, 0.012};
+    for (const std::string& addon : ee.addons) {
+      std::smatch m;
+      if (std::regex_search(addon, m, kBit)) bit.diameter = 1e-3 * std::stod(m[1].str());
+    }
+    bits.push_back(bit);
+  }
+  return bits;
+}
+
+}  // namespace
 
 std::vector<SensorMount> sensor_mounts(const std::vector<model::SensorFrame>& frames) {
   std::vector<SensorMount> out;
@@ -79,6 +100,7 @@ SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const s
     const model_generation::GeneratedModel model = impl_->generator->generate(out.tree);
     out.urdf = model.urdf;
     out.sensors = sensor_mounts(model.sensor_frames);
+    out.drill_bits = drill_bits(model.end_effectors);
   } catch (const std::exception& e) {
     throw std::runtime_error("assembly '" + source + "': model generation failed: " + e.what());
   }

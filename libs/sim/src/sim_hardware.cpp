@@ -20,6 +20,7 @@
 #include "concert/sim/imu_simulator.hpp"
 #include "concert/sim/rgbd_renderer.hpp"
 #include "mjcf_text.hpp"
+#include "drilling_model.hpp"
 #include "sensor_runtime.hpp"
 #include "world_mjcf.hpp"
 
@@ -327,6 +328,8 @@ struct Instance {
   std::vector<DriveCommand> commands;
   std::uint64_t generation{0};
   std::vector<SensorMount> sensors;
+  std::vector<DrillBit> drill_bits;
+  DrillingModel drilling;
   /// What the sensor threads read (null when the sensors are off).
   std::shared_ptr<SensorScene> scene;
   /// Only the world changed: the running instance's whole state carries over.
@@ -337,7 +340,8 @@ struct Instance {
 namespace {
 
 std::unique_ptr<Instance> make_instance(const std::string& urdf, const std::vector<SensorMount>& sensors,
-                                        const World& world, const SimParams& params) {
+                                        const std::vector<DrillBit>& drill_bits, const World& world,
+                                        const SimParams& params) {
   world::validate_world(world, "sim world");
   auto in = std::make_unique<Instance>();
   in->built = build_mjcf(urdf, world, params, sensors);
@@ -359,6 +363,8 @@ std::unique_ptr<Instance> make_instance(const std::string& urdf, const std::vect
   }
   fill_world_hfields(world, in->m);
   in->obstacles = ObstacleMotion(world, in->m);
+  in->drill_bits = drill_bits;
+  in->drilling = DrillingModel(in->m, drill_bits, world, params.drilling);
   in->d = mj_makeData(in->m);
   in->obstacles.apply(in->d, 0.0);
   in->commands.assign(in->built.joints.size(), DriveCommand{});
@@ -422,6 +428,7 @@ struct SimHardware::Impl {
   mutable std::mutex mutex;
   std::string latest_urdf;
   std::vector<SensorMount> latest_sensors;
+  std::vector<DrillBit> latest_drill_bits;
   World latest_world;
   // The sensors: the scene of the running instance (published by the control thread at each
   // switch) and the threads that read it (made on the first sink).
@@ -432,6 +439,10 @@ struct SimHardware::Impl {
   // Ground truth of the base for other threads (base_truth()); the control thread only try-locks.
   mutable std::mutex truth_mutex;
   BaseTruth truth;
+  // Holes (control thread) and the copy holes() returns (under truth_mutex, try-locked).
+  std::vector<SimHole> holes;
+  std::vector<SimHole> holes_copy;
+  bool holes_dirty{false};
 
   void submit(std::unique_ptr<Instance> in) { prepared.submit(std::move(in)); }
 
@@ -466,17 +477,19 @@ struct SimHardware::Impl {
   }
 };
 
-SimHardware::SimHardware(const std::string& urdf, World world, SimParams params, std::vector<SensorMount> sensors)
+SimHardware::SimHardware(const std::string& urdf, World world, SimParams params, std::vector<SensorMount> sensors,
+                         std::vector<DrillBit> drill_bits)
     : impl_(std::make_unique<Impl>()) {
   impl_->params = std::move(params);
   impl_->rng.seed(impl_->params.seed);
   if (impl_->params.timestep <= 0.0) {
     throw HardwareError("sim: timestep must be positive");
   }
-  impl_->active = make_instance(urdf, sensors, world, impl_->params);
+  impl_->active = make_instance(urdf, sensors, drill_bits, world, impl_->params);
   impl_->active->generation = 1;
   impl_->latest_urdf = urdf;
   impl_->latest_sensors = std::move(sensors);
+  impl_->latest_drill_bits = std::move(drill_bits);
   impl_->latest_world = std::move(world);
   impl_->mounted = {1, impl_->active->built.joints};
   impl_->active_scene.store(impl_->active->scene);
@@ -571,6 +584,10 @@ void SimHardware::step(double dt) {
   for (int k = 0; k < n; ++k) {
     impl_->apply_drives();
     impl_->active->obstacles.apply(impl_->active->d, impl_->active->d->time);
+    if (!impl_->active->drilling.empty() &&
+        impl_->active->drilling.apply(impl_->active->m, impl_->active->d, impl_->holes)) {
+      impl_->holes_dirty = true;
+    }
     mj_step(impl_->active->m, impl_->active->d);
   }
   if (impl_->active->scene) {
@@ -584,13 +601,18 @@ void SimHardware::step(double dt) {
       impl_->truth.pose.translation()(r) = d->xpos[3 * root + r];
       for (int c = 0; c < 3; ++c) impl_->truth.pose.linear()(r, c) = d->xmat[9 * root + 3 * r + c];
     }
+    if (impl_->holes_dirty) {
+      impl_->holes_copy = impl_->holes;  // allocates only when a hole opened or deepened
+      impl_->holes_dirty = false;
+    }
     impl_->truth_mutex.unlock();
   }
   // As on real drives, measured efforts and contacts lag the positions by one physics step
   // (mj_step computes forces before integrating); a second mj_forward would double the cost.
 }
 
-bool SimHardware::swap_model(const std::string& urdf, std::vector<SensorMount> sensors) {
+bool SimHardware::swap_model(const std::string& urdf, std::vector<SensorMount> sensors,
+                             std::vector<DrillBit> drill_bits) {
   // Preparations are serialised (each builds on the latest robot and world); mounted() and
   // world() stay answerable meanwhile, as they only take `mutex`.
   std::lock_guard preparing(impl_->preparing);
@@ -602,11 +624,12 @@ bool SimHardware::swap_model(const std::string& urdf, std::vector<SensorMount> s
     }
     world = impl_->latest_world;
   }
-  auto next = make_instance(urdf, sensors, world, impl_->params);
+  auto next = make_instance(urdf, sensors, drill_bits, world, impl_->params);
   std::lock_guard lock(impl_->mutex);
   next->generation = impl_->mounted.generation + 1;
   impl_->latest_urdf = urdf;
   impl_->latest_sensors = std::move(sensors);
+  impl_->latest_drill_bits = std::move(drill_bits);
   impl_->mounted = {next->generation, next->built.joints};
   impl_->submit(std::move(next));
   return true;
@@ -616,12 +639,14 @@ void SimHardware::set_world(const World& world) {
   std::lock_guard preparing(impl_->preparing);
   std::string urdf;
   std::vector<SensorMount> sensors;
+  std::vector<DrillBit> drill_bits;
   {
     std::lock_guard lock(impl_->mutex);
     urdf = impl_->latest_urdf;
     sensors = impl_->latest_sensors;
+    drill_bits = impl_->latest_drill_bits;
   }
-  auto next = make_instance(urdf, sensors, world, impl_->params);
+  auto next = make_instance(urdf, sensors, drill_bits, world, impl_->params);
   next->same_robot = true;
   std::lock_guard lock(impl_->mutex);
   next->generation = impl_->mounted.generation;  // same robot: no new hardware generation
@@ -656,6 +681,11 @@ Eigen::Isometry3d SimHardware::base_pose() const { return link_pose(impl_->activ
 SimHardware::BaseTruth SimHardware::base_truth() const {
   std::lock_guard lock(impl_->truth_mutex);
   return impl_->truth;
+}
+
+std::vector<SimHole> SimHardware::holes() const {
+  std::lock_guard lock(impl_->truth_mutex);
+  return impl_->holes_copy;
 }
 
 Eigen::Vector3d SimHardware::contact_force_on(const std::vector<std::string>& links) const {

@@ -23,7 +23,8 @@ SimNode::SimNode(cdds::Participant& participant, sim::SimHardware& sim, const si
       on_swap_(std::move(on_swap)),
       world_(participant, cdds::topics::world),
       reply_(participant, cdds::topics::sim_reply),
-      truth_(participant, cdds::topics::sim_truth) {
+      truth_(participant, cdds::topics::sim_truth),
+      holes_(participant, cdds::topics::sim_holes) {
   world_.write(world::to_msg(initial_world, world_version_, world_source));
   worker_ = std::thread([this] { work(); });
   truth_thread_ = std::thread([this] { publish_truth(); });
@@ -65,9 +66,42 @@ void SimNode::publish_truth() {
       t.z(truth.pose.translation().z());
       t.yaw(std::atan2(r(1, 0), r(0, 0)));
       truth_.write(t);
+      publish_holes(truth.time);
     }
     lock.lock();
   }
+}
+
+// The drilled holes, rewritten whenever one opens or deepens (latched: a late reader gets them).
+void SimNode::publish_holes(double time) {
+  std::vector<sim::SimHole> holes = sim_.holes();
+  double depth_sum = 0.0;
+  for (const auto& h : holes) depth_sum += h.depth;
+  if (holes.size() == holes_count_ && depth_sum == holes_depth_sum_) return;
+  holes_count_ = holes.size();
+  holes_depth_sum_ = depth_sum;
+  const auto vec = [](const Eigen::Vector3d& v) {
+    msg::Vector3 out;
+    out.x(v.x());
+    out.y(v.y());
+    out.z(v.z());
+    return out;
+  };
+  msg::SimHoles m;
+  m.stamp_ns(static_cast<long long>(std::llround(time * 1e9)));
+  for (const auto& h : holes) {
+    msg::SimHole out;
+    out.wall(h.wall);
+    out.bit(h.bit);
+    out.entry(vec(h.entry));
+    out.axis(vec(h.axis));
+    out.face_normal(vec(h.face_normal));
+    out.depth(h.depth);
+    out.diameter(h.diameter);
+    out.started(h.time);
+    m.holes().push_back(out);
+  }
+  holes_.write(m);
 }
 
 void SimNode::work() {
@@ -110,7 +144,7 @@ std::string SimNode::swap_assembly(const std::string& yaml, const std::string& n
     throw std::runtime_error("the simulated robot is a fixed URDF (--urdf): there is no assembly to swap");
   }
   const sim::SimulatedRobot robot = builder_->build_from_text(yaml, name);
-  if (!sim_.swap_model(robot.urdf, robot.sensors)) {
+  if (!sim_.swap_model(robot.urdf, robot.sensors, robot.drill_bits)) {
     return "the same robot is mounted again: nothing changed";
   }
   // The loop switches at its next cycle boundary; mounted() already names the new joints, so

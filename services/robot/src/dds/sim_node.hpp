@@ -43,6 +43,7 @@ class SimNode {
  private:
   void work();
   void publish_truth();
+  void publish_holes(double time);
   void handle(const msg::SimCommand& command);
 
   sim::SimHardware& sim_;
@@ -52,6 +53,9 @@ class SimNode {
   concert::dds::Writer<msg::World> world_;
   concert::dds::Writer<msg::SimCommandReply> reply_;
   concert::dds::Writer<msg::SimTruth> truth_;
+  concert::dds::Writer<msg::SimHoles> holes_;
+  std::size_t holes_count_{0};     // what was published last (truth thread only)
+  double holes_depth_sum_{0.0};
   std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<msg::SimCommand> queue_;

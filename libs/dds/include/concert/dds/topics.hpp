@@ -5,6 +5,7 @@
 
 #include <string_view>
 
+#include "drillPubSubTypes.h"
 #include "ethercatPubSubTypes.h"
 #include "modelPubSubTypes.h"
 #include "navPubSubTypes.h"
@@ -59,6 +60,10 @@ CONCERT_BIND_PUBSUB(NavPath);
 CONCERT_BIND_PUBSUB(OccupancyGridMap);
 CONCERT_BIND_PUBSUB(NavLocalisation);
 CONCERT_BIND_PUBSUB(NavVehicle);
+CONCERT_BIND_PUBSUB(SimHoles);
+CONCERT_BIND_PUBSUB(DrillMission);
+CONCERT_BIND_PUBSUB(DrillAbort);
+CONCERT_BIND_PUBSUB(DrillStatus);
 #undef CONCERT_BIND_PUBSUB
 
 /// A catalogue topic carrying T.
@@ -107,6 +112,10 @@ inline constexpr TopicHandle<msg::OccupancyGridMap> nav_map{"concert/nav/map"};
 inline constexpr TopicHandle<msg::Odometry> nav_odometry{"concert/nav/odometry"};
 inline constexpr TopicHandle<msg::NavLocalisation> nav_localisation{"concert/nav/localisation"};
 inline constexpr TopicHandle<msg::NavVehicle> nav_vehicle{"concert/nav/vehicle"};
+inline constexpr TopicHandle<msg::SimHoles> sim_holes{"concert/sim/holes"};
+inline constexpr TopicHandle<msg::DrillMission> drill_mission{"concert/drill/mission"};
+inline constexpr TopicHandle<msg::DrillAbort> drill_abort{"concert/drill/abort"};
+inline constexpr TopicHandle<msg::DrillStatus> drill_status{"concert/drill/status"};
 }  // namespace topics
 
 /// Calls f(handle) for every typed topic handle (e.g. to dispatch on a topic name).
@@ -150,6 +159,10 @@ template <class F> void for_each_topic(F&& f) {
   f(topics::nav_odometry);
   f(topics::nav_localisation);
   f(topics::nav_vehicle);
+  f(topics::sim_holes);
+  f(topics::drill_mission);
+  f(topics::drill_abort);
+  f(topics::drill_status);
 }
 
 }  // namespace concert::dds

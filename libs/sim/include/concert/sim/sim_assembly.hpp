@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "concert/model/description.hpp"
+#include "concert/sim/drilling.hpp"
 #include "concert/sim/sensor_params.hpp"
 #include "concert/topology/types.hpp"
 
@@ -18,6 +19,7 @@ struct SimulatedRobot {
   topology::ModuleTree tree;    ///< the tree the assembly describes
   std::string source;           ///< assembly file
   std::vector<SensorMount> sensors;  ///< the sensors its modules carry (sensor frames of its model)
+  std::vector<DrillBit> drill_bits;  ///< the bits of its drill end-effectors (their TCP links)
 };
 
 /// The simulated sensors of a model's sensor frames: cameras (RGB-D), lidars, sonars, IMUs;

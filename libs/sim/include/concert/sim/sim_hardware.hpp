@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "concert/hardware/hardware.hpp"
+#include "concert/sim/drilling.hpp"
 #include "concert/sim/sensor_params.hpp"
 #include "concert/world/world.hpp"
 
@@ -42,6 +43,7 @@ struct SimParams {
   /// resolve to an existing file are skipped; wheel links keep only their primitive shapes.
   std::map<std::string, std::string> package_paths;
   SensorParams sensors;              ///< simulated sensors (sensor_params.hpp)
+  DrillingParams drilling;           ///< how walls resist drill bits (drilling.hpp)
 };
 
 /// MJCF text for a URDF placed in a world (exposed for tests and for debugging in MuJoCo's
@@ -54,7 +56,10 @@ class SimHardware final : public hardware::Hardware {
  public:
   /// `sensors`: the sensors the robot carries (SimulatedRobot::sensors), simulated when
   /// params.sensors.enabled and delivered to the sink given to set_sensor_sink().
-  SimHardware(const std::string& urdf, World world, SimParams params = {}, std::vector<SensorMount> sensors = {});
+  /// `drill_bits`: the drill bits it carries (SimulatedRobot::drill_bits), which cut holes
+  /// in the world's walls (drilling.hpp).
+  SimHardware(const std::string& urdf, World world, SimParams params = {}, std::vector<SensorMount> sensors = {},
+              std::vector<DrillBit> drill_bits = {});
   ~SimHardware() override;
   SimHardware(const SimHardware&) = delete;
   SimHardware& operator=(const SimHardware&) = delete;
@@ -80,8 +85,10 @@ class SimHardware final : public hardware::Hardware {
   /// keep their state, every drive holds position) and generation() increases; mounted()
   /// reports it at once. The same URDF again is no change (returns false). Throws
   /// HardwareError (nothing changes) if the URDF cannot be simulated.
-  /// `sensors` are the new robot's (the old robot's sensors stop, the new ones start).
-  bool swap_model(const std::string& urdf, std::vector<SensorMount> sensors = {});
+  /// `sensors` and `drill_bits` are the new robot's (the old robot's sensors stop, the new
+  /// ones start). Holes already drilled stay in the walls.
+  bool swap_model(const std::string& urdf, std::vector<SensorMount> sensors = {},
+                  std::vector<DrillBit> drill_bits = {});
   /// Replaces the world the same way (keeps the robot state and the hardware generation).
   void set_world(const World& world);
   /// The latest world given (any thread).
@@ -100,6 +107,9 @@ class SimHardware final : public hardware::Hardware {
     Eigen::Isometry3d pose{Eigen::Isometry3d::Identity()};  ///< world_T_root
   };
   [[nodiscard]] BaseTruth base_truth() const;
+  /// Every hole the drill bits have cut so far, in the order they were started (any thread;
+  /// the control thread refreshes the copy when a hole opens or deepens by 0.1 mm).
+  [[nodiscard]] std::vector<SimHole> holes() const;
   /// Total contact force the world exerts on `links` [N], world frame.
   [[nodiscard]] Eigen::Vector3d contact_force_on(const std::vector<std::string>& links) const;
   [[nodiscard]] const std::string& mjcf() const;
