@@ -1,0 +1,111 @@
+#pragma once
+// Closed-loop drilling of one hole (paper section 5.4.3, eq. 3): the Cartesian reference of the
+// drill bit's tip for the arm's Cartesian impedance controller, phase by phase (align in front
+// of the hole, drill along the axis, retract). Plain C++, no DDS.
+//
+// Frames: everything here is in one fixed frame, the frame the robot's Cartesian controller
+// takes targets in (the robot's root link: the base stands still while drilling). A hole frame
+// has its origin where the hole starts on the surface and z along the outward normal; the bit's
+// tip frame (the drill's TCP) has z along the bit. Depth d is how far the tip is behind the
+// surface along -z of the hole frame (negative in front of it).
+//
+// Eq. 3: the reference is the hole's axis point at depth d_ref, d_ref = d_ref + v_drill * dt,
+// with the x-y error to the hole removed; with visual servoing the hole frame is re-estimated
+// from each camera frame (observe()) until the bit is in the wall, when the hole itself holds it.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+
+namespace concert::drill {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+/// Tuning of the drilling motion. Thrust comes from the impedance's axial stiffness times the
+/// reference's lead on the tip; max_lead bounds it (axial_stiffness * max_lead).
+struct DrillParams {
+  double standoff{0.04};           ///< [m] tip in front of the surface when aligned
+  double approach_speed{0.05};     ///< [m/s] of the reference while aligning and retracting
+  double approach_turn{0.3};       ///< [rad/s] of the reference while aligning
+  double align_tolerance{0.0015};  ///< [m] tip off its aligned position, counted as aligned
+  double align_angle{0.02};        ///< [rad] bit axis off the hole's axis, counted as aligned
+  double settle_time{0.3};         ///< [s] aligned this long before drilling starts
+  double feed_rate{0.01};          ///< [m/s] v_drill
+  double max_lead{0.015};          ///< [m] reference ahead of the tip along the bit at most
+  double servo_jump{
+      0.02};  ///< [m] an observed hole further than this from the current estimate is an outlier
+  double align_timeout{15.0};    ///< [s]
+  double drill_timeout{30.0};    ///< [s]
+  double retract_timeout{15.0};  ///< [s]
+  /// Translational stiffness is the same along every axis: the robot's controller takes a
+  /// diagonal in the fixed frame, and an isotropic one needs no rotation to the hole's axes.
+  double stiffness{8000.0};         ///< [N/m]
+  double damping{500.0};            ///< [N s/m]
+  double angular_stiffness{300.0};  ///< [N m/rad]
+  double angular_damping{20.0};     ///< [N m s/rad]
+};
+
+/// A Cartesian impedance reference for the tip, in the fixed frame.
+struct CartesianReference {
+  Eigen::Isometry3d pose{Eigen::Isometry3d::Identity()};
+  Vector6d twist{Vector6d::Zero()};  ///< [m/s, rad/s] feed-forward velocity of the reference
+  Vector6d stiffness{Vector6d::Zero()};
+  Vector6d damping{Vector6d::Zero()};
+};
+
+/// One hole's motion. Call start_*() then update() every control period with the tip's
+/// measured pose and a monotonic time [s]; send the returned reference to the robot.
+class DrillMotion {
+ public:
+  enum class Phase { kIdle, kAligning, kDrilling, kRetracting, kDone, kFailed };
+
+  explicit DrillMotion(DrillParams params = {});
+
+  /// Aligns the tip `standoff` in front of `hole`, the bit along -z of the hole frame.
+  void start_align(const Eigen::Isometry3d& hole, const Eigen::Isometry3d& tip, double now);
+  /// Drills to `depth` [m] behind the surface; `servo`: observe() moves the hole.
+  void start_drill(double depth, bool servo, const Eigen::Isometry3d& tip, double now);
+  /// Pulls the tip back to `standoff` in front of the surface.
+  void start_retract(const Eigen::Isometry3d& tip, double now);
+
+  /// A new estimate of the hole (visual servoing): used while aligning and, with servo, while
+  /// the tip is still in front of the surface; an outlier (servo_jump) is ignored. Returns
+  /// whether it was used.
+  bool observe(const Eigen::Isometry3d& hole);
+
+  /// The reference for now; advances the phase (kAligning -> kDone when settled, kDrilling ->
+  /// kDone at depth, kRetracting -> kDone at the standoff; kFailed on a timeout, with reason()).
+  CartesianReference update(const Eigen::Isometry3d& tip, double now);
+
+  [[nodiscard]] Phase phase() const { return phase_; }
+  [[nodiscard]] const std::string& reason() const { return reason_; }
+  [[nodiscard]] const Eigen::Isometry3d& hole() const { return hole_; }
+  /// The tip's depth behind the hole's surface [m] (negative in front).
+  [[nodiscard]] double depth_of(const Eigen::Isometry3d& tip) const;
+  /// The tip's offset from the hole's axis [m].
+  [[nodiscard]] double lateral_error(const Eigen::Isometry3d& tip) const;
+  /// Deepest depth reached in this drilling [m].
+  [[nodiscard]] double reached() const { return reached_; }
+
+ private:
+  [[nodiscard]] Eigen::Isometry3d axis_pose(double depth, const Eigen::Isometry3d& tip) const;
+  CartesianReference reference(double depth, double feed, const Eigen::Isometry3d& tip) const;
+  void fail(const std::string& why);
+
+  DrillParams params_;
+  Phase phase_{Phase::kIdle};
+  std::string reason_;
+  Eigen::Isometry3d hole_{Eigen::Isometry3d::Identity()};
+  double started_{0.0};
+  double last_{0.0};
+  Eigen::Isometry3d ref_{Eigen::Isometry3d::Identity()};  ///< the reference while aligning
+  double depth_ref_{0.0};                                 ///< reference depth along the axis [m]
+  double target_depth_{0.0};
+  double settled_since_{-1.0};
+  double reached_{0.0};
+  bool servo_{false};
+};
+
+const char* to_string(DrillMotion::Phase phase);
+
+}  // namespace concert::drill

@@ -1,0 +1,183 @@
+#include "drill/drill_motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace concert::drill {
+namespace {
+
+double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0));
+}
+
+}  // namespace
+
+const char* to_string(DrillMotion::Phase phase) {
+  switch (phase) {
+    case DrillMotion::Phase::kIdle:
+      return "idle";
+    case DrillMotion::Phase::kAligning:
+      return "aligning";
+    case DrillMotion::Phase::kDrilling:
+      return "drilling";
+    case DrillMotion::Phase::kRetracting:
+      return "retracting";
+    case DrillMotion::Phase::kDone:
+      return "done";
+    case DrillMotion::Phase::kFailed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+DrillMotion::DrillMotion(DrillParams params) : params_(params) {}
+
+double DrillMotion::depth_of(const Eigen::Isometry3d& tip) const {
+  return -(hole_.inverse() * tip.translation()).z();
+}
+
+double DrillMotion::lateral_error(const Eigen::Isometry3d& tip) const {
+  return (hole_.inverse() * tip.translation()).head<2>().norm();
+}
+
+void DrillMotion::start_align(const Eigen::Isometry3d& hole, const Eigen::Isometry3d& tip,
+                              double now) {
+  hole_ = hole;
+  phase_ = Phase::kAligning;
+  reason_.clear();
+  started_ = last_ = now;
+  settled_since_ = -1.0;
+  ref_ = tip;
+}
+
+void DrillMotion::start_drill(double depth, bool servo, const Eigen::Isometry3d& tip, double now) {
+  phase_ = Phase::kDrilling;
+  reason_.clear();
+  started_ = last_ = now;
+  target_depth_ = depth;
+  servo_ = servo;
+  depth_ref_ = depth_of(tip);
+  reached_ = depth_ref_;
+}
+
+void DrillMotion::start_retract(const Eigen::Isometry3d& tip, double now) {
+  phase_ = Phase::kRetracting;
+  reason_.clear();
+  started_ = last_ = now;
+  depth_ref_ = depth_of(tip);
+}
+
+bool DrillMotion::observe(const Eigen::Isometry3d& hole) {
+  const bool before_surface =
+      phase_ == Phase::kAligning || (phase_ == Phase::kDrilling && servo_ && reached_ < 0.0);
+  if (!before_surface) return false;
+  if ((hole.translation() - hole_.translation()).norm() > params_.servo_jump) return false;
+  hole_ = hole;
+  return true;
+}
+
+void DrillMotion::fail(const std::string& why) {
+  phase_ = Phase::kFailed;
+  reason_ = why;
+}
+
+// The tip's pose on the hole's axis at `depth`: the bit along -z of the hole frame, turned
+// about it as little as possible from the tip's current orientation (the wrist does not spin).
+Eigen::Isometry3d DrillMotion::axis_pose(double depth, const Eigen::Isometry3d& tip) const {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  const Eigen::Vector3d bit = -hole_.linear().col(2);
+  out.translation() = hole_.translation() + depth * bit;
+  const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(tip.linear().col(2), bit);
+  out.linear() = turn.toRotationMatrix() * tip.linear();
+  return out;
+}
+
+CartesianReference DrillMotion::reference(double depth, double feed,
+                                          const Eigen::Isometry3d& tip) const {
+  CartesianReference r;
+  r.pose = axis_pose(depth, tip);
+  r.twist.head<3>() = -feed * hole_.linear().col(2);
+  r.stiffness << params_.stiffness, params_.stiffness, params_.stiffness, params_.angular_stiffness,
+      params_.angular_stiffness, params_.angular_stiffness;
+  r.damping << params_.damping, params_.damping, params_.damping, params_.angular_damping,
+      params_.angular_damping, params_.angular_damping;
+  return r;
+}
+
+CartesianReference DrillMotion::update(const Eigen::Isometry3d& tip, double now) {
+  const double dt = std::max(0.0, now - last_);
+  last_ = now;
+  const double elapsed = now - started_;
+  const double depth = depth_of(tip);
+  switch (phase_) {
+    case Phase::kAligning: {
+      // The reference moves from where the tip was to the aligned pose at approach_speed
+      // (and turns at most approach_turn per second): a jump would be a force step of
+      // stiffness x distance.
+      const Eigen::Isometry3d goal = axis_pose(-params_.standoff, tip);
+      const Eigen::Vector3d step = goal.translation() - ref_.translation();
+      const double max_step = params_.approach_speed * dt;
+      ref_.translation() +=
+          step.norm() > max_step ? Eigen::Vector3d(step.normalized() * max_step) : step;
+      const Eigen::Quaterniond from(ref_.linear()), to(goal.linear());
+      const double turn = from.angularDistance(to);
+      const double max_turn = params_.approach_turn * dt;
+      ref_.linear() = (turn > max_turn ? from.slerp(max_turn / turn, to) : to).toRotationMatrix();
+      const double off = (tip.translation() - goal.translation()).norm();
+      const double angle = angle_between(tip.linear().col(2), -hole_.linear().col(2));
+      if (off < params_.align_tolerance && angle < params_.align_angle) {
+        if (settled_since_ < 0.0) settled_since_ = now;
+        if (now - settled_since_ >= params_.settle_time) phase_ = Phase::kDone;
+      } else {
+        settled_since_ = -1.0;
+      }
+      if (phase_ == Phase::kAligning && elapsed > params_.align_timeout) {
+        std::ostringstream s;
+        s << "not aligned after " << params_.align_timeout << " s: tip " << off * 1000.0
+          << " mm off, bit " << angle * 180.0 / M_PI << " deg off the hole's axis";
+        fail(s.str());
+      }
+      CartesianReference r = reference(-params_.standoff, 0.0, tip);
+      r.pose = ref_;
+      return r;
+    }
+    case Phase::kDrilling: {
+      reached_ = std::max(reached_, depth);
+      // Eq. 3: the reference advances at v_drill, never more than max_lead ahead of the tip.
+      depth_ref_ = std::min(
+          {depth_ref_ + params_.feed_rate * dt, depth + params_.max_lead, target_depth_ + 0.002});
+      if (depth >= target_depth_) {
+        phase_ = Phase::kDone;
+      } else if (elapsed > params_.drill_timeout) {
+        std::ostringstream s;
+        s << "hole " << std::max(0.0, reached_) * 1000.0 << " of " << target_depth_ * 1000.0
+          << " mm deep after " << params_.drill_timeout
+          << " s: the wall resists more than the arm pushes";
+        fail(s.str());
+      }
+      return reference(depth_ref_, phase_ == Phase::kDrilling ? params_.feed_rate : 0.0, tip);
+    }
+    case Phase::kRetracting: {
+      depth_ref_ = std::max(depth_ref_ - params_.approach_speed * dt, -params_.standoff);
+      if (depth <= -params_.standoff + params_.align_tolerance) {
+        phase_ = Phase::kDone;
+      } else if (elapsed > params_.retract_timeout) {
+        std::ostringstream s;
+        s << "bit still " << depth * 1000.0 << " mm deep after " << params_.retract_timeout
+          << " s of retracting";
+        fail(s.str());
+      }
+      return reference(depth_ref_, 0.0, tip);
+    }
+    case Phase::kIdle:
+    case Phase::kDone:
+    case Phase::kFailed:
+      break;
+  }
+  CartesianReference hold = reference(depth, 0.0, tip);
+  hold.pose = tip;
+  return hold;
+}
+
+}  // namespace concert::drill

@@ -1,0 +1,176 @@
+// DrillMotion (eq. 3) against a plant: the tip follows the impedance's reference through a
+// spring-damper on a 15 kg effective mass, and a wall that resists as the simulator's does
+// (threshold + feed damping). The plant is not the controller's code: its thrust comes from
+// the stiffness and the reference's lead alone.
+
+#include "drill/drill_motion.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace concert::drill {
+namespace {
+
+constexpr double kDt = 0.002;
+
+// A wall facing -x at x = 1 (hole frame: z = -x, origin on the surface at y = 0.2, z = 1.1).
+Eigen::Isometry3d hole_at(double y, double z) {
+  Eigen::Isometry3d h = Eigen::Isometry3d::Identity();
+  h.linear() << 0, 0, -1, -1, 0, 0, 0, 1, 0;  // x = -y_w, y = z_w, z = -x_w: right-handed
+  h.translation() = Eigen::Vector3d(1.0, y, z);
+  return h;
+}
+
+struct Plant {
+  Eigen::Isometry3d tip = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  double mass = 15.0;
+  double wall_threshold = 20.0;  // [N]
+  double wall_damping = 6000.0;  // [N s/m]
+  double hole_bottom = 0.0;      // x of the deepest point drilled [m]
+
+  // One step under the reference (translational impedance only; the orientation follows).
+  void step(const CartesianReference& r) {
+    Eigen::Vector3d f =
+        r.stiffness.head<3>().cwiseProduct(r.pose.translation() - tip.translation()) +
+        r.damping.head<3>().cwiseProduct(r.twist.head<3>() - velocity);
+    const double x = tip.translation().x();
+    const bool cutting = x >= 1.0 && x >= hole_bottom - 1e-9 && (f.x() > 0.0 || velocity.x() > 0.0);
+    if (cutting) {
+      // At the bottom of the hole: the wall takes up to the threshold, and its feed damping
+      // is taken implicitly so the step is stable.
+      const double net = f.x() - std::clamp(f.x(), 0.0, wall_threshold);
+      velocity.x() = (mass * velocity.x() + net * kDt) / (mass + wall_damping * kDt);
+      if (velocity.x() < 0.0 && f.x() > 0.0) velocity.x() = 0.0;
+    } else {
+      velocity.x() += f.x() / mass * kDt;
+    }
+    velocity.y() += f.y() / mass * kDt;
+    velocity.z() += f.z() / mass * kDt;
+    tip.translation() += velocity * kDt;
+    hole_bottom = std::max(hole_bottom, tip.translation().x());
+    tip.linear() = r.pose.linear();
+  }
+};
+
+// Runs until the phase leaves `phase` or `seconds` pass; returns the time taken.
+double run(DrillMotion& m, Plant& p, double& now, double seconds) {
+  const DrillMotion::Phase start = m.phase();
+  const double t0 = now;
+  while (m.phase() == start && now - t0 < seconds) {
+    p.step(m.update(p.tip, now));
+    now += kDt;
+  }
+  return now - t0;
+}
+
+Plant plant_in_front(double x) {
+  Plant p;
+  p.tip.translation() = Eigen::Vector3d(x, 0.25, 1.05);
+  // The bit along +x, slightly tilted.
+  p.tip.linear() = Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                   Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  p.hole_bottom = 1.0;
+  return p;
+}
+
+TEST(DrillMotion, AlignsOnTheHolesAxisAtTheStandoffWithoutJumps) {
+  DrillParams params;
+  DrillMotion m(params);
+  Plant p = plant_in_front(0.8);
+  double now = 0.0;
+  m.start_align(hole_at(0.2, 1.1), p.tip, now);
+  Eigen::Vector3d last_ref = p.tip.translation();
+  double largest_step = 0.0;
+  while (m.phase() == DrillMotion::Phase::kAligning && now < 20.0) {
+    const CartesianReference r = m.update(p.tip, now);
+    largest_step = std::max(largest_step, (r.pose.translation() - last_ref).norm());
+    last_ref = r.pose.translation();
+    p.step(r);
+    now += kDt;
+  }
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
+  EXPECT_LE(largest_step, params.approach_speed * kDt + 1e-9);
+  EXPECT_LT(m.lateral_error(p.tip), params.align_tolerance);
+  EXPECT_NEAR(m.depth_of(p.tip), -params.standoff, params.align_tolerance);
+  EXPECT_GT(p.tip.linear().col(2).dot(Eigen::Vector3d::UnitX()), std::cos(params.align_angle));
+}
+
+TEST(DrillMotion, DrillsToDepthWithBoundedThrust) {
+  DrillParams params;
+  DrillMotion m(params);
+  Plant p = plant_in_front(1.0 - params.standoff);
+  p.tip.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  double now = 0.0;
+  m.start_align(hole_at(0.25, 1.05), p.tip, now);
+  run(m, p, now, 10.0);
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone);
+  m.start_drill(0.05, false, p.tip, now);
+  double largest_lead = 0.0;
+  while (m.phase() == DrillMotion::Phase::kDrilling && now < 60.0) {
+    const CartesianReference r = m.update(p.tip, now);
+    largest_lead = std::max(largest_lead, r.pose.translation().x() - p.tip.translation().x());
+    p.step(r);
+    now += kDt;
+  }
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
+  EXPECT_GE(p.hole_bottom - 1.0, 0.05);
+  EXPECT_LT(p.hole_bottom - 1.0, 0.056);
+  EXPECT_LE(largest_lead, params.max_lead + 1e-9);  // thrust <= 8000 N/m x 15 mm = 120 N
+  m.start_retract(p.tip, now);
+  run(m, p, now, 10.0);
+  EXPECT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
+  EXPECT_LT(p.tip.translation().x(), 1.0 - params.standoff + 2 * params.align_tolerance);
+}
+
+TEST(DrillMotion, AWallHarderThanTheArmPushesFailsWithTheReason) {
+  DrillParams params;
+  params.drill_timeout = 3.0;
+  DrillMotion m(params);
+  Plant p = plant_in_front(1.0 - params.standoff);
+  p.tip.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  p.wall_threshold = 1000.0;  // more than stiffness x max_lead
+  double now = 0.0;
+  m.start_align(hole_at(0.25, 1.05), p.tip, now);
+  run(m, p, now, 10.0);
+  m.start_drill(0.05, false, p.tip, now);
+  run(m, p, now, 10.0);
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kFailed);
+  EXPECT_NE(m.reason().find("resists"), std::string::npos) << m.reason();
+}
+
+TEST(DrillMotion, ServoingFollowsTheBlobUntilTheBitIsInTheWall) {
+  DrillMotion m;
+  Plant p = plant_in_front(0.9);
+  double now = 0.0;
+  m.start_align(hole_at(0.25, 1.05), p.tip, now);
+  EXPECT_TRUE(m.observe(hole_at(0.255, 1.05)));  // 5 mm: a better estimate
+  EXPECT_FALSE(m.observe(hole_at(0.4, 1.05)));   // 15 cm: another blob, not this one
+  EXPECT_NEAR(m.hole().translation().y(), 0.255, 1e-12);
+  run(m, p, now, 10.0);
+  m.start_drill(0.05, true, p.tip, now);
+  EXPECT_TRUE(m.observe(hole_at(0.256, 1.05)));
+  while (m.phase() == DrillMotion::Phase::kDrilling && m.depth_of(p.tip) < 0.005 && now < 60.0) {
+    p.step(m.update(p.tip, now));
+    now += kDt;
+  }
+  EXPECT_FALSE(m.observe(hole_at(0.257, 1.05)));  // in the wall: the hole holds the bit
+  EXPECT_NEAR(m.hole().translation().y(), 0.256, 1e-12);
+}
+
+TEST(DrillMotion, NotAlignedInTimeSaysHowFarOff) {
+  DrillParams params;
+  params.align_timeout = 0.5;
+  DrillMotion m(params);
+  Plant p = plant_in_front(0.5);  // 0.46 m to go at 0.05 m/s
+  double now = 0.0;
+  m.start_align(hole_at(0.25, 1.05), p.tip, now);
+  run(m, p, now, 5.0);
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kFailed);
+  EXPECT_NE(m.reason().find("not aligned after 0.5 s"), std::string::npos) << m.reason();
+}
+
+}  // namespace
+}  // namespace concert::drill
