@@ -10,10 +10,10 @@
 
 #include "concert/common/text.hpp"
 #include "concert/dds/participant.hpp"
+#include "concert/world/world_dds.hpp"
 #include "dds/planner_node.hpp"
 #include "model_message.hpp"
 #include "planner/cli.hpp"
-#include "concert/world/world_dds.hpp"
 #include "planner/fixtures.hpp"
 
 using namespace concert;
@@ -35,7 +35,8 @@ msg::PlanRequest request(uint32_t id, uint32_t version, double z, bool execute) 
 }
 
 // Waits (bounded) for a result of `id` in one of the final states; returns the last seen.
-std::optional<msg::PlanResult> wait_final(concert::dds::Reader<msg::PlanResult>& reader, uint32_t id,
+std::optional<msg::PlanResult> wait_final(concert::dds::Reader<msg::PlanResult>& reader,
+                                          uint32_t id,
                                           std::vector<msg::PlanResult>* seen = nullptr) {
   const auto deadline = std::chrono::steady_clock::now() + 20s;
   while (std::chrono::steady_clock::now() < deadline) {
@@ -58,21 +59,29 @@ class PlannerNodeTest : public ::testing::Test {
     w.boxes.push_back(fixtures::wall_at(2.0));
     env.add_world(w);
     planner_->set_environment(env);
-    participant_ = std::make_unique<concert::dds::Participant>(concert::dds::ParticipantOptions{.name = "planner_test"});
-    node_ = std::make_unique<planner::dds::PlannerNode>(*participant_, *planner_, planner::dds::NodeOptions{}, log_);
+    participant_ = std::make_unique<concert::dds::Participant>(
+        concert::dds::ParticipantOptions{.name = "planner_test"});
+    node_ = std::make_unique<planner::dds::PlannerNode>(*participant_, *planner_,
+                                                        planner::dds::NodeOptions{}, log_);
     spinner_ = std::thread([this] { node_->spin(stop_, 20ms); });
-    models_ = std::make_unique<concert::dds::Writer<msg::RobotModel>>(*participant_, concert::dds::topics::robot_model);
-    requests_ = std::make_unique<concert::dds::Writer<msg::PlanRequest>>(*participant_, concert::dds::topics::plan_request);
-    results_ = std::make_unique<concert::dds::Reader<msg::PlanResult>>(*participant_, concert::dds::topics::plan_result);
+    models_ = std::make_unique<concert::dds::Writer<msg::RobotModel>>(
+        *participant_, concert::dds::topics::robot_model);
+    requests_ = std::make_unique<concert::dds::Writer<msg::PlanRequest>>(
+        *participant_, concert::dds::topics::plan_request);
+    results_ = std::make_unique<concert::dds::Reader<msg::PlanResult>>(
+        *participant_, concert::dds::topics::plan_result);
   }
   void TearDown() override {
     stop_ = true;
     spinner_.join();
   }
   void publish_model(char which, uint32_t version) {
-    models_->write(model_message(fixtures::data_dir() / (std::string("morphology_") + which + ".yaml"), static_cast<uint32_t>(version)));
+    models_->write(
+        model_message(fixtures::data_dir() / (std::string("morphology_") + which + ".yaml"),
+                      static_cast<uint32_t>(version)));
     const auto deadline = std::chrono::steady_clock::now() + 10s;
-    while (node_->model_version() != version && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(10ms);
+    while (node_->model_version() != version && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(10ms);
     ASSERT_EQ(node_->model_version(), version) << log_.str();
   }
 
@@ -96,7 +105,8 @@ TEST_F(PlannerNodeTest, ReadyAtModelVersionAndStatusReported) {
   const auto deadline = std::chrono::steady_clock::now() + 10s;
   while (!ready && std::chrono::steady_clock::now() < deadline) {
     const auto s = status.wait(200ms);
-    ready = s && s->service() == "planner" && s->state() == msg::SERVICE_READY && s->model_version() == 3;
+    ready = s && s->service() == "planner" && s->state() == msg::SERVICE_READY &&
+            s->model_version() == 3;
   }
   EXPECT_TRUE(ready);
   // A broken model keeps version 3.
@@ -143,11 +153,58 @@ TEST_F(PlannerNodeTest, StaleVersionIsRefusedAndPlansCarryTheTrajectory) {
   EXPECT_TRUE(planned) << "no update with the trajectory";
 }
 
+TEST_F(PlannerNodeTest, AGivenStartStateIsPlannedFromAndNotExecuted) {
+  publish_model('a', 7);
+  ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
+  const auto model = planner_->model();
+  // The base 0.3 m back and turned, the arm's first joint turned: where the arm would be after
+  // another task.
+  msg::PlanRequest r = request(31, 7, 1.2, false);
+  r.start_names({"base_x", "base_y", "base_yaw"});
+  r.start_position({-0.3, 0.1, 0.2});
+  const std::string first_joint = model->joint_names()[3];  // the arm's first planned joint
+  r.start_names().push_back(first_joint);
+  r.start_position().push_back(0.4);
+  std::vector<msg::PlanResult> seen;
+  requests_->write(r);
+  const auto ok = wait_final(*results_, 31, &seen);
+  ASSERT_TRUE(ok.has_value());
+  ASSERT_EQ(ok->state(), msg::PLAN_SUCCEEDED) << ok->reason();
+  ASSERT_FALSE(ok->trajectory().empty());
+  const auto& start = ok->trajectory().front().position();
+  ASSERT_EQ(start.size(), 9u);
+  EXPECT_NEAR(start[0], -0.3, 1e-9);
+  EXPECT_NEAR(start[1], 0.1, 1e-9);
+  EXPECT_NEAR(start[2], 0.2, 1e-9);
+  EXPECT_NEAR(start[3], 0.4, 1e-9);
+
+  // Executing from a state the robot is not in is refused, as is an unknown joint.
+  r.request_id(32);
+  r.execute(true);
+  requests_->write(r);
+  const auto refused = wait_final(*results_, 32);
+  ASSERT_TRUE(refused.has_value());
+  EXPECT_EQ(refused->failure(), msg::PLAN_INVALID_START);
+  EXPECT_NE(refused->reason().find("cannot be executed"), std::string::npos) << refused->reason();
+  r.request_id(33);
+  r.execute(false);
+  r.start_names().push_back("no_such_joint");
+  r.start_position().push_back(0.0);
+  requests_->write(r);
+  const auto unknown = wait_final(*results_, 33);
+  ASSERT_TRUE(unknown.has_value());
+  EXPECT_EQ(unknown->failure(), msg::PLAN_INVALID_START);
+  EXPECT_NE(unknown->reason().find("no_such_joint"), std::string::npos) << unknown->reason();
+}
+
 TEST_F(PlannerNodeTest, ExecutionGoesThroughTheRobotsTrajectoryCommand) {
   publish_model('a', 6);
-  concert::dds::Reader<msg::JointTrajectoryCommand> commands(*participant_, concert::dds::topics::trajectory_command);
-  concert::dds::Writer<msg::TrajectoryStatus> robot_status(*participant_, concert::dds::topics::trajectory_status);
-  concert::dds::Writer<msg::JointState> joint_state(*participant_, concert::dds::topics::joint_state);
+  concert::dds::Reader<msg::JointTrajectoryCommand> commands(
+      *participant_, concert::dds::topics::trajectory_command);
+  concert::dds::Writer<msg::TrajectoryStatus> robot_status(*participant_,
+                                                           concert::dds::topics::trajectory_status);
+  concert::dds::Writer<msg::JointState> joint_state(*participant_,
+                                                    concert::dds::topics::joint_state);
   // Without a joint state the request cannot be executed.
   ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
   requests_->write(request(21, 6, 2.3, true));
@@ -162,7 +219,8 @@ TEST_F(PlannerNodeTest, ExecutionGoesThroughTheRobotsTrajectoryCommand) {
     js.name().push_back(model->kinematics().joint_names()[static_cast<std::size_t>(i)]);
     js.position().push_back(0.0);
   }
-  // The joint state is a best-effort stream: repeat it, as the robot does, until the planner has it.
+  // The joint state is a best-effort stream: repeat it, as the robot does, until the planner has
+  // it.
   const auto js_deadline = std::chrono::steady_clock::now() + 5s;
   while (!node_->has_joint_state() && std::chrono::steady_clock::now() < js_deadline) {
     joint_state.write(js);
@@ -214,7 +272,8 @@ TEST_F(PlannerNodeTest, ExecutionGoesThroughTheRobotsTrajectoryCommand) {
   EXPECT_EQ(cmd.samples().back().position().size(), 9u);
   EXPECT_EQ(cmd.samples().back().velocity().size(), 9u);
   bool executing = false;
-  for (const auto& r : seen) executing = executing || (r.state() == msg::PLAN_EXECUTING && r.progress() == 0.5);
+  for (const auto& r : seen)
+    executing = executing || (r.state() == msg::PLAN_EXECUTING && r.progress() == 0.5);
   EXPECT_TRUE(executing) << "the robot's progress was not relayed";
 
   // The robot aborts (e-stop): the plan fails with the robot's reason.
@@ -224,7 +283,8 @@ TEST_F(PlannerNodeTest, ExecutionGoesThroughTheRobotsTrajectoryCommand) {
   ASSERT_TRUE(aborted.has_value());
   EXPECT_EQ(aborted->state(), msg::PLAN_FAILED);
   EXPECT_EQ(aborted->failure(), msg::PLAN_EXECUTION_ABORTED);
-  EXPECT_NE(aborted->reason().find("aborted by the robot: safety stop (estop: front left)"), std::string::npos)
+  EXPECT_NE(aborted->reason().find("aborted by the robot: safety stop (estop: front left)"),
+            std::string::npos)
       << aborted->reason();
 }
 
@@ -239,7 +299,8 @@ TEST_F(PlannerNodeTest, AnObstacleOnTheWorldTopicChangesThePlan) {
     requests_->write(req);
     const auto r = wait_final(*results_, id, &seen);
     EXPECT_TRUE(r.has_value());
-    EXPECT_EQ(r ? r->state() : msg::PLAN_FAILED, msg::PLAN_SUCCEEDED) << (r ? r->reason() : "no result");
+    EXPECT_EQ(r ? r->state() : msg::PLAN_FAILED, msg::PLAN_SUCCEEDED)
+        << (r ? r->reason() : "no result");
     return r ? *r : msg::PlanResult{};
   };
   const msg::PlanResult open = plan(51);
@@ -265,7 +326,8 @@ TEST_F(PlannerNodeTest, AnObstacleOnTheWorldTopicChangesThePlan) {
   w.obstacles.push_back(crate);
   worlds.write(world::to_msg(w, 2, "test"));
   const auto deadline = std::chrono::steady_clock::now() + 10s;
-  while (log_.str().find("world version 2") == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+  while (log_.str().find("world version 2") == std::string::npos &&
+         std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(10ms);
   }
   ASSERT_NE(log_.str().find("world version 2 from test: 2 boxes"), std::string::npos) << log_.str();
@@ -274,8 +336,8 @@ TEST_F(PlannerNodeTest, AnObstacleOnTheWorldTopicChangesThePlan) {
   const auto& end = blocked.trajectory().back().position();
   // The base can no longer stand where it stood: it ends outside the crate.
   const bool outside = std::abs(end[0] - open_x) > 0.4 || std::abs(end[1] - open_y) > 0.4;
-  EXPECT_TRUE(outside) << "base ends at (" << end[0] << ", " << end[1] << "), the crate is at (" << open_x << ", "
-                       << open_y << ")";
+  EXPECT_TRUE(outside) << "base ends at (" << end[0] << ", " << end[1] << "), the crate is at ("
+                       << open_x << ", " << open_y << ")";
 }
 
 TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {

@@ -1,9 +1,5 @@
 #include "dds/planner_node.hpp"
 
-#include "concert/model/dds/conversions.hpp"
-#include "concert/model/dds/pose.hpp"
-#include "concert/world/world_dds.hpp"
-
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -15,6 +11,9 @@
 
 #include "concert/common/clock.hpp"
 #include "concert/common/enum_map.hpp"
+#include "concert/model/dds/conversions.hpp"
+#include "concert/model/dds/pose.hpp"
+#include "concert/world/world_dds.hpp"
 
 namespace concert::planner::dds {
 
@@ -48,6 +47,33 @@ constexpr EnumMap kFailures{std::array{
     std::pair{Status::kUnreachable, msg::PLAN_UNREACHABLE},
     std::pair{Status::kNoPath, msg::PLAN_NO_PATH},
 }};
+
+// The full start state a request gives (base_x, base_y, base_yaw and the joints by name).
+// Throws std::runtime_error naming what is missing or unknown.
+Eigen::VectorXd given_start(const PlanningModel& model, const msg::PlanRequest& request) {
+  const auto& names = request.start_names();
+  const auto& values = request.start_position();
+  if (names.size() != values.size()) {
+    throw std::runtime_error("start state has " + std::to_string(names.size()) + " names and " +
+                             std::to_string(values.size()) + " positions");
+  }
+  Eigen::Vector3d base = Eigen::Vector3d::Zero();
+  std::vector<std::string> joints;
+  std::vector<double> positions;
+  constexpr std::array<const char*, 3> kBase{"base_x", "base_y", "base_yaw"};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (!std::isfinite(values[i]))
+      throw std::runtime_error("start state: '" + names[i] + "' is not finite");
+    const auto b = std::find(kBase.begin(), kBase.end(), names[i]);
+    if (b != kBase.end()) {
+      base[b - kBase.begin()] = values[i];
+    } else {
+      joints.push_back(names[i]);
+      positions.push_back(values[i]);
+    }
+  }
+  return model.full_from_named(joints, positions, base);
+}
 
 }  // namespace
 
@@ -259,7 +285,11 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     const Eigen::Vector3d pose =
         odom ? Eigen::Vector3d(odom->x(), odom->y(), odom->yaw()) : Eigen::Vector3d::Zero();
     try {
-      if (js && js->model_version() == model->version()) {
+      if (!request.start_names().empty()) {
+        start = given_start(*model, request);
+        if (request.execute())
+          start_error = "a request with a start state cannot be executed (the robot is not there)";
+      } else if (js && js->model_version() == model->version()) {
         start = model->full_from_named(js->name(), js->position(), pose);
       } else if (request.execute()) {
         start_error = js ? "the robot runs model version " + std::to_string(js->model_version()) +
@@ -330,8 +360,9 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
          << (result.reason.empty() ? "" : " (" + result.reason + ")");
     for (const GoalResult& g : result.goals) {
       if (g.status != Status::kSucceeded) continue;
-      line << "; goal " << g.index << " in " << static_cast<int>(1e3 * (g.nspg_seconds + g.plan_seconds)) << " ms ("
-           << g.path_method << ")";
+      line << "; goal " << g.index << " in "
+           << static_cast<int>(1e3 * (g.nspg_seconds + g.plan_seconds)) << " ms (" << g.path_method
+           << ")";
     }
     log_line(line.str());
   }
@@ -396,7 +427,8 @@ std::string PlannerNode::execute(Execution& e) {
   trajectory_commands_.write(cmd);
   // Bounded wait: the trajectory's duration plus the robot's settling time and a margin.
   const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::milliseconds(static_cast<int64_t>(1e3 * t.duration())) + options_.result_margin;
+                        std::chrono::milliseconds(static_cast<int64_t>(1e3 * t.duration())) +
+                        options_.result_margin;
   double reported = -1.0;
   std::unique_lock lock(mutex_);
   while (true) {
@@ -411,8 +443,8 @@ std::string PlannerNode::execute(Execution& e) {
         case msg::TRAJECTORY_ABORTED:
         case msg::TRAJECTORY_REFUSED:
           trajectory_status_.erase(it);
-          return std::string(st.state() == msg::TRAJECTORY_REFUSED ? "refused" : "aborted") + " by the robot: " +
-                 st.reason();
+          return std::string(st.state() == msg::TRAJECTORY_REFUSED ? "refused" : "aborted") +
+                 " by the robot: " + st.reason();
         case msg::TRAJECTORY_EXECUTING:
           if (st.progress() >= reported + 0.05 || reported < 0.0) {
             reported = st.progress();
@@ -427,9 +459,11 @@ std::string PlannerNode::execute(Execution& e) {
           break;
       }
     }
-    if (wake_.wait_until(lock, deadline) == std::cv_status::timeout && std::chrono::steady_clock::now() >= deadline) {
+    if (wake_.wait_until(lock, deadline) == std::cv_status::timeout &&
+        std::chrono::steady_clock::now() >= deadline) {
       return "no result from the robot service within " +
-             std::to_string(static_cast<int>(t.duration() + 1e-3 * static_cast<double>(options_.result_margin.count()))) +
+             std::to_string(static_cast<int>(
+                 t.duration() + 1e-3 * static_cast<double>(options_.result_margin.count()))) +
              " s (is it running?)";
     }
   }
@@ -442,11 +476,13 @@ void PlannerNode::on_world(const msg::World& w) {
     env.add_world(world);
     planner_.set_environment(env);
     std::ostringstream line;
-    line << "planner: world version " << w.version() << " from " << w.source() << ": " << world.boxes.size()
-         << " boxes, " << world.cylinders.size() << " cylinders, map " << env.occupied_cells() << " occupied cells";
+    line << "planner: world version " << w.version() << " from " << w.source() << ": "
+         << world.boxes.size() << " boxes, " << world.cylinders.size() << " cylinders, map "
+         << env.occupied_cells() << " occupied cells";
     log_line(line.str());
   } catch (const std::exception& e) {
-    log_line(std::string("planner: world version ") + std::to_string(w.version()) + " refused: " + e.what());
+    log_line(std::string("planner: world version ") + std::to_string(w.version()) +
+             " refused: " + e.what());
   }
 }
 
