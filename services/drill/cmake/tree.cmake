@@ -3,6 +3,7 @@
 # bt.hpp for why not BehaviorTree.CPP). Plain C++, no DDS.
 concert_core_library(concert_drill_tree STATIC
   src/core/mission.cpp
+  src/core/mission_tree.cpp
   src/core/bt/bt.cpp)
 target_include_directories(concert_drill_tree
   PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include
