@@ -96,6 +96,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadMission{"a typo at the top", "dpeth: 0.05\nareas: [{point: [1, 2, 3]}]",
                    "mission 'm.yaml': dpeth: unknown key (expected name, ifc, storey, patterns, "
                    "depth, areas)"},
+        BadMission{"a key given twice", "depth: 0.1\ndepth: 0.2\nareas: [{point: [1, 2, 3]}]",
+                   "mission 'm.yaml': depth: given twice"},
+        BadMission{"a key given twice in an area", "areas: [{point: [1, 2, 3], name: a, name: b}]",
+                   "mission 'm.yaml': areas[0].name: given twice"},
         BadMission{"a typo in an area", "areas: [{pont: [1, 2, 3]}]",
                    "mission 'm.yaml': areas[0].pont: unknown key (expected name, marks, wall, at, "
                    "point, pixel, expected)"},

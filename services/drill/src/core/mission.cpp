@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <map>
+#include <set>
 #include <vector>
 
 #include "concert/common/source_text.hpp"
@@ -33,11 +33,14 @@ class Reader {
   void only_keys(const YAML::Node& node, const std::string& path,
                  const std::vector<std::string>& keys) const {
     if (!node.IsMap()) fail(path, "expected a map with " + join(keys));
+    std::set<std::string> seen;
     for (const auto& entry : node) {
       const auto key = entry.first.as<std::string>();
       if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
         fail(child(path, key), "unknown key (expected " + join(keys) + ")");
       }
+      // yaml-cpp keeps the first of two equal keys: the second would be ignored silently.
+      if (!seen.insert(key).second) fail(child(path, key), "given twice");
     }
   }
 
@@ -63,11 +66,10 @@ class Reader {
     return value;
   }
 
-  // A list of N finite numbers, each >= `min`.
+  // A list of N finite numbers (each >= 0 if `non_negative`); `what` says what it is.
   template <int N>
   Eigen::Matrix<double, N, 1> numbers(const YAML::Node& node, const std::string& path,
-                                      const std::string& what,
-                                      double min = -std::numeric_limits<double>::infinity()) const {
+                                      const std::string& what, bool non_negative = false) const {
     if (!node.IsSequence() || node.size() != static_cast<std::size_t>(N)) {
       fail(path, "expected " + what);
     }
@@ -76,7 +78,7 @@ class Reader {
       const YAML::Node element = node[static_cast<std::size_t>(i)];
       const std::string item = path + "[" + std::to_string(i) + "]";
       v(i) = number(element, item);
-      if (v(i) < min) fail(item, "expected a number >= " + format(min) + got(element));
+      if (non_negative && v(i) < 0.0) fail(item, "expected a number >= 0" + got(element));
     }
     return v;
   }
@@ -91,12 +93,6 @@ class Reader {
  private:
   static std::string got(const YAML::Node& node) {
     return node.IsScalar() ? ", got '" + node.Scalar() + "'" : "";
-  }
-  static std::string format(double v) {
-    std::string s = std::to_string(v);
-    s.erase(s.find_last_not_of('0') + 1);
-    if (s.back() == '.') s.pop_back();
-    return s;
   }
 
   std::string prefix_;
@@ -134,13 +130,13 @@ AreaSpec read_area(const Reader& r, const YAML::Node& node, std::size_t index) {
   }
   if (const auto at = node["at"]) {
     if (area.wall.empty()) r.fail(path + ".at", "goes with wall (the centre of a wall area)");
-    area.at = r.numbers<2>(at, path + ".at", "[s, h]: m along the wall, m above the storey", 0.0);
+    area.at = r.numbers<2>(at, path + ".at", "[s, h]: m along the wall, m above the storey", true);
   }
   if (const auto point = node["point"]) {
     area.point = r.numbers<3>(point, path + ".point", "[x, y, z] in the map frame [m]");
   }
   if (const auto pixel = node["pixel"]) {
-    area.pixel = r.numbers<2>(pixel, path + ".pixel", "[u, v] in the drill camera's image", 0.0);
+    area.pixel = r.numbers<2>(pixel, path + ".pixel", "[u, v] in the drill camera's image", true);
   }
   if (const auto expected = node["expected"]) {
     area.expected = r.whole(expected, path + ".expected", 0);
