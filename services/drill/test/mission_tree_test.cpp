@@ -489,6 +489,7 @@ TEST(MissionTree, TimesAddUp) {
   const double resolve = 3 * 1.0;
   EXPECT_DOUBLE_EQ(t.total, fake.now);
   EXPECT_DOUBLE_EQ(t.navigate + t.plan + t.execute + t.drill + resolve, t.total);
+  EXPECT_EQ(fake.health_checks, static_cast<int>(fake.now) + 1) << "one check a tick";
 }
 
 TEST(MissionTree, StatusNamesTheActiveNode) {

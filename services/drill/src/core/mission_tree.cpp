@@ -19,6 +19,8 @@ bool was_drilled(const HoleReport& hole) {
          (hole.state == HoleState::kSkipped && hole.reason == kDrilledBefore);
 }
 
+bool failed(const HoleReport& hole) { return hole.state == HoleState::kFailed; }
+
 std::string quoted(const std::string& kind, const std::string& name) {
   return kind + " '" + name + "'";
 }
@@ -263,12 +265,13 @@ struct MissionTree::Impl {
   }
 
   // A failed approach leaves the arm somewhere along its trajectory: stop() holds it there and
-  // the mission goes on. That is safe because the next area is planned from the robot's
-  // measured state (no plan was started from this area's posture: that happens only after a
-  // successful approach) and the planner refuses a start state in collision, which fails that
-  // area in turn rather than moving; e-stops and lost services are caught by health() on every
-  // tick. What it cannot know is why the trajectory failed: if the arm touched something the
-  // operator should look before resuming, so the failure is in the report's reason.
+  // the mission goes on with the next area. Safe as far as the mission can tell: the next area is
+  // planned from the robot's measured state (no plan was started from this area's posture: that
+  // happens only after a successful approach), the planner refuses a start state in collision
+  // (which fails that area in turn, without moving), and e-stops, limits and lost services end
+  // the mission through health() on every tick. Not safe if the trajectory failed because the
+  // arm touched something that none of these reports: the next approach then moves an arm in
+  // contact. The reason is in the report for the operator to judge.
   Outcome executed() {
     Outcome outcome = ports.execution();
     if (outcome.progress == Progress::kFailed) ports.stop();
@@ -362,14 +365,10 @@ struct MissionTree::Impl {
       return fatal.empty();
     }
     std::vector<std::string> problems;
-    const auto failed = std::count_if(a.holes.begin(), a.holes.end(), [](const HoleReport& h) {
-      return h.state == HoleState::kFailed;
-    });
-    if (failed > 0) {
-      const auto first = std::find_if(a.holes.begin(), a.holes.end(), [](const HoleReport& h) {
-        return h.state == HoleState::kFailed;
-      });
-      problems.push_back(std::to_string(failed) + " of " + std::to_string(a.holes.size()) +
+    const auto n_failed = std::count_if(a.holes.begin(), a.holes.end(), failed);
+    if (n_failed > 0) {
+      const auto first = std::find_if(a.holes.begin(), a.holes.end(), failed);
+      problems.push_back(std::to_string(n_failed) + " of " + std::to_string(a.holes.size()) +
                          " holes failed (" + quoted("hole", first->point.label) + ": " +
                          first->reason + ")");
     }
@@ -408,14 +407,11 @@ struct MissionTree::Impl {
   // Every area done and no hole failed: succeeded; else failed, with what went wrong.
   void conclude() {
     std::vector<std::string> problems;
-    int failed = 0;
-    for (const auto& a : report.areas) {
-      failed += static_cast<int>(std::count_if(a.holes.begin(), a.holes.end(), [](const auto& h) {
-        return h.state == HoleState::kFailed;
-      }));
-    }
-    if (failed > 0) {
-      problems.push_back(std::to_string(failed) + " of " + std::to_string(report.holes_marked()) +
+    std::ptrdiff_t n_failed = 0;
+    for (const auto& a : report.areas)
+      n_failed += std::count_if(a.holes.begin(), a.holes.end(), failed);
+    if (n_failed > 0) {
+      problems.push_back(std::to_string(n_failed) + " of " + std::to_string(report.holes_marked()) +
                          " holes failed");
     }
     for (const auto& a : report.areas) {
