@@ -74,7 +74,7 @@ class FakePorts : public MissionPorts {
     resolving_[area] = start("resolve " + std::to_string(area));
   }
   Outcome resolution(std::size_t area, ResolvedArea& out) override {
-    const Outcome o = poll(resolving_[area]);
+    Outcome o = poll(resolving_[area]);
     if (o.progress == Progress::kSucceeded) out = areas.at(area);
     return o;
   }
@@ -109,7 +109,7 @@ class FakePorts : public MissionPorts {
     execution_ = start(call);
   }
   Outcome execution() override {
-    const Outcome o = poll(execution_);
+    Outcome o = poll(execution_);
     if (o.progress == Progress::kSucceeded) posture_ = "area " + std::to_string(executing_);
     if (o.progress == Progress::kFailed)
       posture_ = "on the way to area " + std::to_string(executing_);
@@ -121,7 +121,7 @@ class FakePorts : public MissionPorts {
     detection_ = start("detect " + std::to_string(area));
   }
   Outcome detection(std::vector<DrillPoint>& found) override {
-    const Outcome o = poll(detection_);
+    Outcome o = poll(detection_);
     if (o.progress == Progress::kSucceeded) found = points.at(detecting_);
     return o;
   }

@@ -18,7 +18,7 @@ Status Node::fail(std::string why) {
 }
 
 void Node::describe(std::string& out, int depth) const {
-  out.append(static_cast<std::size_t>(2 * depth), ' ');
+  out.append(2 * static_cast<std::size_t>(depth), ' ');
   out += name_ + " (" + kind() + ")\n";
   for (const Node* child : children()) child->describe(out, depth + 1);
 }
