@@ -21,6 +21,11 @@ enum class AreaState { kPending, kActive, kDone, kFailed, kSkipped };
 /// The mission as a whole.
 enum class MissionState { kIdle, kRunning, kSucceeded, kFailed, kAborted };
 
+/// HoleReport::reason of a hole that resume() found drilled by a previous run (kSkipped).
+inline constexpr const char* kDrilledBefore = "drilled in a previous run";
+/// AreaReport::reason of an area that resume() found done by a previous run (kSkipped).
+inline constexpr const char* kDoneBefore = "done in a previous run";
+
 const char* to_string(HoleState s);
 const char* to_string(AreaState s);
 const char* to_string(MissionState s);
@@ -57,7 +62,8 @@ struct MissionReport {
   std::vector<AreaReport> areas;
   MissionTimes times;
   [[nodiscard]] int holes_drilled() const;
-  [[nodiscard]] int holes_marked() const;  ///< detected points (pending + drilled + failed + skipped)
+  /// Detected points (pending + drilled + failed + skipped).
+  [[nodiscard]] int holes_marked() const;
 };
 
 /// What the tree is doing now.

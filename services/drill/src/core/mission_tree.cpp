@@ -1,0 +1,537 @@
+#include "drill/mission_tree.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+#include "bt/bt.hpp"
+#include "concert/common/text.hpp"
+
+namespace concert::drill {
+namespace {
+
+constexpr double kSameHole = 0.01;  // [m] a hole of a previous run within this is the same hole
+
+// What the running action waits for: the time until the next tick is counted there.
+enum class Work { kNone, kNavigate, kPlan, kExecute, kDrill };
+
+bool was_drilled(const HoleReport& hole) {
+  return hole.state == HoleState::kDrilled ||
+         (hole.state == HoleState::kSkipped && hole.reason == kDrilledBefore);
+}
+
+bool failed(const HoleReport& hole) { return hole.state == HoleState::kFailed; }
+
+std::string quoted(const std::string& kind, const std::string& name) {
+  return kind + " '" + name + "'";
+}
+
+}  // namespace
+
+const char* to_string(HoleState s) {
+  switch (s) {
+    case HoleState::kPending:
+      return "pending";
+    case HoleState::kDrilled:
+      return "drilled";
+    case HoleState::kFailed:
+      return "failed";
+    case HoleState::kSkipped:
+      return "skipped";
+  }
+  return "?";
+}
+
+const char* to_string(AreaState s) {
+  switch (s) {
+    case AreaState::kPending:
+      return "pending";
+    case AreaState::kActive:
+      return "active";
+    case AreaState::kDone:
+      return "done";
+    case AreaState::kFailed:
+      return "failed";
+    case AreaState::kSkipped:
+      return "skipped";
+  }
+  return "?";
+}
+
+const char* to_string(MissionState s) {
+  switch (s) {
+    case MissionState::kIdle:
+      return "idle";
+    case MissionState::kRunning:
+      return "running";
+    case MissionState::kSucceeded:
+      return "succeeded";
+    case MissionState::kFailed:
+      return "failed";
+    case MissionState::kAborted:
+      return "aborted";
+  }
+  return "?";
+}
+
+int MissionReport::holes_drilled() const {
+  int n = 0;
+  for (const auto& area : areas) {
+    n += static_cast<int>(std::count_if(area.holes.begin(), area.holes.end(), [](const auto& h) {
+      return h.state == HoleState::kDrilled;
+    }));
+  }
+  return n;
+}
+
+int MissionReport::holes_marked() const {
+  int n = 0;
+  for (const auto& area : areas) n += static_cast<int>(area.holes.size());
+  return n;
+}
+
+// The tree of Fig. 11 over the ports, and the report it fills. The tree's nodes call back into
+// this object; `current_area` and `current_hole` are the loops' current items.
+struct MissionTree::Impl {
+  Impl(Mission m, MissionPorts& p) : mission(std::move(m)), ports(p) {
+    report.mission = mission.name;
+    for (const auto& spec : mission.areas) report.areas.push_back({.name = spec.name});
+    drilled_before.resize(mission.areas.size());
+    plan_started.resize(mission.areas.size(), false);
+    root = build();
+  }
+
+  Mission mission;
+  MissionPorts& ports;
+  MissionReport report;
+  std::unique_ptr<bt::Node> root;
+  std::vector<std::vector<Eigen::Vector3d>> drilled_before;  // per area: hole origins [m]
+  std::vector<bool> plan_started;                            // per area
+  std::vector<DrillPoint> detected;
+  std::size_t current_area{0};
+  std::size_t current_hole{0};
+  bool hole_active{false};
+  bool started{false};
+  double last_now{0.0};
+  Work waiting{Work::kNone};
+  std::string fatal;  // why the mission cannot go on safely (set by a failed retraction)
+
+  AreaReport& area() { return report.areas[current_area]; }
+  HoleReport& hole() { return area().holes[current_hole]; }
+  bool finished() const {
+    return report.state != MissionState::kIdle && report.state != MissionState::kRunning;
+  }
+
+  // --- the tree ---------------------------------------------------------------------------
+
+  // An action whose waiting time counts as `work`.
+  bt::NodePtr action(std::string name, Work work, std::function<void()> start,
+                     std::function<Outcome()> poll) {
+    return std::make_unique<bt::Action>(std::move(name), std::move(start),
+                                        [this, work, poll = std::move(poll)] {
+                                          Outcome outcome = poll();
+                                          if (outcome.progress == Progress::kRunning) {
+                                            waiting = work;
+                                          }
+                                          return outcome;
+                                        });
+  }
+
+  // The areas still to work on (not done before, located), in mission order.
+  std::vector<std::size_t> pending_areas() const {
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < report.areas.size(); ++i) {
+      if (report.areas[i].state == AreaState::kPending) out.push_back(i);
+    }
+    return out;
+  }
+
+  // A loop over pending_areas(); with `activate`, the area worked on is kActive.
+  bt::NodePtr for_each_area(std::string name, bool activate,
+                            std::function<bool(std::size_t, bt::Status, const std::string&)> end,
+                            bt::NodePtr body) {
+    bt::ForEach::Hooks hooks{
+        .items = [this] { return pending_areas(); },
+        .label = [this](std::size_t i) { return quoted("area", report.areas[i].name); },
+        .begin =
+            [this, activate](std::size_t i) {
+              current_area = i;
+              current_hole = 0;
+              if (activate) area().state = AreaState::kActive;
+            },
+        .end = std::move(end)};
+    return std::make_unique<bt::ForEach>(std::move(name), std::move(hooks), std::move(body));
+  }
+
+  bt::NodePtr build() {
+    using bt::hidden;
+    using bt::sequence;
+    auto resolve = action(
+        "resolve", Work::kNone,
+        [this] { ports.resolve(current_area, mission.areas[current_area]); },
+        [this] { return ports.resolution(current_area, area().located); });
+    auto initialise =
+        sequence("initialise", for_each_area(
+                                   "areas", false,
+                                   [this](std::size_t, bt::Status status, const std::string& why) {
+                                     return area_resolved(status, why);
+                                   },
+                                   std::move(resolve)));
+
+    auto navigate = bt::fallback(
+        "navigate if the area has a base pose",
+        std::make_unique<bt::Condition>("no base pose", [this] { return !area().located.base; }),
+        action(
+            "navigate", Work::kNavigate, [this] { ports.navigate(*area().located.base); },
+            [this] { return ports.navigation(); }));
+    // Waits for the area's plan; starts it from the robot's current state if it was not planned
+    // ahead: the first area, an area the base navigated to, an area after one whose approach
+    // failed.
+    auto plan = action(
+        "plan", Work::kPlan,
+        [this] {
+          if (!plan_started[current_area]) start_plan(current_area, std::nullopt);
+        },
+        [this] { return ports.planning(current_area); });
+    auto execute = action(
+        "execute", Work::kExecute, [this] { ports.execute(current_area); },
+        [this] { return executed(); });
+    auto plan_next = action(
+        "plan the next area", Work::kNone, [this] { plan_next_area(); },
+        [] { return Outcome::succeeded(); });
+    auto detect = action(
+        "detect", Work::kDrill,
+        [this] { ports.detect(current_area, mission.areas[current_area], area().located); },
+        [this] { return detection(); });
+
+    auto align = action(
+        "align", Work::kDrill, [this] { ports.align(hole().point); },
+        [this] { return ports.alignment(); });
+    auto drill = action(
+        "drill", Work::kDrill, [this] { ports.drill(hole().point, mission.depth); },
+        [this] { return ports.drilling(); });
+    auto retract = action(
+        "retract", Work::kDrill, [this] { ports.retract(); }, [this] { return retraction(); });
+    auto hole_body = std::make_unique<bt::Finally>(
+        "hole", hidden(sequence("align and drill", std::move(align), std::move(drill))),
+        std::move(retract));
+    bt::ForEach::Hooks hole_hooks{
+        .items = [this] { return pending_holes(); },
+        .label = [this](std::size_t i) { return quoted("hole", area().holes[i].point.label); },
+        .begin =
+            [this](std::size_t i) {
+              current_hole = i;
+              hole_active = true;
+            },
+        .end = [this](std::size_t, bt::Status status,
+                      const std::string& why) { return hole_done(status, why); }};
+    auto holes =
+        std::make_unique<bt::ForEach>("holes", std::move(hole_hooks), hidden(std::move(hole_body)));
+
+    auto area_body =
+        sequence("area", hidden(std::move(navigate)), std::move(plan), std::move(execute),
+                 std::move(plan_next), std::move(detect), std::move(holes));
+    auto areas = for_each_area(
+        "areas", true,
+        [this](std::size_t, bt::Status status, const std::string& why) {
+          return area_done(status, why);
+        },
+        hidden(std::move(area_body)));
+    return sequence("mission", std::move(initialise), std::move(areas));
+  }
+
+  // --- what the nodes do --------------------------------------------------------------------
+
+  bool area_resolved(bt::Status status, const std::string& why) {
+    if (status == bt::Status::kFailure) {
+      area().state = AreaState::kFailed;
+      area().reason = why;
+    }
+    return true;
+  }
+
+  void start_plan(std::size_t i, std::optional<std::size_t> after) {
+    ports.plan(i, report.areas[i].located.frame, after);
+    plan_started[i] = true;
+  }
+
+  // Plans the next area while this one is detected and drilled: from this area's approach
+  // posture, where the arm is back after every hole. Not if the next area has a base pose: the
+  // base moves first, and that area is planned from where it stops.
+  void plan_next_area() {
+    const std::vector<std::size_t> pending = pending_areas();
+    const auto next = std::find_if(pending.begin(), pending.end(),
+                                   [this](std::size_t i) { return i > current_area; });
+    if (next != pending.end() && !report.areas[*next].located.base) start_plan(*next, current_area);
+  }
+
+  // A failed approach leaves the arm somewhere along its trajectory: stop() holds it there and
+  // the mission goes on with the next area. Safe as far as the mission can tell: the next area is
+  // planned from the robot's measured state (no plan was started from this area's posture: that
+  // happens only after a successful approach), the planner refuses a start state in collision
+  // (which fails that area in turn, without moving), and e-stops, limits and lost services end
+  // the mission through health() on every tick. Not safe if the trajectory failed because the
+  // arm touched something that none of these reports: the next approach then moves an arm in
+  // contact. The reason is in the report for the operator to judge.
+  Outcome executed() {
+    Outcome outcome = ports.execution();
+    if (outcome.progress == Progress::kFailed) ports.stop();
+    return outcome;
+  }
+
+  Outcome detection() {
+    detected.clear();
+    Outcome outcome = ports.detection(detected);
+    if (outcome.progress != Progress::kSucceeded) return outcome;
+    if (detected.empty()) return Outcome::failed("no drilling point found");
+    select_holes();
+    return outcome;
+  }
+
+  // The detected points as holes: the nearest to the centre when more were found than the area
+  // expects, and not those a previous run drilled.
+  void select_holes() {
+    AreaReport& a = area();
+    a.holes.clear();
+    for (auto& point : detected) a.holes.push_back({.point = std::move(point)});
+    const auto expected = static_cast<std::size_t>(mission.areas[current_area].expected);
+    if (expected > 0 && a.holes.size() > expected) {
+      const Eigen::Vector3d centre = a.located.frame.translation();
+      auto distance = [&](std::size_t i) {
+        return (a.holes[i].point.frame.translation() - centre).norm();
+      };
+      std::vector<std::size_t> order(a.holes.size());
+      std::iota(order.begin(), order.end(), 0);
+      std::stable_sort(order.begin(), order.end(),
+                       [&](std::size_t x, std::size_t y) { return distance(x) < distance(y); });
+      for (std::size_t k = expected; k < order.size(); ++k) {
+        a.holes[order[k]].state = HoleState::kSkipped;
+        a.holes[order[k]].reason = "the area expects " + std::to_string(expected) + " holes and " +
+                                   std::to_string(a.holes.size()) +
+                                   " were found: nearer ones to its centre are drilled";
+      }
+    }
+    for (auto& h : a.holes) {
+      const bool before =
+          std::any_of(drilled_before[current_area].begin(), drilled_before[current_area].end(),
+                      [&](const Eigen::Vector3d& p) {
+                        return (p - h.point.frame.translation()).norm() <= kSameHole;
+                      });
+      if (h.state == HoleState::kPending && before) {
+        h.state = HoleState::kSkipped;
+        h.reason = kDrilledBefore;
+      }
+    }
+  }
+
+  std::vector<std::size_t> pending_holes() const {
+    std::vector<std::size_t> out;
+    const auto& holes = report.areas[current_area].holes;
+    for (std::size_t i = 0; i < holes.size(); ++i) {
+      if (holes[i].state == HoleState::kPending) out.push_back(i);
+    }
+    return out;
+  }
+
+  // A retraction that failed leaves the bit where it is, maybe in the wall, and the arm away from
+  // the approach posture the next hole and the next area's plan start from: nothing may move
+  // until someone looked, so the mission stops.
+  Outcome retraction() {
+    Outcome outcome = ports.retraction();
+    if (outcome.progress == Progress::kFailed) {
+      fatal = quoted("area", area().name) + " " + quoted("hole", hole().point.label) +
+              ": retract: " + outcome.reason +
+              "; the arm is not back at the approach posture (the bit may be in the wall): "
+              "mission stopped";
+    }
+    return outcome;
+  }
+
+  bool hole_done(bt::Status status, const std::string& why) {
+    hole_active = false;
+    if (status == bt::Status::kSuccess) {
+      hole().state = HoleState::kDrilled;
+    } else {
+      hole().state = HoleState::kFailed;
+      hole().reason = why;
+    }
+    return fatal.empty();
+  }
+
+  bool area_done(bt::Status status, const std::string& why) {
+    AreaReport& a = area();
+    if (status == bt::Status::kFailure) {
+      a.state = AreaState::kFailed;
+      a.reason = why;
+      return fatal.empty();
+    }
+    std::vector<std::string> problems;
+    const auto n_failed = std::count_if(a.holes.begin(), a.holes.end(), failed);
+    if (n_failed > 0) {
+      const auto first = std::find_if(a.holes.begin(), a.holes.end(), failed);
+      problems.push_back(std::to_string(n_failed) + " of " + std::to_string(a.holes.size()) +
+                         " holes failed (" + quoted("hole", first->point.label) + ": " +
+                         first->reason + ")");
+    }
+    const int expected = mission.areas[current_area].expected;
+    const int found = static_cast<int>(a.holes.size());
+    if (found < expected) {
+      problems.push_back(std::to_string(expected - found) + " of " + std::to_string(expected) +
+                         " expected holes not found");
+    }
+    a.state = problems.empty() ? AreaState::kDone : AreaState::kFailed;
+    a.reason = join(problems, "; ");
+    return true;
+  }
+
+  // --- the mission's end --------------------------------------------------------------------
+
+  void finish(MissionState state, std::string reason) {
+    report.state = state;
+    report.reason = std::move(reason);
+  }
+
+  // Stops the robot and ends the mission; the area and hole it was working on fail with `why`.
+  void halt(MissionState state, const std::string& why) {
+    ports.stop();
+    if (current_area < report.areas.size() && area().state == AreaState::kActive) {
+      area().state = AreaState::kFailed;
+      area().reason = "stopped: " + why;
+      if (hole_active) {
+        hole().state = HoleState::kFailed;
+        hole().reason = "stopped: " + why;
+      }
+    }
+    finish(state, why);
+  }
+
+  // Every area done and no hole failed: succeeded; else failed, with what went wrong.
+  void conclude() {
+    std::vector<std::string> problems;
+    std::ptrdiff_t n_failed = 0;
+    for (const auto& a : report.areas)
+      n_failed += std::count_if(a.holes.begin(), a.holes.end(), failed);
+    if (n_failed > 0) {
+      problems.push_back(std::to_string(n_failed) + " of " + std::to_string(report.holes_marked()) +
+                         " holes failed");
+    }
+    for (const auto& a : report.areas) {
+      if (a.state != AreaState::kDone && a.state != AreaState::kSkipped) {
+        problems.push_back(quoted("area", a.name) + ": " + a.reason);
+      }
+    }
+    if (problems.empty()) {
+      finish(MissionState::kSucceeded, "");
+    } else {
+      finish(MissionState::kFailed, join(problems, "; "));
+    }
+  }
+
+  // Adds the time since the last tick to what the mission waited for.
+  void account(double now) {
+    if (!started) {
+      started = true;
+      last_now = now;
+      return;
+    }
+    const double dt = std::max(0.0, now - last_now);
+    last_now = now;
+    MissionTimes& t = report.times;
+    t.total += dt;
+    switch (waiting) {
+      case Work::kNavigate:
+        t.navigate += dt;
+        break;
+      case Work::kPlan:
+        t.plan += dt;
+        break;
+      case Work::kExecute:
+        t.execute += dt;
+        break;
+      case Work::kDrill:
+        t.drill += dt;
+        break;
+      case Work::kNone:
+        break;
+    }
+  }
+};
+
+MissionTree::MissionTree(Mission mission, MissionPorts& ports)
+    : impl_(std::make_unique<Impl>(std::move(mission), ports)) {}
+
+MissionTree::~MissionTree() = default;
+
+void MissionTree::resume(const MissionReport& previous) {
+  Impl& m = *impl_;
+  if (m.started) throw DrillError("resume(): mission '" + m.mission.name + "' has started already");
+  if (previous.mission != m.mission.name) {
+    throw DrillError("resume(): the report is of mission '" + previous.mission + "', not '" +
+                     m.mission.name + "'");
+  }
+  for (std::size_t i = 0; i < m.report.areas.size(); ++i) {
+    AreaReport& area = m.report.areas[i];
+    const auto before = std::find_if(previous.areas.begin(), previous.areas.end(),
+                                     [&](const AreaReport& a) { return a.name == area.name; });
+    if (before == previous.areas.end()) continue;
+    if (before->state == AreaState::kDone || before->state == AreaState::kSkipped) {
+      area = *before;
+      area.state = AreaState::kSkipped;
+      area.reason = kDoneBefore;
+      for (auto& hole : area.holes) {
+        if (was_drilled(hole)) {
+          hole.state = HoleState::kSkipped;
+          hole.reason = kDrilledBefore;
+        }
+      }
+      continue;
+    }
+    for (const auto& hole : before->holes) {
+      if (was_drilled(hole)) m.drilled_before[i].push_back(hole.point.frame.translation());
+    }
+  }
+}
+
+MissionState MissionTree::tick(double now) {
+  Impl& m = *impl_;
+  if (m.finished()) return m.report.state;
+  m.account(now);
+  m.report.state = MissionState::kRunning;
+  if (const Outcome health = m.ports.health(); health.progress != Progress::kSucceeded) {
+    m.halt(MissionState::kAborted,
+           "health: " + (health.reason.empty() ? std::string("not healthy") : health.reason));
+    return m.report.state;
+  }
+  m.waiting = Work::kNone;
+  const bt::Status status = m.root->tick();
+  if (!m.fatal.empty()) {
+    m.ports.stop();
+    m.finish(MissionState::kFailed, m.fatal);
+  } else if (status != bt::Status::kRunning) {
+    m.conclude();
+  }
+  return m.report.state;
+}
+
+void MissionTree::abort(const std::string& reason) {
+  if (impl_->finished()) return;
+  impl_->halt(MissionState::kAborted, reason);
+}
+
+MissionStatus MissionTree::status() const {
+  const Impl& m = *impl_;
+  return {.state = m.report.state,
+          .active = m.finished() ? "" : bt::active_path(*m.root),
+          .area = m.current_area,
+          .hole = m.current_hole,
+          .reason = m.report.reason};
+}
+
+const MissionReport& MissionTree::report() const { return impl_->report; }
+
+std::string MissionTree::describe() const {
+  std::string out;
+  impl_->root->describe(out);
+  return out;
+}
+
+}  // namespace concert::drill
