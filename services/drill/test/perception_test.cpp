@@ -63,25 +63,26 @@ world::World wall_world(double face_x = 2.0, double yaw = 0.0) {
   return w;
 }
 
-Mark blob(const std::string& name, Eigen::Vector2d at, double diameter) {
+/// A mark of `type` on the wall's -x face at [u, height].
+Mark mark(const std::string& name, Mark::Type type, const Eigen::Vector2d& at) {
   Mark m;
   m.name = name;
-  m.type = Mark::Type::kBlob;
+  m.type = type;
   m.wall = "wall";
   m.face = Face::kMinusX;
   m.at = at;
+  return m;
+}
+
+Mark blob(const std::string& name, const Eigen::Vector2d& at, double diameter) {
+  Mark m = mark(name, Mark::Type::kBlob, at);
   m.diameter = diameter;
   return m;
 }
 
-Mark marker(const std::string& name, Eigen::Vector2d at, int id, double size = 0.1,
+Mark marker(const std::string& name, const Eigen::Vector2d& at, int id, double size = 0.1,
             double angle = 0.0) {
-  Mark m;
-  m.name = name;
-  m.type = Mark::Type::kAruco;
-  m.wall = "wall";
-  m.face = Face::kMinusX;
-  m.at = at;
+  Mark m = mark(name, Mark::Type::kAruco, at);
   m.size = size;
   m.dictionary = "DICT_4X4_50";
   m.id = id;
@@ -271,7 +272,7 @@ TEST(Frames, BadFramesAreRefusedNamingTheFrameAndWhatIsWrong) {
       [&] {
         detect_aruco(flat_frame(), ArucoParams{"DICT_9X9_1", 0.1, true, 50});
       },
-      {"unknown dictionary 'DICT_9X9_1'", "DICT_4X4_50"});
+      {"ArUco detection: unknown ArUco dictionary 'DICT_9X9_1'", "DICT_4X4_50"});
 }
 
 TEST(Frames, PixelsWithoutDepthAreErrorsNamingThePixel) {

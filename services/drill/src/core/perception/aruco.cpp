@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "concert/world/world.hpp"
 #include "drill/perception.hpp"
 #include "frame_access.hpp"
 
@@ -17,17 +18,15 @@ namespace concert::drill {
 namespace {
 
 cv::Ptr<cv::aruco::Dictionary> dictionary(const std::string& name) {
-  const auto& names = world::aruco_dictionary_names();
-  const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end()) {
-    std::string all;
-    for (const auto& n : names) {
-      all += (all.empty() ? "" : ", ") + n;
-    }
-    throw DrillError("ArUco detection: unknown dictionary '" + name + "' (accepted: " + all + ")");
+  try {
+    world::aruco_dictionary_size(name);  // names the accepted dictionaries if `name` is not one
+  } catch (const world::WorldError& e) {
+    throw DrillError(std::string("ArUco detection: ") + e.what());
   }
   // aruco_dictionary_names() is in the order of OpenCV's PREDEFINED_DICTIONARY_NAME.
-  return cv::aruco::getPredefinedDictionary(static_cast<int>(it - names.begin()));
+  const auto& names = world::aruco_dictionary_names();
+  return cv::aruco::getPredefinedDictionary(
+      static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin()));
 }
 
 Eigen::Isometry3d pose(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
