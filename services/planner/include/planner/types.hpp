@@ -41,6 +41,7 @@ struct Params {
   double environment_padding = 0.03; ///< robot shapes grown by this against the world [m]
   double floor_clearance = 0.02;     ///< non-leg shapes stay this far above the floor [m]
   double base_range = 3.0;           ///< base x, y sampled within start +- this [m]
+  bool fixed_base = false;           ///< per request (PlanRequest::fixed_base): the base keeps its start pose
 
   // Planning. Time budgets are CPU seconds of the planning thread, not wall seconds, so a plan
   // does not depend on what else loads the machine.
@@ -138,6 +139,12 @@ struct PlanRequest {
   uint64_t model_version = 0;     ///< must equal the planner's model version
   std::string end_effector;       ///< tool end-effector name; empty: the arm's tool (by role)
   std::vector<Goal> goals;
+  /// Camera frame to each area along its normal [m]; 0: Params::camera_distance. The drill
+  /// service asks for the camera close to the wall to put the bit at a hole.
+  double camera_distance = 0.0;
+  /// The base keeps its start pose: only the arm moves (the drill service's hole postures:
+  /// a base that moves lets odometry drift between holes).
+  bool fixed_base = false;
 };
 
 /// Result for one goal.
@@ -159,6 +166,7 @@ struct PlanResult {
   uint64_t model_version = 0;
   Status status = Status::kNoPath;  ///< kSucceeded when every goal succeeded
   std::string reason;
+  std::string note;  ///< how the request was planned when not as configured (e.g. without the padding)
   std::vector<GoalResult> goals;
 };
 

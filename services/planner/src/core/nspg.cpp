@@ -83,6 +83,10 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   hi.head<2>() = start.head<2>().cwiseMax(task.position.head<2>()).array() + params.base_range;
   lo[2] = start[2] - 2.0 * M_PI;
   hi[2] = start[2] + 2.0 * M_PI;
+  if (params.fixed_base) {
+    lo.head<3>() = start.head<3>();
+    hi.head<3>() = start.head<3>();
+  }
   const double yaw_hint = start[2];
 
   PostureProblem problem(model, params, &tool, q_start_full, task, checker.distance_field());

@@ -160,7 +160,7 @@ PathSearch::PathSearch(const PlanningModel& model, StateChecker& checker, const 
   lo_.resize(n_);
   hi_.resize(n_);
   for (int i = 0; i < n_; ++i) {
-    const double margin = i < 2 ? params.base_range : M_PI;
+    const double margin = params.fixed_base && i < 3 ? 0.0 : i < 2 ? params.base_range : M_PI;
     lo_[i] = i < 3 ? std::min(q_start_[i], q_goal_[i]) - margin : model.lower()[i];
     hi_[i] = i < 3 ? std::max(q_start_[i], q_goal_[i]) + margin : model.upper()[i];
   }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <mutex>
 #include <optional>
 
@@ -211,7 +212,7 @@ Environment Planner::environment() const {
 
 GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
                               const Eigen::VectorXd& q_start_full, const Eigen::VectorXd& q_goal,
-                              double time_budget, uint64_t seed) const {
+                              double time_budget, uint64_t seed, bool fixed_base) const {
   const auto t0 = Clock::now();
   const auto cpu0 = ThreadCpuClock::now();
   GoalResult r;
@@ -223,7 +224,9 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
         std::string("start state rejected by ") + to_string(vs.constraint) + ": " + vs.detail;
     return r;
   }
-  detail::PathSearch search(model, checker, params_, q_start_full, q_goal, seed,
+  Params params = params_;
+  params.fixed_base = fixed_base;
+  detail::PathSearch search(model, checker, params, q_start_full, q_goal, seed,
                             [&](const Eigen::VectorXd& arm) { return arm_path_to(model, arm); });
   const std::vector<Eigen::VectorXd> waypoints =
       search.run(cpu0 + std::chrono::duration_cast<ThreadCpuClock::duration>(
@@ -284,8 +287,21 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     }
   }
 
-  StateChecker checker(model, env, params_, params_.environment_padding);
-  const Validity start_ok = checker.check(q_start_full);
+  auto checker_ptr = std::make_unique<StateChecker>(model, env, params_, params_.environment_padding);
+  Validity start_ok = checker_ptr->check(q_start_full);
+  if (start_ok.constraint == Constraint::kEnvironmentCollision && params_.environment_padding > 0.0) {
+    // A robot standing closer to the map than the padding (odometry drifts: the map is in the
+    // world, the start in the odometry frame; after the drill's approach the demo's base was
+    // 4 cm off) may still move away from it: this request is planned without the padding, its
+    // shapes against the map's true surfaces.
+    auto unpadded = std::make_unique<StateChecker>(model, env, params_, 0.0);
+    if (const Validity v = unpadded->check(q_start_full); v.valid()) {
+      out.note = "the start is within the environment padding (" + start_ok.detail + "): planned without it";
+      checker_ptr = std::move(unpadded);
+      start_ok = v;
+    }
+  }
+  StateChecker& checker = *checker_ptr;
   if (!start_ok.valid()) {
     return fail(Status::kInvalidStart, std::string("start state rejected by ") +
                                            to_string(start_ok.constraint) + ": " + start_ok.detail);
@@ -301,8 +317,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     // postures sit in torque-feasible pockets no path reaches.
     GoalResult r;
     double nspg = 0.0;
-    const double height =
-        (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, params_.camera_distance)).z();
+    const double distance = request.camera_distance > 0.0 ? request.camera_distance : params_.camera_distance;
+    const double height = (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, distance)).z();
     const std::vector<Eigen::VectorXd> hints = hints_for(*model, height);
     int next_seed = 0;
     // The arm shapes no path reached: the posture search's next seeds are often the same
@@ -318,6 +334,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     for (int attempt = 0;; ++attempt) {
       const auto t_posture = Clock::now();
       Params attempt_params = params_;
+      attempt_params.camera_distance = distance;
+      attempt_params.fixed_base = request.fixed_base;
       PostureResult posture;
       do {
         attempt_params.nspg_time =
@@ -333,13 +351,13 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
         if (attempt > 0) break;  // keep the previous attempt's "no path"
         r.status = Status::kUnreachable;
         r.reason = "no feasible posture puts camera '" + model->camera_frame(*tool) + "' " +
-                   std::to_string(params_.camera_distance) + " m in front of the drilling area (" +
+                   std::to_string(distance) + " m in front of the drilling area (" +
                    std::to_string(posture.candidates) + " seeds solved; " + posture.reason + ")";
         break;
       }
       const double remaining = params_.planning_time - cpu_seconds_since(t0);
       r = plan_path(*model, checker, current, posture.q,
-                    std::min(remaining, params_.path_attempt_time), seed);
+                    std::min(remaining, params_.path_attempt_time), seed, request.fixed_base);
       r.nspg_seconds = nspg;
       if (r.status == Status::kSucceeded) remember(*model, height, posture.q);
       if (r.status == Status::kNoPath) unreached.push_back(posture.q.tail(posture.q.size() - 3));

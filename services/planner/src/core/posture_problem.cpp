@@ -318,6 +318,7 @@ Term PostureProblem::term_of_row(int row) const {
 void solve(PostureProblem& problem, Eigen::VectorXd& q, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, int iterations,
            double tolerance, Eigen::VectorXd& r) {
   const Eigen::Index n = q.size();
+  q = q.cwiseMax(lo).cwiseMin(hi);  // a seed outside the box (a placed base when the base is fixed) starts on it
   problem.evaluate(q, r);
   const Eigen::Index m = r.size() - 6;
   auto merit = [](const Eigen::VectorXd& v) { return 100.0 * v.head<6>().squaredNorm() + v.tail(v.size() - 6).squaredNorm(); };

@@ -320,6 +320,8 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   core.request_id = request.request_id();
   core.model_version = request.model_version();
   core.end_effector = request.end_effector();
+  core.camera_distance = request.camera_distance();
+  core.fixed_base = request.fixed_base();
   for (const msg::Pose& g : request.goals()) core.goals.push_back({to_core(g)});
   const bool execute = request.execute();
   const std::size_t count = core.goals.size();
@@ -357,7 +359,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   {
     std::ostringstream line;
     line << "planner: request " << request.request_id() << ": " << to_string(result.status)
-         << (result.reason.empty() ? "" : " (" + result.reason + ")");
+         << (result.reason.empty() ? "" : " (" + result.reason + ")") << (result.note.empty() ? "" : "; " + result.note);
     for (const GoalResult& g : result.goals) {
       if (g.status != Status::kSucceeded) continue;
       line << "; goal " << g.index << " in "
