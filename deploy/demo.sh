@@ -4,8 +4,11 @@
 #      drill robot of deploy/demo/drill_robot.yaml mounted, discovery, modelgen, safety, ...
 #   2. the robot's simulated EtherCAT bus publishes the scan; discovery rebuilds the module
 #      tree; modelgen publishes robot model version 1; every service reconfigures to it
-#   3. the main job: a drilling approach planned for model version 1 (NSPG goal posture +
-#      whole-body path, 200 N checked) and executed on the simulated robot
+#   3. the main job: a drilling mission on the wall of deploy/demo/drill_site.yaml (two blue
+#      blobs): the drill camera locates the area, the planner plans the whole-body approach
+#      (NSPG goal posture + path, 200 N checked), the robot executes it, the drill service
+#      detects the blobs and drills each with Cartesian impedance and visual servoing; the
+#      report, checked against the simulator's holes
 #   4. hot swap: the drill is replaced by the sanding tool -> new scan -> tree -> model
 #      version 2 -> every service ready again, with the time of each stage
 # Usage: deploy/demo.sh [BUILD_DIR]    Domain: CONCERT_DOMAIN_ID (default 0).
@@ -50,7 +53,7 @@ check_end_state() {
 }
 
 stage "concert up: every service on this machine, domain $CONCERT_DOMAIN_ID, drill robot mounted"
-"$concert" up --assembly deploy/demo/drill_robot.yaml > "$log" 2>&1 &
+"$concert" up --assembly deploy/demo/drill_robot.yaml --world deploy/demo/drill_site.yaml > "$log" 2>&1 &
 up_pid=$!
 sleep 0.5
 sed 's/^/  /' "$log"
@@ -71,11 +74,14 @@ snapshots=$(mktemp -d /tmp/concert-demo-camera.XXXXXX)
   fail "no frame from the drill camera"
 "$concert" topic hz concert/sensors/imu --timeout 3 | sed 's/^/  /' || true
 
-stage "drilling approach: concert plan drill --at 2.0 0.0 1.2 --execute (area 2 m ahead, 1.2 m high)"
-"$concert" plan drill --at 2.0 0.0 1.2 --execute --timeout 60 | sed 's/^/  /'
+stage "drilling mission: concert drill run --mission deploy/demo/drill_mission.yaml (two blobs on the wall 2.2 m ahead)"
+"$concert" drill run --mission deploy/demo/drill_mission.yaml --timeout 300 | sed 's/^/  /' ||
+  fail "the drilling mission did not drill every marked hole (report above)"
+holes=$("$concert" topic echo concert/sim/holes --count 1 --timeout 5 --json) || fail "no hole in the simulator's wall"
+echo "  the simulator's wall: $(echo "$holes" | grep -o '"wall"' | wc -l) holes cut"
 
-stage "after the drilling approach: safety RUNNING, one model everywhere, nothing refused"
-check_end_state "after the drilling approach"
+stage "after the drilling mission: safety RUNNING, one model everywhere, nothing refused"
+check_end_state "after the drilling mission"
 
 stage "hot swap: concert sim swap deploy/demo/sanding_robot.yaml (drill -> sanding tool)"
 swap=$(date +%s%N)

@@ -287,6 +287,7 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
       {"robot", "concert_robot", robot_args, true},
       {"planner", "concert_planner", {}, false},
       {"nav", "concert_nav", nav_args, false},
+      {"drill", "concert_drill", {}, false},
   };
   std::vector<ServiceSpec> services;
   for (const auto& p : plan) {

@@ -49,6 +49,8 @@ struct DrillPoint {
   Eigen::Isometry3d frame{Eigen::Isometry3d::Identity()};
   std::string label;   ///< "blob 1", "aruco 7 hole 3"
   bool servo{false};   ///< visual servoing on the blob while drilling (blobs), else kinematics alone
+  int marker{-1};      ///< ArUco holes: the marker's id (-1 for a blob)
+  int pattern_index{-1};  ///< ArUco holes: the hole's index in the marker's pattern
 };
 
 /// The robot as the mission's tree sees it.

@@ -1,0 +1,27 @@
+# The service: the rig and area detection (core), the DDS adapter, main, `concert drill` verbs.
+concert_core_library(concert_drill_core STATIC src/core/drill_rig.cpp src/core/area_detection.cpp)
+target_include_directories(concert_drill_core PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+target_link_libraries(concert_drill_core
+  PUBLIC concert_drill_tree concert_drill_control concert_drill_perception concert_model concert_kinematics
+         concert_hardware Eigen3::Eigen
+  PRIVATE concert_mobile_base)
+
+if(TARGET concert_dds)
+  add_library(concert_drill_dds STATIC src/dds/drill_node.cpp)
+  concert_target_defaults(concert_drill_dds)
+  target_include_directories(concert_drill_dds PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_link_libraries(concert_drill_dds PUBLIC concert_drill_core concert_model_dds concert_sensors_dds concert_bim
+                        concert_dds)
+
+  add_executable(concert_drill src/main.cpp)
+  concert_target_defaults(concert_drill)
+  target_link_libraries(concert_drill PRIVATE concert_drill_dds concert_cli)
+  target_compile_definitions(concert_drill PRIVATE
+    CONCERT_DRILL_PATTERNS="${CMAKE_CURRENT_SOURCE_DIR}/config/patterns.yaml")
+
+  # `concert drill ...` verbs (wired into the `concert` tool by its CMakeLists).
+  add_library(concert_drill_cli STATIC src/cli/cli.cpp)
+  concert_target_defaults(concert_drill_cli)
+  target_include_directories(concert_drill_cli PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_link_libraries(concert_drill_cli PUBLIC concert_cli PRIVATE concert_dds nlohmann_json::nlohmann_json)
+endif()

@@ -1,0 +1,67 @@
+#pragma once
+// From camera frames to drilling areas and holes (paper sections 5.4.1 and 5.4.3): where a
+// picked point or pixel lies on the wall and its normal, the holes an area's marks ask for,
+// and the blob a servoed hole follows. Uses the perception functions (perception.hpp,
+// patterns.hpp) on a frame whose pose in the world is known. Plain C++, no DDS.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "concert/hardware/sensors.hpp"
+#include "drill/mission.hpp"
+#include "drill/ports.hpp"
+
+namespace concert::drill {
+
+class PatternTable;
+
+/// A camera frame (depth averaged over a few frames) and where the camera was.
+struct CameraView {
+  const hardware::RgbdFrame* frame{nullptr};
+  Eigen::Isometry3d world_T_optical{Eigen::Isometry3d::Identity()};
+};
+
+/// The paper's drilling-area radius for a camera with vertical field of view `fov` [rad] at
+/// `distance` [m] from the wall: rho = d tan(fov / 2) (0.6 m, 55 deg: 0.31 m).
+double area_radius(double distance, double fov);
+
+/// Whether a world point projects into the view's image (in front of the camera).
+bool in_view(const CameraView& view, const Eigen::Vector3d& point);
+
+/// The frame of a picked point no camera sees yet: origin at the point, z horizontal from the
+/// point towards `viewer` (the wall assumed vertical and facing the robot), x horizontal, y up.
+/// The approach is planned to it; the drill camera measures the surface once there.
+ResolvedArea provisional_area(const Eigen::Vector3d& point, const Eigen::Vector3d& viewer);
+
+/// Locates a point or pixel area in a view: the surface point and its normal (PCL, within
+/// 0.07 m), the frame z along the outward normal, x horizontal, y up (world frame). Throws
+/// DrillError naming the area and why (outside the image, no depth there).
+ResolvedArea locate_area(const AreaSpec& area, const CameraView& view);
+
+/// The holes an area's marks ask for in a view: blobs within `radius` of the area's centre,
+/// nearest first (servo on), or the pattern of the ArUco marker nearest the centre (servo
+/// off), each with its frame on the wall (world frame, z along the outward normal). Throws
+/// DrillError with the reason when nothing can be drilled (no blob visible, no marker, a
+/// marker id without a pattern).
+std::vector<DrillPoint> find_holes(const AreaSpec& area, const ResolvedArea& located,
+                                   const CameraView& view, const PatternTable& patterns,
+                                   double radius);
+
+/// A hole re-measured in a fresh view (the base moved since it was detected, and odometry
+/// drifts: 3.5 deg of yaw over the demo's approach): a blob hole at the blob nearest its
+/// predicted position (within `max_distance` [m]), the frame from the surface there; an ArUco
+/// hole from its marker when the marker is in view (the pattern applied again); else the
+/// surface under the predicted position (its normal and distance corrected, the position in
+/// the wall's plane kept). None when the view shows neither the mark nor the wall there.
+std::optional<Eigen::Isometry3d> reanchor(const CameraView& view, const DrillPoint& hole,
+                                          const PatternTable& patterns, double max_distance);
+
+/// The blob nearest to `hole` in a view (world frame, within `max_distance` [m]), as a hole
+/// frame with the observed position and normal; none if no blob is that close.
+std::optional<Eigen::Isometry3d> track_blob(const CameraView& view, const Eigen::Isometry3d& hole,
+                                            double max_distance);
+
+}  // namespace concert::drill

@@ -1,0 +1,985 @@
+#include "dds/drill_node.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "concert/bim/storey_map.hpp"
+#include "concert/bim/wall_goal.hpp"
+#include "concert/common/clock.hpp"
+#include "concert/model/dds/conversions.hpp"
+#include "concert/model/dds/pose.hpp"
+#include "concert/sensors_dds/conversions.hpp"
+
+namespace concert::drill::dds {
+
+namespace cdds = concert::dds;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr const char* kSource = "drill";
+// A service whose status was last seen longer ago than this is lost [s] (heartbeat 1 s).
+constexpr double kServiceLost = 5.0;
+// Joint states older than this mean the robot service is gone [s].
+constexpr double kJointsLost = 1.0;
+// Samples kept: every 5 ms for 2 s.
+constexpr std::int64_t kSampleStep = 5'000'000;
+constexpr std::size_t kSamples = 400;
+constexpr std::size_t kFrames = 12;
+// Wall areas: the base's clearance in front of the wall beyond the footprint's reach [m]
+// (nav's wall_clearance) and the defaults when no nav vehicle is known.
+constexpr double kWallStandoff = 1.05;
+constexpr double kRobotRadius = 0.55;
+// A hole's drilling posture leaves the bit this much further out than the standoff (the
+// Cartesian alignment does the rest) [m]; the way back first takes this long to reach the
+// posture's path [s].
+constexpr double kAlignMargin = 0.03;
+constexpr double kSettleBack = 1.0;
+// Re-measuring a hole from its drilling posture: frames averaged, and how far from the predicted
+// position the mark may be found [m] (odometry drift over the base's move).
+constexpr int kReanchorFrames = 3;
+constexpr double kReanchorDistance = 0.06;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+msg::DrillMissionState to_msg(MissionState s) {
+  switch (s) {
+    case MissionState::kIdle:
+      return msg::DRILL_IDLE;
+    case MissionState::kRunning:
+      return msg::DRILL_RUNNING;
+    case MissionState::kSucceeded:
+      return msg::DRILL_SUCCEEDED;
+    case MissionState::kFailed:
+      return msg::DRILL_FAILED;
+    case MissionState::kAborted:
+      return msg::DRILL_ABORTED;
+  }
+  return msg::DRILL_FAILED;
+}
+
+msg::DrillAreaState to_msg(AreaState s) {
+  switch (s) {
+    case AreaState::kPending:
+      return msg::AREA_PENDING;
+    case AreaState::kActive:
+      return msg::AREA_ACTIVE;
+    case AreaState::kDone:
+      return msg::AREA_DONE;
+    case AreaState::kFailed:
+      return msg::AREA_FAILED;
+    case AreaState::kSkipped:
+      return msg::AREA_SKIPPED;
+  }
+  return msg::AREA_FAILED;
+}
+
+msg::DrillHoleState to_msg(HoleState s) {
+  switch (s) {
+    case HoleState::kPending:
+      return msg::HOLE_PENDING;
+    case HoleState::kDrilled:
+      return msg::HOLE_DRILLED;
+    case HoleState::kFailed:
+      return msg::HOLE_FAILED;
+    case HoleState::kSkipped:
+      return msg::HOLE_SKIPPED;
+  }
+  return msg::HOLE_FAILED;
+}
+
+Eigen::Vector3d odometry_of(const msg::Odometry& o) { return {o.x(), o.y(), o.yaw()}; }
+
+}  // namespace
+
+msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
+                        const MissionReport& report) {
+  msg::DrillStatus out;
+  out.mission_id(mission_id);
+  out.stamp_ns(now_ns());
+  out.mission(report.mission);
+  out.state(to_msg(status.state));
+  out.active(status.active);
+  out.area(static_cast<std::uint32_t>(status.area));
+  out.hole(static_cast<std::uint32_t>(status.hole));
+  out.reason(!report.reason.empty() ? report.reason : status.reason);
+  for (const AreaReport& a : report.areas) {
+    msg::DrillArea area;
+    area.name(a.name);
+    area.state(to_msg(a.state));
+    area.reason(a.reason);
+    area.frame(model::dds::to_pose_msg(a.located.frame));
+    for (const HoleReport& h : a.holes) {
+      msg::DrillHole hole;
+      hole.label(h.point.label);
+      hole.frame(model::dds::to_pose_msg(h.point.frame));
+      hole.state(to_msg(h.state));
+      hole.reason(h.reason);
+      area.holes().push_back(hole);
+    }
+    out.areas().push_back(area);
+  }
+  out.time_navigate(report.times.navigate);
+  out.time_plan(report.times.plan);
+  out.time_execute(report.times.execute);
+  out.time_drill(report.times.drill);
+  out.time_total(report.times.total);
+  out.holes_drilled(static_cast<std::uint32_t>(report.holes_drilled()));
+  out.holes_marked(static_cast<std::uint32_t>(report.holes_marked()));
+  return out;
+}
+
+DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ostream& log)
+    : params_(std::move(params)),
+      log_(log),
+      drill_motion_(params_.motion),
+      status_(participant, "drill"),
+      status_out_(participant, cdds::topics::drill_status),
+      nav_goals_(participant, cdds::topics::nav_goal),
+      nav_cancels_(participant, cdds::topics::nav_cancel),
+      plan_requests_(participant, cdds::topics::plan_request),
+      trajectories_(participant, cdds::topics::trajectory_command),
+      cartesian_(participant, cdds::topics::cartesian_command),
+      joint_commands_(participant, cdds::topics::joint_command),
+      models_(participant, cdds::topics::robot_model,
+              [this](const msg::RobotModel& m, const auto&) {
+                std::lock_guard lock(mutex_);
+                inbox_.model = m;
+              }),
+      joints_in_(participant, cdds::topics::joint_state,
+                 [this](const msg::JointState& s, const auto&) {
+                   std::lock_guard lock(mutex_);
+                   joints_seen_ = Clock::now();
+                   if (!samples_.empty() && s.stamp_ns() - samples_.back().stamp_ns < kSampleStep)
+                     return;
+                   Sample sample;
+                   sample.stamp_ns = s.stamp_ns();
+                   sample.joints = {s.name(), s.position()};
+                   if (odometry_) sample.odometry = odometry_of(*odometry_);
+                   samples_.push_back(std::move(sample));
+                   while (samples_.size() > kSamples) samples_.pop_front();
+                 }),
+      odometry_in_(participant, cdds::topics::odometry,
+                   [this](const msg::Odometry& o, const auto&) {
+                     std::lock_guard lock(mutex_);
+                     odometry_ = o;
+                   }),
+      safety_in_(participant, cdds::topics::safety_state,
+                 [this](const msg::SafetyState& s, const auto&) {
+                   std::lock_guard lock(mutex_);
+                   safety_ = s;
+                 }),
+      services_in_(participant, cdds::topics::status,
+                   [this](const msg::ServiceStatus& s, const auto&) {
+                     std::lock_guard lock(mutex_);
+                     if (s.state() != msg::SERVICE_STOPPED)
+                       services_seen_[s.service()] = Clock::now();
+                     else
+                       services_seen_.erase(s.service());
+                   }),
+      plans_in_(participant, cdds::topics::plan_result,
+                [this](const msg::PlanResult& r, const auto&) {
+                  std::lock_guard lock(mutex_);
+                  plan_results_[r.request_id()] = r;
+                }),
+      trajectories_in_(participant, cdds::topics::trajectory_status,
+                       [this](const msg::TrajectoryStatus& s, const auto&) {
+                         std::lock_guard lock(mutex_);
+                         trajectory_statuses_[s.request_id()] = s;
+                       }),
+      nav_in_(participant, cdds::topics::nav_status,
+              [this](const msg::NavStatus& s, const auto&) {
+                std::lock_guard lock(mutex_);
+                nav_statuses_[s.request_id()] = s;
+              }),
+      rgb_in_(participant, cdds::topics::camera_rgb,
+              [this](const msg::Image& i, const auto&) { on_image(i, false); }),
+      depth_in_(participant, cdds::topics::camera_depth,
+                [this](const msg::Image& i, const auto&) { on_image(i, true); }),
+      info_in_(participant, cdds::topics::camera_info,
+               [this](const msg::CameraInfo& i, const auto&) { on_info(i); }),
+      missions_in_(participant, cdds::topics::drill_mission,
+                   [this](const msg::DrillMission& m, const auto&) {
+                     std::lock_guard lock(mutex_);
+                     inbox_.missions.push_back(m);
+                   }),
+      aborts_in_(participant, cdds::topics::drill_abort,
+                 [this](const msg::DrillAbort& a, const auto&) {
+                   std::lock_guard lock(mutex_);
+                   inbox_.aborts.push_back(a);
+                 }) {
+  if (!params_.patterns.empty()) {
+    try {
+      patterns_ = load_patterns(params_.patterns);
+    } catch (const DrillError& e) {
+      log_line(std::string("drill: ") + e.what() +
+               " (ArUco areas will fail until a mission names a table)");
+    }
+  }
+  status_.report(msg::SERVICE_STARTING, 0, "waiting for a robot model");
+}
+
+DrillNode::~DrillNode() = default;
+
+void DrillNode::log_line(const std::string& line) {
+  std::lock_guard lock(log_mutex_);
+  log_ << line << std::endl;
+}
+
+// Camera messages: the drill camera's rgb, depth and info with the same stamp make one frame,
+// posed with the joint state at that stamp (the latest before it).
+void DrillNode::on_image(const msg::Image& image, bool depth) {
+  std::lock_guard lock(mutex_);
+  if (camera_.empty() || image.sensor() != camera_) return;
+  (depth ? depth_ : rgb_) = image;
+  assemble_frame();
+}
+
+void DrillNode::on_info(const msg::CameraInfo& info) {
+  std::lock_guard lock(mutex_);
+  if (camera_.empty() || info.sensor() != camera_) return;
+  info_ = info;
+  assemble_frame();
+}
+
+void DrillNode::assemble_frame() {
+  if (!rgb_ || !depth_ || !info_ || rgb_->stamp_ns() != depth_->stamp_ns() ||
+      info_->stamp_ns() != rgb_->stamp_ns())
+    return;
+  const std::int64_t stamp = rgb_->stamp_ns();
+  CameraFrame f;
+  try {
+    f.frame = sensors_dds::to_rgbd_frame(*rgb_, *depth_, *info_);
+  } catch (const std::exception& e) {
+    log_line(std::string("drill: camera frame dropped: ") + e.what());
+    rgb_.reset();
+    return;
+  }
+  rgb_.reset();
+  depth_.reset();
+  if (!rig_) return;
+  const Sample* s = nullptr;
+  for (auto it = samples_.rbegin(); it != samples_.rend(); ++it) {
+    if (it->stamp_ns <= stamp) {
+      s = &*it;
+      break;
+    }
+  }
+  if (s == nullptr) return;
+  f.stamp_ns = stamp;
+  f.base_T_optical = rig_->camera_in_base(rig_->q(s->joints));
+  f.world_T_optical = rig_->base_in_world(s->odometry) * f.base_T_optical;
+  frames_.push_back(std::move(f));
+  while (frames_.size() > kFrames) frames_.pop_front();
+}
+
+std::optional<DrillNode::Sample> DrillNode::latest_sample() const {
+  std::lock_guard lock(mutex_);
+  if (samples_.empty()) return std::nullopt;
+  Sample s = samples_.back();
+  if (odometry_) s.odometry = odometry_of(*odometry_);
+  return s;
+}
+
+std::vector<DrillNode::CameraFrame> DrillNode::frames_since(std::int64_t since_ns) const {
+  std::lock_guard lock(mutex_);
+  std::vector<CameraFrame> out;
+  for (const CameraFrame& f : frames_) {
+    if (f.stamp_ns > since_ns) out.push_back(f);
+  }
+  return out;
+}
+
+std::optional<DrillNode::CameraFrame> DrillNode::averaged_view(std::int64_t since_ns,
+                                                               int count) const {
+  std::vector<CameraFrame> frames;
+  {
+    // Copies only the frames averaged (each is 1.5 MB at 640 x 480), once enough have come.
+    std::lock_guard lock(mutex_);
+    const auto newer = std::count_if(frames_.begin(), frames_.end(),
+                                     [&](const CameraFrame& f) { return f.stamp_ns > since_ns; });
+    if (newer < count) return std::nullopt;
+    frames.assign(frames_.end() - count, frames_.end());
+  }
+  DepthAverager averager(static_cast<std::size_t>(count));
+  for (const CameraFrame& f : frames) averager.add(f.frame);
+  CameraFrame out = frames.back();
+  out.frame = averager.average();
+  return out;
+}
+
+// --- The control loop ------------------------------------------------------------------------
+
+// A mission was accepted and has not ended (idle until its first tick).
+bool DrillNode::mission_active() const {
+  return tree_ && (tree_->status().state == MissionState::kIdle ||
+                   tree_->status().state == MissionState::kRunning);
+}
+
+void DrillNode::spin(const std::atomic<bool>& stop) {
+  const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / params_.rate));
+  auto next = Clock::now();
+  const auto t0 = Clock::now();
+  while (!stop) {
+    now_ = std::chrono::duration<double>(Clock::now() - t0).count();
+    tick();
+    next += period;
+    std::this_thread::sleep_until(next);
+    if (Clock::now() > next + 10 * period) next = Clock::now();  // fell behind: do not burst
+  }
+  if (mission_active()) {
+    tree_->abort("the drill service is stopping");
+    publish_status(true);
+  }
+}
+
+void DrillNode::tick() {
+  Inbox in;
+  {
+    std::lock_guard lock(mutex_);
+    std::swap(in, inbox_);
+  }
+  if (in.model) apply_model(*in.model);
+  for (const msg::DrillAbort& a : in.aborts) {
+    if (!mission_active()) continue;
+    if (a.mission_id() != 0 && a.mission_id() != mission_id_) continue;
+    tree_->abort("aborted by " + (a.source().empty() ? std::string("an operator") : a.source()) +
+                 (a.reason().empty() ? "" : ": " + a.reason()));
+    log_line("drill: mission " + std::to_string(mission_id_) + " aborted");
+  }
+  for (const msg::DrillMission& m : in.missions) start_mission(m);
+  if (mission_active()) {
+    control_motion();
+    const MissionState state = tree_->tick(now_);
+    if (state != MissionState::kRunning) {
+      last_reports_[tree_->report().mission] = tree_->report();
+      const MissionReport& r = tree_->report();
+      log_line("drill: mission '" + r.mission + "' " + to_string(state) + ": " +
+               std::to_string(r.holes_drilled()) + " of " + std::to_string(r.holes_marked()) +
+               " holes drilled" + (r.reason.empty() ? "" : " (" + r.reason + ")"));
+    }
+  }
+  publish_status(false);
+}
+
+void DrillNode::apply_model(const msg::RobotModel& m) {
+  if (m.version() <= model_version_) return;
+  const std::uint64_t old = model_version_;
+  model_version_ = m.version();
+  std::shared_ptr<const DrillRig> rig;
+  std::string error;
+  try {
+    rig = std::make_shared<const DrillRig>(model::RobotModel::build(model::dds::to_description(m)));
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  {
+    std::lock_guard lock(mutex_);
+    rig_ = rig;
+    camera_ = rig ? rig->camera() : "";
+    frames_.clear();
+  }
+  rig_error_ = error;
+  if (mission_active()) {
+    tree_->abort("the robot model changed (version " + std::to_string(old) + " -> " +
+                 std::to_string(m.version()) + ")");
+  }
+  if (rig) {
+    status_.report(msg::SERVICE_READY, cdds::ModelId{m.version(), m.content_hash()},
+                   "drill " + rig->tool() + ", camera " + rig->camera());
+    log_line("drill: model version " + std::to_string(m.version()) + ": drill " + rig->tool() +
+             " at " + rig->tcp_frame() + ", camera " + rig->camera());
+  } else {
+    status_.report(msg::SERVICE_READY, cdds::ModelId{m.version(), m.content_hash()},
+                   "cannot drill: " + error);
+    log_line("drill: model version " + std::to_string(m.version()) + ": cannot drill: " + error);
+  }
+}
+
+void DrillNode::start_mission(const msg::DrillMission& m) {
+  const auto refuse = [&](const std::string& why) {
+    status_.refused("mission " + std::to_string(m.mission_id()) + ": " + why);
+    MissionReport report;
+    report.mission = m.name();
+    report.state = MissionState::kFailed;
+    report.reason = why;
+    MissionStatus st;
+    st.state = MissionState::kFailed;
+    st.reason = why;
+    status_out_.write(to_msg(m.mission_id(), st, report));
+    log_line("drill: mission " + std::to_string(m.mission_id()) + " refused: " + why);
+  };
+  if (mission_active()) {
+    return refuse("mission " + std::to_string(mission_id_) + " ('" + tree_->report().mission +
+                  "') is running; abort it first");
+  }
+  if (!rig_)
+    return refuse(rig_error_.empty() ? "no robot model yet" : "cannot drill: " + rig_error_);
+  Mission mission;
+  try {
+    mission = parse_mission(
+        m.yaml(), m.name().empty() ? "mission " + std::to_string(m.mission_id()) : m.name(),
+        m.base_dir());
+    if (!mission.patterns.empty()) patterns_ = load_patterns(mission.patterns);
+  } catch (const DrillError& e) {
+    return refuse(e.what());
+  }
+  mission_ = std::make_unique<Mission>(std::move(mission));
+  mission_id_ = m.mission_id();
+  resolving_.clear();
+  resolve_errors_.clear();
+  resolved_.clear();
+  plans_.clear();
+  motion_ = Motion::kNone;
+  tree_ = std::make_unique<MissionTree>(*mission_, *this);
+  if (m.resume()) {
+    const auto previous = last_reports_.find(mission_->name);
+    if (previous != last_reports_.end()) tree_->resume(previous->second);
+  }
+  log_line("drill: mission " + std::to_string(mission_id_) + " '" + mission_->name + "': " +
+           std::to_string(mission_->areas.size()) + " areas" + (m.resume() ? " (resuming)" : ""));
+  last_active_ = "-";  // the status after the first tick goes out at once
+}
+
+void DrillNode::publish_status(bool force) {
+  if (!tree_) return;
+  const MissionStatus st = tree_->status();
+  if (!force && st.active == last_active_ && seconds_since(last_status_) < 0.5) return;
+  last_active_ = st.active;
+  last_status_ = Clock::now();
+  status_out_.write(to_msg(mission_id_, st, tree_->report()));
+}
+
+// --- Ports: health, areas, navigation, planning, execution -----------------------------------
+
+Outcome DrillNode::health() {
+  std::lock_guard lock(mutex_);
+  if (!rig_)
+    return Outcome::failed("the robot model cannot drill" +
+                           (rig_error_.empty() ? "" : ": " + rig_error_));
+  if (!safety_) return Outcome::failed("no safety state from the safety service");
+  if (safety_->mode() != msg::SAFETY_RUNNING) {
+    std::string causes;
+    for (const auto& c : safety_->causes()) causes += (causes.empty() ? "" : ", ") + c;
+    return Outcome::failed("safety stop" + (causes.empty() ? "" : " (" + causes + ")"));
+  }
+  if (joints_seen_ == Clock::time_point{} || seconds_since(joints_seen_) > kJointsLost) {
+    return Outcome::failed("no joint state from the robot service (lost)");
+  }
+  for (const char* service : {"planner"}) {
+    const auto seen = services_seen_.find(service);
+    if (seen == services_seen_.end() || seconds_since(seen->second) > kServiceLost) {
+      return Outcome::failed(std::string("the ") + service + " service is lost");
+    }
+  }
+  if (nav_request_ != 0) {
+    const auto seen = services_seen_.find("nav");
+    if (seen == services_seen_.end() || seconds_since(seen->second) > kServiceLost) {
+      return Outcome::failed("the nav service is lost");
+    }
+  }
+  return Outcome::succeeded();
+}
+
+void DrillNode::resolve(std::size_t area, const AreaSpec& spec) {
+  resolve_errors_.erase(area);
+  resolved_.erase(area);
+  resolve_specs_[area] = spec;
+  {
+    std::lock_guard lock(mutex_);
+    resolve_since_[area] = frames_.empty() ? 0 : frames_.back().stamp_ns;
+  }
+  if (spec.wall.empty()) return;  // located from the camera in resolution()
+  // A BIM wall: the area frame and the base pose from the building's model (load_ifc runs the
+  // IFC import step, a second or two, off the control thread).
+  const Mission mission = *mission_;
+  resolving_[area] = std::async(std::launch::async, [mission, spec] {
+    const bim::BimModel model = bim::load_ifc(mission.ifc.string());
+    const bim::Element& wall = model.element(spec.wall);
+    const bim::Storey& storey = model.storey(mission.storey.empty() ? wall.storey : mission.storey);
+    const bim::OccupancyGrid grid = bim::storey_map(model, storey);
+    const bim::WallGoal goal = bim::wall_goal(model, grid, spec.wall, spec.at.x(), spec.at.y(),
+                                              kWallStandoff, kRobotRadius);
+    ResolvedArea out;
+    out.frame = goal.area_frame;
+    out.base = BasePose{goal.base_pose.x(), goal.base_pose.y(), goal.base_pose.z()};
+    return out;
+  });
+}
+
+Outcome DrillNode::resolution(std::size_t area, ResolvedArea& out) {
+  const AreaSpec& spec = resolve_specs_.at(area);
+  if (!spec.wall.empty()) {
+    auto it = resolving_.find(area);
+    if (it == resolving_.end())
+      return Outcome::failed("area '" + spec.name + "' was not being located");
+    if (it->second.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+      return Outcome::running();
+    try {
+      out = it->second.get();
+    } catch (const std::exception& e) {
+      resolving_.erase(it);
+      return Outcome::failed("area '" + spec.name + "': wall " + spec.wall + ": " + e.what());
+    }
+    resolving_.erase(it);
+    return Outcome::succeeded();
+  }
+  const std::optional<CameraFrame> view =
+      averaged_view(resolve_since_[area], params_.averaged_frames);
+  if (!view) return Outcome::running();
+  const CameraView camera{&view->frame, view->world_T_optical};
+  if (spec.point && !in_view(camera, *spec.point)) {
+    // Where the arm is parked the drill camera may not see the point: plan the approach to a
+    // frame facing the robot, and measure the surface with the drill camera once there.
+    const std::optional<Sample> s = latest_sample();
+    out = provisional_area(
+        *spec.point, rig_->base_in_world(s ? s->odometry : Eigen::Vector3d::Zero()).translation());
+    log_line("drill: area '" + spec.name +
+             "': the drill camera does not see the point from here; approach planned "
+             "facing the robot, the surface measured there");
+    return Outcome::succeeded();
+  }
+  try {
+    out = locate_area(spec, camera);
+  } catch (const DrillError& e) {
+    return Outcome::failed(e.what());
+  }
+  return Outcome::succeeded();
+}
+
+void DrillNode::navigate(const BasePose& goal) {
+  msg::NavGoal g;
+  nav_request_ = next_request_++;
+  g.request_id(nav_request_);
+  g.model_version(static_cast<std::uint32_t>(model_version_));
+  g.stamp_ns(now_ns());
+  g.source(kSource);
+  g.kind(msg::NAV_GOAL_POSE);
+  msg::Pose2D p;
+  p.x(goal.x);
+  p.y(goal.y);
+  p.yaw(goal.theta);
+  g.pose(p);
+  nav_goals_.write(g);
+}
+
+Outcome DrillNode::navigation() {
+  std::lock_guard lock(mutex_);
+  const auto it = nav_statuses_.find(nav_request_);
+  if (it == nav_statuses_.end()) return Outcome::running();
+  switch (it->second.state()) {
+    case msg::NAV_REACHED:
+      nav_request_ = 0;
+      return Outcome::succeeded();
+    case msg::NAV_FAILED:
+    case msg::NAV_CANCELLED:
+    case msg::NAV_REFUSED:
+      nav_request_ = 0;
+      return Outcome::failed("navigation: " + it->second.reason());
+    default:
+      return Outcome::running();
+  }
+}
+
+void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& frame,
+                     std::optional<std::size_t> after) {
+  Plan p;
+  p.request_id = next_request_++;
+  p.after = after;
+  msg::PlanRequest r;
+  r.request_id(p.request_id);
+  r.model_version(static_cast<std::uint32_t>(model_version_));
+  r.stamp_ns(now_ns());
+  r.source(kSource);
+  r.end_effector(rig_ ? rig_->tool() : "");
+  r.goals().push_back(model::dds::to_pose_msg(frame));
+  r.execute(false);
+  if (after) {
+    const auto prev = plans_.find(*after);
+    if (prev != plans_.end() && prev->second.end.size() > 0) {
+      r.start_names(prev->second.names);
+      r.start_position(std::vector<double>(prev->second.end.data(),
+                                           prev->second.end.data() + prev->second.end.size()));
+    }
+  }
+  plans_[area] = p;
+  plan_requests_.write(r);
+}
+
+Outcome DrillNode::planning(std::size_t area) {
+  auto it = plans_.find(area);
+  if (it == plans_.end()) return Outcome::failed("no plan was asked for this area");
+  Plan& p = it->second;
+  if (p.result) return Outcome::succeeded();
+  std::optional<msg::PlanResult> r;
+  {
+    std::lock_guard lock(mutex_);
+    const auto found = plan_results_.find(p.request_id);
+    if (found != plan_results_.end()) r = found->second;
+  }
+  if (!r) return Outcome::running();
+  if (r->state() == msg::PLAN_FAILED) return Outcome::failed("planner: " + r->reason());
+  if ((r->state() == msg::PLAN_PLANNED || r->state() == msg::PLAN_SUCCEEDED) &&
+      !r->trajectory().empty()) {
+    p.result = r;
+    p.names = r->joint_names();
+    const auto& last = r->trajectory().back().position();
+    p.end = Eigen::Map<const Eigen::VectorXd>(last.data(), static_cast<Eigen::Index>(last.size()));
+    return Outcome::succeeded();
+  }
+  return Outcome::running();
+}
+
+std::uint32_t DrillNode::send_trajectory(const std::vector<std::string>& names,
+                                         const std::vector<msg::TrajectorySample>& samples) {
+  msg::JointTrajectoryCommand c;
+  const std::uint32_t id = next_request_++;
+  c.request_id(id);
+  c.model_version(static_cast<std::uint32_t>(model_version_));
+  c.stamp_ns(now_ns());
+  c.source(kSource);
+  c.joint_names(names);
+  for (const msg::TrajectorySample& s : samples) {
+    msg::JointTrajectorySample out;
+    out.time(s.time());
+    out.position(s.position());
+    out.velocity(s.velocity());
+    c.samples().push_back(out);
+  }
+  trajectories_.write(c);
+  return id;
+}
+
+void DrillNode::execute(std::size_t area) {
+  const Plan& p = plans_.at(area);
+  trajectory_request_ = send_trajectory(p.names, p.result->trajectory());
+}
+
+Outcome DrillNode::execution() {
+  std::lock_guard lock(mutex_);
+  const auto it = trajectory_statuses_.find(trajectory_request_);
+  if (it == trajectory_statuses_.end()) return Outcome::running();
+  switch (it->second.state()) {
+    case msg::TRAJECTORY_SUCCEEDED:
+      return Outcome::succeeded();
+    case msg::TRAJECTORY_ABORTED:
+    case msg::TRAJECTORY_REFUSED:
+      return Outcome::failed(
+          "robot: approach trajectory " +
+          std::string(it->second.state() == msg::TRAJECTORY_REFUSED ? "refused" : "aborted") +
+          ": " + it->second.reason());
+    default:
+      return Outcome::running();
+  }
+}
+
+// --- Ports: detection and the drilling motion ------------------------------------------------
+
+void DrillNode::detect(std::size_t area, const AreaSpec& spec, const ResolvedArea& located) {
+  detection_ = Detection{};
+  detection_.area = area;
+  detection_.spec = spec;
+  detection_.located = located;
+  std::lock_guard lock(mutex_);
+  detection_.since_ns =
+      frames_.empty() ? 0 : frames_.back().stamp_ns;  // frames taken after the arm stopped
+}
+
+Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
+  const std::optional<CameraFrame> view =
+      averaged_view(detection_.since_ns, params_.averaged_frames);
+  if (!view) return Outcome::running();
+  if (!patterns_ && detection_.spec.marks == MarkKind::kAruco) {
+    return Outcome::failed(
+        "area '" + detection_.spec.name +
+        "': no hole-pattern table (give the service --patterns or the mission patterns:)");
+  }
+  try {
+    static const PatternTable kNone;
+    const CameraView camera{&view->frame, view->world_T_optical};
+    // The area's surface as the drill camera sees it now, 0.6 m in front of it (a BIM wall or
+    // a point located from afar may be a few centimetres off).
+    ResolvedArea located = detection_.located;
+    if (!detection_.spec.pixel && in_view(camera, located.frame.translation())) {
+      AreaSpec here = detection_.spec;
+      here.point = located.frame.translation();
+      located = locate_area(here, camera);
+    }
+    points = find_holes(detection_.spec, located, camera, patterns_ ? *patterns_ : kNone,
+                        area_radius(params_.camera_distance, params_.camera_fov));
+  } catch (const DrillError& e) {
+    return Outcome::failed(e.what());
+  }
+  return Outcome::succeeded();
+}
+
+// Aligning a hole: the approach put the drill camera at the working distance (0.6 m), the bit
+// about 0.4 m further from the wall than it drills. Stretching the arm that far in Cartesian
+// impedance is not checked against anything (with the demo arm it held the shoulder J2_E at
+// its continuous torque and the safety layer stopped the robot), so the planner plans each
+// hole's drilling posture: the camera close to the wall on the hole's normal (NSPG with the
+// drilling force checked against the torque limits, the whole body moving) and the path
+// there; the Cartesian alignment does the last centimetres, the way back is that path reversed.
+void DrillNode::align(const DrillPoint& point) {
+  const std::optional<Sample> s = latest_sample();
+  motion_outcome_.reset();
+  if (!s || !rig_) {
+    motion_outcome_ = Outcome::failed("no joint state to align from");
+    return;
+  }
+  point_ = point;
+  const Eigen::VectorXd q = rig_->q(s->joints);
+  const Eigen::Isometry3d camera = rig_->camera_in_base(q);
+  const double camera_to_tip =
+      (rig_->tip_in_base(q).translation() - camera.translation()).dot(camera.linear().col(2));
+  msg::PlanRequest r;
+  hole_plan_request_ = next_request_++;
+  r.request_id(hole_plan_request_);
+  r.model_version(static_cast<std::uint32_t>(model_version_));
+  r.stamp_ns(now_ns());
+  r.source(kSource);
+  r.end_effector(rig_->tool());
+  r.goals().push_back(model::dds::to_pose_msg(point.frame));
+  r.execute(true);
+  r.camera_distance(camera_to_tip + params_.motion.standoff + kAlignMargin);
+  // The arm alone first: the base stays where the area's approach put it, so odometry does not
+  // drift between holes (3.5 deg over one whole-body move on the demo); if the arm cannot
+  // reach the hole from there, the whole body.
+  r.fixed_base(!hole_whole_body_);
+  plan_requests_.write(r);
+  hole_request_ = r;
+  hole_names_.clear();
+  hole_samples_.clear();
+  motion_ = Motion::kApproachHole;
+}
+
+void DrillNode::start_align(const Sample& s) {
+  base_T_world_ = rig_->base_in_world(s.odometry).inverse();
+  drill_motion_.start_align(base_T_world_ * point_.frame, rig_->tip_in_base(rig_->q(s.joints)),
+                            now_);
+  motion_ = Motion::kAlign;
+  std::lock_guard lock(mutex_);
+  servo_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
+}
+
+Outcome DrillNode::alignment() { return motion_outcome_ ? *motion_outcome_ : Outcome::running(); }
+
+void DrillNode::drill(const DrillPoint& point, double depth) {
+  const std::optional<Sample> s = latest_sample();
+  motion_outcome_.reset();
+  if (!s || !rig_) {
+    motion_outcome_ = Outcome::failed("no joint state to drill from");
+    return;
+  }
+  point_ = point;
+  drill_motion_.start_drill(depth, point.servo, rig_->tip_in_base(rig_->q(s->joints)), now_);
+  motion_ = Motion::kDrill;
+}
+
+Outcome DrillNode::drilling() { return motion_outcome_ ? *motion_outcome_ : Outcome::running(); }
+
+void DrillNode::retract() {
+  const std::optional<Sample> s = latest_sample();
+  motion_outcome_.reset();
+  if (!s || !rig_) {
+    motion_outcome_ = Outcome::failed("no joint state to retract from");
+    return;
+  }
+  drill_motion_.start_retract(rig_->tip_in_base(rig_->q(s->joints)), now_);
+  motion_ = Motion::kRetractOut;
+}
+
+Outcome DrillNode::retraction() { return motion_outcome_ ? *motion_outcome_ : Outcome::running(); }
+
+void DrillNode::stop() {
+  msg::NavCancel c;
+  c.request_id(0);
+  c.stamp_ns(now_ns());
+  c.source(kSource);
+  if (nav_request_ != 0) nav_cancels_.write(c);
+  nav_request_ = 0;
+  motion_ = Motion::kNone;
+  send_hold();
+}
+
+// The arm holds where it is (position mode at the measured positions); the base stops.
+void DrillNode::send_hold() {
+  const std::optional<Sample> s = latest_sample();
+  if (!s || !rig_) return;
+  msg::JointCommand c;
+  c.model_version(static_cast<std::uint32_t>(model_version_));
+  c.stamp_ns(now_ns());
+  c.source(kSource);
+  c.mode(msg::JOINT_POSITION);
+  const model::ChainInfo* arm = nullptr;
+  try {
+    arm = &rig_->model().arm();
+  } catch (const model::ModelError&) {
+    return;
+  }
+  for (const std::string& joint : arm->joints) {
+    const auto it = std::find(s->joints.names.begin(), s->joints.names.end(), joint);
+    if (it == s->joints.names.end()) continue;
+    c.name().push_back(joint);
+    c.position().push_back(
+        s->joints.positions[static_cast<std::size_t>(it - s->joints.names.begin())]);
+  }
+  joint_commands_.write(c);
+}
+
+void DrillNode::send_cartesian(const CartesianReference& r) {
+  msg::CartesianImpedanceCommand c;
+  c.model_version(static_cast<std::uint32_t>(model_version_));
+  c.stamp_ns(now_ns());
+  c.source(kSource);
+  c.end_effector(rig_->tcp_frame());
+  c.target(model::dds::to_pose_msg(r.pose));
+  msg::Twist t;
+  msg::Vector3 lin, ang;
+  lin.x(r.twist[0]);
+  lin.y(r.twist[1]);
+  lin.z(r.twist[2]);
+  ang.x(r.twist[3]);
+  ang.y(r.twist[4]);
+  ang.z(r.twist[5]);
+  t.linear(lin);
+  t.angular(ang);
+  c.target_twist(t);
+  for (int i = 0; i < 6; ++i) {
+    c.stiffness()[static_cast<std::size_t>(i)] = r.stiffness[i];
+    c.damping()[static_cast<std::size_t>(i)] = r.damping[i];
+  }
+  c.admittance_axis(255);
+  cartesian_.write(c);
+}
+
+// Every control period while a hole is worked on: the servo's new estimate of the blob from
+// each new camera frame, the motion's reference to the robot, and the phase's outcome.
+void DrillNode::control_motion() {
+  if (motion_ == Motion::kNone || motion_outcome_) return;
+  if (motion_ == Motion::kApproachHole) {
+    std::optional<msg::PlanResult> r;
+    {
+      std::lock_guard lock(mutex_);
+      const auto it = plan_results_.find(hole_plan_request_);
+      if (it != plan_results_.end()) r = it->second;
+    }
+    if (!r) return;
+    if (!r->trajectory().empty()) {
+      hole_names_ = r->joint_names();
+      hole_samples_ = r->trajectory();
+    }
+    if (r->state() == msg::PLAN_FAILED && hole_request_.fixed_base() &&
+        (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH)) {
+      log_line("drill: " + point_.label + ": the arm alone cannot reach it (" + r->reason() +
+               "); the whole body moves");
+      hole_plan_request_ = next_request_++;
+      hole_request_.request_id(hole_plan_request_);
+      hole_request_.fixed_base(false);
+      plan_requests_.write(hole_request_);
+    } else if (r->state() == msg::PLAN_FAILED) {
+      motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());
+      motion_ = Motion::kNone;
+    } else if (r->state() == msg::PLAN_SUCCEEDED) {
+      // The base moved: measure the hole again in frames taken from here.
+      std::lock_guard lock(mutex_);
+      reanchor_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
+      motion_ = Motion::kReanchor;
+    }
+    return;
+  }
+  if (motion_ == Motion::kReanchor) {
+    const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, kReanchorFrames);
+    if (!view) return;
+    static const PatternTable kNone;
+    const std::optional<Eigen::Isometry3d> seen =
+        reanchor(CameraView{&view->frame, view->world_T_optical}, point_,
+                 patterns_ ? *patterns_ : kNone, kReanchorDistance);
+    if (seen) {
+      std::ostringstream line;
+      line.setf(std::ios::fixed);
+      line.precision(1);
+      line << "drill: " << point_.label << " measured again from its drilling posture: "
+           << (seen->translation() - point_.frame.translation()).norm() * 1e3 << " mm, "
+           << std::acos(
+                  std::clamp(seen->linear().col(2).dot(point_.frame.linear().col(2)), -1.0, 1.0)) *
+                  180.0 / M_PI
+           << " deg from the prediction";
+      log_line(line.str());
+      point_.frame = *seen;
+    }
+    if (const std::optional<Sample> s = latest_sample()) start_align(*s);
+    return;
+  }
+  if (motion_ == Motion::kRetractBack) {
+    std::lock_guard lock(mutex_);
+    const auto it = trajectory_statuses_.find(retract_request_);
+    if (it == trajectory_statuses_.end()) return;
+    if (it->second.state() == msg::TRAJECTORY_SUCCEEDED) {
+      motion_outcome_ = Outcome::succeeded();
+      motion_ = Motion::kNone;
+    } else if (it->second.state() != msg::TRAJECTORY_EXECUTING) {
+      motion_outcome_ =
+          Outcome::failed("robot: return to the approach posture: " + it->second.reason());
+      motion_ = Motion::kNone;
+    }
+    return;
+  }
+  const std::optional<Sample> s = latest_sample();
+  if (!s) return;
+  if (point_.servo && (motion_ == Motion::kAlign || motion_ == Motion::kDrill)) {
+    for (const CameraFrame& f : frames_since(servo_since_ns_)) {
+      servo_since_ns_ = f.stamp_ns;
+      const Eigen::Isometry3d world_hole = base_T_world_.inverse() * drill_motion_.hole();
+      const std::optional<Eigen::Isometry3d> seen = track_blob(
+          CameraView{&f.frame, f.world_T_optical}, world_hole, params_.motion.servo_jump);
+      if (seen) drill_motion_.observe(base_T_world_ * *seen);
+    }
+  }
+  const CartesianReference r = drill_motion_.update(rig_->tip_in_base(rig_->q(s->joints)), now_);
+  send_cartesian(r);
+  if (drill_motion_.phase() == DrillMotion::Phase::kFailed) {
+    motion_outcome_ = Outcome::failed(drill_motion_.reason());
+    motion_ = Motion::kNone;
+  } else if (drill_motion_.phase() == DrillMotion::Phase::kDone) {
+    if (motion_ == Motion::kRetractOut && !hole_samples_.empty()) {
+      // Back along the hole's planned path, reversed, to the area's approach posture: first
+      // to where the path ended (the Cartesian phase left the arm within centimetres of it).
+      std::vector<msg::TrajectorySample> back;
+      msg::TrajectorySample here;
+      here.time(0.0);
+      for (const std::string& n : hole_names_) {
+        double v = 0.0;
+        if (n == "base_x" || n == "base_y" || n == "base_yaw") {
+          v = s->odometry[n == "base_x" ? 0 : n == "base_y" ? 1 : 2];
+        } else {
+          const auto it = std::find(s->joints.names.begin(), s->joints.names.end(), n);
+          if (it != s->joints.names.end())
+            v = s->joints.positions[static_cast<std::size_t>(it - s->joints.names.begin())];
+        }
+        here.position().push_back(v);
+        here.velocity().push_back(0.0);
+      }
+      back.push_back(here);
+      const double end = hole_samples_.back().time();
+      for (auto it = hole_samples_.rbegin(); it != hole_samples_.rend(); ++it) {
+        msg::TrajectorySample sample = *it;
+        sample.time(kSettleBack + end - it->time());
+        for (double& v : sample.velocity()) v = -v;
+        back.push_back(sample);
+      }
+      retract_request_ = send_trajectory(hole_names_, back);
+      motion_ = Motion::kRetractBack;
+      return;
+    }
+    motion_outcome_ = Outcome::succeeded();
+    // Keep holding the reference until the next motion (the loop re-sends the last one).
+  }
+}
+
+}  // namespace concert::drill::dds

@@ -1,0 +1,215 @@
+#pragma once
+// DDS adapter of the drill service: the robot model in (the drill and its camera, status READY
+// at the version or "cannot drill: ..."); joint states, odometry, the drill camera's frames,
+// the safety state and the other services' statuses in; missions and aborts in. It implements
+// the mission tree's ports with the other services' topics (nav goals, planner requests, joint
+// trajectories, Cartesian impedance commands) and publishes the mission's status and report.
+//
+// DDS callbacks only queue; one control thread ticks the tree and the drilling motion.
+
+#include <atomic>
+#include <chrono>
+#include <deque>
+#include <future>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/status_reporter.hpp"
+#include "concert/hardware/sensors.hpp"
+#include "drill/area_detection.hpp"
+#include "drill/drill_motion.hpp"
+#include "drill/drill_rig.hpp"
+#include "drill/mission_tree.hpp"
+#include "drill/patterns.hpp"
+#include "drill/perception.hpp"
+#include "drill/ports.hpp"
+
+namespace concert::drill::dds {
+
+/// What the service is started with.
+struct NodeParams {
+  std::string patterns;         ///< default hole-pattern table (a mission may name its own)
+  double rate{50.0};            ///< control rate [Hz]
+  double camera_distance{0.6};  ///< [m] the planner's working distance (area radius from it)
+  double camera_fov{55.0 * M_PI / 180.0};  ///< [rad] smaller field of view of the drill camera
+  int averaged_frames{5};                  ///< depth frames averaged for locating and detecting
+  DrillParams motion;
+};
+
+/// The mission's status message from a tree.
+msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
+                        const MissionReport& report);
+
+class DrillNode final : public MissionPorts {
+ public:
+  DrillNode(concert::dds::Participant& participant, NodeParams params, std::ostream& log);
+  ~DrillNode() override;
+  DrillNode(const DrillNode&) = delete;
+  DrillNode& operator=(const DrillNode&) = delete;
+
+  /// Runs the control loop until `stop` is set (then stops any motion).
+  void spin(const std::atomic<bool>& stop);
+
+  // MissionPorts (control thread).
+  Outcome health() override;
+  void resolve(std::size_t area, const AreaSpec& spec) override;
+  Outcome resolution(std::size_t area, ResolvedArea& out) override;
+  void navigate(const BasePose& goal) override;
+  Outcome navigation() override;
+  void plan(std::size_t area, const Eigen::Isometry3d& frame,
+            std::optional<std::size_t> after) override;
+  Outcome planning(std::size_t area) override;
+  void execute(std::size_t area) override;
+  Outcome execution() override;
+  void detect(std::size_t area, const AreaSpec& spec, const ResolvedArea& located) override;
+  Outcome detection(std::vector<DrillPoint>& points) override;
+  void align(const DrillPoint& point) override;
+  Outcome alignment() override;
+  void drill(const DrillPoint& point, double depth) override;
+  Outcome drilling() override;
+  void retract() override;
+  Outcome retraction() override;
+  void stop() override;
+
+ private:
+  struct Inbox {
+    std::optional<msg::RobotModel> model;
+    std::deque<msg::DrillMission> missions;
+    std::deque<msg::DrillAbort> aborts;
+  };
+  /// A joint state with its odometry, as received (robot clock).
+  struct Sample {
+    std::int64_t stamp_ns{0};
+    JointPositions joints;
+    Eigen::Vector3d odometry{0, 0, 0};
+  };
+  struct Plan {
+    std::uint32_t request_id{0};
+    std::optional<msg::PlanResult> result;
+    std::vector<std::string> names;  ///< of the trajectory
+    Eigen::VectorXd end;             ///< last sample's positions
+    std::optional<std::size_t> after;
+  };
+  struct CameraFrame {
+    std::int64_t stamp_ns{0};
+    hardware::RgbdFrame frame;
+    Eigen::Isometry3d world_T_optical{Eigen::Isometry3d::Identity()};
+    Eigen::Isometry3d base_T_optical{Eigen::Isometry3d::Identity()};
+  };
+  enum class Motion { kNone, kApproachHole, kReanchor, kAlign, kDrill, kRetractOut, kRetractBack };
+
+  void tick();
+  [[nodiscard]] bool mission_active() const;
+  void apply_model(const msg::RobotModel& model);
+  void start_mission(const msg::DrillMission& m);
+  void publish_status(bool force);
+  void control_motion();
+  void send_cartesian(const CartesianReference& r);
+  void send_hold();
+  void start_align(const Sample& s);
+  std::uint32_t send_trajectory(const std::vector<std::string>& names,
+                                const std::vector<msg::TrajectorySample>& samples);
+  [[nodiscard]] std::optional<Sample> latest_sample() const;
+  [[nodiscard]] std::optional<Sample> sample_at(std::int64_t stamp_ns) const;
+  /// Frames of the drill camera since `since` (robot clock), newest last.
+  [[nodiscard]] std::vector<CameraFrame> frames_since(std::int64_t since_ns) const;
+  /// The latest `count` frames averaged (depth), with the newest's pose; none if fewer.
+  [[nodiscard]] std::optional<CameraFrame> averaged_view(std::int64_t since_ns, int count) const;
+  void on_image(const msg::Image& image, bool depth);
+  void on_info(const msg::CameraInfo& info);
+  void assemble_frame();  // with mutex_ held
+  void log_line(const std::string& line);
+
+  NodeParams params_;
+  std::ostream& log_;
+  std::mutex log_mutex_;
+  mutable std::mutex mutex_;  // inbox and the sensor buffers below
+  Inbox inbox_;
+  std::deque<Sample> samples_;  // joint states decimated to 200 Hz, 2 s
+  std::optional<msg::Odometry> odometry_;
+  std::chrono::steady_clock::time_point joints_seen_{};
+  std::optional<msg::SafetyState> safety_;
+  std::map<std::string, std::chrono::steady_clock::time_point> services_seen_;
+  std::map<std::uint32_t, msg::PlanResult> plan_results_;
+  std::map<std::uint32_t, msg::TrajectoryStatus> trajectory_statuses_;
+  std::map<std::uint32_t, msg::NavStatus> nav_statuses_;
+  std::optional<msg::Image> rgb_, depth_;
+  std::optional<msg::CameraInfo> info_;
+  std::deque<CameraFrame> frames_;       // the drill camera's latest frames
+  std::string camera_;                   // sensor name of the drill camera (for the callbacks)
+  std::shared_ptr<const DrillRig> rig_;  // set by the control thread under mutex_
+
+  // Control thread.
+  std::string rig_error_;
+  std::uint64_t model_version_{0};
+  std::unique_ptr<MissionTree> tree_;
+  std::unique_ptr<Mission> mission_;
+  std::uint32_t mission_id_{0};
+  std::map<std::string, MissionReport> last_reports_;  // by mission name, for resume
+  std::optional<PatternTable> patterns_;
+  std::chrono::steady_clock::time_point last_status_{};
+  std::string last_active_;
+  std::uint32_t next_request_{1};
+  std::map<std::size_t, std::future<ResolvedArea>> resolving_;
+  std::map<std::size_t, std::string> resolve_errors_;
+  std::map<std::size_t, ResolvedArea> resolved_;
+  std::map<std::size_t, std::int64_t> resolve_since_;
+  std::map<std::size_t, AreaSpec> resolve_specs_;
+  std::uint32_t nav_request_{0};
+  std::map<std::size_t, Plan> plans_;
+  std::optional<std::size_t> executing_area_;
+  std::uint32_t trajectory_request_{0};
+  // Detection.
+  struct Detection {
+    std::size_t area{0};
+    AreaSpec spec;
+    ResolvedArea located;
+    std::int64_t since_ns{0};
+    std::optional<Outcome> outcome;
+    std::vector<DrillPoint> points;
+  } detection_;
+  // The drilling motion.
+  Motion motion_{Motion::kNone};
+  DrillMotion drill_motion_;
+  DrillPoint point_;
+  Eigen::Isometry3d base_T_world_{Eigen::Isometry3d::Identity()};  // fixed while drilling
+  std::int64_t servo_since_ns_{0};
+  std::uint32_t retract_request_{0};
+  std::uint32_t hole_plan_request_{0};
+  msg::PlanRequest hole_request_;
+  bool hole_whole_body_{false};  // false: a hole's posture is first planned with the base fixed
+  std::int64_t reanchor_since_ns_{0};
+  std::vector<std::string> hole_names_;  // the hole approach's trajectory, for the way back
+  std::vector<msg::TrajectorySample> hole_samples_;
+  std::optional<Outcome> motion_outcome_;
+  double now_{0.0};
+
+  concert::dds::StatusReporter status_;
+  concert::dds::Writer<msg::DrillStatus> status_out_;
+  concert::dds::Writer<msg::NavGoal> nav_goals_;
+  concert::dds::Writer<msg::NavCancel> nav_cancels_;
+  concert::dds::Writer<msg::PlanRequest> plan_requests_;
+  concert::dds::Writer<msg::JointTrajectoryCommand> trajectories_;
+  concert::dds::Writer<msg::CartesianImpedanceCommand> cartesian_;
+  concert::dds::Writer<msg::JointCommand> joint_commands_;
+  concert::dds::Reader<msg::RobotModel> models_;
+  concert::dds::Reader<msg::JointState> joints_in_;
+  concert::dds::Reader<msg::Odometry> odometry_in_;
+  concert::dds::Reader<msg::SafetyState> safety_in_;
+  concert::dds::Reader<msg::ServiceStatus> services_in_;
+  concert::dds::Reader<msg::PlanResult> plans_in_;
+  concert::dds::Reader<msg::TrajectoryStatus> trajectories_in_;
+  concert::dds::Reader<msg::NavStatus> nav_in_;
+  concert::dds::Reader<msg::Image> rgb_in_;
+  concert::dds::Reader<msg::Image> depth_in_;
+  concert::dds::Reader<msg::CameraInfo> info_in_;
+  concert::dds::Reader<msg::DrillMission> missions_in_;
+  concert::dds::Reader<msg::DrillAbort> aborts_in_;
+};
+
+}  // namespace concert::drill::dds
