@@ -200,6 +200,32 @@ std::optional<Eigen::Isometry3d> reanchor(const CameraView& view, const DrillPoi
   }
 }
 
+std::optional<Eigen::Vector3d> blob_shift(const CameraView& view,
+                                          const std::vector<DrillPoint>& area_points,
+                                          const DrillPoint& target, double tolerance) {
+  std::vector<Eigen::Vector3d> seen;
+  for (const Blob& b : detect_blobs(*view.frame)) seen.push_back(view.world_T_optical * b.position);
+  std::optional<Eigen::Vector3d> best;
+  int best_score = -1;
+  for (const Eigen::Vector3d& s : seen) {
+    const Eigen::Vector3d shift = s - target.frame.translation();
+    int score = 0;
+    for (const DrillPoint& p : area_points) {
+      if (p.marker >= 0) continue;
+      const Eigen::Vector3d moved = p.frame.translation() + shift;
+      if (std::any_of(seen.begin(), seen.end(),
+                      [&](const Eigen::Vector3d& o) { return (o - moved).norm() <= tolerance; })) {
+        ++score;
+      }
+    }
+    if (score > best_score || (score == best_score && shift.norm() < best->norm())) {
+      best_score = score;
+      best = shift;
+    }
+  }
+  return best;
+}
+
 std::optional<Eigen::Isometry3d> track_blob(const CameraView& view, const Eigen::Isometry3d& hole,
                                             double max_distance) {
   std::optional<Eigen::Isometry3d> best;

@@ -66,6 +66,11 @@ void DrillMotion::start_retract(const Eigen::Isometry3d& tip, double now) {
   reason_.clear();
   started_ = last_ = now;
   depth_ref_ = depth_of(tip);
+  // The bit pulls straight back as it is: turning it onto the hole's axis here would wrench a
+  // bit that never got aligned (an alignment that failed far from the hole).
+  ref_ = tip;
+  if (depth_ref_ <= -params_.standoff || lateral_error(tip) > params_.servo_jump)
+    phase_ = Phase::kDone;
 }
 
 bool DrillMotion::observe(const Eigen::Isometry3d& hole) {
@@ -159,7 +164,9 @@ CartesianReference DrillMotion::update(const Eigen::Isometry3d& tip, double now)
       return reference(depth_ref_, phase_ == Phase::kDrilling ? params_.feed_rate : 0.0, tip);
     }
     case Phase::kRetracting: {
+      const double before = depth_ref_;
       depth_ref_ = std::max(depth_ref_ - params_.approach_speed * dt, -params_.standoff);
+      ref_.translation() += (before - depth_ref_) * hole_.linear().col(2);
       if (depth <= -params_.standoff + params_.align_tolerance) {
         phase_ = Phase::kDone;
       } else if (elapsed > params_.retract_timeout) {
@@ -168,7 +175,9 @@ CartesianReference DrillMotion::update(const Eigen::Isometry3d& tip, double now)
           << " s of retracting";
         fail(s.str());
       }
-      return reference(depth_ref_, 0.0, tip);
+      CartesianReference r = reference(depth_ref_, 0.0, tip);
+      r.pose = ref_;
+      return r;
     }
     case Phase::kIdle:
     case Phase::kDone:

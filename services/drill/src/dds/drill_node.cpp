@@ -41,6 +41,9 @@ constexpr double kSettleBack = 1.0;
 // position the mark may be found [m] (odometry drift over the base's move).
 constexpr int kReanchorFrames = 3;
 constexpr double kReanchorDistance = 0.06;
+// Blobs of one area matched as a set: a predicted blob lies this close to a seen one [m]
+// (6 deg of odometry yaw over 0.1 m between blobs moves them 1 cm).
+constexpr double kBlobMatch = 0.02;
 
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
@@ -712,6 +715,7 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
     }
     points = find_holes(detection_.spec, located, camera, patterns_ ? *patterns_ : kNone,
                         area_radius(params_.camera_distance, params_.camera_fov));
+    area_points_ = points;
   } catch (const DrillError& e) {
     return Outcome::failed(e.what());
   }
@@ -897,9 +901,19 @@ void DrillNode::control_motion() {
     const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, kReanchorFrames);
     if (!view) return;
     static const PatternTable kNone;
+    const CameraView camera{&view->frame, view->world_T_optical};
+    DrillPoint predicted = point_;
+    double within = kReanchorDistance;
+    if (point_.marker < 0 && area_points_.size() > 1) {
+      // Several blobs: which one is this hole's is told by the pattern they make together.
+      if (const std::optional<Eigen::Vector3d> shift =
+              blob_shift(camera, area_points_, point_, kBlobMatch)) {
+        predicted.frame.translation() += *shift;
+        within = kBlobMatch;
+      }
+    }
     const std::optional<Eigen::Isometry3d> seen =
-        reanchor(CameraView{&view->frame, view->world_T_optical}, point_,
-                 patterns_ ? *patterns_ : kNone, kReanchorDistance);
+        reanchor(camera, predicted, patterns_ ? *patterns_ : kNone, within);
     if (seen) {
       std::ostringstream line;
       line.setf(std::ios::fixed);

@@ -184,6 +184,7 @@ class DrillNode final : public MissionPorts {
   msg::PlanRequest hole_request_;
   bool hole_whole_body_{false};  // false: a hole's posture is first planned with the base fixed
   std::int64_t reanchor_since_ns_{0};
+  std::vector<DrillPoint> area_points_;  // the current area's holes as detected
   std::vector<std::string> hole_names_;  // the hole approach's trajectory, for the way back
   std::vector<msg::TrajectorySample> hole_samples_;
   std::optional<Outcome> motion_outcome_;
