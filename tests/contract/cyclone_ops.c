@@ -7,6 +7,7 @@
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_serdata.h>
 
+#include "drill.h"
 #include "ethercat.h"
 #include "model.h"
 #include "nav.h"
@@ -58,6 +59,10 @@ static const struct {
     {"concert::msg::OccupancyGridMap", &concert_msg_OccupancyGridMap_desc},
     {"concert::msg::NavLocalisation", &concert_msg_NavLocalisation_desc},
     {"concert::msg::NavVehicle", &concert_msg_NavVehicle_desc},
+    {"concert::msg::SimHoles", &concert_msg_SimHoles_desc},
+    {"concert::msg::DrillMission", &concert_msg_DrillMission_desc},
+    {"concert::msg::DrillAbort", &concert_msg_DrillAbort_desc},
+    {"concert::msg::DrillStatus", &concert_msg_DrillStatus_desc},
 };
 
 #define MAX_ENDPOINTS 64

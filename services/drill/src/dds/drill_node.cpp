@@ -37,6 +37,11 @@ constexpr double kRobotRadius = 0.55;
 // posture's path [s].
 constexpr double kAlignMargin = 0.03;
 constexpr double kSettleBack = 1.0;
+// Robot shapes grown against the map in the areas' approach plans [m]: the planner's map is the
+// world, its start pose the wheel odometry, which drifts 4-6 cm over a whole-body move near the
+// wall; a base planned 3 cm from the wall was found inside it by the next plan. (The holes'
+// drilling postures keep the planner's padding: at 10 cm it found none for the demo's blobs.)
+constexpr double kPlanPadding = 0.10;
 // Re-measuring a hole from its drilling posture: frames averaged, and how far from the predicted
 // position the mark may be found [m] (odometry drift over the base's move).
 constexpr int kReanchorFrames = 3;
@@ -438,6 +443,8 @@ void DrillNode::start_mission(const msg::DrillMission& m) {
   resolve_errors_.clear();
   resolved_.clear();
   plans_.clear();
+  hole_chain_.clear();
+  returning_ = false;
   motion_ = Motion::kNone;
   tree_ = std::make_unique<MissionTree>(*mission_, *this);
   if (m.resume()) {
@@ -602,6 +609,7 @@ void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& frame,
   r.end_effector(rig_ ? rig_->tool() : "");
   r.goals().push_back(model::dds::to_pose_msg(frame));
   r.execute(false);
+  r.environment_padding(kPlanPadding);
   if (after) {
     const auto prev = plans_.find(*after);
     if (prev != plans_.end() && prev->second.end.size() > 0) {
@@ -658,22 +666,79 @@ std::uint32_t DrillNode::send_trajectory(const std::vector<std::string>& names,
   return id;
 }
 
+// An area's approach starts where the previous area's approach ended (it was planned from
+// there while that area was drilled): the arm first goes back along the holes' planned paths,
+// reversed, from the last hole to the first.
 void DrillNode::execute(std::size_t area) {
+  executing_area_ = area;
+  if (!hole_chain_.empty()) {
+    if (const std::optional<Sample> s = latest_sample()) {
+      trajectory_request_ = send_trajectory(hole_chain_.front().names, return_path(*s));
+      returning_ = true;
+      return;
+    }
+  }
+  returning_ = false;
   const Plan& p = plans_.at(area);
   trajectory_request_ = send_trajectory(p.names, p.result->trajectory());
+}
+
+// From the measured state back through every hole's planned path, reversed.
+std::vector<msg::TrajectorySample> DrillNode::return_path(const Sample& s) const {
+  const std::vector<std::string>& names = hole_chain_.front().names;
+  std::vector<msg::TrajectorySample> back;
+  msg::TrajectorySample here;
+  here.time(0.0);
+  for (const std::string& n : names) {
+    double v = 0.0;
+    if (n == "base_x" || n == "base_y" || n == "base_yaw") {
+      v = s.odometry[n == "base_x" ? 0 : n == "base_y" ? 1 : 2];
+    } else {
+      const auto it = std::find(s.joints.names.begin(), s.joints.names.end(), n);
+      if (it != s.joints.names.end())
+        v = s.joints.positions[static_cast<std::size_t>(it - s.joints.names.begin())];
+    }
+    here.position().push_back(v);
+    here.velocity().push_back(0.0);
+  }
+  back.push_back(here);
+  double t = 0.0;
+  for (auto path = hole_chain_.rbegin(); path != hole_chain_.rend(); ++path) {
+    // Each path's end is where the Cartesian phase started, within centimetres of where it
+    // left the arm: a settling second to reach it, then the path backwards.
+    t += kSettleBack;
+    const double end = path->samples.back().time();
+    for (auto it = path->samples.rbegin(); it != path->samples.rend(); ++it) {
+      msg::TrajectorySample sample = *it;
+      sample.time(t + end - it->time());
+      for (double& v : sample.velocity()) v = -v;
+      back.push_back(sample);
+    }
+    t += end;
+  }
+  return back;
 }
 
 Outcome DrillNode::execution() {
   std::lock_guard lock(mutex_);
   const auto it = trajectory_statuses_.find(trajectory_request_);
   if (it == trajectory_statuses_.end()) return Outcome::running();
+  if (returning_ && it->second.state() == msg::TRAJECTORY_SUCCEEDED) {
+    returning_ = false;
+    hole_chain_.clear();
+    const Plan& p = plans_.at(*executing_area_);
+    trajectory_request_ = send_trajectory(p.names, p.result->trajectory());
+    return Outcome::running();
+  }
   switch (it->second.state()) {
     case msg::TRAJECTORY_SUCCEEDED:
+      hole_chain_.clear();
       return Outcome::succeeded();
     case msg::TRAJECTORY_ABORTED:
     case msg::TRAJECTORY_REFUSED:
       return Outcome::failed(
-          "robot: approach trajectory " +
+          std::string(returning_ ? "robot: the way back from the holes "
+                                 : "robot: approach trajectory ") +
           std::string(it->second.state() == msg::TRAJECTORY_REFUSED ? "refused" : "aborted") +
           ": " + it->second.reason());
     default:
@@ -878,6 +943,9 @@ void DrillNode::control_motion() {
       hole_names_ = r->joint_names();
       hole_samples_ = r->trajectory();
     }
+    if (r->state() == msg::PLAN_SUCCEEDED && !hole_samples_.empty()) {
+      hole_chain_.push_back({hole_names_, hole_samples_});
+    }
     if (r->state() == msg::PLAN_FAILED && hole_request_.fixed_base() &&
         (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH)) {
       log_line("drill: " + point_.label + ": the arm alone cannot reach it (" + r->reason() +
@@ -930,20 +998,6 @@ void DrillNode::control_motion() {
     if (const std::optional<Sample> s = latest_sample()) start_align(*s);
     return;
   }
-  if (motion_ == Motion::kRetractBack) {
-    std::lock_guard lock(mutex_);
-    const auto it = trajectory_statuses_.find(retract_request_);
-    if (it == trajectory_statuses_.end()) return;
-    if (it->second.state() == msg::TRAJECTORY_SUCCEEDED) {
-      motion_outcome_ = Outcome::succeeded();
-      motion_ = Motion::kNone;
-    } else if (it->second.state() != msg::TRAJECTORY_EXECUTING) {
-      motion_outcome_ =
-          Outcome::failed("robot: return to the approach posture: " + it->second.reason());
-      motion_ = Motion::kNone;
-    }
-    return;
-  }
   const std::optional<Sample> s = latest_sample();
   if (!s) return;
   if (point_.servo && (motion_ == Motion::kAlign || motion_ == Motion::kDrill)) {
@@ -961,36 +1015,6 @@ void DrillNode::control_motion() {
     motion_outcome_ = Outcome::failed(drill_motion_.reason());
     motion_ = Motion::kNone;
   } else if (drill_motion_.phase() == DrillMotion::Phase::kDone) {
-    if (motion_ == Motion::kRetractOut && !hole_samples_.empty()) {
-      // Back along the hole's planned path, reversed, to the area's approach posture: first
-      // to where the path ended (the Cartesian phase left the arm within centimetres of it).
-      std::vector<msg::TrajectorySample> back;
-      msg::TrajectorySample here;
-      here.time(0.0);
-      for (const std::string& n : hole_names_) {
-        double v = 0.0;
-        if (n == "base_x" || n == "base_y" || n == "base_yaw") {
-          v = s->odometry[n == "base_x" ? 0 : n == "base_y" ? 1 : 2];
-        } else {
-          const auto it = std::find(s->joints.names.begin(), s->joints.names.end(), n);
-          if (it != s->joints.names.end())
-            v = s->joints.positions[static_cast<std::size_t>(it - s->joints.names.begin())];
-        }
-        here.position().push_back(v);
-        here.velocity().push_back(0.0);
-      }
-      back.push_back(here);
-      const double end = hole_samples_.back().time();
-      for (auto it = hole_samples_.rbegin(); it != hole_samples_.rend(); ++it) {
-        msg::TrajectorySample sample = *it;
-        sample.time(kSettleBack + end - it->time());
-        for (double& v : sample.velocity()) v = -v;
-        back.push_back(sample);
-      }
-      retract_request_ = send_trajectory(hole_names_, back);
-      motion_ = Motion::kRetractBack;
-      return;
-    }
     motion_outcome_ = Outcome::succeeded();
     // Keep holding the reference until the next motion (the loop re-sends the last one).
   }

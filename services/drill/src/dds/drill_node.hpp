@@ -101,7 +101,7 @@ class DrillNode final : public MissionPorts {
     Eigen::Isometry3d world_T_optical{Eigen::Isometry3d::Identity()};
     Eigen::Isometry3d base_T_optical{Eigen::Isometry3d::Identity()};
   };
-  enum class Motion { kNone, kApproachHole, kReanchor, kAlign, kDrill, kRetractOut, kRetractBack };
+  enum class Motion { kNone, kApproachHole, kReanchor, kAlign, kDrill, kRetractOut };
 
   void tick();
   [[nodiscard]] bool mission_active() const;
@@ -112,6 +112,7 @@ class DrillNode final : public MissionPorts {
   void send_cartesian(const CartesianReference& r);
   void send_hold();
   void start_align(const Sample& s);
+  [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
   std::uint32_t send_trajectory(const std::vector<std::string>& names,
                                 const std::vector<msg::TrajectorySample>& samples);
   [[nodiscard]] std::optional<Sample> latest_sample() const;
@@ -179,7 +180,6 @@ class DrillNode final : public MissionPorts {
   DrillPoint point_;
   Eigen::Isometry3d base_T_world_{Eigen::Isometry3d::Identity()};  // fixed while drilling
   std::int64_t servo_since_ns_{0};
-  std::uint32_t retract_request_{0};
   std::uint32_t hole_plan_request_{0};
   msg::PlanRequest hole_request_;
   bool hole_whole_body_{false};  // false: a hole's posture is first planned with the base fixed
@@ -187,6 +187,12 @@ class DrillNode final : public MissionPorts {
   std::vector<DrillPoint> area_points_;  // the current area's holes as detected
   std::vector<std::string> hole_names_;  // the hole approach's trajectory, for the way back
   std::vector<msg::TrajectorySample> hole_samples_;
+  struct PlannedPath {
+    std::vector<std::string> names;
+    std::vector<msg::TrajectorySample> samples;
+  };
+  std::vector<PlannedPath> hole_chain_;  // the area's hole postures as reached, first to last
+  bool returning_{false};                // execute(): the way back runs before the approach
   std::optional<Outcome> motion_outcome_;
   double now_{0.0};
 

@@ -145,6 +145,9 @@ struct PlanRequest {
   /// The base keeps its start pose: only the arm moves (the drill service's hole postures:
   /// a base that moves lets odometry drift between holes).
   bool fixed_base = false;
+  /// Robot shapes grown against the map [m]; 0: Params::environment_padding. The drill service
+  /// keeps the base 10 cm from the wall: odometry drifts a few cm per whole-body move.
+  double environment_padding = 0.0;
 };
 
 /// Result for one goal.

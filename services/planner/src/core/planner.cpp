@@ -287,16 +287,19 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     }
   }
 
-  auto checker_ptr = std::make_unique<StateChecker>(model, env, params_, params_.environment_padding);
+  const double padding =
+      request.environment_padding > 0.0 ? request.environment_padding : params_.environment_padding;
+  auto checker_ptr = std::make_unique<StateChecker>(model, env, params_, padding);
   Validity start_ok = checker_ptr->check(q_start_full);
-  if (start_ok.constraint == Constraint::kEnvironmentCollision && params_.environment_padding > 0.0) {
+  if (start_ok.constraint == Constraint::kEnvironmentCollision && padding > 0.0) {
     // A robot standing closer to the map than the padding (odometry drifts: the map is in the
     // world, the start in the odometry frame; after the drill's approach the demo's base was
     // 4 cm off) may still move away from it: this request is planned without the padding, its
     // shapes against the map's true surfaces.
     auto unpadded = std::make_unique<StateChecker>(model, env, params_, 0.0);
     if (const Validity v = unpadded->check(q_start_full); v.valid()) {
-      out.note = "the start is within the environment padding (" + start_ok.detail + "): planned without it";
+      out.note = "the start is within the environment padding (" + start_ok.detail +
+                 "): planned without it";
       checker_ptr = std::move(unpadded);
       start_ok = v;
     }
@@ -317,7 +320,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     // postures sit in torque-feasible pockets no path reaches.
     GoalResult r;
     double nspg = 0.0;
-    const double distance = request.camera_distance > 0.0 ? request.camera_distance : params_.camera_distance;
+    const double distance =
+        request.camera_distance > 0.0 ? request.camera_distance : params_.camera_distance;
     const double height = (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, distance)).z();
     const std::vector<Eigen::VectorXd> hints = hints_for(*model, height);
     int next_seed = 0;

@@ -322,6 +322,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   core.end_effector = request.end_effector();
   core.camera_distance = request.camera_distance();
   core.fixed_base = request.fixed_base();
+  core.environment_padding = request.environment_padding();
   for (const msg::Pose& g : request.goals()) core.goals.push_back({to_core(g)});
   const bool execute = request.execute();
   const std::size_t count = core.goals.size();
