@@ -141,9 +141,10 @@ class DrillNode final : public MissionPorts {
   std::map<std::uint32_t, msg::NavStatus> nav_statuses_;
   std::optional<msg::Image> rgb_, depth_;
   std::optional<msg::CameraInfo> info_;
-  std::deque<CameraFrame> frames_;       // the drill camera's latest frames
-  std::string camera_;                   // sensor name of the drill camera (for the callbacks)
-  std::shared_ptr<const DrillRig> rig_;  // set by the control thread under mutex_
+  std::deque<CameraFrame> frames_;          // the drill camera's latest frames
+  std::string camera_;                      // sensor name of the drill camera (for the callbacks)
+  std::shared_ptr<const DrillRig> rig_;     // set by the control thread under mutex_
+  std::atomic<bool> camera_wanted_{false};  // a mission runs: the camera callbacks keep frames
 
   // Control thread.
   std::string rig_error_;
