@@ -1,9 +1,10 @@
 #include "concert/model/dds/conversions.hpp"
-#include "concert/model/dds/pose.hpp"
 
 #include <cmath>
 #include <limits>
 #include <string>
+
+#include "concert/model/dds/pose.hpp"
 
 namespace concert::model::dds {
 namespace {
@@ -120,16 +121,23 @@ namespace concert::model::dds {
 Eigen::Isometry3d to_isometry(const msg::Pose& p) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.translation() = Eigen::Vector3d(p.position().x(), p.position().y(), p.position().z());
-  const Eigen::Quaterniond q(p.orientation().w(), p.orientation().x(), p.orientation().y(), p.orientation().z());
+  const Eigen::Quaterniond q(p.orientation().w(), p.orientation().x(), p.orientation().y(),
+                             p.orientation().z());
   t.linear() = q.norm() > 1e-9 ? q.normalized().toRotationMatrix() : Eigen::Matrix3d::Zero();
   return t;
 }
 
+msg::Vector3 to_vector_msg(const Eigen::Vector3d& v) {
+  msg::Vector3 out;
+  out.x(v.x());
+  out.y(v.y());
+  out.z(v.z());
+  return out;
+}
+
 msg::Pose to_pose_msg(const Eigen::Isometry3d& t) {
   msg::Pose p;
-  p.position().x(t.translation().x());
-  p.position().y(t.translation().y());
-  p.position().z(t.translation().z());
+  p.position(to_vector_msg(t.translation()));
   const Eigen::Quaterniond q(t.linear());
   p.orientation().x(q.x());
   p.orientation().y(q.y());

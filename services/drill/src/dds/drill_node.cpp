@@ -444,8 +444,6 @@ void DrillNode::start_mission(const msg::DrillMission& m) {
   mission_ = std::make_unique<Mission>(std::move(mission));
   mission_id_ = m.mission_id();
   resolving_.clear();
-  resolve_errors_.clear();
-  resolved_.clear();
   plans_.clear();
   hole_chain_.clear();
   returning_ = false;
@@ -501,8 +499,6 @@ Outcome DrillNode::health() {
 }
 
 void DrillNode::resolve(std::size_t area, const AreaSpec& spec) {
-  resolve_errors_.erase(area);
-  resolved_.erase(area);
   resolve_specs_[area] = spec;
   {
     std::lock_guard lock(mutex_);
@@ -604,7 +600,6 @@ void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& frame,
                      std::optional<std::size_t> after) {
   Plan p;
   p.request_id = next_request_++;
-  p.after = after;
   msg::PlanRequest r;
   r.request_id(p.request_id);
   r.model_version(static_cast<std::uint32_t>(model_version_));
@@ -826,8 +821,7 @@ void DrillNode::align(const DrillPoint& point) {
   r.fixed_base(!hole_whole_body_);
   plan_requests_.write(r);
   hole_request_ = r;
-  hole_names_.clear();
-  hole_samples_.clear();
+  hole_path_ = {};
   motion_ = Motion::kApproachHole;
 }
 
@@ -913,15 +907,8 @@ void DrillNode::send_cartesian(const CartesianReference& r) {
   c.end_effector(rig_->tcp_frame());
   c.target(model::dds::to_pose_msg(r.pose));
   msg::Twist t;
-  msg::Vector3 lin, ang;
-  lin.x(r.twist[0]);
-  lin.y(r.twist[1]);
-  lin.z(r.twist[2]);
-  ang.x(r.twist[3]);
-  ang.y(r.twist[4]);
-  ang.z(r.twist[5]);
-  t.linear(lin);
-  t.angular(ang);
+  t.linear(model::dds::to_vector_msg(r.twist.head<3>()));
+  t.angular(model::dds::to_vector_msg(r.twist.tail<3>()));
   c.target_twist(t);
   for (int i = 0; i < 6; ++i) {
     c.stiffness()[static_cast<std::size_t>(i)] = r.stiffness[i];
@@ -943,13 +930,10 @@ void DrillNode::control_motion() {
       if (it != plan_results_.end()) r = it->second;
     }
     if (!r) return;
-    if (!r->trajectory().empty()) {
-      hole_names_ = r->joint_names();
-      hole_samples_ = r->trajectory();
-    }
-    if (r->state() == msg::PLAN_SUCCEEDED && !hole_samples_.empty()) {
-      hole_chain_.push_back({hole_names_, hole_samples_});
-    }
+    // The trajectory comes with PLANNED and the execution updates; SUCCEEDED may arrive alone.
+    if (!r->trajectory().empty()) hole_path_ = {r->joint_names(), r->trajectory()};
+    if (r->state() == msg::PLAN_SUCCEEDED && !hole_path_.samples.empty())
+      hole_chain_.push_back(hole_path_);
     if (r->state() == msg::PLAN_FAILED && hole_request_.fixed_base() &&
         (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH)) {
       log_line("drill: " + point_.label + ": the arm alone cannot reach it (" + r->reason() +

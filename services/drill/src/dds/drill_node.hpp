@@ -93,7 +93,6 @@ class DrillNode final : public MissionPorts {
     std::optional<msg::PlanResult> result;
     std::vector<std::string> names;  ///< of the trajectory
     Eigen::VectorXd end;             ///< last sample's positions
-    std::optional<std::size_t> after;
   };
   struct CameraFrame {
     std::int64_t stamp_ns{0};
@@ -158,8 +157,6 @@ class DrillNode final : public MissionPorts {
   std::string last_active_;
   std::uint32_t next_request_{1};
   std::map<std::size_t, std::future<ResolvedArea>> resolving_;
-  std::map<std::size_t, std::string> resolve_errors_;
-  std::map<std::size_t, ResolvedArea> resolved_;
   std::map<std::size_t, std::int64_t> resolve_since_;
   std::map<std::size_t, AreaSpec> resolve_specs_;
   std::uint32_t nav_request_{0};
@@ -186,12 +183,11 @@ class DrillNode final : public MissionPorts {
   bool hole_whole_body_{false};  // false: a hole's posture is first planned with the base fixed
   std::int64_t reanchor_since_ns_{0};
   std::vector<DrillPoint> area_points_;  // the current area's holes as detected
-  std::vector<std::string> hole_names_;  // the hole approach's trajectory, for the way back
-  std::vector<msg::TrajectorySample> hole_samples_;
   struct PlannedPath {
     std::vector<std::string> names;
     std::vector<msg::TrajectorySample> samples;
   };
+  PlannedPath hole_path_;                // of the hole being approached
   std::vector<PlannedPath> hole_chain_;  // the area's hole postures as reached, first to last
   bool returning_{false};                // execute(): the way back runs before the approach
   std::optional<Outcome> motion_outcome_;

@@ -9,16 +9,20 @@
 #include <utility>
 
 #include "concert/common/enum_map.hpp"
+#include "concert/model/dds/pose.hpp"
 
 namespace concert::robot::dds {
 namespace {
 
-std::string from(const std::string& source) { return source.empty() ? std::string("unnamed sender") : "'" + source + "'"; }
+std::string from(const std::string& source) {
+  return source.empty() ? std::string("unnamed sender") : "'" + source + "'";
+}
 
 void check_length(const msg::JointCommand& c, std::size_t size, const char* field, bool required) {
   if ((required || size != 0) && size != c.name().size()) {
-    throw CommandError("joint command from " + from(c.source()) + ": " + std::to_string(c.name().size()) +
-                       " names but " + std::to_string(size) + " values in '" + field + "'" +
+    throw CommandError("joint command from " + from(c.source()) + ": " +
+                       std::to_string(c.name().size()) + " names but " + std::to_string(size) +
+                       " values in '" + field + "'" +
                        (required ? " (required by the mode)" : " (give one per joint or none)"));
   }
 }
@@ -95,29 +99,32 @@ CartesianCommand to_core(const msg::CartesianImpedanceCommand& c) {
   const auto& o = c.target().orientation();
   const Eigen::Quaterniond q(o.w(), o.x(), o.y(), o.z());
   if (std::abs(q.norm() - 1.0) > 1e-3) {
-    throw CommandError("Cartesian command from " + from(c.source()) + ": target.orientation is not a unit quaternion");
+    throw CommandError("Cartesian command from " + from(c.source()) +
+                       ": target.orientation is not a unit quaternion");
   }
   out.target_pose = Eigen::Isometry3d::Identity();
   out.target_pose.linear() = q.normalized().toRotationMatrix();
   out.target_pose.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
   const auto& t = c.target_twist();
-  out.target_twist << t.linear().x(), t.linear().y(), t.linear().z(), t.angular().x(), t.angular().y(),
-      t.angular().z();
+  out.target_twist << t.linear().x(), t.linear().y(), t.linear().z(), t.angular().x(),
+      t.angular().y(), t.angular().z();
   for (int i = 0; i < 6; ++i) {
     out.stiffness(i) = c.stiffness()[static_cast<std::size_t>(i)];
     out.damping(i) = c.damping()[static_cast<std::size_t>(i)];
   }
   const auto& f = c.feedforward();
-  out.feedforward_wrench << f.force().x(), f.force().y(), f.force().z(), f.torque().x(), f.torque().y(),
-      f.torque().z();
+  out.feedforward_wrench << f.force().x(), f.force().y(), f.force().z(), f.torque().x(),
+      f.torque().y(), f.torque().z();
   const uint8_t axis = c.admittance_axis();
   if (axis != 255) {
     if (axis > 2) {
       throw CommandError("Cartesian command from " + from(c.source()) + ": admittance_axis " +
-                         std::to_string(axis) + " (rotational) is not supported; use 0..2 (x, y, z of the TCP) or 255");
+                         std::to_string(axis) +
+                         " (rotational) is not supported; use 0..2 (x, y, z of the TCP) or 255");
     }
     if (!(c.admittance_gain() > 0.0)) {
-      throw CommandError("Cartesian command from " + from(c.source()) + ": admittance_gain must be > 0 [m/(N s)]");
+      throw CommandError("Cartesian command from " + from(c.source()) +
+                         ": admittance_gain must be > 0 [m/(N s)]");
     }
     out.admittance.enabled = true;
     // The axis is given in the TCP frame: fixed in the world at the target orientation.
@@ -130,7 +137,9 @@ CartesianCommand to_core(const msg::CartesianImpedanceCommand& c) {
   return out;
 }
 
-BaseCommand to_core(const msg::BaseVelocityCommand& c) { return {c.model_version(), c.vx(), c.vy(), c.wz()}; }
+BaseCommand to_core(const msg::BaseVelocityCommand& c) {
+  return {c.model_version(), c.vx(), c.vy(), c.wz()};
+}
 
 JointTrajectory to_core(const msg::JointTrajectoryCommand& c) {
   JointTrajectory t;
@@ -186,15 +195,8 @@ msg::EndEffectorWrench to_wrench(const RobotState& s) {
   out.end_effector(s.end_effector_frame);
   const auto& w = s.end_effector_wrench;
   msg::Wrench wrench;
-  msg::Vector3 force, torque;
-  force.x(w(0));
-  force.y(w(1));
-  force.z(w(2));
-  torque.x(w(3));
-  torque.y(w(4));
-  torque.z(w(5));
-  wrench.force(force);
-  wrench.torque(torque);
+  wrench.force(model::dds::to_vector_msg(w.head<3>()));
+  wrench.torque(model::dds::to_vector_msg(w.tail<3>()));
   out.wrench(wrench);
   return out;
 }

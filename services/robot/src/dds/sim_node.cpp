@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "concert/common/clock.hpp"
+#include "concert/model/dds/pose.hpp"
 #include "concert/world/world_dds.hpp"
 #include "robot_conversions.hpp"
 
@@ -13,9 +14,9 @@ namespace concert::robot::dds {
 
 namespace cdds = concert::dds;
 
-
-SimNode::SimNode(cdds::Participant& participant, sim::SimHardware& sim, const sim::AssemblyBuilder* builder,
-                 RobotNode& robot, const world::World& initial_world, const std::string& world_source,
+SimNode::SimNode(cdds::Participant& participant, sim::SimHardware& sim,
+                 const sim::AssemblyBuilder* builder, RobotNode& robot,
+                 const world::World& initial_world, const std::string& world_source,
                  std::function<void(const sim::SimulatedRobot&)> on_swap)
     : sim_(sim),
       builder_(builder),
@@ -80,22 +81,15 @@ void SimNode::publish_holes(double time) {
   if (holes.size() == holes_count_ && depth_sum == holes_depth_sum_) return;
   holes_count_ = holes.size();
   holes_depth_sum_ = depth_sum;
-  const auto vec = [](const Eigen::Vector3d& v) {
-    msg::Vector3 out;
-    out.x(v.x());
-    out.y(v.y());
-    out.z(v.z());
-    return out;
-  };
   msg::SimHoles m;
   m.stamp_ns(static_cast<long long>(std::llround(time * 1e9)));
   for (const auto& h : holes) {
     msg::SimHole out;
     out.wall(h.wall);
     out.bit(h.bit);
-    out.entry(vec(h.entry));
-    out.axis(vec(h.axis));
-    out.face_normal(vec(h.face_normal));
+    out.entry(model::dds::to_vector_msg(h.entry));
+    out.axis(model::dds::to_vector_msg(h.axis));
+    out.face_normal(model::dds::to_vector_msg(h.face_normal));
     out.depth(h.depth);
     out.diameter(h.diameter);
     out.started(h.time);
@@ -127,8 +121,8 @@ void SimNode::handle(const msg::SimCommand& c) {
     reply.message(c.kind() == msg::SIM_SWAP_ASSEMBLY ? swap_assembly(c.content(), c.name())
                                                      : set_world(c.content(), c.name()));
     reply.accepted(true);
-    std::cerr << "concert_robot: " << what << " from '" << c.name() << "' (" << c.source() << "): " << reply.message()
-              << "\n";
+    std::cerr << "concert_robot: " << what << " from '" << c.name() << "' (" << c.source()
+              << "): " << reply.message() << "\n";
   } catch (const std::exception& e) {
     reply.accepted(false);
     reply.message(what + " '" + c.name() + "' refused, the simulator keeps its " +
@@ -141,7 +135,8 @@ void SimNode::handle(const msg::SimCommand& c) {
 
 std::string SimNode::swap_assembly(const std::string& yaml, const std::string& name) {
   if (builder_ == nullptr) {
-    throw std::runtime_error("the simulated robot is a fixed URDF (--urdf): there is no assembly to swap");
+    throw std::runtime_error(
+        "the simulated robot is a fixed URDF (--urdf): there is no assembly to swap");
   }
   const sim::SimulatedRobot robot = builder_->build_from_text(yaml, name);
   if (!sim_.swap_model(robot.urdf, robot.sensors, robot.drill_bits)) {
@@ -166,9 +161,10 @@ std::string SimNode::set_world(const std::string& yaml, const std::string& name)
     version = ++world_version_;
   }
   world_.write(world::to_msg(w, version, name));
-  return "world version " + std::to_string(version) + ": " + std::to_string(w.walls.size()) + " walls, " +
-         std::to_string(w.obstacles.size()) + " obstacles, " + std::to_string(w.marks.size()) + " marks, " +
-         std::to_string(w.surfaces.size()) + " surfaces";
+  return "world version " + std::to_string(version) + ": " + std::to_string(w.walls.size()) +
+         " walls, " + std::to_string(w.obstacles.size()) + " obstacles, " +
+         std::to_string(w.marks.size()) + " marks, " + std::to_string(w.surfaces.size()) +
+         " surfaces";
 }
 
 }  // namespace concert::robot::dds

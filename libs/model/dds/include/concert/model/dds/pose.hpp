@@ -1,5 +1,6 @@
 #pragma once
-// The one conversion between the Pose message (idl/robot.idl) and Eigen, for every adapter.
+// The one conversion between the Pose and Vector3 messages (idl/robot.idl) and Eigen, for every
+// adapter.
 
 #include <Eigen/Geometry>
 
@@ -12,5 +13,7 @@ namespace concert::model::dds {
 Eigen::Isometry3d to_isometry(const msg::Pose& pose);
 /// Rigid transform -> Pose sample.
 msg::Pose to_pose_msg(const Eigen::Isometry3d& pose);
+/// Vector -> Vector3 sample.
+msg::Vector3 to_vector_msg(const Eigen::Vector3d& v);
 
 }  // namespace concert::model::dds
