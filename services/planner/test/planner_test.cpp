@@ -415,3 +415,105 @@ TEST(Planner, WarmUpRemembersArmPathsThatLaterPlansReplay) {
   EXPECT_NE(g.path_method.find("remembered arm path"), std::string::npos) << g.path_method;
   EXPECT_GT(recheck(*model, environment_of(world, params), params, g, start, area), 10) << "path found by " << g.path_method;
 }
+
+// The drill service's second hole on the demo: the base's odometry had drifted a few cm, so the
+// planner's start had a leg inside the wall map. Such a start is moved out (nearest clear base
+// pose within start_tolerance) and the move prepended; a start deeper inside stays refused.
+TEST(Planner, StartSlightlyInsideTheMapIsMovedOutFirst) {
+  Params params = generous(41);
+  params.environment_padding = 0.0;
+  Planner planner(params);
+  planner.set_model(morphology('a', 1));
+  const auto model = planner.model();
+  const Eigen::VectorXd start = start_state(*model);
+  // The wall position where the start just touches it (1 cm steps towards the robot).
+  double touching = 0.0;
+  for (double x = 1.5; x > 0.0; x -= 0.01) {
+    World w;
+    w.boxes.push_back(fixtures::wall_at(x));
+    StateChecker check(model, environment_of(w, params), params, 0.0);
+    if (check.check(start).constraint == Constraint::kEnvironmentCollision) {
+      touching = x;
+      break;
+    }
+  }
+  ASSERT_GT(touching, 0.2);
+  const auto at_wall = [&](double x) {
+    World w;
+    w.boxes.push_back(fixtures::wall_at(x));
+    return w;
+  };
+  // 2 cm inside (the map's 5 cm voxels: the first occupied voxel may come a cell later).
+  const World inside = at_wall(touching - 0.02);
+  planner.set_environment(environment_of(inside, params));
+  const Eigen::Isometry3d area = fixtures::drilling_area(touching - 0.02, 0.0, 1.2);
+  const PlanResult r = planner.plan({7, 1, "", {{area}}}, start, {});
+  ASSERT_EQ(r.status, Status::kSucceeded) << r.reason;
+  EXPECT_NE(r.note.find("the base moved out by"), std::string::npos) << r.note;
+  const Trajectory& t = r.goals[0].trajectory;
+  ASSERT_GE(t.points.size(), 3u);
+  EXPECT_LT((t.points.front().q - model->to_planned(start)).norm(), 1e-9);
+  // Past the lead-in, every state is clear of the map: find where the base left the start.
+  StateChecker exact(model, environment_of(inside, params), params, 0.0);
+  std::size_t clear_from = 0;
+  while (clear_from < t.points.size() &&
+         !exact.check(model->to_full(t.points[clear_from].q, start)).valid())
+    ++clear_from;
+  ASSERT_LT(clear_from, t.points.size());
+  const Eigen::VectorXd moved = t.points[clear_from].q;
+  EXPECT_LE(std::hypot(moved[0] - start[0], moved[1] - start[1]), params.start_tolerance + 1e-9);
+  for (std::size_t i = clear_from; i < t.points.size(); ++i) {
+    const Validity v = exact.check(model->to_full(t.points[i].q, start));
+    EXPECT_TRUE(v.valid()) << "sample " << i << ": " << v.detail;
+  }
+  // 20 cm inside: refused, naming the collision.
+  planner.set_environment(environment_of(at_wall(touching - 0.2), params));
+  const PlanResult deep = planner.plan({8, 1, "", {{area}}}, start, {});
+  EXPECT_EQ(deep.status, Status::kInvalidStart) << deep.reason;
+  EXPECT_NE(deep.reason.find("environment collision"), std::string::npos) << deep.reason;
+  // start_tolerance 0: refused too.
+  params.start_tolerance = 0.0;
+  Planner strict(params);
+  strict.set_model(morphology('a', 1));
+  strict.set_environment(environment_of(inside, params));
+  EXPECT_EQ(strict.plan({9, 1, "", {{area}}}, start, {}).status, Status::kInvalidStart);
+}
+
+// After a drilled hole the arm stood a hair inside the planner's conservative link shapes
+// (the Cartesian motions leave it a little off the checked posture): the next plan jiggles the
+// arm out first. A start folded deep into itself stays refused.
+TEST(Planner, StartInSlightSelfCollisionIsJiggledOut) {
+  Params params = generous(43);
+  Planner planner(params);
+  planner.set_model(morphology('a', 1));
+  planner.set_environment(environment_of(site(2.2), params));
+  const auto model = planner.model();
+  const int elbow = model->kinematics().joint_index_or_throw("J4_E");
+  StateChecker check(model, environment_of(site(2.2), params), params, 0.0);
+  // Fold the elbow until the links touch.
+  Eigen::VectorXd folded = start_state(*model);
+  double touching = 0.0;
+  for (double a = 0.0; std::abs(a) < 3.2; a -= 0.005) {
+    folded[elbow] = a;
+    const Validity v = check.check(folded);
+    if (v.constraint == Constraint::kSelfCollision) {
+      touching = a;
+      break;
+    }
+    ASSERT_TRUE(v.valid()) << a << ": " << v.detail;
+  }
+  ASSERT_NE(touching, 0.0) << "the elbow never folds into the arm";
+  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.0, 1.2);
+  folded[elbow] = touching - 0.01;
+  ASSERT_EQ(check.check(folded).constraint, Constraint::kSelfCollision);
+  const PlanResult r = planner.plan({11, 1, "", {{area}}}, folded, {});
+  ASSERT_EQ(r.status, Status::kSucceeded) << r.reason;
+  EXPECT_NE(r.note.find("self collision"), std::string::npos) << r.note;
+  const Trajectory& t = r.goals[0].trajectory;
+  EXPECT_LT((t.points.front().q - model->to_planned(folded)).norm(), 1e-9);
+  folded[elbow] = touching - 0.3;
+  EXPECT_EQ(check.check(folded).constraint, Constraint::kSelfCollision);
+  const PlanResult deep = planner.plan({12, 1, "", {{area}}}, folded, {});
+  EXPECT_EQ(deep.status, Status::kInvalidStart) << deep.reason;
+  EXPECT_NE(deep.reason.find("self collision"), std::string::npos) << deep.reason;
+}

@@ -82,10 +82,12 @@ class Planner {
 
   /// Plans a path between two planned-joint postures (src/core/path_search.hpp: direct, projected
   /// line, arm alone and drive, RRT-Connect; simplification), then its timing.
-  /// `fixed_base`: the base joints keep their start values.
-  GoalResult plan_path(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& q_start_full,
-                       const Eigen::VectorXd& q_goal, double time_budget, uint64_t seed,
-                       bool fixed_base = false) const;
+  /// `fixed_base`: the base joints keep their start values. `lead_in` (full q, or null): a
+  /// state the trajectory starts from before `q_start_full` (a start moved out of the map).
+  GoalResult plan_path(const PlanningModel& model, StateChecker& checker,
+                       const Eigen::VectorXd& q_start_full, const Eigen::VectorXd& q_goal,
+                       double time_budget, uint64_t seed, bool fixed_base = false,
+                       const Eigen::VectorXd* lead_in = nullptr) const;
 
  private:
   /// Arm postures that solved earlier goals of this model version, with their camera height

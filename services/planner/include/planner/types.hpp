@@ -39,6 +39,13 @@ struct Params {
   double base_height = std::numeric_limits<double>::quiet_NaN();
   double octomap_resolution = 0.05;  ///< [m]
   double environment_padding = 0.03; ///< robot shapes grown by this against the world [m]
+  /// A start standing up to this far inside the map (odometry drift) is first moved out: the
+  /// nearest base pose clear of the map (x, y within this [m], yaw within this [rad] per metre),
+  /// the move prepended to the path; 0: such a start is refused.
+  double start_tolerance = 0.05;
+  /// A start with links inside each other (self collision) is first moved out by jiggling the
+  /// arm joints by up to this [rad or m], the move prepended; 0: such a start is refused.
+  double start_joint_tolerance = 0.1;
   double floor_clearance = 0.02;     ///< non-leg shapes stay this far above the floor [m]
   double base_range = 3.0;           ///< base x, y sampled within start +- this [m]
   bool fixed_base = false;           ///< per request (PlanRequest::fixed_base): the base keeps its start pose

@@ -24,6 +24,8 @@ Params read_params(config::Document& doc) {
       {"contact_force", &p.contact_force},
       {"torque_margin", &p.torque_margin},
       {"environment_padding", &p.environment_padding},
+      {"start_tolerance", &p.start_tolerance},
+      {"start_joint_tolerance", &p.start_joint_tolerance},
       {"floor_clearance", &p.floor_clearance},
       {"base_range", &p.base_range},
       {"path_attempt_time", &p.path_attempt_time},

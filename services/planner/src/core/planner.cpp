@@ -9,6 +9,8 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <random>
+#include <sstream>
 
 #include "path_search.hpp"
 #include "planner/trajectory.hpp"
@@ -210,9 +212,87 @@ Environment Planner::environment() const {
   return environment_;
 }
 
+namespace {
+
+// The nearest base pose (x, y within `tolerance` [m], yaw within `tolerance` [rad]) at which
+// `q` is clear of the map for `checker`, or none. Candidates on rings of 1 cm, 16 directions,
+// yaw steps of 0.01 rad, cheapest first (distance + yaw x 1 m); deterministic.
+std::optional<Eigen::VectorXd> base_out_of_map(StateChecker& checker, const Eigen::VectorXd& q,
+                                               double tolerance) {
+  struct Candidate {
+    double cost;
+    Eigen::Vector3d d;
+  };
+  std::vector<Candidate> candidates;
+  const int rings = static_cast<int>(std::floor(tolerance / 0.01 + 1e-9));
+  for (int r = 0; r <= rings; ++r) {
+    const int directions = r == 0 ? 1 : 16;
+    for (int k = 0; k < directions; ++k) {
+      const double a = 2.0 * M_PI * k / directions;
+      for (int y = -rings; y <= rings; ++y) {
+        if (r == 0 && y == 0) continue;
+        const Eigen::Vector3d d(0.01 * r * std::cos(a), 0.01 * r * std::sin(a), 0.01 * y);
+        candidates.push_back({0.01 * r + std::abs(d.z()), d});
+      }
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
+  Eigen::VectorXd moved = q;
+  for (const Candidate& c : candidates) {
+    moved.head<3>() = q.head<3>() + c.d;
+    if (checker.check(moved).constraint != Constraint::kEnvironmentCollision) return moved;
+  }
+  return std::nullopt;
+}
+
+// A valid state with the planned arm joints of `q` moved by at most `tolerance` [rad or m]
+// each, or none: one joint at a time first, the smallest move (5 mrad steps; the demo's arm
+// stood 50 mrad of J3_E inside its posture's shapes, the joint's deflection under gravity),
+// then seeded random moves of every joint within growing bounds, as MoveIt's
+// FixStartStateCollision does; clamped to the joint limits.
+std::optional<Eigen::VectorXd> arm_out_of_self_collision(const PlanningModel& model,
+                                                         StateChecker& checker,
+                                                         const Eigen::VectorXd& q, double tolerance,
+                                                         uint64_t seed) {
+  const std::vector<int>& planned = model.planned_indices();
+  const auto clamp = [&](std::size_t j, double v) {
+    return std::clamp(v, model.lower()[static_cast<Eigen::Index>(j)],
+                      model.upper()[static_cast<Eigen::Index>(j)]);
+  };
+  Eigen::VectorXd moved = q;
+  const int steps = static_cast<int>(std::floor(tolerance / 0.005 + 1e-9));
+  for (int k = 1; k <= steps; ++k) {
+    for (std::size_t j = 3; j < planned.size(); ++j) {
+      const int i = planned[j];
+      for (const double sign : {1.0, -1.0}) {
+        moved[i] = clamp(j, q[i] + sign * 0.005 * k);
+        if (checker.check(moved).valid()) return moved;
+      }
+      moved[i] = q[i];
+    }
+  }
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int round = 1; round <= 8; ++round) {
+    const double bound = tolerance * round / 8.0;
+    for (int attempt = 0; attempt < 40; ++attempt) {
+      for (std::size_t j = 3; j < planned.size(); ++j) {
+        const int i = planned[j];
+        moved[i] = clamp(j, q[i] + bound * unit(rng));
+      }
+      if (checker.check(moved).valid()) return moved;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
                               const Eigen::VectorXd& q_start_full, const Eigen::VectorXd& q_goal,
-                              double time_budget, uint64_t seed, bool fixed_base) const {
+                              double time_budget, uint64_t seed, bool fixed_base,
+                              const Eigen::VectorXd* lead_in) const {
   const auto t0 = Clock::now();
   const auto cpu0 = ThreadCpuClock::now();
   GoalResult r;
@@ -228,7 +308,7 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   params.fixed_base = fixed_base;
   detail::PathSearch search(model, checker, params, q_start_full, q_goal, seed,
                             [&](const Eigen::VectorXd& arm) { return arm_path_to(model, arm); });
-  const std::vector<Eigen::VectorXd> waypoints =
+  std::vector<Eigen::VectorXd> waypoints =
       search.run(cpu0 + std::chrono::duration_cast<ThreadCpuClock::duration>(
                             std::chrono::duration<double>(time_budget)));
   r.goal_q = search.goal();
@@ -239,6 +319,7 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
     r.reason = search.reason();
     return r;
   }
+  if (lead_in) waypoints.insert(waypoints.begin(), model.to_planned(*lead_in));
   r.trajectory = time_parameterize(waypoints, model.joint_names(), motion_limits(model, params_),
                                    params_.sample_period);
   r.status = Status::kSucceeded;
@@ -304,12 +385,67 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       start_ok = v;
     }
   }
+  // A start a few centimetres inside the map (the base's odometry drifts; on the demo, a leg
+  // was found 2-4 cm inside the wall after the first hole's whole-body move), or with two links
+  // a hair inside each other (the planner's shapes are conservative, and the drill's Cartesian
+  // motions leave the arm a little off the posture the planner checked): the nearest state clear
+  // of both is planned from, and the move there is prepended to the path (what MoveIt's
+  // FixStartStateCollision adapter does). A start over a joint or torque limit, or on the floor,
+  // is refused as before.
+  std::optional<Eigen::VectorXd> lead_in;
+  Eigen::VectorXd start = q_start_full;
+  if (start_ok.constraint == Constraint::kEnvironmentCollision ||
+      start_ok.constraint == Constraint::kSelfCollision) {
+    auto unpadded = std::make_unique<StateChecker>(model, env, params_, 0.0);
+    std::optional<Eigen::VectorXd> moved = q_start_full;
+    std::vector<std::string> what;
+    Validity v = unpadded->check(*moved);
+    if (v.constraint == Constraint::kEnvironmentCollision && params_.start_tolerance > 0.0) {
+      moved = base_out_of_map(*unpadded, *moved, params_.start_tolerance);
+      if (moved) {
+        const Eigen::Vector3d d = moved->head<3>() - q_start_full.head<3>();
+        std::ostringstream s;
+        s << "inside the map (" << v.detail << "): the base moved out by "
+          << std::round(1e3 * std::hypot(d.x(), d.y())) << " mm and "
+          << std::round(10.0 * d.z() * 180.0 / M_PI) / 10.0 << " deg";
+        what.push_back(s.str());
+        v = unpadded->check(*moved);
+      }
+    }
+    if (moved && v.constraint == Constraint::kSelfCollision &&
+        params_.start_joint_tolerance > 0.0) {
+      const std::string detail = v.detail;
+      moved = arm_out_of_self_collision(*model, *unpadded, *moved, params_.start_joint_tolerance,
+                                        params_.seed + request.request_id);
+      if (moved) {
+        std::ostringstream s;
+        s << "in self collision (" << detail << "): the arm moved out by "
+          << std::round(
+                 1e3 * (moved->tail(moved->size() - 3) - q_start_full.tail(q_start_full.size() - 3))
+                           .cwiseAbs()
+                           .maxCoeff()) /
+                 1e3
+          << " rad at most";
+        what.push_back(s.str());
+        v = unpadded->check(*moved);
+      }
+    }
+    if (moved && v.valid()) {
+      std::string note = "the start is";
+      for (std::size_t i = 0; i < what.size(); ++i) note += (i ? "; and " : " ") + what[i];
+      out.note = note + ", first";
+      lead_in = q_start_full;
+      start = *moved;
+      checker_ptr = std::move(unpadded);
+      start_ok = v;
+    }
+  }
   StateChecker& checker = *checker_ptr;
   if (!start_ok.valid()) {
     return fail(Status::kInvalidStart, std::string("start state rejected by ") +
                                            to_string(start_ok.constraint) + ": " + start_ok.detail);
   }
-  Eigen::VectorXd current = q_start_full;
+  Eigen::VectorXd current = start;
   out.status = Status::kSucceeded;
   for (std::size_t g = 0; g < request.goals.size(); ++g) {
     const auto t0 = ThreadCpuClock::now();
@@ -361,7 +497,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       }
       const double remaining = params_.planning_time - cpu_seconds_since(t0);
       r = plan_path(*model, checker, current, posture.q,
-                    std::min(remaining, params_.path_attempt_time), seed, request.fixed_base);
+                    std::min(remaining, params_.path_attempt_time), seed, request.fixed_base,
+                    g == 0 && lead_in ? &*lead_in : nullptr);
       r.nspg_seconds = nspg;
       if (r.status == Status::kSucceeded) remember(*model, height, posture.q);
       if (r.status == Status::kNoPath) unreached.push_back(posture.q.tail(posture.q.size() - 3));
