@@ -135,8 +135,14 @@ void BaseKinematics::leg_setpoints(const Eigen::Vector3d& twist, const std::vect
     const double current = current_steering[i];
     const Eigen::Vector2d v(twist.x() - twist.z() * leg.position.y(), twist.y() + twist.z() * leg.position.x());
     const double speed = v.norm();
-    if (speed < 1e-6) {
-      out[i] = {current, 0.0};
+    if (speed < kSteeringDeadband) {
+      // Too slow to be worth turning the wheel: the direction of a few mm/s (a tracking
+      // correction at the end of a path) swings with every cycle, and each swing scrubs the
+      // loaded wheel; a leg so steered on the demo's whole-body moves ran its steering drive
+      // over its continuous torque. The wheel rolls the part of v along its heading.
+      const double heading = leg.heading_offset + leg.steering_sign * current;
+      out[i] = {current,
+                (v.x() * std::cos(heading) + v.y() * std::sin(heading)) / leg.wheel_radius};
       continue;
     }
     const double heading = std::atan2(v.y(), v.x());

@@ -31,6 +31,9 @@ struct LegSetpoint {
   double wheel_velocity{0.0};  ///< [rad/s]
 };
 
+/// Contact speed below which a leg is not steered [m/s].
+inline constexpr double kSteeringDeadband = 0.005;
+
 /// Planar base pose and twist (odometry).
 struct Odometry {
   double x{0.0}, y{0.0}, yaw{0.0};     ///< pose in the odometry frame [m, m, rad]
@@ -64,8 +67,9 @@ class BaseKinematics {
   /// Steering angles and wheel speeds for the base twist (vx, vy [m/s], wz [rad/s]).
   /// Each steering angle is chosen closest to `current_steering`: if the wheel would turn
   /// by more than 90 degrees, it turns by the supplement and rolls backwards (the 180
-  /// degree flip); steering limits are respected by flipping too. A leg with ~zero
-  /// contact speed keeps its current angle.
+  /// degree flip); steering limits are respected by flipping too. A leg whose contact speed
+  /// is below kSteeringDeadband keeps its current angle and rolls the part of its velocity
+  /// along its heading.
   [[nodiscard]] std::vector<LegSetpoint> leg_setpoints(const Eigen::Vector3d& twist,
                                                        const std::vector<double>& current_steering) const;
   /// Same into `out` (resized to the leg count: no allocation once it has that size).
