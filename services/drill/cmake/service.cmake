@@ -25,3 +25,10 @@ if(TARGET concert_dds)
   target_include_directories(concert_drill_cli PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
   target_link_libraries(concert_drill_cli PUBLIC concert_cli PRIVATE concert_dds nlohmann_json::nlohmann_json)
 endif()
+
+# Area location on frames the simulator's camera renders (libs/sim SceneCamera).
+concert_add_test(NAME area_detection_test
+  SOURCES test/area_detection_test.cpp
+  LIBS concert_drill_core concert_sim concert_world
+  LABELS drill
+  TIMEOUT 120)

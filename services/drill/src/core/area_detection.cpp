@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "drill/patterns.hpp"
@@ -70,9 +71,22 @@ ResolvedArea locate_area(const AreaSpec& area, const CameraView& view) {
       if (!in_view(view, *area.point)) {
         throw DrillError("point " + fixed(*area.point) + " is outside the drill camera's view");
       }
-      out.frame =
-          view.world_T_optical *
-          area_frame_at(frame, Eigen::Vector3d(view.world_T_optical.inverse() * *area.point), up);
+      const Eigen::Vector3d p = view.world_T_optical.inverse() * *area.point;
+      try {
+        out.frame = view.world_T_optical * area_frame_at(frame, p, up);
+      } catch (const DrillError&) {
+        // No surface near the point itself: it was located from afar, or the base's odometry
+        // drifted over the approach (on the demo the camera once found no wall within 7 cm of
+        // it). The surface along the point's line of sight is taken instead; if none, the
+        // first reason.
+        std::optional<Eigen::Isometry3d> along;
+        try {
+          along = area_frame_at(frame, project(frame.intrinsics, p), up);
+        } catch (const DrillError&) {
+        }
+        if (!along) throw;
+        out.frame = view.world_T_optical * *along;
+      }
     } else {
       throw DrillError("has neither a point nor a pixel to locate it in the camera's view");
     }

@@ -42,6 +42,9 @@ constexpr double kSettleBack = 1.0;
 // wall; a base planned 3 cm from the wall was found inside it by the next plan. (The holes'
 // drilling postures keep the planner's padding: at 10 cm it found none for the demo's blobs.)
 constexpr double kPlanPadding = 0.10;
+// An area's approach is planned again with another seed when no path or posture was found
+// within the planner's budget (on the demo about one plan in ten), this many times in all.
+constexpr int kPlanAttempts = 3;
 // Re-measuring a hole from its drilling posture: frames averaged, and how far from the predicted
 // position the mark may be found [m] (odometry drift over the base's move).
 constexpr int kReanchorFrames = 3;
@@ -617,6 +620,7 @@ void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& frame,
                                            prev->second.end.data() + prev->second.end.size()));
     }
   }
+  p.request = r;
   plans_[area] = p;
   plan_requests_.write(r);
 }
@@ -633,6 +637,19 @@ Outcome DrillNode::planning(std::size_t area) {
     if (found != plan_results_.end()) r = found->second;
   }
   if (!r) return Outcome::running();
+  if (r->state() == msg::PLAN_FAILED && p.attempts < kPlanAttempts &&
+      (r->failure() == msg::PLAN_NO_PATH || r->failure() == msg::PLAN_UNREACHABLE)) {
+    // The search is randomised (seeded by the request id): another request searches anew.
+    ++p.attempts;
+    p.request_id = next_request_++;
+    p.request.request_id(p.request_id);
+    p.request.stamp_ns(now_ns());
+    log_line("drill: area " + std::to_string(area) + ": " + r->reason() +
+             "; planning again (attempt " + std::to_string(p.attempts) + " of " +
+             std::to_string(kPlanAttempts) + ")");
+    plan_requests_.write(p.request);
+    return Outcome::running();
+  }
   if (r->state() == msg::PLAN_FAILED) return Outcome::failed("planner: " + r->reason());
   if ((r->state() == msg::PLAN_PLANNED || r->state() == msg::PLAN_SUCCEEDED) &&
       !r->trajectory().empty()) {
@@ -684,8 +701,43 @@ void DrillNode::execute(std::size_t area) {
 
 // From the measured state back through every hole's planned path, reversed.
 std::vector<msg::TrajectorySample> DrillNode::return_path(const Sample& s) const {
-  const std::vector<std::string>& names = hole_chain_.front().names;
-  std::vector<msg::TrajectorySample> back;
+  std::vector<msg::TrajectorySample> back{sample_here(hole_chain_.front().names, s)};
+  double t = 0.0;
+  for (auto path = hole_chain_.rbegin(); path != hole_chain_.rend(); ++path) {
+    // Each path's end is where the Cartesian phase started, within centimetres of where it
+    // left the arm: a settling second to reach it, then the path backwards.
+    t += path == hole_chain_.rbegin() ? settle_time(path->names, back.front(), path->samples.back())
+                                      : kSettleBack;
+    const double end = path->samples.back().time();
+    for (auto it = path->samples.rbegin(); it != path->samples.rend(); ++it) {
+      msg::TrajectorySample sample = *it;
+      sample.time(t + end - it->time());
+      for (double& v : sample.velocity()) v = -v;
+      back.push_back(sample);
+    }
+    t += end;
+  }
+  return back;
+}
+
+// Time to go straight from `from` to `to` (zero velocity at both ends) at a third of a slow
+// joint speed (0.5 rad/s, base 0.2 m/s): at least kSettleBack. The Cartesian phases can leave
+// a joint far off its posture (a wrist turned about the bit); a fixed second drove the demo's
+// J6_E past its velocity limit.
+double DrillNode::settle_time(const std::vector<std::string>& names,
+                              const msg::TrajectorySample& from, const msg::TrajectorySample& to) {
+  double t = kSettleBack;
+  for (std::size_t i = 0;
+       i < names.size() && i < from.position().size() && i < to.position().size(); ++i) {
+    const bool base = names[i] == "base_x" || names[i] == "base_y";
+    const double speed = base ? 0.2 : 0.5;
+    t = std::max(t, 3.0 * std::abs(to.position()[i] - from.position()[i]) / speed);
+  }
+  return t;
+}
+
+msg::TrajectorySample DrillNode::sample_here(const std::vector<std::string>& names,
+                                             const Sample& s) {
   msg::TrajectorySample here;
   here.time(0.0);
   for (const std::string& n : names) {
@@ -700,22 +752,7 @@ std::vector<msg::TrajectorySample> DrillNode::return_path(const Sample& s) const
     here.position().push_back(v);
     here.velocity().push_back(0.0);
   }
-  back.push_back(here);
-  double t = 0.0;
-  for (auto path = hole_chain_.rbegin(); path != hole_chain_.rend(); ++path) {
-    // Each path's end is where the Cartesian phase started, within centimetres of where it
-    // left the arm: a settling second to reach it, then the path backwards.
-    t += kSettleBack;
-    const double end = path->samples.back().time();
-    for (auto it = path->samples.rbegin(); it != path->samples.rend(); ++it) {
-      msg::TrajectorySample sample = *it;
-      sample.time(t + end - it->time());
-      for (double& v : sample.velocity()) v = -v;
-      back.push_back(sample);
-    }
-    t += end;
-  }
-  return back;
+  return here;
 }
 
 Outcome DrillNode::execution() {
@@ -986,6 +1023,20 @@ void DrillNode::control_motion() {
     if (const std::optional<Sample> s = latest_sample()) start_align(*s);
     return;
   }
+  if (motion_ == Motion::kSettle) {
+    std::lock_guard lock(mutex_);
+    const auto it = trajectory_statuses_.find(trajectory_request_);
+    if (it == trajectory_statuses_.end()) return;
+    if (it->second.state() == msg::TRAJECTORY_SUCCEEDED) {
+      motion_outcome_ = Outcome::succeeded();
+      motion_ = Motion::kNone;
+    } else if (it->second.state() != msg::TRAJECTORY_EXECUTING) {
+      motion_outcome_ =
+          Outcome::failed("robot: back onto the drilling posture: " + it->second.reason());
+      motion_ = Motion::kNone;
+    }
+    return;
+  }
   const std::optional<Sample> s = latest_sample();
   if (!s) return;
   if (point_.servo && (motion_ == Motion::kAlign || motion_ == Motion::kDrill)) {
@@ -1002,6 +1053,24 @@ void DrillNode::control_motion() {
   if (drill_motion_.phase() == DrillMotion::Phase::kFailed) {
     motion_outcome_ = Outcome::failed(drill_motion_.reason());
     motion_ = Motion::kNone;
+  } else if (drill_motion_.phase() == DrillMotion::Phase::kDone && motion_ == Motion::kRetractOut &&
+             !hole_chain_.empty()) {
+    // Out of the hole, the arm goes back onto the drilling posture the planner checked: the
+    // Cartesian phases leave it a little off (up to 0.1 rad on the demo's arm, two of its links
+    // then inside each other by the planner's shapes), and the next hole is planned from here.
+    const PlannedPath& p = hole_chain_.back();
+    const msg::TrajectorySample here = sample_here(p.names, *s);
+    msg::TrajectorySample end = p.samples.back();
+    const double t = settle_time(p.names, here, end);
+    end.time(t);
+    for (double& v : end.velocity()) v = 0.0;
+    if (t > kSettleBack) {
+      std::ostringstream line;
+      line << "drill: " << point_.label << ": back onto the drilling posture over " << t << " s";
+      log_line(line.str());
+    }
+    trajectory_request_ = send_trajectory(p.names, {here, end});
+    motion_ = Motion::kSettle;
   } else if (drill_motion_.phase() == DrillMotion::Phase::kDone) {
     motion_outcome_ = Outcome::succeeded();
     // Keep holding the reference until the next motion (the loop re-sends the last one).

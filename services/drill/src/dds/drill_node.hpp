@@ -90,6 +90,8 @@ class DrillNode final : public MissionPorts {
   };
   struct Plan {
     std::uint32_t request_id{0};
+    msg::PlanRequest request;  ///< as sent (a retry sends it again under a new id)
+    int attempts{1};
     std::optional<msg::PlanResult> result;
     std::vector<std::string> names;  ///< of the trajectory
     Eigen::VectorXd end;             ///< last sample's positions
@@ -100,7 +102,7 @@ class DrillNode final : public MissionPorts {
     Eigen::Isometry3d world_T_optical{Eigen::Isometry3d::Identity()};
     Eigen::Isometry3d base_T_optical{Eigen::Isometry3d::Identity()};
   };
-  enum class Motion { kNone, kApproachHole, kReanchor, kAlign, kDrill, kRetractOut };
+  enum class Motion { kNone, kApproachHole, kReanchor, kAlign, kDrill, kRetractOut, kSettle };
 
   void tick();
   [[nodiscard]] bool mission_active() const;
@@ -112,6 +114,12 @@ class DrillNode final : public MissionPorts {
   void send_hold();
   void start_align(const Sample& s);
   [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
+  // The measured state of `names` (base joints from odometry) as a trajectory sample at t = 0.
+  [[nodiscard]] static double settle_time(const std::vector<std::string>& names,
+                                          const msg::TrajectorySample& from,
+                                          const msg::TrajectorySample& to);
+  [[nodiscard]] static msg::TrajectorySample sample_here(const std::vector<std::string>& names,
+                                                         const Sample& s);
   std::uint32_t send_trajectory(const std::vector<std::string>& names,
                                 const std::vector<msg::TrajectorySample>& samples);
   [[nodiscard]] std::optional<Sample> latest_sample() const;

@@ -1,0 +1,100 @@
+// Locating a drilling area in the drill camera's view (src/core/area_detection.cpp), on frames
+// rendered by the simulator's own camera (libs/sim SceneCamera, RealSense noise on): a picked
+// point on the wall, one a few centimetres off it (located from afar, or odometry drifted over
+// the approach), a pixel, and the errors.
+#include "drill/area_detection.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+
+#include "concert/sim/scene_camera.hpp"
+#include "concert/world/geometry.hpp"
+#include "drill/mission.hpp"
+
+namespace concert::drill {
+namespace {
+
+using ::testing::HasSubstr;
+
+[[maybe_unused]] const bool kHeadless = [] {
+  unsetenv("DISPLAY");
+  unsetenv("WAYLAND_DISPLAY");
+  return true;
+}();
+
+// A wall whose face is x = 2.0 (facing -x) and a camera 0.6 m in front of (2.0, 0, 1.2).
+struct Scene {
+  Scene() {
+    world::WorldShape wall;
+    wall.name = "wall";
+    wall.size = {0.2, 5.0, 3.0};
+    wall.position = {2.1, 0.0, 1.5};
+    w.walls.push_back(wall);
+    sim::CameraParams params;
+    params.noise = true;
+    camera = sim::look_at(Eigen::Vector3d(1.4, 0.0, 1.2), Eigen::Vector3d(2.0, 0.0, 1.2));
+    frame = sim::SceneCamera(w, params, 3).render(camera);
+  }
+  [[nodiscard]] CameraView view() const { return {&frame, camera}; }
+  world::World w;
+  Eigen::Isometry3d camera;
+  hardware::RgbdFrame frame;
+};
+
+AreaSpec point_area(const Eigen::Vector3d& p) {
+  AreaSpec a;
+  a.name = "a1";
+  a.point = p;
+  return a;
+}
+
+TEST(LocateArea, PointOnTheWallGivesItsFrameWithZAlongTheNormal) {
+  const Scene s;
+  const ResolvedArea r = locate_area(point_area({2.0, 0.1, 1.25}), s.view());
+  EXPECT_LT((r.frame.translation() - Eigen::Vector3d(2.0, 0.1, 1.25)).norm(), 0.005)
+      << r.frame.translation().transpose();
+  EXPECT_GT(r.frame.linear().col(2).dot(-Eigen::Vector3d::UnitX()), std::cos(1.0 * M_PI / 180.0));
+  EXPECT_NEAR(r.frame.linear().col(1).z(), 1.0, 1e-3);  // y up
+}
+
+TEST(LocateArea, PointOffTheSurfaceIsTakenAlongItsLineOfSight) {
+  const Scene s;
+  // 9 cm in front of the wall, 1.5 cm aside of the camera's axis: no surface within the normal's
+  // 7 cm; the wall where the point's ray meets it.
+  const Eigen::Vector3d picked(1.91, 0.015, 1.2);
+  const ResolvedArea r = locate_area(point_area(picked), s.view());
+  const Eigen::Vector3d ray = (picked - s.camera.translation()).normalized();
+  const Eigen::Vector3d on_wall =
+      s.camera.translation() + ray * ((2.0 - s.camera.translation().x()) / ray.x());
+  EXPECT_LT((r.frame.translation() - on_wall).norm(), 0.005) << r.frame.translation().transpose();
+  // 9 cm behind the wall: the same ray, the same surface.
+  const Eigen::Vector3d behind =
+      s.camera.translation() + ray * ((2.09 - s.camera.translation().x()) / ray.x());
+  EXPECT_LT((locate_area(point_area(behind), s.view()).frame.translation() - on_wall).norm(),
+            0.005);
+}
+
+TEST(LocateArea, PixelAndErrors) {
+  const Scene s;
+  AreaSpec a;
+  a.name = "a2";
+  a.pixel = Eigen::Vector2d(319.5, 239.5);
+  EXPECT_LT((locate_area(a, s.view()).frame.translation() - Eigen::Vector3d(2.0, 0.0, 1.2)).norm(),
+            0.005);
+  try {
+    (void)locate_area(point_area({2.0, 3.0, 1.2}), s.view());
+    FAIL() << "a point out of the image was located";
+  } catch (const DrillError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("area 'a1'"));
+    EXPECT_THAT(e.what(), HasSubstr("outside the drill camera's view"));
+  }
+  AreaSpec none;
+  none.name = "a3";
+  EXPECT_THROW((void)locate_area(none, s.view()), DrillError);
+}
+
+}  // namespace
+}  // namespace concert::drill
