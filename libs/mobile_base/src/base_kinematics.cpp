@@ -130,19 +130,28 @@ void BaseKinematics::leg_setpoints(const Eigen::Vector3d& twist, const std::vect
                                 " steering angles for " + std::to_string(legs_.size()) + " legs");
   }
   out.resize(legs_.size());
+  const auto contact_velocity = [&](const Leg& leg) {
+    return Eigen::Vector2d(twist.x() - twist.z() * leg.position.y(),
+                           twist.y() + twist.z() * leg.position.x());
+  };
+  // A base twist whose every contact moves slower than the deadband is not driven: the direction
+  // of a few mm/s (a tracking correction at the end of a path) swings with every cycle, and
+  // each swing scrubs the loaded wheels (on the demo's whole-body moves a steering drive ran
+  // over its continuous torque). Per leg it would not do: a leg rolling along a stale heading
+  // while the others steer fights them (a wheel drive over its continuous torque).
+  double fastest = 0.0;
+  for (const Leg& leg : legs_) fastest = std::max(fastest, contact_velocity(leg).norm());
+  if (fastest < kSteeringDeadband) {
+    for (std::size_t i = 0; i < legs_.size(); ++i) out[i] = {current_steering[i], 0.0};
+    return;
+  }
   for (std::size_t i = 0; i < legs_.size(); ++i) {
     const Leg& leg = legs_[i];
     const double current = current_steering[i];
-    const Eigen::Vector2d v(twist.x() - twist.z() * leg.position.y(), twist.y() + twist.z() * leg.position.x());
+    const Eigen::Vector2d v = contact_velocity(leg);
     const double speed = v.norm();
-    if (speed < kSteeringDeadband) {
-      // Too slow to be worth turning the wheel: the direction of a few mm/s (a tracking
-      // correction at the end of a path) swings with every cycle, and each swing scrubs the
-      // loaded wheel; a leg so steered on the demo's whole-body moves ran its steering drive
-      // over its continuous torque. The wheel rolls the part of v along its heading.
-      const double heading = leg.heading_offset + leg.steering_sign * current;
-      out[i] = {current,
-                (v.x() * std::cos(heading) + v.y() * std::sin(heading)) / leg.wheel_radius};
+    if (speed < 1e-6) {
+      out[i] = {current, 0.0};
       continue;
     }
     const double heading = std::atan2(v.y(), v.x());
@@ -189,10 +198,15 @@ Eigen::Vector3d BaseKinematics::twist_from_legs(const std::vector<double>& steer
 void BaseKinematics::integrate(Odometry& odometry, const std::vector<double>& steering,
                                const std::vector<double>& wheel_velocity, double dt) const {
   const Eigen::Vector3d twist = twist_from_legs(steering, wheel_velocity);
-  const double mid_yaw = odometry.yaw + 0.5 * twist.z() * dt;
+  integrate(odometry, twist, twist.z(), dt);
+}
+
+void BaseKinematics::integrate(Odometry& odometry, const Eigen::Vector3d& twist, double yaw_rate,
+                               double dt) {
+  const double mid_yaw = odometry.yaw + 0.5 * yaw_rate * dt;
   odometry.x += (std::cos(mid_yaw) * twist.x() - std::sin(mid_yaw) * twist.y()) * dt;
   odometry.y += (std::sin(mid_yaw) * twist.x() + std::cos(mid_yaw) * twist.y()) * dt;
-  odometry.yaw = wrap(odometry.yaw + twist.z() * dt);
+  odometry.yaw = wrap(odometry.yaw + yaw_rate * dt);
   odometry.vx = twist.x();
   odometry.vy = twist.y();
   odometry.wz = twist.z();

@@ -31,7 +31,7 @@ struct LegSetpoint {
   double wheel_velocity{0.0};  ///< [rad/s]
 };
 
-/// Contact speed below which a leg is not steered [m/s].
+/// Fastest contact speed below which the base is not driven (steering held, wheels stopped) [m/s].
 inline constexpr double kSteeringDeadband = 0.005;
 
 /// Planar base pose and twist (odometry).
@@ -67,9 +67,9 @@ class BaseKinematics {
   /// Steering angles and wheel speeds for the base twist (vx, vy [m/s], wz [rad/s]).
   /// Each steering angle is chosen closest to `current_steering`: if the wheel would turn
   /// by more than 90 degrees, it turns by the supplement and rolls backwards (the 180
-  /// degree flip); steering limits are respected by flipping too. A leg whose contact speed
-  /// is below kSteeringDeadband keeps its current angle and rolls the part of its velocity
-  /// along its heading.
+  /// degree flip); steering limits are respected by flipping too. A leg with ~zero contact
+  /// speed keeps its current angle. A twist whose contacts all move slower than
+  /// kSteeringDeadband is not driven: every leg keeps its angle, every wheel stops.
   [[nodiscard]] std::vector<LegSetpoint> leg_setpoints(const Eigen::Vector3d& twist,
                                                        const std::vector<double>& current_steering) const;
   /// Same into `out` (resized to the leg count: no allocation once it has that size).
@@ -84,6 +84,10 @@ class BaseKinematics {
   /// Integrates the odometry by `dt` [s] with the twist measured from the legs.
   void integrate(Odometry& odometry, const std::vector<double>& steering, const std::vector<double>& wheel_velocity,
                  double dt) const;
+  /// Integrates the odometry by `dt` [s]: the pose with the legs' `twist` (vx, vy) and
+  /// `yaw_rate` [rad/s] (a gyro's, or the twist's wz); the odometry's twist is `twist`.
+  static void integrate(Odometry& odometry, const Eigen::Vector3d& twist, double yaw_rate,
+                        double dt);
 
  private:
   std::vector<Leg> legs_;
