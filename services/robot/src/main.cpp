@@ -66,6 +66,32 @@ class SensorSinkRegistration {
   concert::hardware::Hardware& hardware_;
 };
 
+/// The backend's sensor data to DDS, and the base's IMU also to the core (its odometry's yaw).
+class SensorFanOut final : public concert::hardware::SensorSink {
+ public:
+  SensorFanOut(concert::hardware::SensorSink& publisher, concert::robot::RobotCore& core)
+      : publisher_(publisher), core_(core) {}
+  void on_sensors(const std::vector<concert::hardware::SensorInfo>& mounted) override {
+    publisher_.on_sensors(mounted);
+  }
+  void on_rgbd(const concert::hardware::RgbdFrame& frame) override { publisher_.on_rgbd(frame); }
+  void on_lidar(const concert::hardware::LidarScan& scan) override { publisher_.on_lidar(scan); }
+  void on_scan2d(const concert::hardware::LaserScan2d& scan) override {
+    publisher_.on_scan2d(scan);
+  }
+  void on_sonars(const concert::hardware::SonarRanges& ranges) override {
+    publisher_.on_sonars(ranges);
+  }
+  void on_imu(const concert::hardware::ImuSample& sample) override {
+    core_.on_imu(sample);
+    publisher_.on_imu(sample);
+  }
+
+ private:
+  concert::hardware::SensorSink& publisher_;
+  concert::robot::RobotCore& core_;
+};
+
 void on_signal(int) {
   if (auto* loop = g_loop.load()) {
     loop->stop();
@@ -172,7 +198,8 @@ int run(const Options& options) {
     // The backend's sensor threads hand their data to DDS from now on, until the registration
     // (made after the publisher, so gone before it, also on an exception) unsets it.
     robot::dds::SensorPublisher sensors(participant, static_cast<std::uint32_t>(core.model_version()));
-    const SensorSinkRegistration registration(sim, sensors);
+    SensorFanOut fan_out(sensors, core);
+    const SensorSinkRegistration registration(sim, fan_out);
     if (!options.assembly.empty()) {
       node.publish_scan(simulated.scan, "sim");
     }

@@ -2,14 +2,18 @@
 // tree -> modelgen URDF (public CONCERT module database) -> sim backend + robot core.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cmath>
 #include <filesystem>
+#include <thread>
 
+#include "concert/model_generation/generator.hpp"
 #include "concert/module_db/module_db.hpp"
+#include "concert/sim/sim_assembly.hpp"
+#include "concert/sim/sim_hardware.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/esc_catalog.hpp"
-#include "concert/model_generation/generator.hpp"
 #include "robot/robot_core.hpp"
-#include "concert/sim/sim_hardware.hpp"
 #include "test_helpers.hpp"
 
 namespace concert::robot {
@@ -73,6 +77,57 @@ TEST(PaperRobot, BaseDrivesOnTheGeneratedLegs) {
   const Eigen::Vector3d truth = sim.base_pose().translation();
   EXPECT_GT(truth.x(), 0.3);
   EXPECT_NEAR(s.odometry.x, truth.x(), 0.1 * truth.x());
+}
+
+// The base's yaw from its IMU (the demo's drill robot, its IMU on the base with the simulator's
+// MEMS noise and bias): a turn and back, then a drive. The wheels alone see the turn 3 % too
+// large and miss the base turning while the legs steer in place (measured: 0.036 rad after a
+// 1.12 rad turn, 0.03 rad more over the drive).
+TEST(PaperRobot, TheGyroKeepsTheOdometrysYaw) {
+  const sim::AssemblyBuilder builder({std::string(CONCERT_SOURCE_DIR) + "/data/module_db"});
+  sim::SimulatedRobot robot =
+      builder.build(std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml");
+  std::vector<sim::SensorMount> imu;
+  for (const auto& m : robot.sensors)
+    if (m.type == hardware::SensorType::kImu) imu.push_back(m);
+  ASSERT_EQ(imu.size(), 1u);
+  SimParams params;
+  params.sensors.imu.noise = true;
+  params.sensors.seed = 3;
+  SimHardware sim(robot.urdf, World{}, params, imu);
+  RobotCore core(sim);
+  core.set_model(robot.urdf, 1);
+  struct Forward final : hardware::SensorSink {
+    explicit Forward(RobotCore& c) : core(c) {}
+    void on_imu(const hardware::ImuSample& s) override { core.on_imu(s); }
+    RobotCore& core;
+  } forward(core);
+  sim.set_sensor_sink(&forward);
+  // The sensor threads run beside the loop: give them the wall time of each simulated second.
+  const auto run = [&](const BaseCommand& command, int cycles) {
+    for (int k = 0; k < cycles; ++k) {
+      if (k % 100 == 0) core.command_base(command);
+      core.cycle();
+      if (k % 10 == 0) std::this_thread::sleep_for(std::chrono::microseconds(2000));
+    }
+  };
+  const auto yaw_of = [&] {
+    const Eigen::Matrix3d r = sim.base_pose().rotation();
+    return std::atan2(r(1, 0), r(0, 0));
+  };
+  run({1, 0.0, 0.0, 0.0}, 3000);  // standing: the bias is learnt
+  const double truth0 = yaw_of();
+  const double odom0 = core.state().odometry.yaw;
+  run({1, 0.0, 0.0, 0.3}, 4000);
+  run({1, 0.0, 0.0, 0.0}, 1000);
+  const double turned = yaw_of() - truth0;
+  EXPECT_GT(turned, 0.9);
+  EXPECT_NEAR(core.state().odometry.yaw - odom0, turned, 0.01);
+  run({1, 0.0, 0.0, -0.3}, 4000);
+  run({1, 0.2, 0.1, 0.0}, 3000);
+  run({1, 0.0, 0.0, 0.0}, 1000);
+  sim.set_sensor_sink(nullptr);
+  EXPECT_NEAR(core.state().odometry.yaw - odom0, yaw_of() - truth0, 0.01);
 }
 
 }  // namespace

@@ -2,7 +2,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -11,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "concert/hardware/sensors.hpp"
 #include "concert/kinematics/model.hpp"
 #include "robot/base_kinematics.hpp"
 #include "robot/hardware.hpp"
@@ -223,6 +223,10 @@ class RobotCore {
   /// commands in again (the robot keeps holding until commanded).
   void set_safety_stop(bool stopped, const std::string& reason = "");
   [[nodiscard]] bool safety_stopped() const;
+
+  /// An IMU sample (any thread but the loop's; from the backend's sensor sink). One on the
+  /// base (its root link or a link fixed to it) gives the odometry its yaw rate.
+  void on_imu(const hardware::ImuSample& sample);
 
   /// One control period: switch what was prepared, read the hardware, run the controllers,
   /// write, step it by `params.period`. Loop thread only.

@@ -209,7 +209,27 @@ void BaseController::estimate(CycleData& data) {
     steering_[k] = data.q(legs[k].steering_index);
     wheel_velocity_[k] = data.qd(legs[k].wheel_index);
   }
-  kinematics_.integrate(data.odometry, steering_, wheel_velocity_, data.dt);
+  const Eigen::Vector3d twist = kinematics_.twist_from_legs(steering_, wheel_velocity_);
+  double yaw_rate = twist.z();
+  if (std::isfinite(data.base_yaw_rate)) {
+    constexpr double kStill = 1e-3;    // wheel twist below this: the base stands [m/s, rad/s]
+    constexpr double kBiasTime = 2.0;  // time constant of the bias estimate [s]
+    // Still: no wheel rolls and no leg steers (a leg turning in place twists the base, with no
+    // wheel speed to show it).
+    bool still = twist.head<2>().norm() < kStill && std::abs(twist.z()) < kStill;
+    for (const Leg& leg : kinematics_.legs())
+      still = still && std::abs(data.qd(leg.steering_index)) < kStill;
+    if (still) {
+      gyro_bias_ = gyro_bias_known_
+                       ? gyro_bias_ + data.dt / kBiasTime * (data.base_yaw_rate - gyro_bias_)
+                       : data.base_yaw_rate;
+      gyro_bias_known_ = true;
+      yaw_rate = 0.0;
+    } else if (gyro_bias_known_) {
+      yaw_rate = data.base_yaw_rate - gyro_bias_;
+    }
+  }
+  BaseKinematics::integrate(data.odometry, twist, yaw_rate, data.dt);
 }
 
 void BaseController::update(CycleData& data) {

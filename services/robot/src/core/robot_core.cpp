@@ -1,20 +1,26 @@
 #include "robot/robot_core.hpp"
 
 #include <Eigen/Dense>
-
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <set>
 
-#include "robot/controllers.hpp"
 #include "concert/hardware/realtime_buffer.hpp"
+#include "robot/controllers.hpp"
 
 namespace concert::robot {
 
 using hardware::Handover;
 using hardware::RealtimeBuffer;
+
+namespace {
+// An IMU sample older than this (hardware time) is not used for the odometry's yaw [s].
+constexpr double kGyroFresh = 0.05;
+}  // namespace
 
 namespace {
 
@@ -166,6 +172,12 @@ struct RobotCore::Shared {
   std::string safety_reason;
   bool cartesian_admittance{false};
   mutable std::mutex state_mutex;  // readers of the loop's state buffer
+  // on_imu: the model and IMU frame last seen, and whether that frame rides on the base.
+  std::mutex imu_mutex;
+  const kinematics::Model* imu_model{nullptr};
+  std::string imu_frame;
+  bool imu_on_base{false};
+  Eigen::Matrix3d base_R_imu{Eigen::Matrix3d::Identity()};
 };
 
 /// The loop-thread side.
@@ -187,6 +199,9 @@ struct RobotCore::Loop {
   TrajectoryProgress last_progress;  // of a trajectory that ended with its model
   std::atomic<bool> safety_stopped{false};
   RealtimeBuffer<RobotState> state;
+  // The latest yaw rate of the base from an IMU on it (written by on_imu from sensor threads).
+  std::atomic<double> gyro_yaw_rate{0.0};
+  std::atomic<double> gyro_stamp{-1e9};
 };
 
 RobotCore::RobotCore(Hardware& hardware, RobotParams params)
@@ -646,6 +661,9 @@ void RobotCore::cycle() {
     const kinematics::Model& model = *s->model;
     c.time = L.hw_state.time;
     c.dt = dt;
+    c.base_yaw_rate = std::abs(c.time - L.gyro_stamp.load(std::memory_order_acquire)) <= kGyroFresh
+                          ? L.gyro_yaw_rate.load(std::memory_order_relaxed)
+                          : std::numeric_limits<double>::quiet_NaN();
     for (std::size_t h = 0; h < nh; ++h) {
       const int i = s->hw_to_model[h];
       c.q(i) = L.hw_state.position[h];
@@ -785,6 +803,35 @@ std::vector<std::string> RobotCore::arm_joints() const {
 std::vector<Leg> RobotCore::legs() const {
   std::lock_guard lock(shared_->mutex);
   return shared_->accepted != nullptr ? shared_->accepted->legs : std::vector<Leg>{};
+}
+
+void RobotCore::on_imu(const hardware::ImuSample& sample) {
+  const std::shared_ptr<const kinematics::Model> m = model();
+  if (!m || !sample.angular_velocity.allFinite()) return;
+  std::lock_guard lock(shared_->imu_mutex);
+  if (shared_->imu_model != m.get() || shared_->imu_frame != sample.frame) {
+    shared_->imu_model = m.get();
+    shared_->imu_frame = sample.frame;
+    // On the base: the root link or a link no joint moves relative to it.
+    bool on_base = m->has_frame(sample.frame);
+    for (int j = 0; on_base && j < m->dof(); ++j) {
+      if (m->is_virtual_joint(j)) continue;
+      const auto links = m->subtree_links(j);
+      on_base = std::find(links.begin(), links.end(), sample.frame) == links.end();
+    }
+    shared_->imu_on_base = on_base;
+    if (on_base) {
+      kinematics::Data data = m->make_data();
+      shared_->base_R_imu =
+          m->relative_pose(data, Eigen::VectorXd::Zero(m->dof()), m->root_link(), sample.frame)
+              .linear();
+    }
+  }
+  if (!shared_->imu_on_base) return;
+  // The base stands level on the floor: its yaw rate is the angular velocity's z in its frame.
+  loop_->gyro_yaw_rate.store((shared_->base_R_imu * sample.angular_velocity).z(),
+                             std::memory_order_relaxed);
+  loop_->gyro_stamp.store(sample.stamp, std::memory_order_release);
 }
 
 std::shared_ptr<const kinematics::Model> RobotCore::model() const {
