@@ -372,72 +372,68 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       request.environment_padding > 0.0 ? request.environment_padding : params_.environment_padding;
   auto checker_ptr = std::make_unique<StateChecker>(model, env, params_, padding);
   Validity start_ok = checker_ptr->check(q_start_full);
-  if (start_ok.constraint == Constraint::kEnvironmentCollision && padding > 0.0) {
-    // A robot standing closer to the map than the padding (odometry drifts: the map is in the
-    // world, the start in the odometry frame; after the drill's approach the demo's base was
-    // 4 cm off) may still move away from it: this request is planned without the padding, its
-    // shapes against the map's true surfaces.
-    auto unpadded = std::make_unique<StateChecker>(model, env, params_, 0.0);
-    if (const Validity v = unpadded->check(q_start_full); v.valid()) {
-      out.note = "the start is within the environment padding (" + start_ok.detail +
-                 "): planned without it";
-      checker_ptr = std::move(unpadded);
-      start_ok = v;
-    }
-  }
-  // A start a few centimetres inside the map (the base's odometry drifts; on the demo, a leg
-  // was found 2-4 cm inside the wall after the first hole's whole-body move), or with two links
-  // a hair inside each other (the planner's shapes are conservative, and the drill's Cartesian
-  // motions leave the arm a little off the posture the planner checked): the nearest state clear
-  // of both is planned from, and the move there is prepended to the path (what MoveIt's
-  // FixStartStateCollision adapter does). A start over a joint or torque limit, or on the floor,
-  // is refused as before.
+  // A start a few centimetres inside the map or its padding (the base's odometry drifts: on the
+  // demo a leg was found 2-4 cm inside the wall after a hole's whole-body move), or with two
+  // links a hair inside each other (the planner's shapes are conservative, and the drill's
+  // Cartesian motions leave the arm a little off the posture the planner checked): the nearest
+  // state clear of both is planned from, and the move there is prepended to the path (what
+  // MoveIt's FixStartStateCollision adapter does). First with the padding; if the start cannot
+  // be moved clear of that, a start clear of the map itself is planned without the padding, and
+  // one inside the map is moved out of the map itself. A start over a joint or torque limit, or
+  // on the floor, is refused.
   std::optional<Eigen::VectorXd> lead_in;
   Eigen::VectorXd start = q_start_full;
-  if (start_ok.constraint == Constraint::kEnvironmentCollision ||
-      start_ok.constraint == Constraint::kSelfCollision) {
-    auto unpadded = std::make_unique<StateChecker>(model, env, params_, 0.0);
+  const auto move_out = [&](StateChecker& checker) -> std::optional<std::string> {
     std::optional<Eigen::VectorXd> moved = q_start_full;
     std::vector<std::string> what;
-    Validity v = unpadded->check(*moved);
+    Validity v = checker.check(*moved);
     if (v.constraint == Constraint::kEnvironmentCollision && params_.start_tolerance > 0.0) {
-      moved = base_out_of_map(*unpadded, *moved, params_.start_tolerance);
-      if (moved) {
-        const Eigen::Vector3d d = moved->head<3>() - q_start_full.head<3>();
-        std::ostringstream s;
-        s << "inside the map (" << v.detail << "): the base moved out by "
-          << std::round(1e3 * std::hypot(d.x(), d.y())) << " mm and "
-          << std::round(10.0 * d.z() * 180.0 / M_PI) / 10.0 << " deg";
-        what.push_back(s.str());
-        v = unpadded->check(*moved);
-      }
+      moved = base_out_of_map(checker, *moved, params_.start_tolerance);
+      if (!moved) return std::nullopt;
+      const Eigen::Vector3d d = moved->head<3>() - q_start_full.head<3>();
+      std::ostringstream s;
+      s << "inside the map (" << v.detail << "): the base moved out by "
+        << std::round(1e3 * std::hypot(d.x(), d.y())) << " mm and "
+        << std::round(10.0 * d.z() * 180.0 / M_PI) / 10.0 << " deg";
+      what.push_back(s.str());
+      v = checker.check(*moved);
     }
-    if (moved && v.constraint == Constraint::kSelfCollision &&
-        params_.start_joint_tolerance > 0.0) {
+    if (v.constraint == Constraint::kSelfCollision && params_.start_joint_tolerance > 0.0) {
       const std::string detail = v.detail;
-      moved = arm_out_of_self_collision(*model, *unpadded, *moved, params_.start_joint_tolerance,
+      const Eigen::VectorXd before = *moved;
+      moved = arm_out_of_self_collision(*model, checker, before, params_.start_joint_tolerance,
                                         params_.seed + request.request_id);
-      if (moved) {
-        std::ostringstream s;
-        s << "in self collision (" << detail << "): the arm moved out by "
-          << std::round(
-                 1e3 * (moved->tail(moved->size() - 3) - q_start_full.tail(q_start_full.size() - 3))
-                           .cwiseAbs()
-                           .maxCoeff()) /
-                 1e3
-          << " rad at most";
-        what.push_back(s.str());
-        v = unpadded->check(*moved);
-      }
+      if (!moved) return std::nullopt;
+      std::ostringstream s;
+      s << "in self collision (" << detail << "): the arm moved out by "
+        << std::round(1e3 * (*moved - before).cwiseAbs().maxCoeff()) / 1e3 << " rad at most";
+      what.push_back(s.str());
+      v = checker.check(*moved);
     }
-    if (moved && v.valid()) {
-      std::string note = "the start is";
-      for (std::size_t i = 0; i < what.size(); ++i) note += (i ? "; and " : " ") + what[i];
-      out.note = note + ", first";
-      lead_in = q_start_full;
-      start = *moved;
-      checker_ptr = std::move(unpadded);
-      start_ok = v;
+    if (!v.valid() || what.empty()) return std::nullopt;
+    std::string note = "the start is";
+    for (std::size_t i = 0; i < what.size(); ++i) note += (i ? "; and " : " ") + what[i];
+    lead_in = q_start_full;
+    start = *moved;
+    return note + ", first";
+  };
+  if (start_ok.constraint == Constraint::kEnvironmentCollision ||
+      start_ok.constraint == Constraint::kSelfCollision) {
+    if (auto note = move_out(*checker_ptr)) {
+      out.note = *note;
+      start_ok = {};
+    } else if (padding > 0.0) {
+      auto unpadded = std::make_unique<StateChecker>(model, env, params_, 0.0);
+      if (const Validity v = unpadded->check(q_start_full); v.valid()) {
+        out.note = "the start is within the environment padding (" + start_ok.detail +
+                   "): planned without it";
+        checker_ptr = std::move(unpadded);
+        start_ok = v;
+      } else if (auto unpadded_note = move_out(*unpadded)) {
+        out.note = *unpadded_note + " (planned without the padding)";
+        checker_ptr = std::move(unpadded);
+        start_ok = {};
+      }
     }
   }
   StateChecker& checker = *checker_ptr;
