@@ -817,6 +817,20 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
     points = find_holes(detection_.spec, located, camera, patterns_ ? *patterns_ : kNone,
                         area_radius(params_.camera_distance, params_.camera_fov));
     area_points_ = points;
+    if (detection_.spec.marks == MarkKind::kBlobs && detection_.spec.expected > 0 &&
+        points.size() < static_cast<std::size_t>(detection_.spec.expected)) {
+      // What the camera saw, for the report's "expected holes not found".
+      std::ostringstream line;
+      line.setf(std::ios::fixed);
+      line.precision(3);
+      line << "drill: area '" << detection_.spec.name << "': " << points.size() << " of "
+           << detection_.spec.expected << " blobs found around ("
+           << located.frame.translation().transpose() << "); blobs in the image:";
+      for (const Blob& b : detect_blobs(view->frame))
+        line << " [px " << b.pixel.transpose() << ", at "
+             << (view->world_T_optical * b.position).transpose() << "]";
+      log_line(line.str());
+    }
   } catch (const DrillError& e) {
     return Outcome::failed(e.what());
   }
