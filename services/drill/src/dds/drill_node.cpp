@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 #include <utility>
 
@@ -36,6 +37,9 @@ constexpr double kRobotRadius = 0.55;
 // Cartesian alignment does the rest) [m]; the way back first takes this long to reach the
 // posture's path [s].
 constexpr double kAlignMargin = 0.03;
+// When the whole body finds no drilling posture, it is asked again with the camera this much
+// further from the wall [m], in turn (the alignment's Cartesian move gets that much longer).
+constexpr double kFurtherOut[] = {0.03, 0.07, 0.12};
 constexpr double kSettleBack = 1.0;
 // Robot shapes grown against the map in the areas' approach plans [m]: the planner's map is the
 // world, its start pose the wheel odometry, which drifts 4-6 cm over a whole-body move near the
@@ -865,7 +869,9 @@ void DrillNode::align(const DrillPoint& point) {
   r.end_effector(rig_->tool());
   r.goals().push_back(model::dds::to_pose_msg(point.frame));
   r.execute(true);
-  r.camera_distance(camera_to_tip + params_.motion.standoff + kAlignMargin);
+  hole_distance_ = camera_to_tip + params_.motion.standoff + kAlignMargin;
+  hole_further_ = 0;
+  r.camera_distance(hole_distance_);
   // The arm alone first: the base stays where the area's approach put it, so odometry does not
   // drift between holes (3.5 deg over one whole-body move on the demo); if the arm cannot
   // reach the hole from there, the whole body.
@@ -992,6 +998,20 @@ void DrillNode::control_motion() {
       hole_plan_request_ = next_request_++;
       hole_request_.request_id(hole_plan_request_);
       hole_request_.fixed_base(false);
+      plan_requests_.write(hole_request_);
+    } else if (r->state() == msg::PLAN_FAILED && r->failure() == msg::PLAN_UNREACHABLE &&
+               hole_further_ < std::size(kFurtherOut)) {
+      // The close posture is not found (the demo arm at 1.3 m and up: the posture search finds
+      // none 0.23 m from the wall, though some exist); a few centimetres further out it is,
+      // and the Cartesian alignment moves the bit the rest of the way.
+      const double further = kFurtherOut[hole_further_++];
+      std::ostringstream line;
+      line << "drill: " << point_.label << ": no posture with the camera " << hole_distance_
+           << " m from the wall; asking " << further * 100.0 << " cm further out";
+      log_line(line.str());
+      hole_plan_request_ = next_request_++;
+      hole_request_.request_id(hole_plan_request_);
+      hole_request_.camera_distance(hole_distance_ + further);
       plan_requests_.write(hole_request_);
     } else if (r->state() == msg::PLAN_FAILED) {
       motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());

@@ -189,6 +189,8 @@ class DrillNode final : public MissionPorts {
   std::uint32_t hole_plan_request_{0};
   msg::PlanRequest hole_request_;
   bool hole_whole_body_{false};  // false: a hole's posture is first planned with the base fixed
+  double hole_distance_{0.0};  // the camera's distance from the wall a hole's posture asks for [m]
+  std::size_t hole_further_{0};  // how many times a hole's posture was asked further out
   std::int64_t reanchor_since_ns_{0};
   std::vector<DrillPoint> area_points_;  // the current area's holes as detected
   struct PlannedPath {
