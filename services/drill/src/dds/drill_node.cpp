@@ -708,10 +708,9 @@ std::vector<msg::TrajectorySample> DrillNode::return_path(const Sample& s) const
   std::vector<msg::TrajectorySample> back{sample_here(hole_chain_.front().names, s)};
   double t = 0.0;
   for (auto path = hole_chain_.rbegin(); path != hole_chain_.rend(); ++path) {
-    // Each path's end is where the Cartesian phase started, within centimetres of where it
-    // left the arm: a settling second to reach it, then the path backwards.
-    t += path == hole_chain_.rbegin() ? settle_time(path->names, back.front(), path->samples.back())
-                                      : kSettleBack;
+    // Each path's end is the hole's posture, where the arm went back after its retract: a
+    // settling second to reach it, then the path backwards.
+    t += kSettleBack;
     const double end = path->samples.back().time();
     for (auto it = path->samples.rbegin(); it != path->samples.rend(); ++it) {
       msg::TrajectorySample sample = *it;
