@@ -174,7 +174,7 @@ struct RobotCore::Shared {
   mutable std::mutex state_mutex;  // readers of the loop's state buffer
   // on_imu: the model and IMU frame last seen, and whether that frame rides on the base.
   std::mutex imu_mutex;
-  const kinematics::Model* imu_model{nullptr};
+  std::shared_ptr<const kinematics::Model> imu_model;  // held: a new model never reuses its address
   std::string imu_frame;
   bool imu_on_base{false};
   Eigen::Matrix3d base_R_imu{Eigen::Matrix3d::Identity()};
@@ -809,8 +809,8 @@ void RobotCore::on_imu(const hardware::ImuSample& sample) {
   const std::shared_ptr<const kinematics::Model> m = model();
   if (!m || !sample.angular_velocity.allFinite()) return;
   std::lock_guard lock(shared_->imu_mutex);
-  if (shared_->imu_model != m.get() || shared_->imu_frame != sample.frame) {
-    shared_->imu_model = m.get();
+  if (shared_->imu_model != m || shared_->imu_frame != sample.frame) {
+    shared_->imu_model = m;
     shared_->imu_frame = sample.frame;
     // On the base: the root link or a link no joint moves relative to it.
     bool on_base = m->has_frame(sample.frame);
