@@ -15,6 +15,12 @@ EndpointQos endpoint_qos(EndpointQos q, const QosSpec& spec) {
       spec.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
   q.history().kind = KEEP_LAST_HISTORY_QOS;
   q.history().depth = spec.history_depth;
+  // Keyed topics get an instance per request (plan results, trajectory statuses, nav goals,
+  // drill missions): no bound on instances (<= 0: unlimited), and samples bounded by the
+  // keep-last depth of each instance. Writers unregister their oldest instances (Writer).
+  q.resource_limits().max_instances = 0;
+  q.resource_limits().max_samples = 0;
+  q.resource_limits().max_samples_per_instance = spec.history_depth;
   q.endpoint().history_memory_policy =
       eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return q;

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <vector>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/qos.hpp"
@@ -47,6 +49,44 @@ TEST(Endpoint, LateJoinerGetsTheLastLatchedSampleOnly) {
   EXPECT_EQ(got->version(), 2u);
   EXPECT_LT(std::chrono::steady_clock::now() - start, 2s) << "late joiner waited too long for the latched value";
   EXPECT_FALSE(reader.wait(300ms).has_value()) << "KEEP_LAST 1: only the last value is owed";
+}
+
+msg::PlanResult plan_result(uint32_t request) {
+  msg::PlanResult r;
+  r.request_id(request);
+  r.state(msg::PLAN_SUCCEEDED);
+  r.reason("request " + std::to_string(request));
+  return r;
+}
+
+// Keyed topics have an instance per request (plan results, trajectory statuses, nav goals, drill
+// missions). Fast DDS's default resource limits hold 10 instances: the 11th request's result
+// never reached its reader (a drill mission waited for ever for its 4th hole's posture).
+TEST(Endpoint, EveryRequestOfAKeyedTopicArrivesPastTenInstances) {
+  Participant a({.name = "a"}), b({.name = "b"});
+  Writer<msg::PlanResult> writer(a, topics::plan_result);
+  Reader<msg::PlanResult> reader(b, topics::plan_result);
+  ASSERT_TRUE(writer.wait_for_readers(1, 5s));
+  constexpr uint32_t kRequests = 3 * kLiveInstances;
+  for (uint32_t id = 1; id <= kRequests; ++id) {
+    ASSERT_TRUE(writer.write(plan_result(id))) << "request " << id;
+    const auto got = reader.wait(5s);
+    ASSERT_TRUE(got.has_value()) << "request " << id << " never arrived";
+    EXPECT_EQ(*got, plan_result(id));
+  }
+  // The writer keeps the newest kLiveInstances instances for late joiners and unregisters the
+  // older ones (its memory stays bounded over hours of requests).
+  Participant c({.name = "late"});
+  Reader<msg::PlanResult> late(c, topics::plan_result);
+  std::vector<uint32_t> latched;
+  while (const auto got = late.wait(latched.size() < kLiveInstances ? 5000ms : 300ms)) {
+    latched.push_back(got->request_id());
+    if (latched.size() > 2 * kLiveInstances) break;
+  }
+  ASSERT_EQ(latched.size(), kLiveInstances);
+  std::sort(latched.begin(), latched.end());
+  EXPECT_EQ(latched.front(), kRequests - kLiveInstances + 1);
+  EXPECT_EQ(latched.back(), kRequests);
 }
 
 TEST(Endpoint, CallbackReaderAndQosFromTheCatalogue) {

@@ -1,8 +1,11 @@
 #pragma once
 // Typed writer and reader over a catalogue topic, with the catalogue's QoS.
 
+#include <algorithm>
 #include <chrono>
+#include <deque>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
@@ -13,6 +16,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include "concert/dds/participant.hpp"
+#include "concert/dds/qos.hpp"
 #include "concert/dds/topics.hpp"
 
 namespace concert::dds {
@@ -55,8 +59,27 @@ template <class T> class Writer {
   Writer(const Writer&) = delete;
   Writer& operator=(const Writer&) = delete;
 
-  /// Publishes a sample. Returns false if DDS refused it (e.g. while shutting down).
-  bool write(const T& sample) { return writer_->write(const_cast<T*>(&sample)); }
+  /// Publishes a sample. Returns false if DDS refused it (e.g. while shutting down). On a keyed
+  /// topic a sample of a new instance unregisters the oldest one once kLiveInstances are live
+  /// (late joiners then get the newest kLiveInstances instances' last samples).
+  bool write(const T& sample) {
+    if (!keyed_) return writer_->write(const_cast<T*>(&sample));
+    std::lock_guard lock(instances_mutex_);
+    const eprosima::fastrtps::rtps::InstanceHandle_t handle =
+        writer_->register_instance(const_cast<T*>(&sample));
+    if (handle == eprosima::fastdds::dds::HANDLE_NIL) return false;
+    const bool known = std::any_of(live_.begin(), live_.end(),
+                                   [&](const auto& entry) { return entry.first == handle; });
+    if (!known) {
+      live_.emplace_back(handle, sample);
+      if (live_.size() > kLiveInstances) {
+        writer_->unregister_instance(&live_.front().second, live_.front().first);
+        live_.pop_front();
+      }
+    }
+    return writer_->write(const_cast<T*>(&sample), handle) ==
+           eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
+  }
 
   /// Disposes the instance `sample` names (keyed topics only).
   bool dispose(const T& sample) {
@@ -76,6 +99,10 @@ template <class T> class Writer {
  private:
   Participant& participant_;
   eprosima::fastdds::dds::DataWriter* writer_;
+  bool keyed_ = writer_->get_type()->m_isGetKeyDefined;
+  std::mutex instances_mutex_;
+  // Registered instances, oldest first, with a sample carrying each one's key.
+  std::deque<std::pair<eprosima::fastrtps::rtps::InstanceHandle_t, T>> live_;
 };
 
 /// Reads a catalogue topic. With a callback, every valid sample is handed to it on the DDS

@@ -12,6 +12,11 @@ namespace concert::dds {
 /// data a late-joining reader is owed by up to 3 s).
 inline constexpr int32_t kHeartbeatPeriodMs = 100;
 
+/// Instances of a keyed topic a writer keeps registered: the newest 64 (a late joiner gets their
+/// last samples); older ones are unregistered. Readers and writers hold any number of instances
+/// (Fast DDS's default of 10 refused the samples of an 11th request's instance).
+inline constexpr std::size_t kLiveInstances = 64;
+
 eprosima::fastdds::dds::DataWriterQos writer_qos(QosClass qos);
 eprosima::fastdds::dds::DataReaderQos reader_qos(QosClass qos);
 
