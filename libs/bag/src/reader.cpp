@@ -13,6 +13,21 @@ namespace {
 
 std::string at_byte(uint64_t offset) { return "byte " + std::to_string(offset); }
 
+/// Keeps a Schema or Channel record; false for other records.
+bool take_definition(uint8_t op, In& in, std::map<uint16_t, Schema>& schemas, std::map<uint16_t, Channel>& channels) {
+  if (op == kSchema) {
+    auto schema = read_schema(in);
+    schemas[schema.id] = std::move(schema);
+    return true;
+  }
+  if (op == kChannel) {
+    auto channel = read_channel(in);
+    channels[channel.id] = std::move(channel);
+    return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 /// State of one pass over the data section.
@@ -109,17 +124,11 @@ bool Reader::read_summary_section() {
     if (length > end - pos - kRecordPrefix) throw BagError(where + ": " + record_name(op) + " record overruns the summary");
     In in(std::span<const uint8_t>(bytes).subspan(static_cast<size_t>(pos + kRecordPrefix), static_cast<size_t>(length)),
           where + " (" + record_name(op) + ")");
+    if (take_definition(op, in, summary.schemas, summary.channels)) {
+      pos += kRecordPrefix + length;
+      continue;
+    }
     switch (op) {
-      case kSchema: {
-        auto s = read_schema(in);
-        summary.schemas[s.id] = std::move(s);
-        break;
-      }
-      case kChannel: {
-        auto c = read_channel(in);
-        summary.channels[c.id] = std::move(c);
-        break;
-      }
       case kStatistics: summary.statistics = read_statistics(in); break;
       case kChunkIndex: {
         auto c = read_chunk_index(in);
@@ -187,17 +196,8 @@ void Reader::scan(Scan& s) {
   uint32_t crc = crc32(0, head);
 
   auto on_record = [&](uint8_t op, In& in) {
+    if (take_definition(op, in, s.schemas, s.channels)) return;
     switch (op) {
-      case kSchema: {
-        auto schema = read_schema(in);
-        s.schemas[schema.id] = std::move(schema);
-        return;
-      }
-      case kChannel: {
-        auto channel = read_channel(in);
-        s.channels[channel.id] = std::move(channel);
-        return;
-      }
       case kMessage: {
         Message m;
         m.channel_id = in.u16("channel_id");
