@@ -435,6 +435,48 @@ TEST(BagCli, ARecorderKilledMidRecordingLeavesAFileReadableUpToItsLastCompleteRe
   EXPECT_EQ(check[0].at("decoded").at("concert/robot/joint_state").get<size_t>(), n);
 }
 
+#ifdef CONCERT_DISCOVERY_BIN
+TEST(BagCli, ARecordingOfTheRunningDiscoveryServiceReadsBackWhatItsReadersGot) {
+  // The real discovery service turns a real scan of the CONCERT robot (../shared/data) into the
+  // module tree; the recording holds the scan, the tree and the service's status, the same as
+  // `concert topic echo` received them.
+  testing::TempDir dir("bag-cli");
+  const std::string file = dir.path() + "/stack.mcap";
+  const std::vector<std::string> topics = {"concert/ethercat/scan", "concert/topology/module_tree",
+                                           "concert/system/status"};
+  Process recorder({CONCERT_BIN, "bag", "record", topics[0], topics[1], topics[2], "-o", file});
+  Process discovery({CONCERT_DISCOVERY_BIN, "--module-db", std::string(CONCERT_SHARED_DATA) + "/concert_resources"});
+  Process echo({CONCERT_BIN, "topic", "echo", topics[1], "--count", "1", "--timeout", "60"});
+  wait_recording(recorder, {topics[1], topics[2]});
+  const auto scan = concert({"scan", "publish", "--scan", std::string(CONCERT_SHARED_DATA) + "/ethercat/concert_robot_18slaves.yaml",
+                             "--hold", "3", "--timeout", "20", "--json"});
+  ASSERT_EQ(scan.code, 0) << scan.err;
+  ASSERT_EQ(echo.wait(60s), 0) << echo.err();
+  const Json tree = Json::parse(testing::lines(echo.out()).at(0));
+  ASSERT_EQ(recorder.stop(20s), 0) << recorder.err();
+  ::kill(discovery.pid(), SIGTERM);
+  discovery.wait(15s);
+
+  bag::Reader reader(file);
+  ASSERT_TRUE(reader.complete()) << reader.problem();
+  const auto recorded = read_file(reader);
+  const auto& s = idl::Schema::builtin();
+  ASSERT_EQ(recorded.count(topics[0]), 1u) << "no scan recorded";
+  ASSERT_EQ(recorded.at(topics[1]).size(), 1u);
+  EXPECT_EQ(idl::decode(s, "concert::msg::ModuleTree", recorded.at(topics[1])[0].bytes), tree);
+  EXPECT_EQ(idl::decode(s, "concert::msg::EscScan", recorded.at(topics[0])[0].bytes).at("slaves").size(), 18u) << "the 18 slaves of the real scan";
+  bool discovery_status = false;
+  for (const auto& m : recorded.at(topics[2])) {
+    discovery_status |= idl::decode(s, "concert::msg::ServiceStatus", m.bytes).at("service") == "discovery";
+  }
+  EXPECT_TRUE(discovery_status);
+  const auto check = mcap_check(file);
+  ASSERT_FALSE(check.empty());
+  EXPECT_EQ(check[0].at("decoded").at(topics[1]).get<int>(), 1);
+  EXPECT_EQ(check[0].at("statistics").at("messageCount").get<uint64_t>(), reader.summary().statistics.message_count);
+}
+#endif
+
 TEST(BagCli, BadInputIsRefusedNamingWhatIsWrong) {
   testing::TempDir dir("bag-cli");
   const std::string text = dir.path() + "/notes.txt";
