@@ -10,9 +10,12 @@ namespace concert::bag::detail {
 
 std::string record_name(uint8_t opcode) {
   static constexpr std::array<const char*, 16> kNames = {
-      "",          "Header",          "Footer",     "Schema",   "Channel",       "Message",
-      "Chunk",     "Message Index",   "Chunk Index", "Attachment", "Attachment Index",
-      "Statistics", "Metadata",       "Metadata Index", "Summary Offset", "Data End"};
+      "",           "Header",           "Footer",
+      "Schema",     "Channel",          "Message",
+      "Chunk",      "Message Index",    "Chunk Index",
+      "Attachment", "Attachment Index", "Statistics",
+      "Metadata",   "Metadata Index",   "Summary Offset",
+      "Data End"};
   if (opcode >= 1 && opcode < kNames.size()) return kNames[opcode];
   static const char* digits = "0123456789abcdef";
   return std::string("unknown record 0x") + digits[opcode >> 4] + digits[opcode & 15];
@@ -54,15 +57,16 @@ size_t Out::begin_record(Opcode op) {
 
 void Out::end_record(size_t start) {
   const uint64_t length = bytes_.size() - start - kRecordPrefix;
-  for (int i = 0; i < 8; ++i) bytes_[start + 1 + static_cast<size_t>(i)] = static_cast<uint8_t>(length >> (8 * i));
+  for (int i = 0; i < 8; ++i)
+    bytes_[start + 1 + static_cast<size_t>(i)] = static_cast<uint8_t>(length >> (8 * i));
 }
 
 void In::fail(const std::string& what) const { throw BagError(where_ + ": " + what); }
 
 void In::need(uint64_t n, const char* field) {
   if (bytes_.size() - pos_ < n) {
-    fail(std::string("field '") + field + "' needs " + std::to_string(n) + " bytes, the record has " +
-         std::to_string(bytes_.size() - pos_) + " left");
+    fail(std::string("field '") + field + "' needs " + std::to_string(n) +
+         " bytes, the record has " + std::to_string(bytes_.size() - pos_) + " left");
   }
 }
 
@@ -189,9 +193,10 @@ void compress(Compression compression, std::span<const uint8_t> in, std::vector<
       if (zstd_context == nullptr) zstd_context = ZSTD_createCCtx();
       out.resize(ZSTD_compressBound(in.size()));
       // Level 1: the fastest of the regular levels; recording must keep up with the cameras.
-      const size_t n = ZSTD_compressCCtx(static_cast<ZSTD_CCtx*>(zstd_context), out.data(), out.size(),
-                                         in.data(), in.size(), 1);
-      if (ZSTD_isError(n)) throw BagError(std::string("zstd compression failed: ") + ZSTD_getErrorName(n));
+      const size_t n = ZSTD_compressCCtx(static_cast<ZSTD_CCtx*>(zstd_context), out.data(),
+                                         out.size(), in.data(), in.size(), 1);
+      if (ZSTD_isError(n))
+        throw BagError(std::string("zstd compression failed: ") + ZSTD_getErrorName(n));
       out.resize(n);
       return;
     }
@@ -199,7 +204,8 @@ void compress(Compression compression, std::span<const uint8_t> in, std::vector<
       // MCAP's "lz4" is the LZ4 frame format.
       out.resize(LZ4F_compressFrameBound(in.size(), nullptr));
       const size_t n = LZ4F_compressFrame(out.data(), out.size(), in.data(), in.size(), nullptr);
-      if (LZ4F_isError(n)) throw BagError(std::string("lz4 compression failed: ") + LZ4F_getErrorName(n));
+      if (LZ4F_isError(n))
+        throw BagError(std::string("lz4 compression failed: ") + LZ4F_getErrorName(n));
       out.resize(n);
       return;
     }
@@ -237,13 +243,15 @@ std::vector<uint8_t> decompress(const std::string& compression, std::span<const 
   }
   if (compression == "lz4") {
     LZ4F_dctx* ctx = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) throw BagError(where + ": lz4: no context");
+    if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION)))
+      throw BagError(where + ": lz4: no context");
     size_t produced = 0, consumed = 0;
     size_t status = 1;
     while (status != 0 && consumed < in.size()) {
       size_t dst = out.size() - produced;
       size_t src = in.size() - consumed;
-      status = LZ4F_decompress(ctx, out.data() + produced, &dst, in.data() + consumed, &src, nullptr);
+      status =
+          LZ4F_decompress(ctx, out.data() + produced, &dst, in.data() + consumed, &src, nullptr);
       if (LZ4F_isError(status)) {
         LZ4F_freeDecompressionContext(ctx);
         throw BagError(where + ": lz4: " + LZ4F_getErrorName(status));
@@ -259,7 +267,8 @@ std::vector<uint8_t> decompress(const std::string& compression, std::span<const 
     }
     return out;
   }
-  throw BagError(where + ": unsupported compression '" + compression + "' (known: zstd, lz4, none)");
+  throw BagError(where + ": unsupported compression '" + compression +
+                 "' (known: zstd, lz4, none)");
 }
 
 }  // namespace concert::bag::detail
@@ -268,9 +277,12 @@ namespace concert::bag {
 
 std::string_view to_string(Compression compression) {
   switch (compression) {
-    case Compression::kNone: return "none";
-    case Compression::kZstd: return "zstd";
-    case Compression::kLz4: return "lz4";
+    case Compression::kNone:
+      return "none";
+    case Compression::kZstd:
+      return "zstd";
+    case Compression::kLz4:
+      return "lz4";
   }
   return "?";
 }

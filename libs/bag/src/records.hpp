@@ -54,7 +54,9 @@ class Out {
   void u64(uint64_t v) { le(v, 8); }
   /// uint32 length + bytes.
   void str(std::string_view s);
-  void raw(std::span<const uint8_t> bytes) { bytes_.insert(bytes_.end(), bytes.begin(), bytes.end()); }
+  void raw(std::span<const uint8_t> bytes) {
+    bytes_.insert(bytes_.end(), bytes.begin(), bytes.end());
+  }
   void map(const KeyValues& m);
   void map(const std::map<uint16_t, uint64_t>& m);
   /// Starts a record: opcode and a length patched by end_record(); returns its start.
@@ -72,7 +74,8 @@ class Out {
 /// `where` (file, record and offset) and the field.
 class In {
  public:
-  In(std::span<const uint8_t> content, std::string where) : bytes_(content), where_(std::move(where)) {}
+  In(std::span<const uint8_t> content, std::string where)
+      : bytes_(content), where_(std::move(where)) {}
   uint8_t u8(const char* field) { return static_cast<uint8_t>(le(1, field)); }
   uint16_t u16(const char* field) { return static_cast<uint16_t>(le(2, field)); }
   uint32_t u32(const char* field) { return static_cast<uint32_t>(le(4, field)); }

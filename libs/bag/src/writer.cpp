@@ -9,7 +9,8 @@ namespace concert::bag {
 
 using namespace detail;
 
-Writer::Writer(const std::string& path, WriterOptions options) : path_(path), options_(std::move(options)) {
+Writer::Writer(const std::string& path, WriterOptions options)
+    : path_(path), options_(std::move(options)) {
   file_ = std::fopen(path.c_str(), "wb");
   if (file_ == nullptr) throw BagError(path + ": cannot create: " + std::strerror(errno));
   std::vector<uint8_t> start(kMagic.begin(), kMagic.end());
@@ -39,7 +40,8 @@ void Writer::require_open(const char* what) const {
 void Writer::put(std::span<const uint8_t> bytes, bool data_section) {
   if (bytes.empty()) return;
   if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
-    throw BagError(path_ + ": write failed at byte " + std::to_string(position_) + ": " + std::strerror(errno));
+    throw BagError(path_ + ": write failed at byte " + std::to_string(position_) + ": " +
+                   std::strerror(errno));
   }
   position_ += bytes.size();
   if (data_section) data_crc_ = crc32(data_crc_, bytes);
@@ -58,12 +60,13 @@ uint16_t Writer::add_channel(uint16_t schema_id, std::string topic, std::string 
                              KeyValues metadata) {
   require_open("add_channel");
   if (schema_id != 0 && !schemas_.count(schema_id)) {
-    throw BagError(path_ + ": channel '" + topic + "' refers to schema " + std::to_string(schema_id) +
-                   ", which was not added");
+    throw BagError(path_ + ": channel '" + topic + "' refers to schema " +
+                   std::to_string(schema_id) + ", which was not added");
   }
   if (channels_.size() >= 0xFFFF) throw BagError(path_ + ": more than 65535 channels");
   const auto id = static_cast<uint16_t>(channels_.size());
-  channels_[id] = Channel{id, schema_id, std::move(topic), std::move(message_encoding), std::move(metadata)};
+  channels_[id] =
+      Channel{id, schema_id, std::move(topic), std::move(message_encoding), std::move(metadata)};
   ++statistics_.channel_count;
   return id;
 }
@@ -72,7 +75,8 @@ void Writer::write(const Message& message) {
   require_open("write");
   const auto channel = channels_.find(message.channel_id);
   if (channel == channels_.end()) {
-    throw BagError(path_ + ": message on channel " + std::to_string(message.channel_id) + ", which was not added");
+    throw BagError(path_ + ": message on channel " + std::to_string(message.channel_id) +
+                   ", which was not added");
   }
   Out out(chunk_);
   // A channel (and its schema) goes into the chunk of its first message, so that a reader that
@@ -116,7 +120,9 @@ void Writer::write_chunk() {
   index.message_start_time = chunk_start_;
   index.message_end_time = chunk_end_;
   index.chunk_start_offset = position_;
-  index.compression = options_.compression == Compression::kNone ? "" : std::string(to_string(options_.compression));
+  index.compression = options_.compression == Compression::kNone
+                          ? ""
+                          : std::string(to_string(options_.compression));
   index.uncompressed_size = chunk_.size();
   const uint32_t crc = crc32(0, chunk_);
   std::span<const uint8_t> records = chunk_;
@@ -198,7 +204,8 @@ void Writer::close() {
   auto group = [&](Opcode op, const auto& write_records) {
     const size_t begin = summary.size();
     write_records();
-    if (summary.size() > begin) groups.push_back({op, {summary_start + begin, summary.size() - begin}});
+    if (summary.size() > begin)
+      groups.push_back({op, {summary_start + begin, summary.size() - begin}});
   };
   group(kSchema, [&] {
     for (const auto& [id, schema] : schemas_) put_schema(sum, schema);

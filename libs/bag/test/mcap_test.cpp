@@ -2,6 +2,8 @@
 // the summary's indexes point at the records they index, a file cut at any byte is read up to
 // its last complete record and says so, and corrupt bytes are reported naming the record.
 // (tools/mcap_check runs an independent reader, @mcap/core, on files of `concert bag record`.)
+#include "concert/bag/mcap.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -9,7 +11,6 @@
 #include <fstream>
 #include <random>
 
-#include "concert/bag/mcap.hpp"
 #include "concert/common/error_text.hpp"
 #include "process.hpp"
 
@@ -43,13 +44,16 @@ uint64_t le64(const std::vector<uint8_t>& b, uint64_t at) {
 
 /// Writes `count` seeded messages on three channels (one more channel stays empty), sizes from
 /// 0 bytes to more than a chunk, and returns them.
-std::vector<Sent> write_file(const std::string& path, WriterOptions options, int count, bool flush_often = false) {
+std::vector<Sent> write_file(const std::string& path, WriterOptions options, int count,
+                             bool flush_often = false) {
   std::mt19937 rng(1234);
   Writer w(path, options);
-  const uint16_t s1 = w.add_schema("concert::msg::A", "omgidl", "module concert { module msg { struct A { long x; }; }; };");
+  const uint16_t s1 = w.add_schema("concert::msg::A", "omgidl",
+                                   "module concert { module msg { struct A { long x; }; }; };");
   const uint16_t s2 = w.add_schema("concert::msg::B", "omgidl", "struct B { octet y; };");
   const std::vector<uint16_t> channels = {
-      w.add_channel(s1, "concert/a", "cdr", {{"qos", "latched"}}), w.add_channel(s2, "concert/b", "cdr"),
+      w.add_channel(s1, "concert/a", "cdr", {{"qos", "latched"}}),
+      w.add_channel(s2, "concert/b", "cdr"),
       w.add_channel(s1, "concert/a2", "cdr", {{"qos", "stream"}, {"keyed", "true"}})};
   w.add_channel(s2, "concert/never", "cdr");
   std::vector<Sent> sent;
@@ -61,8 +65,10 @@ std::vector<Sent> write_file(const std::string& path, WriterOptions options, int
     t += std::uniform_int_distribution<uint64_t>(0, 2'000'000)(rng);
     m.log_time = t;
     m.publish_time = t - 1000;
-    const size_t size = i % 17 == 5 ? options.chunk_size + 100 : std::uniform_int_distribution<size_t>(0, 300)(rng);
-    for (size_t k = 0; k < size; ++k) m.data.push_back(static_cast<uint8_t>(rng() % 7));  // compressible
+    const size_t size =
+        i % 17 == 5 ? options.chunk_size + 100 : std::uniform_int_distribution<size_t>(0, 300)(rng);
+    for (size_t k = 0; k < size; ++k)
+      m.data.push_back(static_cast<uint8_t>(rng() % 7));  // compressible
     w.write({m.channel, m.sequence, m.log_time, m.publish_time, m.data});
     if (flush_often && i % 5 == 4) w.flush();
     sent.push_back(std::move(m));
@@ -76,7 +82,8 @@ std::vector<Sent> read_all(Reader& reader) {
   std::vector<Sent> got;
   reader.read_messages([&](const Message& m, const Channel& c) {
     EXPECT_EQ(m.channel_id, c.id);
-    got.push_back({m.channel_id, m.sequence, m.log_time, m.publish_time, {m.data.begin(), m.data.end()}});
+    got.push_back(
+        {m.channel_id, m.sequence, m.log_time, m.publish_time, {m.data.begin(), m.data.end()}});
     return true;
   });
   return got;
@@ -186,7 +193,8 @@ TEST_P(Mcap, AFileCutAtAnyByteIsReadUpToItsLastCompleteRecord) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Compressions, Mcap,
-                         ::testing::Values(Compression::kNone, Compression::kZstd, Compression::kLz4),
+                         ::testing::Values(Compression::kNone, Compression::kZstd,
+                                           Compression::kLz4),
                          [](const auto& param) { return std::string(to_string(param.param)); });
 
 TEST(McapErrors, CorruptBytesAreReportedNamingTheRecord) {
@@ -203,7 +211,8 @@ TEST(McapErrors, CorruptBytesAreReportedNamingTheRecord) {
   write_bytes(bad, flipped, flipped.size());
   Reader r1(bad);
   const std::string chunk_error = error_text<BagError>([&] { read_all(r1); });
-  EXPECT_THAT(chunk_error, HasSubstr(bad + ": Chunk record at byte " + std::to_string(chunk.chunk_start_offset)));
+  EXPECT_THAT(chunk_error, HasSubstr(bad + ": Chunk record at byte " +
+                                     std::to_string(chunk.chunk_start_offset)));
   EXPECT_THAT(chunk_error, HasSubstr("CRC of its records does not match"));
 
   flipped = bytes;
@@ -211,12 +220,14 @@ TEST(McapErrors, CorruptBytesAreReportedNamingTheRecord) {
   flipped.at(index_at + 20) ^= 0x01;  // a Message Index: only the data section CRC covers it
   write_bytes(bad, flipped, flipped.size());
   Reader r2(bad);
-  EXPECT_THAT(error_text<BagError>([&] { read_all(r2); }), HasSubstr("data section's CRC does not match"));
+  EXPECT_THAT(error_text<BagError>([&] { read_all(r2); }),
+              HasSubstr("data section's CRC does not match"));
 
   flipped = bytes;
   flipped.at(bytes.size() - 8 - 29 - 5) ^= 0x01;  // in the summary offsets
   write_bytes(bad, flipped, flipped.size());
-  EXPECT_THAT(error_text<BagError>([&] { Reader r3(bad); }), HasSubstr("summary section's CRC does not match"));
+  EXPECT_THAT(error_text<BagError>([&] { Reader r3(bad); }),
+              HasSubstr("summary section's CRC does not match"));
 
   write_bytes(bad, {'h', 'e', 'l', 'l', 'o', ' ', 'w', 'o', 'r', 'l', 'd'}, 11);
   EXPECT_EQ(error_text<BagError>([&] { Reader r4(bad); }),
@@ -231,7 +242,9 @@ TEST(McapErrors, TheWriterRefusesWhatTheFileCannotHold) {
   Writer w(dir.path() + "/a.mcap");
   EXPECT_THROW(w.add_channel(9, "t", "cdr"), BagError);
   const std::vector<uint8_t> data = {1, 2, 3};
-  EXPECT_THAT(error_text<BagError>([&] { w.write({5, 0, 1, 1, data}); }),
+  EXPECT_THAT(error_text<BagError>([&] {
+                w.write({5, 0, 1, 1, data});
+              }),
               HasSubstr("message on channel 5, which was not added"));
   w.close();
   EXPECT_THROW(w.write({0, 0, 1, 1, data}), BagError);

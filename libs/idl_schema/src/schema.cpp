@@ -203,13 +203,20 @@ std::pair<std::vector<std::string>, std::string> split_scoped(const std::string&
 /// dimensions follow the member name).
 std::string idl_spelling(const TypeRef& type, const std::vector<std::string>& scope) {
   switch (type.kind) {
-    case Kind::kBool: return "boolean";
-    case Kind::kInt16: return "short";
-    case Kind::kUInt16: return "unsigned short";
-    case Kind::kInt32: return "long";
-    case Kind::kUInt32: return "unsigned long";
-    case Kind::kInt64: return "long long";
-    case Kind::kUInt64: return "unsigned long long";
+    case Kind::kBool:
+      return "boolean";
+    case Kind::kInt16:
+      return "short";
+    case Kind::kUInt16:
+      return "unsigned short";
+    case Kind::kInt32:
+      return "long";
+    case Kind::kUInt32:
+      return "unsigned long";
+    case Kind::kInt64:
+      return "long long";
+    case Kind::kUInt64:
+      return "unsigned long long";
     case Kind::kStruct:
     case Kind::kEnum: {
       auto [modules, local] = split_scoped(type.name);
@@ -217,12 +224,15 @@ std::string idl_spelling(const TypeRef& type, const std::vector<std::string>& sc
     }
     case Kind::kSequence:
       if (type.element->kind == Kind::kArray) {
-        throw SchemaError("a sequence of arrays needs a typedef, which the IDL text does not write");
+        throw SchemaError(
+            "a sequence of arrays needs a typedef, which the IDL text does not write");
       }
       return "sequence<" + idl_spelling(*type.element, scope) +
              (type.bound ? ", " + std::to_string(type.bound) : "") + ">";
-    case Kind::kArray: throw SchemaError("arrays are spelled at the member");
-    default: return Schema::spell(type);  // octet, char, int8, uint8, float, double, string
+    case Kind::kArray:
+      throw SchemaError("arrays are spelled at the member");
+    default:
+      return Schema::spell(type);  // octet, char, int8, uint8, float, double, string
   }
 }
 
@@ -252,7 +262,8 @@ std::string Schema::idl(std::string_view struct_name) const {
   for (const std::string& name : order) {
     auto [modules, local] = split_scoped(name);
     size_t common = 0;
-    while (common < open.size() && common < modules.size() && open[common] == modules[common]) ++common;
+    while (common < open.size() && common < modules.size() && open[common] == modules[common])
+      ++common;
     while (open.size() > common) {
       open.pop_back();
       out << indent() << "};\n";
@@ -278,7 +289,8 @@ std::string Schema::idl(std::string_view struct_name) const {
         dims += "[" + std::to_string(t->bound) + "]";
         t = t->element.get();
       }
-      out << indent() << "  " << (f.key ? "@key " : "") << idl_spelling(*t, modules) << " " << f.name << dims << ";\n";
+      out << indent() << "  " << (f.key ? "@key " : "") << idl_spelling(*t, modules) << " "
+          << f.name << dims << ";\n";
     }
     out << indent() << "};\n";
   }

@@ -5,6 +5,8 @@
 //     joint states at 1 kHz and RGB + depth 640x480 at 15 Hz for 10 s over DDS: samples recorded
 //     of those written, MB/s, the recorder's CPU time.
 // Usage: bench_bag [--seconds S]   (figures in README.md, with the machine they were taken on)
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -14,7 +16,6 @@
 #include <sstream>
 #include <string>
 #include <thread>
-#include <unistd.h>
 
 #include "concert/bag/mcap.hpp"
 #include "concert/dds/participant.hpp"
@@ -77,7 +78,8 @@ double cpu_seconds(pid_t pid) {
 
 void writer_alone(const std::string& dir) {
   std::printf("libs/bag writer alone (file in %s):\n", dir.c_str());
-  std::printf("  %-24s %-6s %12s %10s %10s %8s\n", "messages", "comp.", "messages/s", "MB/s in", "MB/s file", "ratio");
+  std::printf("  %-24s %-6s %12s %10s %10s %8s\n", "messages", "comp.", "messages/s", "MB/s in",
+              "MB/s file", "ratio");
   struct Case {
     const char* name;
     std::vector<std::vector<uint8_t>> samples;
@@ -89,17 +91,20 @@ void writer_alone(const std::string& dir) {
   cases.push_back({"Image 640x480 rgb8", {}, 300});
   for (uint32_t i = 0; i < 8; ++i) cases.back().samples.push_back(image(i, false));
   for (const auto& c : cases) {
-    for (const auto compression : {concert::bag::Compression::kNone, concert::bag::Compression::kZstd,
-                                   concert::bag::Compression::kLz4}) {
+    for (const auto compression :
+         {concert::bag::Compression::kNone, concert::bag::Compression::kZstd,
+          concert::bag::Compression::kLz4}) {
       const std::string file = dir + "/writer.mcap";
       uint64_t bytes = 0;
       const auto start = Clock::now();
       {
         concert::bag::Writer w(file, {.compression = compression});
-        const uint16_t ch = w.add_channel(w.add_schema("T", "omgidl", "struct T { long x; };"), "t", "cdr");
+        const uint16_t ch =
+            w.add_channel(w.add_schema("T", "omgidl", "struct T { long x; };"), "t", "cdr");
         for (int i = 0; i < c.count; ++i) {
           const auto& data = c.samples[static_cast<size_t>(i) % c.samples.size()];
-          w.write({ch, static_cast<uint32_t>(i), static_cast<uint64_t>(i) * 1000, static_cast<uint64_t>(i) * 1000, data});
+          w.write({ch, static_cast<uint32_t>(i), static_cast<uint64_t>(i) * 1000,
+                   static_cast<uint64_t>(i) * 1000, data});
           bytes += data.size();
         }
         w.close();
@@ -107,8 +112,9 @@ void writer_alone(const std::string& dir) {
       const double s = std::chrono::duration<double>(Clock::now() - start).count();
       const auto file_bytes = std::filesystem::file_size(file);
       std::printf("  %-24s %-6s %12.0f %10.1f %10.1f %8.2f\n", c.name,
-                  std::string(concert::bag::to_string(compression)).c_str(), c.count / s, static_cast<double>(bytes) / s / 1e6,
-                  static_cast<double>(file_bytes) / s / 1e6, static_cast<double>(bytes) / static_cast<double>(file_bytes));
+                  std::string(concert::bag::to_string(compression)).c_str(), c.count / s,
+                  static_cast<double>(bytes) / s / 1e6, static_cast<double>(file_bytes) / s / 1e6,
+                  static_cast<double>(bytes) / static_cast<double>(file_bytes));
     }
   }
 }
@@ -117,7 +123,8 @@ struct Writer {
   Writer(concert::dds::Participant& p, const std::string& topic) {
     const auto info = *concert::dds::find_topic(topic);
     const bool keyed = schema().at(info.type_name).keyed();
-    auto* t = p.topic(topic, eprosima::fastdds::dds::TypeSupport(new concert::dds::RawPubSubType(std::string(info.type_name), keyed)));
+    auto* t = p.topic(topic, eprosima::fastdds::dds::TypeSupport(new concert::dds::RawPubSubType(
+                                 std::string(info.type_name), keyed)));
     writer = p.publisher()->create_datawriter(t, concert::dds::writer_qos(info.qos));
   }
   bool matched() const {
@@ -131,13 +138,15 @@ struct Writer {
 void end_to_end(const std::string& dir, double seconds) {
   const std::string file = dir + "/e2e.mcap";
   concert::testing::Process recorder({CONCERT_BIN, "bag", "record", "concert/robot/joint_state",
-                                      "concert/sensors/camera/rgb", "concert/sensors/camera/depth", "-o", file});
+                                      "concert/sensors/camera/rgb", "concert/sensors/camera/depth",
+                                      "-o", file});
   concert::dds::Participant participant({.name = "bench-bag"});
   Writer joints(participant, "concert/robot/joint_state");
   Writer rgb(participant, "concert/sensors/camera/rgb");
   Writer depth(participant, "concert/sensors/camera/depth");
   const auto deadline = Clock::now() + 30s;
-  while (!(joints.matched() && rgb.matched() && depth.matched()) && Clock::now() < deadline) std::this_thread::sleep_for(10ms);
+  while (!(joints.matched() && rgb.matched() && depth.matched()) && Clock::now() < deadline)
+    std::this_thread::sleep_for(10ms);
   std::this_thread::sleep_for(500ms);
   std::vector<std::vector<uint8_t>> frames, depths, states;
   for (uint32_t i = 0; i < 4; ++i) {
@@ -156,8 +165,10 @@ void end_to_end(const std::string& dir, double seconds) {
     ++written;
     bytes += s.bytes.size();
     if (tick % 67 == 0) {  // 15 Hz
-      concert::dds::RawSample f{frames[(tick / 67) % frames.size()], std::array<uint8_t, 16>{0, 0, 0, 1}};
-      concert::dds::RawSample d{depths[(tick / 67) % depths.size()], std::array<uint8_t, 16>{0, 0, 0, 2}};
+      concert::dds::RawSample f{frames[(tick / 67) % frames.size()],
+                                std::array<uint8_t, 16>{0, 0, 0, 1}};
+      concert::dds::RawSample d{depths[(tick / 67) % depths.size()],
+                                std::array<uint8_t, 16>{0, 0, 0, 2}};
       rgb.writer->write(&f);
       depth.writer->write(&d);
       written_images += 2;
@@ -173,19 +184,26 @@ void end_to_end(const std::string& dir, double seconds) {
   const auto& st = reader.summary().statistics;
   uint64_t recorded_images = 0;
   for (const auto& [id, c] : reader.summary().channels) {
-    if (c.topic != "concert/robot/joint_state") recorded_images += st.channel_message_counts.count(id) ? st.channel_message_counts.at(id) : 0;
+    if (c.topic != "concert/robot/joint_state")
+      recorded_images += st.channel_message_counts.count(id) ? st.channel_message_counts.at(id) : 0;
   }
   std::printf("\nconcert bag record, end to end over DDS (%.1f s, zstd):\n", elapsed);
-  std::printf("  written: %lu joint states (%.0f Hz) + %lu images (RGB + depth 640x480, 15 Hz each): %.1f MB/s\n",
-              static_cast<unsigned long>(written), static_cast<double>(written) / elapsed,
-              static_cast<unsigned long>(written_images), static_cast<double>(bytes) / elapsed / 1e6);
-  std::printf("  recorded: %lu joint states, %lu images (%.1f %% / %.1f %%); file %.1f MB (%.1f MB/s)\n",
-              static_cast<unsigned long>(st.message_count - recorded_images), static_cast<unsigned long>(recorded_images),
-              100.0 * static_cast<double>(st.message_count - recorded_images) / static_cast<double>(written),
-              100.0 * static_cast<double>(recorded_images) / static_cast<double>(written_images),
-              static_cast<double>(reader.summary().file_size) / 1e6,
-              static_cast<double>(reader.summary().file_size) / elapsed / 1e6);
-  std::printf("  recorder CPU: %.2f s for %.1f s (%.0f %% of one core)\n", cpu, elapsed, 100.0 * cpu / elapsed);
+  std::printf(
+      "  written: %lu joint states (%.0f Hz) + %lu images (RGB + depth 640x480, 15 Hz each): %.1f "
+      "MB/s\n",
+      static_cast<unsigned long>(written), static_cast<double>(written) / elapsed,
+      static_cast<unsigned long>(written_images), static_cast<double>(bytes) / elapsed / 1e6);
+  std::printf(
+      "  recorded: %lu joint states, %lu images (%.1f %% / %.1f %%); file %.1f MB (%.1f MB/s)\n",
+      static_cast<unsigned long>(st.message_count - recorded_images),
+      static_cast<unsigned long>(recorded_images),
+      100.0 * static_cast<double>(st.message_count - recorded_images) /
+          static_cast<double>(written),
+      100.0 * static_cast<double>(recorded_images) / static_cast<double>(written_images),
+      static_cast<double>(reader.summary().file_size) / 1e6,
+      static_cast<double>(reader.summary().file_size) / elapsed / 1e6);
+  std::printf("  recorder CPU: %.2f s for %.1f s (%.0f %% of one core)\n", cpu, elapsed,
+              100.0 * cpu / elapsed);
 }
 
 }  // namespace

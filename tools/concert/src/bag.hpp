@@ -37,7 +37,7 @@ struct RecordOptions {
   std::vector<std::string> topics;  ///< empty: every catalogue topic
   std::string output;
   std::string compression = "zstd";
-  bool force = false;  ///< overwrite an existing file
+  bool force = false;   ///< overwrite an existing file
   cli::DdsOptions dds;  ///< dds.timeout_s: stop after this long (0: until Ctrl-C)
 };
 int record(const RecordOptions& options, std::ostream& out, std::ostream& err);
@@ -47,8 +47,8 @@ struct PlayOptions {
   double rate = 1.0;
   bool loop = false;
   std::vector<std::string> topics;  ///< empty: every recorded topic
-  double wait_s = 1.0;  ///< wait for readers to match before the first message
-  cli::DdsOptions dds;  ///< dds.timeout_s: stop after this long (0: at the end)
+  double wait_s = 1.0;              ///< wait for readers to match before the first message
+  cli::DdsOptions dds;              ///< dds.timeout_s: stop after this long (0: at the end)
 };
 int play(const PlayOptions& options, std::ostream& out, std::ostream& err);
 

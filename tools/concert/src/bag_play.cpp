@@ -39,11 +39,14 @@ struct Track {
 int play(const PlayOptions& o, std::ostream& out, std::ostream& err) {
   bag::Reader reader(o.file);
   const bag::Summary& summary = reader.summary();
-  if (!reader.complete()) err << "concert bag play: " << o.file << ": " << reader.problem() << std::endl;
+  if (!reader.complete())
+    err << "concert bag play: " << o.file << ": " << reader.problem() << std::endl;
   for (const auto& t : o.topics) {
     const bool recorded = std::any_of(summary.channels.begin(), summary.channels.end(),
                                       [&](const auto& c) { return c.second.topic == t; });
-    if (!recorded) throw cli::UsageError("topic '" + t + "' is not in " + o.file + " (`concert bag info` lists them)");
+    if (!recorded)
+      throw cli::UsageError("topic '" + t + "' is not in " + o.file +
+                            " (`concert bag info` lists them)");
   }
   const std::set<std::string> only(o.topics.begin(), o.topics.end());
 
@@ -53,14 +56,17 @@ int play(const PlayOptions& o, std::ostream& out, std::ostream& err) {
   for (const auto& [id, c] : summary.channels) {
     if (!only.empty() && !only.count(c.topic)) continue;
     const auto s = summary.schemas.find(c.schema_id);
-    if (s == summary.schemas.end() || s->second.encoding != kSchemaEncoding || c.message_encoding != kMessageEncoding) {
-      err << "concert bag play: " << c.topic << ": not an OMG IDL schema with CDR messages; skipped" << std::endl;
+    if (s == summary.schemas.end() || s->second.encoding != kSchemaEncoding ||
+        c.message_encoding != kMessageEncoding) {
+      err << "concert bag play: " << c.topic << ": not an OMG IDL schema with CDR messages; skipped"
+          << std::endl;
       continue;
     }
     auto& parsed = schemas[s->first];
     if (!parsed) {
       try {
-        parsed = std::make_shared<const idl::Schema>(idl::Schema::parse(s->second.data, o.file + ": schema " + s->second.name));
+        parsed = std::make_shared<const idl::Schema>(
+            idl::Schema::parse(s->second.data, o.file + ": schema " + s->second.name));
       } catch (const idl::SchemaError& e) {
         throw cli::Failure(e.what());
       }
@@ -73,9 +79,11 @@ int play(const PlayOptions& o, std::ostream& out, std::ostream& err) {
     if (const auto ours = dds::find_topic(c.topic)) {
       t.qos = ours->qos;
       const auto* now = idl::Schema::builtin().find_struct(t.type);
-      if (ours->type_name != t.type || now == nullptr || idl::Schema::builtin().shape(t.type) != parsed->shape(t.type)) {
+      if (ours->type_name != t.type || now == nullptr ||
+          idl::Schema::builtin().shape(t.type) != parsed->shape(t.type)) {
         err << "concert bag play: " << c.topic << ": the recording's type " << t.type
-            << " differs from the current IDL's " << ours->type_name << "; played as recorded" << std::endl;
+            << " differs from the current IDL's " << ours->type_name << "; played as recorded"
+            << std::endl;
       }
     } else if (const auto qos = c.metadata.find(kQosKey); qos != c.metadata.end()) {
       t.qos = parse_qos_name(qos->second).value_or(dds::QosClass::kStream);
@@ -87,23 +95,42 @@ int play(const PlayOptions& o, std::ostream& out, std::ostream& err) {
   const int32_t domain = o.dds.domain_id();
   dds::Participant participant({.name = "concert-bag-play", .domain_id = domain});
   for (auto& [id, t] : tracks) {
-    auto* topic = participant.topic(t.topic, eprosima::fastdds::dds::TypeSupport(new dds::RawPubSubType(t.type, t.keyed)));
+    auto* topic = participant.topic(
+        t.topic, eprosima::fastdds::dds::TypeSupport(new dds::RawPubSubType(t.type, t.keyed)));
     t.writer = participant.publisher()->create_datawriter(topic, dds::writer_qos(t.qos));
     if (t.writer == nullptr) throw cli::Failure("cannot create a writer on '" + t.topic + "'");
   }
+  // Until every topic has a reader and no further reader has matched for a moment (readers of
+  // several programs match one after the other), or --wait runs out.
   const auto wait_until = Clock::now() + std::chrono::duration<double>(o.wait_s);
-  auto all_matched = [&] {
-    return std::all_of(tracks.begin(), tracks.end(), [](const auto& kv) {
+  constexpr auto kSettle = 300ms;
+  auto matches = [&] {
+    std::vector<int32_t> counts;
+    for (const auto& [id, t] : tracks) {
       eprosima::fastdds::dds::PublicationMatchedStatus m;
-      kv.second.writer->get_publication_matched_status(m);
-      return m.current_count > 0;
-    });
+      t.writer->get_publication_matched_status(m);
+      counts.push_back(m.current_count);
+    }
+    return counts;
   };
-  while (!interrupted() && Clock::now() < wait_until && !all_matched()) std::this_thread::sleep_for(10ms);
+  auto seen = matches();
+  auto changed = Clock::now();
+  while (!interrupted() && Clock::now() < wait_until) {
+    const auto now = matches();
+    if (now != seen) {
+      seen = now;
+      changed = Clock::now();
+    }
+    const bool all = std::all_of(seen.begin(), seen.end(), [](int32_t n) { return n > 0; });
+    if (all && Clock::now() - changed >= kSettle) break;
+    std::this_thread::sleep_for(10ms);
+  }
 
   const auto start = Clock::now();
   const auto stop_at = start + std::chrono::duration<double>(o.dds.timeout_s);
-  auto should_stop = [&] { return interrupted() || (o.dds.timeout_s > 0 && Clock::now() >= stop_at); };
+  auto should_stop = [&] {
+    return interrupted() || (o.dds.timeout_s > 0 && Clock::now() >= stop_at);
+  };
   std::vector<double> late_ms;  // how late each write was against its schedule
   uint64_t played = 0;
   int passes = 0;
@@ -114,8 +141,9 @@ int play(const PlayOptions& o, std::ostream& out, std::ostream& err) {
       auto track = tracks.find(m.channel_id);
       if (track == tracks.end()) return !should_stop();
       if (!first) first = m.log_time;
-      const auto due = pass_start + std::chrono::duration_cast<Clock::duration>(
-                                        std::chrono::duration<double>(static_cast<double>(m.log_time - *first) * 1e-9 / o.rate));
+      const auto due =
+          pass_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                           static_cast<double>(m.log_time - *first) * 1e-9 / o.rate));
       while (Clock::now() < due) {
         if (should_stop()) return false;
         std::this_thread::sleep_until(std::min(due, Clock::now() + 50ms));
@@ -127,14 +155,16 @@ int play(const PlayOptions& o, std::ostream& out, std::ostream& err) {
         try {
           sample.key = idl::key_hash_of_cdr(*t.schema, t.type, m.data);
         } catch (const idl::CdrError& e) {
-          err << "concert bag play: " << t.topic << ": message " << m.sequence << " does not decode as " << t.type
-              << ": " << e.what() << "; skipped" << std::endl;
+          err << "concert bag play: " << t.topic << ": message " << m.sequence
+              << " does not decode as " << t.type << ": " << e.what() << "; skipped" << std::endl;
           return true;
         }
       }
-      if (late_ms.size() < 1'000'000) late_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - due).count());
+      if (late_ms.size() < 1'000'000)
+        late_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - due).count());
       if (!t.writer->write(&sample)) {
-        throw cli::Failure("writing message " + std::to_string(m.sequence) + " on '" + t.topic + "' failed");
+        throw cli::Failure("writing message " + std::to_string(m.sequence) + " on '" + t.topic +
+                           "' failed");
       }
       ++t.written;
       ++played;
@@ -145,7 +175,8 @@ int play(const PlayOptions& o, std::ostream& out, std::ostream& err) {
 
   // Reliable readers get what was written before the writers go (bounded).
   for (auto& [id, t] : tracks) {
-    if (dds::qos_spec(t.qos).reliable) t.writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
+    if (dds::qos_spec(t.qos).reliable)
+      t.writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
   }
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   std::sort(late_ms.begin(), late_ms.end());
@@ -154,16 +185,23 @@ int play(const PlayOptions& o, std::ostream& out, std::ostream& err) {
   for (auto& [id, t] : tracks) participant.publisher()->delete_datawriter(t.writer);
 
   if (o.dds.json) {
-    nlohmann::ordered_json j = {{"file", o.file},          {"messages", played},      {"passes", passes},
-                                {"seconds", elapsed},      {"rate", o.rate},          {"late_ms_median", late_median},
-                                {"late_ms_max", late_max}, {"complete", reader.complete()},
+    nlohmann::ordered_json j = {{"file", o.file},
+                                {"messages", played},
+                                {"passes", passes},
+                                {"seconds", elapsed},
+                                {"rate", o.rate},
+                                {"late_ms_median", late_median},
+                                {"late_ms_max", late_max},
+                                {"complete", reader.complete()},
                                 {"topics", nlohmann::ordered_json::object()}};
     for (const auto& [id, t] : tracks) j["topics"][t.topic] = t.written;
     out << j.dump() << "\n";
   } else {
-    out << "played " << played << " message(s) on " << tracks.size() << " topic(s) of " << o.file << " in " << std::fixed
-        << std::setprecision(2) << elapsed << " s (rate " << o.rate << (passes > 1 ? ", " + std::to_string(passes) + " passes" : "")
-        << "; writes late by median " << std::setprecision(3) << late_median << " ms, max " << late_max << " ms)\n";
+    out << "played " << played << " message(s) on " << tracks.size() << " topic(s) of " << o.file
+        << " in " << std::fixed << std::setprecision(2) << elapsed << " s (rate " << o.rate
+        << (passes > 1 ? ", " + std::to_string(passes) + " passes" : "")
+        << "; writes late by median " << std::setprecision(3) << late_median << " ms, max "
+        << late_max << " ms)\n";
   }
   return 0;
 }

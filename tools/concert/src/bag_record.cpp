@@ -1,5 +1,7 @@
 // `concert bag record`: DDS readers (one per topic, its class's QoS) hand each sample to a
 // queue; one thread writes the queue into the MCAP file, chunk by chunk.
+#include <unistd.h>
+
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -12,7 +14,6 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
-#include <unistd.h>
 
 #include "bag.hpp"
 #include "concert/common/clock.hpp"
@@ -61,7 +62,8 @@ class Queue {
       const auto now = static_cast<uint64_t>(now_ns());
       last_ = std::max(last_, now);
       bytes_ += bytes.size();
-      items_.push_back({channel, last_, publish_ns > 0 ? static_cast<uint64_t>(publish_ns) : last_, std::move(bytes)});
+      items_.push_back({channel, last_, publish_ns > 0 ? static_cast<uint64_t>(publish_ns) : last_,
+                        std::move(bytes)});
     }
     ready_.notify_one();
     return true;
@@ -111,7 +113,8 @@ int record(const RecordOptions& o, std::ostream& out, std::ostream& err) {
   }
   for (const auto& t : o.topics) {
     if (!dds::find_topic(t)) {
-      throw cli::UsageError("topic '" + t + "' is not in the catalogue (`concert topic list` shows the topics)");
+      throw cli::UsageError("topic '" + t +
+                            "' is not in the catalogue (`concert topic list` shows the topics)");
     }
     if (seen.insert(t).second) topics.push_back(t);
   }
@@ -121,7 +124,8 @@ int record(const RecordOptions& o, std::ostream& out, std::ostream& err) {
   }
   const int32_t domain = o.dds.domain_id();
 
-  bag::Writer writer(o.output, {.compression = compression, .library = "concert bag record (libs/bag)"});
+  bag::Writer writer(o.output,
+                     {.compression = compression, .library = "concert bag record (libs/bag)"});
   const auto& schema = idl::Schema::builtin();
   std::map<std::string, uint16_t> schema_ids;
   std::vector<std::pair<std::string, Resolved>> channels;  // by channel id
@@ -168,7 +172,8 @@ int record(const RecordOptions& o, std::ostream& out, std::ostream& err) {
       const auto channel = static_cast<uint16_t>(i);
       subscriptions.push_back(std::make_unique<RawSubscription>(
           participant, topic, r,
-          [&queue, channel](std::vector<uint8_t>& bytes, const eprosima::fastdds::dds::SampleInfo& info) {
+          [&queue, channel](std::vector<uint8_t>& bytes,
+                            const eprosima::fastdds::dds::SampleInfo& info) {
             queue.push(channel, info.source_timestamp.to_ns(), bytes);
           },
           [&err, &err_mutex, topic = topic](int32_t writers) {
@@ -178,8 +183,8 @@ int record(const RecordOptions& o, std::ostream& out, std::ostream& err) {
     }
     {
       std::lock_guard lock(err_mutex);
-      err << "concert bag record: recording " << topics.size() << " topic(s) on domain " << domain << " into "
-          << o.output << "; Ctrl-C stops" << std::endl;
+      err << "concert bag record: recording " << topics.size() << " topic(s) on domain " << domain
+          << " into " << o.output << "; Ctrl-C stops" << std::endl;
     }
     const auto deadline = start + std::chrono::duration<double>(o.dds.timeout_s);
     while (!interrupted() && !write_failed && (o.dds.timeout_s == 0 || Clock::now() < deadline)) {
@@ -196,7 +201,8 @@ int record(const RecordOptions& o, std::ostream& out, std::ostream& err) {
   bag::Metadata recording{kRecordingMetadata, {}};
   for (const auto& [channel, c] : counts) {
     dropped += c.dropped;
-    if (c.dropped) recording.entries["dropped " + channels[channel].first] = std::to_string(c.dropped);
+    if (c.dropped)
+      recording.entries["dropped " + channels[channel].first] = std::to_string(c.dropped);
   }
   char host[256] = "";
   gethostname(host, sizeof host - 1);
@@ -210,19 +216,24 @@ int record(const RecordOptions& o, std::ostream& out, std::ostream& err) {
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   const auto& st = writer.statistics();
   if (o.dds.json) {
-    nlohmann::ordered_json j = {{"file", o.output},       {"messages", st.message_count},
-                                {"dropped", dropped},     {"seconds", elapsed},
-                                {"bytes", writer.file_size()}, {"topics", nlohmann::ordered_json::object()}};
+    nlohmann::ordered_json j = {{"file", o.output},
+                                {"messages", st.message_count},
+                                {"dropped", dropped},
+                                {"seconds", elapsed},
+                                {"bytes", writer.file_size()},
+                                {"topics", nlohmann::ordered_json::object()}};
     for (size_t i = 0; i < channels.size(); ++i) {
       const auto c = counts.find(static_cast<uint16_t>(i));
-      j["topics"][channels[i].first] = {{"messages", c == counts.end() ? 0 : c->second.received - c->second.dropped},
-                                        {"dropped", c == counts.end() ? 0 : c->second.dropped}};
+      j["topics"][channels[i].first] = {
+          {"messages", c == counts.end() ? 0 : c->second.received - c->second.dropped},
+          {"dropped", c == counts.end() ? 0 : c->second.dropped}};
     }
     out << j.dump() << "\n";
   } else {
-    out << "recorded " << st.message_count << " message(s) on " << counts.size() << " of " << topics.size()
-        << " topic(s) in " << std::fixed << std::setprecision(1) << elapsed << " s into " << o.output << " ("
-        << std::setprecision(2) << static_cast<double>(writer.file_size()) / 1e6 << " MB)";
+    out << "recorded " << st.message_count << " message(s) on " << counts.size() << " of "
+        << topics.size() << " topic(s) in " << std::fixed << std::setprecision(1) << elapsed
+        << " s into " << o.output << " (" << std::setprecision(2)
+        << static_cast<double>(writer.file_size()) / 1e6 << " MB)";
     if (dropped) out << "; " << dropped << " dropped (the disk did not keep up)";
     out << "\n";
   }

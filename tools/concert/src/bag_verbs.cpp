@@ -100,10 +100,11 @@ int info(const std::string& file, bool json, std::ostream& out, std::ostream& er
     for (const auto& [id, c] : s.channels) {
       const auto schema = s.schemas.find(c.schema_id);
       const auto count = st.channel_message_counts.find(id);
-      j["topics"].push_back({{"topic", c.topic},
-                             {"type", schema == s.schemas.end() ? "" : schema->second.name},
-                             {"messages", count == st.channel_message_counts.end() ? 0 : count->second},
-                             {"metadata", c.metadata}});
+      j["topics"].push_back(
+          {{"topic", c.topic},
+           {"type", schema == s.schemas.end() ? "" : schema->second.name},
+           {"messages", count == st.channel_message_counts.end() ? 0 : count->second},
+           {"metadata", c.metadata}});
     }
     j["metadata"] = nlohmann::ordered_json::object();
     for (const auto& m : s.metadata) j["metadata"][m.name] = m.entries;
@@ -114,25 +115,29 @@ int info(const std::string& file, bool json, std::ostream& out, std::ostream& er
       << static_cast<double>(s.file_size) / 1e6 << " MB)\n";
   out << "complete:    " << (reader.complete() ? "yes" : "no: " + reader.problem()) << "\n";
   out << "written by:  " << (s.library.empty() ? "(not named)" : s.library) << "\n";
-  out << "compression: " << (compressions.empty() ? "-" : join(compressions)) << " (" << st.chunk_count
-      << " chunk(s))\n";
+  out << "compression: " << (compressions.empty() ? "-" : join(compressions)) << " ("
+      << st.chunk_count << " chunk(s))\n";
   out << "messages:    " << st.message_count << "\n";
   if (st.message_count > 0) {
-    out << "start:       " << utc_text(st.message_start_time) << " (" << epoch_text(st.message_start_time) << ")\n";
-    out << "end:         " << utc_text(st.message_end_time) << " (" << epoch_text(st.message_end_time) << ")\n";
+    out << "start:       " << utc_text(st.message_start_time) << " ("
+        << epoch_text(st.message_start_time) << ")\n";
+    out << "end:         " << utc_text(st.message_end_time) << " ("
+        << epoch_text(st.message_end_time) << ")\n";
     out << "duration:    " << std::setprecision(3) << seconds(duration) << " s\n";
   }
   size_t width = 5;
   for (const auto& [id, c] : s.channels) width = std::max(width, c.topic.size());
-  out << "\n" << std::left << std::setw(static_cast<int>(width) + 2) << "TOPIC" << std::setw(44) << "TYPE"
-      << std::right << std::setw(10) << "MESSAGES" << "  QOS\n";
+  out << "\n"
+      << std::left << std::setw(static_cast<int>(width) + 2) << "TOPIC" << std::setw(44) << "TYPE"
+      << std::right << std::setw(10) << "MESSAGES"
+      << "  QOS\n";
   for (const auto& [id, c] : s.channels) {
     const auto schema = s.schemas.find(c.schema_id);
     const auto count = st.channel_message_counts.find(id);
     const auto qos = c.metadata.find(kQosKey);
     out << std::left << std::setw(static_cast<int>(width) + 2) << c.topic << std::setw(44)
-        << (schema == s.schemas.end() ? "(no schema)" : schema->second.name) << std::right << std::setw(10)
-        << (count == st.channel_message_counts.end() ? 0 : count->second) << "  "
+        << (schema == s.schemas.end() ? "(no schema)" : schema->second.name) << std::right
+        << std::setw(10) << (count == st.channel_message_counts.end() ? 0 : count->second) << "  "
         << (qos == c.metadata.end() ? "" : qos->second) << "\n";
   }
   for (const auto& m : s.metadata) {
@@ -146,14 +151,20 @@ int info(const std::string& file, bool json, std::ostream& out, std::ostream& er
 
 void register_bag_verbs(cli::Cli& concert) {
   using namespace bag_verbs;
-  CLI::App& bag = concert.group(concert.app(), "bag", "recordings of topics in MCAP files: record, info, play");
+  CLI::App& bag =
+      concert.group(concert.app(), "bag", "recordings of topics in MCAP files: record, info, play");
 
   auto rec = std::make_shared<RecordOptions>();
   CLI::App& record_verb = concert.verb(
-      bag, "record", "record topics (default: every catalogue topic) into an MCAP file until Ctrl-C or --timeout",
-      [&concert, rec] { return interruptible([&] { return record(*rec, concert.out(), concert.err()); }); });
+      bag, "record",
+      "record topics (default: every catalogue topic) into an MCAP file until Ctrl-C or --timeout",
+      [&concert, rec] {
+        return interruptible([&] { return record(*rec, concert.out(), concert.err()); });
+      });
   record_verb.add_option("TOPICS", rec->topics, "catalogue topics to record (none: all of them)");
-  record_verb.add_option("-o,--output", rec->output, "the MCAP file to write")->required()->type_name("FILE");
+  record_verb.add_option("-o,--output", rec->output, "the MCAP file to write")
+      ->required()
+      ->type_name("FILE");
   cli::Cli::add_choice(record_verb, "--compression", rec->compression, {"zstd", "lz4", "none"},
                        "chunk compression (default zstd)");
   record_verb.add_flag("--force", rec->force, "overwrite FILE if it exists");
@@ -163,14 +174,18 @@ void register_bag_verbs(cli::Cli& concert) {
   auto info_json = std::make_shared<bool>(false);
   CLI::App& info_verb = concert.verb(
       bag, "info", "topics, types, message counts, start, end and duration of a recording",
-      [&concert, info_file, info_json] { return info(*info_file, *info_json, concert.out(), concert.err()); });
+      [&concert, info_file, info_json] {
+        return info(*info_file, *info_json, concert.out(), concert.err());
+      });
   info_verb.add_option("FILE", *info_file, "an MCAP file")->required();
   info_verb.add_flag("--json", *info_json, "machine-readable output");
 
   auto pl = std::make_shared<PlayOptions>();
   CLI::App& play_verb = concert.verb(
       bag, "play", "publish a recording again with its timing, each topic with its catalogue QoS",
-      [&concert, pl] { return interruptible([&] { return play(*pl, concert.out(), concert.err()); }); });
+      [&concert, pl] {
+        return interruptible([&] { return play(*pl, concert.out(), concert.err()); });
+      });
   play_verb.add_option("FILE", pl->file, "an MCAP file (`concert bag record`)")->required();
   play_verb.add_option("--rate", pl->rate, "speed factor (2: twice as fast)")
       ->type_name("R")
@@ -179,8 +194,10 @@ void register_bag_verbs(cli::Cli& concert) {
   play_verb.add_flag("--loop", pl->loop, "start again at the end, until Ctrl-C or --timeout");
   play_verb.add_option("--topics", pl->topics, "play only these topics")->type_name("TOPIC...");
   cli::Cli::add_seconds_option(play_verb, "--wait", "", pl->wait_s,
-                               "how long to wait for readers to match before the first message");
-  concert.add_dds_options(play_verb, pl->dds, 0.0, "stop after S seconds (0: at the end of the recording)");
+                               "wait up to S seconds for readers: play starts once every topic has "
+                               "one and no other matched for 0.3 s");
+  concert.add_dds_options(play_verb, pl->dds, 0.0,
+                          "stop after S seconds (0: at the end of the recording)");
 }
 
 }  // namespace concert::tool

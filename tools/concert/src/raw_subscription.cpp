@@ -23,12 +23,13 @@ std::optional<Resolved> from_catalogue(const std::string& topic) {
   return r;
 }
 
-RawSubscription::RawSubscription(dds::Participant& participant, const std::string& topic, const Resolved& r,
-                                 Callback cb, Matched matched)
+RawSubscription::RawSubscription(dds::Participant& participant, const std::string& topic,
+                                 const Resolved& r, Callback cb, Matched matched)
     : participant_(participant), callback_(std::move(cb)), matched_(std::move(matched)) {
   auto* t = participant.topic(topic, TypeSupport(new dds::RawPubSubType(r.type, r.keyed)));
   auto qos = dds::reader_qos(r.reliable ? dds::QosClass::kCommand : dds::QosClass::kStream);
-  qos.durability().kind = r.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
+  qos.durability().kind =
+      r.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
   qos.history().depth = 1000;
   reader_ = participant.subscriber()->create_datareader(
       t, qos, this, StatusMask::data_available() << StatusMask::subscription_matched());
@@ -43,12 +44,14 @@ RawSubscription::~RawSubscription() {
 void RawSubscription::on_data_available(DataReader* reader) {
   dds::RawSample sample;
   SampleInfo info;
-  while (reader->take_next_sample(&sample, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+  while (reader->take_next_sample(&sample, &info) ==
+         eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
     if (info.valid_data) callback_(sample.bytes, info);
   }
 }
 
-void RawSubscription::on_subscription_matched(DataReader*, const SubscriptionMatchedStatus& status) {
+void RawSubscription::on_subscription_matched(DataReader*,
+                                              const SubscriptionMatchedStatus& status) {
   if (matched_) matched_(status.current_count);
 }
 

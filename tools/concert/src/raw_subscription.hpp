@@ -29,21 +29,23 @@ std::optional<Resolved> from_catalogue(const std::string& topic);
 class RawSubscription : public eprosima::fastdds::dds::DataReaderListener {
  public:
   /// Each valid sample: its bytes (the callee may take them) and its SampleInfo.
-  using Callback = std::function<void(std::vector<uint8_t>& bytes, const eprosima::fastdds::dds::SampleInfo& info)>;
+  using Callback = std::function<void(std::vector<uint8_t>& bytes,
+                                      const eprosima::fastdds::dds::SampleInfo& info)>;
   /// The number of writers matched, each time it changes.
   using Matched = std::function<void(int32_t writers)>;
 
   /// Reliable and transient-local as `r` says (a transient-local reader gets the latched samples
   /// at once), keeping up to 1000 samples per instance until the listener takes them.
-  RawSubscription(dds::Participant& participant, const std::string& topic, const Resolved& r, Callback cb,
-                  Matched matched = {});
+  RawSubscription(dds::Participant& participant, const std::string& topic, const Resolved& r,
+                  Callback cb, Matched matched = {});
   ~RawSubscription() override;
   RawSubscription(const RawSubscription&) = delete;
   RawSubscription& operator=(const RawSubscription&) = delete;
 
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override;
-  void on_subscription_matched(eprosima::fastdds::dds::DataReader* reader,
-                               const eprosima::fastdds::dds::SubscriptionMatchedStatus& status) override;
+  void on_subscription_matched(
+      eprosima::fastdds::dds::DataReader* reader,
+      const eprosima::fastdds::dds::SubscriptionMatchedStatus& status) override;
 
  private:
   dds::Participant& participant_;
