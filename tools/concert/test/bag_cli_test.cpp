@@ -2,9 +2,11 @@
 // published before the recorder starts, keyed and unkeyed, reliable and best-effort, camera
 // images) recorded by the `concert` process read back equal sample for sample; Foxglove's MCAP
 // reader (tools/mcap_check, @mcap/core + @foxglove/omgidl-serialization) accepts the file and
-// decodes every message to the same values; `play` publishes with the recorded timing and
-// `concert topic echo` sees it; a recorder killed mid-recording leaves a file `info`, `play` and
-// the independent reader read up to its last complete record.
+// decodes every message to the same values; the running discovery service is recorded, and its
+// recorded scan played into a fresh one gives the same tree; `play` publishes with the recorded
+// timing (latched topics latched) and `concert topic echo` sees it; a recorder killed
+// mid-recording leaves a file `info`, `play` and the independent reader read up to its last
+// complete record.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -359,10 +361,21 @@ TEST(BagCli, PlayPublishesWithTheRecordedTimingAndTopicEchoSeesIt) {
   for (const double rate : {1.0, 2.0}) {
     SCOPED_TRACE("rate " + std::to_string(rate));
     const size_t before = commands.size();
-    const auto play =
-        concert({"bag", "play", file, "--rate", std::to_string(rate), "--wait", "20", "--json"});
-    ASSERT_EQ(play.code, 0) << play.err;
-    const Json report = Json::parse(play.out);
+    Process play({CONCERT_BIN, "bag", "play", file, "--rate", std::to_string(rate), "--wait", "20",
+                  "--json"});
+    if (rate == 1.0) {
+      // The status was played first; a reader that joins later still gets it: latched.
+      const auto joined = Clock::now() + 20s;
+      while (commands.size() < before + 2 && Clock::now() < joined)
+        std::this_thread::sleep_for(5ms);
+      ASSERT_GE(commands.size(), before + 2);
+      const auto late =
+          concert({"topic", "echo", "concert/system/status", "--count", "1", "--timeout", "20"});
+      ASSERT_EQ(late.code, 0) << late.err;
+      EXPECT_EQ(Json::parse(late.out), idl::decode(s, "concert::msg::ServiceStatus", f.status));
+    }
+    ASSERT_EQ(play.wait(30s), 0) << play.err();
+    const Json report = Json::parse(play.out());
     EXPECT_EQ(report.at("messages"), 8);
     EXPECT_EQ(report.at("topics").at("concert/robot/joint_command"), 7);
     const auto deadline = Clock::now() + 10s;
@@ -469,7 +482,7 @@ TEST(BagCli, ARecorderKilledMidRecordingLeavesAFileReadableUpToItsLastCompleteRe
 }
 
 #ifdef CONCERT_DISCOVERY_BIN
-TEST(BagCli, ARecordingOfTheRunningDiscoveryServiceReadsBackWhatItsReadersGot) {
+TEST(BagCli, TheRunningDiscoveryServiceRecordedThenItsScanReplayedIntoAFreshOne) {
   // The real discovery service turns a real scan of the CONCERT robot (../shared/data) into the
   // module tree; the recording holds the scan, the tree and the service's status, the same as
   // `concert topic echo` received them.
@@ -515,6 +528,21 @@ TEST(BagCli, ARecordingOfTheRunningDiscoveryServiceReadsBackWhatItsReadersGot) {
   EXPECT_EQ(check[0].at("decoded").at(topics[1]).get<int>(), 1);
   EXPECT_EQ(check[0].at("statistics").at("messageCount").get<uint64_t>(),
             reader.summary().statistics.message_count);
+
+  // The recorded scan, played into a fresh discovery service, gives the same tree again.
+  Process again({CONCERT_DISCOVERY_BIN, "--module-db",
+                 std::string(CONCERT_SHARED_DATA) + "/concert_resources"});
+  Process tree_again({CONCERT_BIN, "topic", "echo", topics[1], "--count", "1", "--timeout", "60"});
+  const auto play = concert({"bag", "play", file, "--topics", topics[0], "--wait", "20"});
+  ASSERT_EQ(play.code, 0) << play.err;
+  ASSERT_EQ(tree_again.wait(60s), 0) << tree_again.err() << again.err();
+  Json replayed = Json::parse(testing::lines(tree_again.out()).at(0));
+  Json original = tree;
+  replayed.erase("stamp_ns");
+  original.erase("stamp_ns");
+  EXPECT_EQ(replayed, original);
+  ::kill(again.pid(), SIGTERM);
+  again.wait(15s);
 }
 #endif
 
