@@ -2,8 +2,8 @@
 # Installs every Debian package the project needs (Debian 12). Idempotent and non-interactive:
 # packages already installed are skipped, so a second run does nothing and takes a second.
 # The lists live in deploy/packages/*.txt (one package a line, '#' comments), one file per area.
-# Then the npm packages of the project's Node.js steps (tools/ifc_import: the IFC engine web-ifc)
-# are installed from their committed lockfiles with `npm ci`, when node_modules is missing or
+# Then the npm packages of the project's Node.js steps (tools/ifc_import: the IFC engine web-ifc;
+# tools/mcap_check: Foxglove's MCAP reader, run by the bag tests) are installed from their committed lockfiles with `npm ci`, when node_modules is missing or
 # older than the lockfile; nothing is fetched at run time.
 # Usage: deploy/install-deps.sh [--check]   (--check: only report what is missing; exit 1 if any)
 set -euo pipefail
@@ -46,7 +46,7 @@ fi
 # npm packages, one folder per Node.js step, from its committed package-lock.json. Quiet when
 # node_modules is already newer than the lockfile.
 # (A folder that is not there, as in the Docker build's first layer, is skipped.)
-for dir in "$here/../tools/ifc_import"; do
+for dir in "$here/../tools/ifc_import" "$here/../tools/mcap_check"; do
   [ -f "$dir/package-lock.json" ] || continue
   dir=$(cd "$dir" && pwd)
   lock="$dir/package-lock.json"

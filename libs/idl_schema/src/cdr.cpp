@@ -452,6 +452,23 @@ std::optional<std::array<uint8_t, 16>> key_hash(const Schema& schema, std::strin
   return hash;
 }
 
+std::optional<std::array<uint8_t, 16>> key_hash_of_cdr(const Schema& schema, std::string_view type,
+                                                       std::span<const uint8_t> bytes) {
+  const StructDef& def = schema.at(type);
+  if (!def.keyed()) return std::nullopt;
+  size_t last_key = 0;
+  for (size_t i = 0; i < def.fields.size(); ++i) {
+    if (def.fields[i].key) last_key = i;
+  }
+  Reader reader(schema, bytes);
+  Json prefix = Json::object();
+  for (size_t i = 0; i <= last_key; ++i) {
+    const Field& f = def.fields[i];
+    prefix[f.name] = reader.value(f.type, f.name);
+  }
+  return key_hash(schema, type, prefix);
+}
+
 Json sample_with_every_field_set(const Schema& schema, std::string_view type, uint32_t seed) {
   TypeRef ref;
   ref.kind = Kind::kStruct;

@@ -1,6 +1,7 @@
 #include "concert/idl_schema/schema.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <set>
 #include <sstream>
 
@@ -178,6 +179,124 @@ std::string Schema::shape(std::string_view struct_name) const {
       if (t->kind == Kind::kStruct || t->kind == Kind::kEnum) todo.push_back(t->name);
     }
     out << "}\n";
+  }
+  return out.str();
+}
+
+}  // namespace concert::idl
+
+namespace concert::idl {
+namespace {
+
+/// "concert::msg::Pose" -> {"concert", "msg"}, "Pose".
+std::pair<std::vector<std::string>, std::string> split_scoped(const std::string& name) {
+  std::vector<std::string> modules;
+  size_t start = 0;
+  for (size_t at = name.find("::"); at != std::string::npos; at = name.find("::", start)) {
+    modules.push_back(name.substr(start, at - start));
+    start = at + 2;
+  }
+  return {modules, name.substr(start)};
+}
+
+/// A type as IDL spells it in a declaration inside module `scope` (arrays excluded: their
+/// dimensions follow the member name).
+std::string idl_spelling(const TypeRef& type, const std::vector<std::string>& scope) {
+  switch (type.kind) {
+    case Kind::kBool:
+      return "boolean";
+    case Kind::kInt16:
+      return "short";
+    case Kind::kUInt16:
+      return "unsigned short";
+    case Kind::kInt32:
+      return "long";
+    case Kind::kUInt32:
+      return "unsigned long";
+    case Kind::kInt64:
+      return "long long";
+    case Kind::kUInt64:
+      return "unsigned long long";
+    case Kind::kStruct:
+    case Kind::kEnum: {
+      auto [modules, local] = split_scoped(type.name);
+      return modules == scope ? local : type.name;
+    }
+    case Kind::kSequence:
+      if (type.element->kind == Kind::kArray) {
+        throw SchemaError(
+            "a sequence of arrays needs a typedef, which the IDL text does not write");
+      }
+      return "sequence<" + idl_spelling(*type.element, scope) +
+             (type.bound ? ", " + std::to_string(type.bound) : "") + ">";
+    case Kind::kArray:
+      throw SchemaError("arrays are spelled at the member");
+    default:
+      return Schema::spell(type);  // octet, char, int8, uint8, float, double, string
+  }
+}
+
+}  // namespace
+
+std::string Schema::idl(std::string_view struct_name) const {
+  // Depth first, each definition after those it uses.
+  std::vector<std::string> order;
+  std::set<std::string> seen;
+  std::function<void(const std::string&)> visit = [&](const std::string& name) {
+    if (!seen.insert(name).second) return;
+    if (find_enum(name) == nullptr) {
+      for (const auto& f : at(name).fields) {
+        const TypeRef* t = &f.type;
+        while (t->kind == Kind::kSequence || t->kind == Kind::kArray) t = t->element.get();
+        if (t->kind == Kind::kStruct || t->kind == Kind::kEnum) visit(t->name);
+      }
+    }
+    order.push_back(name);
+  };
+  visit(std::string(struct_name));
+
+  std::ostringstream out;
+  out << "// " << struct_name << " and the types it uses (generated from the CONCERT IDL)\n";
+  std::vector<std::string> open;  // modules currently open
+  auto indent = [&] { return std::string(2 * open.size(), ' '); };
+  for (const std::string& name : order) {
+    auto [modules, local] = split_scoped(name);
+    size_t common = 0;
+    while (common < open.size() && common < modules.size() && open[common] == modules[common])
+      ++common;
+    while (open.size() > common) {
+      open.pop_back();
+      out << indent() << "};\n";
+    }
+    while (open.size() < modules.size()) {
+      out << indent() << "module " << modules[open.size()] << " {\n";
+      open.push_back(modules[open.size()]);
+    }
+    if (const auto* en = find_enum(name)) {
+      out << indent() << "enum " << local << " {";
+      for (size_t i = 0; i < en->enumerators.size(); ++i) {
+        const auto& [e, v] = en->enumerators[i];
+        out << (i ? ", " : " ") << (v == i ? "" : "@value(" + std::to_string(v) + ") ") << e;
+      }
+      out << " };\n";
+      continue;
+    }
+    out << indent() << "struct " << local << " {\n";
+    for (const auto& f : at(name).fields) {
+      const TypeRef* t = &f.type;
+      std::string dims;
+      while (t->kind == Kind::kArray) {
+        dims += "[" + std::to_string(t->bound) + "]";
+        t = t->element.get();
+      }
+      out << indent() << "  " << (f.key ? "@key " : "") << idl_spelling(*t, modules) << " "
+          << f.name << dims << ";\n";
+    }
+    out << indent() << "};\n";
+  }
+  while (!open.empty()) {
+    open.pop_back();
+    out << indent() << "};\n";
   }
   return out.str();
 }

@@ -61,6 +61,21 @@ TEST(Cdr, EveryBuiltinTypeRoundTripsWithEveryFieldSet) {
   }
 }
 
+TEST(Cdr, KeyHashFromTheBytesEqualsTheOneFromTheSample) {
+  const auto& s = Schema::builtin();
+  int keyed = 0;
+  for (const auto& name : s.struct_names()) {
+    SCOPED_TRACE(name);
+    const Json v = sample_with_every_field_set(s, name, 5);
+    const auto expected = key_hash(s, name, v);
+    EXPECT_EQ(key_hash_of_cdr(s, name, encode(s, name, v)), expected);
+    if (expected) ++keyed;
+  }
+  EXPECT_GE(keyed, 8);
+  const std::vector<uint8_t> short_payload = {0, 1, 0, 0, 7};
+  EXPECT_THROW(key_hash_of_cdr(s, "concert::msg::ServiceStatus", short_payload), CdrError);
+}
+
 TEST(Cdr, ErrorsNameTheField) {
   const Json v = {{"a", 1}, {"b", 0.5}, {"c", "hi"}, {"d", {7, 8}}, {"e", "GREEN"}, {"f", {-1, 2}}};
   auto bytes = encode(small(), "t::S", v);

@@ -56,5 +56,33 @@ TEST(Schema, ShapeChangesWithAnyFieldChange) {
   EXPECT_NE(Schema::parse("module m { enum E { A, B }; struct In { double x; }; struct S { long id; In in; E e; sequence<string<8>, 4> names; }; };").shape("m::S"), a);
 }
 
+TEST(Schema, IdlTextOfEveryTypeParsesBackToTheSameShape) {
+  const auto& s = Schema::builtin();
+  for (const auto& name : s.struct_names()) {
+    const std::string text = s.idl(name);
+    Schema back;
+    ASSERT_NO_THROW(back = Schema::parse(text, name)) << text;
+    EXPECT_EQ(back.shape(name), s.shape(name)) << text;
+  }
+}
+
+TEST(Schema, IdlTextHasOnlyWhatTheTypeUsesInDependencyOrder) {
+  const auto s = Schema::parse(
+      "module m { enum E { A, B }; struct In { double x; }; struct Unused { long u; };"
+      " module n { struct T { In a[2][3]; }; };"
+      " struct S { @key long id; n::T t; E e; sequence<In, 4> ins; string<8> name; unsigned long long big; }; };");
+  const std::string text = s.idl("m::S");
+  EXPECT_EQ(text.find("Unused"), std::string::npos) << text;
+  EXPECT_LT(text.find("struct In"), text.find("module n"));
+  EXPECT_LT(text.find("module n"), text.find("struct S"));
+  EXPECT_NE(text.find("m::In a[2][3];"), std::string::npos) << text;
+  EXPECT_NE(text.find("@key long id;"), std::string::npos) << text;
+  EXPECT_NE(text.find("n::T t;"), std::string::npos) << text;
+  EXPECT_NE(text.find("enum E { A, B };"), std::string::npos) << text;
+  EXPECT_NE(text.find("sequence<In, 4> ins;"), std::string::npos) << text;
+  EXPECT_NE(text.find("unsigned long long big;"), std::string::npos) << text;
+  EXPECT_EQ(Schema::parse(text).shape("m::S"), s.shape("m::S"));
+}
+
 }  // namespace
 }  // namespace concert::idl

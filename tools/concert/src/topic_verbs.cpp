@@ -6,9 +6,6 @@
 #include <cmath>
 #include <csignal>
 #include <fastdds/dds/publisher/DataWriter.hpp>
-#include <fastdds/dds/subscriber/DataReader.hpp>
-#include <fastdds/dds/subscriber/DataReaderListener.hpp>
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <iomanip>
 #include <map>
 #include <mutex>
@@ -23,6 +20,7 @@
 #include "concert/dds/raw_type.hpp"
 #include "concert/idl_schema/cdr.hpp"
 #include "graph.hpp"
+#include "raw_subscription.hpp"
 
 namespace concert::tool {
 namespace {
@@ -46,26 +44,9 @@ std::string qos_text(bool reliable, bool transient_local) {
   return std::string(reliable ? "reliable" : "best-effort") + " " + (transient_local ? "transient-local" : "volatile");
 }
 
-/// How to subscribe to a topic: its type and the QoS that matches its writers.
-struct Resolved {
-  std::string type;
-  bool keyed = false;
-  bool reliable = false;
-  bool transient_local = false;
-  bool ours = false;
-};
-
 Resolved resolve(DomainGraph& graph, const std::string& topic, double wait_s, int32_t domain) {
+  if (auto ours = from_catalogue(topic)) return *ours;
   Resolved r;
-  if (const auto info = dds::find_topic(topic)) {
-    const auto spec = dds::qos_spec(info->qos);
-    r.type = info->type_name;
-    r.keyed = idl::Schema::builtin().at(info->type_name).keyed();
-    r.reliable = spec.reliable;
-    r.transient_local = spec.transient_local;
-    r.ours = true;
-    return r;
-  }
   const auto deadline = Clock::now() + std::chrono::duration<double>(wait_s);
   std::vector<EndpointInfo> writers;
   while (!g_interrupted) {
@@ -87,41 +68,6 @@ Resolved resolve(DomainGraph& graph, const std::string& topic, double wait_s, in
   r.transient_local = std::all_of(writers.begin(), writers.end(), [](const auto& w) { return w.transient_local; });
   return r;
 }
-
-/// A reader of any topic that hands over each sample's bytes and arrival time.
-class RawSubscription : public eprosima::fastdds::dds::DataReaderListener {
- public:
-  using Callback = std::function<void(const std::vector<uint8_t>&, Clock::time_point)>;
-
-  RawSubscription(dds::Participant& participant, const std::string& topic, const Resolved& r, Callback cb)
-      : participant_(participant), callback_(std::move(cb)) {
-    auto* t = participant.topic(topic, eprosima::fastdds::dds::TypeSupport(new dds::RawPubSubType(r.type, r.keyed)));
-    auto qos = dds::reader_qos(r.reliable ? dds::QosClass::kCommand : dds::QosClass::kStream);
-    qos.durability().kind = r.transient_local ? eprosima::fastdds::dds::TRANSIENT_LOCAL_DURABILITY_QOS
-                                              : eprosima::fastdds::dds::VOLATILE_DURABILITY_QOS;
-    qos.history().depth = 1000;
-    reader_ = participant.subscriber()->create_datareader(t, qos, this,
-                                                          eprosima::fastdds::dds::StatusMask::data_available());
-    if (reader_ == nullptr) throw Failure("cannot subscribe to '" + topic + "'");
-  }
-  ~RawSubscription() override {
-    reader_->set_listener(nullptr);
-    participant_.subscriber()->delete_datareader(reader_);
-  }
-
-  void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
-    dds::RawSample sample;
-    eprosima::fastdds::dds::SampleInfo info;
-    while (reader->take_next_sample(&sample, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
-      if (info.valid_data) callback_(sample.bytes, Clock::now());
-    }
-  }
-
- private:
-  dds::Participant& participant_;
-  Callback callback_;
-  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
-};
 
 /// Runs until `count` samples (0 = no limit), the timeout (0 = none) or Ctrl-C.
 void run_until(const std::function<size_t()>& received, long count, double timeout_s) {
@@ -237,7 +183,7 @@ int echo(const Follow& f, std::ostream& out, std::ostream& err) {
   }
   std::mutex mutex;
   size_t printed = 0;
-  RawSubscription sub(graph.participant(), topic, r, [&](const std::vector<uint8_t>& bytes, Clock::time_point) {
+  RawSubscription sub(graph.participant(), topic, r, [&](const std::vector<uint8_t>& bytes, const auto&) {
     std::lock_guard lock(mutex);
     if (count != 0 && printed >= static_cast<size_t>(count)) return;
     try {
@@ -273,7 +219,8 @@ int hz(const Follow& f, std::ostream& out, std::ostream& err) {
   const Resolved r = resolve(graph, topic, f.wait_s, domain);
   std::mutex mutex;
   std::vector<Clock::time_point> arrivals;
-  RawSubscription sub(graph.participant(), topic, r, [&](const std::vector<uint8_t>&, Clock::time_point t) {
+  RawSubscription sub(graph.participant(), topic, r, [&](const std::vector<uint8_t>&, const auto&) {
+    const auto t = Clock::now();
     std::lock_guard lock(mutex);
     arrivals.push_back(t);
   });

@@ -2,6 +2,7 @@
 
 #include <memory>
 
+#include "bag_verbs.hpp"
 #include "bim_verbs.hpp"
 #include "camera_verbs.hpp"
 #include "launcher.hpp"
@@ -47,6 +48,7 @@ void register_all(cli::Cli& concert) {
   register_launcher_verbs(concert);
   register_status_verb(concert);
   register_topic_verbs(concert);
+  register_bag_verbs(concert);
   register_scan_verbs(concert);
   register_camera_verbs(concert);
   register_bim_verbs(concert);

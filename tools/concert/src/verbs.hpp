@@ -1,5 +1,5 @@
 #pragma once
-// Every verb of the `concert` tool: its own (topic, scan, camera, bim, status, up, sim, help) and those each
+// Every verb of the `concert` tool: its own (topic, bag, scan, camera, bim, status, up, sim, help) and those each
 // service's CLI library registers (discover, model, safety, plan), for the services built.
 
 #include "concert/cli/cli.hpp"

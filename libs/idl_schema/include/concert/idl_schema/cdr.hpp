@@ -51,6 +51,11 @@ Json complete(const Schema& schema, std::string_view type, const Json& partial);
 std::optional<std::array<uint8_t, 16>> key_hash(const Schema& schema, std::string_view type,
                                                 const Json& sample);
 
+/// key_hash() of a sample given as its CDR bytes (with encapsulation header): only the fields up
+/// to the last key field are decoded. Throws CdrError when those do not decode.
+std::optional<std::array<uint8_t, 16>> key_hash_of_cdr(const Schema& schema, std::string_view type,
+                                                       std::span<const uint8_t> bytes);
+
 /// A sample with every field set to a non-default value derived from `seed`: non-empty
 /// sequences and strings, every array element, non-zero numbers. Deterministic.
 Json sample_with_every_field_set(const Schema& schema, std::string_view type, uint32_t seed);

@@ -72,6 +72,12 @@ class Schema {
   /// type lock file: changes to any field name, type, bound, key or enumerator change it.
   std::string shape(std::string_view struct_name) const;
 
+  /// OMG IDL text defining `struct_name` and every struct and enum it uses, each before its
+  /// first use, in their modules: what a program that has only this text needs to decode the
+  /// type (the schema of a recorded topic in an MCAP file). Throws SchemaError for an unknown
+  /// type or a shape IDL cannot spell without a typedef (a sequence of arrays).
+  std::string idl(std::string_view struct_name) const;
+
   /// Text of a type reference, e.g. "sequence<concert::msg::EscSlave>" or "double[6]".
   static std::string spell(const TypeRef& type);
 
