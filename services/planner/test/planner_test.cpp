@@ -517,3 +517,44 @@ TEST(Planner, StartInSlightSelfCollisionIsJiggledOut) {
   EXPECT_EQ(deep.status, Status::kInvalidStart) << deep.reason;
   EXPECT_NE(deep.reason.find("self collision"), std::string::npos) << deep.reason;
 }
+
+// A drive holds a few mrad past the limit a trajectory ended on (the demo's J1_E at -2.7504 rad
+// of +-2.75): such a start is clamped onto the limit and planned from, the clamp prepended; a
+// start farther out than start_joint_tolerance is refused.
+TEST(Planner, StartAHairPastAJointLimitIsClampedFirst) {
+  Params params = generous(47);
+  Planner planner(params);
+  planner.set_model(morphology('a', 1));
+  planner.set_environment(environment_of(site(2.2), params));
+  const auto model = planner.model();
+  const auto& k = model->kinematics();
+  const int first = k.joint_index_or_throw("J1_E");
+  const auto names = model->joint_names();
+  const auto j = static_cast<Eigen::Index>(
+      std::find(names.begin(), names.end(), "J1_E") - names.begin());
+  ASSERT_LT(j, static_cast<Eigen::Index>(names.size()));
+  Eigen::VectorXd past = start_state(*model);
+  past[first] = model->lower()[j] - 4e-4;
+  StateChecker check(model, environment_of(site(2.2), params), params, 0.0);
+  ASSERT_EQ(check.check(past).constraint, Constraint::kJointLimit);
+  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.0, 1.2);
+  const PlanResult r = planner.plan({13, 1, "", {{area}}}, past, {});
+  ASSERT_EQ(r.status, Status::kSucceeded) << r.reason;
+  EXPECT_NE(r.note.find("joint limit"), std::string::npos) << r.note;
+  const Trajectory& t = r.goals[0].trajectory;
+  EXPECT_LT((t.points.front().q - model->to_planned(past)).norm(), 1e-9);
+  // From the start onto the limit, never further out, and within the limits from there on.
+  bool inside = false;
+  for (const TrajectoryPoint& p : t.points) {
+    EXPECT_GE(p.q[j], past[first] - 1e-9);
+    if (p.q[j] >= model->lower()[j] - 1e-9) inside = true;
+    if (inside) {
+      EXPECT_GE(p.q[j], model->lower()[j] - 1e-9);
+    }
+  }
+  EXPECT_TRUE(inside);
+  past[first] = model->lower()[j] - 0.3;
+  const PlanResult far = planner.plan({14, 1, "", {{area}}}, past, {});
+  EXPECT_EQ(far.status, Status::kInvalidStart) << far.reason;
+  EXPECT_NE(far.reason.find("joint limit"), std::string::npos) << far.reason;
+}

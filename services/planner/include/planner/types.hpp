@@ -49,6 +49,7 @@ struct Params {
   double floor_clearance = 0.02;     ///< non-leg shapes stay this far above the floor [m]
   double base_range = 3.0;           ///< base x, y sampled within start +- this [m]
   bool fixed_base = false;           ///< per request (PlanRequest::fixed_base): the base keeps its start pose
+  double base_travel = 0.0;          ///< per request (PlanRequest::base_travel) [m and rad]; 0: no bound
 
   // Planning. Time budgets are CPU seconds of the planning thread, not wall seconds, so a plan
   // does not depend on what else loads the machine.
@@ -155,6 +156,11 @@ struct PlanRequest {
   /// Robot shapes grown against the map [m]; 0: Params::environment_padding. The drill service
   /// keeps the base 10 cm from the wall: odometry drifts a few cm per whole-body move.
   double environment_padding = 0.0;
+  /// The base ends at most this far from its start [m] and turned at most this much [rad]; 0:
+  /// anywhere within Params::base_range of the start and the goal. The drill service bounds a
+  /// hole's whole-body posture: odometry drifts with every centimetre and degree the base moves
+  /// (a hole posture that spun the demo base by 2.3 rad left it 5 cm off).
+  double base_travel = 0.0;
 };
 
 /// Result for one goal.

@@ -86,6 +86,9 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   if (params.fixed_base) {
     lo.head<3>() = start.head<3>();
     hi.head<3>() = start.head<3>();
+  } else if (params.base_travel > 0.0) {
+    lo.head<3>() = start.head<3>().array() - params.base_travel;
+    hi.head<3>() = start.head<3>().array() + params.base_travel;
   }
   const double yaw_hint = start[2];
 

@@ -383,14 +383,45 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   // on the floor, is refused.
   std::optional<Eigen::VectorXd> lead_in;
   Eigen::VectorXd start = q_start_full;
+  // A start a hair past a joint's limit (a drive holds a few mrad beyond the limit a trajectory
+  // ended on: J1_E at -2.7504 rad of +-2.75 on the demo, and the drill could not turn its
+  // camera) is clamped onto the limit first, as MoveIt's FixStartStateBounds does; a joint more
+  // than start_joint_tolerance out is refused below.
+  std::string clamped_note;
+  if (start_ok.constraint == Constraint::kJointLimit) {
+    Eigen::VectorXd clamped = q_start_full;
+    const std::vector<int>& planned = model->planned_indices();
+    double worst = 0.0;
+    std::string worst_joint;
+    for (std::size_t j = 3; j < planned.size(); ++j) {
+      const auto jj = static_cast<Eigen::Index>(j);
+      const double v = q_start_full[planned[j]];
+      const double c = std::clamp(v, model->lower()[jj], model->upper()[jj]);
+      if (std::abs(v - c) > worst) {
+        worst = std::abs(v - c);
+        worst_joint = model->joint_names()[j];
+      }
+      clamped[planned[j]] = c;
+    }
+    if (worst <= params_.start_joint_tolerance) {
+      std::ostringstream note;
+      note << "the start is past a joint limit (" << start_ok.detail << "): " << worst_joint
+           << " moved onto its limit by " << std::round(worst * 1e4) / 1e4 << " rad, first";
+      clamped_note = note.str();
+      lead_in = q_start_full;
+      start = clamped;
+      start_ok = checker_ptr->check(start);
+    }
+  }
+  const Eigen::VectorXd q_from = start;  // the start, on its joint limits
   const auto move_out = [&](StateChecker& checker) -> std::optional<std::string> {
-    std::optional<Eigen::VectorXd> moved = q_start_full;
+    std::optional<Eigen::VectorXd> moved = q_from;
     std::vector<std::string> what;
     Validity v = checker.check(*moved);
     if (v.constraint == Constraint::kEnvironmentCollision && params_.start_tolerance > 0.0) {
       moved = base_out_of_map(checker, *moved, params_.start_tolerance);
       if (!moved) return std::nullopt;
-      const Eigen::Vector3d d = moved->head<3>() - q_start_full.head<3>();
+      const Eigen::Vector3d d = moved->head<3>() - q_from.head<3>();
       std::ostringstream s;
       s << "inside the map (" << v.detail << "): the base moved out by "
         << std::round(1e3 * std::hypot(d.x(), d.y())) << " mm and "
@@ -417,20 +448,24 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     start = *moved;
     return note + ", first";
   };
+  const auto add_note = [&](const std::string& note) {
+    out.note = out.note.empty() ? note : out.note + "; " + note;
+  };
+  if (!clamped_note.empty()) add_note(clamped_note);
   if (start_ok.constraint == Constraint::kEnvironmentCollision ||
       start_ok.constraint == Constraint::kSelfCollision) {
     if (auto note = move_out(*checker_ptr)) {
-      out.note = *note;
+      add_note(*note);
       start_ok = {};
     } else if (padding > 0.0) {
       auto unpadded = std::make_unique<StateChecker>(model, env, params_, 0.0);
-      if (const Validity v = unpadded->check(q_start_full); v.valid()) {
-        out.note = "the start is within the environment padding (" + start_ok.detail +
-                   "): planned without it";
+      if (const Validity v = unpadded->check(q_from); v.valid()) {
+        add_note("the start is within the environment padding (" + start_ok.detail +
+                 "): planned without it");
         checker_ptr = std::move(unpadded);
         start_ok = v;
       } else if (auto unpadded_note = move_out(*unpadded)) {
-        out.note = *unpadded_note + " (planned without the padding)";
+        add_note(*unpadded_note + " (planned without the padding)");
         checker_ptr = std::move(unpadded);
         start_ok = {};
       }
@@ -472,6 +507,7 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       Params attempt_params = params_;
       attempt_params.camera_distance = distance;
       attempt_params.fixed_base = request.fixed_base;
+      attempt_params.base_travel = request.base_travel;
       PostureResult posture;
       do {
         attempt_params.nspg_time =

@@ -323,6 +323,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   core.camera_distance = request.camera_distance();
   core.fixed_base = request.fixed_base();
   core.environment_padding = request.environment_padding();
+  core.base_travel = request.base_travel();
   for (const msg::Pose& g : request.goals()) core.goals.push_back({to_core(g)});
   const bool execute = request.execute();
   const std::size_t count = core.goals.size();
