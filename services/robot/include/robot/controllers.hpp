@@ -147,7 +147,8 @@ class BaseController final : public Controller {
   /// yaw from the base's gyro (data.base_yaw_rate) when there is one: the wheels' yaw rate is
   /// off by their scrub in turns (3 % on the paper's base in simulation) and misses the base
   /// turning while the legs steer, which over a 1.7 m approach put the demo's odometry 15 cm
-  /// off. The gyro's bias is learnt while the wheels stand still (a zero-velocity update).
+  /// off. The gyro's bias is learnt while the whole robot stands still (a zero-velocity update:
+  /// no wheel rolls, no leg steers, no arm joint moves).
   void estimate(CycleData& data);
   /// The gyro bias learnt so far [rad/s].
   [[nodiscard]] double gyro_bias() const { return gyro_bias_; }
@@ -164,7 +165,8 @@ class BaseController final : public Controller {
   double command_time_{-1e9};
   std::vector<double> steering_, wheel_velocity_;
   std::vector<LegSetpoint> setpoints_;
-  double gyro_bias_{0.0};  // [rad/s], learnt while the wheels stand still
+  double gyro_bias_{0.0};  // [rad/s], learnt while the whole robot stands still
+  double bias_samples_{0.0};  // samples the bias was learnt from
   bool gyro_bias_known_{false};
 };
 
