@@ -59,6 +59,20 @@ std::vector<DrillPoint> find_holes(const AreaSpec& area, const ResolvedArea& loc
 std::optional<Eigen::Isometry3d> reanchor(const CameraView& view, const DrillPoint& hole,
                                           const PatternTable& patterns, double max_distance);
 
+/// Where the marker of an ArUco hole stands (world frame, z out of the wall), from the hole's
+/// frame and its pattern; none for a blob hole or a marker without a pattern.
+std::optional<Eigen::Isometry3d> marker_of(const DrillPoint& hole, const PatternTable& patterns);
+
+/// An ArUco hole's frame from where its marker stands (`world_T_marker`: the pattern applied);
+/// none for a blob hole or a marker without a pattern.
+std::optional<Eigen::Isometry3d> hole_of(const DrillPoint& hole,
+                                         const Eigen::Isometry3d& world_T_marker,
+                                         const PatternTable& patterns);
+
+/// Where marker `id` stands in a view (world frame, depth-refined), if it is detected.
+std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,
+                                             const PatternTable& patterns);
+
 /// How far the blobs of an area appear from where they were predicted (world frame, [m]): the
 /// shift that lays the most predicted blob positions of `area_points` onto blobs seen in the
 /// view (within `tolerance`), among the shifts that put `target` on a seen blob; ties go to

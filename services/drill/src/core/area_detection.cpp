@@ -188,18 +188,10 @@ std::optional<Eigen::Isometry3d> reanchor(const CameraView& view, const DrillPoi
       }
       if (best != nullptr)
         return view.world_T_optical * area_frame(surface_at(frame, best->pixel), up);
-    } else {
-      ArucoParams params;
-      params.dictionary = patterns.dictionary();
-      params.marker_size = patterns.marker_size();
-      const HolePattern* pattern = patterns.find(hole.marker);
-      for (const ArucoDetection& m : detect_aruco(frame, params)) {
-        if (m.id != hole.marker || pattern == nullptr) continue;
-        const auto holes = pattern_holes(view.world_T_optical * m.optical_T_marker, *pattern);
-        const auto i = static_cast<std::size_t>(hole.pattern_index);
-        if (i < holes.size() && (holes[i].translation() - predicted).norm() <= max_distance)
-          return holes[i];
-      }
+    } else if (const std::optional<Eigen::Isometry3d> marker =
+                   find_marker(view, hole.marker, patterns)) {
+      const std::optional<Eigen::Isometry3d> seen = hole_of(hole, *marker, patterns);
+      if (seen && (seen->translation() - predicted).norm() <= max_distance) return seen;
     }
     if (!in_view(view, predicted)) return std::nullopt;
     // The wall under the predicted position: its normal, and the position moved onto it.
@@ -212,6 +204,36 @@ std::optional<Eigen::Isometry3d> reanchor(const CameraView& view, const DrillPoi
   } catch (const DrillError&) {
     return std::nullopt;  // no depth there, too few points: the prediction stands
   }
+}
+
+std::optional<Eigen::Isometry3d> hole_of(const DrillPoint& hole,
+                                         const Eigen::Isometry3d& world_T_marker,
+                                         const PatternTable& patterns) {
+  const HolePattern* pattern = hole.marker < 0 ? nullptr : patterns.find(hole.marker);
+  if (pattern == nullptr || hole.pattern_index < 0) return std::nullopt;
+  const std::vector<Eigen::Isometry3d> holes = pattern_holes(world_T_marker, *pattern);
+  const auto i = static_cast<std::size_t>(hole.pattern_index);
+  if (i >= holes.size()) return std::nullopt;
+  return holes[i];
+}
+
+std::optional<Eigen::Isometry3d> marker_of(const DrillPoint& hole, const PatternTable& patterns) {
+  // The pattern laid on a marker at the origin gives marker_T_hole.
+  const std::optional<Eigen::Isometry3d> marker_T_hole =
+      hole_of(hole, Eigen::Isometry3d::Identity(), patterns);
+  if (!marker_T_hole) return std::nullopt;
+  return hole.frame * marker_T_hole->inverse();
+}
+
+std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,
+                                             const PatternTable& patterns) {
+  ArucoParams params;
+  params.dictionary = patterns.dictionary();
+  params.marker_size = patterns.marker_size();
+  for (const ArucoDetection& m : detect_aruco(*view.frame, params)) {
+    if (m.id == id) return view.world_T_optical * m.optical_T_marker;
+  }
+  return std::nullopt;
 }
 
 std::optional<Eigen::Vector3d> blob_shift(const CameraView& view,

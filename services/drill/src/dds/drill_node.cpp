@@ -37,9 +37,23 @@ constexpr double kRobotRadius = 0.55;
 // Cartesian alignment does the rest) [m]; the way back first takes this long to reach the
 // posture's path [s].
 constexpr double kAlignMargin = 0.03;
-// When the whole body finds no drilling posture, it is asked again with the camera this much
-// further from the wall [m], in turn (the alignment's Cartesian move gets that much longer).
-constexpr double kFurtherOut[] = {0.03, 0.07, 0.12};
+// A hole's drilling posture, in the order it is asked for: the arm alone with the camera at the
+// hole's distance, then 3, 7 and 12 cm further from the wall (the alignment's Cartesian move gets
+// that much longer); then the whole body with the base moving at most 0.3 m and 0.3 rad, again
+// further out; last the whole body anywhere. The base stays where the area's approach put it as
+// long as the arm reaches, and moves as little as it can: odometry drifts with every centimetre
+// and degree the base moves, and an ArUco pattern is drilled by the kinematics alone (on the demo
+// wall, holes drilled after unbounded whole-body moves were 5-100 mm off; one posture spun the
+// base by 2.3 rad).
+struct HoleAttempt {
+  bool fixed_base;
+  double base_travel;  // [m, rad] for the whole body; 0: anywhere
+  double further;      // [m] beyond the hole's camera distance
+};
+constexpr HoleAttempt kHoleAttempts[] = {
+    {true, 0.0, 0.0},  {true, 0.0, 0.03},  {true, 0.0, 0.07},  {true, 0.0, 0.12},
+    {false, 0.3, 0.0}, {false, 0.3, 0.03}, {false, 0.3, 0.07}, {false, 0.3, 0.12},
+    {false, 0.0, 0.0}, {false, 0.0, 0.07}};
 constexpr double kSettleBack = 1.0;
 // Robot shapes grown against the map in the areas' approach plans [m]: the planner's map is the
 // world, its start pose the wheel odometry, which drifts 4-6 cm over a whole-body move near the
@@ -52,6 +66,12 @@ constexpr int kPlanAttempts = 3;
 // Re-measuring a hole from its drilling posture: frames averaged, and how far from the predicted
 // position the mark may be found [m] (odometry drift over the base's move).
 constexpr int kReanchorFrames = 3;
+// After the whole body moved to an ArUco hole's drilling posture, the arm alone turns the camera
+// to the marker and the pattern is measured again from there: the pattern is drilled by the
+// kinematics alone, and the base's odometry drifts 2-4 cm over such a move (the demo wall's
+// pattern: holes 20-37 mm off without this). The camera is asked for at the distance the hole's
+// posture reached (the arm only shifts across the wall), then this much further out [m], in turn.
+constexpr double kMarkerViewFurther[] = {0.0, 0.1, 0.2};
 constexpr double kReanchorDistance = 0.06;
 // Blobs of one area matched as a set: a predicted blob lies this close to a seen one [m]
 // (6 deg of odometry yaw over 0.1 m between blobs moves them 1 cm).
@@ -820,6 +840,7 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
     points = find_holes(detection_.spec, located, camera, patterns_ ? *patterns_ : kNone,
                         area_radius(params_.camera_distance, params_.camera_fov));
     area_points_ = points;
+    markers_seen_.clear();
     if (detection_.spec.marks == MarkKind::kBlobs && detection_.spec.expected > 0 &&
         points.size() < static_cast<std::size_t>(detection_.spec.expected)) {
       // What the camera saw, for the report's "expected holes not found".
@@ -855,6 +876,12 @@ void DrillNode::align(const DrillPoint& point) {
     return;
   }
   point_ = point;
+  marker_looked_ = false;
+  // The pattern as its marker was last seen (after a base move), not as first detected.
+  if (const auto it = markers_seen_.find(point.marker); it != markers_seen_.end() && patterns_) {
+    if (const std::optional<Eigen::Isometry3d> f = hole_of(point, it->second, *patterns_))
+      point_.frame = *f;
+  }
   const Eigen::VectorXd q = rig_->q(s->joints);
   const Eigen::Isometry3d camera = rig_->camera_in_base(q);
   const double camera_to_tip =
@@ -866,15 +893,15 @@ void DrillNode::align(const DrillPoint& point) {
   r.stamp_ns(now_ns());
   r.source(kSource);
   r.end_effector(rig_->tool());
-  r.goals().push_back(model::dds::to_pose_msg(point.frame));
+  r.goals().push_back(model::dds::to_pose_msg(point_.frame));
   r.execute(true);
   hole_distance_ = camera_to_tip + params_.motion.standoff + kAlignMargin;
-  hole_further_ = 0;
-  r.camera_distance(hole_distance_);
-  // The arm alone first: the base stays where the area's approach put it, so odometry does not
-  // drift between holes (3.5 deg over one whole-body move on the demo); if the arm cannot
-  // reach the hole from there, the whole body.
-  r.fixed_base(!hole_whole_body_);
+  // The arm alone first (kHoleAttempts): the base stays where the area's approach put it, so
+  // odometry does not drift between holes (3.5 deg over one whole-body move on the demo).
+  hole_attempt_ = 0;
+  r.camera_distance(hole_distance_ + kHoleAttempts[0].further);
+  r.fixed_base(kHoleAttempts[0].fixed_base);
+  r.base_travel(kHoleAttempts[0].base_travel);
   plan_requests_.write(r);
   hole_request_ = r;
   hole_path_ = {};
@@ -974,6 +1001,42 @@ void DrillNode::send_cartesian(const CartesianReference& r) {
   cartesian_.write(c);
 }
 
+void DrillNode::start_reanchor(Motion next) {
+  std::lock_guard lock(mutex_);
+  reanchor_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
+  motion_ = next;
+}
+
+// The whole body moved to an ArUco hole's drilling posture: the arm alone turns the camera to
+// the hole's marker (kMarkerViewFurther), where the pattern is measured again.
+void DrillNode::look_at_marker() {
+  marker_looked_ = true;
+  const std::optional<Eigen::Isometry3d> marker =
+      patterns_ ? marker_of(point_, *patterns_) : std::nullopt;
+  if (!marker) {
+    start_reanchor(Motion::kReanchor);
+    return;
+  }
+  look_goal_ = *marker;
+  hole_reached_ = hole_request_.camera_distance();
+  request_marker_view(0);
+}
+
+void DrillNode::request_marker_view(std::size_t attempt) {
+  look_attempt_ = attempt;
+  msg::PlanRequest r = hole_request_;
+  look_request_ = next_request_++;
+  r.request_id(look_request_);
+  r.stamp_ns(now_ns());
+  r.goals().clear();
+  r.goals().push_back(model::dds::to_pose_msg(look_goal_));
+  r.camera_distance(hole_reached_ + kMarkerViewFurther[attempt]);
+  r.fixed_base(true);
+  plan_requests_.write(r);
+  look_path_ = {};
+  motion_ = Motion::kLookAtMarker;
+}
+
 // Every control period while a hole is worked on: the servo's new estimate of the blob from
 // each new camera frame, the motion's reference to the robot, and the phase's outcome.
 void DrillNode::control_motion() {
@@ -990,37 +1053,110 @@ void DrillNode::control_motion() {
     if (!r->trajectory().empty()) hole_path_ = {r->joint_names(), r->trajectory()};
     if (r->state() == msg::PLAN_SUCCEEDED && !hole_path_.samples.empty())
       hole_chain_.push_back(hole_path_);
-    if (r->state() == msg::PLAN_FAILED && hole_request_.fixed_base() &&
-        (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH)) {
-      log_line("drill: " + point_.label + ": the arm alone cannot reach it (" + r->reason() +
-               "); the whole body moves");
-      hole_plan_request_ = next_request_++;
-      hole_request_.request_id(hole_plan_request_);
-      hole_request_.fixed_base(false);
-      plan_requests_.write(hole_request_);
-    } else if (r->state() == msg::PLAN_FAILED && r->failure() == msg::PLAN_UNREACHABLE &&
-               hole_further_ < std::size(kFurtherOut)) {
-      // The close posture is not found (the demo arm at 1.3 m and up: the posture search finds
-      // none 0.23 m from the wall, though some exist); a few centimetres further out it is,
-      // and the Cartesian alignment moves the bit the rest of the way.
-      const double further = kFurtherOut[hole_further_++];
+    if (r->state() == msg::PLAN_FAILED &&
+        (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH) &&
+        hole_attempt_ + 1 < std::size(kHoleAttempts)) {
+      const HoleAttempt& next = kHoleAttempts[++hole_attempt_];
       std::ostringstream line;
-      line << "drill: " << point_.label << ": no posture with the camera " << hole_distance_
-           << " m from the wall; asking " << further * 100.0 << " cm further out";
+      const auto who = [](bool fixed, double travel) {
+        std::ostringstream w;
+        w << (fixed ? "the arm alone" : "the whole body");
+        if (!fixed && travel > 0.0) w << " (the base within " << travel << " m and rad)";
+        return w.str();
+      };
+      line << "drill: " << point_.label << ": no drilling posture for "
+           << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with the camera "
+           << hole_request_.camera_distance() << " m from the wall (" << r->reason()
+           << "); asking for " << who(next.fixed_base, next.base_travel) << " at "
+           << hole_distance_ + next.further << " m";
       log_line(line.str());
       hole_plan_request_ = next_request_++;
       hole_request_.request_id(hole_plan_request_);
-      hole_request_.camera_distance(hole_distance_ + further);
+      hole_request_.fixed_base(next.fixed_base);
+      hole_request_.base_travel(next.base_travel);
+      hole_request_.camera_distance(hole_distance_ + next.further);
       plan_requests_.write(hole_request_);
     } else if (r->state() == msg::PLAN_FAILED) {
       motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());
       motion_ = Motion::kNone;
     } else if (r->state() == msg::PLAN_SUCCEEDED) {
-      // The base moved: measure the hole again in frames taken from here.
-      std::lock_guard lock(mutex_);
-      reanchor_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
-      motion_ = Motion::kReanchor;
+      if (point_.marker >= 0 && !hole_request_.fixed_base() && !marker_looked_) {
+        look_at_marker();
+      } else {
+        // The base moved: measure the hole again in frames taken from here.
+        start_reanchor(Motion::kReanchor);
+      }
     }
+    return;
+  }
+  if (motion_ == Motion::kLookAtMarker) {
+    std::optional<msg::PlanResult> r;
+    {
+      std::lock_guard lock(mutex_);
+      const auto it = plan_results_.find(look_request_);
+      if (it != plan_results_.end()) r = it->second;
+    }
+    if (!r) return;
+    if (!r->trajectory().empty()) look_path_ = {r->joint_names(), r->trajectory()};
+    if (r->state() == msg::PLAN_SUCCEEDED) {
+      if (!look_path_.samples.empty()) hole_chain_.push_back(look_path_);
+      start_reanchor(Motion::kMarkerReanchor);
+    } else if (r->state() == msg::PLAN_FAILED && look_attempt_ + 1 < std::size(kMarkerViewFurther)) {
+      request_marker_view(look_attempt_ + 1);
+    } else if (r->state() == msg::PLAN_FAILED) {
+      log_line("drill: " + point_.label + ": the camera cannot be turned to marker " +
+               std::to_string(point_.marker) + " from here (" + r->reason() +
+               "); the hole is drilled where odometry puts it");
+      start_reanchor(Motion::kReanchor);
+    }
+    return;
+  }
+  if (motion_ == Motion::kMarkerReanchor) {
+    const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, kReanchorFrames);
+    if (!view) return;
+    const CameraView camera{&view->frame, view->world_T_optical};
+    std::optional<Eigen::Isometry3d> marker;
+    try {
+      if (patterns_) marker = find_marker(camera, point_.marker, *patterns_);
+    } catch (const DrillError&) {
+      marker.reset();
+    }
+    std::optional<Eigen::Isometry3d> hole;
+    if (marker) hole = hole_of(point_, *marker, *patterns_);
+    if (hole) {
+      std::ostringstream line;
+      line.setf(std::ios::fixed);
+      line.precision(1);
+      line << "drill: " << point_.label << ": marker " << point_.marker
+           << " seen again after the base moved: the hole is "
+           << (hole->translation() - point_.frame.translation()).norm() * 1e3
+           << " mm from where odometry put it";
+      log_line(line.str());
+      markers_seen_[point_.marker] = *marker;
+      point_.frame = *hole;
+    } else {
+      log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
+               " not seen from the look posture; the hole is drilled where odometry puts it");
+    }
+    // Back to the hole's drilling posture with the arm alone (the base stands where the whole
+    // body put it), at the distance that reached it.
+    const double reached = hole_reached_;
+    hole_attempt_ = 0;
+    while (hole_attempt_ + 1 < std::size(kHoleAttempts) &&
+           !(kHoleAttempts[hole_attempt_].fixed_base &&
+             hole_distance_ + kHoleAttempts[hole_attempt_].further >= reached - 1e-6))
+      ++hole_attempt_;
+    hole_plan_request_ = next_request_++;
+    hole_request_.request_id(hole_plan_request_);
+    hole_request_.goals().clear();
+    hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
+    hole_request_.fixed_base(true);
+    hole_request_.base_travel(0.0);
+    hole_request_.camera_distance(reached);
+    hole_request_.stamp_ns(now_ns());
+    plan_requests_.write(hole_request_);
+    hole_path_ = {};
+    motion_ = Motion::kApproachHole;
     return;
   }
   if (motion_ == Motion::kReanchor) {

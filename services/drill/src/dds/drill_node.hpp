@@ -102,7 +102,17 @@ class DrillNode final : public MissionPorts {
     Eigen::Isometry3d world_T_optical{Eigen::Isometry3d::Identity()};
     Eigen::Isometry3d base_T_optical{Eigen::Isometry3d::Identity()};
   };
-  enum class Motion { kNone, kApproachHole, kReanchor, kAlign, kDrill, kRetractOut, kSettle };
+  enum class Motion {
+    kNone,
+    kApproachHole,
+    kLookAtMarker,
+    kMarkerReanchor,
+    kReanchor,
+    kAlign,
+    kDrill,
+    kRetractOut,
+    kSettle
+  };
 
   void tick();
   [[nodiscard]] bool mission_active() const;
@@ -113,6 +123,9 @@ class DrillNode final : public MissionPorts {
   void send_cartesian(const CartesianReference& r);
   void send_hold();
   void start_align(const Sample& s);
+  void start_reanchor(Motion next);
+  void look_at_marker();
+  void request_marker_view(std::size_t attempt);
   [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
   // The measured state of `names` (base joints from odometry) as a trajectory sample at t = 0.
   [[nodiscard]] static double settle_time(const std::vector<std::string>& names,
@@ -188,9 +201,8 @@ class DrillNode final : public MissionPorts {
   std::int64_t servo_since_ns_{0};
   std::uint32_t hole_plan_request_{0};
   msg::PlanRequest hole_request_;
-  bool hole_whole_body_{false};  // false: a hole's posture is first planned with the base fixed
   double hole_distance_{0.0};  // the camera's distance from the wall a hole's posture asks for [m]
-  std::size_t hole_further_{0};  // how many times a hole's posture was asked further out
+  std::size_t hole_attempt_{0};  // which of kHoleAttempts the hole's posture request is
   std::int64_t reanchor_since_ns_{0};
   std::vector<DrillPoint> area_points_;  // the current area's holes as detected
   struct PlannedPath {
@@ -198,6 +210,13 @@ class DrillNode final : public MissionPorts {
     std::vector<msg::TrajectorySample> samples;
   };
   PlannedPath hole_path_;                // of the hole being approached
+  PlannedPath look_path_;                // of the camera turned to the hole's marker
+  std::uint32_t look_request_{0};        // the plan request turning the camera to the marker
+  bool marker_looked_{false};            // the marker was looked at for the hole being approached
+  std::size_t look_attempt_{0};          // which of kMarkerViewFurther the look request is
+  Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the marker as predicted (world)
+  double hole_reached_{0.0};             // camera distance of the hole's posture reached [m]
+  std::map<int, Eigen::Isometry3d> markers_seen_;  // marker id -> where last seen (world), this area
   std::vector<PlannedPath> hole_chain_;  // the area's hole postures as reached, first to last
   bool returning_{false};                // execute(): the way back runs before the approach
   std::optional<Outcome> motion_outcome_;
