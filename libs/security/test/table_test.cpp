@@ -126,7 +126,7 @@ TEST(SecurityDocuments, GovernanceProtectsDiscoveryLivelinessMessagesAndEveryTop
   EXPECT_EQ(text(rule, "enable_join_access_control"), "true");
   EXPECT_EQ(text(rule, "discovery_protection_kind"), "ENCRYPT");
   EXPECT_EQ(text(rule, "liveliness_protection_kind"), "ENCRYPT");
-  EXPECT_EQ(text(rule, "rtps_protection_kind"), "SIGN");
+  EXPECT_EQ(text(rule, "rtps_protection_kind"), "ENCRYPT");
   const auto* topic =
       rule->FirstChildElement("topic_access_rules")->FirstChildElement("topic_rule");
   EXPECT_EQ(text(topic, "topic_expression"), "*");
@@ -134,7 +134,7 @@ TEST(SecurityDocuments, GovernanceProtectsDiscoveryLivelinessMessagesAndEveryTop
                            "enable_read_access_control", "enable_write_access_control"}) {
     EXPECT_EQ(text(topic, flag), "true") << flag;
   }
-  EXPECT_EQ(text(topic, "metadata_protection_kind"), "ENCRYPT");
+  EXPECT_EQ(text(topic, "metadata_protection_kind"), "NONE");
   EXPECT_EQ(text(topic, "data_protection_kind"), "NONE");
   const std::string signed_only =
       governance_xml({.metadata = Protection::kSign, .data = Protection::kSign});

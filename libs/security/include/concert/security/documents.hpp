@@ -19,18 +19,19 @@ enum class Protection { kNone, kSign, kEncrypt };
 
 /// The governance's choices. The defaults are the stack's: what `concert security init` writes.
 struct GovernanceOptions {
-  /// Every RTPS message carries a MAC (AES-GMAC) of the sender: nothing from a participant
-  /// that did not authenticate is accepted, not even a forged heartbeat.
-  Protection rtps = Protection::kSign;
+  /// Every RTPS message is encrypted and authenticated (AES-GCM) with the sending participant's
+  /// key, which only authenticated participants get: nothing from outside is accepted, not even
+  /// a forged heartbeat, and nothing inside can be read from outside.
+  Protection rtps = Protection::kEncrypt;
   /// Discovery (endpoints, topic names, QoS) and liveliness are encrypted.
   Protection discovery = Protection::kEncrypt;
   Protection liveliness = Protection::kEncrypt;
-  /// Every topic's submessages (data with its payload, heartbeats, acknacks) are encrypted and
-  /// authenticated with the writer's or reader's key (AES-GCM): nobody outside reads a sample.
-  Protection metadata = Protection::kEncrypt;
-  /// No second, payload-level protection: the submessage's already covers the payload, and
-  /// Cyclone DDS 0.10 cannot decode Fast DDS 2.9's protected payloads (measured: with SIGN or
-  /// ENCRYPT here no sample crosses Fast DDS -> Cyclone; submessage protection crosses).
+  /// No second, per-writer protection of each topic's submessages: its keys go to the matched
+  /// readers only, which protects nothing more while every identity may read every topic, and
+  /// doubles the cost (bench_dds: README).
+  Protection metadata = Protection::kNone;
+  /// No payload protection either: Cyclone DDS 0.10 cannot decode Fast DDS 2.9's protected
+  /// payloads (measured: with SIGN or ENCRYPT here no sample crosses Fast DDS -> Cyclone).
   Protection data = Protection::kNone;
 };
 /// The governance document: unauthenticated participants not allowed, join access control,
