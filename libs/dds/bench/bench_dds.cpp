@@ -13,6 +13,7 @@
 //   encrypt-all  messages, submessages and payloads encrypted (Fast DDS only: see README)
 // Usage: bench_dds [--pings N] [--seconds S] [--joints J] [--security off,default,...]
 //        (default: off,default; prints a table and a JSON line per mode)
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -21,6 +22,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <mutex>
@@ -54,8 +56,17 @@ Stats stats(std::vector<double> v) {
   return {at(0.5), at(0.99), sum / static_cast<double>(v.size()), v.back()};
 }
 
-/// The robot's side in a child process: echoes the round trip and writes the 1 kHz stream.
-int child(int pings, int stream_samples, int joints) {
+/// CPU time of this process so far [us] (user + system, every thread).
+double cpu_us() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) * 1e6 +
+         static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+/// The robot's side in a child process: echoes the round trip and writes the 1 kHz stream;
+/// reports the CPU time it spent while streaming on `report` (text, microseconds).
+int child(int pings, int stream_samples, int joints, int report) {
   dds::Participant p({.name = "bench_robot", .identity = "robot"});
   dds::Writer<msg::Odometry> pong(p, dds::topics::odometry);
   std::atomic<int> echoed{0};
@@ -83,13 +94,16 @@ int child(int pings, int stream_samples, int joints) {
   s.velocity(std::vector<double>(static_cast<size_t>(joints), 0.2));
   s.effort(std::vector<double>(static_cast<size_t>(joints), 0.3));
   auto next = Clock::now();
+  const double cpu0 = cpu_us();
   for (int i = 0; i < stream_samples; ++i) {
     next += 1ms;
     std::this_thread::sleep_until(next);
     s.stamp_ns(now_ns());
     stream.write(s);
   }
-  // Stay until the parent has read the stream (it closes the pipe), at most 10 s.
+  const std::string cpu = std::to_string(cpu_us() - cpu0) + "\n";
+  (void)!write(report, cpu.data(), cpu.size());
+  // Stay until the parent has read the stream (it closes the pipe).
   char byte = 0;
   (void)!read(0, &byte, 1);
   return 0;
@@ -99,20 +113,23 @@ struct Result {
   double match_ms;
   Stats rtt, latency, period;
   size_t received;
+  double writer_cpu_us, reader_cpu_us;  ///< CPU of each side while the stream ran
 };
 
 /// One run: the robot's side forked, this process commands and reads the stream.
 std::optional<Result> run(int pings, int stream_samples, int joints) {
-  int to_child[2];
-  if (pipe(to_child) != 0) return std::nullopt;
+  int to_child[2], from_child[2];
+  if (pipe(to_child) != 0 || pipe(from_child) != 0) return std::nullopt;
   const auto start = Clock::now();
   const pid_t pid = fork();
   if (pid == 0) {
     dup2(to_child[0], 0);
     close(to_child[1]);
-    _exit(child(pings, stream_samples, joints));
+    close(from_child[0]);
+    _exit(child(pings, stream_samples, joints, from_child[1]));
   }
   close(to_child[0]);
+  close(from_child[1]);
 
   std::optional<Result> result;
   {
@@ -148,19 +165,25 @@ std::optional<Result> run(int pings, int stream_samples, int joints) {
       }
       // The stream: until 95 % arrived and a second passed since the last sample, at most
       // 10 s after it should have ended.
+      const double cpu0 = cpu_us();
       const auto end = Clock::now() + std::chrono::milliseconds(stream_samples) + 10s;
       while (Clock::now() < end) {
         std::this_thread::sleep_for(50ms);
         std::lock_guard lock(m);
         if (static_cast<int>(latency_us.size()) >= stream_samples * 95 / 100 && now_ns() - last > 1'000'000'000) break;
       }
+      const double reader_cpu = cpu_us() - cpu0;
+      char report[64] = {};
+      const ssize_t n = read(from_child[0], report, sizeof report - 1);
       std::lock_guard lock(m);
-      if (!rtt_us.empty() && latency_us.size() >= 10) {
-        result = Result{match_ms, stats(rtt_us), stats(latency_us), stats(period_us), latency_us.size()};
+      if (!rtt_us.empty() && latency_us.size() >= 10 && n > 0) {
+        result = Result{match_ms,          stats(rtt_us),         stats(latency_us), stats(period_us),
+                        latency_us.size(), std::atof(report), reader_cpu};
       }
     }
   }
   close(to_child[1]);  // the child may go
+  close(from_child[0]);
   int status = 0;
   waitpid(pid, &status, 0);
   return result;
@@ -225,11 +248,15 @@ int bench_main(int argc, char** argv) {
     std::printf("  1 kHz JointState period         median %8.1f us   p99 %8.1f us   max %8.1f us\n",
                 r->period.median, r->period.p99, r->period.max);
     std::printf("  stream samples received         %zu of %d\n", r->received, stream_samples);
+    std::printf("  stream CPU, writer / reader     %8.1f / %.1f ms per second of stream\n",
+                r->writer_cpu_us / 1e3 / seconds, r->reader_cpu_us / 1e3 / seconds);
     std::printf("{\"security\":\"%s\",\"match_ms\":%.1f,\"rtt_us\":{\"median\":%.1f,\"p99\":%.1f},"
                 "\"stream_latency_us\":{\"median\":%.1f,\"p99\":%.1f},"
-                "\"stream_period_us\":{\"median\":%.1f,\"p99\":%.1f},\"received\":%zu,\"sent\":%d}\n",
+                "\"stream_period_us\":{\"median\":%.1f,\"p99\":%.1f},\"received\":%zu,\"sent\":%d,"
+                "\"stream_cpu_ms_per_s\":{\"writer\":%.1f,\"reader\":%.1f}}\n",
                 mode.c_str(), r->match_ms, r->rtt.median, r->rtt.p99, r->latency.median, r->latency.p99,
-                r->period.median, r->period.p99, r->received, stream_samples);
+                r->period.median, r->period.p99, r->received, stream_samples, r->writer_cpu_us / 1e3 / seconds,
+                r->reader_cpu_us / 1e3 / seconds);
     std::fflush(stdout);
   }
   return 0;
