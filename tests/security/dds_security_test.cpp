@@ -106,28 +106,42 @@ TEST_F(Security, SecuredParticipantsTalkAcrossProcesses) {
   EXPECT_THAT(tool.out(), HasSubstr(R"("name":["J1_A"],"position":[0.5])"));
 }
 
+/// An intruder writing joint commands and a spy reading joint state (contract peers `binary`
+/// run with `env`) while the robot publishes: the spy gets nothing, the robot no command, and
+/// none of their endpoints matches the robot's.
+void expect_kept_out(Robot& robot, const char* binary, const std::vector<std::string>& env) {
+  Process intruder(peer(binary, {"write", "--topics", "concert/robot/joint_command", "--repeat-ms",
+                                 "50", "--linger-ms", std::to_string(kQuietMs)}),
+                   env);
+  Process spy(peer(binary, {"read", "--topics", "concert/robot/joint_state", "--timeout-ms",
+                            std::to_string(kQuietMs)}),
+              env);
+  robot.publish_for(kQuietMs);
+  EXPECT_EQ(spy.wait(10s), 1) << spy.out() << spy.err();
+  EXPECT_THAT(spy.out(),
+              HasSubstr(R"({"event":"missing","topics":["concert/robot/joint_state"]})"));
+  EXPECT_EQ(intruder.wait(10s), 0) << intruder.err();
+  EXPECT_THAT(intruder.out(), HasSubstr(R"("event":"written")")) << "the intruder did write";
+  EXPECT_EQ(robot.commands, 0);
+  EXPECT_EQ(robot.reader.matched_writers(), 0);
+  EXPECT_EQ(robot.writer.matched_readers(), 0);
+}
+
 TEST_F(Security, UnauthenticatedFastDdsDiscoversNothingAndCannotCommandTheRobot) {
   Robot robot;
-  // Unsecured Fast DDS peers on the same domain: a joint command writer, a joint state reader,
-  // and the concert tool listing every topic it discovers.
-  Process intruder(
-      peer(CONTRACT_PEER_FAST, {"write", "--topics", "concert/robot/joint_command", "--repeat-ms",
-                                "50", "--linger-ms", std::to_string(kQuietMs)}),
-      kUnsecured);
-  Process spy(peer(CONTRACT_PEER_FAST, {"read", "--topics", "concert/robot/joint_state",
-                                        "--timeout-ms", std::to_string(kQuietMs)}),
-              kUnsecured);
+  // The concert tool, unsecured, lists every endpoint it discovers meanwhile; a secured one
+  // beside it sees the robot's (the observation works).
   Process list({CONCERT_BIN, "topic", "list", "--json", "--timeout", "4"}, kUnsecured);
-  // A secured tool listing at the same time sees the robot's topics (the observation works).
   Process secured_list({CONCERT_BIN, "topic", "list", "--json", "--timeout", "4"});
-  robot.publish_for(kQuietMs);
+  expect_kept_out(robot, CONTRACT_PEER_FAST, kUnsecured);
 
   // The unsecured list sees the intruder's writer and the spy's reader, and none of the robot's
-  // endpoints (its joint command reader, its joint state writer); the secured list sees them.
+  // endpoints (its joint command reader, its joint state writer).
   const auto endpoints = [](const Process& p, const std::string& topic) {
     for (const auto& row : idl::Json::parse(p.out())) {
-      if (row.at("topic") == topic)
+      if (row.at("topic") == topic) {
         return std::make_pair(row.at("writers").get<int>(), row.at("readers").get<int>());
+      }
     }
     return std::make_pair(0, 0);
   };
@@ -139,48 +153,17 @@ TEST_F(Security, UnauthenticatedFastDdsDiscoversNothingAndCannotCommandTheRobot)
       << secured_list.out();
   EXPECT_EQ(endpoints(secured_list, "concert/robot/joint_state"), std::make_pair(1, 0))
       << secured_list.out();
-
-  EXPECT_EQ(spy.wait(10s), 1) << spy.out() << spy.err();
-  EXPECT_THAT(spy.out(),
-              HasSubstr(R"({"event":"missing","topics":["concert/robot/joint_state"]})"));
-  EXPECT_EQ(intruder.wait(10s), 0) << intruder.err();
-  EXPECT_THAT(intruder.out(), HasSubstr(R"("event":"written")")) << "the intruder did write";
-  EXPECT_EQ(robot.commands, 0);
-  EXPECT_EQ(robot.reader.matched_writers(), 0);
-  EXPECT_EQ(robot.writer.matched_readers(), 0);
 }
 
 TEST_F(Security, UnsecuredCycloneDdsDiscoversNothingAndCannotCommandTheRobot) {
   Robot robot;
-  Process intruder(
-      peer(CONTRACT_PEER_CYCLONE, {"write", "--topics", "concert/robot/joint_command",
-                                   "--repeat-ms", "50", "--linger-ms", std::to_string(kQuietMs)}),
-      kUnsecured);
-  Process spy(peer(CONTRACT_PEER_CYCLONE, {"read", "--topics", "concert/robot/joint_state",
-                                           "--timeout-ms", std::to_string(kQuietMs)}),
-              kUnsecured);
-  robot.publish_for(kQuietMs);
-  EXPECT_EQ(spy.wait(10s), 1) << spy.out() << spy.err();
-  EXPECT_THAT(spy.out(),
-              HasSubstr(R"({"event":"missing","topics":["concert/robot/joint_state"]})"));
-  EXPECT_EQ(intruder.wait(10s), 0) << intruder.err();
-  EXPECT_THAT(intruder.out(), HasSubstr(R"("event":"written")"));
-  EXPECT_EQ(robot.commands, 0);
-  EXPECT_EQ(robot.reader.matched_writers(), 0);
-  EXPECT_EQ(robot.writer.matched_readers(), 0);
+  expect_kept_out(robot, CONTRACT_PEER_CYCLONE, kUnsecured);
 }
 
 TEST_F(Security, AnIdentityOfAnotherCaIsNotLetIn) {
   Robot robot;
   // The rogue PKI's planner has every file a planner has, signed by another CA.
-  Process intruder(
-      peer(CONTRACT_PEER_FAST, {"write", "--topics", "concert/robot/joint_command", "--repeat-ms",
-                                "50", "--linger-ms", std::to_string(kQuietMs)}),
-      secured(rogue(), "planner"));
-  robot.publish_for(kQuietMs);
-  EXPECT_EQ(intruder.wait(10s), 0) << intruder.err();
-  EXPECT_EQ(robot.commands, 0);
-  EXPECT_EQ(robot.reader.matched_writers(), 0);
+  expect_kept_out(robot, CONTRACT_PEER_FAST, secured(rogue(), "planner"));
 }
 
 TEST_F(Security, TheOperatorIsRefusedJointCommandsAndMayEngageAnEStop) {
