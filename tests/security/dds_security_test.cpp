@@ -185,6 +185,13 @@ TEST_F(Security, TheOperatorIsRefusedJointCommandsAndMayEngageAnEStop) {
                    30s, secured(pki(), "operator"));
   EXPECT_EQ(refused.code, 2);
   EXPECT_THAT(refused.err, HasSubstr("identity 'operator' may not publish it"));
+  // And from the operator's command line.
+  const auto pub = testing::run(
+      {CONCERT_BIN, "topic", "pub", "concert/robot/joint_command", "{}", "--timeout", "1"}, 30s);
+  EXPECT_EQ(pub.code, 1);
+  EXPECT_THAT(pub.err, HasSubstr("concert topic pub: cannot create a writer on "
+                                 "'concert/robot/joint_command': identity 'operator' may not "
+                                 "publish it (only planner, nav, drill may;"));
 
   // What the operator may write reaches the safety service's identity.
   dds::Participant safety({.name = "safety"});

@@ -21,23 +21,6 @@ TopicInfo checked(std::string_view name, const TypeSupport& type) {
   }
   return *info;
 }
-
-/// Why a secured participant may not have been allowed an endpoint on `name`.
-std::string security_hint(const Participant& participant, std::string_view name, bool writer) {
-  if (participant.security_identity().empty()) return "";
-  const std::string& id = participant.security_identity();
-  const std::string where = "CONCERT_SECURITY=" + participant.security_dir();
-  if (!writer) return " (" + where + ": the permissions of '" + id + "' do not allow reading it)";
-  const auto writers = security::writers_of(name);
-  if (!security::may_write(id, name)) {
-    return ": identity '" + id + "' may not publish it (" +
-           (writers.empty() ? std::string("nobody may") : "only " + join(writers, ", ") + " may") +
-           "; " + where + ")";
-  }
-  return ": the permissions in " + participant.security_dir() + " do not let '" + id +
-         "' publish it, though this build's table does (made before the topic was added? `concert "
-         "security init " + participant.security_dir() + " --force` makes them again)";
-}
 }  // namespace
 
 DataWriter* create_writer(Participant& participant, std::string_view name, TypeSupport type) {
@@ -46,7 +29,7 @@ DataWriter* create_writer(Participant& participant, std::string_view name, TypeS
   DataWriter* writer = participant.publisher()->create_datawriter(topic, writer_qos(info.qos));
   if (writer == nullptr) {
     throw std::runtime_error("cannot create a DDS writer on '" + std::string(name) + "'" +
-                             security_hint(participant, name, true));
+                             why_refused(participant, name, true));
   }
   return writer;
 }
@@ -59,7 +42,7 @@ DataReader* create_reader(Participant& participant, std::string_view name, TypeS
       topic, reader_qos(info.qos), listener, listener ? StatusMask::data_available() : StatusMask::none());
   if (reader == nullptr) {
     throw std::runtime_error("cannot create a DDS reader on '" + std::string(name) + "'" +
-                             security_hint(participant, name, false));
+                             why_refused(participant, name, false));
   }
   return reader;
 }
@@ -97,3 +80,23 @@ bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds tim
 }
 
 }  // namespace concert::dds::detail
+
+namespace concert::dds {
+
+std::string why_refused(const Participant& participant, std::string_view topic, bool writer) {
+  if (participant.security_identity().empty()) return "";
+  const std::string& id = participant.security_identity();
+  const std::string where = "CONCERT_SECURITY=" + participant.security_dir();
+  if (!writer) return " (" + where + ": the permissions of '" + id + "' do not allow reading it)";
+  const auto writers = security::writers_of(topic);
+  if (!security::may_write(id, topic)) {
+    return ": identity '" + id + "' may not publish it (" +
+           (writers.empty() ? std::string("nobody may") : "only " + join(writers, ", ") + " may") +
+           "; " + where + ")";
+  }
+  return ": the permissions in " + participant.security_dir() + " do not let '" + id +
+         "' publish it, though this build's table does (made before the topic was added? `concert "
+         "security init " + participant.security_dir() + " --force` makes them again)";
+}
+
+}  // namespace concert::dds
