@@ -176,7 +176,9 @@ void write_file(const fs::path& path, const std::string& content, mode_t mode) {
     }
     done += static_cast<size_t>(n);
   }
-  if (::fchmod(fd, mode) != 0 || ::close(fd) != 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
+  const bool moded = ::fchmod(fd, mode) == 0;  // whatever the umask took away
+  const bool closed = ::close(fd) == 0;
+  if (!moded || !closed || std::rename(tmp.c_str(), path.c_str()) != 0) {
     throw std::runtime_error("cannot write '" + path.string() + "': " + std::strerror(errno));
   }
 }
