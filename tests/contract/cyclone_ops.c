@@ -5,7 +5,9 @@
 #include <string.h>
 
 #include <dds/dds.h>
+#include <dds/ddsi/ddsi_cdrstream.h>
 #include <dds/ddsi/ddsi_serdata.h>
+#include <dds/ddsrt/endian.h>
 
 #include "drill.h"
 #include "ethercat.h"
@@ -70,7 +72,6 @@ static struct {
   dds_entity_t entity;
   const dds_topic_descriptor_t* desc;
   int is_writer;
-  struct ddsi_serdata* type_holder; /* keeps the sertype alive (writers) */
 } g_ep[MAX_ENDPOINTS];
 static int g_n = 0;
 static dds_entity_t g_pp = 0;
@@ -100,10 +101,16 @@ static dds_qos_t* make_qos(cy_qos q, int writer) {
  * CONCERT_CYCLONE_CONFIG is deploy/dds/cyclonedds_localhost.xml, as a file:// URI. */
 static const char* k_localhost_config = CONCERT_CYCLONE_CONFIG;
 
-int cy_open(int domain_id) {
+int cy_open(int domain_id, const char* extra_config) {
   const char* uri = getenv("CYCLONEDDS_URI");
-  if (uri == NULL || *uri == '\0') {
-    dds_entity_t dom = dds_create_domain((dds_domainid_t)domain_id, k_localhost_config);
+  const char* base = (uri == NULL || *uri == '\0') ? k_localhost_config : uri;
+  if (base == k_localhost_config || extra_config != NULL) {
+    /* A config string is a comma-separated list of URIs and XML fragments. */
+    const size_t n = strlen(base) + (extra_config ? strlen(extra_config) + 1 : 0) + 1;
+    char* config = malloc(n);
+    snprintf(config, n, "%s%s%s", base, extra_config ? "," : "", extra_config ? extra_config : "");
+    dds_entity_t dom = dds_create_domain((dds_domainid_t)domain_id, config);
+    free(config);
     if (dom < 0) {
       fprintf(stderr, "cyclone peer: cannot create domain: %s\n", dds_strretcode(dom));
       return -1;
@@ -117,19 +124,13 @@ int cy_open(int domain_id) {
   return 0;
 }
 
-void cy_close(void) {
-  for (int i = 0; i < g_n; ++i) {
-    if (g_ep[i].type_holder) ddsi_serdata_unref(g_ep[i].type_holder);
-  }
-  dds_delete(g_pp);
-}
+void cy_close(void) { dds_delete(g_pp); }
 
-static int add(dds_entity_t e, const dds_topic_descriptor_t* desc, int writer, struct ddsi_serdata* holder) {
+static int add(dds_entity_t e, const dds_topic_descriptor_t* desc, int writer) {
   if (g_n == MAX_ENDPOINTS) return -1;
   g_ep[g_n].entity = e;
   g_ep[g_n].desc = desc;
   g_ep[g_n].is_writer = writer;
-  g_ep[g_n].type_holder = holder;
   return g_n++;
 }
 
@@ -151,48 +152,14 @@ int cy_create_reader(const char* topic, const char* type_name, cy_qos q) {
   const dds_topic_descriptor_t* desc = find_desc(type_name);
   if (!desc) return -1;
   dds_entity_t r = make_endpoint(topic, desc, q, 0);
-  return r < 0 ? -1 : add(r, desc, 0, NULL);
-}
-
-/* Cyclone 0.10's C API offers no way to get a topic's sertype (dds_get_entity_sertype came in
- * a later release), and a serdata can only be built from bytes with one. So: write an empty
- * sample of the type to a private probe topic with a local reader, and take it back as serdata;
- * its sertype is the type's (Cyclone shares one sertype per type in a domain). */
-static struct ddsi_serdata* sertype_probe(const char* topic, const dds_topic_descriptor_t* desc) {
-  char name[256];
-  snprintf(name, sizeof name, "concert_contract_probe/%s", topic);
-  dds_entity_t t = dds_create_topic(g_pp, desc, name, NULL, NULL);
-  dds_qos_t* qos = make_qos((cy_qos){1, 0, 1}, 0);
-  dds_entity_t r = dds_create_reader(g_pp, t, qos, NULL);
-  dds_entity_t w = dds_create_writer(g_pp, t, qos, NULL);
-  dds_delete_qos(qos);
-  void* empty = dds_alloc(desc->m_size);
-  memset(empty, 0, desc->m_size);
-  dds_write(w, empty);
-  dds_sample_free(empty, desc, DDS_FREE_ALL);
-  struct ddsi_serdata* sd = NULL;
-  dds_sample_info_t info;
-  for (int i = 0; i < 200; ++i) {
-    if (dds_takecdr(r, &sd, 1, &info, DDS_ANY_STATE) == 1) break;
-    dds_sleepfor(DDS_MSECS(5));
-  }
-  dds_delete(w);
-  dds_delete(r);
-  if (!sd) fprintf(stderr, "cyclone peer: sertype probe for %s got nothing\n", topic);
-  return sd;
+  return r < 0 ? -1 : add(r, desc, 0);
 }
 
 int cy_create_writer(const char* topic, const char* type_name, cy_qos q) {
   const dds_topic_descriptor_t* desc = find_desc(type_name);
   if (!desc) return -1;
-  struct ddsi_serdata* holder = sertype_probe(topic, desc);
-  if (!holder) return -1;
   dds_entity_t w = make_endpoint(topic, desc, q, 1);
-  if (w < 0) {
-    ddsi_serdata_unref(holder);
-    return -1;
-  }
-  return add(w, desc, 1, holder);
+  return w < 0 ? -1 : add(w, desc, 1);
 }
 
 static uint8_t* to_bytes(const struct ddsi_serdata* sd, size_t* len) {
@@ -229,22 +196,42 @@ int cy_take(int reader, uint8_t** wire, size_t* wire_len, uint8_t** reser, size_
   return 0;
 }
 
+/* Bytes -> C sample with Cyclone's own CDR code (the type's serializer ops): the payload is
+ * checked and byte-swapped by dds_stream_normalize_data (what Cyclone does to received data),
+ * then read by dds_stream_read. Cyclone 0.10 offers no sertype lookup to build a serdata from
+ * bytes, and the probe topic this peer used for one is refused under DDS Security. */
 int cy_write(int writer, const uint8_t* bytes, size_t len) {
-  const struct ddsi_sertype* type = g_ep[writer].type_holder->type;
-  ddsrt_iovec_t iov;
-  iov.iov_base = (void*)bytes;
-  iov.iov_len = (ddsrt_iov_len_t)len;
-  struct ddsi_serdata* sd = ddsi_serdata_from_ser_iov(type, SDK_DATA, 1, &iov, len);
-  if (!sd) {
-    fprintf(stderr, "cyclone peer: Cyclone rejected the serialized sample\n");
+  const dds_topic_descriptor_t* desc = g_ep[writer].desc;
+  if (len < 4 || len - 4 > UINT32_MAX) {
+    fprintf(stderr, "cyclone peer: a serialized sample of %zu bytes\n", len);
     return -1;
   }
-  const dds_topic_descriptor_t* desc = g_ep[writer].desc;
+  /* Encapsulation: CDR_BE 0, CDR_LE 1 (XCDR1); CDR2/D_CDR2 6..9 (XCDR2), odd = little-endian. */
+  const unsigned rep = ((unsigned)bytes[0] << 8) | bytes[1];
+  const uint32_t xcdr = (rep == 0 || rep == 1) ? 1 : (rep >= 6 && rep <= 9) ? 2 : 0;
+  if (xcdr == 0) {
+    fprintf(stderr, "cyclone peer: unknown encapsulation 0x%04x\n", rep);
+    return -1;
+  }
+  const bool little = (rep & 1u) != 0;
+  const uint32_t size = (uint32_t)(len - 4);
+  char* data = malloc(size + 1);
+  memcpy(data, bytes + 4, size);
+  uint32_t off = 0;
+  if (dds_stream_normalize_data(data, &off, size, little != (DDSRT_ENDIAN == DDSRT_LITTLE_ENDIAN), xcdr,
+                                desc->m_ops) == NULL) {
+    fprintf(stderr, "cyclone peer: Cyclone rejected the serialized sample\n");
+    free(data);
+    return -1;
+  }
+  dds_istream_t is;
+  dds_istream_init(&is, size, data, xcdr);
   void* sample = dds_alloc(desc->m_size);
   memset(sample, 0, desc->m_size);
-  int ok = ddsi_serdata_to_sample(sd, sample, NULL, NULL);
-  ddsi_serdata_unref(sd);
-  dds_return_t rc = ok ? dds_write(g_ep[writer].entity, sample) : -1;
+  dds_stream_read(&is, sample, desc->m_ops);
+  dds_istream_fini(&is);
+  free(data);
+  dds_return_t rc = dds_write(g_ep[writer].entity, sample);
   dds_sample_free(sample, desc, DDS_FREE_ALL);
   if (rc < 0) {
     fprintf(stderr, "cyclone peer: write failed\n");

@@ -18,7 +18,8 @@ typedef struct cy_qos {
 } cy_qos;
 
 /* All functions return a negative value on error and write a message to stderr. */
-int cy_open(int domain_id);
+/* extra_config: an XML fragment added to the configuration (e.g. <Security>), or NULL. */
+int cy_open(int domain_id, const char* extra_config);
 void cy_close(void);
 /* Endpoint handles are small integers. */
 int cy_create_reader(const char* topic, const char* type_name, cy_qos qos);

@@ -2,6 +2,7 @@
 #include <cstdlib>
 #include <thread>
 
+#include "concert/security/dds_config.hpp"
 #include "cyclone_ops.h"
 #include "peer_common.hpp"
 
@@ -11,7 +12,15 @@ using namespace std::chrono_literals;
 int main(int argc, char** argv) try {
   const auto args = contract::parse_peer_args(argc, argv);
   const auto& schema = idl::Schema::builtin();
-  if (cy_open(dds::domain_id_from_env()) != 0) return 2;
+  // CONCERT_SECURITY: secured with Cyclone's plugins, as the identity the Fast DDS peers would
+  // take (CONCERT_SECURITY_IDENTITY, else operator).
+  std::string security;
+  if (const auto pki = security::pki_from_environment()) {
+    const auto files = security::identity_files(*pki, security::resolve_identity("", "contract_cyclone"));
+    security::check_identity(files);
+    security = security::cyclone_security_config(files, CONCERT_CYCLONE_SECURITY_PLUGINS);
+  }
+  if (cy_open(dds::domain_id_from_env(), security.empty() ? nullptr : security.c_str()) != 0) return 2;
 
   struct Endpoint {
     dds::TopicInfo info;

@@ -3,7 +3,9 @@
 #include <stdexcept>
 #include <thread>
 
+#include "concert/common/text.hpp"
 #include "concert/dds/qos.hpp"
+#include "concert/security/table.hpp"
 
 namespace concert::dds::detail {
 
@@ -25,7 +27,10 @@ DataWriter* create_writer(Participant& participant, std::string_view name, TypeS
   const TopicInfo info = checked(name, type);
   Topic* topic = participant.topic(std::string(name), type);
   DataWriter* writer = participant.publisher()->create_datawriter(topic, writer_qos(info.qos));
-  if (writer == nullptr) throw std::runtime_error("cannot create a DDS writer on '" + std::string(name) + "'");
+  if (writer == nullptr) {
+    throw std::runtime_error("cannot create a DDS writer on '" + std::string(name) + "'" +
+                             why_refused(participant, name, true));
+  }
   return writer;
 }
 
@@ -35,7 +40,10 @@ DataReader* create_reader(Participant& participant, std::string_view name, TypeS
   Topic* topic = participant.topic(std::string(name), type);
   DataReader* reader = participant.subscriber()->create_datareader(
       topic, reader_qos(info.qos), listener, listener ? StatusMask::data_available() : StatusMask::none());
-  if (reader == nullptr) throw std::runtime_error("cannot create a DDS reader on '" + std::string(name) + "'");
+  if (reader == nullptr) {
+    throw std::runtime_error("cannot create a DDS reader on '" + std::string(name) + "'" +
+                             why_refused(participant, name, false));
+  }
   return reader;
 }
 
@@ -72,3 +80,23 @@ bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds tim
 }
 
 }  // namespace concert::dds::detail
+
+namespace concert::dds {
+
+std::string why_refused(const Participant& participant, std::string_view topic, bool writer) {
+  if (participant.security_identity().empty()) return "";
+  const std::string& id = participant.security_identity();
+  const std::string where = "CONCERT_SECURITY=" + participant.security_dir();
+  if (!writer) return " (" + where + ": the permissions of '" + id + "' do not allow reading it)";
+  const auto writers = security::writers_of(topic);
+  if (!security::may_write(id, topic)) {
+    return ": identity '" + id + "' may not publish it (" +
+           (writers.empty() ? std::string("nobody may") : "only " + join(writers, ", ") + " may") +
+           "; " + where + ")";
+  }
+  return ": the permissions in " + participant.security_dir() + " do not let '" + id +
+         "' publish it, though this build's table does (made before the topic was added? `concert "
+         "security init " + participant.security_dir() + " --force` makes them again)";
+}
+
+}  // namespace concert::dds

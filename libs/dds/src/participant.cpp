@@ -9,6 +9,8 @@
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
+#include "concert/security/dds_config.hpp"
+
 namespace concert::dds {
 
 using namespace eprosima::fastdds::dds;
@@ -56,10 +58,32 @@ void use_localhost_only(DomainParticipantQos& qos) {
 
 }  // namespace
 
+void Participant::use_security(DomainParticipantQos& qos, const std::filesystem::path& pki,
+                               const ParticipantOptions& options) {
+  const std::string where = "CONCERT_SECURITY=" + pki.string();
+  if (domain_id_ < security::kFirstDomain || domain_id_ > security::kLastDomain) {
+    throw std::invalid_argument(where + ": domain " + std::to_string(domain_id_) +
+                                " is outside the domains the PKI covers (" +
+                                std::to_string(security::kFirstDomain) + " to " +
+                                std::to_string(security::kLastDomain) + ")");
+  }
+  security_identity_ = security::resolve_identity(options.identity, options.name);
+  security_dir_ = pki.string();
+  const security::IdentityFiles files = security::identity_files(pki, security_identity_);
+  try {
+    security::check_identity(files);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(where + ": " + e.what());
+  }
+  auto& properties = qos.properties().properties();
+  for (auto& [name, value] : security::fastdds_properties(files)) properties.emplace_back(name, value);
+}
+
 Participant::Participant(ParticipantOptions options) : name_(options.name) {
   domain_id_ = options.domain_id >= 0 ? options.domain_id : domain_id_from_env();
   auto* factory = DomainParticipantFactory::get_instance();
 
+  DomainParticipantQos qos = PARTICIPANT_QOS_DEFAULT;
   std::string profiles = options.profiles_file;
   if (profiles.empty()) {
     if (const char* env = std::getenv("CONCERT_DDS_PROFILES")) profiles = env;
@@ -68,29 +92,35 @@ Participant::Participant(ParticipantOptions options) : name_(options.name) {
     if (factory->load_XML_profiles_file(profiles) != ReturnCode_t::RETCODE_OK) {
       throw std::runtime_error("DDS profiles file '" + profiles + "' cannot be loaded (missing or invalid XML)");
     }
-    DomainParticipantQos qos;
     if (factory->get_participant_qos_from_profile(options.profile_name, qos) != ReturnCode_t::RETCODE_OK) {
       throw std::runtime_error("DDS profiles file '" + profiles + "' has no participant profile '" +
                                options.profile_name + "'");
     }
-    qos.name(options.name);
-    participant_ = factory->create_participant(domain_id_, qos, options.listener, StatusMask::none());
   } else {
     std::string network = options.network;
     if (network.empty()) {
       const char* env = std::getenv("CONCERT_DDS_NETWORK");
       network = env != nullptr && *env != '\0' ? env : "localhost";
     }
-    DomainParticipantQos qos = PARTICIPANT_QOS_DEFAULT;
-    qos.name(options.name);
     if (network == "localhost") {
       use_localhost_only(qos);
     } else if (network != "system") {
       throw std::invalid_argument("CONCERT_DDS_NETWORK: '" + network + "' is not 'localhost' or 'system'");
     }
-    participant_ = factory->create_participant(domain_id_, qos, options.listener, StatusMask::none());
   }
+  qos.name(options.name);
+  if (const auto pki = security::pki_from_environment()) {
+    use_security(qos, *pki, options);
+  }
+  participant_ = factory->create_participant(domain_id_, qos, options.listener, StatusMask::none());
   if (participant_ == nullptr) {
+    if (!security_identity_.empty()) {
+      // Fast DDS logs no reason for a refused security setting; check_identity() ruled out
+      // what it can name.
+      throw std::runtime_error("cannot create a secured DDS participant as '" + security_identity_ +
+                               "' on domain " + std::to_string(domain_id_) + " (CONCERT_SECURITY=" +
+                               security_dir_ + "): Fast DDS refused its security settings");
+    }
     throw std::runtime_error("cannot create a DDS participant on domain " + std::to_string(domain_id_));
   }
   publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);

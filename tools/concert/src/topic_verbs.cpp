@@ -16,6 +16,7 @@
 
 #include "concert/common/text.hpp"
 #include "concert/dds/catalogue.hpp"
+#include "concert/dds/endpoint.hpp"
 #include "concert/dds/qos.hpp"
 #include "concert/dds/raw_type.hpp"
 #include "concert/idl_schema/cdr.hpp"
@@ -297,7 +298,9 @@ int pub(const Publish& p, std::ostream& out) {
       p.topic,
       eprosima::fastdds::dds::TypeSupport(new dds::RawPubSubType(type, schema.at(type).keyed())));
   auto* writer = participant.publisher()->create_datawriter(topic, dds::writer_qos(info->qos));
-  if (writer == nullptr) throw Failure("cannot create a writer on '" + p.topic + "'");
+  if (writer == nullptr) {
+    throw Failure("cannot create a writer on '" + p.topic + "'" + dds::why_refused(participant, p.topic, true));
+  }
   const auto deadline = Clock::now() + std::chrono::duration<double>(p.wait_s);
   eprosima::fastdds::dds::PublicationMatchedStatus matched;
   while (!g_interrupted && Clock::now() < deadline) {

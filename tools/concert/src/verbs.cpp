@@ -5,6 +5,7 @@
 #include "bag_verbs.hpp"
 #include "bim_verbs.hpp"
 #include "camera_verbs.hpp"
+#include "concert/security/cli.hpp"
 #include "launcher.hpp"
 #include "scan_verbs.hpp"
 #include "status_verbs.hpp"
@@ -52,6 +53,7 @@ void register_all(cli::Cli& concert) {
   register_scan_verbs(concert);
   register_camera_verbs(concert);
   register_bim_verbs(concert);
+  security::register_verbs(concert);
   register_service_verbs(concert);
   register_help(concert);
 }

@@ -21,6 +21,11 @@
 
 namespace concert::dds {
 
+/// Why a secured participant may have been refused a writer (or reader) on `topic`, as text to
+/// append to the error (": identity 'operator' may not publish it (only planner, nav, drill may;
+/// CONCERT_SECURITY=DIR)"); empty when the participant is not secured.
+std::string why_refused(const Participant& participant, std::string_view topic, bool writer);
+
 namespace detail {
 /// Checks `name` against the catalogue (exists, type name matches) and creates the writer.
 eprosima::fastdds::dds::DataWriter* create_writer(Participant& participant, std::string_view name,

@@ -1,13 +1,17 @@
 #pragma once
 // A Fast DDS domain participant with one publisher and one subscriber, configured from the
-// environment (CONCERT_DOMAIN_ID) and optionally an XML profile (deploy/dds/).
+// environment (CONCERT_DOMAIN_ID) and optionally an XML profile (deploy/dds/); secured (DDS
+// Security: authentication, access control, encryption) when CONCERT_SECURITY names a PKI folder
+// made by `concert security init` (libs/security).
 
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <string>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
@@ -38,12 +42,18 @@ struct ParticipantOptions {
   std::string network;
   /// Optional listener for discovery events (participants, writers, readers on the domain).
   eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr;
+  /// The security identity when CONCERT_SECURITY is set (its files are
+  /// $CONCERT_SECURITY/<identity>/). Empty: the name when it is a service's ("robot"), else
+  /// CONCERT_SECURITY_IDENTITY if set, else "operator" (security::resolve_identity).
+  std::string identity;
 };
 
 /// Owns a DomainParticipant. Writers and readers made from it must be destroyed before it.
 class Participant {
  public:
-  /// Throws std::runtime_error (or std::invalid_argument for a bad domain id) with the reason.
+  /// Throws std::runtime_error (or std::invalid_argument for a bad domain id) with the reason;
+  /// when secured, also for an identity whose files are missing, expired or do not verify
+  /// against the PKI's CA (naming the file).
   explicit Participant(ParticipantOptions options = {});
   ~Participant();
   Participant(const Participant&) = delete;
@@ -51,6 +61,10 @@ class Participant {
 
   int32_t domain_id() const { return domain_id_; }
   const std::string& name() const { return name_; }
+  /// The security identity this participant authenticated as; empty when not secured.
+  const std::string& security_identity() const { return security_identity_; }
+  /// The PKI folder (CONCERT_SECURITY) when secured; empty otherwise.
+  const std::string& security_dir() const { return security_dir_; }
   eprosima::fastdds::dds::DomainParticipant* get() const { return participant_; }
   eprosima::fastdds::dds::Publisher* publisher() const { return publisher_; }
   eprosima::fastdds::dds::Subscriber* subscriber() const { return subscriber_; }
@@ -60,7 +74,13 @@ class Participant {
   eprosima::fastdds::dds::Topic* topic(const std::string& name, eprosima::fastdds::dds::TypeSupport type);
 
  private:
+  /// Turns DDS Security on in `qos` with the identity `options` resolve to in `pki`.
+  void use_security(eprosima::fastdds::dds::DomainParticipantQos& qos, const std::filesystem::path& pki,
+                    const ParticipantOptions& options);
+
   std::string name_;
+  std::string security_identity_;
+  std::string security_dir_;
   int32_t domain_id_ = 0;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
