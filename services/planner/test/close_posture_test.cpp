@@ -22,14 +22,8 @@ namespace {
 constexpr double kWallX = 2.2;          // the demo wall's face (deploy/demo/drill_site.yaml)
 constexpr double kHoleDistance = 0.23;  // the drill service's camera distance at a hole
 
-Params generous(uint64_t seed) {
-  Params params;
-  params.seed = seed;
-  params.planning_time = 20.0;
-  params.nspg_time = 10.0;
-  params.path_attempt_time = 6.0;
-  return params;
-}
+
+using fixtures::generous;
 
 std::unique_ptr<Planner> demo_planner(const Params& params) {
   auto planner = std::make_unique<Planner>(params);

@@ -21,5 +21,9 @@ model_generation::GeneratedModel generated_model(const std::filesystem::path& as
 Eigen::Isometry3d drilling_area(double wall_x, double y, double z);
 /// A wall box 0.2 m thick, 6 m wide, 3.2 m high, front face at x = wall_x.
 WorldBox wall_at(double wall_x);
+/// Parameters seeded with `seed`, with budgets generous enough that a loaded machine (ctest -j2
+/// next to a build) cannot make a plan fail: searches stop when they succeed, so the budget is
+/// only a bound.
+Params generous(uint64_t seed);
 
 }  // namespace concert::planner::fixtures

@@ -220,7 +220,10 @@ void PostureProblem::evaluate(const Eigen::VectorXd& q, Eigen::VectorXd& r) {
   if (task_) {
     const Eigen::Isometry3d& cam = poses_[static_cast<std::size_t>(camera_)];
     r.segment<3>(0) = kTaskWeight * (cam.translation() - task_->position);
-    r.segment<3>(3) = kTaskWeight * cam.linear().col(2).cross(task_->axis);
+    // The axis as a difference, not a cross product: a cross product is zero for the camera
+    // looking away from the wall too, and the solver converged there (a hole posture on the
+    // demo robot passed every check with the camera turned 180 deg from the hole).
+    r.segment<3>(3) = kTaskWeight * (cam.linear().col(2) - task_->axis);
   } else {
     r.head<6>().setZero();
   }
