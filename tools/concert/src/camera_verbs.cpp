@@ -181,11 +181,16 @@ int snapshot(const SnapshotOptions& o, std::ostream& out) {
     }
     return names;
   };
+  // The sensor list is latched but may reach a late joiner after the first frames: without
+  // a camera named, frames alone decide only once this grace has passed.
+  const auto list_grace =
+      std::min(deadline, std::chrono::steady_clock::now() + std::chrono::seconds(2));
   const bool got = l.wait_until(deadline, [&] {
     const auto names = known_cameras();
     if (o.camera.empty()) {
       // Default: the robot's first camera; without a sensor list, the first that publishes.
       if (names.empty()) return false;
+      if (!l.sensor_list && std::chrono::steady_clock::now() < list_grace) return false;
       camera = names.front();
     } else if (l.sensor_list && std::find(names.begin(), names.end(), camera) == names.end()) {
       unknown = joined(names);
