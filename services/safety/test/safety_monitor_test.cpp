@@ -133,6 +133,31 @@ TEST(SafetyMonitor, SilentTaskServiceStopsNamingIt) {
                                                                     {"robot@rt", false}}));
 }
 
+TEST(SafetyMonitor, ItsOwnStallIsNobodysSilence) {
+  // The safety process starved for 1.7 s (a loaded machine: CI saw drill, planner and robot
+  // "silent for 1.69 s" at once): the heartbeats waiting in its readers are no silence.
+  SafetyMonitor m(with_liveliness_timeout(1000ms), kT0);
+  m.on_heartbeat("planner", "manip", false, kT0);
+  m.on_heartbeat("robot", "rt", false, kT0);
+  m.check_liveliness(kT0 + 50ms);
+  m.check_liveliness(kT0 + 1750ms);  // the monitor ran 1.7 s late
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+  EXPECT_EQ(m.own_stalls(), 1u);
+  // The robot beats on; the planner really is gone: caught one bound of checked time after
+  // its last heartbeat.
+  for (int i = 1; i <= 40; ++i) {
+    m.on_heartbeat("robot", "rt", false, kT0 + 1750ms + i * 50ms);
+    m.check_liveliness(kT0 + 1750ms + i * 50ms);
+    if (i <= 18) {
+      EXPECT_EQ(m.status().mode, Mode::kRunning) << i;
+    }
+  }
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  ASSERT_EQ(m.status().causes.size(), 1u);
+  EXPECT_NE(m.status().causes[0].find("planner@manip silent"), std::string::npos);
+  EXPECT_EQ(m.own_stalls(), 1u);
+}
+
 TEST(SafetyMonitor, UnwatchedServicesAreIgnored) {
   SafetyMonitor m(with_liveliness_timeout(100ms), kT0);
   m.on_heartbeat("modelgen", "rt", false, kT0);

@@ -83,8 +83,13 @@ class SafetyMonitor {
                     TimePoint now);
 
   /// Checks liveliness at `now`: a watched instance silent beyond the bound stops the robot,
-  /// with a cause naming it.
+  /// with a cause naming it. Silence counts only while the monitor checks: a check later than
+  /// kOwnStallChecks check periods after the previous one finds the monitor itself was
+  /// stalled, and the stalled time is not counted as anyone's silence (own_stalls() counts it).
   void check_liveliness(TimePoint now);
+  /// How many of its own stalls check_liveliness has found.
+  uint64_t own_stalls() const { return own_stalls_; }
+  static constexpr int kOwnStallChecks = 5;
 
   /// A new robot model: the limits table the watchdog enforces from now on. The thermal load
   /// of every joint starts cold.
@@ -140,6 +145,8 @@ class SafetyMonitor {
   std::vector<std::string> cause_keys_;
   SafetyStatus status_;
   uint64_t revision_ = 0;
+  std::optional<TimePoint> last_check_;
+  uint64_t own_stalls_ = 0;
 };
 
 }  // namespace concert::safety

@@ -96,6 +96,17 @@ void SafetyMonitor::on_heartbeat(const std::string& service, const std::string& 
 }
 
 void SafetyMonitor::check_liveliness(TimePoint now) {
+  if (last_check_ && now - *last_check_ > kOwnStallChecks * params_.check_period) {
+    // The monitor itself did not run (a starved process on a loaded machine: its listeners
+    // had not taken in the heartbeats waiting for it either). Time it did not watch is not
+    // silence it heard: every instance's silence counts on from here, so a service dead
+    // meanwhile is caught that much later, and a stall of the safety service alone is no stop.
+    const auto asleep = now - *last_check_;
+    for (auto& [who, instance] : instances_)
+      instance.last_seen = std::min(now, instance.last_seen + asleep);
+    ++own_stalls_;
+  }
+  last_check_ = now;
   for (auto& [who, instance] : instances_) {
     const auto silent_for = now - instance.last_seen;
     if (instance.silent || silent_for <= params_.liveliness_timeout) continue;

@@ -157,7 +157,13 @@ void SafetyNode::on_reset(const msg::SafetyReset& reset) {
 
 void SafetyNode::tick() {
   std::unique_lock lock(mutex_);
+  const uint64_t stalls = monitor_.own_stalls();
   monitor_.check_liveliness(Clock::now());
+  if (monitor_.own_stalls() != stalls) {
+    log_ << "safety: the liveliness check ran over " << SafetyMonitor::kOwnStallChecks
+         << " periods late (this process was stalled); that time is not counted as silence"
+         << std::endl;
+  }
   const auto text = publish_locked(false);
   lock.unlock();
   note(text);
