@@ -1,0 +1,138 @@
+// Benchmark of the drilling service on whole simulated stacks (issue #17; paper section 6.1): the
+// paper's scenarios run as missions, the holes the simulator's wall records scored against the
+// marks' truth. Cameras with their noise, every service a process on this machine.
+//   blobs     scenario 1: six blue blobs in four clusters, 0.95-2.15 m high, morphology B
+//             (deploy/bench/drill_blobs_*.yaml; visual servoing)
+//   patterns  scenario 3, the part morphology A reaches: four ArUco 60 cm rows at 0.5-2.0 m
+//             (deploy/bench/drill_patterns_*.yaml; the kinematics alone)
+//   demo      the demo wall's pattern (deploy/demo/drill_site.yaml)
+// Usage: bench_drill_mission [--scenario blobs|patterns|demo|all] [--runs N]   (default: all, 1)
+// Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
+// marked, error median / p95 / max, and the mission time split. Minutes per run.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "drill_runner.hpp"
+
+using namespace concert::system_test;
+using concert::msg::DrillStatus;
+
+namespace {
+
+struct Scenario {
+  std::string name, assembly, site, mission;
+};
+
+std::string source(const std::string& path) { return std::string(CONCERT_SOURCE_DIR) + "/" + path; }
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const double at = p * static_cast<double>(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(at));
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string which = "all";
+  int runs = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--scenario" && i + 1 < argc) {
+      which = argv[++i];
+    } else if (a == "--runs" && i + 1 < argc) {
+      runs = std::atoi(argv[++i]);
+    } else {
+      std::cerr << "bench_drill_mission: unknown argument '" << a
+                << "' (--scenario blobs|patterns|demo|all, --runs N)\n";
+      return 2;
+    }
+  }
+  const std::vector<Scenario> all{
+      {"blobs", source("services/planner/data/morphology_b.yaml"),
+       source("deploy/bench/drill_blobs_site.yaml"), source("deploy/bench/drill_blobs_mission.yaml")},
+      {"patterns", source("services/planner/data/morphology_a.yaml"),
+       source("deploy/bench/drill_patterns_site.yaml"), source("deploy/bench/drill_patterns_mission.yaml")},
+      {"demo", source("deploy/demo/drill_robot.yaml"), source("deploy/demo/drill_site.yaml"), ""},
+  };
+  const concert::drill::PatternTable patterns =
+      concert::drill::load_patterns(source("services/drill/config/patterns.yaml"));
+  bool known = false;
+  for (const Scenario& sc : all) {
+    if (which != "all" && which != sc.name) continue;
+    known = true;
+    const std::string mission =
+        sc.mission.empty() ? "name: bench demo pattern\ndepth: 0.03\nareas:\n"
+                             "  - {name: pattern, marks: aruco, point: [2.2, -0.9, 1.45]}\n"
+                           : read(sc.mission);
+    std::vector<Target> targets = targets_of(concert::world::load_world_file(sc.site), patterns);
+    if (sc.name == "demo") {  // the demo wall's blobs are another mission's
+      std::erase_if(targets, [](const Target& t) { return t.name.rfind("blob", 0) == 0; });
+    }
+    std::vector<double> errors;
+    std::size_t drilled = 0, marked = 0;
+    double t_nav = 0, t_plan = 0, t_exec = 0, t_drill = 0, t_total = 0;
+    for (int r = 0; r < runs; ++r) {
+      const MissionRun run = run_mission(sc.assembly, sc.site, mission, std::chrono::seconds(3600));
+      if (!run.status) {
+        std::cerr << sc.name << " run " << r + 1 << ": no status from the drill service" << run.logs
+                  << "\n";
+        marked += targets.size();
+        continue;
+      }
+      const DrillStatus& s = *run.status;
+      std::printf("%s run %d: mission %s, %u of %u marked holes drilled, safety %s%s%s\n",
+                  sc.name.c_str(), r + 1,
+                  s.state() == concert::msg::DRILL_SUCCEEDED ? "succeeded" : "did not succeed",
+                  s.holes_drilled(), s.holes_marked(), run.safety_running ? "RUNNING" : "STOPPED",
+                  s.reason().empty() ? "" : ": ", s.reason().c_str());
+      for (const Target& t : targets) {
+        marked += 1;
+        const auto [hole, e] = nearest_hole(run.holes, t);
+        // A hole within 5 cm is this mark's; farther, the mark was not drilled.
+        if (hole == nullptr || e.norm() > 0.05) {
+          std::printf("  %-22s not drilled\n", t.name.c_str());
+          continue;
+        }
+        drilled += 1;
+        errors.push_back(e.norm());
+        std::printf("  %-22s x %+6.2f mm  y %+6.2f mm  |e| %5.2f mm  depth %4.1f mm\n",
+                    t.name.c_str(), e.horizontal * 1e3, e.vertical * 1e3, e.norm() * 1e3,
+                    hole->depth() * 1e3);
+      }
+      t_nav += s.time_navigate();
+      t_plan += s.time_plan();
+      t_exec += s.time_execute();
+      t_drill += s.time_drill();
+      t_total += s.time_total();
+      std::fflush(stdout);
+    }
+    std::printf(
+        "== %s (%d run%s): %zu of %zu marked holes drilled; error median %.2f mm, p95 %.2f mm, "
+        "max %.2f mm; time per run: navigate %.0f s, plan %.0f s, execute %.0f s, drill %.0f s, "
+        "total %.0f s\n",
+        sc.name.c_str(), runs, runs == 1 ? "" : "s", drilled, marked, percentile(errors, 0.5) * 1e3,
+        percentile(errors, 0.95) * 1e3, percentile(errors, 1.0) * 1e3, t_nav / runs, t_plan / runs,
+        t_exec / runs, t_drill / runs, t_total / runs);
+  }
+  if (!known) {
+    std::cerr << "bench_drill_mission: unknown scenario '" << which
+              << "' (blobs, patterns, demo or all)\n";
+    return 2;
+  }
+  return 0;
+}
