@@ -64,9 +64,14 @@ class FakePorts : public MissionPorts {
   std::function<void(const std::string&)> on_call;  ///< called after each recorded call
   std::vector<std::string> violations;              ///< what the robot would have refused
   int health_checks{0};
+  int unheard_checks{0};  ///< health() is kRunning (a service not heard yet) this many times
 
   Outcome health() override {
     ++health_checks;
+    if (unheard_checks > 0) {
+      --unheard_checks;
+      return Outcome::running();
+    }
     return unhealthy.empty() ? Outcome::succeeded() : Outcome::failed(unhealthy);
   }
 

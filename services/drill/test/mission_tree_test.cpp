@@ -352,6 +352,21 @@ TEST(MissionTree, HealthFailureMidDrillStopsEverything) {
   EXPECT_EQ(tree.status().active, "");
 }
 
+TEST(MissionTree, WaitsForServicesNotHeardYetThenRuns) {
+  // A mission sent right after the stack started: the planner's status not heard yet. The
+  // tree waits (nothing started, nothing failed) and then runs as usual.
+  FakePorts fake(1);
+  fake.unheard_checks = 3;
+  MissionTree tree(mission_of(1), fake);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(tree.tick(fake.now), MissionState::kRunning) << i;
+    fake.now += 0.1;
+  }
+  EXPECT_THAT(fake.calls, IsEmpty());
+  ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
+  EXPECT_EQ(tree.report().holes_drilled(), 2);
+}
+
 TEST(MissionTree, AbortStopsEverything) {
   FakePorts fake(2);
   fake.default_seconds = 1.0;

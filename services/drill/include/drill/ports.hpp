@@ -59,8 +59,9 @@ class MissionPorts {
   virtual ~MissionPorts() = default;
 
   /// Whether the robot may move: succeeded when safety is RUNNING and every service the
-  /// mission uses is alive; failed with the reason otherwise (e-stop, a lost service). Never
-  /// kRunning.
+  /// mission uses is alive; failed with the reason otherwise (e-stop, a lost service);
+  /// kRunning while a service the mission uses has not been heard yet, shortly after the
+  /// mission began (the tree then waits; the port bounds how long).
   virtual Outcome health() = 0;
 
   /// Locates an area (a BIM wall: frame + base pose; a point or a pixel: the normal from the

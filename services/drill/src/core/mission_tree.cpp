@@ -496,7 +496,9 @@ MissionState MissionTree::tick(double now) {
   if (m.finished()) return m.report.state;
   m.account(now);
   m.report.state = MissionState::kRunning;
-  if (const Outcome health = m.ports.health(); health.progress != Progress::kSucceeded) {
+  const Outcome health = m.ports.health();
+  if (health.progress == Progress::kRunning) return m.report.state;  // not all heard yet
+  if (health.progress != Progress::kSucceeded) {
     m.halt(MissionState::kAborted,
            "health: " + (health.reason.empty() ? std::string("not healthy") : health.reason));
     return m.report.state;

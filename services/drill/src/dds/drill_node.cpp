@@ -475,6 +475,7 @@ void DrillNode::start_mission(const msg::DrillMission& m) {
   hole_chain_.clear();
   returning_ = false;
   motion_ = Motion::kNone;
+  mission_started_ = Clock::now();
   tree_ = std::make_unique<MissionTree>(*mission_, *this);
   if (m.resume()) {
     const auto previous = last_reports_.find(mission_->name);
@@ -501,17 +502,28 @@ Outcome DrillNode::health() {
   if (!rig_)
     return Outcome::failed("the robot model cannot drill" +
                            (rig_error_.empty() ? "" : ": " + rig_error_));
-  if (!safety_) return Outcome::failed("no safety state from the safety service");
+  // A service not heard yet when the mission began (a stack just started: its status or the
+  // joint states not matched yet) is waited for, kServiceLost at most.
+  const bool starting = seconds_since(mission_started_) < kServiceLost;
+  if (!safety_) {
+    return starting ? Outcome::running()
+                    : Outcome::failed("no safety state from the safety service");
+  }
   if (safety_->mode() != msg::SAFETY_RUNNING) {
     std::string causes;
     for (const auto& c : safety_->causes()) causes += (causes.empty() ? "" : ", ") + c;
     return Outcome::failed("safety stop" + (causes.empty() ? "" : " (" + causes + ")"));
   }
-  if (joints_seen_ == Clock::time_point{} || seconds_since(joints_seen_) > kJointsLost) {
+  if (joints_seen_ == Clock::time_point{}) {
+    if (starting) return Outcome::running();
+    return Outcome::failed("no joint state from the robot service (never heard)");
+  }
+  if (seconds_since(joints_seen_) > kJointsLost) {
     return Outcome::failed("no joint state from the robot service (lost)");
   }
   for (const char* service : {"planner"}) {
     const auto seen = services_seen_.find(service);
+    if (seen == services_seen_.end() && starting) return Outcome::running();
     if (seen == services_seen_.end() || seconds_since(seen->second) > kServiceLost) {
       return Outcome::failed(std::string("the ") + service + " service is lost");
     }

@@ -154,6 +154,7 @@ class DrillNode final : public MissionPorts {
   std::deque<Sample> samples_;  // joint states decimated to 200 Hz, 2 s
   std::optional<msg::Odometry> odometry_;
   std::chrono::steady_clock::time_point joints_seen_{};
+  std::chrono::steady_clock::time_point mission_started_{};  // health waits a while from here
   std::optional<msg::SafetyState> safety_;
   std::map<std::string, std::chrono::steady_clock::time_point> services_seen_;
   std::map<std::uint32_t, msg::PlanResult> plan_results_;
