@@ -30,6 +30,13 @@ namespace concert::tool {
 
 namespace fs = std::filesystem;
 
+std::chrono::milliseconds restart_delay(const BackoffParams& backoff,
+                                        std::chrono::steady_clock::duration ran, int& failures) {
+  failures = ran >= backoff.stable ? 1 : failures + 1;
+  const auto delay = backoff.first * (int64_t{1} << std::min(failures - 1, 20));
+  return std::min(delay, backoff.max);
+}
+
 Supervisor::Supervisor(std::vector<ServiceSpec> services, fs::path log_dir, std::ostream& log, BackoffParams backoff)
     : log_dir_(std::move(log_dir)), log_(log), backoff_(backoff) {
   for (auto& s : services) children_.push_back(Child{std::move(s)});
@@ -82,10 +89,7 @@ void Supervisor::poll() {
       const std::string how = WIFEXITED(status) ? "exited with code " + std::to_string(WEXITSTATUS(status))
                                                 : "was killed by signal " + std::to_string(WTERMSIG(status));
       c.pid = -1;
-      const bool stable = Clock::now() - c.started > backoff_.stable;
-      c.failures_in_a_row = stable ? 0 : c.failures_in_a_row + 1;
-      auto delay = backoff_.first * (1 << std::min(c.failures_in_a_row, 10));
-      if (delay > backoff_.max) delay = backoff_.max;
+      const auto delay = restart_delay(backoff_, Clock::now() - c.started, c.failures_in_a_row);
       c.restart_at = Clock::now() + delay;
       ++c.restarts;
       std::ostringstream msg;
