@@ -250,9 +250,15 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
 
   const fs::path dir = run_dir(domain);
   fs::create_directories(dir / "logs");
+  // The simulator's assembly and world: the robot service writes accepted hot swaps and worlds
+  // back over these copies (--keep-swaps), so that a robot service restarted after a crash
+  // mounts what was mounted, in the world it was in. Without a world: an empty one.
   install_file(assembly, dir / "assembly.yaml");
-  if (world) install_file(*world, dir / "world.yaml");
-  if (!ifc_world.empty()) std::ofstream(dir / "world.yaml") << ifc_world;
+  if (world) {
+    install_file(*world, dir / "world.yaml");
+  } else {
+    std::ofstream(dir / "world.yaml", std::ios::trunc) << ifc_world;
+  }
   // The simulated robot's start pose (robot.yaml's sim section; the rest stays the default).
   {
     std::ofstream params(dir / "robot_params.yaml");
@@ -270,9 +276,10 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
     std::vector<std::string> args;
     bool required;
   };
-  std::vector<std::string> robot_args = {"--assembly", (dir / "assembly.yaml").string(), "--params",
-                                         (dir / "robot_params.yaml").string()};
-  if (world || !ifc_world.empty()) robot_args.insert(robot_args.end(), {"--world", (dir / "world.yaml").string()});
+  std::vector<std::string> robot_args = {"--assembly", (dir / "assembly.yaml").string(),
+                                         "--world",    (dir / "world.yaml").string(),
+                                         "--params",   (dir / "robot_params.yaml").string(),
+                                         "--keep-swaps"};
   robot_args.insert(robot_args.end(), db_args.begin(), db_args.end());
   // nav: the building's map when there is one, localised at the start pose.
   std::vector<std::string> nav_args;
