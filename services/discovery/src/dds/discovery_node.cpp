@@ -5,8 +5,10 @@
 
 namespace concert::discovery::dds {
 DiscoveryNode::DiscoveryNode(concert::dds::Participant& participant, DiscoveryService service,
-                             std::ostream& log)
+                             std::ostream& log, std::chrono::milliseconds resume_wait)
     : service_(std::move(service)),
+      resume_wait_(resume_wait),
+      models_(participant, concert::dds::topics::robot_model),
       scans_(participant, concert::dds::topics::esc_scan),
       trees_(participant, concert::dds::topics::module_tree),
       status_(participant, "discovery"),
@@ -42,7 +44,20 @@ ScanOutcome DiscoveryNode::handle(const msg::EscScan& scan) {
   return outcome;
 }
 
+void DiscoveryNode::resume_from_wire() {
+  resumed_ = true;
+  // On a running stack the latched model arrives as soon as the readers match; a fresh stack
+  // has none yet (the wait runs out while modelgen waits for its own first tree).
+  const auto model = models_.wait(resume_wait_);
+  if (!model || model->tree_version() == 0) return;
+  service_.continue_after(model->tree_version());
+  log_ << "discovery: the running model version " << model->version()
+       << " was generated from tree version " << model->tree_version()
+       << ": trees are numbered after it" << std::endl;
+}
+
 int DiscoveryNode::spin_once(std::chrono::milliseconds timeout) {
+  if (!resumed_) resume_from_wire();
   int handled = 0;
   if (auto scan = scans_.wait(timeout)) {
     handle(*scan);

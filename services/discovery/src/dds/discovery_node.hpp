@@ -17,8 +17,12 @@ class DiscoveryNode {
  public:
   /// Creates the reader, writer and status reporter on `participant` (which must outlive the
   /// node) and reports the service READY, waiting for a scan. `log` gets one line per scan.
+  /// Before the first scan, spin_once() listens up to `resume_wait` for the robot model on the
+  /// wire (latched): a restarted discovery numbers its trees after the tree that model was
+  /// generated from (DiscoveryService::continue_after).
   DiscoveryNode(concert::dds::Participant& participant, DiscoveryService service,
-                std::ostream& log);
+                std::ostream& log,
+                std::chrono::milliseconds resume_wait = std::chrono::milliseconds(1000));
 
   /// Handles one scan sample: rebuild, publish a new tree version or report the error.
   ScanOutcome handle(const msg::EscScan& scan);
@@ -33,7 +37,12 @@ class DiscoveryNode {
   const DiscoveryService& service() const { return service_; }
 
  private:
+  void resume_from_wire();
+
   DiscoveryService service_;
+  std::chrono::milliseconds resume_wait_;
+  bool resumed_ = false;
+  concert::dds::Reader<msg::RobotModel> models_;
   concert::dds::Reader<msg::EscScan> scans_;
   concert::dds::Writer<msg::ModuleTree> trees_;
   concert::dds::StatusReporter status_;
