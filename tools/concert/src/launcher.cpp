@@ -291,8 +291,13 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
     nav_args = {"--ifc", fs::absolute(o.ifc).string(), "--storey", o.storey, "--initial-pose", x.str(), y.str(),
                 yaw.str()};
   }
+  // The safety service keeps its latched state (a stop, its causes, the inputs, the services it
+  // watches) in the run folder, so a safety service killed and restarted holds the same stop;
+  // a new `concert up` starts from none.
+  const fs::path safety_state = dir / "safety_state.yaml";
+  fs::remove(safety_state);
   const std::vector<Plan> plan = {
-      {"safety", "concert_safety", {}, false},
+      {"safety", "concert_safety", {"--state", safety_state.string()}, false},
       {"discovery", "concert_discovery", db_args, true},
       {"modelgen", "concert_modelgen", db_args, true},
       {"robot", "concert_robot", robot_args, true},
