@@ -1,5 +1,8 @@
 #include "discovery_node.hpp"
 
+#include <memory>
+#include <optional>
+
 #include "concert/common/clock.hpp"
 #include "concert/topology/dds/conversions.hpp"
 
@@ -9,6 +12,8 @@ DiscoveryNode::DiscoveryNode(concert::dds::Participant& participant, DiscoverySe
     : service_(std::move(service)),
       resume_wait_(resume_wait),
       models_(participant, concert::dds::topics::robot_model),
+      statuses_(std::make_unique<concert::dds::Reader<msg::ServiceStatus>>(
+          participant, concert::dds::topics::status)),
       scans_(participant, concert::dds::topics::esc_scan),
       trees_(participant, concert::dds::topics::module_tree),
       status_(participant, "discovery"),
@@ -46,9 +51,20 @@ ScanOutcome DiscoveryNode::handle(const msg::EscScan& scan) {
 
 void DiscoveryNode::resume_from_wire() {
   resumed_ = true;
-  // On a running stack the latched model arrives as soon as the readers match; a fresh stack
-  // has none yet (the wait runs out while modelgen waits for its own first tree).
-  const auto model = models_.wait(resume_wait_);
+  // The statuses (small, latched, every service beats) say whether a model runs: on a fresh
+  // stack none does and the wait ends after resume_wait; after a restart the model (large: its
+  // URDF) can take longer to arrive than the statuses on a loaded machine, so the wait goes on
+  // for it (up to 5 x resume_wait).
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  bool a_model_runs = false;
+  std::optional<msg::RobotModel> model;
+  while (!model) {
+    while (auto s = statuses_->take()) a_model_runs = a_model_runs || s->model_version() > 0;
+    if (Clock::now() - start >= resume_wait_ * (a_model_runs ? 5 : 1)) break;
+    model = models_.wait(std::chrono::milliseconds(20));
+  }
+  statuses_.reset();
   if (!model || model->tree_version() == 0) return;
   service_.continue_after(model->tree_version());
   log_ << "discovery: the running model version " << model->version()
