@@ -255,13 +255,32 @@ TEST(SafetyMonitor, ARestoredMonitorKeepsTheStopTheInputsAndTheWatchedServices) 
   EXPECT_FALSE(contains(after.status().causes, "planner@manip"));
   EXPECT_TRUE(after.reset("op", t1 + 300ms).accepted);
   EXPECT_EQ(after.status().mode, Mode::kRunning);
-  // A watched service that never beats again after the restore is silent after the bound.
+  // A watched service that never beats again after the restore is silent the bound after the
+  // first status heard (the restarted service's readers took 1.5 s to match here).
   SafetyMonitor gone(with_liveliness_timeout(1000ms), t1);
   gone.restore(read, t1);
   gone.set_estop(EStopSource::kWireless, false, "");
-  gone.on_heartbeat("robot", "rt", false, t1 + 1100ms, "robot-1");
-  gone.check_liveliness(t1 + 1100ms);
+  gone.check_liveliness(t1 + 1500ms);
+  EXPECT_FALSE(contains(gone.status().causes, "silent"));
+  gone.on_heartbeat("safety", "rt", false, t1 + 1500ms, "self");  // its own status: not the wire
+  gone.on_heartbeat("robot", "rt", false, t1 + 1500ms, "robot-1");
+  gone.on_heartbeat("drill", "manip", false, t1 + 1600ms, "drill-1");
+  gone.check_liveliness(t1 + 2400ms);
+  EXPECT_FALSE(contains(gone.status().causes, "silent"));
+  gone.on_heartbeat("robot", "rt", false, t1 + 2500ms, "robot-1");
+  gone.on_heartbeat("drill", "manip", false, t1 + 2500ms, "drill-1");
+  gone.check_liveliness(t1 + 2600ms);
   EXPECT_TRUE(contains(gone.status().causes, "planner@manip silent"));
+  EXPECT_FALSE(contains(gone.status().causes, "drill@manip"));
+  // Every watched service died while the safety service was down: silent all the same.
+  SafetyMonitor all_gone(with_liveliness_timeout(1000ms), t1);
+  all_gone.restore(read, t1);
+  all_gone.check_liveliness(t1 + 4900ms);
+  EXPECT_EQ(all_gone.status().causes.size(), 1u);  // the wireless input only
+  all_gone.check_liveliness(t1 + 5000ms);
+  all_gone.check_liveliness(t1 + 5100ms);
+  EXPECT_TRUE(contains(all_gone.status().causes, "robot@rt silent"));
+  EXPECT_TRUE(contains(all_gone.status().causes, "planner@manip silent"));
 }
 
 TEST(LatchedState, RunningEmptyAndErrorsNamingFileAndKey) {

@@ -100,8 +100,11 @@ class SafetyMonitor {
   /// Increases every time latched() changes.
   uint64_t latched_revision() const { return latched_revision_; }
   /// Continues from `state` after a restart of the safety service: the same stop and causes,
-  /// the same inputs engaged, the same instances watched, each silent from `now` on until
-  /// heard again (from the process it was heard from before; another is a restart).
+  /// the same inputs engaged, the same instances watched. Their silence counts from the first
+  /// watched service heard after the restore (the restarted service's readers match the other
+  /// processes' writers only some time after `now`), at the latest from 5 bounds after `now`;
+  /// each must then be heard within the bound, from the process it was heard from before
+  /// (another is a restart).
   void restore(const LatchedState& state, TimePoint now);
 
   const SafetyStatus& status() const { return status_; }
@@ -142,6 +145,8 @@ class SafetyMonitor {
   SafetyStatus status_;
   uint64_t revision_ = 0;
   uint64_t latched_revision_ = 0;
+  bool restored_unheard_ = false;  // restored instances wait for the first watched status heard
+  TimePoint restored_at_{};
 };
 
 }  // namespace concert::safety

@@ -82,6 +82,13 @@ bool SafetyMonitor::is_watched(const std::string& service) const {
 void SafetyMonitor::on_heartbeat(const std::string& service, const std::string& host,
                                  bool clean_stop, TimePoint now, const std::string& incarnation) {
   if (!is_watched(service)) return;
+  if (restored_unheard_) {
+    // The first watched service heard after a restore: the wire is heard from now on, and a
+    // restored instance silent for the bound from here is silent. (Not any status: our own
+    // reaches us before the other processes' writers have matched.)
+    restored_unheard_ = false;
+    for (auto& [who, instance] : instances_) instance.last_seen = std::max(instance.last_seen, now);
+  }
   const std::string who = service + "@" + host;
   const bool robot = service == params_.robot_service;
   if (clean_stop) {
@@ -112,6 +119,13 @@ void SafetyMonitor::on_heartbeat(const std::string& service, const std::string& 
 }
 
 void SafetyMonitor::check_liveliness(TimePoint now) {
+  if (restored_unheard_) {
+    // Nothing watched heard since the restore: silence means nothing yet, unless it lasts
+    // (every watched service died while the safety service was down).
+    if (now - restored_at_ < 5 * params_.liveliness_timeout) return;
+    restored_unheard_ = false;
+    for (auto& [who, instance] : instances_) instance.last_seen = now - params_.liveliness_timeout;
+  }
   for (auto& [who, instance] : instances_) {
     const auto silent_for = now - instance.last_seen;
     if (instance.silent || silent_for <= params_.liveliness_timeout) continue;
@@ -263,6 +277,8 @@ void SafetyMonitor::restore(const LatchedState& state, TimePoint now) {
     if (service == params_.robot_service) robot_heard_ = true;
   }
   robot_start_cause_ = robot_heard_;
+  restored_unheard_ = !instances_.empty();
+  restored_at_ = now;
   ++revision_;
   ++latched_revision_;
 }
