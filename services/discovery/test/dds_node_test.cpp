@@ -70,7 +70,8 @@ TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "discovery_test"});
   concert::dds::Reader<msg::ServiceStatus> status(participant, concert::dds::topics::status);
   std::ostringstream log;
-  dds::DiscoveryNode node(participant, DiscoveryService(topology::Discovery(catalog)), log);
+  // Alone on the wire: no model to resume from (listened for 0.2 s).
+  dds::DiscoveryNode node(participant, DiscoveryService(topology::Discovery(catalog)), log, 200ms);
   concert::dds::Writer<msg::EscScan> scans(participant, concert::dds::topics::esc_scan);
   concert::dds::Reader<msg::ModuleTree> trees(participant, concert::dds::topics::module_tree);
   ASSERT_TRUE(scans.wait_for_readers(1, 10s));

@@ -51,17 +51,25 @@ ScanOutcome DiscoveryNode::handle(const msg::EscScan& scan) {
 
 void DiscoveryNode::resume_from_wire() {
   resumed_ = true;
-  // The statuses (small, latched, every service beats) say whether a model runs: on a fresh
-  // stack none does and the wait ends after resume_wait; after a restart the model (large: its
-  // URDF) can take longer to arrive than the statuses on a loaded machine, so the wait goes on
-  // for it (up to 5 x resume_wait).
+  // The other services' statuses (small, latched, every service beats) say whether a model
+  // runs: on a fresh stack none does and the wait ends after resume_wait. After a restart the
+  // model (large: its URDF) can take longer to arrive than the statuses, and on a loaded
+  // machine the other processes' writers can take longer than resume_wait to match at all:
+  // the wait goes on while nobody else was heard (up to 3 x resume_wait) and while a model
+  // runs that has not arrived (up to 5 x resume_wait).
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
+  bool heard_others = false;
   bool a_model_runs = false;
   std::optional<msg::RobotModel> model;
   while (!model) {
-    while (auto s = statuses_->take()) a_model_runs = a_model_runs || s->model_version() > 0;
-    if (Clock::now() - start >= resume_wait_ * (a_model_runs ? 5 : 1)) break;
+    while (auto s = statuses_->take()) {
+      if (s->service() == "discovery") continue;  // our own
+      heard_others = true;
+      a_model_runs = a_model_runs || s->model_version() > 0;
+    }
+    const int bound = a_model_runs ? 5 : heard_others ? 1 : 3;
+    if (Clock::now() - start >= bound * resume_wait_) break;
     model = models_.wait(std::chrono::milliseconds(20));
   }
   statuses_.reset();
