@@ -46,8 +46,10 @@ namespace {
 constexpr double kHoldBaseTolerance = 0.02;   // [m]
 constexpr double kHoldJointTolerance = 0.05;  // [rad]
 /// Heartbeats come every 200 ms: a service whose statuses this harness heard with a gap this
-/// long before the safety service called it silent really went quiet on the wire (starved).
-constexpr double kStarvedGap = 0.8;  // [s]
+/// long (2.5 periods) before the safety service called it silent was starved on the wire; the
+/// safety service's own starvation makes up the rest of its 1 s bound. A safety service that
+/// misjudges a service beating on time sees no such gap here (0.2 s).
+constexpr double kStarvedGap = 0.5;  // [s]
 /// After a stop is seen, the robot has this long to come to rest before the hold is watched.
 constexpr auto kHoldSettle = 500ms;
 /// Without a kill of a watched service, no stop may come this long after the services are back
@@ -681,6 +683,11 @@ struct Chaos::Impl {
   void hold_and_reset(RoundReport& r, Clock::time_point stopped_since, Clock::time_point t0) {
     auto fail = [&](const std::string& text) { r.failures.push_back(text); };
     std::this_thread::sleep_until(stopped_since + kHoldSettle);
+    // The reference is what the robot says now: after a robot restart the last samples heard
+    // can still be the killed simulator's (bounded wait for fresh ones; judged below).
+    const auto fresh_after = Clock::now();
+    wait_until(fresh_after + 5s,
+               [&] { return truth_received > fresh_after && joints_received > fresh_after; });
     const auto hold_start = Clock::now();
     const auto reference = pose_now();
     auto watch = [&] {

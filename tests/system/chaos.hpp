@@ -50,7 +50,7 @@ struct RoundReport {
   bool stopped = false;                           ///< a safety stop happened in the round
   std::vector<std::string> causes;                ///< the stop's causes
   /// Stops naming a service nobody killed whose heartbeats this harness also heard go quiet
-  /// (>= 0.8 s): the machine starved it; the stop was right (a false stop is a failure).
+  /// (>= 0.5 s): the machine starved it; the stop was right (a false stop is a failure).
   std::vector<std::string> starved;
   double held_base_m = 0.0;     ///< largest base motion while stopped [m]
   double held_joint_rad = 0.0;  ///< largest joint motion while stopped [rad]
