@@ -70,7 +70,8 @@ TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "discovery_test"});
   concert::dds::Reader<msg::ServiceStatus> status(participant, concert::dds::topics::status);
   std::ostringstream log;
-  dds::DiscoveryNode node(participant, DiscoveryService(topology::Discovery(catalog)), log);
+  // Alone on the wire: no model to resume from (listened for 0.2 s).
+  dds::DiscoveryNode node(participant, DiscoveryService(topology::Discovery(catalog)), log, 200ms);
   concert::dds::Writer<msg::EscScan> scans(participant, concert::dds::topics::esc_scan);
   concert::dds::Reader<msg::ModuleTree> trees(participant, concert::dds::topics::module_tree);
   ASSERT_TRUE(scans.wait_for_readers(1, 10s));
@@ -138,6 +139,32 @@ TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
   EXPECT_NE(ready->message().find("1 unknown; 1 warning: slave 12: blank module identity"),
             std::string::npos)
       << ready->message();
+}
+
+TEST(DiscoveryNode, ARestartedNodeContinuesAfterTheTreeTheRunningModelCameFrom) {
+  const auto catalog = topology::EscCatalog::load(kPublicDb);
+  const auto assembly = simbus::load_assembly(kExamples + "/concert_paper_robot.yaml");
+  concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "discovery_test"});
+  // What modelgen keeps on the wire: model version 4, generated from tree version 6.
+  concert::dds::Writer<msg::RobotModel> models(participant, concert::dds::topics::robot_model);
+  msg::RobotModel model;
+  model.version(4);
+  model.tree_version(6);
+  ASSERT_TRUE(models.write(model));
+  std::ostringstream log;
+  dds::DiscoveryNode node(participant, DiscoveryService(topology::Discovery(catalog)), log);
+  concert::dds::Writer<msg::EscScan> scans(participant, concert::dds::topics::esc_scan);
+  concert::dds::Reader<msg::ModuleTree> trees(participant, concert::dds::topics::module_tree);
+  ASSERT_TRUE(scans.wait_for_readers(1, 10s));
+  ASSERT_TRUE(scans.write(topology::dds::to_msg(simbus::simulate_scan(assembly, catalog), 1, 0, "test")));
+  int handled = 0;
+  for (int i = 0; i < 50 && handled == 0; ++i) handled = node.spin_once(200ms);
+  ASSERT_EQ(handled, 1);
+  const auto tree = trees.wait(10s);
+  ASSERT_TRUE(tree);
+  EXPECT_EQ(tree->version(), 7u);
+  EXPECT_NE(log.str().find("model version 4 was generated from tree version 6"), std::string::npos)
+      << log.str();
 }
 
 TEST(ServiceParams, ShippedConfigListsEveryParameterWithItsDefault) {

@@ -9,6 +9,21 @@ namespace {
 
 using Kind = ScanOutcome::Kind;
 
+TEST(DiscoveryService, ARestartedServiceNumbersItsTreesAfterTheVersionOnTheWire) {
+  DiscoveryService service(topology::Discovery(simbus::synthetic_catalog()));
+  service.continue_after(7);
+  EXPECT_EQ(service.version(), 0u);  // no tree yet
+  const auto one = simbus::testing::make_scan({{0b0011, simbus::testing::kJoint}, {0b0001, simbus::testing::kTool}});
+  ScanOutcome outcome = service.on_scan(one, 1);
+  EXPECT_EQ(outcome.kind, Kind::kPublished);
+  EXPECT_EQ(outcome.version, 8u);
+  EXPECT_EQ(service.on_scan(one, 2).kind, Kind::kUnchanged);
+  // Learning an older version later changes nothing.
+  service.continue_after(3);
+  const auto two = simbus::testing::make_scan({{0b0011, simbus::testing::kJoint}, {0b0001, simbus::testing::kWheel}});
+  EXPECT_EQ(service.on_scan(two, 3).version, 9u);
+}
+
 TEST(DiscoveryService, VersionsGoodTreesAndKeepsThemOnFaultyScans) {
   DiscoveryService service(topology::Discovery(simbus::synthetic_catalog()));
   EXPECT_EQ(service.version(), 0u);

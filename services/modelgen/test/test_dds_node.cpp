@@ -46,7 +46,8 @@ TEST(ModelgenNode, PublishesVersionedModelsOverDds) {
   concert::dds::Participant node_participant({.name = "modelgen_under_test"});
   concert::dds::Participant test_participant({.name = "modelgen_test"});
   std::ostringstream log;
-  modelgen::dds::ModelgenNode node(node_participant, service, log);
+  // Alone on the wire: no model to resume from (listened for 0.2 s).
+  modelgen::dds::ModelgenNode node(node_participant, service, log, 200ms);
   concert::dds::Writer<msg::ModuleTree> trees(test_participant, concert::dds::topics::module_tree);
   concert::dds::Writer<msg::ModelCustomisation> requests(test_participant, concert::dds::topics::customisation);
   concert::dds::Reader<msg::RobotModel> models(test_participant, concert::dds::topics::robot_model);

@@ -286,6 +286,42 @@ TEST_F(PlannerNodeTest, ExecutionGoesThroughTheRobotsTrajectoryCommand) {
   EXPECT_NE(aborted->reason().find("aborted by the robot: safety stop (estop: front left)"),
             std::string::npos)
       << aborted->reason();
+
+  // Other clients' requests queued behind one whose execution fails still run and get their
+  // answers (the whole queue was dropped with the failed one: those requests were never
+  // answered). 26 planned means 25 is queued: one planning thread, first in first out.
+  requests_->write(request(24, 6, 2.3, true));
+  requests_->write(request(25, 6, 2.2, true));
+  requests_->write(request(26, 6, 2.3, true));
+  const auto first = commands.wait(20s);
+  ASSERT_TRUE(first.has_value());
+  bool queued = false;
+  for (const auto until = std::chrono::steady_clock::now() + 20s;
+       !queued && std::chrono::steady_clock::now() < until;) {
+    const auto r = results_->wait(100ms);
+    queued = r && r->request_id() == 26 && r->state() == msg::PLAN_PLANNED;
+  }
+  ASSERT_TRUE(queued) << "request 26 was not planned while 24 executed";
+  msg::TrajectoryStatus st;
+  st.request_id(first->request_id());
+  st.model_version(6);
+  st.state(msg::TRAJECTORY_ABORTED);
+  st.reason("safety stop (liveliness: robot@rt restarted)");
+  robot_status.write(st);
+  const auto failed = wait_final(*results_, 24);
+  ASSERT_TRUE(failed.has_value());
+  EXPECT_EQ(failed->state(), msg::PLAN_FAILED);
+  for (const uint32_t id : {25u, 26u}) {
+    const auto next = commands.wait(20s);
+    ASSERT_TRUE(next.has_value()) << "request " << id << " was dropped with 24";
+    st.request_id(next->request_id());
+    st.state(msg::TRAJECTORY_SUCCEEDED);
+    st.reason("");
+    robot_status.write(st);
+    const auto answered = wait_final(*results_, id);
+    ASSERT_TRUE(answered.has_value()) << id;
+    EXPECT_EQ(answered->state(), msg::PLAN_SUCCEEDED) << answered->reason();
+  }
 }
 
 TEST_F(PlannerNodeTest, AnObstacleOnTheWorldTopicChangesThePlan) {

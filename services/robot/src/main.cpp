@@ -2,6 +2,7 @@
 //   concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE]
 //                 [--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK]
 //                 [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...] [--params FILE]
+//                 [--keep-swaps]
 // --params: YAML with sections robot, sim, loop, node (config/robot.yaml); flags override it.
 // --assembly and --world are the initial robot and world; later ones come as SimCommands over
 // DDS (`concert sim swap FILE`, `concert sim world FILE`, from any host), and the world it
@@ -40,6 +41,7 @@ struct Options {
   std::string urdf;
   std::vector<std::filesystem::path> module_dbs;
   std::string world;
+  bool keep_swaps{false};
   bool fast{false};
   double duration{0.0};
   std::string ee_frame;
@@ -112,6 +114,9 @@ void add_options(CLI::App& app, Options& o) {
       ->type_name("DIR");
   app.add_option("--world", o.world, "the simulated world (walls, obstacles; watched)")
       ->type_name("FILE");
+  app.add_flag("--keep-swaps", o.keep_swaps,
+               "write each accepted hot swap and world over the --assembly and --world files, so "
+               "that a restarted simulator mounts the same modules in the same world");
   app.add_option("--backend", o.backend, "hardware backend")
       ->type_name("sim|ethercat")
       ->default_str("sim");
@@ -156,6 +161,9 @@ void check(Options& o) {
   }
   if (o.assembly.empty() == o.urdf.empty()) {
     throw concert::cli::UsageError("give exactly one of --assembly FILE or --urdf FILE");
+  }
+  if (o.keep_swaps && (o.assembly.empty() || o.world.empty())) {
+    throw concert::cli::UsageError("--keep-swaps writes over the --assembly and --world files: give both");
   }
   if (o.module_dbs.empty()) {
     o.module_dbs.emplace_back(CONCERT_DEFAULT_MODULE_DB);
@@ -238,7 +246,9 @@ int run(const Options& options) {
           if (options.standalone) {
             node.apply_model(mounted.urdf, core.model_version() + 1, options.ee_frame);
           }
-        });
+        },
+        options.keep_swaps ? robot::dds::SimNode::Keep{options.assembly, options.world}
+                           : robot::dds::SimNode::Keep{});
     robot::Loop loop(loop_params, [&] { core.cycle(); });
     g_loop = &loop;
     concert::cli::on_stop_signals(on_signal);

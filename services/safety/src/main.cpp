@@ -1,7 +1,7 @@
 // concert_safety: the safety layer. Watches the e-stop inputs, the liveliness of the robot and
 // task services and the joint limits; publishes concert/safety/state (STOPPED, latched until
 // every input is released and a SafetyReset arrives).
-//   concert_safety [--params FILE]
+//   concert_safety [--params FILE] [--state FILE]
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
 #include <atomic>
 #include <iostream>
@@ -15,14 +15,14 @@
 
 namespace {
 
-int run(const std::string& params_file) {
+int run(const std::string& params_file, const std::string& state_file) {
   using namespace concert;
   safety::Params params;
   if (!params_file.empty()) params = safety::load_params(params_file);
   const std::atomic<bool>& stop = concert::cli::stop_on_signals();
   safety::dds::use_interprocess_delivery_only();
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "safety"});
-  safety::dds::SafetyNode node(participant, params, std::cerr);
+  safety::dds::SafetyNode node(participant, params, std::cerr, state_file);
   std::string watched = params.robot_service;
   for (const auto& s : params.task_services) watched += ", " + s;
   std::cerr << "concert_safety: domain " << participant.domain_id() << ", watching " << watched
@@ -39,9 +39,15 @@ int main(int argc, char** argv) {
       "The safety layer: e-stop inputs, liveliness of the services, joint limits.", std::cout,
       std::cerr);
   std::string params;
+  std::string state;
   cli.app()
       .add_option("--params", params, "parameters file (config/safety.yaml lists every key)")
       ->type_name("FILE");
-  cli.on_run(cli.app(), [&params] { return run(params); });
+  cli.app()
+      .add_option("--state", state,
+                  "keep the latched state (stop, causes, e-stop inputs, watched services) in "
+                  "FILE: restored at start, rewritten on every change")
+      ->type_name("FILE");
+  cli.on_run(cli.app(), [&params, &state] { return run(params, state); });
   return cli.run(argc, argv);
 }

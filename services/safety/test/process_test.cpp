@@ -4,6 +4,7 @@
 #include "process.hpp"
 
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -109,6 +110,89 @@ TEST(SafetyProcess, EStopResetAndLivelinessOverDds) {
   EXPECT_NE(err.find("safety: STOPPED: liveliness: drill@manip-pc silent"), std::string::npos)
       << err;
   std::filesystem::remove(params);
+}
+
+TEST(SafetyProcess, KilledHardItComesBackWithItsLatchedStop) {
+  const auto state = temp_file("safety_state", "");
+  std::filesystem::remove(state);
+  Participant p({.name = "safety_process_test"});
+  Writer<msg::EStopInput> inputs(p, topics::estop);
+  auto stopped_by_wireless = [](const msg::SafetyState& s) {
+    return s.mode() == msg::SAFETY_STOPPED && s.causes().size() == 1 &&
+           s.causes()[0] == "estop: wireless engaged (operator)";
+  };
+  {
+    testing::Process safety({SAFETY_BINARY, "--state", state.string()});
+    Reader<msg::SafetyState> states(p, topics::safety_state);
+    ASSERT_TRUE(wait_state(
+        states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 20s))
+        << safety.err();
+    ASSERT_TRUE(inputs.wait_for_readers(1, 10s));
+    msg::EStopInput wireless;
+    wireless.source(msg::ESTOP_WIRELESS);
+    wireless.engaged(true);
+    wireless.reason("operator");
+    ASSERT_TRUE(inputs.write(wireless));
+    ASSERT_TRUE(wait_state(states, stopped_by_wireless, 10s)) << safety.err();
+    ASSERT_EQ(::kill(safety.pid(), SIGKILL), 0);
+    ASSERT_TRUE(safety.wait(10s).has_value());
+  }
+  // The test writes the input no more, yet the restarted service still holds the stop and the
+  // input engaged. The operator's writers are a fresh participant's: this one still counts the
+  // killed process' readers as matched until their lease ends (5 s), and a command written to
+  // them only is lost.
+  testing::Process again({SAFETY_BINARY, "--state", state.string()});
+  {
+    Participant operator_panel({.name = "safety_process_test_panel"});
+    Writer<msg::EStopInput> panel_inputs(operator_panel, topics::estop);
+    Writer<msg::SafetyReset> panel_resets(operator_panel, topics::safety_reset);
+    Reader<msg::SafetyState> states(operator_panel, topics::safety_state);
+    ASSERT_TRUE(wait_state(states, stopped_by_wireless, 20s)) << again.err();
+    ASSERT_TRUE(panel_resets.wait_for_readers(1, 10s));
+    ASSERT_TRUE(panel_inputs.wait_for_readers(1, 10s));
+    msg::SafetyReset reset;
+    reset.request_id(1);
+    reset.source("process test");
+    ASSERT_TRUE(panel_resets.write(reset));
+    EXPECT_FALSE(wait_state(
+        states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 1s));
+    msg::EStopInput released;
+    released.source(msg::ESTOP_WIRELESS);
+    released.engaged(false);
+    ASSERT_TRUE(panel_inputs.write(released));
+    reset.request_id(2);
+    std::this_thread::sleep_for(200ms);
+    ASSERT_TRUE(panel_resets.write(reset));
+    ASSERT_TRUE(wait_state(
+        states, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 10s))
+        << again.err();
+  }
+  EXPECT_EQ(again.stop(15s), 0);
+  EXPECT_NE(again.err().find("safety: restored from " + state.string() +
+                             ": STOPPED: estop: wireless engaged (operator)"),
+            std::string::npos)
+      << again.err();
+  EXPECT_NE(again.err().find("refused: e-stop input(s) still engaged: wireless"), std::string::npos)
+      << again.err();
+
+  // A state file that cannot be read: stopped, naming it, until an operator reset.
+  std::ofstream(state, std::ios::trunc) << "mode: [broken\n";
+  testing::Process broken({SAFETY_BINARY, "--state", state.string()});
+  {
+    Participant fresh({.name = "safety_process_test_fresh"});
+    Reader<msg::SafetyState> states(fresh, topics::safety_state);
+    EXPECT_TRUE(wait_state(
+        states,
+        [&](const auto& s) {
+          return s.mode() == msg::SAFETY_STOPPED && s.causes().size() == 1 &&
+                 s.causes()[0].find("safety: the latched state could not be read back: " +
+                                    state.string()) == 0;
+        },
+        20s))
+        << broken.err();
+  }
+  EXPECT_EQ(broken.stop(15s), 0);
+  std::filesystem::remove(state);
 }
 
 /// Runs `concert safety <args>` in this process; returns (code, stdout + stderr).

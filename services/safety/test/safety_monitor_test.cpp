@@ -203,6 +203,146 @@ TEST(SafetyMonitor, SilentRobotBlocksResetSilentTaskIsForgottenByReset) {
   EXPECT_TRUE(contains(m.status().causes, "liveliness: nav@navpc silent"));
 }
 
+TEST(SafetyMonitor, AServiceRestartedWithinTheBoundStopsNamingIt) {
+  // A killed planner that `concert up` restarts within the liveliness bound is never silent
+  // long enough: a heartbeat from another process names the restart.
+  SafetyMonitor m(with_liveliness_timeout(1000ms), kT0);
+  m.on_heartbeat("planner", "manip", false, kT0, "process-1");
+  m.on_heartbeat("planner", "manip", false, kT0 + 200ms, "process-1");
+  m.on_heartbeat("robot", "rt", false, kT0 + 200ms, "robot-1");
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+  m.on_heartbeat("planner", "manip", false, kT0 + 700ms, "process-2");
+  m.check_liveliness(kT0 + 800ms);
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  ASSERT_EQ(m.status().causes.size(), 1u);
+  EXPECT_EQ(m.status().causes[0],
+            "liveliness: planner@manip restarted (its process died without stopping; a new one "
+            "took its place)");
+  // The new process is watched; a reset lets the robot go again.
+  m.on_heartbeat("robot", "rt", false, kT0 + 900ms, "robot-1");
+  EXPECT_TRUE(m.reset("op", kT0 + 900ms).accepted);
+  m.on_heartbeat("planner", "manip", false, kT0 + 1000ms, "process-2");
+  m.check_liveliness(kT0 + 1100ms);
+  EXPECT_EQ(m.status().mode, Mode::kRunning);
+
+  // Already stopped for its silence: the restart adds no second cause.
+  m.on_heartbeat("robot", "rt", false, kT0 + 2500ms, "robot-1");
+  m.check_liveliness(kT0 + 2500ms);
+  ASSERT_EQ(m.status().causes.size(), 1u);
+  EXPECT_TRUE(contains(m.status().causes, "planner@manip silent"));
+  m.on_heartbeat("planner", "manip", false, kT0 + 2600ms, "process-3");
+  EXPECT_EQ(m.status().causes.size(), 1u);
+
+  // A clean stop, then a new process: no fault. Unknown processes ("") are never a restart.
+  SafetyMonitor clean(with_liveliness_timeout(1000ms), kT0);
+  clean.on_heartbeat("drill", "manip", false, kT0, "a");
+  clean.on_heartbeat("drill", "manip", true, kT0 + 100ms, "a");
+  clean.on_heartbeat("drill", "manip", false, kT0 + 300ms, "b");
+  clean.on_heartbeat("nav", "nav", false, kT0, "");
+  clean.on_heartbeat("nav", "nav", false, kT0 + 100ms, "c");
+  EXPECT_EQ(clean.status().mode, Mode::kRunning);
+}
+
+TEST(SafetyMonitor, ARestoredMonitorKeepsTheStopTheInputsAndTheWatchedServices) {
+  SafetyMonitor before(with_liveliness_timeout(1000ms), kT0);
+  before.on_heartbeat("robot", "rt", false, kT0, "robot-1");
+  before.on_heartbeat("planner", "manip", false, kT0, "planner-1");
+  before.on_heartbeat("drill", "manip", false, kT0, "drill-1");
+  before.set_estop(EStopSource::kWireless, true, "operator");
+  const uint64_t revision = before.latched_revision();
+  before.on_heartbeat("planner", "manip", false, kT0 + 100ms, "planner-1");  // a beat: no change
+  EXPECT_EQ(before.latched_revision(), revision);
+  const LatchedState state = before.latched();
+  EXPECT_EQ(state.mode, Mode::kStopped);
+  EXPECT_EQ(state.engaged, std::vector<EStopSource>{EStopSource::kWireless});
+  EXPECT_EQ(state.watched.size(), 3u);
+  EXPECT_EQ(state.watched.at("planner@manip"), "planner-1");
+
+  // Through the file format and back.
+  const LatchedState read = parse_latched_state(to_yaml(state), "state.yaml");
+  EXPECT_EQ(read, state) << to_yaml(state);
+
+  const TimePoint t1 = kT0 + 60s;  // the restarted safety service
+  SafetyMonitor after(with_liveliness_timeout(1000ms), t1);
+  after.restore(read, t1);
+  EXPECT_EQ(after.status().mode, Mode::kStopped);
+  EXPECT_EQ(after.status().causes, before.status().causes);
+  EXPECT_EQ(after.latched(), state);
+  // The input is still engaged: no reset.
+  EXPECT_FALSE(after.reset("op", t1).accepted);
+  after.set_estop(EStopSource::kWireless, false, "");
+  // The same robot and planner processes beat on; the drill came back as a new process while
+  // the safety service was down: a restart; nav was never watched.
+  after.on_heartbeat("robot", "rt", false, t1 + 200ms, "robot-1");
+  after.on_heartbeat("planner", "manip", false, t1 + 200ms, "planner-1");
+  after.on_heartbeat("drill", "manip", false, t1 + 200ms, "drill-2");
+  EXPECT_TRUE(contains(after.status().causes, "drill@manip restarted"));
+  EXPECT_FALSE(contains(after.status().causes, "planner@manip"));
+  EXPECT_TRUE(after.reset("op", t1 + 300ms).accepted);
+  EXPECT_EQ(after.status().mode, Mode::kRunning);
+  // A watched service that never beats again after the restore is silent the bound after the
+  // first status heard (the restarted service's readers took 1.5 s to match here).
+  SafetyMonitor gone(with_liveliness_timeout(1000ms), t1);
+  gone.restore(read, t1);
+  gone.set_estop(EStopSource::kWireless, false, "");
+  gone.check_liveliness(t1 + 1500ms);
+  EXPECT_FALSE(contains(gone.status().causes, "silent"));
+  gone.on_heartbeat("safety", "rt", false, t1 + 1500ms, "self");  // its own status: not the wire
+  gone.on_heartbeat("robot", "rt", false, t1 + 1500ms, "robot-1");
+  gone.on_heartbeat("drill", "manip", false, t1 + 1600ms, "drill-1");
+  gone.check_liveliness(t1 + 2400ms);
+  EXPECT_FALSE(contains(gone.status().causes, "silent"));
+  gone.on_heartbeat("robot", "rt", false, t1 + 2500ms, "robot-1");
+  gone.on_heartbeat("drill", "manip", false, t1 + 2500ms, "drill-1");
+  gone.check_liveliness(t1 + 2600ms);
+  EXPECT_TRUE(contains(gone.status().causes, "planner@manip silent"));
+  EXPECT_FALSE(contains(gone.status().causes, "drill@manip"));
+  // Every watched service died while the safety service was down: silent all the same.
+  SafetyMonitor all_gone(with_liveliness_timeout(1000ms), t1);
+  all_gone.restore(read, t1);
+  all_gone.check_liveliness(t1 + 4900ms);
+  EXPECT_EQ(all_gone.status().causes.size(), 1u);  // the wireless input only
+  all_gone.check_liveliness(t1 + 5000ms);
+  all_gone.check_liveliness(t1 + 5100ms);
+  EXPECT_TRUE(contains(all_gone.status().causes, "robot@rt silent"));
+  EXPECT_TRUE(contains(all_gone.status().causes, "planner@manip silent"));
+}
+
+TEST(LatchedState, RunningEmptyAndErrorsNamingFileAndKey) {
+  const LatchedState empty;
+  EXPECT_EQ(parse_latched_state(to_yaml(empty), "s.yaml"), empty);
+  auto error_of = [](const std::string& yaml) {
+    try {
+      (void)parse_latched_state(yaml, "s.yaml");
+    } catch (const config::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(error_of("mode: HALTED"),
+            "s.yaml: mode: expected one of RUNNING, STOPPED, got 'HALTED' (line 1)");
+  EXPECT_EQ(error_of("mode: STOPPED\ncauses: [a]\ncause_keys: []\n"),
+            "s.yaml: cause_keys: expected one per cause (1 causes, 0 keys) (line 3)");
+  EXPECT_EQ(error_of("mode: STOPPED\n"), "s.yaml: causes: a stop needs its causes");
+  EXPECT_EQ(error_of("engaged: [nowhere]"), "s.yaml: engaged: unknown e-stop input 'nowhere' (line 1)");
+  EXPECT_EQ(error_of("watched: {planner: x}"), "s.yaml: watched: 'planner' is not service@host (line 1)");
+  EXPECT_NE(error_of("bogus: 1").find("s.yaml: bogus: unknown key"), std::string::npos);
+
+  // Written through a temporary file and a rename.
+  const std::string file = std::filesystem::temp_directory_path() /
+                           ("safety_state_" + std::to_string(::getpid()) + ".yaml");
+  LatchedState s;
+  s.mode = Mode::kStopped;
+  s.causes = {"liveliness: planner@manip silent for 1.04 s (bound 1.00 s)"};
+  s.cause_keys = {"silent:planner@manip"};
+  s.watched = {{"robot@rt", "01.0f.aa"}};
+  save_latched_state(file, s);
+  EXPECT_EQ(load_latched_state(file), s);
+  EXPECT_FALSE(std::filesystem::exists(file + ".tmp"));
+  std::filesystem::remove(file);
+  EXPECT_THROW(save_latched_state("/nonexistent/dir/state.yaml", s), std::runtime_error);
+}
+
 TEST(SafetyMonitor, RequiredRobotMustBeHeardAfterStart) {
   Params p = with_liveliness_timeout(1s);
   p.require_robot = true;

@@ -30,6 +30,13 @@ namespace concert::tool {
 
 namespace fs = std::filesystem;
 
+std::chrono::milliseconds restart_delay(const BackoffParams& backoff,
+                                        std::chrono::steady_clock::duration ran, int& failures) {
+  failures = ran >= backoff.stable ? 1 : failures + 1;
+  const auto delay = backoff.first * (int64_t{1} << std::min(failures - 1, 20));
+  return std::min(delay, backoff.max);
+}
+
 Supervisor::Supervisor(std::vector<ServiceSpec> services, fs::path log_dir, std::ostream& log, BackoffParams backoff)
     : log_dir_(std::move(log_dir)), log_(log), backoff_(backoff) {
   for (auto& s : services) children_.push_back(Child{std::move(s)});
@@ -82,10 +89,7 @@ void Supervisor::poll() {
       const std::string how = WIFEXITED(status) ? "exited with code " + std::to_string(WEXITSTATUS(status))
                                                 : "was killed by signal " + std::to_string(WTERMSIG(status));
       c.pid = -1;
-      const bool stable = Clock::now() - c.started > backoff_.stable;
-      c.failures_in_a_row = stable ? 0 : c.failures_in_a_row + 1;
-      auto delay = backoff_.first * (1 << std::min(c.failures_in_a_row, 10));
-      if (delay > backoff_.max) delay = backoff_.max;
+      const auto delay = restart_delay(backoff_, Clock::now() - c.started, c.failures_in_a_row);
       c.restart_at = Clock::now() + delay;
       ++c.restarts;
       std::ostringstream msg;
@@ -246,9 +250,15 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
 
   const fs::path dir = run_dir(domain);
   fs::create_directories(dir / "logs");
+  // The simulator's assembly and world: the robot service writes accepted hot swaps and worlds
+  // back over these copies (--keep-swaps), so that a robot service restarted after a crash
+  // mounts what was mounted, in the world it was in. Without a world: an empty one.
   install_file(assembly, dir / "assembly.yaml");
-  if (world) install_file(*world, dir / "world.yaml");
-  if (!ifc_world.empty()) std::ofstream(dir / "world.yaml") << ifc_world;
+  if (world) {
+    install_file(*world, dir / "world.yaml");
+  } else {
+    std::ofstream(dir / "world.yaml", std::ios::trunc) << ifc_world;
+  }
   // The simulated robot's start pose (robot.yaml's sim section; the rest stays the default).
   {
     std::ofstream params(dir / "robot_params.yaml");
@@ -266,9 +276,10 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
     std::vector<std::string> args;
     bool required;
   };
-  std::vector<std::string> robot_args = {"--assembly", (dir / "assembly.yaml").string(), "--params",
-                                         (dir / "robot_params.yaml").string()};
-  if (world || !ifc_world.empty()) robot_args.insert(robot_args.end(), {"--world", (dir / "world.yaml").string()});
+  std::vector<std::string> robot_args = {"--assembly", (dir / "assembly.yaml").string(),
+                                         "--world",    (dir / "world.yaml").string(),
+                                         "--params",   (dir / "robot_params.yaml").string(),
+                                         "--keep-swaps"};
   robot_args.insert(robot_args.end(), db_args.begin(), db_args.end());
   // nav: the building's map when there is one, localised at the start pose.
   std::vector<std::string> nav_args;
@@ -280,8 +291,13 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
     nav_args = {"--ifc", fs::absolute(o.ifc).string(), "--storey", o.storey, "--initial-pose", x.str(), y.str(),
                 yaw.str()};
   }
+  // The safety service keeps its latched state (a stop, its causes, the inputs, the services it
+  // watches) in the run folder, so a safety service killed and restarted holds the same stop;
+  // a new `concert up` starts from none.
+  const fs::path safety_state = dir / "safety_state.yaml";
+  fs::remove(safety_state);
   const std::vector<Plan> plan = {
-      {"safety", "concert_safety", {}, false},
+      {"safety", "concert_safety", {"--state", safety_state.string()}, false},
       {"discovery", "concert_discovery", db_args, true},
       {"modelgen", "concert_modelgen", db_args, true},
       {"robot", "concert_robot", robot_args, true},

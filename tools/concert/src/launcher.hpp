@@ -20,11 +20,22 @@ struct ServiceSpec {
   std::vector<std::string> argv;  ///< argv[0] is the executable's path
 };
 
+/// Restart back-off: a service that dies is restarted after `first`, doubling while it keeps
+/// dying within `stable` of its start (a crash loop), at most `max`; a run of `stable` or longer
+/// resets it. `stable` is short: a service that was killed after it ran (chaos: kill -> ready
+/// again aimed at <= 2 s) is restarted after `first`, not after a delay its earlier deaths
+/// grew.
 struct BackoffParams {
   std::chrono::milliseconds first{500};  ///< delay before the first restart
   std::chrono::milliseconds max{10'000};
-  std::chrono::seconds stable{30};       ///< a run this long resets the back-off
+  std::chrono::seconds stable{5};        ///< a run this long resets the back-off
 };
+
+/// The delay before restarting a service that died after running for `ran`; `failures` counts
+/// its deaths in a row (runs shorter than `stable`) and is updated: first, 2 x first, 4 x first,
+/// ... at most `max`, back to `first` after a run of `stable`.
+std::chrono::milliseconds restart_delay(const BackoffParams& backoff,
+                                        std::chrono::steady_clock::duration ran, int& failures);
 
 class Supervisor {
  public:

@@ -15,6 +15,7 @@
 #include <mutex>
 #include <optional>
 #include <regex>
+#include <sstream>
 #include <thread>
 
 #include "concert/dds/endpoint.hpp"
@@ -111,6 +112,15 @@ TEST_F(UpTest, WholeStackSwapRestartAndStop) {
   ASSERT_EQ(r.code, 0) << r.err;
   r = concert({"status", "--until-version", "2", "--timeout", "60"});
   ASSERT_EQ(r.code, 0) << r.out << r.err;
+  // The simulator keeps what it mounted for a restart (the robot service's --keep-swaps over
+  // the run folder's copy): the modules stay bolted on when the software dies.
+  const char* domain = std::getenv("CONCERT_DOMAIN_ID");
+  const fs::path kept = fs::path(run_) / (std::string("concert-d") + (domain ? domain : "0")) / "assembly.yaml";
+  std::ifstream kept_in(kept), sanding_in(CONCERT_SOURCE_DIR "/deploy/demo/sanding_robot.yaml");
+  std::stringstream kept_text, sanding_text;
+  kept_text << kept_in.rdbuf();
+  sanding_text << sanding_in.rdbuf();
+  EXPECT_EQ(kept_text.str(), sanding_text.str()) << kept;
 
   // A service that dies is restarted (with back-off) and the stack is whole again.
   std::smatch m;

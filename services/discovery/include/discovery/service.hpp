@@ -2,6 +2,7 @@
 // What the discovery service does with each scan, without any middleware: keep the last good
 // tree and its version; a faulty scan never replaces it.
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -31,6 +32,12 @@ class DiscoveryService {
   /// scan: the error is in the outcome.
   ScanOutcome on_scan(const topology::EscScan& scan, uint32_t scan_id);
 
+  /// A restarted service continues the versions of its previous incarnation: its next tree is
+  /// numbered after `version` (the newest the wire names: the tree the running model was
+  /// generated from), so tree versions never go back or repeat. The tree's own latched sample
+  /// died with the previous process, so a tree equal to it gets the next version too.
+  void continue_after(uint32_t version) { resumed_after_ = std::max(resumed_after_, version); }
+
   /// The last good tree, if any.
   const std::optional<topology::ModuleTree>& tree() const { return tree_; }
   /// Its version: 1 for the first tree, +1 for every different tree; 0 = none yet.
@@ -42,6 +49,7 @@ class DiscoveryService {
   topology::Discovery discovery_;
   std::optional<topology::ModuleTree> tree_;
   uint32_t version_ = 0;
+  uint32_t resumed_after_ = 0;
   uint32_t tree_scan_id_ = 0;
 };
 

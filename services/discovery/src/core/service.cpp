@@ -48,7 +48,7 @@ ScanOutcome DiscoveryService::on_scan(const topology::EscScan& scan, uint32_t sc
     return outcome;
   }
   tree_ = std::move(tree);
-  ++version_;
+  version_ = std::max(version_, resumed_after_) + 1;
   tree_scan_id_ = scan_id;
   outcome.kind = ScanOutcome::Kind::kPublished;
   outcome.version = version_;

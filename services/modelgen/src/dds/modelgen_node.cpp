@@ -33,16 +33,23 @@ void ModelgenNode::resume_from_wire() {
   // Status samples are latched per service and heartbeat every 200 ms: whatever runs on the
   // domain is heard within the wait. Our own earlier incarnation's status is not among them
   // (its writer died with it) unless it stopped cleanly, in which case it is as good a witness.
+  // On a loaded machine the other processes' writers can take longer than resume_wait to
+  // match: the wait goes on (up to 3 x resume_wait) while no service that runs models (not
+  // discovery, which reports none) was heard, else a restarted modelgen published the running
+  // model's content again as version 1.
   uint64_t version = 0;
   std::string hash;
   std::string who;
-  const auto deadline = std::chrono::steady_clock::now() + resume_wait_;
+  bool heard_others = false;
+  const auto start = std::chrono::steady_clock::now();
   while (true) {
+    const auto deadline = start + resume_wait_ * (heard_others ? 1 : 3);
     const auto now = std::chrono::steady_clock::now();
     if (now >= deadline) break;
     const auto s =
         statuses_.wait(std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now));
     if (!s) continue;
+    heard_others = heard_others || (s->service() != "modelgen" && s->service() != "discovery");
     if (s->model_version() > version && !s->model_hash().empty()) {
       version = s->model_version();
       hash = s->model_hash();

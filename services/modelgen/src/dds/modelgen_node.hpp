@@ -22,7 +22,8 @@ class ModelgenNode {
 
   /// Reads the status of the services on the domain for up to `resume_wait` and tells the
   /// service the newest model they run (version and hash): a restarted modelgen then gives
-  /// the running model its version again, and never reuses a version for other content. A
+  /// the running model its version again, and never reuses a version for other content. While
+  /// no other service that runs models was heard the wait goes on, up to 3 x `resume_wait`: a
   /// modelgen running alone simply waits that long once. Called by the first spin_once.
   void resume_from_wire();
 

@@ -400,8 +400,12 @@ void PlannerNode::execute_loop() {
     if (!ok) {
       r.failure(msg::PLAN_EXECUTION_ABORTED);
       r.reason("execution of goal " + std::to_string(r.goal_index()) + " aborted: " + error);
+      // The failed request's later goals go with it; other requests queued behind it still
+      // run, each to its own answer (dropped, they were never answered).
       std::lock_guard relock(mutex_);
-      executions_.clear();
+      std::erase_if(executions_, [&](const Execution& later) {
+        return later.result.request_id() == r.request_id();
+      });
     }
     publish(r);
   }

@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <stdexcept>
 
@@ -14,14 +16,42 @@ namespace concert::robot::dds {
 
 namespace cdds = concert::dds;
 
+namespace {
+
+/// Writes `text` over `path` through a temporary file and a rename, so a simulator started
+/// meanwhile reads the old content or the new, never half of it. "" when written, else why not.
+std::string write_over(const std::string& path, const std::string& text) {
+  if (path.empty()) return "";
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << text;
+    if (!out.flush()) return "cannot write " + tmp;
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  return ec ? "cannot rename " + tmp + " to " + path + ": " + ec.message() : "";
+}
+
+/// "; not kept in FILE: why" when writing back failed (the change itself stands).
+std::string kept(const std::string& path, const std::string& text) {
+  const std::string error = write_over(path, text);
+  if (error.empty()) return "";
+  std::cerr << "concert_robot: " << error << "\n";
+  return "; not kept for a restart: " + error;
+}
+
+}  // namespace
+
 SimNode::SimNode(cdds::Participant& participant, sim::SimHardware& sim,
                  const sim::AssemblyBuilder* builder, RobotNode& robot,
                  const world::World& initial_world, const std::string& world_source,
-                 std::function<void(const sim::SimulatedRobot&)> on_swap)
+                 std::function<void(const sim::SimulatedRobot&)> on_swap, Keep keep)
     : sim_(sim),
       builder_(builder),
       robot_(robot),
       on_swap_(std::move(on_swap)),
+      keep_(std::move(keep)),
       world_(participant, cdds::topics::world),
       reply_(participant, cdds::topics::sim_reply),
       truth_(participant, cdds::topics::sim_truth),
@@ -149,7 +179,7 @@ std::string SimNode::swap_assembly(const std::string& yaml, const std::string& n
     on_swap_(robot);
   }
   return "mounted: " + std::to_string(robot.scan.slaves.size()) + " EtherCAT slaves, " +
-         std::to_string(robot.tree.modules.size()) + " modules";
+         std::to_string(robot.tree.modules.size()) + " modules" + kept(keep_.assembly_file, yaml);
 }
 
 std::string SimNode::set_world(const std::string& yaml, const std::string& name) {
@@ -164,7 +194,7 @@ std::string SimNode::set_world(const std::string& yaml, const std::string& name)
   return "world version " + std::to_string(version) + ": " + std::to_string(w.walls.size()) +
          " walls, " + std::to_string(w.obstacles.size()) + " obstacles, " +
          std::to_string(w.marks.size()) + " marks, " + std::to_string(w.surfaces.size()) +
-         " surfaces";
+         " surfaces" + kept(keep_.world_file, yaml);
 }
 
 }  // namespace concert::robot::dds

@@ -23,12 +23,20 @@ namespace concert::robot::dds {
 
 class SimNode {
  public:
+  /// Where accepted swaps and worlds are written back (`concert_robot --keep-swaps`), so that
+  /// a restarted simulator mounts what was mounted and simulates the world it simulated: the
+  /// modules of a real robot stay bolted on when its software dies. Empty: not kept.
+  struct Keep {
+    std::string assembly_file;
+    std::string world_file;
+  };
+
   /// `builder` is null when the simulated robot is a fixed URDF (no assembly to swap).
   /// `on_swap` runs after each accepted swap (e.g. standalone mode applies the new model).
   /// Publishes `initial_world` (from `world_source`) as world version 1.
   SimNode(concert::dds::Participant& participant, sim::SimHardware& sim, const sim::AssemblyBuilder* builder,
           RobotNode& robot, const world::World& initial_world, const std::string& world_source,
-          std::function<void(const sim::SimulatedRobot&)> on_swap = {});
+          std::function<void(const sim::SimulatedRobot&)> on_swap = {}, Keep keep = {});
   ~SimNode();
   SimNode(const SimNode&) = delete;
   SimNode& operator=(const SimNode&) = delete;
@@ -50,6 +58,7 @@ class SimNode {
   const sim::AssemblyBuilder* builder_;
   RobotNode& robot_;
   std::function<void(const sim::SimulatedRobot&)> on_swap_;
+  Keep keep_;
   concert::dds::Writer<msg::World> world_;
   concert::dds::Writer<msg::SimCommandReply> reply_;
   concert::dds::Writer<msg::SimTruth> truth_;

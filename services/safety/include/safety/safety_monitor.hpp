@@ -18,24 +18,13 @@
 #include <vector>
 
 #include "concert/model/limits.hpp"
+#include "safety/latched_state.hpp"
 #include "safety/params.hpp"
 
 namespace concert::safety {
 
 using Clock = std::chrono::steady_clock;
 using TimePoint = Clock::time_point;
-
-/// The six e-stop inputs of the CONCERT base (paper section 3): four corner buttons, the
-/// wireless receiver, and a software stop. Same order as msg::EStopSource.
-enum class EStopSource {
-  kButtonFrontLeft,
-  kButtonFrontRight,
-  kButtonRearLeft,
-  kButtonRearRight,
-  kWireless,
-  kSoftware
-};
-inline constexpr std::size_t kEStopSourceCount = 6;
 
 /// "button front left", ..., "wireless", "software".
 std::string_view to_string(EStopSource source);
@@ -48,8 +37,6 @@ struct JointSample {
   std::vector<double> velocity;  ///< [rad/s]
   std::vector<double> effort;    ///< [N m]
 };
-
-enum class Mode { kRunning, kStopped };
 
 struct SafetyStatus {
   Mode mode = Mode::kRunning;
@@ -79,8 +66,12 @@ class SafetyMonitor {
   /// the service said it stops (SERVICE_STOPPED). Services other than the robot and the
   /// task services are ignored. A task service that stops cleanly is no longer watched; the
   /// robot service stopping is a stop cause (nothing holds the drives any more).
+  /// `incarnation` names the process that sent it (opaque; "" = unknown): a watched instance
+  /// heard from another process without having stopped cleanly was restarted after dying, and
+  /// that stops the robot naming it, however fast the restart was (a restart within the
+  /// liveliness bound is never silent long enough to be caught as silence).
   void on_heartbeat(const std::string& service, const std::string& host, bool clean_stop,
-                    TimePoint now);
+                    TimePoint now, const std::string& incarnation = {});
 
   /// Checks liveliness at `now`: a watched instance silent beyond the bound stops the robot,
   /// with a cause naming it. Silence counts only while the monitor checks: a check later than
@@ -109,6 +100,18 @@ class SafetyMonitor {
   /// acknowledges them gone; a new heartbeat watches them again) and clears the causes.
   ResetOutcome reset(const std::string& source, TimePoint now);
 
+  /// What a restart of the service must not lose (LatchedState).
+  LatchedState latched() const;
+  /// Increases every time latched() changes.
+  uint64_t latched_revision() const { return latched_revision_; }
+  /// Continues from `state` after a restart of the safety service: the same stop and causes,
+  /// the same inputs engaged, the same instances watched. Their silence counts from the first
+  /// watched service heard after the restore (the restarted service's readers match the other
+  /// processes' writers only some time after `now`), at the latest from 5 bounds after `now`;
+  /// each must then be heard within the bound, from the process it was heard from before
+  /// (another is a restart).
+  void restore(const LatchedState& state, TimePoint now);
+
   const SafetyStatus& status() const { return status_; }
   /// Increases every time status() changes.
   uint64_t revision() const { return revision_; }
@@ -124,6 +127,7 @@ class SafetyMonitor {
     std::string service;
     TimePoint last_seen;
     bool silent = false;
+    std::string incarnation;
   };
 
   bool is_watched(const std::string& service) const;
@@ -147,6 +151,9 @@ class SafetyMonitor {
   uint64_t revision_ = 0;
   std::optional<TimePoint> last_check_;
   uint64_t own_stalls_ = 0;
+  uint64_t latched_revision_ = 0;
+  bool restored_unheard_ = false;  // restored instances wait for the first watched status heard
+  TimePoint restored_at_{};
 };
 
 }  // namespace concert::safety

@@ -57,12 +57,14 @@ void SafetyMonitor::stop(const std::string& key, const std::string& text) {
   status_.mode = Mode::kStopped;
   status_.reset_required = true;
   ++revision_;
+  ++latched_revision_;
 }
 
 void SafetyMonitor::set_estop(EStopSource source, bool engaged, const std::string& reason) {
   const auto i = static_cast<std::size_t>(source);
   if (i >= kEStopSourceCount)
     throw std::invalid_argument("unknown e-stop source " + std::to_string(i));
+  if (engaged_[i] != engaged) ++latched_revision_;
   engaged_[i] = engaged;
   if (engaged) {
     std::string text = "estop: " + std::string(to_string(source)) + " engaged";
@@ -78,21 +80,42 @@ bool SafetyMonitor::is_watched(const std::string& service) const {
 }
 
 void SafetyMonitor::on_heartbeat(const std::string& service, const std::string& host,
-                                 bool clean_stop, TimePoint now) {
+                                 bool clean_stop, TimePoint now, const std::string& incarnation) {
   if (!is_watched(service)) return;
+  if (restored_unheard_) {
+    // The first watched service heard after a restore: the wire is heard from now on, and a
+    // restored instance silent for the bound from here is silent. (Not any status: our own
+    // reaches us before the other processes' writers have matched.)
+    restored_unheard_ = false;
+    for (auto& [who, instance] : instances_) instance.last_seen = std::max(instance.last_seen, now);
+  }
   const std::string who = service + "@" + host;
   const bool robot = service == params_.robot_service;
   if (clean_stop) {
-    instances_.erase(who);
+    if (instances_.erase(who) > 0) ++latched_revision_;
     if (robot) stop("stopped:" + who, "liveliness: " + who + " stopped (nothing holds the drives)");
     return;
   }
   if (robot) robot_heard_ = true;
-  auto [it, inserted] = instances_.try_emplace(who, Instance{service, now, false});
-  if (!inserted) {
-    it->second.last_seen = std::max(it->second.last_seen, now);
-    it->second.silent = false;
+  auto [it, inserted] = instances_.try_emplace(who, Instance{service, now, false, incarnation});
+  if (inserted) {
+    ++latched_revision_;
+    return;
   }
+  Instance& instance = it->second;
+  if (!incarnation.empty() && incarnation != instance.incarnation) {
+    // Another process: the one watched died without a goodbye. Already stopped for its silence,
+    // that cause names it; else this one does.
+    if (!instance.incarnation.empty() && !instance.silent) {
+      stop("restarted:" + who, "liveliness: " + who +
+                                   " restarted (its process died without stopping; a new one "
+                                   "took its place)");
+    }
+    instance.incarnation = incarnation;
+    ++latched_revision_;
+  }
+  instance.last_seen = std::max(instance.last_seen, now);
+  instance.silent = false;
 }
 
 void SafetyMonitor::check_liveliness(TimePoint now) {
@@ -107,6 +130,13 @@ void SafetyMonitor::check_liveliness(TimePoint now) {
     ++own_stalls_;
   }
   last_check_ = now;
+  if (restored_unheard_) {
+    // Nothing watched heard since the restore: silence means nothing yet, unless it lasts
+    // (every watched service died while the safety service was down).
+    if (now - restored_at_ < 5 * params_.liveliness_timeout) return;
+    restored_unheard_ = false;
+    for (auto& [who, instance] : instances_) instance.last_seen = now - params_.liveliness_timeout;
+  }
   for (auto& [who, instance] : instances_) {
     const auto silent_for = now - instance.last_seen;
     if (instance.silent || silent_for <= params_.liveliness_timeout) continue;
@@ -222,10 +252,46 @@ ResetOutcome SafetyMonitor::reset(const std::string& source, TimePoint now) {
   cause_keys_.clear();
   robot_start_cause_ = robot_heard_;
   ++revision_;
+  ++latched_revision_;
   std::string message =
       "reset by " + source + " accepted: " + std::to_string(cleared) + " cause(s) cleared";
   if (!forgotten.empty()) message += "; no longer watching silent " + forgotten;
   return {true, message};
+}
+
+LatchedState SafetyMonitor::latched() const {
+  LatchedState s;
+  s.mode = status_.mode;
+  s.causes = status_.causes;
+  s.cause_keys = cause_keys_;
+  for (std::size_t i = 0; i < kEStopSourceCount; ++i) {
+    if (engaged_[i]) s.engaged.push_back(static_cast<EStopSource>(i));
+  }
+  for (const auto& [who, instance] : instances_) s.watched[who] = instance.incarnation;
+  return s;
+}
+
+void SafetyMonitor::restore(const LatchedState& state, TimePoint now) {
+  if (state.causes.size() != state.cause_keys.size())
+    throw std::invalid_argument("a latched state needs one key per cause");
+  status_.mode = state.mode;
+  status_.reset_required = state.mode == Mode::kStopped;
+  status_.causes = state.causes;
+  cause_keys_ = state.cause_keys;
+  engaged_.fill(false);
+  for (const auto e : state.engaged) engaged_.at(static_cast<std::size_t>(e)) = true;
+  instances_.clear();
+  for (const auto& [who, incarnation] : state.watched) {
+    const std::string service = who.substr(0, who.find('@'));
+    if (!is_watched(service)) continue;
+    instances_[who] = Instance{service, now, false, incarnation};
+    if (service == params_.robot_service) robot_heard_ = true;
+  }
+  robot_start_cause_ = robot_heard_;
+  restored_unheard_ = !instances_.empty();
+  restored_at_ = now;
+  ++revision_;
+  ++latched_revision_;
 }
 
 std::vector<std::string> SafetyMonitor::engaged_inputs() const {

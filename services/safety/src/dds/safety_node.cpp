@@ -2,7 +2,9 @@
 
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 
+#include <filesystem>
 #include <optional>
+#include <sstream>
 #include <thread>
 
 #include "concert/common/clock.hpp"
@@ -28,31 +30,70 @@ void use_interprocess_delivery_only() {
   eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
 }
 
-SafetyNode::SafetyNode(concert::dds::Participant& participant, Params params, std::ostream& log)
+SafetyNode::SafetyNode(concert::dds::Participant& participant, Params params, std::ostream& log,
+                       std::string state_file)
     : monitor_(std::move(params), Clock::now()),
       log_(log),
+      state_file_(std::move(state_file)),
       state_writer_(participant, concert::dds::topics::safety_state),
       status_(participant, "safety"),
       estops_(participant, concert::dds::topics::estop,
               [this](const auto& s, const auto&) { on_estop(s); }),
       statuses_(participant, concert::dds::topics::status,
-                [this](const auto& s, const auto&) { on_status(s); }),
+                [this](const auto& s, const auto& info) {
+                  // The status writer's GUID names the process: a new one is a restart.
+                  std::ostringstream writer;
+                  writer << info.sample_identity.writer_guid();
+                  on_status(s, writer.str());
+                }),
       models_(participant, concert::dds::topics::robot_model,
               [this](const auto& s, const auto&) { on_model(s); }),
       joint_states_(participant, concert::dds::topics::joint_state,
                     [this](const auto& s, const auto&) { on_joint_state(s); }),
       resets_(participant, concert::dds::topics::safety_reset,
               [this](const auto& s, const auto&) { on_reset(s); }) {
+  std::string text;
   {
     std::lock_guard lock(mutex_);
+    restore_locked();
     publish_locked(true);
+    text = summary(monitor_.status());
   }
-  status_.report(msg::SERVICE_READY, 0, "RUNNING");
+  status_.report(msg::SERVICE_READY, 0, text);
+}
+
+void SafetyNode::restore_locked() {
+  if (state_file_.empty() || !std::filesystem::exists(state_file_)) return;
+  try {
+    const LatchedState state = load_latched_state(state_file_);
+    monitor_.restore(state, Clock::now());
+    log_ << "safety: restored from " << state_file_ << ": " << summary(monitor_.status())
+         << "; watching " << state.watched.size() << " service instance(s) again" << std::endl;
+  } catch (const std::exception& e) {
+    // What it held is unknown: stopped until an operator looks.
+    LatchedState unknown;
+    unknown.mode = Mode::kStopped;
+    unknown.causes = {std::string("safety: the latched state could not be read back: ") + e.what()};
+    unknown.cause_keys = {"state"};
+    monitor_.restore(unknown, Clock::now());
+    log_ << "safety: " << unknown.causes.front() << std::endl;
+  }
+}
+
+void SafetyNode::persist_locked() {
+  if (state_file_.empty() || monitor_.latched_revision() == persisted_revision_) return;
+  persisted_revision_ = monitor_.latched_revision();
+  try {
+    save_latched_state(state_file_, monitor_.latched());
+  } catch (const std::exception& e) {
+    log_ << "safety: " << e.what() << " (a restart would not find this state)" << std::endl;
+  }
 }
 
 SafetyNode::~SafetyNode() = default;
 
 std::optional<std::string> SafetyNode::publish_locked(bool force) {
+  persist_locked();  // before the state goes out: a restart after this write keeps it
   const auto now = Clock::now();
   const bool changed = monitor_.revision() != published_revision_;
   if (!changed && !force && now - last_publish_ < monitor_.params().publish_period)
@@ -85,10 +126,10 @@ void SafetyNode::on_estop(const msg::EStopInput& input) {
   note(text);
 }
 
-void SafetyNode::on_status(const msg::ServiceStatus& status) {
+void SafetyNode::on_status(const msg::ServiceStatus& status, const std::string& incarnation) {
   std::unique_lock lock(mutex_);
   monitor_.on_heartbeat(status.service(), status.host(), status.state() == msg::SERVICE_STOPPED,
-                        Clock::now());
+                        Clock::now(), incarnation);
   const auto text = publish_locked(false);
   lock.unlock();
   note(text);

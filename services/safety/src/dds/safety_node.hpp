@@ -28,7 +28,11 @@ void use_interprocess_delivery_only();
 class SafetyNode {
  public:
   /// `participant` must outlive the node. `log` gets one line per state change and reset.
-  SafetyNode(concert::dds::Participant& participant, Params params, std::ostream& log);
+  /// `state_file` (empty: none) keeps the latched state (LatchedState) across restarts: read
+  /// here when it exists, rewritten on every change. A file that cannot be read stops the
+  /// robot, naming it, until an operator reset (the state it held is unknown).
+  SafetyNode(concert::dds::Participant& participant, Params params, std::ostream& log,
+             std::string state_file = {});
   ~SafetyNode();
   SafetyNode(const SafetyNode&) = delete;
   SafetyNode& operator=(const SafetyNode&) = delete;
@@ -46,13 +50,17 @@ class SafetyNode {
 
  private:
   void on_estop(const msg::EStopInput& input);
-  void on_status(const msg::ServiceStatus& status);
+  void on_status(const msg::ServiceStatus& status, const std::string& incarnation);
   void on_model(const msg::RobotModel& model);
   void on_joint_state(const msg::JointState& state);
   void on_reset(const msg::SafetyReset& reset);
   /// Publishes if the monitor changed (or `force`); caller holds mutex_. Returns the new
   /// state's summary if it changed, for note() once the lock is released.
   std::optional<std::string> publish_locked(bool force);
+  /// Reads the state file at start (caller holds mutex_).
+  void restore_locked();
+  /// Rewrites the state file if the latched state changed (caller holds mutex_).
+  void persist_locked();
   /// Puts `text` in the service status. Never called with mutex_ held: the status write is
   /// delivered in-process to our own status reader, which takes mutex_.
   void note(const std::optional<std::string>& text);
@@ -64,6 +72,8 @@ class SafetyNode {
   Clock::time_point last_publish_{};
   uint64_t checked_samples_ = 0;
   std::string model_hash_;  // content hash of the model whose limits are enforced
+  std::string state_file_;
+  uint64_t persisted_revision_ = ~uint64_t{0};
   concert::dds::Writer<msg::SafetyState> state_writer_;
   concert::dds::StatusReporter status_;
   // Readers last: destroyed first, so no callback runs on a half-destroyed node.
