@@ -23,10 +23,12 @@ bool contains(const std::vector<std::string>& causes, const std::string& text) {
   return false;
 }
 
-/// Default parameters but for the liveliness bound.
+/// Default parameters but for the liveliness bound. The tests call check_liveliness only where
+/// it matters, standing for a monitor that checks every period: no stall detection.
 Params with_liveliness_timeout(std::chrono::milliseconds timeout) {
   Params p;
   p.liveliness_timeout = timeout;
+  p.stall_checks = 0;
   return p;
 }
 
@@ -136,7 +138,7 @@ TEST(SafetyMonitor, SilentTaskServiceStopsNamingIt) {
 TEST(SafetyMonitor, ItsOwnStallIsNobodysSilence) {
   // The safety process starved for 1.7 s (a loaded machine: CI saw drill, planner and robot
   // "silent for 1.69 s" at once): the heartbeats waiting in its readers are no silence.
-  SafetyMonitor m(with_liveliness_timeout(1000ms), kT0);
+  SafetyMonitor m(Params{}, kT0);  // 1 s bound, checks every 50 ms, a stall past 5 of them
   m.on_heartbeat("planner", "manip", false, kT0);
   m.on_heartbeat("robot", "rt", false, kT0);
   m.check_liveliness(kT0 + 50ms);
@@ -502,7 +504,7 @@ TEST(SafetyParams, DefaultsAndOverrides) {
   const auto p = parse_params(
       "liveliness_timeout: 0.5\nrobot_service: rob\ntask_services: [a, b]\nrequire_robot: true\n"
       "position_tolerance: 0.1\nvelocity_margin: 0.2\neffort_margin: 0.3\npublish_period: "
-      "0.1\ncheck_period: 0.02\n",
+      "0.1\ncheck_period: 0.02\nstall_checks: 0\n",
       "x");
   EXPECT_EQ(p.liveliness_timeout, 500ms);
   EXPECT_EQ(p.robot_service, "rob");
@@ -513,13 +515,14 @@ TEST(SafetyParams, DefaultsAndOverrides) {
   EXPECT_DOUBLE_EQ(p.effort_margin, 0.3);
   EXPECT_EQ(p.publish_period, 100ms);
   EXPECT_EQ(p.check_period, 20ms);
+  EXPECT_EQ(p.stall_checks, 0);
 }
 
 TEST(SafetyParams, ShippedConfigListsEveryParameterWithItsDefault) {
   auto doc = config::Document::load(std::string(CONCERT_SOURCE_DIR) +
                                     "/services/safety/config/safety.yaml");
   (void)read_params(doc);
-  EXPECT_EQ(doc.keys().size(), 9u);
+  EXPECT_EQ(doc.keys().size(), 10u);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
 }

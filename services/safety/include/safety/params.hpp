@@ -30,6 +30,9 @@ struct Params {
   std::chrono::milliseconds publish_period{200};
   /// Period of the liveliness check in the adapter [ms].
   std::chrono::milliseconds check_period{50};
+  /// A liveliness check more than this many check periods after the previous one finds the
+  /// safety process itself stalled: that time is not counted as anyone's silence (0: off).
+  int stall_checks = 5;
 };
 
 /// Reads a params YAML file: every key optional, unknown keys are errors. Throws

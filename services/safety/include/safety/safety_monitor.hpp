@@ -75,12 +75,11 @@ class SafetyMonitor {
 
   /// Checks liveliness at `now`: a watched instance silent beyond the bound stops the robot,
   /// with a cause naming it. Silence counts only while the monitor checks: a check later than
-  /// kOwnStallChecks check periods after the previous one finds the monitor itself was
+  /// Params::stall_checks check periods after the previous one finds the monitor itself was
   /// stalled, and the stalled time is not counted as anyone's silence (own_stalls() counts it).
   void check_liveliness(TimePoint now);
   /// How many of its own stalls check_liveliness has found.
   uint64_t own_stalls() const { return own_stalls_; }
-  static constexpr int kOwnStallChecks = 5;
 
   /// A new robot model: the limits table the watchdog enforces from now on. The thermal load
   /// of every joint starts cold.

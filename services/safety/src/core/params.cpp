@@ -15,6 +15,7 @@ Params read_params(config::Document& doc) {
   root.number("effort_margin", p.effort_margin, config::Range::non_negative());
   root.duration("publish_period", p.publish_period, period);
   root.duration("check_period", p.check_period, period);
+  root.integer("stall_checks", p.stall_checks, 0, 1000);
   doc.finish();
   if (p.check_period > p.liveliness_timeout) {
     root.fail("check_period", "must not exceed liveliness_timeout");

@@ -119,7 +119,8 @@ void SafetyMonitor::on_heartbeat(const std::string& service, const std::string& 
 }
 
 void SafetyMonitor::check_liveliness(TimePoint now) {
-  if (last_check_ && now - *last_check_ > kOwnStallChecks * params_.check_period) {
+  if (last_check_ && params_.stall_checks > 0 &&
+      now - *last_check_ > params_.stall_checks * params_.check_period) {
     // The monitor itself did not run (a starved process on a loaded machine: its listeners
     // had not taken in the heartbeats waiting for it either). Time it did not watch is not
     // silence it heard: every instance's silence counts on from here, so a service dead

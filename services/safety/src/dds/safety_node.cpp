@@ -201,7 +201,7 @@ void SafetyNode::tick() {
   const uint64_t stalls = monitor_.own_stalls();
   monitor_.check_liveliness(Clock::now());
   if (monitor_.own_stalls() != stalls) {
-    log_ << "safety: the liveliness check ran over " << SafetyMonitor::kOwnStallChecks
+    log_ << "safety: the liveliness check ran over " << monitor_.params().stall_checks
          << " periods late (this process was stalled); that time is not counted as silence"
          << std::endl;
   }
