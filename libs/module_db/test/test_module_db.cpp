@@ -301,5 +301,12 @@ module_ports:
   EXPECT_EQ(error_of([&] { load_esc_index(dir / "bad_index.yaml"); }), "bad_index.yaml: modules[0].mod_id: missing");
   std::ofstream(dir / "bad_port.yaml") << "modules: []\nmobile_base_ports:\n  - {mod_type: 2, mod_id: 3, port: 7, leads_to: 1}\n";
   EXPECT_EQ(error_of([&] { load_esc_index(dir / "bad_port.yaml"); }), "bad_port.yaml: mobile_base_ports[0].port: must be 0..3");
+  // Found by tests/fuzz: yaml-cpp's BadSubscript escaped for a document or row of another kind.
+  std::ofstream(dir / "not_a_map.yaml") << "just text\n";
+  EXPECT_EQ(error_of([&] { load_esc_index(dir / "not_a_map.yaml"); }),
+            "not_a_map.yaml: (document): expected a mapping with a 'modules:' list");
+  std::ofstream(dir / "scalar_row.yaml") << "modules: [5]\n";
+  EXPECT_EQ(error_of([&] { load_esc_index(dir / "scalar_row.yaml"); }),
+            "scalar_row.yaml: modules[0]: expected a mapping");
   fs::remove_all(dir);
 }
