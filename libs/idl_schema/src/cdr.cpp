@@ -157,6 +157,13 @@ class Reader {
           if (s.back() != '\0') fail(path, "string is not NUL-terminated");
           s.pop_back();
         }
+        // JSON text is Unicode: a string that is not valid UTF-8 cannot be shown (the JSON
+        // library's serialiser, which would throw later, checks it here).
+        try {
+          (void)Json(s).dump();
+        } catch (const Json::type_error& e) {
+          fail(path, std::string("string is not valid UTF-8: ") + e.what());
+        }
         return s;
       }
       case Kind::kSequence: case Kind::kArray: {

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "concert/idl_schema/cdr.hpp"
 
 namespace concert::idl {
@@ -87,6 +89,19 @@ TEST(Cdr, ErrorsNameTheField) {
   EXPECT_THROW(encode(small(), "t::S", bad), CdrError);
   EXPECT_THROW(decode(small(), "t::S", std::vector<uint8_t>{0x00, 0x01}), CdrError);
   EXPECT_THROW(decode(small(), "t::S", std::vector<uint8_t>{0x00, 0x03, 0, 0, 1}), CdrError);
+  // A string that is not UTF-8 cannot be shown as JSON: refused naming the field (it made the
+  // JSON serialiser throw in `concert topic echo`; found by tests/fuzz).
+  bytes = encode(small(), "t::S", v);
+  const auto h = std::find(bytes.begin(), bytes.end(), uint8_t{'h'});
+  ASSERT_NE(h, bytes.end());
+  *h = 0xff;
+  try {
+    decode(small(), "t::S", bytes);
+    FAIL();
+  } catch (const CdrError& e) {
+    EXPECT_NE(std::string(e.what()).find("c: string is not valid UTF-8"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
