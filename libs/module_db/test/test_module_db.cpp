@@ -166,6 +166,14 @@ connectors:
   bad_body.replace(bad_body.find("body: link, size: large, pose"), 10, "body: lnk,");
   std::ofstream(dir / "bad_body.yaml") << bad_body;
   EXPECT_EQ(error_of([&] { load_yaml_module(dir / "bad_body.yaml"); }), "bad_body.yaml: connectors[1].body: no body 'lnk'");
+
+  // Found by tests/fuzz: yaml-cpp's BadSubscript escaped for a shape that is not a mapping.
+  std::string scalar_shape = good;
+  scalar_shape.replace(scalar_shape.find("inertia: [0.01, 0.01, 0.01, 0, 0, 0]}"), 37,
+                       "inertia: [0.01, 0.01, 0.01, 0, 0, 0], collision: [oops]}");
+  std::ofstream(dir / "scalar_shape.yaml") << scalar_shape;
+  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "scalar_shape.yaml"); }),
+            "scalar_shape.yaml: bodies[0].collision[0]: expected a mapping (line 3)");
   fs::remove_all(dir);
 }
 
