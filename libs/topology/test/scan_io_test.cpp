@@ -141,6 +141,8 @@ TEST(ScanIo, RoundTripThroughFilesInBothFormats) {
   EXPECT_EQ(load_scan(dir / "scan.yaml"), scan);
   EXPECT_EQ(load_scan(dir / "scan.json"), scan);
   std::filesystem::remove_all(dir);
+  // An empty scan too (found by tests/fuzz: "slaves:" alone reads as null, not as no slave).
+  EXPECT_EQ(parse_scan_yaml(scan_to_yaml(EscScan{}), "empty.yaml"), EscScan{});
 }
 
 TEST(TreeJson, HasTheDiscoverShape) {
