@@ -1,0 +1,88 @@
+// Assembly files (libs/simbus: `concert up --assembly`, `concert sim swap`, `concert scan show`)
+// and what the stack does with one: checked against the real catalogues, the simulated bus's
+// scan (faults applied), the tree it describes, and discovery on that scan. Documented
+// failures: AssemblyError. Properties: assembly_to_yaml reads back as the same assembly;
+// without faults, discovery rebuilds exactly the tree the assembly describes (both frame orders).
+#include <vector>
+
+#include "concert/simbus/assembly.hpp"
+#include "concert/topology/esc_catalog.hpp"
+#include "concert/topology/reconstruction.hpp"
+#include "concert/topology/scan_io.hpp"
+#include "fuzz.hpp"
+
+namespace {
+
+using namespace concert;
+
+/// The catalogues the stack runs with: the project's module database and the public one (each
+/// alone: merged, the public entries replace the project's, which share identities).
+const std::vector<topology::EscCatalog>& catalogues() {
+  static const std::vector<topology::EscCatalog> c{
+      topology::EscCatalog::load(fuzz::source_dir() / "data/module_db"),
+      topology::EscCatalog::load(fuzz::shared_data_dir() / "concert_resources")};
+  return c;
+}
+
+/// Names and keys read back as written, if they are text (YAML is Unicode: yaml-cpp reads
+/// other bytes as they come, and its emitter writes U+FFFD for them).
+void check_round_trip(const simbus::Assembly& assembly, std::string_view text) {
+  if (!fuzz::valid_utf8(text)) return;
+  const std::string yaml = simbus::assembly_to_yaml(assembly);
+  simbus::Assembly back;
+  try {
+    back = simbus::parse_assembly(yaml, "<assembly_to_yaml>");
+  } catch (const simbus::AssemblyError& e) {
+    CONCERT_FUZZ_CHECK(false, std::string("assembly_to_yaml wrote what parse_assembly refuses: ") +
+                                  e.what() + "\n" + yaml);
+  }
+  CONCERT_FUZZ_CHECK(back.modules == assembly.modules && back.faults == assembly.faults,
+                     "assembly_to_yaml does not read back as the same assembly:\n" + yaml);
+}
+
+void simulate(const simbus::Assembly& assembly, const topology::EscCatalog& catalog) {
+  for (const auto order : {topology::PortOrder::kReal0312, topology::PortOrder::kNumeric0123}) {
+    try {
+      simbus::validate(assembly, catalog, order);
+    } catch (const simbus::AssemblyError&) {
+      return;
+    }
+    const topology::EscScan scan = simbus::simulate_scan(assembly, catalog, order);
+    const topology::ModuleTree expected = simbus::tree_from_assembly(assembly, catalog, order);
+    const topology::Discovery discovery(catalog, topology::DiscoveryParams{order});
+    const topology::ModuleTree got = discovery.rebuild(scan);
+    if (assembly.faults.empty()) {
+      CONCERT_FUZZ_CHECK(got == expected,
+                         "discovery does not rebuild the assembly's tree (" +
+                             topology::to_string(order) + "):\n" +
+                             simbus::assembly_to_yaml(assembly) + "expected:\n" +
+                             topology::tree_to_text(expected) + "got:\n" +
+                             topology::tree_to_text(got));
+    }
+    volatile size_t sink = topology::tree_to_json(got).dump().size();
+    (void)sink;
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  simbus::Assembly assembly;
+  try {
+    assembly = simbus::parse_assembly(fuzz::text_of(data, size), "assembly.yaml");
+  } catch (const simbus::AssemblyError&) {
+    return 0;
+  }
+  check_round_trip(assembly, fuzz::text_of(data, size));
+  for (const topology::EscCatalog& catalog : catalogues()) simulate(assembly, catalog);
+  return 0;
+}
+
+void concert::fuzz::write_seeds(SeedWriter& seeds) {
+  seeds.add_files(source_dir() / "libs/simbus/examples", ".yaml");
+  seeds.add_files(source_dir() / "deploy/demo", "_robot.yaml");
+  seeds.add_tokens(kYamlTokens);
+  seeds.add_tokens({"upside_down", "broken_link", "unknown_identity", "wrong_topology",
+                    "upstream_port", "identity", "esc", "topology", "connector", "robot_id",
+                    "parent", "faults", "modules"});
+}
