@@ -13,6 +13,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "concert/common/text.hpp"
 #include "urdf_to_kdl.hpp"
 
 namespace concert::kinematics {
@@ -106,6 +107,12 @@ Eigen::Isometry3d to_eigen(const KDL::Frame& f) {
 Model::Model(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
 
 Model Model::from_urdf_string(const std::string& urdf_xml, const ModelOptions& options) {
+  // TinyXML 2.6.2, which urdfdom parses with, skips a multi-byte UTF-8 character by the length
+  // its lead byte announces, past the end of the text when the character is cut short there: a
+  // heap over-read (found by tests/fuzz). Text that is not UTF-8 is refused before.
+  if (const auto at = invalid_utf8_at(urdf_xml)) {
+    throw ModelError("URDF is not valid UTF-8 (byte " + std::to_string(*at) + ")");
+  }
   const urdf::ModelInterfaceSharedPtr parsed = urdf::parseURDF(urdf_xml);
   if (!parsed) {
     throw ModelError("URDF could not be parsed (malformed XML, missing links or joints; see urdfdom messages)");

@@ -314,6 +314,14 @@ TEST(KinematicsModel, NoMovingJoint) {
 
 TEST(KinematicsModel, ClearErrors) {
   EXPECT_THROW(Model::from_urdf_string("<robot name='x'><link name='a'/>"), ModelError);
+  // A character cut short at the end made the XML parser read past the text (found by
+  // tests/fuzz): refused before parsing.
+  try {
+    (void)Model::from_urdf_string("<robot name='x'><link name='a\xf0'/></robot>");
+    FAIL();
+  } catch (const ModelError& e) {
+    EXPECT_EQ(std::string(e.what()), "URDF is not valid UTF-8 (byte 29)");
+  }
   try {
     (void)Model::from_urdf_file("/nonexistent/robot.urdf");
     FAIL();
