@@ -87,6 +87,14 @@ TEST(Cdr, ErrorsNameTheField) {
   bad = v;
   bad["a"] = 300;
   EXPECT_THROW(encode(small(), "t::S", bad), CdrError);
+  // An enum by value must be an enumerator's (found by tests/fuzz: 113 was sent, and no reader
+  // decodes it); a valid value is the enumerator.
+  bad = v;
+  bad["e"] = 113;
+  EXPECT_THROW(encode(small(), "t::S", bad), CdrError);
+  Json by_value = v;
+  by_value["e"] = 1;
+  EXPECT_EQ(encode(small(), "t::S", by_value), encode(small(), "t::S", v));
   EXPECT_THROW(decode(small(), "t::S", std::vector<uint8_t>{0x00, 0x01}), CdrError);
   EXPECT_THROW(decode(small(), "t::S", std::vector<uint8_t>{0x00, 0x03, 0, 0, 1}), CdrError);
   // A string that is not UTF-8 cannot be shown as JSON: refused naming the field (it made the
