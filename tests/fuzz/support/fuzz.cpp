@@ -9,7 +9,7 @@
 #include <iostream>
 #include <stdexcept>
 
-#include <nlohmann/json.hpp>
+#include "concert/common/text.hpp"
 
 namespace concert::fuzz {
 
@@ -83,15 +83,7 @@ bool word_char(char c, bool first) {
 
 }  // namespace
 
-bool valid_utf8(std::string_view text) {
-  // nlohmann::json checks UTF-8 when it serialises a string (type_error 316 otherwise).
-  try {
-    (void)nlohmann::json(std::string(text)).dump();
-    return true;
-  } catch (const nlohmann::json::type_error&) {
-    return false;
-  }
-}
+bool valid_utf8(std::string_view text) { return !invalid_utf8_at(text); }
 
 fs::path input_file(const std::string& name, std::string_view content) {
   const fs::path file = private_temp_dir() / name;
