@@ -45,18 +45,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     again = idl::encode(schema, type, sample);
   } catch (const idl::CdrError& e) {
-    CONCERT_FUZZ_CHECK(false, std::string("a decoded sample does not encode: ") + e.what() +
-                                  "\n" + text);
+    CONCERT_FUZZ_CHECK(false,
+                       std::string("a decoded sample does not encode: ") + e.what() + "\n" + text);
   }
   idl::Json back;
   try {
     back = idl::decode(schema, type, again);
   } catch (const idl::CdrError& e) {
-    CONCERT_FUZZ_CHECK(false, std::string("a re-encoded sample does not decode: ") + e.what() +
-                                  "\n" + text);
+    CONCERT_FUZZ_CHECK(
+        false, std::string("a re-encoded sample does not decode: ") + e.what() + "\n" + text);
   }
-  CONCERT_FUZZ_CHECK(back.dump() == text, "decode(encode(sample)) differs:\n" + text + "\n" +
-                                              back.dump());
+  CONCERT_FUZZ_CHECK(back.dump() == text,
+                     "decode(encode(sample)) differs:\n" + text + "\n" + back.dump());
   CONCERT_FUZZ_CHECK(idl::key_hash(schema, type, sample) == idl::key_hash(schema, type, back),
                      "the key hash changed through encode/decode: " + text);
   return 0;

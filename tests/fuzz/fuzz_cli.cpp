@@ -82,7 +82,8 @@ std::vector<std::string> words_after_concert(const std::string& line) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<std::string> args;
   if (size > 0) {
-    for (std::string_view a : fuzz::split(fuzz::text_of(data, size), '\0', 256)) args.emplace_back(a);
+    for (std::string_view a : fuzz::split(fuzz::text_of(data, size), '\0', 256))
+      args.emplace_back(a);
   }
   const int code = parse(args, false);
   if (code == 0 && !args.empty() && args.front() == "help") parse(args, true);
@@ -99,8 +100,8 @@ void concert::fuzz::write_seeds(SeedWriter& seeds) {
   for (auto it = std::filesystem::recursive_directory_iterator(source_dir());
        it != std::filesystem::recursive_directory_iterator(); ++it) {
     const std::string name = it->path().filename().string();
-    if (it->is_directory() && (name.rfind("build", 0) == 0 || name == "node_modules" ||
-                               name.front() == '.')) {
+    if (it->is_directory() &&
+        (name.rfind("build", 0) == 0 || name == "node_modules" || name.front() == '.')) {
       it.disable_recursion_pending();
     } else if (it->is_regular_file() && name == "README.md") {
       readmes.push_back(it->path());
@@ -148,6 +149,6 @@ void concert::fuzz::write_seeds(SeedWriter& seeds) {
     add(all);
   }
   seeds.add_tokens(tokens);
-  seeds.add_tokens({std::string(1, '\0'), "--", "-", "=", "--help", "-h", "--help-all", "0",
-                    "-1", "1e9", "nan", "inf", "1.5", "4294967296"});
+  seeds.add_tokens({std::string(1, '\0'), "--", "-", "=", "--help", "-h", "--help-all", "0", "-1",
+                    "1e9", "nan", "inf", "1.5", "4294967296"});
 }

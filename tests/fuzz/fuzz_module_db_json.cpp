@@ -9,18 +9,9 @@
 using namespace concert;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::filesystem::path file = fuzz::input_file("fuzz_module.json", fuzz::text_of(data, size));
-  try {
-    (void)module_db::load_json_addon(file);
-  } catch (const module_db::ModuleDbError&) {
-  }
-  module_db::ModuleDescription module;
-  try {
-    module = module_db::load_json_module(file);
-  } catch (const module_db::ModuleDbError&) {
-    return 0;
-  }
-  fuzz::generate_with(fuzz::databases()[1].db, module, "module_joint_elbow_A_concert", "module_drill_concert");
+  fuzz::module_file(fuzz::text_of(data, size), "fuzz_module.json", module_db::load_json_module,
+                    module_db::load_json_addon, fuzz::databases()[1].db,
+                    "module_joint_elbow_A_concert", "module_drill_concert");
   return 0;
 }
 

@@ -9,19 +9,9 @@
 using namespace concert;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::filesystem::path file = fuzz::input_file("fuzz_module.yaml", fuzz::text_of(data, size));
-  try {
-    (void)module_db::load_yaml_addon(file);
-  } catch (const module_db::ModuleDbError&) {
-  }
-  module_db::ModuleDescription module;
-  try {
-    module = module_db::load_yaml_module(file);
-  } catch (const module_db::ModuleDbError&) {
-    return 0;
-  }
-  if (fuzz::databases()[0].db.find(module.key) != nullptr) return 0;  // a key of the database: refused there
-  fuzz::generate_with(fuzz::databases()[0].db, module, "concert_elbow_a", "concert_drill");
+  fuzz::module_file(fuzz::text_of(data, size), "fuzz_module.yaml", module_db::load_yaml_module,
+                    module_db::load_yaml_addon, fuzz::databases()[0].db, "concert_elbow_a",
+                    "concert_drill");
   return 0;
 }
 

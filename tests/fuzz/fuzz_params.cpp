@@ -69,7 +69,8 @@ AllKinds read_all_kinds(config::Document& doc) {
   return p;
 }
 
-constexpr const char* kEveryKey = R"(# Every key of the all-getters reader of tests/fuzz/fuzz_params.cpp.
+constexpr const char* kEveryKey =
+    R"(# Every key of the all-getters reader of tests/fuzz/fuzz_params.cpp.
 number: -2.5
 positive: 1e-3
 maybe_auto: auto

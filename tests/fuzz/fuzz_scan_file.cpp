@@ -2,10 +2,7 @@
 // with the scan: the module tree rebuilt with the real catalogues (both frame orders), rendered
 // as JSON and text. Documented failures: ScanFormatError. Properties: a scan read back from
 // scan_to_yaml / scan_to_json is the same scan; Discovery::rebuild never throws.
-#include <optional>
-#include <vector>
-
-#include "concert/topology/esc_catalog.hpp"
+#include "bus.hpp"
 #include "concert/topology/reconstruction.hpp"
 #include "concert/topology/scan_io.hpp"
 #include "fuzz.hpp"
@@ -14,15 +11,6 @@ namespace {
 
 using namespace concert;
 using topology::EscScan;
-
-/// The catalogues the stack runs with: the project's module database and the public one (each
-/// alone: merged, the public entries replace the project's, which share identities).
-const std::vector<topology::EscCatalog>& catalogues() {
-  static const std::vector<topology::EscCatalog> c{
-      topology::EscCatalog::load(fuzz::source_dir() / "data/module_db"),
-      topology::EscCatalog::load(fuzz::shared_data_dir() / "concert_resources")};
-  return c;
-}
 
 void check_round_trip(const EscScan& scan) {
   const std::string yaml = topology::scan_to_yaml(scan);
@@ -38,7 +26,7 @@ void check_round_trip(const EscScan& scan) {
 }
 
 void discover(const EscScan& scan) {
-  for (const topology::EscCatalog& catalog : catalogues()) {
+  for (const topology::EscCatalog& catalog : fuzz::catalogues()) {
     for (const auto order : {topology::PortOrder::kReal0312, topology::PortOrder::kNumeric0123}) {
       const topology::Discovery discovery(catalog, topology::DiscoveryParams{order});
       const topology::ModuleTree tree = discovery.rebuild(scan);
@@ -49,11 +37,17 @@ void discover(const EscScan& scan) {
   }
 }
 
-void parse(std::optional<EscScan> (*read)(std::string_view), std::string_view text) {
-  const std::optional<EscScan> scan = read(text);
-  if (!scan) return;
-  check_round_trip(*scan);
-  discover(*scan);
+/// `text` through one of the scan readers, and what the stack does with the scan.
+void parse(EscScan (*read)(std::string_view, const std::string&), std::string_view text,
+           const std::string& source) {
+  EscScan scan;
+  try {
+    scan = read(text, source);
+  } catch (const topology::ScanFormatError&) {
+    return;
+  }
+  check_round_trip(scan);
+  discover(scan);
 }
 
 }  // namespace
@@ -61,24 +55,8 @@ void parse(std::optional<EscScan> (*read)(std::string_view), std::string_view te
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text = fuzz::text_of(data, size);
   // Every input as both formats: the file name's extension is all that chooses between them.
-  parse(
-      [](std::string_view t) -> std::optional<EscScan> {
-        try {
-          return topology::parse_scan_yaml(t, "scan.yaml");
-        } catch (const topology::ScanFormatError&) {
-          return std::nullopt;
-        }
-      },
-      text);
-  parse(
-      [](std::string_view t) -> std::optional<EscScan> {
-        try {
-          return topology::parse_scan_json(t, "scan.json");
-        } catch (const topology::ScanFormatError&) {
-          return std::nullopt;
-        }
-      },
-      text);
+  parse(topology::parse_scan_yaml, text, "scan.yaml");
+  parse(topology::parse_scan_json, text, "scan.json");
   return 0;
 }
 

@@ -29,7 +29,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const std::runtime_error&) {
     return 0;
   }
-  volatile size_t sink = topology::tree_to_text(tree).size() + topology::tree_to_json(tree).dump().size();
+  volatile size_t sink =
+      topology::tree_to_text(tree).size() + topology::tree_to_json(tree).dump().size();
   (void)sink;
   for (const fuzz::Database& d : fuzz::databases()) {
     fuzz::generate_and_build(model_generation::ModelGenerator(d.db), tree);

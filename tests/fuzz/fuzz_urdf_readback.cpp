@@ -37,8 +37,11 @@ void read_tables(std::string_view tables, model::ModelDescription& d) {
       d.joints.push_back({field(f[1]), field(f[2]), number(f[3]), number(f[4]), number(f[5]),
                           number(f[6]), number(f[7])});
     } else if (f[0] == "chain" && f.size() >= 5) {
-      model::ChainInfo c{field(f[1]), model::chain_role_from_string(f[2], "chain role"),
-                         field(f[3]), field(f[4]), {}};
+      model::ChainInfo c{field(f[1]),
+                         model::chain_role_from_string(f[2], "chain role"),
+                         field(f[3]),
+                         field(f[4]),
+                         {}};
       for (size_t i = 5; i < f.size(); ++i) c.joints.push_back(field(f[i]));
       d.chains.push_back(std::move(c));
     } else if (f[0] == "ee" && f.size() == 6) {

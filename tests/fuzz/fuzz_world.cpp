@@ -58,6 +58,6 @@ void concert::fuzz::write_seeds(SeedWriter& seeds) {
   seeds.add_files(source_dir() / "libs/world/test/fixtures", ".yaml");
   seeds.add_tokens(kYamlTokens);
   seeds.add_tokens(world::aruco_dictionary_names());
-  seeds.add_tokens({"loop", "pingpong", "once", "box", "cylinder", "+x", "-x", "+y", "-y",
-                    "blob", "aruco"});
+  seeds.add_tokens(
+      {"loop", "pingpong", "once", "box", "cylinder", "+x", "-x", "+y", "-y", "blob", "aruco"});
 }

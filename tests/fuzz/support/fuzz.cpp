@@ -95,7 +95,8 @@ fs::path source_dir() { return CONCERT_SOURCE_DIR; }
 
 std::vector<fs::path> assembly_files() {
   std::vector<fs::path> files;
-  for (const fs::path& dir : {source_dir() / "libs/simbus/examples", source_dir() / "deploy/demo"}) {
+  for (const fs::path& dir :
+       {source_dir() / "libs/simbus/examples", source_dir() / "deploy/demo"}) {
     for (const auto& entry : fs::directory_iterator(dir)) {
       const std::string name = entry.path().filename().string();
       const bool other = name.find("_site") != std::string::npos ||
@@ -108,25 +109,111 @@ std::vector<fs::path> assembly_files() {
 }
 fs::path shared_data_dir() { return CONCERT_SHARED_DATA; }
 
-const std::vector<std::string> kYamlTokens = {
-    ": ", "- ", "-", "{", "}", "[", "]", ", ", "\n", "\n  ", "\n  - ", "---\n", "...\n", "#",
-    "&a ", "*a", "<<: ", "!!str ", "!!int ", "!!map", "!!seq", "? ", "|\n", ">\n", "\"", "'",
-    "~", "null", "true", "false", "yes", "no", ".inf", "-.inf", ".nan", "0x", "0o", "1e9",
-    "-1", "0", "2147483648", "-2147483649", "9223372036854775808", "1e400"};
+const std::vector<std::string> kYamlTokens = {": ",
+                                              "- ",
+                                              "-",
+                                              "{",
+                                              "}",
+                                              "[",
+                                              "]",
+                                              ", ",
+                                              "\n",
+                                              "\n  ",
+                                              "\n  - ",
+                                              "---\n",
+                                              "...\n",
+                                              "#",
+                                              "&a ",
+                                              "*a",
+                                              "<<: ",
+                                              "!!str ",
+                                              "!!int ",
+                                              "!!map",
+                                              "!!seq",
+                                              "? ",
+                                              "|\n",
+                                              ">\n",
+                                              "\"",
+                                              "'",
+                                              "~",
+                                              "null",
+                                              "true",
+                                              "false",
+                                              "yes",
+                                              "no",
+                                              ".inf",
+                                              "-.inf",
+                                              ".nan",
+                                              "0x",
+                                              "0o",
+                                              "1e9",
+                                              "-1",
+                                              "0",
+                                              "2147483648",
+                                              "-2147483649",
+                                              "9223372036854775808",
+                                              "1e400"};
 const std::vector<std::string> kJsonTokens = {
-    "{", "}", "[", "]", ":", ",", "\"", "\\u0000", "\\\"", "null", "true", "false", "-",
-    "1e308", "1e400", "-0", "0.5", "2147483648", "-2147483649", "18446744073709551616",
+    "{",        "}",     "[",          "]",           ":",
+    ",",        "\"",    "\\u0000",    "\\\"",        "null",
+    "true",     "false", "-",          "1e308",       "1e400",
+    "-0",       "0.5",   "2147483648", "-2147483649", "18446744073709551616",
     "Infinity", "NaN"};
-const std::vector<std::string> kXmlTokens = {
-    "<", ">", "</", "/>", "=\"", "\"", "<?xml version=\"1.0\"?>", "<!--", "-->", "<![CDATA[",
-    "]]>", "&amp;", "&lt;", "&#x41;", "<robot name=\"r\">", "</robot>", "<link name=\"",
-    "<joint name=\"", "type=\"revolute\"", "type=\"continuous\"", "type=\"prismatic\"",
-    "type=\"fixed\"", "type=\"floating\"", "type=\"planar\"", "<parent link=\"",
-    "<child link=\"", "<origin xyz=\"", "rpy=\"", "<axis xyz=\"", "<limit ", "lower=\"",
-    "upper=\"", "effort=\"", "velocity=\"", "<inertial>", "<mass value=\"", "<inertia ",
-    "ixx=\"", "<collision>", "<visual>", "<geometry>", "<box size=\"", "<cylinder radius=\"",
-    "length=\"", "<sphere radius=\"", "<mesh filename=\"", "scale=\"", "<disable_collisions ",
-    "link1=\"", "link2=\"", "nan", "inf", "-1e308", "0 0 0", "1 0 0"};
+const std::vector<std::string> kXmlTokens = {"<",
+                                             ">",
+                                             "</",
+                                             "/>",
+                                             "=\"",
+                                             "\"",
+                                             "<?xml version=\"1.0\"?>",
+                                             "<!--",
+                                             "-->",
+                                             "<![CDATA[",
+                                             "]]>",
+                                             "&amp;",
+                                             "&lt;",
+                                             "&#x41;",
+                                             "<robot name=\"r\">",
+                                             "</robot>",
+                                             "<link name=\"",
+                                             "<joint name=\"",
+                                             "type=\"revolute\"",
+                                             "type=\"continuous\"",
+                                             "type=\"prismatic\"",
+                                             "type=\"fixed\"",
+                                             "type=\"floating\"",
+                                             "type=\"planar\"",
+                                             "<parent link=\"",
+                                             "<child link=\"",
+                                             "<origin xyz=\"",
+                                             "rpy=\"",
+                                             "<axis xyz=\"",
+                                             "<limit ",
+                                             "lower=\"",
+                                             "upper=\"",
+                                             "effort=\"",
+                                             "velocity=\"",
+                                             "<inertial>",
+                                             "<mass value=\"",
+                                             "<inertia ",
+                                             "ixx=\"",
+                                             "<collision>",
+                                             "<visual>",
+                                             "<geometry>",
+                                             "<box size=\"",
+                                             "<cylinder radius=\"",
+                                             "length=\"",
+                                             "<sphere radius=\"",
+                                             "<mesh filename=\"",
+                                             "scale=\"",
+                                             "<disable_collisions ",
+                                             "link1=\"",
+                                             "link2=\"",
+                                             "nan",
+                                             "inf",
+                                             "-1e308",
+                                             "0 0 0",
+                                             "1 0 0"};
 
 SeedWriter::SeedWriter(fs::path dir) : dir_(std::move(dir)) {
   std::error_code ec;
@@ -172,7 +259,8 @@ void SeedWriter::add_files(const fs::path& root, std::string_view suffix) {
     }
   }
   if (files.empty()) {
-    throw std::runtime_error(root.string() + ": no *" + std::string(suffix) + " file for the seeds");
+    throw std::runtime_error(root.string() + ": no *" + std::string(suffix) +
+                             " file for the seeds");
   }
   std::sort(files.begin(), files.end());
   for (const fs::path& f : files) add_file(f, root.parent_path());

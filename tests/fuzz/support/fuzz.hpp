@@ -19,8 +19,8 @@
 
 /// Checks a property of the code under test; on failure prints where and what, then aborts, so
 /// that libFuzzer records the input as a crash and the replay test fails.
-#define CONCERT_FUZZ_CHECK(condition, message)                                       \
-  do {                                                                               \
+#define CONCERT_FUZZ_CHECK(condition, message)                                                  \
+  do {                                                                                          \
     if (!(condition)) ::concert::fuzz::check_failed(__FILE__, __LINE__, #condition, (message)); \
   } while (false)
 

@@ -14,7 +14,8 @@ void exercise_kinematics(const kinematics::Model& kin, const model::RobotModel& 
   kinematics::Data data = kin.make_data();
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(kin.dof());
   double sum = 0.0;
-  for (const std::string& frame : kin.frame_names()) sum += kin.frame_pose(data, q, frame).translation().sum();
+  for (const std::string& frame : kin.frame_names())
+    sum += kin.frame_pose(data, q, frame).translation().sum();
   for (const model::EndEffectorInfo& e : model.end_effectors()) {
     sum += kin.frame_jacobian(data, q, e.frame).sum();
   }
@@ -36,7 +37,8 @@ void documented(F&& f) {
 const std::vector<Database>& databases() {
   static const std::vector<Database> dbs = [] {
     std::vector<Database> out;
-    for (const auto& dir : {source_dir() / "data/module_db", shared_data_dir() / "concert_resources"}) {
+    for (const auto& dir :
+         {source_dir() / "data/module_db", shared_data_dir() / "concert_resources"}) {
       out.push_back({module_db::load_module_database(dir), topology::EscCatalog::load(dir)});
     }
     return out;
@@ -54,7 +56,8 @@ const Database& database_of(const simbus::Assembly& assembly) {
 void exercise(const model::RobotModel& model) {
   for (const auto role : {model::ChainRole::kArm, model::ChainRole::kLeg, model::ChainRole::kTool,
                           model::ChainRole::kOther}) {
-    for (const model::ChainInfo* c : model.chains(role)) documented([&] { (void)model.chain(c->name); });
+    for (const model::ChainInfo* c : model.chains(role))
+      documented([&] { (void)model.chain(c->name); });
   }
   documented([&] { (void)model.arm(); });
   documented([&] { (void)model.legs(); });
@@ -67,9 +70,9 @@ void exercise(const model::RobotModel& model) {
     (void)model.end_effectors(kind);
   }
   for (const model::EndEffectorInfo& e : model.end_effectors()) {
-    for (const auto kind : {model::SensorKind::kCamera, model::SensorKind::kLidar,
-                            model::SensorKind::kSonar, model::SensorKind::kImu,
-                            model::SensorKind::kForceTorque, model::SensorKind::kOther}) {
+    for (const auto kind :
+         {model::SensorKind::kCamera, model::SensorKind::kLidar, model::SensorKind::kSonar,
+          model::SensorKind::kImu, model::SensorKind::kForceTorque, model::SensorKind::kOther}) {
       documented([&] { (void)model.sensor(e, kind); });
       (void)model.sensor_frames(kind);
     }
@@ -88,12 +91,38 @@ void generate_with(const module_db::ModuleDatabase& db, const module_db::ModuleD
   alone.modules.push_back({.index = 0, .key = module.key, .slave_positions = {1}});
   topology::ModuleTree between;
   between.modules.push_back({.index = 0, .key = parent_key, .slave_positions = {1}});
-  between.modules.push_back({.index = 1, .key = module.key, .slave_positions = {2},
-                             .parent_module = 0, .parent_connector = 1});
-  between.modules.push_back({.index = 2, .key = child_key, .slave_positions = {3},
-                             .parent_module = 1, .parent_connector = 1});
+  between.modules.push_back({.index = 1,
+                             .key = module.key,
+                             .slave_positions = {2},
+                             .parent_module = 0,
+                             .parent_connector = 1});
+  between.modules.push_back({.index = 2,
+                             .key = child_key,
+                             .slave_positions = {3},
+                             .parent_module = 1,
+                             .parent_connector = 1});
 
   for (const topology::ModuleTree* tree : {&alone, &between}) generate_and_build(generator, *tree);
+}
+
+void module_file(std::string_view content, const std::string& name,
+                 module_db::ModuleDescription (*load_module)(const std::filesystem::path&),
+                 module_db::AddonDescription (*load_addon)(const std::filesystem::path&),
+                 const module_db::ModuleDatabase& db, const std::string& parent_key,
+                 const std::string& child_key) {
+  const std::filesystem::path file = input_file(name, content);
+  try {
+    (void)load_addon(file);
+  } catch (const module_db::ModuleDbError&) {
+  }
+  module_db::ModuleDescription module;
+  try {
+    module = load_module(file);
+  } catch (const module_db::ModuleDbError&) {
+    return;
+  }
+  if (db.find(module.key) != nullptr) return;  // a key of the database: refused when added
+  generate_with(db, module, parent_key, child_key);
 }
 
 void generate_and_build(const model_generation::ModelGenerator& generator,

@@ -3,7 +3,9 @@
 // targets: model generation (modelgen), the RobotModel every service builds from the message,
 // and what the services ask of it first (chains, legs, tools, sensors, kinematics).
 
+#include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "concert/model/robot_model.hpp"
@@ -38,6 +40,14 @@ void exercise(const model::RobotModel& model);
 /// a model the services refuse), which is then exercised.
 void generate_and_build(const model_generation::ModelGenerator& generator,
                         const topology::ModuleTree& tree);
+
+/// A module database file with `content`, named `name`, through the format's add-on and module
+/// readers (ModuleDbError documented); a module whose key `db` lacks goes through generate_with.
+void module_file(std::string_view content, const std::string& name,
+                 module_db::ModuleDescription (*load_module)(const std::filesystem::path&),
+                 module_db::AddonDescription (*load_addon)(const std::filesystem::path&),
+                 const module_db::ModuleDatabase& db, const std::string& parent_key,
+                 const std::string& child_key);
 
 /// Generates models with `module` (its key must be new to `db`) alone and mounted between real
 /// modules of `db` (`parent_key` -> `module` on connector 1 -> `child_key` on its connector 1),
