@@ -1,8 +1,8 @@
+#include "concert/idl_schema/cdr.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
-
-#include "concert/idl_schema/cdr.hpp"
 
 namespace concert::idl {
 namespace {

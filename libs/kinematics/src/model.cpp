@@ -1,15 +1,15 @@
 #include "concert/kinematics/model.hpp"
 
-#include <kdl/jacobian.hpp>
-#include <kdl/jntarray.hpp>
-#include <kdl/treefksolverpos_recursive.hpp>
-#include <kdl/treeidsolver_recursive_newton_euler.hpp>
-#include <kdl/treejnttojacsolver.hpp>
 #include <urdf_parser/urdf_parser.h>
 
 #include <algorithm>
 #include <fstream>
 #include <functional>
+#include <kdl/jacobian.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/treefksolverpos_recursive.hpp>
+#include <kdl/treeidsolver_recursive_newton_euler.hpp>
+#include <kdl/treejnttojacsolver.hpp>
 #include <sstream>
 #include <unordered_map>
 

@@ -309,7 +309,8 @@ TEST(KinematicsModel, NoMovingJoint) {
   EXPECT_EQ(jac.rows(), 6);
   EXPECT_EQ(jac.cols(), 0);
   EXPECT_EQ(m.gravity_torques(d, q).size(), 0);
-  EXPECT_EQ(m.inverse_dynamics(d, q, q, q, {{"tip", Eigen::Matrix<double, 6, 1>::Ones()}}).size(), 0);
+  EXPECT_EQ(m.inverse_dynamics(d, q, q, q, {{"tip", Eigen::Matrix<double, 6, 1>::Ones()}}).size(),
+            0);
 }
 
 TEST(KinematicsModel, ClearErrors) {

@@ -86,7 +86,8 @@ std::vector<std::string> ModuleDatabase::addon_keys() const {
 namespace {
 
 int32_t req_int(const YAML::Node& row, const std::string& key, const fs::path& file, const std::string& path) {
-  if (!row.IsMap()) fail(file, path.empty() ? key : path.substr(0, path.size() - 1), "expected a mapping");
+  if (!row.IsMap())
+    fail(file, path.empty() ? key : path.substr(0, path.size() - 1), "expected a mapping");
   const YAML::Node v = row[key];
   if (!v || !v.IsScalar()) fail(file, path + key, "missing");
   try {

@@ -136,7 +136,9 @@ TEST(JsonErrors, NameFileAndField) {
             std::string::npos);
   // Found by tests/fuzz: the JSON library's out_of_range (a number beyond double) escaped.
   std::ofstream(dir / "huge.json") << "{ \"header\": {\"type\": \"link\"}, \"mass\": 1e400 }";
-  EXPECT_NE(error_of([&] { load_json_module(dir / "huge.json"); }).find("huge.json: (document): invalid JSON"),
+  EXPECT_NE(error_of([&] {
+              load_json_module(dir / "huge.json");
+            }).find("huge.json: (document): invalid JSON"),
             std::string::npos);
   fs::remove_all(dir);
 }

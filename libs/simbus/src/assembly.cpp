@@ -1,13 +1,13 @@
 #include "concert/simbus/assembly.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <limits>
 #include <map>
 #include <set>
-
-#include <yaml-cpp/yaml.h>
 
 #include "concert/common/enum_map.hpp"
 #include "concert/common/source_text.hpp"
@@ -316,7 +316,8 @@ std::string assembly_to_yaml(const Assembly& assembly) {
       out << YAML::Key << "parent" << YAML::Value << m.parent;
       out << YAML::Key << "connector" << YAML::Value << m.connector;
     }
-    if (m.robot_ids.size() == 1) out << YAML::Key << "robot_id" << YAML::Value << m.robot_ids.front();
+    if (m.robot_ids.size() == 1)
+      out << YAML::Key << "robot_id" << YAML::Value << m.robot_ids.front();
     if (m.robot_ids.size() > 1) {
       out << YAML::Key << "robot_id" << YAML::Value << YAML::Flow << m.robot_ids;
     }
@@ -332,17 +333,18 @@ std::string assembly_to_yaml(const Assembly& assembly) {
       out << YAML::Key << "module" << YAML::Value << f.module;
       switch (f.type) {
         case FaultType::kUpsideDown:
-          if (f.upstream_port) out << YAML::Key << "upstream_port" << YAML::Value << *f.upstream_port;
+          if (f.upstream_port)
+            out << YAML::Key << "upstream_port" << YAML::Value << *f.upstream_port;
           break;
         case FaultType::kBrokenLink:
           break;
         case FaultType::kUnknownIdentity:
           out << YAML::Key << "esc" << YAML::Value << f.esc;
-          out << YAML::Key << "identity" << YAML::Value << YAML::Flow << YAML::BeginMap
-              << YAML::Key << "mod_type" << YAML::Value << f.identity.mod_type
-              << YAML::Key << "mod_id" << YAML::Value << f.identity.mod_id
-              << YAML::Key << "mod_size" << YAML::Value << f.identity.mod_size
-              << YAML::Key << "mod_rev" << YAML::Value << f.identity.mod_rev << YAML::EndMap;
+          out << YAML::Key << "identity" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
+              << "mod_type" << YAML::Value << f.identity.mod_type << YAML::Key << "mod_id"
+              << YAML::Value << f.identity.mod_id << YAML::Key << "mod_size" << YAML::Value
+              << f.identity.mod_size << YAML::Key << "mod_rev" << YAML::Value << f.identity.mod_rev
+              << YAML::EndMap;
           break;
         case FaultType::kWrongTopology:
           out << YAML::Key << "esc" << YAML::Value << f.esc;

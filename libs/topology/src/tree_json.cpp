@@ -13,10 +13,11 @@ using nlohmann::json;
 /// `v` as an int32; throws naming `what` for another type or a value out of range.
 int32_t int32_of(const json& v, const std::string& what) {
   if (!v.is_number_integer()) throw std::runtime_error(what + ": expected an integer");
-  const bool fits = v.is_number_unsigned()
-                        ? v.get<uint64_t>() <= static_cast<uint64_t>(std::numeric_limits<int32_t>::max())
-                        : v.get<int64_t>() >= std::numeric_limits<int32_t>::min() &&
-                              v.get<int64_t>() <= std::numeric_limits<int32_t>::max();
+  const bool fits =
+      v.is_number_unsigned()
+          ? v.get<uint64_t>() <= static_cast<uint64_t>(std::numeric_limits<int32_t>::max())
+          : v.get<int64_t>() >= std::numeric_limits<int32_t>::min() &&
+                v.get<int64_t>() <= std::numeric_limits<int32_t>::max();
   if (!fits) throw std::runtime_error(what + ": " + v.dump() + " is out of range");
   return v.get<int32_t>();
 }
@@ -49,7 +50,8 @@ ModuleTree tree_from_json(const json& doc, const std::string& source) {
     ModuleNode n;
     n.index = m.contains("index") ? int_field(m, "index", where) : static_cast<int32_t>(i);
     if (n.index != static_cast<int32_t>(i)) throw std::runtime_error(where + ".index: " + std::to_string(n.index) + " but it is entry " + std::to_string(i));
-    if (m.contains("key") && !m.at("key").is_string()) throw std::runtime_error(where + ".key: expected a string");
+    if (m.contains("key") && !m.at("key").is_string())
+      throw std::runtime_error(where + ".key: expected a string");
     n.key = m.value("key", std::string());
     if (m.contains("known")) {
       if (!m.at("known").is_boolean())
