@@ -1,10 +1,13 @@
 // Reader of the project's own YAML module database (schema: data/module_db/README.md).
 
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
+#include "concert/common/text.hpp"
 #include "concert/module_db/module_db.hpp"
 #include "internal.hpp"
 
@@ -157,10 +160,17 @@ std::vector<std::string> string_list(const YAML::Node& v, const fs::path& file, 
 }
 
 YAML::Node load_file(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in || fs::is_directory(file)) throw ModuleDbError(file.string() + ": cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  // yaml-cpp takes bytes that are not UTF-8 as they come: they would reach the generated URDF,
+  // which the services refuse (found by fuzzing).
+  if (const auto at = invalid_utf8_at(text.str())) {
+    fail(file, "(document)", "not valid UTF-8 (byte " + std::to_string(*at) + ")");
+  }
   try {
-    return YAML::LoadFile(file.string());
-  } catch (const YAML::BadFile&) {
-    throw ModuleDbError(file.string() + ": cannot open");
+    return YAML::Load(text.str());
   } catch (const YAML::Exception& e) {
     fail(file, "(document)", std::string("invalid YAML: ") + e.what());
   }

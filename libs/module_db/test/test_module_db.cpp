@@ -140,6 +140,18 @@ TEST(JsonErrors, NameFileAndField) {
               load_json_module(dir / "huge.json");
             }).find("huge.json: (document): invalid JSON"),
             std::string::npos);
+  // Found by tests/fuzz: modelgen wrote these into URDF that urdfdom refuses (lower="-inf",
+  // a colour component beyond float).
+  nlohmann::json one_limit = doc;
+  one_limit["joints"][0]["limits"].erase("positionLower");
+  EXPECT_EQ(error_of([&] { load_json_module(write(one_limit)); }),
+            "module_joint_elbow_A_concert.json: joints[0].limits: lower and upper position limits "
+            "required (a revolute joint without both is continuous)");
+  nlohmann::json bad_colour = doc;
+  bad_colour["bodies"][1]["visual"][0]["parameters"]["color"]["rgba"][2] = 1e39;
+  EXPECT_EQ(error_of([&] { load_json_module(write(bad_colour)); }),
+            "module_joint_elbow_A_concert.json: bodies[1].visual[0].rgba: components must be "
+            "within 0..1");
   fs::remove_all(dir);
 }
 
@@ -180,6 +192,14 @@ connectors:
   std::ofstream(dir / "scalar_shape.yaml") << scalar_shape;
   EXPECT_EQ(error_of([&] { load_yaml_module(dir / "scalar_shape.yaml"); }),
             "scalar_shape.yaml: bodies[0].collision[0]: expected a mapping (line 3)");
+  // Found by tests/fuzz: yaml-cpp reads bytes that are not UTF-8 as they come, and they reached
+  // the generated URDF, which the services refuse.
+  std::string not_utf8 = good;
+  not_utf8.replace(not_utf8.find("name: input"), 11, "name: in\xfc\xfc");
+  std::ofstream(dir / "not_utf8.yaml") << not_utf8;
+  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "not_utf8.yaml"); }),
+            "not_utf8.yaml: (document): not valid UTF-8 (byte " +
+                std::to_string(good.find("name: input") + 8) + ")");
   fs::remove_all(dir);
 }
 
