@@ -1,11 +1,11 @@
 // Reader of the project's own YAML module database (schema: data/module_db/README.md).
 
+#include <yaml-cpp/yaml.h>
+
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
-
-#include <yaml-cpp/yaml.h>
 
 #include "concert/common/text.hpp"
 #include "concert/module_db/module_db.hpp"
