@@ -169,35 +169,38 @@ connectors:
   EXPECT_EQ(m.key, "good_link");
   EXPECT_DOUBLE_EQ(m.connectors[1].pose.translation().z(), 0.2);
 
-  std::string no_mass = good;
-  no_mass.replace(no_mass.find("mass: 1.0, "), 11, "");
-  std::ofstream(dir / "no_mass.yaml") << no_mass;
-  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "no_mass.yaml"); }).rfind("no_mass.yaml: bodies[0].mass: missing", 0), 0u);
-
-  std::string bad_role = good;
-  bad_role.replace(bad_role.find("role: output"), 12, "role: sideways");
-  std::ofstream(dir / "bad_role.yaml") << bad_role;
-  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "bad_role.yaml"); }),
-            "bad_role.yaml: connectors[1].role: unknown role 'sideways' (expected input, output, tcp, base)");
-
-  std::string bad_body = good;
-  bad_body.replace(bad_body.find("body: link, size: large, pose"), 10, "body: lnk,");
-  std::ofstream(dir / "bad_body.yaml") << bad_body;
-  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "bad_body.yaml"); }), "bad_body.yaml: connectors[1].body: no body 'lnk'");
-
+  // `good` with `what` replaced by `with`, written as `name` in the scratch folder.
+  auto edited = [&](const std::string& name, const std::string& what, const std::string& with) {
+    std::string text = good;
+    text.replace(text.find(what), what.size(), with);
+    std::ofstream(dir / name) << text;
+    return dir / name;
+  };
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("no_mass.yaml", "mass: 1.0, ", ""));
+            }).rfind("no_mass.yaml: bodies[0].mass: missing", 0),
+            0u);
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("bad_role.yaml", "role: output", "role: sideways"));
+            }),
+            "bad_role.yaml: connectors[1].role: unknown role 'sideways' (expected input, output, "
+            "tcp, base)");
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("bad_body.yaml", "body: link, size: large, pose",
+                                      "body: lnk, size: large, pose"));
+            }),
+            "bad_body.yaml: connectors[1].body: no body 'lnk'");
   // Found by tests/fuzz: yaml-cpp's BadSubscript escaped for a shape that is not a mapping.
-  std::string scalar_shape = good;
-  scalar_shape.replace(scalar_shape.find("inertia: [0.01, 0.01, 0.01, 0, 0, 0]}"), 37,
-                       "inertia: [0.01, 0.01, 0.01, 0, 0, 0], collision: [oops]}");
-  std::ofstream(dir / "scalar_shape.yaml") << scalar_shape;
-  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "scalar_shape.yaml"); }),
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("scalar_shape.yaml", "inertia: [0.01, 0.01, 0.01, 0, 0, 0]}",
+                                      "inertia: [0.01, 0.01, 0.01, 0, 0, 0], collision: [oops]}"));
+            }),
             "scalar_shape.yaml: bodies[0].collision[0]: expected a mapping (line 3)");
   // Found by tests/fuzz: yaml-cpp reads bytes that are not UTF-8 as they come, and they reached
   // the generated URDF, which the services refuse.
-  std::string not_utf8 = good;
-  not_utf8.replace(not_utf8.find("name: input"), 11, "name: in\xfc\xfc");
-  std::ofstream(dir / "not_utf8.yaml") << not_utf8;
-  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "not_utf8.yaml"); }),
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("not_utf8.yaml", "name: input", "name: in\xfc\xfc"));
+            }),
             "not_utf8.yaml: (document): not valid UTF-8 (byte " +
                 std::to_string(good.find("name: input") + 8) + ")");
   fs::remove_all(dir);
