@@ -3,8 +3,15 @@ BUILD_DIR ?= build
 JOBS ?= 2
 BUILD_TYPE ?= RelWithDebInfo
 CMAKE_ARGS ?=
+# Fuzzing (tests/fuzz/README.md): a separate clang build, each target run FUZZ_SECONDS;
+# FUZZ_TARGETS: a subset (default: every target); FUZZ_SEED: libFuzzer's seed (0: random).
+FUZZ_BUILD_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?=
+FUZZ_SEED ?= 0
+FUZZ_CMAKE_ARGS ?=
 
-.PHONY: all deps configure build test demo bench idl-lock clean help
+.PHONY: all deps configure build test demo bench fuzz fuzz-configure fuzz-smoke idl-lock clean help
 
 all: build
 
@@ -12,6 +19,8 @@ help:
 	@echo "make demo   install what is missing, build, run the stack in simulation"
 	@echo "make test   install what is missing, build, run every test with ctest"
 	@echo "make bench  build and run the benchmarks (figures go in README.md)"
+	@echo "make fuzz   clang build of the fuzz targets, each run FUZZ_SECONDS (default 60)"
+	@echo "make fuzz-smoke  CI's short fuzz run (5 s a target, fixed seed, fuzz_cli left out)"
 	@echo "make idl-lock  rewrite idl/types.lock after changing a message type"
 	@echo "make deps | build | clean"
 
@@ -33,9 +42,28 @@ demo: build
 bench: build
 	./deploy/bench.sh $(BUILD_DIR)
 
+# The fuzzing build: clang-16 with libFuzzer, ASan and UBSan, assertions on, -O1; only the fuzz
+# targets and what they link are built. Warnings are not errors there (clang warns where gcc,
+# which the project is written against, does not).
+fuzz-configure: deps
+	cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DCMAKE_C_COMPILER=clang-16 -DCMAKE_CXX_COMPILER=clang++-16 \
+	  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+	  -DCONCERT_FUZZ=ON -DCONCERT_WERROR=OFF $(FUZZ_CMAKE_ARGS)
+
+fuzz: fuzz-configure
+	cmake --build $(FUZZ_BUILD_DIR) -j$(JOBS) --target $(if $(FUZZ_TARGETS),$(FUZZ_TARGETS),fuzz_all)
+	FUZZ_SEED=$(FUZZ_SEED) ./tests/fuzz/run.sh $(FUZZ_BUILD_DIR) $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
+# CI: every target but the heavy fuzz_cli, 5 s each with a fixed seed (regressions of all of
+# them replay in `make test`).
+fuzz-smoke: fuzz-configure
+	cmake --build $(FUZZ_BUILD_DIR) -j$(JOBS) --target fuzz_smoke
+	FUZZ_SEED=1 ./tests/fuzz/run.sh $(FUZZ_BUILD_DIR) 5 --smoke
+
 # After changing a message type: rewrite idl/types.lock (review its diff, commit both).
 idl-lock: configure
 	cmake --build $(BUILD_DIR) -j$(JOBS) --target idl-lock
 
 clean:
-	rm -rf $(BUILD_DIR)
+	rm -rf $(BUILD_DIR) $(FUZZ_BUILD_DIR)

@@ -15,6 +15,10 @@ endif()
 option(CONCERT_WERROR "Treat warnings in project code as errors" ON)
 set(CONCERT_SANITIZE "" CACHE STRING "Sanitizers for project code, e.g. address,undefined or thread")
 option(CONCERT_COVERAGE "Instrument project code for gcov/lcov coverage" OFF)
+# The fuzzing build (`make fuzz`, tests/fuzz/README.md): clang, project code instrumented for
+# libFuzzer with AddressSanitizer and UndefinedBehaviorSanitizer (every finding aborts), and
+# assertions kept (no NDEBUG).
+option(CONCERT_FUZZ "Build the fuzz targets with libFuzzer (clang), sanitizers and assertions" OFF)
 
 find_program(CCACHE_PROGRAM ccache)
 if(CCACHE_PROGRAM)
@@ -30,6 +34,15 @@ target_compile_options(concert_build_options INTERFACE
 if(CONCERT_SANITIZE)
   target_compile_options(concert_build_options INTERFACE -fsanitize=${CONCERT_SANITIZE} -fno-omit-frame-pointer)
   target_link_options(concert_build_options INTERFACE -fsanitize=${CONCERT_SANITIZE})
+endif()
+if(CONCERT_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "CONCERT_FUZZ needs clang (libFuzzer): configure with CXX=clang++-16 CC=clang-16")
+  endif()
+  target_compile_options(concert_build_options INTERFACE
+    -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+    -UNDEBUG)
+  target_link_options(concert_build_options INTERFACE -fsanitize=address,undefined)
 endif()
 if(CONCERT_COVERAGE)
   target_compile_options(concert_build_options INTERFACE --coverage -O0)

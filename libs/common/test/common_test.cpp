@@ -38,6 +38,20 @@ TEST(Text, SplitLeavesOutEmptyPieces) {
   EXPECT_EQ(split("x y", ' '), (std::vector<std::string>{"x", "y"}));
 }
 
+TEST(Text, InvalidUtf8At) {
+  EXPECT_EQ(invalid_utf8_at(""), std::nullopt);
+  EXPECT_EQ(invalid_utf8_at("plain ascii"), std::nullopt);
+  EXPECT_EQ(invalid_utf8_at("caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\xa4\x96"),
+            std::nullopt);                                       // é € 🤖
+  EXPECT_EQ(invalid_utf8_at("ab\x80"), 2u);                      // stray continuation byte
+  EXPECT_EQ(invalid_utf8_at("x\xf0\x9f\xa4"), 1u);               // cut short at the end
+  EXPECT_EQ(invalid_utf8_at(std::string("\xf0\0\0\0", 4)), 0u);  // a NUL is no continuation
+  EXPECT_EQ(invalid_utf8_at("\xc0\xaf"), 0u);                    // overlong '/'
+  EXPECT_EQ(invalid_utf8_at("\xed\xa0\x80"), 0u);                // surrogate U+D800
+  EXPECT_EQ(invalid_utf8_at("\xf4\x90\x80\x80"), 0u);            // above U+10FFFF
+  EXPECT_EQ(invalid_utf8_at("\xff"), 0u);
+}
+
 TEST(Text, ReadFileNamesTheFileItCannotOpen) {
   const auto file = std::filesystem::temp_directory_path() / "concert_common_test.txt";
   std::ofstream(file) << "line 1\nline 2\n";

@@ -54,10 +54,13 @@ class Writer {
       case Kind::kEnum: {
         const auto* en = schema_.find_enum(type.name);
         if (en == nullptr) fail(path, "unknown enum " + type.name);
-        if (v.is_number_unsigned()) { put<uint32_t>(v.get<uint32_t>()); return; }
-        if (v.is_string()) {
-          for (const auto& [name, val] : en->enumerators) {
-            if (name == v.get_ref<const std::string&>()) { put<uint32_t>(val); return; }
+        // By name or by value; either must be an enumerator (a reader refuses any other value).
+        for (const auto& [name, val] : en->enumerators) {
+          if ((v.is_string() && name == v.get_ref<const std::string&>()) ||
+              (v.is_number_unsigned() && v.get<uint64_t>() == val) ||
+              (v.is_number_integer() && v.get<int64_t>() == static_cast<int64_t>(val))) {
+            put<uint32_t>(val);
+            return;
           }
         }
         fail(path, "not an enumerator of " + type.name + ": " + v.dump());
@@ -156,6 +159,13 @@ class Reader {
         if (n > 0) {
           if (s.back() != '\0') fail(path, "string is not NUL-terminated");
           s.pop_back();
+        }
+        // JSON text is Unicode: a string that is not valid UTF-8 cannot be shown (the JSON
+        // library's serialiser, which would throw later, checks it here).
+        try {
+          (void)Json(s).dump();
+        } catch (const Json::type_error& e) {
+          fail(path, std::string("string is not valid UTF-8: ") + e.what());
         }
         return s;
       }

@@ -1,6 +1,8 @@
+#include "concert/idl_schema/cdr.hpp"
+
 #include <gtest/gtest.h>
 
-#include "concert/idl_schema/cdr.hpp"
+#include <algorithm>
 
 namespace concert::idl {
 namespace {
@@ -100,8 +102,29 @@ TEST(Cdr, ErrorsNameTheField) {
   bad = v;
   bad["a"] = 300;
   EXPECT_THROW(encode(small(), "t::S", bad), CdrError);
+  // An enum by value must be an enumerator's (found by tests/fuzz: 113 was sent, and no reader
+  // decodes it); a valid value is the enumerator.
+  bad = v;
+  bad["e"] = 113;
+  EXPECT_THROW(encode(small(), "t::S", bad), CdrError);
+  Json by_value = v;
+  by_value["e"] = 1;
+  EXPECT_EQ(encode(small(), "t::S", by_value), encode(small(), "t::S", v));
   EXPECT_THROW(decode(small(), "t::S", std::vector<uint8_t>{0x00, 0x01}), CdrError);
   EXPECT_THROW(decode(small(), "t::S", std::vector<uint8_t>{0x00, 0x03, 0, 0, 1}), CdrError);
+  // A string that is not UTF-8 cannot be shown as JSON: refused naming the field (it made the
+  // JSON serialiser throw in `concert topic echo`; found by tests/fuzz).
+  bytes = encode(small(), "t::S", v);
+  const auto h = std::find(bytes.begin(), bytes.end(), uint8_t{'h'});
+  ASSERT_NE(h, bytes.end());
+  *h = 0xff;
+  try {
+    decode(small(), "t::S", bytes);
+    FAIL();
+  } catch (const CdrError& e) {
+    EXPECT_NE(std::string(e.what()).find("c: string is not valid UTF-8"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

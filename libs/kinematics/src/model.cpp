@@ -1,18 +1,19 @@
 #include "concert/kinematics/model.hpp"
 
-#include <kdl/jacobian.hpp>
-#include <kdl/jntarray.hpp>
-#include <kdl/treefksolverpos_recursive.hpp>
-#include <kdl/treeidsolver_recursive_newton_euler.hpp>
-#include <kdl/treejnttojacsolver.hpp>
 #include <urdf_parser/urdf_parser.h>
 
 #include <algorithm>
 #include <fstream>
 #include <functional>
+#include <kdl/jacobian.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/treefksolverpos_recursive.hpp>
+#include <kdl/treeidsolver_recursive_newton_euler.hpp>
+#include <kdl/treejnttojacsolver.hpp>
 #include <sstream>
 #include <unordered_map>
 
+#include "concert/common/text.hpp"
 #include "urdf_to_kdl.hpp"
 
 namespace concert::kinematics {
@@ -61,6 +62,35 @@ void check_frame(const Model::Impl& m, std::string_view frame) {
   }
 }
 
+// KDL's tree solvers read q(i) for every segment on the way, fixed ones included (at index 0),
+// which is out of bounds for a tree without moving joints (a robot of passive modules only):
+// Debian's KDL then fails an assertion and aborts the process (found by tests/fuzz). Such a
+// tree is composed here instead: the pose of each fixed segment, up to the root.
+bool has_no_joint(const Model::Impl& m) { return m.kdl.tree.getNrOfJoints() == 0; }
+
+KDL::Frame fixed_tree_pose(const KDL::Tree& tree, const std::string& frame) {
+  KDL::Frame pose = KDL::Frame::Identity();
+  for (auto it = tree.getSegments().find(frame); it != tree.getRootSegment();
+       it = GetTreeElementParent(it->second)) {
+    pose = GetTreeElementSegment(it->second).pose(0.0) * pose;
+  }
+  return pose;
+}
+
+/// Forward kinematics of `frame` at d.q (a frame of the model); false if KDL fails.
+bool pose_at(const Model::Impl& m, Data::Impl& d, const std::string& frame, KDL::Frame& out) {
+  if (has_no_joint(m)) {
+    out = fixed_tree_pose(m.kdl.tree, frame);
+    return true;
+  }
+  return d.fk.JntToCart(d.q, out, frame) >= 0;
+}
+
+/// Jacobian of `frame` at d.q into d.jac; without moving joints it has no column.
+bool jacobian_at(const Model::Impl& m, Data::Impl& d, const std::string& frame) {
+  return has_no_joint(m) || d.jac_solver.JntToJac(d.q, d.jac, frame) >= 0;
+}
+
 Eigen::Isometry3d to_eigen(const KDL::Frame& f) {
   Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
   for (int r = 0; r < 3; ++r) {
@@ -77,6 +107,12 @@ Eigen::Isometry3d to_eigen(const KDL::Frame& f) {
 Model::Model(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
 
 Model Model::from_urdf_string(const std::string& urdf_xml, const ModelOptions& options) {
+  // TinyXML 2.6.2, which urdfdom parses with, skips a multi-byte UTF-8 character by the length
+  // its lead byte announces, past the end of the text when the character is cut short there: a
+  // heap over-read (found by tests/fuzz). Text that is not UTF-8 is refused before.
+  if (const auto at = invalid_utf8_at(urdf_xml)) {
+    throw ModelError("URDF is not valid UTF-8 (byte " + std::to_string(*at) + ")");
+  }
   const urdf::ModelInterfaceSharedPtr parsed = urdf::parseURDF(urdf_xml);
   if (!parsed) {
     throw ModelError("URDF could not be parsed (malformed XML, missing links or joints; see urdfdom messages)");
@@ -192,7 +228,7 @@ Eigen::Isometry3d Model::frame_pose(Data& data, const Eigen::VectorXd& q, std::s
   auto& d = *data.impl_;
   d.q.data = q;
   KDL::Frame out;
-  if (d.fk.JntToCart(d.q, out, std::string(frame)) < 0) {
+  if (!pose_at(*impl_, d, std::string(frame), out)) {
     throw ModelError("model '" + impl_->name + "': forward kinematics failed for frame '" + std::string(frame) + "'");
   }
   return to_eigen(out);
@@ -209,7 +245,7 @@ Eigen::MatrixXd Model::frame_jacobian(Data& data, const Eigen::VectorXd& q, std:
   auto& d = *data.impl_;
   d.q.data = q;
   // KDL: reference point at the frame origin, expressed in the root ("world") frame.
-  if (d.jac_solver.JntToJac(d.q, d.jac, std::string(frame)) < 0) {
+  if (!jacobian_at(*impl_, d, std::string(frame))) {
     throw ModelError("model '" + impl_->name + "': Jacobian failed for frame '" + std::string(frame) + "'");
   }
   return d.jac.data;
@@ -237,7 +273,7 @@ Eigen::VectorXd Model::inverse_dynamics(Data& data, const Eigen::VectorXd& q, co
       continue;
     }
     KDL::Frame pose;
-    d.fk.JntToCart(d.q, pose, frame);
+    (void)pose_at(*impl_, d, frame, pose);
     // KDL wants the wrench in the segment frame, reference point at the segment origin.
     const KDL::Wrench world_aligned(KDL::Vector(w(0), w(1), w(2)), KDL::Vector(w(3), w(4), w(5)));
     d.wrenches[frame] = pose.M.Inverse(world_aligned);
@@ -253,7 +289,7 @@ void Model::frame_pose_into(Data& data, const Eigen::VectorXd& q, const std::str
   auto& d = *data.impl_;
   d.q.data = q;
   KDL::Frame f;
-  d.fk.JntToCart(d.q, f, frame);
+  (void)pose_at(*impl_, d, frame, f);
   out = to_eigen(f);
 }
 
@@ -261,7 +297,7 @@ void Model::frame_jacobian_into(Data& data, const Eigen::VectorXd& q, const std:
                                 Eigen::MatrixXd& out) const {
   auto& d = *data.impl_;
   d.q.data = q;
-  d.jac_solver.JntToJac(d.q, d.jac, frame);
+  (void)jacobian_at(*impl_, d, frame);
   out = d.jac.data;
 }
 

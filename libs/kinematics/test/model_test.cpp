@@ -283,8 +283,46 @@ TEST(KinematicsModel, InverseKinematicsReachesPosesFromFk) {
   EXPECT_EQ(p.q(m.joint_index_or_throw("J_wheel_fl")), 0.0);
 }
 
+// A robot of passive modules only (no moving joint): KDL's solvers cannot be used (they read
+// q(0) of an empty q); poses compose the fixed joints, the Jacobian has no column, no torque.
+TEST(KinematicsModel, NoMovingJoint) {
+  const Model m = Model::from_urdf_string(R"(<robot name="passive">
+    <link name="base_link"/>
+    <link name="post"><inertial><mass value="2"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+    <link name="tip"/>
+    <joint name="fixed_post" type="fixed"><parent link="base_link"/><child link="post"/>
+      <origin xyz="0.1 0 0.3" rpy="0 0 1.5707963267948966"/></joint>
+    <joint name="fixed_tip" type="fixed"><parent link="post"/><child link="tip"/>
+      <origin xyz="0.2 0 0" rpy="0 0 0"/></joint>
+  </robot>)");
+  ASSERT_EQ(m.dof(), 0);
+  Data d = m.make_data();
+  const Eigen::VectorXd q(0);
+  const Eigen::Isometry3d tip = m.frame_pose(d, q, "tip");
+  EXPECT_TRUE(tip.translation().isApprox(Eigen::Vector3d(0.1, 0.2, 0.3), 1e-12))
+      << tip.translation().transpose();
+  EXPECT_TRUE(m.frame_pose(d, q, "world").isApprox(Eigen::Isometry3d::Identity()));
+  Eigen::Isometry3d into;
+  m.frame_pose_into(d, q, "tip", into);
+  EXPECT_TRUE(into.isApprox(tip));
+  const Eigen::MatrixXd jac = m.frame_jacobian(d, q, "tip");
+  EXPECT_EQ(jac.rows(), 6);
+  EXPECT_EQ(jac.cols(), 0);
+  EXPECT_EQ(m.gravity_torques(d, q).size(), 0);
+  EXPECT_EQ(m.inverse_dynamics(d, q, q, q, {{"tip", Eigen::Matrix<double, 6, 1>::Ones()}}).size(),
+            0);
+}
+
 TEST(KinematicsModel, ClearErrors) {
   EXPECT_THROW(Model::from_urdf_string("<robot name='x'><link name='a'/>"), ModelError);
+  // A character cut short at the end made the XML parser read past the text (found by
+  // tests/fuzz): refused before parsing.
+  try {
+    (void)Model::from_urdf_string("<robot name='x'><link name='a\xf0'/></robot>");
+    FAIL();
+  } catch (const ModelError& e) {
+    EXPECT_EQ(std::string(e.what()), "URDF is not valid UTF-8 (byte 29)");
+  }
   try {
     (void)Model::from_urdf_file("/nonexistent/robot.urdf");
     FAIL();

@@ -86,6 +86,8 @@ std::vector<std::string> ModuleDatabase::addon_keys() const {
 namespace {
 
 int32_t req_int(const YAML::Node& row, const std::string& key, const fs::path& file, const std::string& path) {
+  if (!row.IsMap())
+    fail(file, path.empty() ? key : path.substr(0, path.size() - 1), "expected a mapping");
   const YAML::Node v = row[key];
   if (!v || !v.IsScalar()) fail(file, path + key, "missing");
   try {
@@ -117,17 +119,8 @@ std::vector<fs::path> sorted_files(const fs::path& dir, const std::string& ext) 
   return files;
 }
 
-}  // namespace
-
-EscIndex load_esc_index(const fs::path& file) {
-  YAML::Node doc;
-  try {
-    doc = YAML::LoadFile(file.string());
-  } catch (const YAML::BadFile&) {
-    throw ModuleDbError(file.string() + ": cannot open");
-  } catch (const YAML::Exception& e) {
-    fail(file, "(document)", std::string("invalid YAML: ") + e.what());
-  }
+EscIndex read_esc_index(const YAML::Node& doc, const fs::path& file) {
+  if (!doc.IsMap()) fail(file, "(document)", "expected a mapping with a 'modules:' list");
   EscIndex index;
   const YAML::Node mods = doc["modules"];
   if (!mods || !mods.IsSequence()) fail(file, "modules", "missing or not a list");
@@ -167,6 +160,25 @@ EscIndex load_esc_index(const fs::path& file) {
     }
   }
   return index;
+}
+
+}  // namespace
+
+EscIndex load_esc_index(const fs::path& file) {
+  YAML::Node doc;
+  try {
+    doc = YAML::LoadFile(file.string());
+  } catch (const YAML::BadFile&) {
+    throw ModuleDbError(file.string() + ": cannot open");
+  } catch (const YAML::Exception& e) {
+    fail(file, "(document)", std::string("invalid YAML: ") + e.what());
+  }
+  try {
+    return read_esc_index(doc, file);
+  } catch (const YAML::Exception& e) {
+    // A node of another kind than the reader checked for: named by its line.
+    fail(file, "(document)", "line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
 }
 
 DatabaseFormat detect_format(const fs::path& dir) {

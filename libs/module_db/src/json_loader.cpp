@@ -54,7 +54,7 @@ json read_json(const fs::path& file) {
   ss << in.rdbuf();
   try {
     return json::parse(replace_infinity(ss.str()));
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // not JSON, or a number out of range (out_of_range)
     fail(file, "(document)", std::string("invalid JSON: ") + e.what());
   }
 }

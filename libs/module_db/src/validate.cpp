@@ -1,7 +1,7 @@
-#include <cmath>
-
 #include <Eigen/SVD>
+#include <cmath>
 #include <set>
+#include <utility>
 
 #include "concert/module_db/module_db.hpp"
 #include "internal.hpp"
@@ -47,6 +47,16 @@ void validate_and_normalise(ModuleDescription& m, const std::filesystem::path& f
         !(b.inertial.inertia - b.inertial.inertia.transpose()).isZero(1e-9)) {
       fail(file, f + ".inertia", "not symmetric");
     }
+    for (const auto& [shapes, field] :
+         {std::pair{&b.visuals, ".visual"}, {&b.collisions, ".collision"}}) {
+      for (size_t k = 0; k < shapes->size(); ++k) {
+        const auto& rgba = (*shapes)[k].rgba;
+        if (rgba && !(rgba->array() >= 0.0 && rgba->array() <= 1.0).all()) {
+          fail(file, f + field + "[" + std::to_string(k) + "].rgba",
+               "components must be within 0..1");
+        }
+      }
+    }
   }
   int inputs = 0;
   for (size_t i = 0; i < m.connectors.size(); ++i) {
@@ -76,6 +86,12 @@ void validate_and_normalise(ModuleDescription& m, const std::filesystem::path& f
     if (j.actuated()) {
       if (std::isnan(j.limits.lower) || std::isnan(j.limits.upper) || j.limits.lower > j.limits.upper) {
         fail(file, f + ".limits", "lower position limit above upper");
+      }
+      if (j.type != JointType::kContinuous &&
+          (!std::isfinite(j.limits.lower) || !std::isfinite(j.limits.upper))) {
+        fail(file, f + ".limits",
+             "lower and upper position limits required (a revolute joint without both is "
+             "continuous)");
       }
       if (!std::isfinite(j.limits.velocity) || j.limits.velocity <= 0.0) fail(file, f + ".limits.velocity", "must be > 0");
       if (!std::isfinite(j.limits.peak_torque) || j.limits.peak_torque <= 0.0) {

@@ -1,10 +1,13 @@
 // Reader of the project's own YAML module database (schema: data/module_db/README.md).
 
-#include <cmath>
-#include <limits>
-
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "concert/common/text.hpp"
 #include "concert/module_db/module_db.hpp"
 #include "internal.hpp"
 
@@ -95,6 +98,7 @@ std::vector<Shape> shapes(const YAML::Node& arr, const fs::path& file, const std
   for (size_t i = 0; i < arr.size(); ++i) {
     const YAML::Node s = arr[i];
     const std::string p = path + "[" + std::to_string(i) + "].";
+    if (!s.IsMap()) fail(file, p.substr(0, p.size() - 1), "expected a mapping" + at_line(s));
     Shape sh;
     if (s["mesh"]) {
       sh.kind = Shape::Kind::kMesh;
@@ -156,10 +160,17 @@ std::vector<std::string> string_list(const YAML::Node& v, const fs::path& file, 
 }
 
 YAML::Node load_file(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in || fs::is_directory(file)) throw ModuleDbError(file.string() + ": cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  // yaml-cpp takes bytes that are not UTF-8 as they come: they would reach the generated URDF,
+  // which the services refuse (found by fuzzing).
+  if (const auto at = invalid_utf8_at(text.str())) {
+    fail(file, "(document)", "not valid UTF-8 (byte " + std::to_string(*at) + ")");
+  }
   try {
-    return YAML::LoadFile(file.string());
-  } catch (const YAML::BadFile&) {
-    throw ModuleDbError(file.string() + ": cannot open");
+    return YAML::Load(text.str());
   } catch (const YAML::Exception& e) {
     fail(file, "(document)", std::string("invalid YAML: ") + e.what());
   }
@@ -186,9 +197,7 @@ void for_each_item(const YAML::Node& list, const fs::path& file, const std::stri
   for (size_t i = 0; i < list.size(); ++i) read(list[i], field + "[" + std::to_string(i) + "].");
 }
 
-}  // namespace
-
-ModuleDescription load_yaml_module(const fs::path& file) {
+ModuleDescription read_module(const fs::path& file) {
   ModuleDescription m;
   const YAML::Node doc = read_document(file, m);
   m.type = enum_from(module_type_from_string, req_str(doc, "type", file, ""), file, "type");
@@ -295,7 +304,7 @@ ModuleDescription load_yaml_module(const fs::path& file) {
   return m;
 }
 
-AddonDescription load_yaml_addon(const fs::path& file) {
+AddonDescription read_addon(const fs::path& file) {
   AddonDescription a;
   const YAML::Node doc = read_document(file, a);
   a.type = req_str(doc, "type", file, "");
@@ -317,6 +326,27 @@ AddonDescription load_yaml_addon(const fs::path& file) {
     }
   }
   return a;
+}
+
+/// `read()`, with an error of yaml-cpp that the reader does not check for (a node of another
+/// kind than expected somewhere) turned into a ModuleDbError naming the file and the line.
+template <class Read>
+auto with_yaml_errors(const fs::path& file, Read read) {
+  try {
+    return read();
+  } catch (const YAML::Exception& e) {
+    fail(file, "(document)", "line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+}
+
+}  // namespace
+
+ModuleDescription load_yaml_module(const fs::path& file) {
+  return with_yaml_errors(file, [&] { return read_module(file); });
+}
+
+AddonDescription load_yaml_addon(const fs::path& file) {
+  return with_yaml_errors(file, [&] { return read_addon(file); });
 }
 
 }  // namespace concert::module_db

@@ -134,6 +134,24 @@ TEST(JsonErrors, NameFileAndField) {
   std::ofstream(dir / "broken.json") << "{ \"header\": ";
   EXPECT_NE(error_of([&] { load_json_module(dir / "broken.json"); }).find("broken.json: (document): invalid JSON"),
             std::string::npos);
+  // Found by tests/fuzz: the JSON library's out_of_range (a number beyond double) escaped.
+  std::ofstream(dir / "huge.json") << "{ \"header\": {\"type\": \"link\"}, \"mass\": 1e400 }";
+  EXPECT_NE(error_of([&] {
+              load_json_module(dir / "huge.json");
+            }).find("huge.json: (document): invalid JSON"),
+            std::string::npos);
+  // Found by tests/fuzz: modelgen wrote these into URDF that urdfdom refuses (lower="-inf",
+  // a colour component beyond float).
+  nlohmann::json one_limit = doc;
+  one_limit["joints"][0]["limits"].erase("positionLower");
+  EXPECT_EQ(error_of([&] { load_json_module(write(one_limit)); }),
+            "module_joint_elbow_A_concert.json: joints[0].limits: lower and upper position limits "
+            "required (a revolute joint without both is continuous)");
+  nlohmann::json bad_colour = doc;
+  bad_colour["bodies"][1]["visual"][0]["parameters"]["color"]["rgba"][2] = 1e39;
+  EXPECT_EQ(error_of([&] { load_json_module(write(bad_colour)); }),
+            "module_joint_elbow_A_concert.json: bodies[1].visual[0].rgba: components must be "
+            "within 0..1");
   fs::remove_all(dir);
 }
 
@@ -151,21 +169,40 @@ connectors:
   EXPECT_EQ(m.key, "good_link");
   EXPECT_DOUBLE_EQ(m.connectors[1].pose.translation().z(), 0.2);
 
-  std::string no_mass = good;
-  no_mass.replace(no_mass.find("mass: 1.0, "), 11, "");
-  std::ofstream(dir / "no_mass.yaml") << no_mass;
-  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "no_mass.yaml"); }).rfind("no_mass.yaml: bodies[0].mass: missing", 0), 0u);
-
-  std::string bad_role = good;
-  bad_role.replace(bad_role.find("role: output"), 12, "role: sideways");
-  std::ofstream(dir / "bad_role.yaml") << bad_role;
-  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "bad_role.yaml"); }),
-            "bad_role.yaml: connectors[1].role: unknown role 'sideways' (expected input, output, tcp, base)");
-
-  std::string bad_body = good;
-  bad_body.replace(bad_body.find("body: link, size: large, pose"), 10, "body: lnk,");
-  std::ofstream(dir / "bad_body.yaml") << bad_body;
-  EXPECT_EQ(error_of([&] { load_yaml_module(dir / "bad_body.yaml"); }), "bad_body.yaml: connectors[1].body: no body 'lnk'");
+  // `good` with `what` replaced by `with`, written as `name` in the scratch folder.
+  auto edited = [&](const std::string& name, const std::string& what, const std::string& with) {
+    std::string text = good;
+    text.replace(text.find(what), what.size(), with);
+    std::ofstream(dir / name) << text;
+    return dir / name;
+  };
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("no_mass.yaml", "mass: 1.0, ", ""));
+            }).rfind("no_mass.yaml: bodies[0].mass: missing", 0),
+            0u);
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("bad_role.yaml", "role: output", "role: sideways"));
+            }),
+            "bad_role.yaml: connectors[1].role: unknown role 'sideways' (expected input, output, "
+            "tcp, base)");
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("bad_body.yaml", "body: link, size: large, pose",
+                                      "body: lnk, size: large, pose"));
+            }),
+            "bad_body.yaml: connectors[1].body: no body 'lnk'");
+  // Found by tests/fuzz: yaml-cpp's BadSubscript escaped for a shape that is not a mapping.
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("scalar_shape.yaml", "inertia: [0.01, 0.01, 0.01, 0, 0, 0]}",
+                                      "inertia: [0.01, 0.01, 0.01, 0, 0, 0], collision: [oops]}"));
+            }),
+            "scalar_shape.yaml: bodies[0].collision[0]: expected a mapping (line 3)");
+  // Found by tests/fuzz: yaml-cpp reads bytes that are not UTF-8 as they come, and they reached
+  // the generated URDF, which the services refuse.
+  EXPECT_EQ(error_of([&] {
+              load_yaml_module(edited("not_utf8.yaml", "name: input", "name: in\xfc\xfc"));
+            }),
+            "not_utf8.yaml: (document): not valid UTF-8 (byte " +
+                std::to_string(good.find("name: input") + 8) + ")");
   fs::remove_all(dir);
 }
 
@@ -301,5 +338,12 @@ module_ports:
   EXPECT_EQ(error_of([&] { load_esc_index(dir / "bad_index.yaml"); }), "bad_index.yaml: modules[0].mod_id: missing");
   std::ofstream(dir / "bad_port.yaml") << "modules: []\nmobile_base_ports:\n  - {mod_type: 2, mod_id: 3, port: 7, leads_to: 1}\n";
   EXPECT_EQ(error_of([&] { load_esc_index(dir / "bad_port.yaml"); }), "bad_port.yaml: mobile_base_ports[0].port: must be 0..3");
+  // Found by tests/fuzz: yaml-cpp's BadSubscript escaped for a document or row of another kind.
+  std::ofstream(dir / "not_a_map.yaml") << "just text\n";
+  EXPECT_EQ(error_of([&] { load_esc_index(dir / "not_a_map.yaml"); }),
+            "not_a_map.yaml: (document): expected a mapping with a 'modules:' list");
+  std::ofstream(dir / "scalar_row.yaml") << "modules: [5]\n";
+  EXPECT_EQ(error_of([&] { load_esc_index(dir / "scalar_row.yaml"); }),
+            "scalar_row.yaml: modules[0]: expected a mapping");
   fs::remove_all(dir);
 }

@@ -1,14 +1,13 @@
 #include "concert/simbus/assembly.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <limits>
 #include <map>
 #include <set>
-#include <sstream>
-
-#include <yaml-cpp/yaml.h>
 
 #include "concert/common/enum_map.hpp"
 #include "concert/common/source_text.hpp"
@@ -306,43 +305,58 @@ Assembly load_assembly(const std::filesystem::path& file) {
 }
 
 std::string assembly_to_yaml(const Assembly& assembly) {
-  std::ostringstream out;
-  out << "modules:\n";
+  // yaml-cpp's emitter quotes the names and keys that need it (a name may hold ", " or "}").
+  YAML::Emitter out;
+  out << YAML::BeginMap << YAML::Key << "modules" << YAML::Value << YAML::BeginSeq;
   for (const auto& m : assembly.modules) {
-    out << "  - {name: " << m.name << ", key: " << m.key;
-    if (!m.parent.empty()) out << ", parent: " << m.parent << ", connector: " << m.connector;
-    if (m.robot_ids.size() == 1) out << ", robot_id: " << m.robot_ids.front();
-    if (m.robot_ids.size() > 1) {
-      out << ", robot_id: [";
-      for (std::size_t k = 0; k < m.robot_ids.size(); ++k) out << (k ? ", " : "") << m.robot_ids[k];
-      out << "]";
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << m.name;
+    out << YAML::Key << "key" << YAML::Value << m.key;
+    if (!m.parent.empty()) {
+      out << YAML::Key << "parent" << YAML::Value << m.parent;
+      out << YAML::Key << "connector" << YAML::Value << m.connector;
     }
-    out << "}\n";
+    if (m.robot_ids.size() == 1)
+      out << YAML::Key << "robot_id" << YAML::Value << m.robot_ids.front();
+    if (m.robot_ids.size() > 1) {
+      out << YAML::Key << "robot_id" << YAML::Value << YAML::Flow << m.robot_ids;
+    }
+    out << YAML::EndMap;
   }
+  out << YAML::EndSeq;
   if (!assembly.faults.empty()) {
-    out << "faults:\n";
+    out << YAML::Key << "faults" << YAML::Value << YAML::BeginSeq;
     for (const auto& f : assembly.faults) {
-      out << "  - {type: " << kFaultTypes.to(f.type).value_or("unknown")
-          << ", module: " << f.module;
+      out << YAML::Flow << YAML::BeginMap;
+      out << YAML::Key << "type" << YAML::Value
+          << std::string(kFaultTypes.to(f.type).value_or("unknown"));
+      out << YAML::Key << "module" << YAML::Value << f.module;
       switch (f.type) {
         case FaultType::kUpsideDown:
-          if (f.upstream_port) out << ", upstream_port: " << *f.upstream_port;
+          if (f.upstream_port)
+            out << YAML::Key << "upstream_port" << YAML::Value << *f.upstream_port;
           break;
         case FaultType::kBrokenLink:
           break;
         case FaultType::kUnknownIdentity:
-          out << ", esc: " << f.esc << ", identity: {mod_type: " << f.identity.mod_type
-              << ", mod_id: " << f.identity.mod_id << ", mod_size: " << f.identity.mod_size
-              << ", mod_rev: " << f.identity.mod_rev << "}";
+          out << YAML::Key << "esc" << YAML::Value << f.esc;
+          out << YAML::Key << "identity" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
+              << "mod_type" << YAML::Value << f.identity.mod_type << YAML::Key << "mod_id"
+              << YAML::Value << f.identity.mod_id << YAML::Key << "mod_size" << YAML::Value
+              << f.identity.mod_size << YAML::Key << "mod_rev" << YAML::Value << f.identity.mod_rev
+              << YAML::EndMap;
           break;
         case FaultType::kWrongTopology:
-          out << ", esc: " << f.esc << ", topology: " << f.topology;
+          out << YAML::Key << "esc" << YAML::Value << f.esc;
+          out << YAML::Key << "topology" << YAML::Value << f.topology;
           break;
       }
-      out << "}\n";
+      out << YAML::EndMap;
     }
+    out << YAML::EndSeq;
   }
-  return out.str();
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
 }
 
 void validate(const Assembly& assembly, const EscCatalog& catalog, PortOrder order) {

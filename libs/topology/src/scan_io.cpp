@@ -146,7 +146,7 @@ EscScan parse_scan_json(std::string_view text, const std::string& source) {
 
 std::string scan_to_yaml(const EscScan& scan) {
   std::ostringstream out;
-  out << "slaves:\n";
+  out << (scan.slaves.empty() ? "slaves: []\n" : "slaves:\n");  // "slaves:" alone is null
   for (const auto& s : scan.slaves) {
     out << "  - {position: " << s.position << ", active_ports: " << int{s.active_ports}
         << ", topology: " << s.topology << ", esc_type: " << s.esc_type

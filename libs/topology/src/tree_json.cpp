@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -9,11 +10,21 @@ namespace {
 
 using nlohmann::json;
 
+/// `v` as an int32; throws naming `what` for another type or a value out of range.
+int32_t int32_of(const json& v, const std::string& what) {
+  if (!v.is_number_integer()) throw std::runtime_error(what + ": expected an integer");
+  const bool fits =
+      v.is_number_unsigned()
+          ? v.get<uint64_t>() <= static_cast<uint64_t>(std::numeric_limits<int32_t>::max())
+          : v.get<int64_t>() >= std::numeric_limits<int32_t>::min() &&
+                v.get<int64_t>() <= std::numeric_limits<int32_t>::max();
+  if (!fits) throw std::runtime_error(what + ": " + v.dump() + " is out of range");
+  return v.get<int32_t>();
+}
+
 int32_t int_field(const json& obj, const char* key, const std::string& where) {
   if (!obj.contains(key)) throw std::runtime_error(where + "." + key + ": missing");
-  const json& v = obj.at(key);
-  if (!v.is_number_integer()) throw std::runtime_error(where + "." + key + ": expected an integer");
-  return v.get<int32_t>();
+  return int32_of(obj.at(key), where + "." + key);
 }
 
 ModuleKind kind_from(const std::string& s, const std::string& where) {
@@ -39,6 +50,8 @@ ModuleTree tree_from_json(const json& doc, const std::string& source) {
     ModuleNode n;
     n.index = m.contains("index") ? int_field(m, "index", where) : static_cast<int32_t>(i);
     if (n.index != static_cast<int32_t>(i)) throw std::runtime_error(where + ".index: " + std::to_string(n.index) + " but it is entry " + std::to_string(i));
+    if (m.contains("key") && !m.at("key").is_string())
+      throw std::runtime_error(where + ".key: expected a string");
     n.key = m.value("key", std::string());
     if (m.contains("known")) {
       if (!m.at("known").is_boolean())
@@ -53,8 +66,7 @@ ModuleTree tree_from_json(const json& doc, const std::string& source) {
     if (m.contains("slave_positions")) {
       if (!m.at("slave_positions").is_array()) throw std::runtime_error(where + ".slave_positions: expected a list");
       for (const json& p : m.at("slave_positions")) {
-        if (!p.is_number_integer()) throw std::runtime_error(where + ".slave_positions: expected integers");
-        n.slave_positions.push_back(p.get<int32_t>());
+        n.slave_positions.push_back(int32_of(p, where + ".slave_positions"));
       }
     }
     n.parent_module = int_field(m, "parent_module", where);

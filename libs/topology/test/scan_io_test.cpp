@@ -141,6 +141,8 @@ TEST(ScanIo, RoundTripThroughFilesInBothFormats) {
   EXPECT_EQ(load_scan(dir / "scan.yaml"), scan);
   EXPECT_EQ(load_scan(dir / "scan.json"), scan);
   std::filesystem::remove_all(dir);
+  // An empty scan too (found by tests/fuzz: "slaves:" alone reads as null, not as no slave).
+  EXPECT_EQ(parse_scan_yaml(scan_to_yaml(EscScan{}), "empty.yaml"), EscScan{});
 }
 
 TEST(TreeJson, HasTheDiscoverShape) {
@@ -191,6 +193,25 @@ TEST(TreeJson, HasTheDiscoverShape) {
     EXPECT_NE(std::string(e.what()).find("tree.json"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("parent_connector"), std::string::npos) << e.what();
   }
+  // Found by tests/fuzz: a key that is not a string threw the JSON library's type_error; an
+  // integer beyond int32 was silently cut.
+  const auto error_of = [](const nlohmann::json& doc) {
+    try {
+      tree_from_json(doc, "tree.json");
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  broken = j;
+  broken["modules"][0]["key"] = 5;
+  EXPECT_EQ(error_of(broken), "tree.json: modules[0].key: expected a string");
+  broken = j;
+  broken["modules"][1]["parent_module"] = 4294967296;
+  EXPECT_EQ(error_of(broken), "tree.json: modules[1].parent_module: 4294967296 is out of range");
+  broken = j;
+  broken["modules"][1]["slave_positions"] = {-2147483649};
+  EXPECT_EQ(error_of(broken), "tree.json: modules[1].slave_positions: -2147483649 is out of range");
 }
 
 }  // namespace

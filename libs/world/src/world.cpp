@@ -41,6 +41,20 @@ std::string text(const Ctx& ctx, const YAML::Node& node, const std::string& fiel
   return node.as<std::string>();
 }
 
+bool boolean(const Ctx& ctx, const YAML::Node& node, const std::string& field) {
+  try {
+    return node.as<bool>();
+  } catch (const YAML::Exception&) {
+    ctx.fail(field, "expected true or false");
+  }
+}
+
+/// The text of a mapping key (a list or a mapping as a key is refused).
+std::string key_text(const Ctx& ctx, const YAML::Node& key, const std::string& field) {
+  if (!key.IsScalar()) ctx.fail(field, "a key that is not a name");
+  return key.Scalar();
+}
+
 int integer(const Ctx& ctx, const YAML::Node& node, const std::string& field) {
   try {
     return node.as<int>();
@@ -67,7 +81,7 @@ void only_keys(const Ctx& ctx, const YAML::Node& node, const std::string& field,
     ctx.fail(field, "expected a map with " + what);
   }
   for (const auto& kv : node) {
-    const auto key = kv.first.as<std::string>();
+    const std::string key = key_text(ctx, kv.first, field);
     if (keys.count(key) == 0) {
       ctx.fail(field + "." + key, "unknown key (expected " + what + ")");
     }
@@ -458,15 +472,9 @@ void validate_world(const World& world, const std::string& where) {
   }
 }
 
-World parse_world_yaml(const std::string& text, const std::string& source) {
-  const Ctx ctx{source};
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw WorldError("world file '" + source + "': YAML error at line " +
-                     std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+namespace {
+
+World parse_world_node(const YAML::Node& root, const Ctx& ctx) {
   World world;
   if (root.IsNull()) {
     return world;
@@ -475,7 +483,7 @@ World parse_world_yaml(const std::string& text, const std::string& source) {
     ctx.fail("top level", "expected a map with floor, walls, obstacles, marks, surfaces");
   }
   for (const auto& kv : root) {
-    const auto key = kv.first.as<std::string>();
+    const std::string key = key_text(ctx, kv.first, "top level");
     if (key != "floor" && key != "walls" && key != "obstacles" && key != "marks" &&
         key != "surfaces") {
       ctx.fail(key, "unknown key (expected floor, walls, obstacles, marks, surfaces)");
@@ -483,12 +491,12 @@ World parse_world_yaml(const std::string& text, const std::string& source) {
   }
   if (const auto floor = root["floor"]) {
     if (floor.IsScalar()) {
-      world.floor = floor.as<bool>();
+      world.floor = boolean(ctx, floor, "floor");
     } else {
       only_keys(ctx, floor, "floor", {"enabled", "height", "friction"},
                 "enabled, height, friction");
       if (floor["enabled"]) {
-        world.floor = floor["enabled"].as<bool>();
+        world.floor = boolean(ctx, floor["enabled"], "floor.enabled");
       }
       if (floor["height"]) {
         world.floor_height = number(ctx, floor["height"], "floor.height");
@@ -521,6 +529,22 @@ World parse_world_yaml(const std::string& text, const std::string& source) {
   each("surfaces", [&](const YAML::Node& n, const std::string& f) {
     world.surfaces.push_back(surface(ctx, n, f));
   });
+  return world;
+}
+
+}  // namespace
+
+World parse_world_yaml(const std::string& text, const std::string& source) {
+  const Ctx ctx{source};
+  World world;
+  try {
+    world = parse_world_node(YAML::Load(text), ctx);
+  } catch (const YAML::Exception& e) {
+    // Not valid YAML, or a node of another kind than the reader checked for (the readers above
+    // name the field where they can; this names the line for the rest).
+    throw WorldError("world file '" + source + "': YAML error at line " +
+                     std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
   validate_world(world, "world file '" + source + "'");
   return world;
 }

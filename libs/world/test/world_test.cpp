@@ -55,6 +55,11 @@ TEST(World, ClearErrorsNameFileAndField) {
   expect_error("walls: [\n", "YAML error");
   expect_error("walls:\n  - name: a\n    size: [1, x, 1]\n    position: [0, 0, 0]\n",
                "walls[0].size[1]");
+  // Found by tests/fuzz: yaml-cpp's conversion errors escaped the parser.
+  expect_error("floor: f\n", "floor: expected true or false");
+  expect_error("floor: {enabled: 3}\n", "floor.enabled: expected true or false");
+  expect_error("{[a]: 1}\n", "top level: a key that is not a name");
+  expect_error("walls:\n  - {[a]: 1}\n", "walls[0]: a key that is not a name");
 }
 
 // A wall 4 m wide (along y), 2 m high, whose -x face is at x = 0.9: u = -y on that face.

@@ -287,7 +287,7 @@ int pub(const Publish& p, std::ostream& out) {
     sample = idl::complete(schema, type, idl::Json::parse(p.json));
     bytes = idl::encode(schema, type, sample);
     key = idl::key_hash(schema, type, sample);
-  } catch (const idl::Json::parse_error& e) {
+  } catch (const idl::Json::exception& e) {  // not JSON, or a number out of range
     throw UsageError("JSON: " + std::string(e.what()));
   } catch (const idl::CdrError& e) {
     throw UsageError("JSON for " + type + ": " + e.what());

@@ -1,7 +1,9 @@
 #pragma once
 // Text helpers shared by the services, the tools and the tests.
 
+#include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,6 +27,11 @@ std::string join(const Range& items, std::string_view separator = ", ") {
 /// The pieces of `text` between `separator` characters, empty pieces left out
 /// ("a,,b," -> {"a", "b"}).
 std::vector<std::string> split(std::string_view text, char separator = ',');
+
+/// Index of the first byte of `text` that does not begin a valid UTF-8 character (a stray
+/// continuation byte, a character cut short, an overlong form, a surrogate, a code point above
+/// U+10FFFF); nullopt for valid UTF-8.
+std::optional<std::size_t> invalid_utf8_at(std::string_view text);
 
 /// The whole content of `file`. Throws std::runtime_error "`what` file 'FILE' cannot be opened"
 /// when it cannot be read (`what` e.g. "parameters", "world").
