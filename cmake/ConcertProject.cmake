@@ -198,11 +198,12 @@ endfunction()
 
 # Unit/integration test from sources, linked with GoogleTest and GoogleMock (matchers such as
 # HasSubstr), registered with ctest.
-#   concert_add_test(NAME name SOURCES a.cpp ... LIBS lib ... [LABELS l ...] [TIMEOUT s] [DDS])
+#   concert_add_test(NAME name SOURCES a.cpp ... LIBS lib ... [LABELS l ...] [TIMEOUT s] [DDS] [MANUAL])
+#   MANUAL: the test program is built but not registered with ctest (make chaos runs one).
 # DDS: the test gets a private CONCERT_DOMAIN_ID and the label "dds".
 set(CONCERT_TEST_SUPPORT_DIR ${CMAKE_CURRENT_LIST_DIR}/../tests/support)
 function(concert_add_test)
-  cmake_parse_arguments(T "DDS" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(T "DDS;MANUAL" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
   concert_target_defaults(${T_NAME})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gmock GTest::gtest GTest::gtest_main Threads::Threads)
@@ -211,6 +212,9 @@ function(concert_add_test)
   target_compile_definitions(${T_NAME} PRIVATE
     CONCERT_SHARED_DATA="${CONCERT_SHARED_DATA}"
     CONCERT_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  if(T_MANUAL)
+    return()  # built, run by hand or by a make target, not by ctest
+  endif()
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 120)
   endif()
