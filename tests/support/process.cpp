@@ -54,10 +54,9 @@ Process::Process(std::vector<std::string> argv, std::vector<std::string> env) {
 }
 
 Process::~Process() {
-  if (running()) {
-    kill(pid_, SIGKILL);
-    waitpid(pid_, nullptr, 0);
-  }
+  // SIGINT first: a `concert up` left running by a test that ended at an assertion then stops
+  // its services instead of leaving them on the machine.
+  if (running()) stop(std::chrono::seconds(5));
 }
 
 bool Process::running() {

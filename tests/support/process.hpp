@@ -29,7 +29,7 @@ class Process {
   /// Starts argv[0] with the arguments; stdout and stderr go to files in a fresh temp folder.
   /// `env` entries ("NAME=value") are added to the environment.
   explicit Process(std::vector<std::string> argv, std::vector<std::string> env = {});
-  /// Kills the process (SIGKILL) if still running.
+  /// Stops the process if still running: SIGINT, SIGKILL 5 s later.
   ~Process();
   Process(const Process&) = delete;
   Process& operator=(const Process&) = delete;

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -52,6 +53,7 @@ void Supervisor::say(const std::string& line) {
 
 void Supervisor::start(Child& child) {
   const auto log_file = log_dir_ / (child.spec.name + ".log");
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) {
     say("cannot fork for " + child.spec.name);
@@ -65,6 +67,11 @@ void Supervisor::start(Child& child) {
     dup2(fd, 2);
     dup2(in, 0);
     setpgid(0, 0);  // Ctrl-C in the terminal reaches `concert up`, which stops the services in order
+    // A `concert up` that dies without stopping them (SIGKILL, a crash) takes its services along:
+    // orphans kept a whole stack running on the domain (a test that ended at an assertion left
+    // one, and the next test on the machine starved).
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(127);
     std::vector<char*> argv;
     for (auto& a : child.spec.argv) argv.push_back(a.data());
     argv.push_back(nullptr);

@@ -4,7 +4,11 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <unistd.h>
+#include <sys/wait.h>
+
 #include <chrono>
+#include <fstream>
 #include <sstream>
 #include <thread>
 
@@ -83,6 +87,49 @@ TEST(Supervisor, BacksOffACrashLoopAndRestartsAKilledStableServiceAtOnce) {
   stable_run();
   kill_and_wait_restart("sleeper was killed by signal 9; restarting in 0.1 s (restart 3");
   s.stop_all(2000ms);
+}
+
+// Whether `pid` runs (a zombie waiting for its reaper does not).
+bool alive(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  const auto paren = line.rfind(')');
+  return paren != std::string::npos && paren + 2 < line.size() && line[paren + 2] != 'Z';
+}
+
+TEST(Supervisor, AKilledConcertUpTakesItsServicesAlong) {
+  // `concert up` killed with SIGKILL cannot stop its services: they get SIGTERM from the kernel
+  // (a test ending at an assertion left a whole stack running before).
+  testing::TempDir dir("concert-supervisor-orphans");
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const pid_t up = fork();
+  ASSERT_GE(up, 0);
+  if (up == 0) {
+    std::ostringstream log;
+    Supervisor s({{"sleeper", {"/bin/sleep", "60"}}}, dir.path(), log, BackoffParams{});
+    s.start_all();
+    const pid_t service = s.pid("sleeper").value_or(-1);
+    (void)!write(fds[1], &service, sizeof service);
+    pause();
+    _exit(0);
+  }
+  pid_t service = -1;
+  ASSERT_EQ(read(fds[0], &service, sizeof service), static_cast<ssize_t>(sizeof service));
+  ASSERT_GT(service, 0);
+  EXPECT_TRUE(alive(service));
+  ASSERT_EQ(::kill(up, SIGKILL), 0);
+  waitpid(up, nullptr, 0);
+  bool gone = false;
+  for (int i = 0; i < 500 && !gone; ++i) {  // 5 s at most
+    gone = !alive(service);
+    if (!gone) std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_TRUE(gone) << "the service outlived concert up";
+  if (!gone) ::kill(service, SIGKILL);
+  close(fds[0]);
+  close(fds[1]);
 }
 
 }  // namespace
