@@ -1,12 +1,13 @@
 #include "concert/dds/participant.hpp"
 
 #include <cstdlib>
+#include <fstream>
+#include <iostream>
 #include <stdexcept>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
-#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
 #include "concert/security/dds_config.hpp"
@@ -22,14 +23,40 @@ namespace {
 // ports of the first kMaxLocalParticipants participant ids); no multicast, no other interface.
 constexpr uint32_t kMaxLocalParticipants = 48;
 
+// Once per process: a kernel that caps socket buffers below kSocketBufferBytes loses camera
+// frames; say how to fix it instead of letting frames vanish silently.
+void check_socket_buffer_limit() {
+  static const bool checked = [] {
+    std::ifstream in("/proc/sys/net/core/rmem_max");
+    uint64_t rmem_max = 0;
+    if (in >> rmem_max && rmem_max < kSocketBufferBytes) {
+      std::cerr << "concert dds: net.core.rmem_max is " << rmem_max << " bytes, below the "
+                << kSocketBufferBytes << " the localhost transport asks for: large samples (camera images) "
+                << "may be lost; raise it (deploy/install-deps.sh does: sysctl -w net.core.rmem_max="
+                << kSocketBufferBytes << " net.core.wmem_max=" << kSocketBufferBytes << ")\n";
+    }
+    return true;
+  }();
+  (void)checked;
+}
+
 void use_localhost_only(DomainParticipantQos& qos) {
+  // UDP on loopback only, no shared memory: a process killed with SIGKILL (a crash, the chaos
+  // test) leaves Fast DDS 2.9's shared-memory ports in a state where restarted processes, and
+  // sometimes running ones, no longer hear each other (upstream, still open in 2.14: a
+  // restarted subscriber matches but receives nothing; a killed one breaks the others). We saw
+  // it as a restarted robot deaf to the safety stop naming it and a restarted drill service
+  // that never got the latched model; over UDP every restart was heard (tests/system chaos).
+  // Loopback UDP with 4 MiB socket buffers carries the 1.5 MB RGB + depth pairs at 15 Hz
+  // without loss (bench_sensors_dds: 300 of 300 pairs, latency median 1.5 ms, vs 2.0 ms over
+  // shared memory); with the kernel's default 208 KiB buffers two frames in three were lost.
+  check_socket_buffer_limit();
   auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
   udp->interfaceWhiteList.emplace_back("127.0.0.1");
   udp->maxInitialPeersRange = kMaxLocalParticipants;
+  udp->sendBufferSize = kSocketBufferBytes;
+  udp->receiveBufferSize = kSocketBufferBytes;
   qos.transport().use_builtin_transports = false;
-  auto shm = std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>();
-  shm->segment_size(kShmSegmentBytes);
-  qos.transport().user_transports.push_back(shm);
   qos.transport().user_transports.push_back(udp);
 
   eprosima::fastrtps::rtps::Locator_t local;
@@ -40,11 +67,7 @@ void use_localhost_only(DomainParticipantQos& qos) {
   // A user-given metatraffic unicast locator keeps Fast DDS from adding its multicast one.
   builtin.metatrafficUnicastLocatorList.push_back(local);
   builtin.metatrafficMulticastLocatorList.clear();
-  // No user-given default unicast locator: Fast DDS then announces both a shared-memory locator
-  // and the (whitelisted) UDP 127.0.0.1 one for user data, and local readers get their samples
-  // through shared memory. With a UDP locator given here, user data went over UDP only, where a
-  // 1 MB best-effort image (16 fragments in one burst) overflows the socket buffer: about half
-  // the camera frames were lost (bench_sensors_dds).
+  // No user-given default unicast locator: Fast DDS announces the whitelisted UDP 127.0.0.1 one.
 
   // Announce often: unicast announcements to 48 local ports cost nothing on loopback, and a
   // participant that starts late (a tool, a restarted service) is seen within half a second

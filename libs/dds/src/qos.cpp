@@ -23,6 +23,11 @@ EndpointQos endpoint_qos(EndpointQos q, const QosSpec& spec) {
   q.resource_limits().max_samples_per_instance = spec.history_depth;
   q.endpoint().history_memory_policy =
       eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+  // No data sharing (Fast DDS's automatic shared-memory delivery of bounded types between
+  // local processes): like the shared-memory transport (participant.cpp), it keeps state in
+  // /dev/shm that a process killed with SIGKILL leaves behind; every sample goes through the
+  // participant's transport.
+  q.data_sharing().off();
   return q;
 }
 

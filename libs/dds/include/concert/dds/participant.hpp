@@ -21,14 +21,12 @@
 
 namespace concert::dds {
 
-/// Size of each participant's shared-memory segment [bytes] (the "localhost" network). A sample
-/// is fragmented into <= 64 KB messages that all sit in the writer's segment until every local
-/// reader has taken them; Fast DDS's default (512 KiB) holds less than one 640x480 RGB8 image
-/// (921,600 bytes) and lost most camera frames (bench_sensors_dds). 16 MiB holds about ten
-/// RGB + depth pairs (1.5 MB each). Reserved in /dev/shm per participant, pages touched as used.
-/// Images are not zero-copy (Fast DDS 2.9 loans need fixed-size types): the writer serializes
-/// into the segment, the reader deserializes out of it.
-inline constexpr uint32_t kShmSegmentBytes = 16u * 1024u * 1024u;
+/// Send and receive socket buffer of the "localhost" network's UDP transport [bytes]. A sample
+/// is sent as <= 64 KB fragments in one burst; a 640x480 RGB8 image (921,600 bytes) plus its
+/// depth image overflow the kernel's default 208 KiB receive buffer (bench_sensors_dds lost two
+/// frames in three). The kernel caps the request at net.core.rmem_max / wmem_max
+/// (deploy/install-deps.sh raises them; a participant warns once when they are lower).
+inline constexpr uint32_t kSocketBufferBytes = 4u * 1024u * 1024u;
 
 struct ParticipantOptions {
   std::string name = "concert";   ///< participant name, shown by DDS tools
@@ -36,7 +34,7 @@ struct ParticipantOptions {
   /// Fast DDS XML profiles file; empty: CONCERT_DDS_PROFILES if set, else built-in defaults.
   std::string profiles_file;
   std::string profile_name = "concert_participant";  ///< participant profile in that file
-  /// Without a profile: "localhost" (default; UDP on 127.0.0.1 + shared memory, unicast
+  /// Without a profile: "localhost" (default; UDP on 127.0.0.1, no shared memory, unicast
   /// discovery, nothing leaves the machine) or "system" (Fast DDS defaults: every interface,
   /// multicast discovery). Empty: CONCERT_DDS_NETWORK if set, else "localhost".
   std::string network;
