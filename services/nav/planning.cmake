@@ -29,4 +29,4 @@ concert_add_test(NAME nav_local_controller_test
 
 add_executable(bench_global_planner ${CMAKE_CURRENT_LIST_DIR}/bench/bench_global_planner.cpp)
 concert_target_defaults(bench_global_planner)
-target_link_libraries(bench_global_planner PRIVATE concert_nav_planning_fixtures)
+target_link_libraries(bench_global_planner PRIVATE concert_cli concert_nav_planning_fixtures)

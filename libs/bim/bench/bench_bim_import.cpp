@@ -7,6 +7,7 @@
 
 #include "concert/bim/model.hpp"
 #include "concert/bim/storey_map.hpp"
+#include "concert/cli/benchmark_main.hpp"
 
 namespace {
 
@@ -57,4 +58,9 @@ BENCHMARK_CAPTURE(rasterise, duplex_level_2, std::string("duplex.ifc"), std::str
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  return concert::cli::benchmark_main(
+      "bench_bim_import",
+      "IFC import time per shared file and the storey map rasterisation time at 5 cm cells.", argc,
+      argv);
+}

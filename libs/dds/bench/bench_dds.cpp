@@ -32,6 +32,7 @@
 #include <thread>
 #include <vector>
 
+#include "concert/cli/cli.hpp"
 #include "concert/common/clock.hpp"
 #include "concert/common/text.hpp"
 #include "concert/dds/endpoint.hpp"
@@ -207,21 +208,7 @@ std::optional<security::GovernanceOptions> governance(const std::string& mode) {
 
 }  // namespace
 
-int bench_main(int argc, char** argv) {
-  int pings = 2000, seconds = 5, joints = 18;
-  std::string modes = "off,default";
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    if (a == "--pings") pings = std::stoi(argv[i + 1]);
-    else if (a == "--seconds") seconds = std::stoi(argv[i + 1]);
-    else if (a == "--joints") joints = std::stoi(argv[i + 1]);
-    else if (a == "--security") modes = argv[i + 1];
-    else {
-      std::cerr << "usage: bench_dds [--pings N] [--seconds S] [--joints J] [--security "
-                   "off,auth,sign,default,submessages,encrypt-all]\n";
-      return 2;
-    }
-  }
+int bench(int pings, int seconds, int joints, const std::string& modes) {
   const int stream_samples = seconds * 1000;
   for (const std::string& mode : split(modes)) {
     const auto options = governance(mode);
@@ -264,4 +251,38 @@ int bench_main(int argc, char** argv) {
 
 }  // namespace concert
 
-int main(int argc, char** argv) { return concert::bench_main(argc, argv); }
+int main(int argc, char** argv) {
+  concert::cli::Cli cli("bench_dds",
+                        "DDS between two processes on loopback: command -> state round trip and a "
+                        "1 kHz JointState stream, under each DDS Security governance named.",
+                        std::cout, std::cerr);
+  int pings = 2000, seconds = 5, joints = 18;
+  std::string modes = "off,default";
+  auto& app = cli.app();
+  app.add_option("--pings", pings, "round trips measured")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 1e9, true));
+  app.add_option("--seconds", seconds, "length of the 1 kHz stream [s]")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 86400, true));
+  app.add_option("--joints", joints, "joints in each JointState sample")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 1000, true));
+  app.add_option("--security", modes,
+                 "governances, comma-separated: off, auth, sign, default, submessages, encrypt-all")
+      ->capture_default_str()
+      ->type_name("MODE,...")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            try {
+              for (const std::string& mode : concert::split(text)) (void)concert::governance(mode);
+            } catch (const std::invalid_argument& e) {
+              const std::string what = e.what();  // "--security: 'x' is not ...": CLI11 names it
+              return what.substr(what.find('\''));
+            }
+            return "";
+          },
+          "", "governances"));
+  cli.on_run(app, [&] { return concert::bench(pings, seconds, joints, modes); });
+  return cli.run(argc, argv);
+}

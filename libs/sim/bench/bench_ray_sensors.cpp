@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 
+#include "concert/cli/benchmark_main.hpp"
 #include "concert/sim/imu_simulator.hpp"
 #include "concert/sim/ray_sensors.hpp"
 #include "concert/sim/sim_hardware.hpp"
@@ -164,4 +165,9 @@ BENCHMARK(BM_ImuSample);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  return concert::cli::benchmark_main("bench_ray_sensors",
+                                      "The simulated sensors' cost per reading (VLP-16, sonars, 2D "
+                                      "scan, IMU) in a room around the drill robot.",
+                                      argc, argv);
+}

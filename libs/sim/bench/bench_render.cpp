@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "concert/cli/benchmark_main.hpp"
 #include "concert/common/text.hpp"
 #include "concert/sim/rgbd_renderer.hpp"
 #include "concert/sim/sim_hardware.hpp"
@@ -168,4 +169,10 @@ BENCHMARK(BM_MakeRenderer)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  return concert::cli::benchmark_main(
+      "bench_render",
+      "The simulated RGB-D camera: a 640 x 480 frame rendered headless, with and without the D400 "
+      "noise, and a new renderer (hot swap).",
+      argc, argv);
+}

@@ -11,11 +11,13 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <iostream>
 #include <map>
 #include <mutex>
 #include <string>
 #include <thread>
 
+#include "concert/cli/cli.hpp"
 #include "concert/sim/sim_assembly.hpp"
 #include "concert/sim/sim_hardware.hpp"
 #include "concert/world/world.hpp"
@@ -78,10 +80,7 @@ void run(const char* name, sim::SimHardware& sim, Counter& counter, double secon
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const double seconds = argc > 1 ? std::stod(argv[1]) : 10.0;
+int bench(double seconds) {
   const std::string source = CONCERT_SOURCE_DIR;
   const sim::AssemblyBuilder builder({source + "/data/module_db"});
   const sim::SimulatedRobot robot = builder.build(source + "/deploy/demo/drill_robot.yaml");
@@ -103,4 +102,21 @@ int main(int argc, char** argv) {
   run("free-running physics", sim, counter, seconds, false);
   sim.set_sensor_sink(nullptr);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  concert::cli::Cli cli(
+      "bench_sim_sensors",
+      "The simulation with every sensor of the demo drill robot on: the real-time "
+      "factor of the paced 1 kHz loop and each sensor's rate, then physics unpaced.",
+      std::cout, std::cerr);
+  double seconds = 10.0;
+  cli.app()
+      .add_option("SECONDS", seconds, "simulated seconds per run")
+      ->capture_default_str()
+      ->check(concert::cli::positive_seconds());
+  cli.on_run(cli.app(), [&seconds] { return bench(seconds); });
+  return cli.run(argc, argv);
 }

@@ -6,6 +6,7 @@
 #include <random>
 #include <string>
 
+#include "concert/cli/benchmark_main.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/simbus/testing.hpp"
 #include "concert/topology/reconstruction.hpp"
@@ -135,4 +136,9 @@ BENCHMARK(BM_NetworkComb<true>)->Name("BM_NetworkCombPaperReference")
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  return concert::cli::benchmark_main(
+      "bench_discovery",
+      "Scan -> module tree: the paper robot and synthetic trees of 100 .. 10 000 slaves.", argc,
+      argv);
+}

@@ -1,11 +1,13 @@
 // Tree -> model (URDF + SRDF + controller config + hash) and scan -> model, for the public
 // database's 18-module robot and synthetic 100 / 1 000-module trees. Not a test.
+//   bench_modelgen [--benchmark_filter=...]   (Google Benchmark flags; --help lists them)
+
+#include <benchmark/benchmark.h>
 
 #include <filesystem>
 #include <random>
 
-#include <benchmark/benchmark.h>
-
+#include "concert/cli/benchmark_main.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/reconstruction.hpp"
 #include "modelgen/model_generator.hpp"
@@ -107,4 +109,8 @@ BENCHMARK_CAPTURE(BM_TreeToModel, synthetic_100, synthetic(100, 1))->Unit(benchm
 BENCHMARK_CAPTURE(BM_TreeToModel, synthetic_1000, synthetic(1000, 2))->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ScanToModel18)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadPublicDatabase)->Unit(benchmark::kMillisecond);
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  return concert::cli::benchmark_main(
+      "bench_modelgen", "Tree -> model (URDF + SRDF + controller config + hash) and scan -> model.",
+      argc, argv);
+}

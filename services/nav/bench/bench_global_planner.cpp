@@ -10,9 +10,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <iostream>
 #include <string>
 #include <vector>
 
+#include "concert/cli/cli.hpp"
 #include "planning_fixtures.hpp"
 
 namespace nav = concert::nav;
@@ -42,27 +44,7 @@ void row(const char* name, const std::vector<double>& v, const char* unit) {
               quantile(v, 0.95), v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()), unit);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::string map_yaml;
-  int pairs = 100;
-  int missions = 20;
-  unsigned seed = 1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if ((a == "--pairs" || a == "--missions" || a == "--seed") && i + 1 < argc) {
-      const int v = std::atoi(argv[++i]);
-      if (a == "--pairs") pairs = v;
-      if (a == "--missions") missions = v;
-      if (a == "--seed") seed = static_cast<unsigned>(v);
-    } else if (!a.empty() && a[0] != '-' && map_yaml.empty()) {
-      map_yaml = a;
-    } else {
-      std::fprintf(stderr, "usage: %s [MAP_YAML] [--pairs N] [--missions N] [--seed S]\n", argv[0]);
-      return 2;
-    }
-  }
+int bench(const std::string& map_yaml, int pairs, int missions, unsigned seed) {
   nt::Building building;
   try {
     if (map_yaml.empty()) {
@@ -162,4 +144,34 @@ int main(int argc, char** argv) {
   row("heading error at goal", yaw_err, "deg");
   row("replans", replans, "");
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  concert::cli::Cli cli("bench_global_planner",
+                        "Global planner (plan time over seeded start/goal pairs, costmap build and "
+                        "scan update) and closed-loop navigation (seeded missions with unmapped "
+                        "obstacles in the kinematic simulation).",
+                        std::cout, std::cerr);
+  std::string map_yaml;
+  int pairs = 100;
+  int missions = 20;
+  unsigned seed = 1;
+  auto& app = cli.app();
+  app.add_option("MAP_YAML", map_yaml,
+                 "storey map (default: a synthetic storey of 4 x 3 rooms of 5 m at 5 cm cells)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--pairs", pairs, "seeded start/goal pairs planned")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 1e6, true));
+  app.add_option("--missions", missions,
+                 "seeded closed-loop missions (synthetic storey only; 0: none)")
+      ->capture_default_str()
+      ->check(concert::cli::number(0, 1e6, true));
+  app.add_option("--seed", seed, "seed of the storey, the pairs and the missions")
+      ->capture_default_str()
+      ->check(concert::cli::number(0, 4294967295.0, true));
+  cli.on_run(app, [&] { return bench(map_yaml, pairs, missions, seed); });
+  return cli.run(argc, argv);
 }

@@ -24,6 +24,7 @@
 #include <random>
 #include <string>
 
+#include "concert/cli/cli.hpp"
 #include "planner/config.hpp"
 #include "planner/fixtures.hpp"
 #include "planner/planner.hpp"
@@ -80,47 +81,38 @@ double percentile(std::vector<double> v, double p) {
   return v[std::min(i, v.size() - 1)];
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The command line (defaults as documented at the top).
+struct Options {
   int count = 24;
   uint64_t seed = 2024;
   bool verbose = false;
-  Params base_params;
+  std::string params_file;
   std::optional<double> contact_force;
   int only = -1;
   bool warm = false;
   std::string morphologies = "abc";
   double oracle = 0.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--problems" && i + 1 < argc) {
-      count = std::stoi(argv[++i]);
-    } else if (a == "--seed" && i + 1 < argc) {
-      seed = std::stoull(argv[++i]);
-    } else if (a == "--contact-force" && i + 1 < argc) {
-      contact_force = std::stod(argv[++i]);
-    } else if (a == "--params" && i + 1 < argc) {
-      try {
-        base_params = load_params(argv[++i]);
-      } catch (const PlannerError& e) {
-        std::cerr << "bench_planner: " << e.what() << "\n";
-        return 2;
-      }
-    } else if (a == "--only" && i + 1 < argc) {
-      only = std::stoi(argv[++i]);
-    } else if (a == "--morphology" && i + 1 < argc) {
-      morphologies = argv[++i];
-    } else if (a == "--oracle" && i + 1 < argc) {
-      oracle = std::stod(argv[++i]);
-    } else if (a == "--warm-up") {
-      warm = true;
-    } else if (a == "--verbose") {
-      verbose = true;
-    } else {
-      std::cerr << "bench_planner: unknown argument '" << a
-                << "' (use --problems N, --seed S, --contact-force NEWTON, --params FILE, --only I, --morphology abc, --warm-up, --oracle SECONDS, --verbose)\n";
-      return 2;
+};
+
+int bench(const Options& options) {
+  const int count = options.count;
+  const uint64_t seed = options.seed;
+  const bool verbose = options.verbose;
+  const std::optional<double> contact_force = options.contact_force;
+  const int only = options.only;
+  const bool warm = options.warm;
+  const std::string morphologies = options.morphologies;
+  const double oracle = options.oracle;
+  if (only >= count) {
+    throw concert::cli::UsageError("--only: " + std::to_string(only) +
+                                   " is not below --problems (" + std::to_string(count) + ")");
+  }
+  Params base_params;
+  if (!options.params_file.empty()) {
+    try {
+      base_params = load_params(options.params_file);
+    } catch (const PlannerError& e) {
+      throw concert::cli::UsageError(e.what());
     }
   }
   const std::vector<Problem> problems = make_problems(count, seed);
@@ -233,4 +225,54 @@ int main(int argc, char** argv) {
     report("A<2.4m<=C", assigned);
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  concert::cli::Cli cli(
+      "bench_planner",
+      "A fixed, seeded set of drilling-approach problems per morphology through the "
+      "whole planner: success rate, planning time, motion duration.",
+      std::cout, std::cerr);
+  Options o;
+  auto& app = cli.app();
+  app.add_option("--problems", o.count, "problems per morphology")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 1e6, true));
+  app.add_option("--seed", o.seed, "seed of the problems and the planner")
+      ->capture_default_str()
+      ->check(concert::cli::count());
+  app.add_option("--contact-force", o.contact_force,
+                 "drilling force checked at the goal [N] (default: the parameters')")
+      ->type_name("NEWTON")
+      ->check(concert::cli::number(0.0));
+  app.add_option("--params", o.params_file, "planner parameters (YAML; default: built-in)")
+      ->type_name("FILE")
+      ->check(CLI::ExistingFile);
+  app.add_option("--only", o.only, "run problem I alone (0-based), with --verbose to see it")
+      ->type_name("I")
+      ->check(concert::cli::count());
+  app.add_option("--morphology", o.morphologies, "morphologies to run, letters of abc")
+      ->capture_default_str()
+      ->type_name("abc")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            if (text.empty() || text.find_first_not_of("abc") != std::string::npos) {
+              return "'" + text + "' is not letters of abc (morphologies A, B, C)";
+            }
+            return "";
+          },
+          "", "morphologies"));
+  app.add_flag("--warm-up", o.warm, "warm the planner up (27 heights) before each morphology")
+      ->disable_flag_override();
+  app.add_option(
+         "--oracle", o.oracle,
+         "re-plan every failure with this budget [s] to find the solvable problems (0: off)")
+      ->capture_default_str()
+      ->type_name("SECONDS")
+      ->check(concert::cli::seconds());
+  app.add_flag("--verbose", o.verbose, "one line per problem")->disable_flag_override();
+  cli.on_run(app, [&o] { return bench(o); });
+  return cli.run(argc, argv);
 }

@@ -13,9 +13,10 @@
 #include <string>
 #include <thread>
 
+#include "concert/cli/cli.hpp"
+#include "concert/sim/sim_hardware.hpp"
 #include "robot/loop.hpp"
 #include "robot/robot_core.hpp"
-#include "concert/sim/sim_hardware.hpp"
 
 namespace {
 
@@ -64,26 +65,7 @@ struct Setup {
   std::thread commander;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  double seconds = 5.0;
-  std::string urdf_path = std::string(ROBOT_FIXTURES) + "/mobile_drill.urdf";
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--seconds" && i + 1 < argc) {
-      seconds = std::atof(argv[++i]);
-    } else if (arg == "--urdf" && i + 1 < argc) {
-      urdf_path = argv[++i];
-    } else {
-      std::cerr << "bench_robot: unknown argument '" << arg << "' (usage: bench_robot [--seconds S] [--urdf FILE])\n";
-      return 2;
-    }
-  }
-  if (seconds <= 0.0) {
-    std::cerr << "bench_robot: --seconds must be positive\n";
-    return 2;
-  }
+int bench(double seconds, const std::string& urdf_path) {
   try {
     const std::string urdf = read_file(urdf_path);
     const auto cycles = static_cast<std::uint64_t>(seconds * 1000.0);
@@ -131,4 +113,26 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  concert::cli::Cli cli(
+      "bench_robot",
+      "Control-loop period jitter in real-time mode and the simulation's real-time "
+      "factor, for the 6-DoF drill arm on the mobile base.",
+      std::cout, std::cerr);
+  double seconds = 5.0;
+  std::string urdf_path = std::string(ROBOT_FIXTURES) + "/mobile_drill.urdf";
+  auto& app = cli.app();
+  app.add_option("--seconds", seconds, "simulated seconds per run (1 ms cycles)")
+      ->capture_default_str()
+      ->check(concert::cli::positive_seconds());
+  app.add_option("--urdf", urdf_path, "robot model")
+      ->capture_default_str()
+      ->type_name("FILE")
+      ->check(CLI::ExistingFile);
+  cli.on_run(app, [&] { return bench(seconds, urdf_path); });
+  return cli.run(argc, argv);
 }

@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "concert/cli/cli.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "dds/safety_node.hpp"
 #include "safety/safety_monitor.hpp"
@@ -126,8 +127,20 @@ void bench_dds(int repetitions) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int repetitions = argc > 1 ? std::max(1, std::atoi(argv[1])) : 200;
-  bench_core();
-  bench_dds(repetitions);
-  return 0;
+  concert::cli::Cli cli(
+      "bench_safety",
+      "The limits watchdog's cost per joint sample, and e-stop reaction over DDS "
+      "through a real SafetyNode in another participant. Domain: CONCERT_DOMAIN_ID.",
+      std::cout, std::cerr);
+  int repetitions = 200;
+  cli.app()
+      .add_option("REPETITIONS", repetitions, "e-stop / reset cycles measured over DDS")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 1e6, true));
+  cli.on_run(cli.app(), [&repetitions] {
+    bench_core();
+    bench_dds(repetitions);
+    return 0;
+  });
+  return cli.run(argc, argv);
 }

@@ -9,13 +9,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <iostream>
 #include <map>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <thread>
 
+#include "concert/cli/cli.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "process.hpp"
 
@@ -48,11 +49,7 @@ double pct(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))];
 }
 
-int bench(int argc, char** argv) {
-  int swaps = 20;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (std::string(argv[i]) == "--swaps") swaps = std::stoi(argv[i + 1]);
-  }
+int bench(int swaps) {
   if (std::getenv("CONCERT_DOMAIN_ID") == nullptr) setenv("CONCERT_DOMAIN_ID", "198", 1);
   char tmpl[] = "/tmp/concert-bench-XXXXXX";
   const std::string run = mkdtemp(tmpl);
@@ -167,4 +164,18 @@ int bench(int argc, char** argv) {
 }  // namespace
 }  // namespace concert
 
-int main(int argc, char** argv) { return concert::bench(argc, argv); }
+int main(int argc, char** argv) {
+  concert::cli::Cli cli(
+      "bench_reconfig",
+      "Hot swaps of the mounted assembly under `concert up` (simulated robot), each "
+      "stage timed: scan, module tree, robot model, every service ready. Domain: "
+      "CONCERT_DOMAIN_ID, default 198.",
+      std::cout, std::cerr);
+  int swaps = 20;
+  cli.app()
+      .add_option("--swaps", swaps, "hot swaps timed")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 1e6, true));
+  cli.on_run(cli.app(), [&swaps] { return concert::bench(swaps); });
+  return cli.run(argc, argv);
+}

@@ -1,19 +1,20 @@
-#include "raw_subscription.hpp"
+#include "concert/dds/raw_subscription.hpp"
 
-#include "concert/cli/cli.hpp"
+#include <stdexcept>
+
 #include "concert/dds/catalogue.hpp"
 #include "concert/dds/qos.hpp"
 #include "concert/dds/raw_type.hpp"
 #include "concert/idl_schema/schema.hpp"
 
-namespace concert::tool {
+namespace concert::dds {
 
 using namespace eprosima::fastdds::dds;
 
 std::optional<Resolved> from_catalogue(const std::string& topic) {
-  const auto info = dds::find_topic(topic);
+  const auto info = find_topic(topic);
   if (!info) return std::nullopt;
-  const auto spec = dds::qos_spec(info->qos);
+  const auto spec = qos_spec(info->qos);
   Resolved r;
   r.type = info->type_name;
   r.keyed = idl::Schema::builtin().at(info->type_name).keyed();
@@ -23,17 +24,17 @@ std::optional<Resolved> from_catalogue(const std::string& topic) {
   return r;
 }
 
-RawSubscription::RawSubscription(dds::Participant& participant, const std::string& topic,
+RawSubscription::RawSubscription(Participant& participant, const std::string& topic,
                                  const Resolved& r, Callback cb, Matched matched)
     : participant_(participant), callback_(std::move(cb)), matched_(std::move(matched)) {
-  auto* t = participant.topic(topic, TypeSupport(new dds::RawPubSubType(r.type, r.keyed)));
-  auto qos = dds::reader_qos(r.reliable ? dds::QosClass::kCommand : dds::QosClass::kStream);
+  auto* t = participant.topic(topic, TypeSupport(new RawPubSubType(r.type, r.keyed)));
+  auto qos = reader_qos(r.reliable ? QosClass::kCommand : QosClass::kStream);
   qos.durability().kind =
       r.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
   qos.history().depth = 1000;
   reader_ = participant.subscriber()->create_datareader(
       t, qos, this, StatusMask::data_available() << StatusMask::subscription_matched());
-  if (reader_ == nullptr) throw cli::Failure("cannot subscribe to '" + topic + "'");
+  if (reader_ == nullptr) throw std::runtime_error("cannot subscribe to '" + topic + "'");
 }
 
 RawSubscription::~RawSubscription() {
@@ -42,7 +43,7 @@ RawSubscription::~RawSubscription() {
 }
 
 void RawSubscription::on_data_available(DataReader* reader) {
-  dds::RawSample sample;
+  RawSample sample;
   SampleInfo info;
   while (reader->take_next_sample(&sample, &info) ==
          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
@@ -55,4 +56,4 @@ void RawSubscription::on_subscription_matched(DataReader*,
   if (matched_) matched_(status.current_count);
 }
 
-}  // namespace concert::tool
+}  // namespace concert::dds
