@@ -21,6 +21,10 @@ int main(int argc, char** argv) try {
     security = security::cyclone_security_config(files, CONCERT_CYCLONE_SECURITY_PLUGINS);
   }
   if (cy_open(dds::domain_id_from_env(), security.empty() ? nullptr : security.c_str()) != 0) return 2;
+  // Cyclone's threads stopped on every way out, before exit() runs OpenSSL's cleanup under them.
+  struct CloseAtExit {
+    ~CloseAtExit() { cy_close(); }
+  } close_at_exit;
 
   struct Endpoint {
     dds::TopicInfo info;
@@ -74,7 +78,6 @@ int main(int argc, char** argv) try {
       }
       std::this_thread::sleep_for(10ms);
     }
-    cy_close();
     return 0;
   }
 
@@ -102,7 +105,6 @@ int main(int argc, char** argv) try {
     }
     std::this_thread::sleep_for(5ms);
   }
-  cy_close();
   return contract::report_missing(endpoints);
 } catch (const std::exception& e) {
   std::cerr << "contract_peer_cyclone: " << e.what() << std::endl;
