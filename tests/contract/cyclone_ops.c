@@ -9,8 +9,10 @@
 #include <dds/ddsi/ddsi_serdata.h>
 #include <dds/ddsrt/endian.h>
 
+#include "collab.h"
 #include "drill.h"
 #include "ethercat.h"
+#include "finish.h"
 #include "model.h"
 #include "nav.h"
 #include "planning.h"
@@ -65,6 +67,11 @@ static const struct {
     {"concert::msg::DrillMission", &concert_msg_DrillMission_desc},
     {"concert::msg::DrillAbort", &concert_msg_DrillAbort_desc},
     {"concert::msg::DrillStatus", &concert_msg_DrillStatus_desc},
+    {"concert::msg::CollabCommand", &concert_msg_CollabCommand_desc},
+    {"concert::msg::CollabState", &concert_msg_CollabState_desc},
+    {"concert::msg::FinishAreas", &concert_msg_FinishAreas_desc},
+    {"concert::msg::FinishCommand", &concert_msg_FinishCommand_desc},
+    {"concert::msg::FinishStatus", &concert_msg_FinishStatus_desc},
 };
 
 #define MAX_ENDPOINTS 64

@@ -175,7 +175,7 @@ TEST_F(Security, TheOperatorIsRefusedJointCommandsAndMayEngageAnEStop) {
   } catch (const std::runtime_error& e) {
     EXPECT_THAT(e.what(),
                 HasSubstr("cannot create a DDS writer on 'concert/robot/joint_command': identity "
-                          "'operator' may not publish it (only planner, nav, drill may; "
+                          "'operator' may not publish it (only planner, nav, drill, collab, surface_finish may; "
                           "CONCERT_SECURITY=" +
                           pki().string() + ")"));
   }
@@ -191,7 +191,7 @@ TEST_F(Security, TheOperatorIsRefusedJointCommandsAndMayEngageAnEStop) {
   EXPECT_EQ(pub.code, 1);
   EXPECT_THAT(pub.err, HasSubstr("concert topic pub: cannot create a writer on "
                                  "'concert/robot/joint_command': identity 'operator' may not "
-                                 "publish it (only planner, nav, drill may;"));
+                                 "publish it (only planner, nav, drill, collab, surface_finish may;"));
 
   // What the operator may write reaches the safety service's identity.
   dds::Participant safety({.name = "safety"});

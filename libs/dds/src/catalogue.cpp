@@ -96,6 +96,16 @@ constexpr std::array kTopics = {
               "tools/operator: stop the running drilling mission"},
     TopicInfo{"concert/drill/status", "concert::msg::DrillStatus", QosClass::kLatched,
               "drill: the mission's active behaviour-tree node, areas, holes and time split, per mission"},
+    TopicInfo{"concert/collab/command", "concert::msg::CollabCommand", QosClass::kCommand,
+              "tools/GUI/voice: a collaborative-transport command (\"hey concert follow me\" or a mode)"},
+    TopicInfo{"concert/collab/state", "concert::msg::CollabState", QosClass::kLatched,
+              "collab: the Fig. 12 state, the last command and why it was ignored, follow-me figures"},
+    TopicInfo{"concert/finish/areas", "concert::msg::FinishAreas", QosClass::kLatched,
+              "surface_finish: the predetermined wall areas of the current model and tool"},
+    TopicInfo{"concert/finish/command", "concert::msg::FinishCommand", QosClass::kCommand,
+              "tools/operator: spray or sand an area, or abort"},
+    TopicInfo{"concert/finish/status", "concert::msg::FinishStatus", QosClass::kLatched,
+              "surface_finish: a run's state, progress and spray report, per request"},
 };
 
 }  // namespace

@@ -6,8 +6,8 @@
 namespace concert::security {
 namespace {
 
-constexpr std::array<std::string_view, 8> kIdentities = {
-    "robot", "safety", "discovery", "modelgen", "planner", "nav", "drill", kOperator};
+constexpr std::array<std::string_view, 10> kIdentities = {
+    "robot", "safety", "discovery", "modelgen", "planner", "nav", "drill", "collab", "surface_finish", kOperator};
 constexpr size_t kServices = kIdentities.size() - 1;
 
 // Writer groups. A topic's row names one of them.
@@ -18,14 +18,16 @@ constexpr std::string_view kModelgen[] = {"modelgen"};
 constexpr std::string_view kPlanner[] = {"planner"};
 constexpr std::string_view kNav[] = {"nav"};
 constexpr std::string_view kDrill[] = {"drill"};
+constexpr std::string_view kCollab[] = {"collab"};
+constexpr std::string_view kFinish[] = {"surface_finish"};
 constexpr std::string_view kOperatorOnly[] = {kOperator};
 /// Motion commands to the robot: the planner and the task services, never a tool.
-constexpr std::string_view kCommanders[] = {"planner", "nav", "drill"};
+constexpr std::string_view kCommanders[] = {"planner", "nav", "drill", "collab", "surface_finish"};
 /// Requests to a service: the operator's tools and the task services that chain them.
 constexpr std::string_view kOperatorAndDrill[] = {kOperator, "drill"};
 /// Every service heartbeats its own status instance.
-constexpr std::string_view kServicesOnly[] = {"robot",   "safety", "discovery", "modelgen",
-                                              "planner", "nav",    "drill"};
+constexpr std::string_view kServicesOnly[] = {"robot", "safety", "discovery", "modelgen", "planner",
+                                              "nav",   "drill",  "collab",    "surface_finish"};
 
 constexpr std::string_view kState = "the service that owns this state";
 constexpr std::string_view kMotion = "motion commands: the planner and the task services";
@@ -78,6 +80,11 @@ constexpr std::array kRules = {
     WriteRule{"concert/drill/mission", kOperatorOnly, kOperatorRule},
     WriteRule{"concert/drill/abort", kOperatorOnly, kOperatorRule},
     WriteRule{"concert/drill/status", kDrill, kState},
+    WriteRule{"concert/collab/command", kOperatorOnly, "only the operator's tools (voice, GUI, concert collab)"},
+    WriteRule{"concert/collab/state", kCollab, kState},
+    WriteRule{"concert/finish/areas", kFinish, kState},
+    WriteRule{"concert/finish/command", kOperatorOnly, kOperatorRule},
+    WriteRule{"concert/finish/status", kFinish, kState},
 };
 
 const WriteRule* find_rule(std::string_view topic) {

@@ -225,8 +225,8 @@ TEST(SecurityCli, InitPrintsWhatItCreatedRefusesTwiceChecksAndPrintsTheTable) {
   std::string out, err;
   ASSERT_EQ(run_cli({"security", "init", dir, "--days", "10"}, out, err), 0) << err;
   EXPECT_THAT(out, HasSubstr("created " + dir + "/robot/key.pem  (private key of robot)"));
-  EXPECT_THAT(out, HasSubstr("PKI for 8 identities (robot, safety, discovery, modelgen, planner, "
-                             "nav, drill, operator)"));
+  EXPECT_THAT(out, HasSubstr("PKI for 10 identities (robot, safety, discovery, modelgen, planner, "
+                             "nav, drill, collab, surface_finish, operator)"));
   EXPECT_THAT(out, HasSubstr("Run the stack secured with CONCERT_SECURITY=" + dir));
   EXPECT_EQ(err, "");
   EXPECT_EQ(split(out, '\n').size(), 4 + 4 * identities().size() + 2);
@@ -249,7 +249,7 @@ TEST(SecurityCli, InitPrintsWhatItCreatedRefusesTwiceChecksAndPrintsTheTable) {
 
   ASSERT_EQ(run_cli({"security", "table"}, out, err), 0);
   EXPECT_THAT(out, HasSubstr("  concert/robot/joint_state         robot\n"));
-  EXPECT_THAT(out, HasSubstr("  concert/robot/joint_command       planner, nav, drill\n"));
+  EXPECT_THAT(out, HasSubstr("  concert/robot/joint_command       planner, nav, drill, collab, surface_finish\n"));
   ASSERT_EQ(run_cli({"security", "table", "--json"}, out, err), 0);
   EXPECT_THAT(
       out,

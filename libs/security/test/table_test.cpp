@@ -59,7 +59,8 @@ TEST(SecurityTable, FollowsTheIssuesRules) {
   // The planner and the task services write the robot's commands; no tool does.
   for (const char* command : {"concert/robot/joint_command", "concert/robot/cartesian_command",
                               "concert/robot/base_velocity", "concert/robot/trajectory_command"}) {
-    EXPECT_THAT(writers_of(command), UnorderedElementsAre("planner", "nav", "drill")) << command;
+    EXPECT_THAT(writers_of(command), UnorderedElementsAre("planner", "nav", "drill", "collab", "surface_finish"))
+        << command;
     EXPECT_FALSE(may_write(kOperator, command)) << command;
   }
   EXPECT_TRUE(may_write("planner", "concert/robot/joint_command"));

@@ -5,8 +5,10 @@
 
 #include <string_view>
 
+#include "collabPubSubTypes.h"
 #include "drillPubSubTypes.h"
 #include "ethercatPubSubTypes.h"
+#include "finishPubSubTypes.h"
 #include "modelPubSubTypes.h"
 #include "navPubSubTypes.h"
 #include "planningPubSubTypes.h"
@@ -64,6 +66,11 @@ CONCERT_BIND_PUBSUB(SimHoles);
 CONCERT_BIND_PUBSUB(DrillMission);
 CONCERT_BIND_PUBSUB(DrillAbort);
 CONCERT_BIND_PUBSUB(DrillStatus);
+CONCERT_BIND_PUBSUB(CollabCommand);
+CONCERT_BIND_PUBSUB(CollabState);
+CONCERT_BIND_PUBSUB(FinishAreas);
+CONCERT_BIND_PUBSUB(FinishCommand);
+CONCERT_BIND_PUBSUB(FinishStatus);
 #undef CONCERT_BIND_PUBSUB
 
 /// A catalogue topic carrying T.
@@ -116,6 +123,11 @@ inline constexpr TopicHandle<msg::SimHoles> sim_holes{"concert/sim/holes"};
 inline constexpr TopicHandle<msg::DrillMission> drill_mission{"concert/drill/mission"};
 inline constexpr TopicHandle<msg::DrillAbort> drill_abort{"concert/drill/abort"};
 inline constexpr TopicHandle<msg::DrillStatus> drill_status{"concert/drill/status"};
+inline constexpr TopicHandle<msg::CollabCommand> collab_command{"concert/collab/command"};
+inline constexpr TopicHandle<msg::CollabState> collab_state{"concert/collab/state"};
+inline constexpr TopicHandle<msg::FinishAreas> finish_areas{"concert/finish/areas"};
+inline constexpr TopicHandle<msg::FinishCommand> finish_command{"concert/finish/command"};
+inline constexpr TopicHandle<msg::FinishStatus> finish_status{"concert/finish/status"};
 }  // namespace topics
 
 /// Calls f(handle) for every typed topic handle (e.g. to dispatch on a topic name).
@@ -163,6 +175,11 @@ template <class F> void for_each_topic(F&& f) {
   f(topics::drill_mission);
   f(topics::drill_abort);
   f(topics::drill_status);
+  f(topics::collab_command);
+  f(topics::collab_state);
+  f(topics::finish_areas);
+  f(topics::finish_command);
+  f(topics::finish_status);
 }
 
 }  // namespace concert::dds
