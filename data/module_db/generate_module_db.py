@@ -324,11 +324,11 @@ link("concert_base_link_600", "Passive Base Link 0.6 m", "base_link", ["link", "
 
 # --- End-effectors ----------------------------------------------------------------------------
 def tool(key, label, tags, mass, size, tcp_pose, identity, frames=(), addon_types=(), project_assigned=False,
-         paper=()):
+         paper=(), extra_shapes=()):
     a, b, c = size
     module(key, label, "end_effector", tags,
            [body("tool", mass, (0, 0, c / 2), box_inertia(mass, a, b, c),
-                 ["{box: %s, pose: %s}" % (v(size), pose((0, 0, c / 2)))])],
+                 ["{box: %s, pose: %s}" % (v(size), pose((0, 0, c / 2)))] + list(extra_shapes))],
            [connector("input", "input", "tool"), tcp("tcp", "tool", tcp_pose)], frames=frames,
            addon_types=addon_types, paper=list(paper) or [label], estimated=EST_GEOM + ["tcp pose"] + (["frames.* pose"] if frames else []),
            identity=identity, project_assigned=project_assigned)
@@ -340,8 +340,11 @@ tool("concert_drill", "Drill", ["drill", "tool", "arm"], 10.35, (0.35, 0.12, 0.2
      addon_types=["drillbit", "handle"], paper=["Drill with integrated RealSense D435i camera"])
 tool("concert_spraying_tool", "Spraying Tool", ["spraying_tool", "tool", "arm"], 1.8, (0.12, 0.12, 0.2),
      pose((-0.086, 0, 0.25)), (3, 5, 4, 0))
+# The sanding disc (0.23 m, estimated) between the motor box and the TCP, its face at the TCP, so
+# that the tool touches a wall with its disc (surface_finish's sanding runs in the simulator).
 tool("concert_sanding_tool", "Sanding Tool", ["sanding_tool", "tool", "arm"], 3.5, (0.25, 0.25, 0.15),
-     pose((0, 0, 0.2)), (3, 6, 4, 0), addon_types=["sensor"], project_assigned=True)
+     pose((0, 0, 0.2)), (3, 6, 4, 0), addon_types=["sensor"], project_assigned=True,
+     extra_shapes=[cyl_shape(0.115, 0.05, 0.175)])
 for variant, tcp_z, ident in (("panel", 0.18, (3, 7, 4, 0)), ("tube", 0.16, (3, 8, 4, 0))):
     module("concert_active_gripper_" + variant, "Active Gripper (%s)" % variant, "end_effector",
            ["gripper", "active_gripper", variant, "arm"],

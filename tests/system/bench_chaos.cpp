@@ -7,26 +7,17 @@
 #include <cstdlib>
 #include <iostream>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "chaos.hpp"
+#include "concert/cli/cli.hpp"
 #include "process.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int bench(unsigned seed, double duration_s) {
   using namespace concert::system_test::chaos;
-  unsigned seed = 1;
-  double duration_s = 300.0;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string arg = argv[i];
-    if (arg == "--seed") {
-      seed = static_cast<unsigned>(std::stoul(argv[i + 1]));
-    } else if (arg == "--duration") {
-      duration_s = std::stod(argv[i + 1]);
-    } else {
-      std::cerr << "usage: bench_chaos [--seed N] [--duration S]\n";
-      return 2;
-    }
-  }
   if (std::getenv("CONCERT_DOMAIN_ID") == nullptr) setenv("CONCERT_DOMAIN_ID", "197", 1);
   concert::testing::TempDir run("concert-bench-chaos");
   Chaos chaos(demo_options(run.path()));
@@ -57,4 +48,26 @@ int main(int argc, char** argv) {
             << "kill -> ready at the current model:\n"
             << figures(rounds) << summary(task, rounds);
   return failed == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  concert::cli::Cli cli(
+      "bench_chaos",
+      "The random phase of system_chaos_test for longer: the stack under `concert "
+      "up` in simulation, random services killed with SIGKILL round after round. "
+      "Domain: CONCERT_DOMAIN_ID, default 197.",
+      std::cout, std::cerr);
+  unsigned seed = 1;
+  double duration_s = 300.0;
+  auto& app = cli.app();
+  app.add_option("--seed", seed, "seed of the kills")
+      ->capture_default_str()
+      ->check(concert::cli::number(0, 4294967295.0, true));
+  app.add_option("--duration", duration_s, "how long to kill services [s]")
+      ->capture_default_str()
+      ->check(concert::cli::positive_seconds());
+  cli.on_run(app, [&] { return bench(seed, duration_s); });
+  return cli.run(argc, argv);
 }

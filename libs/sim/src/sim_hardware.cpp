@@ -91,11 +91,15 @@ struct MjcfWriter {
         continue;
       }
       const std::string name = "\"" + link.name + "_collision_" + std::to_string(k++) + "\"";
+      const auto own = params.link_friction.find(link.name);
+      const double mu = own != params.link_friction.end() ? own->second
+                        : is_wheel                         ? params.wheel_friction
+                                                           : params.robot_friction;
       const std::string common = " name=" + name + " " + pos_quat(c->origin) + " group=\"" +
                                  std::to_string(houses_camera(link) ? kCameraHousingGeomGroup : kRobotGeomGroup) +
-                                 "\" contype=\"1\" conaffinity=\"0\"" +
-                                 " friction=\"" + num(is_wheel ? params.wheel_friction : params.robot_friction) +
-                                 " 0.005 0.0001\"";
+                                 "\" contype=\"1\" conaffinity=\"0\"" + " friction=\"" + num(mu) +
+                                 " 0.005 0.0001\"" +
+                                 (own != params.link_friction.end() ? " priority=\"1\"" : "");
       switch (c->geometry->type) {
         case urdf::Geometry::BOX: {
           const auto& b = dynamic_cast<const urdf::Box&>(*c->geometry);
@@ -241,6 +245,14 @@ struct Built {
 Built build_mjcf(const std::string& urdf, const World& world, const SimParams& params,
                  const std::vector<SensorMount>& sensors) {
   const auto parsed = parse(urdf);
+  for (const auto& [link, mu] : params.link_friction) {
+    if (!parsed->getLink(link)) {
+      throw HardwareError("sim: link_friction names '" + link + "', which is no link of the robot");
+    }
+    if (!(mu >= 0.0) || !std::isfinite(mu)) {
+      throw HardwareError("sim: link_friction of '" + link + "' must be a finite friction >= 0");
+    }
+  }
   const auto radii = collision_cylinder_radii(urdf);
   const kinematics::Model model = kinematics::Model::from_urdf_string(urdf);
   std::vector<Leg> legs = detect_legs(model, radii);
@@ -443,6 +455,35 @@ struct SimHardware::Impl {
   std::vector<SimHole> holes;
   std::vector<SimHole> holes_copy;
   bool holes_dirty{false};
+  // set_external_force(): body, force and point (world), applied at every physics step (control thread).
+  std::string external_link;
+  int external_body{-1};
+  const Instance* external_instance{nullptr};  // the instance external_body was resolved on
+  Eigen::Vector3d external_force{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d external_point{Eigen::Vector3d::Zero()};
+
+  // MuJoCo's xfrc_applied acts at the body's centre of mass: the force at `point` adds the
+  // moment (point - com) x force. Re-resolved after a swap; cleared if the link is gone.
+  void apply_external_force() {
+    if (external_link.empty()) return;
+    Instance& in = *active;
+    if (external_instance != &in) {
+      external_body = mj_name2id(in.m, mjOBJ_BODY, external_link.c_str());
+      external_instance = &in;
+      if (external_body < 0) {
+        external_link.clear();
+        return;
+      }
+    }
+    double* f = in.d->xfrc_applied + 6 * external_body;
+    const double* com = in.d->xipos + 3 * external_body;
+    const Eigen::Vector3d r = external_point - Eigen::Vector3d(com[0], com[1], com[2]);
+    const Eigen::Vector3d moment = r.cross(external_force);
+    for (int i = 0; i < 3; ++i) {
+      f[i] = external_force[i];
+      f[3 + i] = moment[i];
+    }
+  }
 
   void submit(std::unique_ptr<Instance> in) { prepared.submit(std::move(in)); }
 
@@ -583,6 +624,7 @@ void SimHardware::step(double dt) {
   const int n = std::max(1, static_cast<int>(std::lround(dt / impl_->params.timestep)));
   for (int k = 0; k < n; ++k) {
     impl_->apply_drives();
+    impl_->apply_external_force();
     impl_->active->obstacles.apply(impl_->active->d, impl_->active->d->time);
     if (!impl_->active->drilling.empty() &&
         impl_->active->drilling.apply(impl_->active->m, impl_->active->d, impl_->holes)) {
@@ -657,6 +699,36 @@ void SimHardware::set_world(const World& world) {
 World SimHardware::world() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->latest_world;
+}
+
+void SimHardware::set_external_force(const std::string& link, const Eigen::Vector3d& force,
+                                     const Eigen::Vector3d& point) {
+  if (!force.allFinite() || !point.allFinite()) {
+    throw HardwareError("sim: external force on '" + link + "': non-finite force or point");
+  }
+  Instance& in = *impl_->active;
+  const int id = mj_name2id(in.m, mjOBJ_BODY, link.c_str());
+  if (id < 0) {
+    throw HardwareError("sim: external force on unknown link '" + link + "'");
+  }
+  if (impl_->external_body >= 0 && impl_->external_instance == &in && impl_->external_body != id) {
+    std::fill_n(in.d->xfrc_applied + 6 * impl_->external_body, 6, 0.0);  // the previous body lets go
+  }
+  impl_->external_link = link;
+  impl_->external_body = id;
+  impl_->external_instance = &in;
+  impl_->external_force = force;
+  impl_->external_point = point;
+}
+
+void SimHardware::clear_external_force() {
+  Instance& in = *impl_->active;
+  if (impl_->external_body >= 0 && impl_->external_instance == &in) {
+    std::fill_n(in.d->xfrc_applied + 6 * impl_->external_body, 6, 0.0);
+  }
+  impl_->external_link.clear();
+  impl_->external_body = -1;
+  impl_->external_instance = nullptr;
 }
 
 double SimHardware::time() const { return impl_->active->d->time; }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include <fstream>
 #include <sstream>
@@ -44,6 +45,31 @@ TEST(SimHardware, MjcfHasActuatorLimitsFrictionWorldAndFreeBase) {
   EXPECT_EQ(urdf_to_mjcf(read_fixture("arm_drill.urdf"), world, {}).find("<freejoint"), std::string::npos);
 }
 
+// A link's own friction (a running sanding disc) decides its contacts: priority over the wall's.
+TEST(SimHardware, LinkFrictionOverridesTheLinksGeomsWithPriority) {
+  SimParams p;
+  p.link_friction["drill"] = 0.02;
+  const std::string mjcf = urdf_to_mjcf(read_fixture("arm_drill.urdf"), World{}, p);
+  const auto drill = mjcf.find("name=\"drill_collision_0\"");
+  ASSERT_NE(drill, std::string::npos);
+  const std::string geom = mjcf.substr(drill, mjcf.find("/>", drill) - drill);
+  EXPECT_NE(geom.find("friction=\"0.02 0.005 0.0001\" priority=\"1\""), std::string::npos) << geom;
+  const auto link6 = mjcf.find("name=\"arm_link_6_collision_0\"");
+  ASSERT_NE(link6, std::string::npos);
+  const std::string other = mjcf.substr(link6, mjcf.find("/>", link6) - link6);
+  EXPECT_NE(other.find("friction=\"0.5 0.005 0.0001\""), std::string::npos) << other;
+  EXPECT_EQ(other.find("priority"), std::string::npos) << other;
+  p.link_friction = {{"no_such_link", 0.1}};
+  try {
+    (void)urdf_to_mjcf(read_fixture("arm_drill.urdf"), World{}, p);
+    ADD_FAILURE() << "an unknown link was accepted";
+  } catch (const HardwareError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_link"), std::string::npos) << e.what();
+  }
+  p.link_friction = {{"drill", -1.0}};
+  EXPECT_THROW((void)urdf_to_mjcf(read_fixture("arm_drill.urdf"), World{}, p), HardwareError);
+}
+
 TEST(SimHardware, MobileBaseRestsOnTheFloorOnItsWheels) {
   SimHardware sim(read_fixture("mobile_drill.urdf"), World{}, {});
   EXPECT_TRUE(sim.floating_base());
@@ -63,6 +89,26 @@ TEST(SimHardware, MobileBaseRestsOnTheFloorOnItsWheels) {
   // Arm holds its position under gravity (position-mode drives).
   const auto j2 = index_of(sim.joint_names(), "J2_A");
   EXPECT_NEAR(s.position[j2], 0.0, 0.01);
+}
+
+// An external force (a person's hand in services/collab's transport scenario) reaches the
+// ground through the wheels, until cleared; an unknown link or a NaN is refused by name.
+TEST(SimHardware, ExternalForceIsAppliedUntilCleared) {
+  SimHardware sim(read_fixture("mobile_drill.urdf"), World{}, {});
+  const auto settle = [&sim] {
+    for (int i = 0; i < 500; ++i) sim.step(0.001);
+    return sim.contact_force_on({"wheel_fl", "wheel_fr", "wheel_rl", "wheel_rr"}).z();
+  };
+  const double weight = settle();
+  const Eigen::Isometry3d base = sim.base_pose();
+  sim.set_external_force("mobile_base", Eigen::Vector3d(0, 0, -200.0), base.translation());
+  EXPECT_NEAR(settle() - weight, 200.0, 4.0);
+  sim.clear_external_force();
+  EXPECT_NEAR(settle(), weight, 2.0);
+  EXPECT_THROW(sim.set_external_force("no_such_link", Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()),
+               HardwareError);
+  EXPECT_THROW(sim.set_external_force("mobile_base", Eigen::Vector3d(std::nan(""), 0, 0), Eigen::Vector3d::Zero()),
+               HardwareError);
 }
 
 TEST(SimHardware, TorqueSaturatesAtTheUrdfEffortLimit) {

@@ -1,7 +1,7 @@
 // concert_robot: the robot service (XBot2's role). Simulated hardware by default.
 //   concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE]
 //                 [--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK]
-//                 [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...] [--params FILE]
+//                 [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...] [--safety-timeout S] [--params FILE]
 //                 [--keep-swaps]
 // --params: YAML with sections robot, sim, loop, node (config/robot.yaml); flags override it.
 // --assembly and --world are the initial robot and world; later ones come as SimCommands over
@@ -47,6 +47,7 @@ struct Options {
   std::string ee_frame;
   bool standalone{false};
   int fifo{0};
+  double safety_timeout{-1.0};  // < 0: the parameters file's (node.safety_timeout)
   std::map<std::string, std::string> packages;
   std::string params;
 };
@@ -145,6 +146,11 @@ void add_options(CLI::App& app, Options& o) {
                                                       : std::string();
           },
           "", "NAME=DIR"));
+  app.add_option("--safety-timeout", o.safety_timeout,
+                 "hold until the safety service is heard and whenever it is silent this long "
+                 "(0: not required; default: node.safety_timeout of --params, 0)")
+      ->type_name("S")
+      ->check(concert::cli::seconds());
   app.add_option("--params", o.params, "parameters file (config/robot.yaml lists every key)")
       ->type_name("FILE");
 }
@@ -198,6 +204,9 @@ int run(const Options& options) {
     robot::RobotParams& params = service.robot;
     if (!options.ee_frame.empty()) {
       params.end_effector_frame = options.ee_frame;
+    }
+    if (options.safety_timeout >= 0.0) {
+      service.node.safety_timeout = options.safety_timeout;
     }
     robot::RobotCore core(sim, params);
 

@@ -156,6 +156,78 @@ TEST_F(RobotNodeDds, ModelCommandsAndStateOverDds) {
   EXPECT_TRUE(core.ready());
 }
 
+// With a safety timeout (as `concert up` runs it) the robot moves only while it hears the
+// safety service: before its first state and after a silence longer than the bound every
+// command is refused and the robot holds; a RUNNING state heard again releases it.
+TEST(RobotNodeSafetyTimeout, MovesOnlyWhileItHearsTheSafetyService) {
+  SimHardware sim{test::read_fixture("mobile_drill.urdf"), World{}, {}};
+  RobotCore core{sim};
+  cdds::Participant robot_side{{.name = "robot"}};
+  dds::NodeParams params;
+  params.safety_timeout = 0.3;
+  dds::RobotNode node{robot_side, core, params};
+  EXPECT_TRUE(core.safety_stopped());
+  cdds::Participant client{{.name = "client"}};
+  cdds::Writer<msg::RobotModel> models{client, cdds::topics::robot_model};
+  cdds::Writer<msg::JointCommand> joints(client, cdds::topics::joint_command);
+  cdds::Writer<msg::SafetyState> safety(client, cdds::topics::safety_state);
+  ASSERT_TRUE(models.wait_for_readers(1, 10s));
+  ASSERT_TRUE(joints.wait_for_readers(1, 10s));
+  ASSERT_TRUE(safety.wait_for_readers(1, 10s));
+  models.write(model_msg(test::read_fixture("mobile_drill.urdf"), 3));
+  ASSERT_TRUE(run_until(core, node, [&] { return core.ready(); }));
+
+  msg::JointCommand move;
+  move.model_version(3);
+  move.source("test");
+  move.mode(msg::JOINT_POSITION);
+  move.name({"J1_A"});
+  move.position({0.3});
+  const auto j1 = [&] {
+    const auto s = core.state();
+    return s.position[test::hw_index(s, "J1_A")];
+  };
+  // Not heard yet: refused, the joint stays.
+  joints.write(move);
+  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() >= 1; }));
+  EXPECT_NE(node.last_error().find("safety service not heard yet"), std::string::npos) << node.last_error();
+  EXPECT_NEAR(j1(), 0.0, 0.01);
+
+  // RUNNING heard: released, the command moves the joint.
+  msg::SafetyState run;
+  run.mode(msg::SAFETY_RUNNING);
+  safety.write(run);
+  ASSERT_TRUE(run_until(core, node, [&] { return !core.safety_stopped(); }));
+  joints.write(move);
+  ASSERT_TRUE(run_until(core, node, [&] { return std::abs(j1() - 0.3) < 0.01; }));
+
+  // Silent for longer than the bound: stopped, commands refused naming the silence.
+  ASSERT_TRUE(run_until(core, node, [&] { return core.safety_stopped(); }));
+  move.position({-0.3});
+  const auto refused = node.refused_commands();
+  joints.write(move);
+  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() > refused; }));
+  EXPECT_NE(node.last_error().find("safety service not heard for"), std::string::npos) << node.last_error();
+  run_until(core, node, [] { return false; }, 2000);
+  EXPECT_NEAR(j1(), 0.3, 0.01);
+
+  // Heard again, STOPPED: it keeps holding for the safety service's own reason.
+  msg::SafetyState stop;
+  stop.mode(msg::SAFETY_STOPPED);
+  stop.causes({"robot silent 1.2 s"});
+  safety.write(stop);
+  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() > refused && core.safety_stopped(); }));
+  const auto refused_stop = node.refused_commands();
+  joints.write(move);
+  ASSERT_TRUE(run_until(core, node, [&] { return node.refused_commands() > refused_stop; }));
+  EXPECT_NE(node.last_error().find("robot silent 1.2 s"), std::string::npos) << node.last_error();
+  // RUNNING (an operator reset): released.
+  safety.write(run);
+  ASSERT_TRUE(run_until(core, node, [&] { return !core.safety_stopped(); }));
+  joints.write(move);
+  EXPECT_TRUE(run_until(core, node, [&] { return std::abs(j1() + 0.3) < 0.01; }));
+}
+
 /// Newest TrajectoryStatus of `request` seen so far (drains the reader).
 struct StatusLog {
   cdds::Reader<msg::TrajectoryStatus>& reader;
@@ -290,6 +362,11 @@ TEST(RobotConversions, CartesianAdmittanceAxisIsTheTcpAxisInTheWorld) {
   EXPECT_THROW((void)dds::to_core(c), CommandError);
   c.admittance_axis(255);
   EXPECT_FALSE(dds::to_core(c).admittance.enabled);
+  c.payload_mass(7.5);
+  EXPECT_DOUBLE_EQ(dds::to_core(c).payload_mass, 7.5);
+  c.payload_mass(-1.0);
+  EXPECT_THROW((void)dds::to_core(c), CommandError);
+  c.payload_mass(0.0);
   q.w(2.0);
   pose.orientation(q);
   c.target(pose);
@@ -300,7 +377,7 @@ TEST(RobotParamsYaml, ShippedConfigListsEveryParameterWithItsDefault) {
   auto doc =
       config::Document::load(std::string(CONCERT_SOURCE_DIR) + "/services/robot/config/robot.yaml");
   (void)dds::read_service_params(doc);
-  EXPECT_EQ(doc.keys().size(), 78u);
+  EXPECT_EQ(doc.keys().size(), 79u);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
 }

@@ -134,6 +134,12 @@ TEST(RobotMain, SimCommandsSwapTheAssemblyAndChangeTheWorld) {
   ASSERT_TRUE(second.has_value());
   EXPECT_GT(second->scan_id(), first->scan_id());
   EXPECT_EQ(second->slaves().size(), 17u);
+  // The same command again (a client resending until it hears the reply): the same answer,
+  // not applied twice (that would answer "the same robot is mounted again").
+  const std::string answer = reply->message();
+  reply = send(commands, replies, swap);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_EQ(reply->message(), answer);
   // Standalone: the service takes the new hardware's own model and reports ready at version 2.
   bool ready_v2 = false;
   for (int i = 0; i < 200 && !ready_v2; ++i) {

@@ -157,20 +157,61 @@ TEST_F(RobotCoreTest, SafetyStopHoldsAndRefusesCommands) {
   EXPECT_NO_THROW(core_.command_base({1, 0.1, 0, 0}));
 }
 
-TEST(RobotCore, CartesianWithZeroGainsIsGravityCompensation) {
-  // What DDS clients use for teaching mode (README): no stiffness, no damping.
-  test::SimulatedArm arm({{"J2_A", 0.5}, {"J3_A", 0.6}}, 200);
-  RobotCore& core = arm.core;
+// What DDS clients use for teaching mode (README): no stiffness, no damping.
+CartesianCommand gravity_compensation(double payload_mass = 0.0) {
   CartesianCommand c;
   c.model_version = 1;
   c.stiffness.setZero();
   c.damping.setZero();
+  c.payload_mass = payload_mass;
+  return c;
+}
+
+TEST(RobotCore, CartesianWithZeroGainsIsGravityCompensation) {
+  test::SimulatedArm arm({{"J2_A", 0.5}, {"J3_A", 0.6}}, 200);
+  RobotCore& core = arm.core;
+  const CartesianCommand c = gravity_compensation();
   core.command_cartesian(c);  // target pose irrelevant without stiffness
   run_cycles(core, 1000);
   const RobotState s = core.state();
   EXPECT_NEAR(s.position[hw_index(s, "J2_A")], 0.5, 5e-3);
   EXPECT_NEAR(s.position[hw_index(s, "J3_A")], 0.6, 5e-3);
   EXPECT_EQ(s.owners[hw_index(s, "J2_A")], JointOwner::kCartesian);
+}
+
+// A payload at the TCP (a 3 kg weight hung there in MuJoCo): told its mass, the Cartesian
+// gravity compensation holds the arm where it was; not told, the arm falls under the weight.
+TEST(RobotCore, CartesianPayloadMassIsGravityCompensated) {
+  auto joints_after = [](double told_mass) {
+    test::SimulatedArm arm({{"J2_A", 0.5}, {"J3_A", 0.6}}, 200);
+    RobotCore& core = arm.core;
+    core.command_cartesian(gravity_compensation(told_mass));
+    const std::string tcp = core.state().end_effector_frame;
+    for (int k = 0; k < 1000; ++k) {
+      const Eigen::Isometry3d T = arm.sim.link_pose(tcp);
+      arm.sim.set_external_force(tcp, Eigen::Vector3d(0.0, 0.0, -3.0 * 9.81), T.translation());
+      core.cycle();
+    }
+    const RobotState s = core.state();
+    return Eigen::Vector2d(s.position[hw_index(s, "J2_A")], s.position[hw_index(s, "J3_A")]);
+  };
+  const Eigen::Vector2d told = joints_after(3.0);
+  EXPECT_NEAR(told.x(), 0.5, 5e-3);
+  EXPECT_NEAR(told.y(), 0.6, 5e-3);
+  const Eigen::Vector2d untold = joints_after(0.0);
+  EXPECT_GT((untold - Eigen::Vector2d(0.5, 0.6)).norm(), 0.05) << untold.transpose();
+}
+
+TEST(RobotCore, CartesianPayloadMassMustBeFiniteAndNotNegative) {
+  test::SimulatedArm arm({}, 10);
+  CartesianCommand c;
+  c.model_version = 1;
+  c.payload_mass = -1.0;
+  EXPECT_NE(message_of([&] { arm.core.command_cartesian(c); }).find("payload_mass"), std::string::npos);
+  c.payload_mass = std::nan("");
+  EXPECT_NE(message_of([&] { arm.core.command_cartesian(c); }).find("payload_mass"), std::string::npos);
+  c.payload_mass = 2.0;
+  EXPECT_EQ(message_of([&] { arm.core.command_cartesian(c); }), "");
 }
 
 TEST_F(RobotCoreTest, CommandsAndModelsFromAnotherThreadWhileCycling) {

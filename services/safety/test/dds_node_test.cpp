@@ -2,7 +2,10 @@
 // of StatusReporter that the liveliness check relies on.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <atomic>
+#include <filesystem>
 #include <functional>
 #include <sstream>
 #include <thread>
@@ -10,6 +13,7 @@
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 #include "dds/conversions.hpp"
+#include "safety/latched_state.hpp"
 #include "dds/safety_node.hpp"
 #include "test_helpers.hpp"
 
@@ -165,6 +169,52 @@ TEST_F(SafetyNodeTest, SilentTaskServiceStopsWithItsName) {
       },
       10s))
       << log_.str();
+}
+
+// A safety service restarted while the watched services keep beating (the chaos test's
+// planner-then-safety round): the stop in its state file survives. The status topic is
+// latched, so the new process's reader gets the heartbeats at once; a heartbeat handled before
+// the restore persisted the fresh RUNNING over the file's stop, which the restore then read
+// back.
+TEST(SafetyNodeRestore, HeartbeatsDuringTheRestartDoNotReplaceTheLatchedStop) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("safety_restore_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string file = (dir / "safety_state.yaml").string();
+  LatchedState stopped;
+  stopped.mode = Mode::kStopped;
+  stopped.causes = {"liveliness: planner@manip restarted"};
+  stopped.cause_keys = {"restarted:planner@manip"};
+  stopped.watched = {{"planner@manip", "old"}};
+
+  Participant services({.name = "services"});
+  Writer<msg::ServiceStatus> statuses(services, topics::status);
+  std::atomic<bool> beating{true};
+  std::thread beats([&] {
+    msg::ServiceStatus beat;
+    beat.id(concert::dds::status_instance_id("planner", "manip"));
+    beat.service("planner");
+    beat.host("manip");
+    beat.state(msg::SERVICE_READY);
+    for (int i = 0; i < 20000 && beating; ++i) {  // bounded: 20 s at most
+      statuses.write(beat);
+      std::this_thread::sleep_for(1ms);
+    }
+  });
+  Params params;
+  params.liveliness_timeout = 2s;
+  for (int restart = 0; restart < 8; ++restart) {
+    save_latched_state(file, stopped);
+    Participant participant({.name = "safety"});
+    std::ostringstream log;
+    SafetyNode node(participant, params, log, file);
+    std::this_thread::sleep_for(100ms);  // heartbeats flowing into the restored node
+    EXPECT_EQ(node.status().mode, Mode::kStopped) << "restart " << restart << ":\n" << log.str();
+    EXPECT_EQ(load_latched_state(file).mode, Mode::kStopped) << "restart " << restart << ":\n" << log.str();
+  }
+  beating = false;
+  beats.join();
+  std::filesystem::remove_all(dir);
 }
 
 TEST_F(SafetyNodeTest, JointBeyondModelLimitStops) {

@@ -69,6 +69,9 @@ struct CartesianCommand {
   Vector6d stiffness{(Vector6d() << 800, 800, 800, 60, 60, 60).finished()};  ///< [N/m x3, Nm/rad x3]
   Vector6d damping{(Vector6d() << 80, 80, 80, 6, 6, 6).finished()};         ///< [N s/m x3, Nm s/rad x3]
   Vector6d feedforward_wrench{Vector6d::Zero()};  ///< wrench the frame applies [N, Nm], world-aligned
+  /// Mass held at the frame's origin (an object in the gripper) [kg], >= 0: its weight is added
+  /// to the gravity compensation, the frame pushes up by m |g| (the model's gravity).
+  double payload_mass{0.0};
   Admittance admittance;
   double nullspace_damping{2.0};           ///< joint damping of the arm [Nm s/rad]
 };

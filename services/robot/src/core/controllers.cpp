@@ -133,6 +133,7 @@ void CartesianController::set(const CartesianCommand& command, bool keep_admitta
   command_.stiffness = command.stiffness;
   command_.damping = command.damping;
   command_.feedforward_wrench = command.feedforward_wrench;
+  command_.payload_mass = command.payload_mass;
   command_.admittance = command.admittance;
   command_.nullspace_damping = command.nullspace_damping;
   if (!keep_admittance) {
@@ -167,8 +168,12 @@ void CartesianController::update(CycleData& data) {
   Vector6d error;
   error.head<3>() = target.translation() - data.ee_pose.translation();
   error.tail<3>() = rotation_error(target.linear(), data.ee_pose.linear());
-  const Vector6d force =
+  Vector6d force =
       cc.stiffness.cwiseProduct(error) + cc.damping.cwiseProduct(cc.target_twist - twist) + cc.feedforward_wrench;
+  // The payload's weight, held at the frame's origin (J^T m (-g), beside the arm's own g(q)).
+  if (cc.payload_mass > 0.0) {
+    force.head<3>() -= cc.payload_mass * data.model->gravity();
+  }
   tau_arm_.noalias() = data.jac_arm.transpose().lazyProduct(force);
   tau_arm_ -= cc.nullspace_damping * data.qd_arm;
   for (std::size_t k = 0; k < arm_.size(); ++k) {

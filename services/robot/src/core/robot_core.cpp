@@ -356,6 +356,10 @@ void RobotCore::command_cartesian(const CartesianCommand& command) {
       !command.target_twist.allFinite()) {
     throw CommandError("Cartesian command refused: negative gains or non-finite values");
   }
+  if (!(command.payload_mass >= 0.0) || !std::isfinite(command.payload_mass)) {
+    throw CommandError("Cartesian command refused: payload_mass " + std::to_string(command.payload_mass) +
+                       " kg must be finite and >= 0");
+  }
   if (command.admittance.enabled &&
       (std::abs(command.admittance.axis.norm() - 1.0) > 1e-6 || command.admittance.mass <= 0.0 ||
        command.admittance.damping < 0.0)) {

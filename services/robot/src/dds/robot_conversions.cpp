@@ -115,6 +115,11 @@ CartesianCommand to_core(const msg::CartesianImpedanceCommand& c) {
   const auto& f = c.feedforward();
   out.feedforward_wrench << f.force().x(), f.force().y(), f.force().z(), f.torque().x(),
       f.torque().y(), f.torque().z();
+  if (!(c.payload_mass() >= 0.0) || !std::isfinite(c.payload_mass())) {
+    throw CommandError("Cartesian command from " + from(c.source()) + ": payload_mass " +
+                       std::to_string(c.payload_mass()) + " kg must be finite and >= 0");
+  }
+  out.payload_mass = c.payload_mass();
   const uint8_t axis = c.admittance_axis();
   if (axis != 255) {
     if (axis > 2) {

@@ -22,7 +22,8 @@ RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams
       odometry_(participant, cdds::topics::odometry),
       wrench_(participant, cdds::topics::ee_wrench),
       scan_(participant, cdds::topics::esc_scan),
-      trajectory_status_(participant, cdds::topics::trajectory_status) {
+      trajectory_status_(participant, cdds::topics::trajectory_status),
+      safety_watchdog_(params_.safety_timeout, SafetyWatchdog::Clock::now()) {
   status_.report(msg::SERVICE_STARTING, 0, "waiting for a robot model");
   model_reader_ = std::make_unique<cdds::Reader<msg::RobotModel>>(
       participant, cdds::topics::robot_model, [this](const msg::RobotModel& m, const auto&) { on_model(m); });
@@ -37,19 +38,9 @@ RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams
       participant, cdds::topics::base_velocity, [this](const msg::BaseVelocityCommand& c, const auto&) {
         guarded("base command", [&] { core_.command_base(to_core(c)); });
       });
+  if (safety_watchdog_.required()) check_safety_silence();  // holds until the safety service is heard
   safety_reader_ = std::make_unique<cdds::Reader<msg::SafetyState>>(
-      participant, cdds::topics::safety_state, [this](const msg::SafetyState& s, const auto&) {
-        const bool stopped = s.mode() == msg::SAFETY_STOPPED;
-        std::string causes;
-        for (const auto& c : s.causes()) {
-          causes += (causes.empty() ? "" : "; ") + c;
-        }
-        const bool was = core_.safety_stopped();
-        core_.set_safety_stop(stopped, causes);
-        if (stopped != was) {
-          status_.note(stopped ? "safety stop: holding (" + causes + ")" : "safety stop released");
-        }
-      });
+      participant, cdds::topics::safety_state, [this](const msg::SafetyState& s, const auto&) { on_safety(s); });
   trajectory_reader_ = std::make_unique<cdds::Reader<msg::JointTrajectoryCommand>>(
       participant, cdds::topics::trajectory_command,
       [this](const msg::JointTrajectoryCommand& c, const auto&) { on_trajectory(c); });
@@ -60,6 +51,37 @@ std::string tool_end_effector(const msg::RobotModel& m) {
     return model::RobotModel::build(model::dds::to_description(m))->tool().frame;
   } catch (const std::exception&) {
     return "";  // no parsable description or no arm tool: the core's own choice
+  }
+}
+
+void RobotNode::on_safety(const msg::SafetyState& s) {
+  const bool stopped = s.mode() == msg::SAFETY_STOPPED;
+  std::string causes;
+  for (const auto& c : s.causes()) {
+    causes += (causes.empty() ? "" : "; ") + c;
+  }
+  std::lock_guard lock(safety_mutex_);
+  safety_watchdog_.heard(SafetyWatchdog::Clock::now());
+  const bool was = core_.safety_stopped();
+  core_.set_safety_stop(stopped, causes);
+  if (safety_silent_) {
+    safety_silent_ = false;
+    holding_ = stopped ? "safety stop: holding (" + causes + "; the safety service heard again)" : "";
+    status_.note(stopped ? holding_ : "safety stop released (the safety service heard again, RUNNING)");
+  } else if (stopped != was) {
+    holding_ = stopped ? "safety stop: holding (" + causes + ")" : "";
+    status_.note(stopped ? holding_ : "safety stop released");
+  }
+}
+
+void RobotNode::check_safety_silence() {
+  std::lock_guard lock(safety_mutex_);
+  if (safety_silent_) return;
+  if (auto why = safety_watchdog_.silence(SafetyWatchdog::Clock::now())) {
+    safety_silent_ = true;
+    core_.set_safety_stop(true, *why);
+    holding_ = "safety stop: holding (" + *why + ")";
+    status_.note(holding_);
   }
 }
 
@@ -130,6 +152,10 @@ void RobotNode::apply_model(const std::string& urdf, std::uint64_t version,
     status_.report(msg::SERVICE_READY,
                    concert::dds::ModelId{static_cast<uint32_t>(version), content_hash},
                    "ready at model version " + std::to_string(version));
+    // Still holding for the safety layer: say so again, as the message the heartbeat repeats
+    // (a reader that matched after the first saying, e.g. after a restart, hears it).
+    std::lock_guard lock(safety_mutex_);
+    if (!holding_.empty()) status_.note(holding_);
   } catch (const std::exception& e) {
     ++refused_;
     {
@@ -145,6 +171,7 @@ void RobotNode::apply_model(const std::string& urdf, std::uint64_t version,
 }
 
 void RobotNode::publish(const RobotState& s) {
+  if (safety_watchdog_.required()) check_safety_silence();
   joint_state_.write(to_joint_state(s));
   if (s.has_base) {
     distance_ += std::hypot(s.odometry.x - last_x_, s.odometry.y - last_y_);

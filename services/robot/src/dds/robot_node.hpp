@@ -11,6 +11,7 @@
 #include "concert/dds/status_reporter.hpp"
 #include "concert/topology/types.hpp"
 #include "robot/robot_core.hpp"
+#include "robot/safety_watchdog.hpp"
 
 namespace concert::robot::dds {
 
@@ -19,6 +20,10 @@ struct NodeParams {
   int odometry_decimation{10};  ///< odometry every N cycles (100 Hz at 1 kHz)
   int wrench_decimation{10};    ///< end-effector wrench every N cycles
   int trajectory_decimation{100};  ///< trajectory progress every N cycles (10 Hz), and on each change
+  /// > 0: the robot holds (a safety stop) until it hears the safety service and whenever it has
+  /// not heard it for this long [s] (SafetyWatchdog); 0: the safety service is not required
+  /// (a robot run on its own). `concert up` sets it when it starts the safety service.
+  double safety_timeout{0.0};
 };
 
 /// The end-effector a Cartesian command drives, from the model message: libs/model's tool (the
@@ -27,7 +32,8 @@ struct NodeParams {
 std::string tool_end_effector(const msg::RobotModel& model);
 
 /// A SAFETY_STOPPED safety state holds the robot, aborts a running trajectory and refuses
-/// commands until SAFETY_RUNNING. Readers call the core from the DDS listener threads (the core
+/// commands until SAFETY_RUNNING. With NodeParams::safety_timeout, not hearing the safety
+/// service is a stop too (checked on each publish()). Readers call the core from the DDS listener threads (the core
 /// checks there and hands over to its loop without locking it); publish() is called by the
 /// service's publisher thread with each new state of the loop, never by the loop itself.
 /// Trajectories: JointTrajectoryCommand in, TrajectoryStatus out (refused at once with the
@@ -56,6 +62,8 @@ class RobotNode {
 
  private:
   void on_model(const msg::RobotModel& model);
+  void on_safety(const msg::SafetyState& state);
+  void check_safety_silence();
   template <class F> void guarded(const std::string& what, F&& f);
 
   concert::dds::Participant& participant_;
@@ -73,6 +81,10 @@ class RobotNode {
   std::unique_ptr<concert::dds::Reader<msg::SafetyState>> safety_reader_;
   std::unique_ptr<concert::dds::Reader<msg::JointTrajectoryCommand>> trajectory_reader_;
   concert::dds::Writer<msg::TrajectoryStatus> trajectory_status_;
+  std::mutex safety_mutex_;  // the watchdog and the stop it decides, from two threads
+  SafetyWatchdog safety_watchdog_;
+  bool safety_silent_{false};  // the stop in force is the watchdog's
+  std::string holding_;        // "safety stop: holding (...)" while stopped, else empty
   struct Request {
     std::uint32_t id{0};
     std::uint64_t model_version{0};

@@ -106,6 +106,7 @@ ServiceParams read_service_params(config::Document& doc) {
   node.string("service_name", p.node.service_name, false);
   node.integer("odometry_decimation", p.node.odometry_decimation, 1);
   node.integer("wrench_decimation", p.node.wrench_decimation, 1);
+  node.number("safety_timeout", p.node.safety_timeout, non_negative);
 
   doc.finish();
   p.loop.period = p.robot.period;

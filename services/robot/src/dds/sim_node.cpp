@@ -144,6 +144,13 @@ void SimNode::work() {
 }
 
 void SimNode::handle(const msg::SimCommand& c) {
+  const std::pair<std::uint32_t, std::int64_t> key{c.request_id(), c.stamp_ns()};
+  for (const auto& [k, r] : answered_) {
+    if (k == key) {
+      reply_.write(r);  // a resent command: its answer again, nothing applied twice
+      return;
+    }
+  }
   msg::SimCommandReply reply;
   reply.request_id(c.request_id());
   const std::string what = c.kind() == msg::SIM_SWAP_ASSEMBLY ? "assembly" : "world";
@@ -161,6 +168,9 @@ void SimNode::handle(const msg::SimCommand& c) {
   }
   reply.stamp_ns(now_ns());
   reply_.write(reply);
+  answered_.emplace_back(key, reply);
+  constexpr std::size_t kAnswersKept = 64;
+  if (answered_.size() > kAnswersKept) answered_.pop_front();
 }
 
 std::string SimNode::swap_assembly(const std::string& yaml, const std::string& name) {

@@ -68,6 +68,11 @@ class SimNode {
   std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<msg::SimCommand> queue_;
+  // The latest commands answered (worker thread only): a client resends a command until it
+  // hears the reply (the command topic is volatile, and the reader it waited for may have been
+  // another tool's), so a command seen again (same request id and stamp) is answered again,
+  // not applied twice.
+  std::deque<std::pair<std::pair<std::uint32_t, std::int64_t>, msg::SimCommandReply>> answered_;
   bool stopping_{false};
   std::uint32_t world_version_{1};
   std::unique_ptr<concert::dds::Reader<msg::SimCommand>> commands_;

@@ -32,7 +32,10 @@ void use_interprocess_delivery_only() {
 
 SafetyNode::SafetyNode(concert::dds::Participant& participant, Params params, std::ostream& log,
                        std::string state_file)
-    : monitor_(std::move(params), Clock::now()),
+    // Restored before the readers below exist: a heartbeat taken in before the restore was
+    // published and persisted as the fresh monitor's RUNNING, over the stop in the file,
+    // which the restore then read back (the chaos test: a latched stop lost on a restart).
+    : monitor_(restored_monitor(std::move(params), state_file, log)),
       log_(log),
       state_file_(std::move(state_file)),
       state_writer_(participant, concert::dds::topics::safety_state),
@@ -55,29 +58,30 @@ SafetyNode::SafetyNode(concert::dds::Participant& participant, Params params, st
   std::string text;
   {
     std::lock_guard lock(mutex_);
-    restore_locked();
     publish_locked(true);
     text = summary(monitor_.status());
   }
   status_.report(msg::SERVICE_READY, 0, text);
 }
 
-void SafetyNode::restore_locked() {
-  if (state_file_.empty() || !std::filesystem::exists(state_file_)) return;
+SafetyMonitor SafetyNode::restored_monitor(Params params, const std::string& state_file, std::ostream& log) {
+  SafetyMonitor monitor(std::move(params), Clock::now());
+  if (state_file.empty() || !std::filesystem::exists(state_file)) return monitor;
   try {
-    const LatchedState state = load_latched_state(state_file_);
-    monitor_.restore(state, Clock::now());
-    log_ << "safety: restored from " << state_file_ << ": " << summary(monitor_.status())
-         << "; watching " << state.watched.size() << " service instance(s) again" << std::endl;
+    const LatchedState state = load_latched_state(state_file);
+    monitor.restore(state, Clock::now());
+    log << "safety: restored from " << state_file << ": " << summary(monitor.status()) << "; watching "
+        << state.watched.size() << " service instance(s) again" << std::endl;
   } catch (const std::exception& e) {
     // What it held is unknown: stopped until an operator looks.
     LatchedState unknown;
     unknown.mode = Mode::kStopped;
     unknown.causes = {std::string("safety: the latched state could not be read back: ") + e.what()};
     unknown.cause_keys = {"state"};
-    monitor_.restore(unknown, Clock::now());
-    log_ << "safety: " << unknown.causes.front() << std::endl;
+    monitor.restore(unknown, Clock::now());
+    log << "safety: " << unknown.causes.front() << std::endl;
   }
+  return monitor;
 }
 
 void SafetyNode::persist_locked() {

@@ -58,7 +58,8 @@ class SafetyNode {
   /// state's summary if it changed, for note() once the lock is released.
   std::optional<std::string> publish_locked(bool force);
   /// Reads the state file at start (caller holds mutex_).
-  void restore_locked();
+  /// The monitor restored from `state_file` (when there is one), made before any reader exists.
+  static SafetyMonitor restored_monitor(Params params, const std::string& state_file, std::ostream& log);
   /// Rewrites the state file if the latched state changed (caller holds mutex_).
   void persist_locked();
   /// Puts `text` in the service status. Never called with mutex_ held: the status write is

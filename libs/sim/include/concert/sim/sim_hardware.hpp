@@ -30,6 +30,11 @@ struct SimParams {
   double damping_scale{1.0};         ///< multiplies URDF <dynamics damping> (viscous, [Nm s/rad])
   double wheel_friction{1.0};        ///< sliding friction of wheel geoms [-]
   double robot_friction{0.5};        ///< sliding friction of other robot geoms [-]
+  /// Sliding friction of the collision geoms of these links (link name -> [-]), which decides
+  /// their contacts (MuJoCo geom priority 1: the contact takes this friction instead of the
+  /// larger of the two geoms'). For a tool whose contact is not a dry block sliding on the
+  /// wall, e.g. a running sanding disc (surface_finish). A name that is no link is an error.
+  std::map<std::string, double> link_friction;
   /// Floating (free) base: default true iff the model has steering+wheel legs.
   std::optional<bool> floating_base;
   Eigen::Vector3d base_position{0.0, 0.0, 0.0};  ///< [m]; z is computed for a floating base on the floor
@@ -93,6 +98,15 @@ class SimHardware final : public hardware::Hardware {
   void set_world(const World& world);
   /// The latest world given (any thread).
   [[nodiscard]] World world() const;
+
+  /// An external force on `link` (a MuJoCo body: fixed links may be merged into their parent,
+  /// then name the parent) acting at `point` (world frame, [m]) with `force` (world frame, [N]),
+  /// applied at every physics step until replaced or cleared: a person's hand on the robot in
+  /// tests and benchmarks (services/collab's simulated person). Control thread only (between
+  /// step() calls). Throws HardwareError for an unknown link or a non-finite value. A swap
+  /// (switch_prepared) keeps it when the new model has the link, else clears it.
+  void set_external_force(const std::string& link, const Eigen::Vector3d& force, const Eigen::Vector3d& point);
+  void clear_external_force();
 
   // Ground truth, for tests and benchmarks.
   [[nodiscard]] double time() const;
