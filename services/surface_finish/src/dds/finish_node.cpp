@@ -1,0 +1,424 @@
+#include "dds/finish_node.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "concert/common/clock.hpp"
+#include "concert/model/dds/conversions.hpp"
+
+namespace concert::surface_finish::dds {
+
+namespace cdds = concert::dds;
+namespace topics = concert::dds::topics;
+
+namespace {
+
+constexpr const char* kSource = "surface_finish";
+constexpr std::size_t kMaxMeasured = 5000;
+
+}  // namespace
+
+FinishNode::FinishNode(cdds::Participant& participant, NodeParams params, std::ostream& log)
+    : params_(std::move(params)),
+      log_(log),
+      status_(participant, "surface_finish"),
+      areas_writer_(participant, topics::finish_areas),
+      status_writer_(participant, topics::finish_status),
+      trajectories_(participant, topics::trajectory_command),
+      model_reader_(participant, topics::robot_model,
+                    [this](const msg::RobotModel& m, const auto&) {
+                      std::lock_guard lock(mutex_);
+                      if (!new_model_ || m.version() > new_model_->version()) new_model_ = m;
+                    }),
+      joint_reader_(participant, topics::joint_state,
+                    [this](const msg::JointState& s, const auto&) {
+                      Measured m{s.stamp_ns(), s.name(), s.position()};
+                      std::lock_guard lock(mutex_);
+                      if (run_active_.load()) {
+                        measured_.push_back(m);
+                        if (measured_.size() > kMaxMeasured) measured_.pop_front();
+                      }
+                      latest_ = std::move(m);
+                    }),
+      scan_reader_(participant, topics::scan,
+                   [this](const msg::LaserScan& s, const auto&) {
+                     std::lock_guard lock(mutex_);
+                     scan_ = s;
+                     scan_seen_ = std::chrono::steady_clock::now();
+                   }),
+      command_reader_(participant, topics::finish_command,
+                      [this](const msg::FinishCommand& c, const auto&) {
+                        std::lock_guard lock(mutex_);
+                        commands_.push_back(c);
+                      }),
+      trajectory_reader_(participant, topics::trajectory_status, [this](const msg::TrajectoryStatus& s, const auto&) {
+        if (s.source() != kSource) return;
+        std::lock_guard lock(mutex_);
+        trajectory_statuses_[s.request_id()] = s;
+      }) {
+  status_.report(msg::SERVICE_STARTING, 0u, "waiting for the robot model");
+}
+
+FinishNode::~FinishNode() = default;
+
+void FinishNode::log_line(const std::string& line) { log_ << line << std::endl; }
+
+void FinishNode::spin(const std::atomic<bool>& stop) {
+  const auto period = std::chrono::duration<double>(1.0 / params_.rate);
+  while (!stop.load()) {
+    const auto next = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+    tick();
+    std::this_thread::sleep_until(next);
+  }
+  if (run_) abort_run("the service stops");
+}
+
+void FinishNode::tick() {
+  std::optional<msg::RobotModel> model;
+  std::deque<msg::FinishCommand> commands;
+  {
+    std::lock_guard lock(mutex_);
+    if (new_model_ && new_model_->version() > version_seen_) model = new_model_;
+    new_model_.reset();
+    commands.swap(commands_);
+  }
+  if (model) on_model(*model);
+  if (preparing_.valid() && preparing_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) finish_preparation();
+  for (const msg::FinishCommand& c : commands) handle(c);
+  if (run_) follow_run();
+}
+
+void FinishNode::on_model(const msg::RobotModel& m) {
+  version_seen_ = m.version();
+  if (run_) abort_run("the robot model changed to version " + std::to_string(m.version()));
+  status_.report(msg::SERVICE_RECONFIGURING, cdds::ModelId{m.version(), m.content_hash()},
+                 "computing the areas of model version " + std::to_string(m.version()));
+  preparing_version_ = m.version();
+  const NodeParams params = params_;
+  // The areas take seconds (inverse kinematics over the wall grid at several distances): a
+  // worker thread; a newer model replaces the result when it comes.
+  preparing_ = std::async(std::launch::async, [m, params]() {
+    Prepared p;
+    try {
+      p.model = model::RobotModel::build(model::dds::to_description(m));
+      const bool sprays = !p.model->end_effectors(model::EndEffectorKind::kSpraying).empty();
+      const bool sands = !p.model->end_effectors(model::EndEffectorKind::kSanding).empty();
+      if (!sprays && !sands) {
+        (void)p.model->tool(model::EndEffectorKind::kSpraying);  // throws, listing what the arm carries
+      }
+      p.task = sprays ? Task::kSpray : Task::kSand;
+      ReachParams rp;
+      rp.contact_force = sprays ? 0.0 : params.sand_force;
+      p.reach = std::make_shared<Reach>(p.model, sprays ? model::EndEffectorKind::kSpraying : model::EndEffectorKind::kSanding, rp);
+      const ToolSpec& tool = sprays ? params.spray : params.sand;
+      p.areas = working_areas(*p.reach, p.task, tool.standoff, params.areas);
+    } catch (const std::exception& e) {
+      p.error = e.what();
+    }
+    return p;
+  });
+}
+
+void FinishNode::finish_preparation() {
+  Prepared p = preparing_.get();
+  if (preparing_version_ < version_seen_) return;  // a newer model is being prepared
+  current_ = std::move(p);
+  current_version_ = preparing_version_;
+  msg::FinishAreas a;
+  a.model_version(static_cast<std::uint32_t>(current_version_));
+  a.stamp_ns(now_ns());
+  const std::string hash = current_.model ? current_.model->content_hash() : std::string();
+  if (current_.areas) {
+    const AreaMap& m = *current_.areas;
+    a.tool(to_string(current_.task));
+    a.wall_distance(m.wall_distance);
+    a.standoff(m.standoff);
+    a.roll(m.roll);
+    for (const Area& area : m.areas) {
+      msg::FinishArea fa;
+      fa.id(area.id);
+      fa.x0(area.rect.x0);
+      fa.x1(area.rect.x1);
+      fa.y0(area.rect.y0);
+      fa.y1(area.rect.y1);
+      a.areas().push_back(fa);
+    }
+    status_.report(msg::SERVICE_READY, cdds::ModelId{static_cast<std::uint32_t>(current_version_), hash},
+                   std::string(to_string(current_.task)) + " with " + current_.reach->tool_name() + ": band " +
+                       m.band.str() + " at " + std::to_string(m.wall_distance).substr(0, 4) + " m from the wall");
+    log_line("surface_finish: model version " + std::to_string(current_version_) + ": " + to_string(current_.task) +
+             ", band " + m.band.str() + ", working distance " + std::to_string(m.wall_distance).substr(0, 4) + " m");
+  } else {
+    a.reason("cannot finish: " + current_.error);
+    status_.report(msg::SERVICE_READY, cdds::ModelId{static_cast<std::uint32_t>(current_version_), hash},
+                   "cannot finish: " + current_.error);
+    log_line("surface_finish: model version " + std::to_string(current_version_) + ": cannot finish: " + current_.error);
+  }
+  areas_writer_.write(a);
+}
+
+void FinishNode::publish(std::uint32_t request_id, msg::FinishState state, const std::string& reason, const Run* run,
+                         const std::string& report) {
+  msg::FinishStatus s;
+  s.request_id(request_id);
+  s.stamp_ns(now_ns());
+  s.model_version(static_cast<std::uint32_t>(current_version_));
+  s.state(state);
+  s.reason(reason);
+  if (run != nullptr) {
+    s.progress(run->progress);
+    s.strokes(static_cast<std::uint32_t>(run->plan.strokes.size()));
+    s.duration(run->plan.duration());
+    s.wall_distance(run->wall_distance);
+  }
+  s.report_json(report);
+  status_writer_.write(s);
+}
+
+void FinishNode::refuse(const msg::FinishCommand& c, const std::string& why) {
+  status_.refused("request " + std::to_string(c.request_id()) + ": " + why);
+  log_line("surface_finish: request " + std::to_string(c.request_id()) + " refused: " + why);
+  publish(c.request_id(), msg::FINISH_FAILED, why, nullptr);
+}
+
+void FinishNode::handle(const msg::FinishCommand& c) {
+  if (c.verb() == msg::FINISH_ABORT) {
+    if (run_) abort_run("aborted by " + (c.source().empty() ? std::string("a client") : c.source()));
+    return;
+  }
+  if (c.model_version() != current_version_ || current_version_ == 0) {
+    refuse(c, "command for model version " + std::to_string(c.model_version()) + " refused: " +
+                  (current_version_ == 0 ? std::string("no model ready yet")
+                                         : "current model version is " + std::to_string(current_version_)));
+    return;
+  }
+  if (!current_.areas) return refuse(c, "cannot finish: " + current_.error);
+  if (run_) return refuse(c, "a run is in progress (request " + std::to_string(run_->request_id) + ")");
+  if (c.verb() == msg::FINISH_SAND) {
+    if (current_.task != Task::kSand) return refuse(c, "the arm carries no sanding tool (it sprays)");
+    return refuse(c, "sanding through the robot service is not in the DDS adapter yet; the sanding run works in the simulator without DDS (bench_surface_finish --sand; services/surface_finish README)");
+  }
+  if (current_.task != Task::kSpray) return refuse(c, "the arm carries no spraying tool (it sands)");
+  try {
+    start_spray(c);
+  } catch (const std::exception& e) {
+    run_.reset();
+    run_active_.store(false);
+    refuse(c, e.what());
+  }
+}
+
+Eigen::VectorXd FinishNode::q_of(const Measured& m) const {
+  const kinematics::Model& k = current_.model->kinematics();
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(k.dof());
+  for (std::size_t i = 0; i < m.names.size() && i < m.positions.size(); ++i) {
+    if (auto j = k.joint_index(m.names[i])) q[*j] = m.positions[i];
+  }
+  return q;
+}
+
+WallFit FinishNode::measure_wall() {
+  std::optional<msg::LaserScan> scan;
+  std::optional<Measured> latest;
+  std::chrono::steady_clock::time_point seen;
+  {
+    std::lock_guard lock(mutex_);
+    scan = scan_;
+    latest = latest_;
+    seen = scan_seen_;
+  }
+  if (!scan) throw FinishError("no laser scan received (concert/sensors/scan): the wall is unknown");
+  if (std::chrono::duration<double>(std::chrono::steady_clock::now() - seen).count() > params_.scan_max_age) {
+    throw FinishError("the laser scan is older than " + std::to_string(params_.scan_max_age).substr(0, 3) + " s");
+  }
+  if (!latest) throw FinishError("no joint state received: the robot's posture is unknown");
+  const kinematics::Model& k = current_.model->kinematics();
+  if (!k.has_frame(scan->frame())) throw FinishError("the laser scan's frame '" + scan->frame() + "' is not in model version " + std::to_string(current_version_));
+  kinematics::Data data = k.make_data();
+  const Eigen::Isometry3d base_T_scan = k.frame_pose(data, q_of(*latest), scan->frame());
+  std::vector<Eigen::Vector2d> pts;
+  for (std::size_t i = 0; i < scan->ranges().size(); ++i) {
+    const double r = scan->ranges()[i];
+    if (!std::isfinite(r) || r < scan->range_min() || r > scan->range_max()) continue;
+    const double a = scan->angle_min() + static_cast<double>(i) * scan->angle_increment();
+    const Eigen::Vector3d p = base_T_scan * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0.0);
+    pts.emplace_back(p.x(), p.y());
+  }
+  return fit_wall(pts, current_.reach->standing_height());
+}
+
+void FinishNode::start_spray(const msg::FinishCommand& c) {
+  const AreaMap& areas = *current_.areas;
+  const Area& area = areas.area(c.area());
+  const Rect rect = c.has_rect() ? reshape(area, Rect{c.x0(), c.x1(), c.y0(), c.y1()}) : area.rect;
+  const WallFit fit = measure_wall();
+  const double d = fit.wall.distance();
+  if (std::abs(d - areas.wall_distance) > params_.distance_tolerance) {
+    char b[200];
+    std::snprintf(b, sizeof b, "the wall is %.2f m from the base (scan), the areas need the base %.2f m +- %.2f m from it: move the base first",
+                  d, areas.wall_distance, params_.distance_tolerance);
+    throw FinishError(b);
+  }
+  std::optional<Measured> latest;
+  {
+    std::lock_guard lock(mutex_);
+    latest = latest_;
+  }
+  const Eigen::VectorXd q_now = q_of(*latest);
+  ToolSpec tool = params_.spray;
+  PathParams path = params_.path;
+  if (c.speed() > 0.0) path.speed = c.speed();
+  const auto strokes = serpentine_strokes(rect, tool, path.visible);
+  Run run;
+  run.request_id = c.request_id();
+  run.wall = fit.wall;
+  run.wall_distance = d;
+  run.plan = plan_serpentine(*current_.reach, fit.wall, rect, tool, areas.roll, path, q_now,
+                             &areas.posture_near(strokes.front().x, strokes.front().y_start));
+  run.deposition = std::make_unique<SprayDeposition>(fit.wall, rect, tool, path.speed, static_cast<int>(run.plan.strokes.size()));
+  // One joint trajectory of the arm's joints.
+  const kinematics::Model& k = current_.model->kinematics();
+  msg::JointTrajectoryCommand t;
+  run.trajectory_id = next_trajectory_++;
+  t.request_id(run.trajectory_id);
+  t.model_version(static_cast<std::uint32_t>(current_version_));
+  t.stamp_ns(now_ns());
+  t.source(kSource);
+  const std::vector<int>& arm = current_.reach->arm_joints();
+  for (int j : arm) t.joint_names().push_back(k.joint_names()[static_cast<std::size_t>(j)]);
+  for (const PathSample& s : run.plan.samples) {
+    msg::JointTrajectorySample out;
+    out.time(s.t);
+    for (int j : arm) {
+      out.position().push_back(s.q[j]);
+      out.velocity().push_back(s.qd[j]);
+    }
+    t.samples().push_back(out);
+  }
+  {
+    std::lock_guard lock(mutex_);
+    measured_.clear();
+  }
+  run_active_.store(true);
+  run.sent = std::chrono::steady_clock::now();
+  trajectories_.write(t);
+  char b[200];
+  std::snprintf(b, sizeof b, "request %u: spraying %s of area '%s': %zu strokes, %.1f s, wall %.3f m (scan, %d points)",
+                c.request_id(), rect.str().c_str(), area.id.c_str(), run.plan.strokes.size(), run.plan.duration(), d,
+                fit.inliers);
+  log_line(std::string("surface_finish: ") + b);
+  run_ = std::move(run);
+  publish(run_->request_id, msg::FINISH_RUNNING, "", &*run_);
+}
+
+void FinishNode::follow_run() {
+  Run& run = *run_;
+  std::deque<Measured> measured;
+  std::optional<msg::TrajectoryStatus> ts;
+  {
+    std::lock_guard lock(mutex_);
+    measured.swap(measured_);
+    if (auto it = trajectory_statuses_.find(run.trajectory_id); it != trajectory_statuses_.end()) ts = it->second;
+  }
+  // The deposition model, fed the TCP of every measured posture; the plan sample it is at is
+  // tracked forwards in joint space (the nearest of the next samples).
+  const auto& samples = run.plan.samples;
+  for (const Measured& m : measured) {
+    const Eigen::VectorXd q = q_of(m);
+    std::size_t best = run.index;
+    double best_d = (samples[run.index].q - q).squaredNorm();
+    for (std::size_t i = run.index + 1; i < samples.size() && i <= run.index + 40; ++i) {
+      const double dist = (samples[i].q - q).squaredNorm();
+      if (dist < best_d) {
+        best_d = dist;
+        best = i;
+      }
+    }
+    run.index = best;
+    const double dt = run.last_stamp > 0 ? static_cast<double>(m.stamp_ns - run.last_stamp) * 1e-9 : 0.0;
+    run.last_stamp = m.stamp_ns;
+    const std::size_t next = std::min(best + 1, samples.size() - 1);
+    const PathSample& s = samples[next];
+    if (!s.tool_on || dt <= 0.0 || dt > 0.1) continue;
+    const Eigen::Isometry3d tcp = current_.reach->tcp_pose(q);
+    if (valve_open(run.plan.strokes[static_cast<std::size_t>(s.stroke)], run.wall.coordinates(tcp.translation()))) {
+      run.deposition->add(tcp, dt, s.stroke);
+    }
+  }
+  if (ts) run.progress = ts->progress();
+  if (ts && ts->state() == msg::TRAJECTORY_SUCCEEDED) {
+    end_run(msg::FINISH_SUCCEEDED, "");
+  } else if (ts && (ts->state() == msg::TRAJECTORY_ABORTED || ts->state() == msg::TRAJECTORY_REFUSED)) {
+    end_run(msg::FINISH_FAILED, "the robot stopped the path: " + ts->reason());
+  } else if (!ts && std::chrono::steady_clock::now() - run.sent > std::chrono::seconds(10)) {
+    end_run(msg::FINISH_FAILED, "the robot service did not answer the path's trajectory within 10 s");
+  }
+}
+
+void FinishNode::end_run(msg::FinishState state, const std::string& reason) {
+  Run& run = *run_;
+  run_active_.store(false);
+  std::vector<double> xs;
+  std::vector<bool> ups;
+  for (const Stroke& s : run.plan.strokes) {
+    xs.push_back(s.x);
+    ups.push_back(s.up());
+  }
+  const SprayReport rep = run.deposition->measure(xs, ups);
+  const std::string json = SprayDeposition::to_json(rep);
+  if (!params_.out_dir.empty()) {
+    try {
+      std::filesystem::create_directories(params_.out_dir);
+      const std::string stem = params_.out_dir + "/spray_" + std::to_string(run.request_id);
+      std::ofstream(stem + ".json") << json << "\n";
+      run.deposition->write_png(stem + ".png");
+    } catch (const std::exception& e) {
+      log_line(std::string("surface_finish: cannot write the report: ") + e.what());
+    }
+  }
+  char b[200];
+  std::snprintf(b, sizeof b, "request %u: %s: coverage %.2f %%, max |dh| %.1f mm, max coat width error %.1f mm",
+                run.request_id, state == msg::FINISH_SUCCEEDED ? "done" : "stopped", rep.coverage * 100.0,
+                rep.max_abs_delta_h * 1e3, rep.max_width_error * 1e3);
+  log_line(std::string("surface_finish: ") + b + (reason.empty() ? "" : " (" + reason + ")"));
+  if (state == msg::FINISH_SUCCEEDED) run.progress = 1.0;
+  publish(run.request_id, state, reason, &run, json);
+  run_.reset();
+}
+
+void FinishNode::hold_here() {
+  std::optional<Measured> latest;
+  {
+    std::lock_guard lock(mutex_);
+    latest = latest_;
+  }
+  if (!latest || !current_.model || !current_.reach) return;
+  const kinematics::Model& k = current_.model->kinematics();
+  const Eigen::VectorXd q = q_of(*latest);
+  msg::JointTrajectoryCommand t;
+  t.request_id(next_trajectory_++);
+  t.model_version(static_cast<std::uint32_t>(current_version_));
+  t.stamp_ns(now_ns());
+  t.source(kSource);
+  msg::JointTrajectorySample a, b;
+  a.time(0.0);
+  b.time(0.1);
+  for (int j : current_.reach->arm_joints()) {
+    t.joint_names().push_back(k.joint_names()[static_cast<std::size_t>(j)]);
+    a.position().push_back(q[j]);
+    b.position().push_back(q[j]);
+  }
+  t.samples().push_back(a);
+  t.samples().push_back(b);
+  trajectories_.write(t);
+}
+
+void FinishNode::abort_run(const std::string& why) {
+  hold_here();
+  end_run(msg::FINISH_ABORTED, why);
+}
+
+}  // namespace concert::surface_finish::dds

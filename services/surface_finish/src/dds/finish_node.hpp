@@ -1,0 +1,126 @@
+#pragma once
+// DDS adapter of the surface finishing service: the robot model in (the arm's spraying or sanding
+// tool; the areas computed on a worker thread, status READY at the version once they are, or
+// "cannot finish: ..."), joint states, the lidars' planar scan (the wall and its normal) and the
+// robot's trajectory statuses in; commands in; the areas (latched) and every run's status and
+// report out. A spray run is executed as one joint trajectory through the robot service; the
+// deposition model is fed the TCP of every measured joint state.
+//
+// DDS callbacks only queue; one control thread does the rest.
+#include <atomic>
+#include <chrono>
+#include <deque>
+#include <future>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/status_reporter.hpp"
+#include "surface_finish/areas.hpp"
+#include "surface_finish/deposition.hpp"
+#include "surface_finish/serpentine.hpp"
+#include "surface_finish/wall_fit.hpp"
+
+namespace concert::surface_finish::dds {
+
+struct NodeParams {
+  double rate{50.0};                             ///< control rate [Hz]
+  AreaParams areas;
+  PathParams path;
+  ToolSpec spray{Task::kSpray, 0.3, 0.1, 0.1};   ///< 0.3 m standoff, 0.1 m coats (paper 6.2)
+  ToolSpec sand{Task::kSand, 0.0, 0.23, 0.1};    ///< disc diameter: an estimate
+  double sand_force{30.0};          ///< [N] the sanding areas keep the torques for this force
+  double distance_tolerance{0.15};  ///< measured wall distance vs the working distance [m]
+  double scan_max_age{2.0};         ///< [s]
+  std::string out_dir;              ///< where each run's report JSON and PNG go ("" = nowhere)
+};
+
+class FinishNode {
+ public:
+  FinishNode(concert::dds::Participant& participant, NodeParams params, std::ostream& log);
+  ~FinishNode();
+  FinishNode(const FinishNode&) = delete;
+  FinishNode& operator=(const FinishNode&) = delete;
+  /// Runs the control loop until `stop` is set (a running path is stopped, the arm held).
+  void spin(const std::atomic<bool>& stop);
+
+ private:
+  struct Prepared {
+    std::shared_ptr<const model::RobotModel> model;
+    std::shared_ptr<Reach> reach;
+    std::optional<AreaMap> areas;
+    Task task{Task::kSpray};
+    std::string error;
+  };
+  struct Measured {
+    std::int64_t stamp_ns{0};
+    std::vector<std::string> names;
+    std::vector<double> positions;
+  };
+  struct Run {
+    std::uint32_t request_id{0};
+    std::uint32_t trajectory_id{0};
+    SerpentinePlan plan;
+    WallFrame wall;
+    std::unique_ptr<SprayDeposition> deposition;
+    std::size_t index{0};          // plan sample the measured posture is at
+    std::int64_t last_stamp{0};
+    double progress{0.0};
+    double wall_distance{0.0};
+    std::chrono::steady_clock::time_point sent{};
+  };
+
+  void tick();
+  void on_model(const msg::RobotModel& m);
+  void finish_preparation();
+  void handle(const msg::FinishCommand& c);
+  void start_spray(const msg::FinishCommand& c);
+  void abort_run(const std::string& why);
+  void follow_run();
+  void end_run(msg::FinishState state, const std::string& reason);
+  void publish(std::uint32_t request_id, msg::FinishState state, const std::string& reason, const Run* run,
+               const std::string& report = {});
+  void refuse(const msg::FinishCommand& c, const std::string& why);
+  [[nodiscard]] Eigen::VectorXd q_of(const Measured& m) const;
+  [[nodiscard]] WallFit measure_wall();
+  void hold_here();
+  void log_line(const std::string& line);
+
+  NodeParams params_;
+  std::ostream& log_;
+  concert::dds::StatusReporter status_;
+  concert::dds::Writer<msg::FinishAreas> areas_writer_;
+  concert::dds::Writer<msg::FinishStatus> status_writer_;
+  concert::dds::Writer<msg::JointTrajectoryCommand> trajectories_;
+
+  std::mutex mutex_;  // the inbox below
+  std::optional<msg::RobotModel> new_model_;
+  std::deque<msg::FinishCommand> commands_;
+  std::deque<Measured> measured_;  // joint states since the last tick (bounded)
+  std::optional<Measured> latest_;
+  std::optional<msg::LaserScan> scan_;
+  std::chrono::steady_clock::time_point scan_seen_{};
+  std::map<std::uint32_t, msg::TrajectoryStatus> trajectory_statuses_;
+
+  std::uint64_t version_seen_{0};
+  std::future<Prepared> preparing_;
+  std::uint64_t preparing_version_{0};
+  Prepared current_;
+  std::uint64_t current_version_{0};
+  std::optional<Run> run_;
+  std::atomic<bool> run_active_{false};  // joint states are queued only while a run is on
+  std::uint32_t next_trajectory_{0x46000001};
+
+  // Readers last: their callbacks use everything above.
+  concert::dds::Reader<msg::RobotModel> model_reader_;
+  concert::dds::Reader<msg::JointState> joint_reader_;
+  concert::dds::Reader<msg::LaserScan> scan_reader_;
+  concert::dds::Reader<msg::FinishCommand> command_reader_;
+  concert::dds::Reader<msg::TrajectoryStatus> trajectory_reader_;
+};
+
+}  // namespace concert::surface_finish::dds
