@@ -3,7 +3,8 @@
 # packages already installed are skipped, so a second run does nothing and takes a second.
 # The lists live in deploy/packages/*.txt (one package a line, '#' comments), one file per area.
 # Then the npm packages of the project's Node.js steps (tools/ifc_import: the IFC engine web-ifc;
-# tools/mcap_check: Foxglove's MCAP reader, run by the bag tests) are installed from their committed lockfiles with `npm ci`, when node_modules is missing or
+# tools/mcap_check: Foxglove's MCAP reader, run by the bag tests; services/gui/app: the operator GUI's
+# three.js, urdf-loader, esbuild and playwright-core) are installed from their committed lockfiles with `npm ci`, when node_modules is missing or
 # older than the lockfile; nothing is fetched at run time.
 # Usage: deploy/install-deps.sh [--check]   (--check: only report what is missing; exit 1 if any)
 set -euo pipefail
@@ -46,7 +47,7 @@ fi
 # npm packages, one folder per Node.js step, from its committed package-lock.json. Quiet when
 # node_modules is already newer than the lockfile.
 # (A folder that is not there, as in the Docker build's first layer, is skipped.)
-for dir in "$here/../tools/ifc_import" "$here/../tools/mcap_check"; do
+for dir in "$here/../tools/ifc_import" "$here/../tools/mcap_check" "$here/../services/gui/app"; do
   [ -f "$dir/package-lock.json" ] || continue
   dir=$(cd "$dir" && pwd)
   lock="$dir/package-lock.json"
@@ -67,4 +68,27 @@ for dir in "$here/../tools/ifc_import" "$here/../tools/mcap_check"; do
   fi
   echo "install-deps: npm ci in $dir"
   (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+done
+
+# Socket buffers: DDS on one machine runs over loopback UDP (libs/dds participant.cpp, no shared
+# memory) and asks for 4 MiB buffers, which the kernel caps at net.core.rmem_max / wmem_max
+# (Debian's default: 208 KiB, where two camera frames in three were lost). Raised here and kept
+# in /etc/sysctl.d; where the kernel's settings cannot be changed (a container without the
+# right), only a warning: the services warn too, and run.
+want_buf=4194304
+for key in rmem_max wmem_max; do
+  have=$(cat /proc/sys/net/core/$key 2>/dev/null || echo 0)
+  [ "$have" -ge "$want_buf" ] && continue
+  if [ "$check_only" -eq 1 ]; then
+    echo "install-deps: net.core.$key is $have, below $want_buf (DDS camera frames may be lost)" >&2
+    continue
+  fi
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && command -v sudo >/dev/null && sudo="sudo"
+  if $sudo sysctl -q -w "net.core.$key=$want_buf" 2>/dev/null; then
+    echo "net.core.$key = $want_buf" | $sudo tee -a /etc/sysctl.d/60-concert-dds.conf >/dev/null 2>&1 || true
+    echo "install-deps: net.core.$key raised from $have to $want_buf (DDS socket buffers)"
+  else
+    echo "install-deps: warning: net.core.$key is $have and cannot be raised here to $want_buf; large DDS samples (camera images) may be lost" >&2
+  fi
 done

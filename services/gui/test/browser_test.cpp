@@ -1,0 +1,122 @@
+// The operator GUI in a real headless browser against the whole stack in simulation: `concert
+// up` (which starts the gateway, surface_finish and collab with the rest) with the drill robot in
+// front of the demo wall; then the playwright-core script app/test/browser_test.mjs drives Debian's
+// chromium through the pages: module tree and model version, a hot swap seen live, the e-stop
+// button stopping the safety service (read back on DDS with `concert safety status`), the reset
+// button bringing RUNNING back, the Topics page's live rates, the storey view (a tap on the wall
+// adds a point area to the mission YAML), the sanding panel (an area of the
+// sanding robot chosen, force set, start pressed) and a transport mode button; it saves a
+// screenshot of each page in <build>/services/gui/screenshots/. This test's own DDS readers
+// check what the sanding start and the mode button wrote: typed FinishCommand and CollabCommand
+// samples with the operator's choices.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <iostream>
+#include <mutex>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "../../../tests/system/helpers.hpp"
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/participant.hpp"
+#include "concert/dds/topics.hpp"
+#include "process.hpp"
+
+namespace concert::gui {
+namespace {
+
+using namespace std::chrono_literals;
+using concert::testing::Process;
+using concert::system_test::dies_with_test;
+namespace topics = concert::dds::topics;
+
+/// Every sample of a command topic, kept for the checks after the browser's run.
+template <class T>
+struct Recorder {
+  std::mutex mutex;
+  std::vector<T> samples;
+  concert::dds::Reader<T> reader;
+  Recorder(concert::dds::Participant& p, concert::dds::TopicHandle<T> topic)
+      : reader(p, topic, [this](const T& s, const auto&) {
+          std::lock_guard lock(mutex);
+          samples.push_back(s);
+        }) {}
+  std::vector<T> all() {
+    std::lock_guard lock(mutex);
+    return samples;
+  }
+};
+
+TEST(GuiBrowser, ModuleTreeHotSwapEStopResetSandingAndTransportInChromium) {
+  concert::testing::TempDir run_dir("concert-gui-browser");
+  const std::vector<std::string> env{"XDG_RUNTIME_DIR=" + run_dir.path()};
+  // The judge's readers, created first: matched long before the browser presses anything.
+  concert::dds::Participant judge({.name = "gui-browser-test"});
+  Recorder<msg::FinishCommand> finish(judge, topics::finish_command);
+  Recorder<msg::CollabCommand> collab(judge, topics::collab_command);
+
+  Process up(dies_with_test({CONCERT_BIN, "up", "--assembly", CONCERT_SOURCE_DIR "/deploy/demo/drill_robot.yaml", "--world",
+                                CONCERT_SOURCE_DIR "/deploy/demo/drill_site.yaml"}),
+             env);
+  const auto logs = [&] {
+    const char* d = std::getenv("CONCERT_DOMAIN_ID");
+    const std::string finish_log = run_dir.path() + "/concert-d" + std::string(d ? d : "0") + "/logs/surface_finish.log";
+    return "\n--- concert up:\n" + up.out() + up.err() + "\n--- surface_finish:\n" +
+           concert::testing::run({"/bin/cat", finish_log}, 5s).out;
+  };
+  ASSERT_TRUE(up.wait_for_output("operator GUI: http://", 30s)) << logs();
+  std::smatch m;
+  const std::string out = up.out();
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("operator GUI: (http://[0-9.]+:[0-9]+/)"))) << logs();
+  const std::string url = m[1];
+
+  auto status = concert::testing::run({CONCERT_BIN, "status", "--until-version", "1", "--timeout", "90"}, 120s, env);
+  ASSERT_EQ(status.code, 0) << status.out << status.err << logs();
+
+  Process browser({CONCERT_NODE, CONCERT_SOURCE_DIR "/services/gui/app/test/browser_test.mjs"},
+                  {"GUI_URL=" + url, "CONCERT_BIN=" CONCERT_BIN, "CONCERT_SOURCE_DIR=" CONCERT_SOURCE_DIR,
+                   "SHOTS_DIR=" GUI_SCREENSHOTS, "XDG_RUNTIME_DIR=" + run_dir.path()});
+  const auto code = browser.wait(420s);
+  const char* domain = std::getenv("CONCERT_DOMAIN_ID");
+  const std::string gui_log =
+      concert::testing::run({"/bin/cat", run_dir.path() + "/concert-d" + std::string(domain ? domain : "0") + "/logs/gui.log"}, 5s)
+          .out;
+  std::cout << "--- browser_test.mjs:\n" << browser.out() << std::flush;  // its steps, in ctest's log
+  EXPECT_EQ(code, 0) << "--- browser_test.mjs:\n"
+                     << browser.out() << browser.err() << "\n--- gateway log:\n"
+                     << gui_log << logs();
+  // Every command the browser sent is in the gateway's log with its origin.
+  EXPECT_NE(gui_log.find("command from 127.0.0.1:"), std::string::npos) << gui_log;
+  EXPECT_NE(gui_log.find("on concert/safety/reset"), std::string::npos) << gui_log;
+
+  // The sanding start: on DDS, typed, with the area, force and verb the operator chose, for the
+  // sanding robot's model version (2, after the swap), naming the browser.
+  const auto commands = finish.all();
+  ASSERT_FALSE(commands.empty()) << "no FinishCommand on DDS\n" << browser.out() << gui_log;
+  const msg::FinishCommand& c = commands.front();
+  ASSERT_EQ(commands.size(), 2u) << "expected the start and the abort";
+  EXPECT_EQ(c.verb(), msg::FINISH_SAND);
+  EXPECT_EQ(c.area(), "centre");
+  EXPECT_DOUBLE_EQ(c.force(), 25.0);  // the test types 25 over the panel's default 30
+  EXPECT_EQ(c.model_version(), 2u);
+  EXPECT_FALSE(c.has_rect());
+  EXPECT_EQ(c.source().rfind("concert gui (127.0.0.1:", 0), 0u) << c.source();
+  EXPECT_GT(c.stamp_ns(), 0);
+  EXPECT_NE(browser.out().find("request " + std::to_string(c.request_id())), std::string::npos)
+      << "the page did not show the service's status of request " << c.request_id() << "\n" << browser.out();
+  // Then the abort button.
+  EXPECT_EQ(commands.back().verb(), msg::FINISH_ABORT);
+  EXPECT_EQ(commands.back().source(), c.source());
+
+  // The transport page's follow-me button.
+  const auto modes = collab.all();
+  ASSERT_EQ(modes.size(), 1u) << "CollabCommand samples on DDS: " << modes.size() << "\n" << browser.out();
+  EXPECT_EQ(modes.front().text(), "follow-me");
+  EXPECT_TRUE(modes.front().direct());
+  EXPECT_EQ(modes.front().source(), "gui");
+}
+
+}  // namespace
+}  // namespace concert::gui
