@@ -5,8 +5,12 @@
 //             (deploy/bench/drill_blobs_*.yaml; visual servoing)
 //   patterns  scenario 3, the part morphology A reaches: four ArUco 60 cm rows at 0.5-2.0 m
 //             (deploy/bench/drill_patterns_*.yaml; the kinematics alone)
+//   bim       scenario 2: the FZK house's ground floor (IFC), an area picked on a wall of the
+//             building's model, two blue blobs 0.1 m apart drawn there; the robot (morphology A)
+//             starts in another part of the room, navigates to the BIM base pose, then drills
 //   demo      the demo wall's pattern (deploy/demo/drill_site.yaml)
-// Usage: bench_drill_mission [--scenario blobs|patterns|demo|all] [--runs N]   (default: all, 1)
+// Usage: bench_drill_mission [--scenario blobs|patterns|bim|demo|all] [--runs N] [--assembly FILE]
+//        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
 #include <algorithm>
@@ -18,6 +22,9 @@
 #include <string>
 #include <vector>
 
+#include <optional>
+
+#include "concert/cli/cli.hpp"
 #include "drill_runner.hpp"
 
 using namespace concert::system_test;
@@ -27,7 +34,9 @@ namespace {
 
 struct Scenario {
   std::string name, assembly, site, mission;
+  std::optional<Building> building;  // scenario 2: the site is made from the IFC storey
 };
+
 
 std::string source(const std::string& path) { return std::string(CONCERT_SOURCE_DIR) + "/" + path; }
 
@@ -45,28 +54,14 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::string which = "all";
-  int runs = 1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--scenario" && i + 1 < argc) {
-      which = argv[++i];
-    } else if (a == "--runs" && i + 1 < argc) {
-      runs = std::atoi(argv[++i]);
-    } else {
-      std::cerr << "bench_drill_mission: unknown argument '" << a
-                << "' (--scenario blobs|patterns|demo|all, --runs N)\n";
-      return 2;
-    }
-  }
+int bench(const std::string& which, int runs, const std::string& assembly) {
   const std::vector<Scenario> all{
       {"blobs", source("services/planner/data/morphology_b.yaml"),
        source("deploy/bench/drill_blobs_site.yaml"), source("deploy/bench/drill_blobs_mission.yaml")},
       {"patterns", source("services/planner/data/morphology_a.yaml"),
        source("deploy/bench/drill_patterns_site.yaml"), source("deploy/bench/drill_patterns_mission.yaml")},
+      {"bim", source("services/planner/data/morphology_a.yaml"), "", bim_mission("bench bim area"),
+       fzk_living_room()},
       {"demo", source("deploy/demo/drill_robot.yaml"), source("deploy/demo/drill_site.yaml"), ""},
   };
   const concert::drill::PatternTable patterns =
@@ -76,10 +71,12 @@ int main(int argc, char** argv) {
     if (which != "all" && which != sc.name) continue;
     known = true;
     const std::string mission =
-        sc.mission.empty() ? "name: bench demo pattern\ndepth: 0.03\nareas:\n"
-                             "  - {name: pattern, marks: aruco, point: [2.2, -0.9, 1.45]}\n"
-                           : read(sc.mission);
-    std::vector<Target> targets = targets_of(concert::world::load_world_file(sc.site), patterns);
+        sc.building            ? sc.mission
+        : sc.mission.empty() ? "name: bench demo pattern\ndepth: 0.03\nareas:\n"
+                               "  - {name: pattern, marks: aruco, point: [2.2, -0.9, 1.45]}\n"
+                             : read(sc.mission);
+    const std::string site = sc.building ? building_site(*sc.building) : sc.site;
+    std::vector<Target> targets = targets_of(concert::world::load_world_file(site), patterns);
     if (sc.name == "demo") {  // the demo wall's blobs are another mission's
       std::erase_if(targets, [](const Target& t) { return t.name.rfind("blob", 0) == 0; });
     }
@@ -87,7 +84,8 @@ int main(int argc, char** argv) {
     std::size_t drilled = 0, marked = 0;
     double t_nav = 0, t_plan = 0, t_exec = 0, t_drill = 0, t_total = 0;
     for (int r = 0; r < runs; ++r) {
-      const MissionRun run = run_mission(sc.assembly, sc.site, mission, std::chrono::seconds(3600));
+      const MissionRun run = run_mission(assembly.empty() ? sc.assembly : assembly, site, mission,
+                                         std::chrono::seconds(3600), sc.building);
       if (!run.status) {
         std::cerr << sc.name << " run " << r + 1 << ": no status from the drill service" << run.logs
                   << "\n";
@@ -100,6 +98,9 @@ int main(int argc, char** argv) {
                   s.state() == concert::msg::DRILL_SUCCEEDED ? "succeeded" : "did not succeed",
                   s.holes_drilled(), s.holes_marked(), run.safety_running ? "RUNNING" : "STOPPED",
                   s.reason().empty() ? "" : ": ", s.reason().c_str());
+      if (s.state() != concert::msg::DRILL_SUCCEEDED) {
+        std::cerr << sc.name << " run " << r + 1 << ": the services' logs" << run.logs << "\n";
+      }
       for (const Target& t : targets) {
         marked += 1;
         const auto [hole, e] = nearest_hole(run.holes, t);
@@ -131,8 +132,33 @@ int main(int argc, char** argv) {
   }
   if (!known) {
     std::cerr << "bench_drill_mission: unknown scenario '" << which
-              << "' (blobs, patterns, demo or all)\n";
+              << "' (blobs, patterns, bim, demo or all)\n";
     return 2;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  concert::cli::Cli cli("bench_drill_mission",
+                        "The paper's drilling scenarios as missions on whole simulated stacks, the "
+                        "holes scored against the marks' truth. Minutes per run.",
+                        std::cout, std::cerr);
+  std::string which = "all";
+  int runs = 1;
+  auto& app = cli.app();
+  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "bim", "demo", "all"},
+                                "scenario to run")
+      ->capture_default_str();
+  std::string assembly;
+  app.add_option("--assembly", assembly,
+                 "the robot of every scenario run (default: the scenario's, e.g. morphology A "
+                 "for bim)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--runs", runs, "runs per scenario")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 1e6, true));
+  cli.on_run(app, [&] { return bench(which, runs, assembly); });
+  return cli.run(argc, argv);
 }

@@ -6,17 +6,27 @@
 // true positions (libs/world) and the patterns laid on the markers' true poses.
 
 #include <Eigen/Geometry>
+#include <unistd.h>
+
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "concert/bim/model.hpp"
+#include "concert/bim/storey_map.hpp"
+#include "concert/bim/storey_world.hpp"
+#include "concert/bim/wall_goal.hpp"
 #include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/participant.hpp"
@@ -101,21 +111,107 @@ struct MissionRun {
   std::string logs;
 };
 
+/// A mission in a building (paper scenario 2): the nav service maps the IFC storey and
+/// localises the robot, which starts at `start` (x, y, theta in the map frame); the site is the
+/// storey's world (bim::storey_world) with two blue blobs drawn 5 cm either side of the area the
+/// user picks on the model (wall, at = [s, h], face), as in the paper (6.1: the dots are drawn,
+/// then the area is aligned with them on the BIM).
+struct Building {
+  std::string ifc;
+  std::string storey;
+  std::array<double, 3> start{0, 0, 0};
+  std::string wall;  // IFC GlobalId
+  std::array<double, 2> at{0, 0};
+  std::string face{"auto"};
+};
+
+/// The paper's scenario 2 in the KIT FZK house (../shared/data/bim): the ground floor; the area
+/// on the living room's face (right) of the interior wall north of it (Wand-Int-ERDG-5), 1.75 m
+/// along its axis, 1.2 m high; the robot starts inside the terrace door east of the spiral
+/// stair, facing north, 4.3 m from where it drills, and drives around the stair.
+inline Building fzk_living_room() {
+  return {std::string(CONCERT_SHARED_DATA) + "/bim/AC20-FZK-Haus.ifc",
+          "Erdgeschoss",
+          {6.0, 1.2, M_PI / 2},
+          "1$wmdwWPjDYuku_ghVkynE",
+          {1.75, 1.2},
+          "right"};
+}
+
+/// The mission drilling both blobs of a Building's area.
+inline std::string bim_mission(const std::string& name, const Building& b = fzk_living_room()) {
+  std::ostringstream m;
+  m << "name: " << name << "\ndepth: 0.03\nifc: " << b.ifc << "\nstorey: " << b.storey
+    << "\nareas:\n  - {name: bim, marks: blobs, wall: \"" << b.wall << "\", at: [" << b.at[0]
+    << ", " << b.at[1] << "], face: " << b.face << ", expected: 2}\n";
+  return m.str();
+}
+
+/// The Building's world file (a temp file): the storey's boxes and the two blobs, drawn on the
+/// face the drill service's wall goal picks (its standoff 1.05 m and robot radius 0.55 m:
+/// services/drill/src/dds/drill_node.cpp kWallStandoff, kRobotRadius).
+inline std::string building_site(const Building& b) {
+  const bim::BimModel house = bim::load_ifc(b.ifc);
+  const bim::Storey& storey = house.storey(b.storey);
+  world::World w = bim::storey_world(house, storey);
+  bim::GoalOptions options;
+  options.face = bim::face_choice(b.face);
+  const bim::WallGoal goal = bim::wall_goal(house, bim::storey_map(house, storey), b.wall, b.at[0],
+                                            b.at[1], 1.05, 0.55, options);
+  const Eigen::Vector3d centre = goal.area_frame.translation();
+  const Eigen::Vector3d normal = goal.area_frame.linear().col(2);
+  const Eigen::Vector3d right = Eigen::Vector3d::UnitZ().cross(normal).normalized();
+  w.marks.push_back(bim::mark_on_wall(w, b.wall, centre - 0.05 * right, normal, "bim_left", 0.025));
+  w.marks.push_back(bim::mark_on_wall(w, b.wall, centre + 0.05 * right, normal, "bim_right", 0.025));
+  std::printf("building: area (%.3f, %.3f, %.3f) normal (%.2f, %.2f, %.2f), base goal (%.2f, "
+              "%.2f, %.2f), start (%.2f, %.2f, %.2f): %.2f m to drive\n",
+              centre.x(), centre.y(), centre.z(), normal.x(), normal.y(), normal.z(),
+              goal.base_pose.x(), goal.base_pose.y(), goal.base_pose.z(), b.start[0], b.start[1],
+              b.start[2], std::hypot(goal.base_pose.x() - b.start[0], goal.base_pose.y() - b.start[1]));
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("drill_building_site_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(file) << bim::world_yaml(w);
+  return file.string();
+}
+
 /// Runs `mission` (a mission file's text) with the robot of `assembly` in the world `site`, and
-/// waits for its end (bounded by `timeout`) and for the holes the status counts.
+/// waits for its end (bounded by `timeout`) and for the holes the status counts. With a
+/// `building`, the nav service runs too (started only when NAV_BINARY is defined).
 inline MissionRun run_mission(const std::string& assembly, const std::string& site,
-                              const std::string& mission, std::chrono::seconds timeout) {
+                              const std::string& mission, std::chrono::seconds timeout,
+                              const std::optional<Building>& building = std::nullopt) {
   using namespace std::chrono_literals;
   MissionRun run;
+  std::vector<std::string> robot_args = {ROBOT_BINARY, "--assembly", assembly, "--world", site};
+  std::vector<std::string> nav_args;
+  if (building) {
+    const std::filesystem::path params = std::filesystem::temp_directory_path() /
+                                         ("drill_runner_robot_" + std::to_string(::getpid()) + ".yaml");
+    std::ofstream(params) << std::setprecision(17) << "sim:\n  base_position: ["
+                          << building->start[0] << ", " << building->start[1]
+                          << ", 0.0]\n  base_yaw: " << building->start[2] << "\n";
+    robot_args.insert(robot_args.end(), {"--params", params.string()});
+#ifdef NAV_BINARY
+    std::ostringstream x, y, yaw;
+    x << std::setprecision(17) << building->start[0];
+    y << std::setprecision(17) << building->start[1];
+    yaw << std::setprecision(17) << building->start[2];
+    nav_args = {NAV_BINARY, "--ifc", building->ifc, "--storey", building->storey,
+                "--initial-pose", x.str(), y.str(), yaw.str()};
+#endif
+  }
   testing::Process safety(dies_with_test({SAFETY_BINARY}));
   testing::Process discovery(dies_with_test({DISCOVERY_BINARY}));
   testing::Process modelgen(dies_with_test({MODELGEN_BINARY}));
-  testing::Process robot(dies_with_test({ROBOT_BINARY, "--assembly", assembly, "--world", site}));
+  testing::Process robot(dies_with_test(robot_args));
   testing::Process planner(dies_with_test({PLANNER_BINARY}));
   testing::Process drill(dies_with_test({DRILL_BINARY}));
+  std::optional<testing::Process> nav;
+  if (!nav_args.empty()) nav.emplace(dies_with_test(nav_args));
   const auto logs = [&] {
-    return "\n--- drill:\n" + drill.err() + "--- planner:\n" + planner.err() + "--- safety:\n" +
-           safety.err() + "--- robot:\n" + robot.err() + "--- modelgen:\n" + modelgen.err();
+    return "\n--- drill:\n" + drill.err() + "--- planner:\n" + planner.err() +
+           (nav ? "--- nav:\n" + nav->err() : std::string()) + "--- safety:\n" + safety.err() +
+           "--- robot:\n" + robot.err() + "--- modelgen:\n" + modelgen.err();
   };
   concert::dds::Participant p({.name = "drill_mission_runner"});
   concert::dds::Reader<msg::SimHoles> holes(p, concert::dds::topics::sim_holes);
@@ -126,6 +222,21 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
       !wait_for_err(planner, "planner: model version 1", 60s) || !missions.wait_for_readers(1, 10s)) {
     run.logs = logs();
     return run;
+  }
+  if (nav) {  // the building's map loaded and the robot localised in it at its start
+    concert::dds::Reader<msg::NavLocalisation> localisations(p, concert::dds::topics::nav_localisation);
+    bool tracking = false;
+    if (wait_for_err(*nav, "nav: model version 1:", 90s)) {
+      for (const auto until = std::chrono::steady_clock::now() + 30s;
+           !tracking && std::chrono::steady_clock::now() < until;) {
+        const auto l = localisations.wait(200ms);
+        tracking = l && l->state() == msg::LOCALISATION_TRACKING;
+      }
+    }
+    if (!tracking) {
+      run.logs = "nav: not localised at the start" + logs();
+      return run;
+    }
   }
   msg::DrillMission m;
   m.mission_id(static_cast<uint32_t>(now_ns() & 0x7fffffff));

@@ -3,7 +3,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
+#include <optional>
+#include <sstream>
+
+#include "concert/world/geometry.hpp"
 
 namespace concert::bim {
 
@@ -91,9 +97,51 @@ concert::world::World storey_world(const BimModel& model, const Storey& storey,
   return w;
 }
 
+concert::world::Mark mark_on_wall(const concert::world::World& world, const std::string& global_id,
+                                  const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                                  const std::string& name, double diameter) {
+  using concert::world::Face;
+  const std::string prefix = to_string(Category::kWall) + "_" + global_id + "_";
+  const Eigen::Vector3d n = normal.normalized();
+  std::optional<concert::world::Mark> best;
+  double best_distance = std::numeric_limits<double>::infinity();
+  bool any_box = false;
+  for (const auto& box : world.walls) {
+    if (box.name.rfind(prefix, 0) != 0) continue;
+    any_box = true;
+    for (const Face face : {Face::kPlusX, Face::kMinusX, Face::kPlusY, Face::kMinusY}) {
+      const Eigen::Isometry3d frame = concert::world::face_frame(box, face);
+      if (frame.linear().col(2).dot(n) < std::cos(0.3)) continue;
+      const Eigen::Vector3d local = frame.inverse() * point;
+      const Eigen::Vector2d size = concert::world::face_size(box, face);
+      const double r = diameter / 2;
+      if (std::abs(local.x()) > size.x() / 2 - r || std::abs(local.y()) > size.y() / 2 - r) continue;
+      // Within a few map cells of the face: the IFC's face and the boxes' are a cell apart at most.
+      if (std::abs(local.z()) > 0.15 || std::abs(local.z()) >= best_distance) continue;
+      best_distance = std::abs(local.z());
+      concert::world::Mark m;
+      m.name = name;
+      m.type = concert::world::Mark::Type::kBlob;
+      m.diameter = diameter;
+      m.wall = box.name;
+      m.face = face;
+      m.at = {local.x(), point.z()};
+      best = m;
+    }
+  }
+  if (!best) {
+    std::ostringstream where;
+    where << "(" << point.x() << ", " << point.y() << ", " << point.z() << ")";
+    throw BimError("mark '" + name + "': wall " + global_id +
+                   (any_box ? ": no face of its boxes looking that way holds the point (within 0.15 m) " + where.str()
+                            : ": not in this storey's world (no box named " + prefix + "*)"));
+  }
+  return *best;
+}
+
 std::string world_yaml(const concert::world::World& world) {
-  if (!world.marks.empty() || !world.surfaces.empty()) {
-    throw BimError("world_yaml writes floors and boxes only, not marks or surfaces");
+  if (!world.surfaces.empty()) {
+    throw BimError("world_yaml writes floors, boxes and marks only, not sanding surfaces");
   }
   YAML::Node root;
   root["floor"]["enabled"] = world.floor;
@@ -116,6 +164,32 @@ std::string world_yaml(const concert::world::World& world) {
   };
   shapes(world.walls, "walls");
   shapes(world.obstacles, "obstacles");
+  for (const auto& m : world.marks) {
+    YAML::Node n;
+    n["name"] = m.name;
+    n["wall"] = m.wall;
+    n["face"] = concert::world::to_string(m.face);
+    YAML::Node at(YAML::NodeType::Sequence);
+    at.SetStyle(YAML::EmitterStyle::Flow);
+    at.push_back(m.at.x());
+    at.push_back(m.at.y());
+    n["at"] = at;
+    if (m.type == concert::world::Mark::Type::kBlob) {
+      n["type"] = "blob";
+      n["diameter"] = m.diameter;
+      YAML::Node rgba(YAML::NodeType::Sequence);
+      rgba.SetStyle(YAML::EmitterStyle::Flow);
+      for (int i = 0; i < 4; ++i) rgba.push_back(m.rgba[i]);
+      n["rgba"] = rgba;
+    } else {
+      n["type"] = "aruco";
+      n["size"] = m.size;
+      n["dictionary"] = m.dictionary;
+      n["id"] = m.id;
+      n["angle"] = m.angle;
+    }
+    root["marks"].push_back(n);
+  }
   YAML::Emitter out;
   out.SetDoublePrecision(9);
   out << root;

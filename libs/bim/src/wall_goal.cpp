@@ -112,6 +112,13 @@ double region_area(const OccupancyGrid& grid, const std::vector<bool>& free,
 
 }  // namespace
 
+FaceChoice face_choice(const std::string& name) {
+  if (name == "auto") return FaceChoice::kAuto;
+  if (name == "left") return FaceChoice::kLeft;
+  if (name == "right") return FaceChoice::kRight;
+  throw BimError("unknown face '" + name + "' (expected auto, left or right)");
+}
+
 WallGoal wall_goal(const BimModel& model, const OccupancyGrid& grid,
                    const std::string& wall_global_id, double s, double h, double standoff,
                    double robot_radius, const GoalOptions& options) {

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "bim_test_models.hpp"
+#include "concert/bim/wall_goal.hpp"
+#include "concert/world/geometry.hpp"
 
 namespace concert::bim {
 namespace {
@@ -51,6 +53,45 @@ TEST(StoreyWorld, YamlRoundTripThroughTheWorldParser) {
     EXPECT_NEAR((back.walls[i].size - w.walls[i].size).norm(), 0, 1e-9);
     EXPECT_NEAR((back.walls[i].position - w.walls[i].position).norm(), 0, 1e-9);
   }
+}
+
+TEST(StoreyWorld, MarksGoOnTheSimulatedFaceOfTheWallABimGoalNames) {
+  // The FZK house's interior wall north of the living room (Wand-Int-ERDG-5: y = 4.13 m, 0.24 m
+  // thick): an area 1.75 m along its axis, 1.2 m high, on the face wall_goal picks.
+  const BimModel& m = shared_model("AC20-FZK-Haus.ifc");
+  const Storey& storey = m.storey("Erdgeschoss");
+  world::World w = storey_world(m, storey);
+  const OccupancyGrid grid = storey_map(m, storey);
+  const std::string wall = "1$wmdwWPjDYuku_ghVkynE";
+  const WallGoal goal = wall_goal(m, grid, wall, 1.75, 1.2, 0.8, 0.4);
+  const Eigen::Vector3d normal = goal.area_frame.linear().col(2);
+  const Eigen::Vector3d right = Eigen::Vector3d::UnitZ().cross(normal);
+  w.marks.push_back(mark_on_wall(w, wall, goal.area_frame.translation() - 0.05 * right, normal,
+                                 "left", 0.025));
+  w.marks.push_back(mark_on_wall(w, wall, goal.area_frame.translation() + 0.05 * right, normal,
+                                 "right", 0.025));
+  const world::World back = world::parse_world_yaml(world_yaml(w), "fzk_marks.yaml");
+  ASSERT_EQ(back.marks.size(), 2u);
+  const auto truth = world::mark_truth(back);
+  ASSERT_EQ(truth.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Vector3d asked =
+        goal.area_frame.translation() + (i == 0 ? -0.05 : 0.05) * right;
+    SCOPED_TRACE(truth[i].name);
+    EXPECT_LT((truth[i].normal - normal).norm(), 1e-9);  // the face the area looks out of
+    // Along the face: where asked; along the normal: on the simulator's face, within a map cell
+    // of the IFC's face.
+    const Eigen::Vector3d d = truth[i].centre - asked;
+    EXPECT_NEAR(d.dot(right), 0.0, 1e-9);
+    EXPECT_NEAR(d.z(), 0.0, 1e-9);
+    EXPECT_LE(std::abs(d.dot(normal)), grid.resolution + 0.002);
+  }
+  EXPECT_NEAR((truth[1].centre - truth[0].centre).dot(right), 0.1, 1e-9);
+  // A point on another wall's face, and a wall not in the storey, are refused by name.
+  EXPECT_THAT([&] { (void)mark_on_wall(w, wall, {2.05, 0.0, 1.2}, normal, "far", 0.025); },
+              ::testing::ThrowsMessage<BimError>(::testing::HasSubstr("holds the point")));
+  EXPECT_THAT([&] { (void)mark_on_wall(w, "nope", {2.05, 4.0, 1.2}, normal, "x", 0.025); },
+              ::testing::ThrowsMessage<BimError>(::testing::HasSubstr("not in this storey")));
 }
 
 TEST(StoreyWorld, YamlRefusesWhatItDoesNotWrite) {

@@ -60,6 +60,22 @@ TEST_F(WallGoalTest, FrameOnTheFaceAndBaseAtTheStandoffFacingIt) {
   EXPECT_EQ(goal.storey, "Erdgeschoss");
 }
 
+TEST(FaceChoiceName, ReadsTheThreeWordsAndNamesAnyOther) {
+  EXPECT_EQ(face_choice("auto"), FaceChoice::kAuto);
+  EXPECT_EQ(face_choice("left"), FaceChoice::kLeft);
+  EXPECT_EQ(face_choice("right"), FaceChoice::kRight);
+  EXPECT_THROW(
+      {
+        try {
+          (void)face_choice("north");
+        } catch (const BimError& e) {
+          EXPECT_NE(std::string(e.what()).find("'north'"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      BimError);
+}
+
 TEST_F(WallGoalTest, BothFacesOfAnInteriorWallCanBeAsked) {
   const WallGeometry g = wall_geometry(model().element(kInteriorWall));
   const WallGoal left =

@@ -11,7 +11,7 @@ if(TARGET concert_dds)
   concert_target_defaults(concert_drill_dds)
   target_include_directories(concert_drill_dds PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/src)
   target_link_libraries(concert_drill_dds PUBLIC concert_drill_core concert_model_dds concert_sensors_dds concert_bim
-                        concert_dds)
+                        concert_dds concert_mobile_base)
 
   add_executable(concert_drill src/main.cpp)
   concert_target_defaults(concert_drill)
@@ -24,6 +24,14 @@ if(TARGET concert_dds)
   concert_target_defaults(concert_drill_cli)
   target_include_directories(concert_drill_cli PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
   target_link_libraries(concert_drill_cli PUBLIC concert_cli PRIVATE concert_dds nlohmann_json::nlohmann_json)
+
+  # The DDS adapter on its own (no robot model): what it takes from the mission topic.
+  concert_add_test(NAME drill_node_test
+    SOURCES test/node_test.cpp
+    LIBS concert_drill_dds
+    LABELS drill
+    TIMEOUT 60
+    DDS)
 endif()
 
 # Area location on frames the simulator's camera renders (libs/sim SceneCamera).

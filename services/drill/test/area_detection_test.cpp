@@ -96,5 +96,67 @@ TEST(LocateArea, PixelAndErrors) {
   EXPECT_THROW((void)locate_area(none, s.view()), DrillError);
 }
 
+// Two blobs 0.1 m apart on the wall (the demo's), the camera 0.25 m in front of the first.
+struct TwoBlobs {
+  explicit TwoBlobs(bool second_only) {
+    world::WorldShape wall;
+    wall.name = "wall";
+    wall.size = {0.2, 5.0, 3.0};
+    wall.position = {2.1, 0.0, 1.5};
+    w.walls.push_back(wall);
+    for (const auto& [name, u] : {std::pair{"blob_1", -0.05}, std::pair{"blob_2", 0.05}}) {
+      if (second_only && std::string(name) == "blob_1") continue;  // missed by the detector
+      world::Mark m;
+      m.name = name;
+      m.type = world::Mark::Type::kBlob;
+      m.wall = "wall";
+      m.face = world::Face::kMinusX;
+      m.at = Eigen::Vector2d(u, 1.2);
+      m.diameter = 0.025;
+      w.marks.push_back(m);
+    }
+    sim::CameraParams params;
+    params.noise = true;
+    camera = sim::look_at(Eigen::Vector3d(1.75, 0.05, 1.2), Eigen::Vector3d(2.0, 0.05, 1.2));
+    frame = sim::SceneCamera(w, params, 3).render(camera);
+  }
+  [[nodiscard]] CameraView view() const { return {&frame, camera}; }
+  world::World w;
+  Eigen::Isometry3d camera;
+  hardware::RgbdFrame frame;
+};
+
+// The area's blobs as detected before the approach, `drift` [m] off their true centres (blob_1
+// at y = 0.05, blob_2 at y = -0.05 on the face x = 2.0).
+std::vector<DrillPoint> predicted_blobs(const Eigen::Vector3d& drift) {
+  std::vector<DrillPoint> points(2);
+  points[0].label = "blob 1";
+  points[0].frame.translation() = Eigen::Vector3d(2.0, 0.05, 1.2) + drift;
+  points[1].label = "blob 2";
+  points[1].frame.translation() = Eigen::Vector3d(2.0, -0.05, 1.2) + drift;
+  return points;
+}
+
+TEST(BlobShift, BlobsMatchedAsASetFindTheTargetsOwnBlobWhereTheNearestIsTheNeighbour) {
+  const TwoBlobs s(false);
+  // Predicted 6 cm towards blob 2: blob 2's centre is 4 cm from blob 1's prediction, blob 1's 6.
+  const std::vector<DrillPoint> area = predicted_blobs({0.0, -0.06, 0.0});
+  const std::optional<Eigen::Vector3d> shift = blob_shift(s.view(), area, area[0], 0.02, 0.07);
+  ASSERT_TRUE(shift);
+  EXPECT_LT((area[0].frame.translation() + *shift - Eigen::Vector3d(2.0, 0.05, 1.2)).norm(), 0.005)
+      << shift->transpose();
+}
+
+TEST(BlobShift, TheNeighbourSeenAloneIsNotTakenForTheTarget) {
+  const TwoBlobs s(true);
+  const std::vector<DrillPoint> area = predicted_blobs({0.0, 0.01, 0.0});
+  // Blob 1 is not in the image; blob 2, 0.1 m from blob 1's prediction, is no shift of it.
+  EXPECT_FALSE(blob_shift(s.view(), area, area[0], 0.02, 0.06));
+  // Blob 2's own hole is found (1 cm off).
+  const std::optional<Eigen::Vector3d> shift = blob_shift(s.view(), area, area[1], 0.02, 0.06);
+  ASSERT_TRUE(shift);
+  EXPECT_NEAR(shift->y(), -0.01, 0.005);
+}
+
 }  // namespace
 }  // namespace concert::drill

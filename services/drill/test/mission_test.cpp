@@ -37,6 +37,7 @@ TEST(MissionFile, ReadsEveryFieldAndResolvesPathsAgainstTheFile) {
   EXPECT_EQ(wall.marks, MarkKind::kBlobs);
   EXPECT_EQ(wall.wall, "1$wmdwWPjDYuku_ghVkynE");
   EXPECT_TRUE(wall.at.isApprox(Eigen::Vector2d(1.2, 1.1)));
+  EXPECT_EQ(wall.face, "right");
   EXPECT_FALSE(wall.point);
   EXPECT_FALSE(wall.pixel);
   EXPECT_EQ(wall.expected, 0);
@@ -44,6 +45,7 @@ TEST(MissionFile, ReadsEveryFieldAndResolvesPathsAgainstTheFile) {
   const AreaSpec& point = m.areas[1];
   EXPECT_EQ(point.marks, MarkKind::kAruco);
   EXPECT_TRUE(point.wall.empty());
+  EXPECT_EQ(point.face, "auto");
   ASSERT_TRUE(point.point);
   EXPECT_TRUE(point.point->isApprox(Eigen::Vector3d(2.0, 0.3, 1.2)));
 
@@ -102,7 +104,11 @@ INSTANTIATE_TEST_SUITE_P(
                    "mission 'm.yaml': areas[0].name: given twice"},
         BadMission{"a typo in an area", "areas: [{pont: [1, 2, 3]}]",
                    "mission 'm.yaml': areas[0].pont: unknown key (expected name, marks, wall, at, "
-                   "point, pixel, expected)"},
+                   "face, point, pixel, expected)"},
+        BadMission{"a face without a wall", "areas: [{point: [1, 2, 3], face: left}]",
+                   "mission 'm.yaml': areas[0].face: goes with wall (the face of a wall area)"},
+        BadMission{"an unknown face", "ifc: h.ifc\nareas: [{wall: abc, at: [1, 1], face: north}]",
+                   "mission 'm.yaml': areas[0].face: expected auto, left or right, got 'north'"},
         BadMission{"a wall without the building", "areas: [{wall: abc, at: [1, 1]}]",
                    "mission 'm.yaml': areas[0].wall: a wall area needs the building model: set "
                    "ifc at the top level"},
@@ -137,8 +143,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadMission{"an empty file", "",
                    "mission 'm.yaml': areas: missing: a mission needs at least one area"},
         BadMission{"an area that is not a map", "areas: [3]",
-                   "mission 'm.yaml': areas[0]: expected a map with name, marks, wall, at, point, "
-                   "pixel, expected"},
+                   "mission 'm.yaml': areas[0]: expected a map with name, marks, wall, at, face, "
+                   "point, pixel, expected"},
         BadMission{"a list at the top", "- a\n- b",
                    "mission 'm.yaml': expected a map with name, ifc, storey, patterns, depth, "
                    "areas"},

@@ -178,6 +178,15 @@ TEST(OdometryFilter, RefusesBadMeasurementsAndKeepsItsState) {
       "gyro yaw rate is not finite");
   expect_refused([&] { filter.update(GyroRate{nan, 0.0, 1e-5}); }, "gyro stamp is not finite");
   expect_refused([&] { filter.update(GyroRate{0.1, 0.0, 1e-5}); }, "older than the filter's time");
+  // A late sample is told apart from a malformed one: the caller drops it and counts it.
+  EXPECT_THROW(filter.update(GyroRate{0.1, 0.0, 1e-5}), LateMeasurement);
+  EXPECT_THROW(filter.update(WheelTwist{0.1, {0.3, 0, 0}, Eigen::Matrix3d::Identity() * 1e-4}), LateMeasurement);
+  try {
+    filter.update(GyroRate{nan, 0.0, 1e-5});
+  } catch (const LateMeasurement&) {
+    ADD_FAILURE() << "a NaN stamp is bad input, not a late sample";
+  } catch (const OdometryFilterError&) {
+  }
   // The filter still works afterwards.
   filter.update(WheelTwist{0.6, {0.3, 0, 0}, Eigen::Matrix3d::Identity() * 1e-4});
   EXPECT_GT(filter.estimate().pose.x(), before.pose.x());

@@ -8,8 +8,10 @@
 #include <sstream>
 #include <thread>
 
+#include "concert/common/clock.hpp"
 #include "concert/common/text.hpp"
 #include "concert/dds/participant.hpp"
+#include "concert/mobile_base/map_frame.hpp"
 #include "concert/world/world_dds.hpp"
 #include "dds/planner_node.hpp"
 #include "model_message.hpp"
@@ -374,6 +376,59 @@ TEST_F(PlannerNodeTest, AnObstacleOnTheWorldTopicChangesThePlan) {
   const bool outside = std::abs(end[0] - open_x) > 0.4 || std::abs(end[1] - open_y) > 0.4;
   EXPECT_TRUE(outside) << "base ends at (" << end[0] << ", " << end[1] << "), the crate is at ("
                        << open_x << ", " << open_y << ")";
+}
+
+TEST_F(PlannerNodeTest, ALocalisedBaseIsPlannedInTheMapAndAnsweredInOdometry) {
+  // The robot was switched on elsewhere: its odometry frame lies at (1, -2) in the map, turned
+  // by 90 degrees. The nav service localises the base at the map's origin, facing the wall the
+  // world has at x = 2 m; the client asks for the drilling area on that wall in the odometry
+  // frame. Without the map frame the base's odometry pose, (2, 1), is inside the wall.
+  publish_model('a', 9);
+  ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
+  const Eigen::Vector3d map_T_odom(1.0, -2.0, M_PI / 2);
+  const Eigen::Vector3d base_odom = mobile_base::inverse(map_T_odom);  // the base at the map's origin
+  concert::dds::Writer<msg::Odometry> odometry(*participant_, concert::dds::topics::odometry);
+  concert::dds::Writer<msg::NavLocalisation> localisation(*participant_,
+                                                          concert::dds::topics::nav_localisation);
+  ASSERT_TRUE(odometry.wait_for_readers(1, 5s));
+  ASSERT_TRUE(localisation.wait_for_readers(1, 5s));
+  const auto stamp = static_cast<long long>(now_ns());
+  msg::Odometry o;
+  o.stamp_ns(stamp);
+  o.x(base_odom.x());
+  o.y(base_odom.y());
+  o.yaw(base_odom.z());
+  odometry.write(o);
+  msg::NavLocalisation l;
+  l.stamp_ns(stamp);
+  l.state(msg::LOCALISATION_TRACKING);
+  l.pose().x(0.0);
+  l.pose().y(0.0);
+  l.pose().yaw(0.0);
+  std::this_thread::sleep_for(200ms);  // the odometry first, as nav only stamps what it got
+  localisation.write(l);
+  std::this_thread::sleep_for(300ms);
+
+  msg::PlanRequest req = request(61, 9, 1.2, false);
+  const Eigen::Isometry3d area_map = fixtures::drilling_area(2.0, 0.0, 1.2);
+  req.goals()[0] = planner::dds::to_msg(mobile_base::isometry(base_odom) * area_map);
+  requests_->write(req);
+  const auto r = wait_final(*results_, 61);
+  ASSERT_TRUE(r.has_value()) << log_.str();
+  ASSERT_EQ(r->state(), msg::PLAN_SUCCEEDED) << r->reason() << log_.str();
+  ASSERT_GT(r->trajectory().size(), 1u);
+  EXPECT_NE(log_.str().find("planned in the map"), std::string::npos) << log_.str();
+  // It starts where the robot's odometry is, in the odometry frame...
+  const auto& first = r->trajectory().front().position();
+  EXPECT_NEAR(first[0], base_odom.x(), 1e-6);
+  EXPECT_NEAR(first[1], base_odom.y(), 1e-6);
+  EXPECT_NEAR(first[2], base_odom.z(), 1e-6);
+  // ...and ends, seen in the map, in front of the wall at x = 2 m, facing it.
+  const auto& last = r->trajectory().back().position();
+  const Eigen::Vector3d end_map = mobile_base::compose(map_T_odom, {last[0], last[1], last[2]});
+  EXPECT_LT(end_map.x(), 1.6) << end_map.transpose();
+  EXPECT_GT(end_map.x(), 0.0) << end_map.transpose();
+  EXPECT_LT(std::abs(end_map.y()), 0.8) << end_map.transpose();
 }
 
 TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {

@@ -216,9 +216,7 @@ int run_goal(const GoalOptions& o, std::ostream& out) {
     }
     const bim::OccupancyGrid grid = bim::load_map((dir / map_dir / "map.yaml").string());
     bim::GoalOptions options;
-    options.face = o.face == "left"    ? bim::FaceChoice::kLeft
-                   : o.face == "right" ? bim::FaceChoice::kRight
-                                       : bim::FaceChoice::kAuto;
+    options.face = bim::face_choice(o.face);
     double standoff = o.standoff, robot_radius = o.robot_radius;
     std::string sizes = "given";
     if (standoff <= 0.0 || robot_radius <= 0.0) {

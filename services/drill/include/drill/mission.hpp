@@ -35,6 +35,9 @@ struct AreaSpec {
   /// pose wall_goal() gives before the approach.
   std::string wall;
   Eigen::Vector2d at{0.0, 0.0};
+  /// Which face of the wall: "left" or "right" of its axis (as `concert bim goal --face` shows
+  /// them), or "auto" (wall_goal's choice: the face in the larger free region).
+  std::string face{"auto"};
   /// (b) A point on the wall in the world (map) frame [m]; the normal comes from the point cloud.
   std::optional<Eigen::Vector3d> point;
   /// (c) A pixel [u, v] of the drill camera's current image; the point is where its depth ray
@@ -52,7 +55,7 @@ struct AreaSpec {
 ///   patterns: path/patterns.yaml  # ArUco hole patterns (default: the service's table)
 ///   depth: 0.05                   # hole depth [m] (default 0.05)
 ///   areas:
-///     - {name: a1, marks: blobs, wall: "1$wmdwWPjDYuku_ghVkynE", at: [1.2, 1.1]}
+///     - {name: a1, marks: blobs, wall: "1$wmdwWPjDYuku_ghVkynE", at: [1.2, 1.1], face: right}
 ///     - {name: a2, marks: aruco, point: [2.0, 0.3, 1.2]}
 ///     - {name: a3, marks: blobs, pixel: [320, 240], expected: 2}
 struct Mission {

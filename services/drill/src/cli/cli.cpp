@@ -2,12 +2,14 @@
 
 #include "drill/cli.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -163,12 +165,29 @@ int run_mission(const RunOptions& o, std::ostream& out, std::ostream& err) {
   m.yaml(text.str());
   m.base_dir(fs::absolute(fs::path(o.mission)).parent_path().string());
   m.resume(o.resume);
-  missions.write(m);
+  // The reader matched may be another tool's (the GUI's gateway, a recorder) before the drill
+  // service's: the mission is written again every second until a status names it (the service
+  // takes a mission it has seen, same id and stamp, once). --no-wait writes it once.
+  std::optional<msg::DrillStatus> first;
+  do {
+    missions.write(m);
+    const auto next = std::min(deadline, Clock::now() + std::chrono::seconds(1));
+    while (!o.no_wait && !first && Clock::now() < next) {
+      const auto s = statuses.wait(left_until(next));
+      if (s && s->mission_id() == o.mission_id) first = s;
+    }
+  } while (!o.no_wait && !first && left_until(deadline).count() > 0);
   if (!o.dds.json) out << "mission " << o.mission_id << " sent (" << m.name() << ")" << std::endl;
   if (o.no_wait) return 0;
+  if (!first) {
+    err << "concert drill run: the drill service did not take mission " << o.mission_id
+        << " within " << o.dds.timeout_s << " s\n";
+    return 1;
+  }
   std::string printed;
-  while (left_until(deadline).count() > 0) {
-    const auto s = statuses.wait(left_until(deadline));
+  while (first || left_until(deadline).count() > 0) {
+    const auto s = first ? first : statuses.wait(left_until(deadline));
+    first.reset();
     if (!s || s->mission_id() != o.mission_id || s->state() == msg::DRILL_IDLE) continue;
     if (s->state() == msg::DRILL_RUNNING) {
       if (!o.dds.json && s->active() != printed) {

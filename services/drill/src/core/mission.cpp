@@ -100,7 +100,7 @@ class Reader {
 
 AreaSpec read_area(const Reader& r, const YAML::Node& node, std::size_t index) {
   const std::string path = "areas[" + std::to_string(index) + "]";
-  r.only_keys(node, path, {"name", "marks", "wall", "at", "point", "pixel", "expected"});
+  r.only_keys(node, path, {"name", "marks", "wall", "at", "face", "point", "pixel", "expected"});
   AreaSpec area;
   area.name =
       node["name"] ? r.text(node["name"], path + ".name") : "area " + std::to_string(index + 1);
@@ -131,6 +131,13 @@ AreaSpec read_area(const Reader& r, const YAML::Node& node, std::size_t index) {
   if (const auto at = node["at"]) {
     if (area.wall.empty()) r.fail(path + ".at", "goes with wall (the centre of a wall area)");
     area.at = r.numbers<2>(at, path + ".at", "[s, h]: m along the wall, m above the storey", true);
+  }
+  if (const auto face = node["face"]) {
+    if (area.wall.empty()) r.fail(path + ".face", "goes with wall (the face of a wall area)");
+    area.face = r.text(face, path + ".face");
+    if (area.face != "auto" && area.face != "left" && area.face != "right") {
+      r.fail(path + ".face", "expected auto, left or right, got '" + area.face + "'");
+    }
   }
   if (const auto point = node["point"]) {
     area.point = r.numbers<3>(point, path + ".point", "[x, y, z] in the map frame [m]");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <iterator>
 #include <sstream>
 #include <utility>
@@ -200,6 +201,7 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
                  }),
       odometry_in_(participant, cdds::topics::odometry,
                    [this](const msg::Odometry& o, const auto&) {
+                     map_frame_.on_odometry(o.stamp_ns(), odometry_of(o));
                      std::lock_guard lock(mutex_);
                      odometry_ = o;
                    }),
@@ -231,6 +233,12 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
                 std::lock_guard lock(mutex_);
                 nav_statuses_[s.request_id()] = s;
               }),
+      localisation_in_(participant, cdds::topics::nav_localisation,
+                       [this](const msg::NavLocalisation& l, const auto&) {
+                         if (l.state() != msg::LOCALISATION_TRACKING) return;
+                         map_frame_.on_localisation(l.stamp_ns(),
+                                                    {l.pose().x(), l.pose().y(), l.pose().yaw()});
+                       }),
       rgb_in_(participant, cdds::topics::camera_rgb,
               [this](const msg::Image& i, const auto&) { on_image(i, false); }),
       depth_in_(participant, cdds::topics::camera_depth,
@@ -441,6 +449,9 @@ void DrillNode::apply_model(const msg::RobotModel& m) {
 }
 
 void DrillNode::start_mission(const msg::DrillMission& m) {
+  const std::pair<std::uint32_t, std::int64_t> key{m.mission_id(), m.stamp_ns()};
+  if (key == last_mission_key_) return;  // written again by a sender that had not heard us yet
+  last_mission_key_ = key;
   const auto refuse = [&](const std::string& why) {
     status_.refused("mission " + std::to_string(m.mission_id()) + ": " + why);
     MissionReport report;
@@ -471,6 +482,7 @@ void DrillNode::start_mission(const msg::DrillMission& m) {
   mission_ = std::make_unique<Mission>(std::move(mission));
   mission_id_ = m.mission_id();
   resolving_.clear();
+  bim_frames_.clear();
   plans_.clear();
   hole_chain_.clear();
   returning_ = false;
@@ -552,8 +564,10 @@ void DrillNode::resolve(std::size_t area, const AreaSpec& spec) {
     const bim::Element& wall = model.element(spec.wall);
     const bim::Storey& storey = model.storey(mission.storey.empty() ? wall.storey : mission.storey);
     const bim::OccupancyGrid grid = bim::storey_map(model, storey);
+    bim::GoalOptions options;
+    options.face = bim::face_choice(spec.face);
     const bim::WallGoal goal = bim::wall_goal(model, grid, spec.wall, spec.at.x(), spec.at.y(),
-                                              kWallStandoff, kRobotRadius);
+                                              kWallStandoff, kRobotRadius, options);
     ResolvedArea out;
     out.frame = goal.area_frame;
     out.base = BasePose{goal.base_pose.x(), goal.base_pose.y(), goal.base_pose.z()};
@@ -576,6 +590,21 @@ Outcome DrillNode::resolution(std::size_t area, ResolvedArea& out) {
       return Outcome::failed("area '" + spec.name + "': wall " + spec.wall + ": " + e.what());
     }
     resolving_.erase(it);
+    // The base pose stays in the map (nav's goal); the area frame goes to the odometry frame,
+    // where the camera and the planner's requests are (again when it is planned: nav corrects
+    // the odometry's drift on the way).
+    bim_frames_[area] = out.frame;
+    out.frame = map_frame_.to_odom(out.frame);
+    if (map_frame_.localised()) {
+      const Eigen::Vector3d m = map_frame_.map_T_odom();
+      std::ostringstream line;
+      line << std::fixed << std::setprecision(3) << "drill: area '" << spec.name
+           << "': BIM frame at (" << bim_frames_[area].translation().transpose()
+           << ") in the map, (" << out.frame.translation().transpose()
+           << ") in the odometry frame (map -> odom " << m.x() << ", " << m.y() << ", " << m.z()
+           << ")";
+      log_line(line.str());
+    }
     return Outcome::succeeded();
   }
   const std::optional<CameraFrame> view =
@@ -635,8 +664,10 @@ Outcome DrillNode::navigation() {
   }
 }
 
-void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& frame,
+void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& located,
                      std::optional<std::size_t> after) {
+  const auto bim = bim_frames_.find(area);
+  const Eigen::Isometry3d frame = bim == bim_frames_.end() ? located : map_frame_.to_odom(bim->second);
   Plan p;
   p.request_id = next_request_++;
   msg::PlanRequest r;
@@ -853,6 +884,20 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
                         area_radius(params_.camera_distance, params_.camera_fov));
     area_points_ = points;
     markers_seen_.clear();
+    if (detection_.spec.marks == MarkKind::kBlobs && !points.empty()) {
+      // Which blob is drilled first, and by what margin (odometry drifts over the approach: a
+      // pick between two blobs can land nearer the other one).
+      std::ostringstream line;
+      line.setf(std::ios::fixed);
+      line.precision(1);
+      line << "drill: area '" << detection_.spec.name << "': " << points.size()
+           << " blobs, nearest first, from (" << std::setprecision(3)
+           << located.frame.translation().transpose() << ")" << std::setprecision(1);
+      for (const DrillPoint& p : points)
+        line << "; " << p.label << " at "
+             << (p.frame.translation() - located.frame.translation()).norm() * 1e3 << " mm";
+      log_line(line.str());
+    }
     if (detection_.spec.marks == MarkKind::kBlobs && detection_.spec.expected > 0 &&
         points.size() < static_cast<std::size_t>(detection_.spec.expected)) {
       // What the camera saw, for the report's "expected holes not found".
@@ -1181,7 +1226,7 @@ void DrillNode::control_motion() {
     if (point_.marker < 0 && area_points_.size() > 1) {
       // Several blobs: which one is this hole's is told by the pattern they make together.
       if (const std::optional<Eigen::Vector3d> shift =
-              blob_shift(camera, area_points_, point_, kBlobMatch)) {
+              blob_shift(camera, area_points_, point_, kBlobMatch, kReanchorDistance)) {
         predicted.frame.translation() += *shift;
         within = kBlobMatch;
       }

@@ -17,10 +17,12 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 #include "concert/hardware/sensors.hpp"
+#include "concert/mobile_base/map_frame.hpp"
 #include "drill/area_detection.hpp"
 #include "drill/drill_motion.hpp"
 #include "drill/drill_rig.hpp"
@@ -153,6 +155,9 @@ class DrillNode final : public MissionPorts {
   Inbox inbox_;
   std::deque<Sample> samples_;  // joint states decimated to 200 Hz, 2 s
   std::optional<msg::Odometry> odometry_;
+  // Where the odometry frame lies in the map (nav's localisation): a BIM wall area is in the map,
+  // the camera and the planner's requests in the odometry frame. Thread-safe on its own.
+  mobile_base::MapFrame map_frame_;
   std::chrono::steady_clock::time_point joints_seen_{};
   std::chrono::steady_clock::time_point mission_started_{};  // health waits a while from here
   std::optional<msg::SafetyState> safety_;
@@ -173,6 +178,9 @@ class DrillNode final : public MissionPorts {
   std::unique_ptr<MissionTree> tree_;
   std::unique_ptr<Mission> mission_;
   std::uint32_t mission_id_{0};
+  // (id, stamp) of the last mission message taken: `concert drill run` writes a mission again
+  // every second until a status names it, and each is taken once.
+  std::pair<std::uint32_t, std::int64_t> last_mission_key_{0, 0};
   std::map<std::string, MissionReport> last_reports_;  // by mission name, for resume
   std::optional<PatternTable> patterns_;
   std::chrono::steady_clock::time_point last_status_{};
@@ -181,6 +189,7 @@ class DrillNode final : public MissionPorts {
   std::map<std::size_t, std::future<ResolvedArea>> resolving_;
   std::map<std::size_t, std::int64_t> resolve_since_;
   std::map<std::size_t, AreaSpec> resolve_specs_;
+  std::map<std::size_t, Eigen::Isometry3d> bim_frames_;  // BIM wall areas' frames in the map
   std::uint32_t nav_request_{0};
   std::map<std::size_t, Plan> plans_;
   std::optional<std::size_t> executing_area_;
@@ -239,6 +248,7 @@ class DrillNode final : public MissionPorts {
   concert::dds::Reader<msg::PlanResult> plans_in_;
   concert::dds::Reader<msg::TrajectoryStatus> trajectories_in_;
   concert::dds::Reader<msg::NavStatus> nav_in_;
+  concert::dds::Reader<msg::NavLocalisation> localisation_in_;
   concert::dds::Reader<msg::Image> rgb_in_;
   concert::dds::Reader<msg::Image> depth_in_;
   concert::dds::Reader<msg::CameraInfo> info_in_;

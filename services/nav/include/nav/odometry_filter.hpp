@@ -22,6 +22,14 @@ class OdometryFilterError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+/// A well-formed measurement that came too late (its time more than max_lag before the
+/// filter's): dropped, not bad input. A loaded host delivers a sample late now and then; the
+/// caller counts these apart from refused input.
+class LateMeasurement : public OdometryFilterError {
+ public:
+  using OdometryFilterError::OdometryFilterError;
+};
+
 /// Noise model and options of the filter.
 struct OdometryFilterParams {
   double linear_accel_noise{0.5};        ///< white acceleration on vx, vy [m/s^2/sqrt(Hz)]
@@ -73,11 +81,12 @@ class OdometryFilter {
   void reset(double stamp, const Eigen::Vector3d& pose = Eigen::Vector3d::Zero());
 
   /// Predicts to `stamp` [s] without a measurement (the covariance grows). Throws
-  /// OdometryFilterError for a time that is not finite or more than max_lag before the filter's.
+  /// OdometryFilterError for a time that is not finite, LateMeasurement for one more than max_lag before the
+  /// filter's.
   void predict(double stamp);
   /// Predicts to the measurement's time and fuses it. Throws OdometryFilterError (state kept)
-  /// for NaN/inf values, a covariance that is not symmetric with a positive diagonal, or a time
-  /// more than max_lag before the filter's.
+  /// for NaN/inf values or a covariance that is not symmetric with a positive diagonal, and
+  /// LateMeasurement (state kept) for a time more than max_lag before the filter's.
   void update(const WheelTwist& wheels);
   /// Same for a gyro sample (variance must be positive).
   void update(const GyroRate& gyro);

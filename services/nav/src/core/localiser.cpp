@@ -8,6 +8,8 @@
 #include <string>
 #include <unordered_map>
 
+#include "concert/mobile_base/map_frame.hpp"
+
 namespace concert::nav {
 
 namespace {
@@ -21,16 +23,9 @@ double wrap(double angle) {
 
 bool occupied_cell(std::int8_t value) { return value >= 50; }
 
-// a * b for planar poses (x, y, yaw).
-Eigen::Vector3d compose(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const double c = std::cos(a.z()), s = std::sin(a.z());
-  return {a.x() + c * b.x() - s * b.y(), a.y() + s * b.x() + c * b.y(), wrap(a.z() + b.z())};
-}
-
-Eigen::Vector3d inverse(const Eigen::Vector3d& a) {
-  const double c = std::cos(a.z()), s = std::sin(a.z());
-  return {-c * a.x() - s * a.y(), s * a.x() - c * a.y(), wrap(-a.z())};
-}
+// a * b and a^-1 for planar poses (x, y, yaw).
+using mobile_base::compose;
+using mobile_base::inverse;
 
 // 1D squared Euclidean distance transform of f (Felzenszwalb & Huttenlocher 2012): d[q] =
 // min_p (q - p)^2 + f[p]. v, z: scratch of n and n + 1 entries.

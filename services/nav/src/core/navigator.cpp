@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "concert/bim/wall_goal.hpp"
+#include "concert/mobile_base/map_frame.hpp"
 
 namespace concert::nav {
 namespace {
@@ -13,10 +14,7 @@ namespace {
 double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 // a ∘ b for planar poses (x, y, yaw).
-Eigen::Vector3d compose(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const double c = std::cos(a.z()), s = std::sin(a.z());
-  return {a.x() + c * b.x() - s * b.y(), a.y() + s * b.x() + c * b.y(), wrap(a.z() + b.z())};
-}
+using mobile_base::compose;
 
 Eigen::Vector3d vec(const Pose2& p) { return {p.x, p.y, p.yaw}; }
 Pose2 pose2(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }

@@ -62,7 +62,7 @@ void OdometryFilter::reset(double stamp, const Eigen::Vector3d& pose) {
 void OdometryFilter::check_time(double stamp, const char* what) const {
   require_finite(stamp, std::string(what) + " stamp");
   if (started_ && stamp < stamp_ - params_.max_lag) {
-    throw OdometryFilterError("odometry filter: " + std::string(what) + " stamp " +
+    throw LateMeasurement("odometry filter: " + std::string(what) + " stamp " +
                               std::to_string(stamp) + " s is older than the filter's time " +
                               std::to_string(stamp_) + " s by more than max_lag " +
                               std::to_string(params_.max_lag) + " s; measurement ignored");

@@ -199,6 +199,14 @@ NavNode::NavNode(cdds::Participant& participant, Navigator& navigator, std::stri
 
 NavNode::~NavNode() = default;
 
+void NavNode::dropped_late(const std::string& what, const std::exception& e) {
+  // The first and every 100th: a loaded host may deliver many late, the log must not drown.
+  const std::uint64_t n = ++late_samples_;
+  if (n == 1 || n % 100 == 0) {
+    log_line("nav: " + what + " dropped, too late (" + std::to_string(n) + " late samples so far): " + e.what());
+  }
+}
+
 void NavNode::log_line(const std::string& line) {
   std::lock_guard lock(log_mutex_);
   log_ << line << std::endl;
@@ -294,6 +302,8 @@ void NavNode::tick() {
     last_stamp_ns_ = std::max(last_stamp_ns_, static_cast<std::int64_t>(o.stamp_ns()));
     try {
       navigator_.on_wheel_odometry(to_s(o.stamp_ns()), {o.vx(), o.vy(), o.wz()});
+    } catch (const LateMeasurement& e) {
+      dropped_late("odometry", e);
     } catch (const std::exception& e) {
       status_.refused(std::string("odometry refused: ") + e.what());
     }
@@ -312,6 +322,8 @@ void NavNode::tick() {
           base_R_imu * Eigen::Vector3d(s.angular_velocity().x(), s.angular_velocity().y(),
                                        s.angular_velocity().z());
       navigator_.on_gyro(to_s(s.stamp_ns()), w.z());
+    } catch (const LateMeasurement& e) {
+      dropped_late("IMU sample", e);
     } catch (const std::exception& e) {
       status_.refused(std::string("IMU sample refused: ") + e.what());
     }

@@ -49,6 +49,9 @@ class NavNode {
   void spin(const std::atomic<bool>& stop);
   /// Inputs refused since start (models, goals), as the service status reports them.
   [[nodiscard]] uint32_t refusals() const { return status_.refusals(); }
+  /// Odometry and IMU samples dropped because they came too late for the filter
+  /// (LateMeasurement: a loaded host, not bad input; logged, not refused).
+  [[nodiscard]] std::uint64_t late_samples() const { return late_samples_.load(); }
 
  private:
   struct Inbox {
@@ -66,6 +69,7 @@ class NavNode {
   void publish_status();
   void publish_map();
   void log_line(const std::string& line);
+  void dropped_late(const std::string& what, const std::exception& e);
 
   Navigator& navigator_;
   std::string map_source_;
@@ -74,6 +78,7 @@ class NavNode {
   std::mutex mutex_;
   Inbox inbox_;
   std::int64_t last_stamp_ns_{0};  // robot clock: the latest odometry stamp
+  std::atomic<std::uint64_t> late_samples_{0};
   std::uint64_t model_version_{0};
   std::string model_hash_;
   std::chrono::steady_clock::time_point last_localisation_{};

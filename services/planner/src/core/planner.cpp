@@ -471,6 +471,22 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       }
     }
   }
+  if (start_ok.constraint == Constraint::kTorqueLimit) {
+    // The robot stands where it is: a start a hair above the continuous torque (a posture held
+    // after a stop, 160.4 N m against 160 in the chaos test) is planned from with the limit
+    // raised by kStartTorqueTolerance, inside the 10 % the safety service allows on the RMS
+    // torque, rather than refusing every request from there for ever.
+    constexpr double kStartTorqueTolerance = 0.05;
+    Params lenient_params = params_;
+    lenient_params.torque_margin *= 1.0 + kStartTorqueTolerance;
+    auto lenient = std::make_unique<StateChecker>(model, env, lenient_params, padding);
+    if (const Validity v = lenient->check(q_from); v.valid()) {
+      add_note("the start needs more than the continuous torque (" + start_ok.detail +
+               "): planned with the torque limit raised by 5 %");
+      checker_ptr = std::move(lenient);
+      start_ok = v;
+    }
+  }
   StateChecker& checker = *checker_ptr;
   if (!start_ok.valid()) {
     return fail(Status::kInvalidStart, std::string("start state rejected by ") +

@@ -33,6 +33,24 @@ World to_planner_world(const world::World& w) {
 
 Eigen::Isometry3d to_core(const msg::Pose& p) { return model::dds::to_isometry(p); }
 
+Trajectory to_odometry_frame(Trajectory trajectory, const Eigen::Vector3d& map_T_odom,
+                             double yaw_offset) {
+  const double c = std::cos(map_T_odom.z()), s = std::sin(map_T_odom.z());
+  for (TrajectoryPoint& p : trajectory.points) {
+    if (p.q.size() < 3) continue;
+    const double dx = p.q(0) - map_T_odom.x(), dy = p.q(1) - map_T_odom.y();
+    p.q(0) = c * dx + s * dy;
+    p.q(1) = -s * dx + c * dy;
+    p.q(2) += yaw_offset;
+    if (p.qd.size() >= 2) {
+      const double vx = p.qd(0), vy = p.qd(1);
+      p.qd(0) = c * vx + s * vy;
+      p.qd(1) = -s * vx + c * vy;
+    }
+  }
+  return trajectory;
+}
+
 msg::Pose to_msg(const Eigen::Isometry3d& t) { return model::dds::to_pose_msg(t); }
 
 namespace {
@@ -96,9 +114,16 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
                     }),
       odometries_(participant, concert::dds::topics::odometry,
                   [this](const auto& s, const auto&) {
+                    map_frame_.on_odometry(s.stamp_ns(), {s.x(), s.y(), s.yaw()});
                     std::lock_guard lock(mutex_);
                     odometry_ = s;
                   }),
+      localisations_(participant, concert::dds::topics::nav_localisation,
+                     [this](const msg::NavLocalisation& l, const auto&) {
+                       if (l.state() != msg::LOCALISATION_TRACKING) return;
+                       map_frame_.on_localisation(l.stamp_ns(),
+                                                  {l.pose().x(), l.pose().y(), l.pose().yaw()});
+                     }),
       trajectory_statuses_(participant, concert::dds::topics::trajectory_status,
                            [this](const msg::TrajectoryStatus& st, const auto&) {
                              {
@@ -316,6 +341,18 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     return;
   }
 
+  // Into the map frame, where the world is (the identity until nav localises the base).
+  const Eigen::Vector3d map_T_odom = map_frame_.map_T_odom();
+  const Eigen::Isometry3d map_from_odom = mobile_base::isometry(map_T_odom);
+  // The yaw back: minus the frame's turn, plus whatever whole turn wrapping the start's map yaw
+  // took away; one offset for every goal of the request, so their trajectories join up.
+  double yaw_offset = -map_T_odom.z();
+  if (start.size() >= 3) {
+    const double odom_yaw = start(2);
+    start.head<3>() = mobile_base::compose(map_T_odom, start.head<3>());
+    yaw_offset = odom_yaw - start(2);
+  }
+
   PlanRequest core;
   core.request_id = request.request_id();
   core.model_version = request.model_version();
@@ -324,7 +361,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   core.fixed_base = request.fixed_base();
   core.environment_padding = request.environment_padding();
   core.base_travel = request.base_travel();
-  for (const msg::Pose& g : request.goals()) core.goals.push_back({to_core(g)});
+  for (const msg::Pose& g : request.goals()) core.goals.push_back({map_from_odom * to_core(g)});
   const bool execute = request.execute();
   const std::size_t count = core.goals.size();
   msg::PlanResult last_planned;
@@ -340,8 +377,9 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
       return;
     }
     r.state(msg::PLAN_PLANNED);
-    r.joint_names(g.trajectory.joint_names);
-    for (const TrajectoryPoint& p : g.trajectory.points) {
+    const Trajectory trajectory = to_odometry_frame(g.trajectory, map_T_odom, yaw_offset);
+    r.joint_names(trajectory.joint_names);
+    for (const TrajectoryPoint& p : trajectory.points) {
       msg::TrajectorySample s;
       s.time(p.time);
       s.position(std::vector<double>(p.q.data(), p.q.data() + p.q.size()));
@@ -353,7 +391,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     if (execute) {
       {
         std::lock_guard lock(mutex_);
-        executions_.push_back({r, model, g.trajectory, g.index + 1 == count});
+        executions_.push_back({r, model, trajectory, g.index + 1 == count});
       }
       wake_.notify_all();
     }
@@ -362,6 +400,10 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     std::ostringstream line;
     line << "planner: request " << request.request_id() << ": " << to_string(result.status)
          << (result.reason.empty() ? "" : " (" + result.reason + ")") << (result.note.empty() ? "" : "; " + result.note);
+    if (map_frame_.localised()) {
+      line << "; planned in the map, odometry frame at (" << map_T_odom.x() << ", "
+           << map_T_odom.y() << ", " << map_T_odom.z() << ")";
+    }
     for (const GoalResult& g : result.goals) {
       if (g.status != Status::kSucceeded) continue;
       line << "; goal " << g.index << " in "
@@ -433,11 +475,14 @@ std::string PlannerNode::execute(Execution& e) {
   e.result.state(msg::PLAN_EXECUTING);
   e.result.trajectory().clear();
   trajectory_commands_.write(cmd);
-  // Bounded wait: the trajectory's duration plus the robot's settling time and a margin.
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::milliseconds(static_cast<int64_t>(1e3 * t.duration())) +
-                        options_.result_margin;
+  // Bounded wait: the trajectory's duration plus the robot's settling time and a margin, and
+  // while the robot reports progress, a margin after its latest report: a robot whose loop runs
+  // slower than the wall clock (a loaded simulator host) is late, not gone.
+  auto deadline = std::chrono::steady_clock::now() +
+                  std::chrono::milliseconds(static_cast<int64_t>(1e3 * t.duration())) +
+                  options_.result_margin;
   double reported = -1.0;
+  double furthest = 0.0;
   std::unique_lock lock(mutex_);
   while (true) {
     if (stopping_) return "the planner is stopping";
@@ -454,6 +499,10 @@ std::string PlannerNode::execute(Execution& e) {
           return std::string(st.state() == msg::TRAJECTORY_REFUSED ? "refused" : "aborted") +
                  " by the robot: " + st.reason();
         case msg::TRAJECTORY_EXECUTING:
+          if (st.progress() > furthest) {  // moving on, not repeating where it stands
+            furthest = st.progress();
+            deadline = std::max(deadline, std::chrono::steady_clock::now() + options_.result_margin);
+          }
           if (st.progress() >= reported + 0.05 || reported < 0.0) {
             reported = st.progress();
             e.result.progress(st.progress());
@@ -472,6 +521,8 @@ std::string PlannerNode::execute(Execution& e) {
       return "no result from the robot service within " +
              std::to_string(static_cast<int>(
                  t.duration() + 1e-3 * static_cast<double>(options_.result_margin.count()))) +
+             " s, nor progress for the last " +
+             std::to_string(static_cast<int>(1e-3 * static_cast<double>(options_.result_margin.count()))) +
              " s (is it running?)";
     }
   }

@@ -7,6 +7,13 @@
 // TrajectoryStatus becomes the PlanResult's progress and result, while later goals are still
 // being planned (FIFO). The world topic (latched) replaces the planner's map of walls and
 // obstacles whenever it changes.
+//
+// Frames: the world (walls, obstacles) is in the map frame; the robot's odometry, the start
+// states and goals clients send and the trajectories the planner returns are in the odometry
+// frame, as the robot executes them. Once the nav service has localised the base in a map
+// (NavLocalisation), the planner plans in the map frame: start and goals go in through
+// map_T_odom (mobile_base::MapFrame), trajectories come out through its inverse. Without a
+// localisation the two frames are one (a world without a building).
 
 #include <atomic>
 #include <chrono>
@@ -20,6 +27,7 @@
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
+#include "concert/mobile_base/map_frame.hpp"
 #include "concert/world/world.hpp"
 #include "planner/planner.hpp"
 
@@ -31,6 +39,12 @@ Eigen::Isometry3d to_core(const msg::Pose& pose);
 World to_planner_world(const world::World& world);
 msg::Pose to_msg(const Eigen::Isometry3d& pose);
 msg::PlanFailure to_failure(Status status);
+/// A trajectory planned in the map frame, in the odometry frame whose pose in the map is
+/// `map_T_odom` (x, y, yaw): the base's positions and velocities turned and shifted; the yaw
+/// shifted by `yaw_offset` (the frame's turn back, and any whole turn the start's wrapped map yaw
+/// lost), not wrapped, so it stays continuous and starts where the robot's odometry yaw is.
+Trajectory to_odometry_frame(Trajectory trajectory, const Eigen::Vector3d& map_T_odom,
+                             double yaw_offset);
 
 struct NodeOptions {
   /// How long after a trajectory's duration the robot's result may take (its settling time).
@@ -90,6 +104,7 @@ class PlannerNode {
   std::optional<msg::JointState> joint_state_;
   std::optional<msg::Odometry> odometry_;
   bool stopping_ = false;
+  mobile_base::MapFrame map_frame_;
   uint64_t warm_version_ = 0;  // model version the warm-up thread should prepare (0: none)
   concert::dds::Writer<msg::PlanResult> results_;
   concert::dds::Writer<msg::JointTrajectoryCommand> trajectory_commands_;
@@ -100,6 +115,7 @@ class PlannerNode {
   concert::dds::Reader<msg::RobotModel> models_;
   concert::dds::Reader<msg::JointState> joint_states_;
   concert::dds::Reader<msg::Odometry> odometries_;
+  concert::dds::Reader<msg::NavLocalisation> localisations_;
   concert::dds::Reader<msg::TrajectoryStatus> trajectory_statuses_;
   concert::dds::Reader<msg::World> worlds_;
   concert::dds::Reader<msg::PlanRequest> request_reader_;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Geometry>
 #include <string>
 
 #include "concert/bim/model.hpp"
@@ -20,9 +21,20 @@ namespace concert::bim {
 concert::world::World storey_world(const BimModel& model, const Storey& storey,
                                    const SliceParams& params = {}, double max_height = 3.0);
 
-/// The world file text (libs/world README "World file") of a world made of a floor and static
-/// boxes, as storey_world() makes. Throws BimError for what it does not write (marks, surfaces,
-/// cylinders, moving obstacles).
+/// Where a mark goes on the building's wall `global_id` in a storey_world(): the box of that wall
+/// whose face looks along `normal` (within 0.3 rad) and holds `point` (a world point, e.g. a
+/// bim::wall_goal area frame's origin, projected onto the nearest such face). Returns a blob mark
+/// (name `name`, `diameter`) with wall, face and at set; the caller may make it an ArUco marker.
+/// The box faces are the storey map's cells, so they lie up to one cell off the IFC's face: a
+/// mark is put on the wall the simulator has, as a user marks the wall that was built.
+/// Throws BimError naming the wall and the point when no box face holds it.
+concert::world::Mark mark_on_wall(const concert::world::World& world, const std::string& global_id,
+                                  const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                                  const std::string& name, double diameter);
+
+/// The world file text (libs/world README "World file") of a world made of a floor, static boxes
+/// (as storey_world() makes) and marks (as mark_on_wall() makes). Throws BimError for what it
+/// does not write (sanding surfaces, cylinders, meshes, moving obstacles).
 std::string world_yaml(const concert::world::World& world);
 
 }  // namespace concert::bim

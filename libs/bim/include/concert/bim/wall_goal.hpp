@@ -15,6 +15,10 @@ enum class FaceChoice {
   kRight,  ///< WallGeometry::faces[1]
 };
 
+/// The choice named "auto", "left" or "right" (as `concert bim goal --face` and a drilling
+/// mission's `face:` spell it); throws BimError naming the word otherwise.
+FaceChoice face_choice(const std::string& name);
+
 /// What wall_goal needs besides the point on the wall.
 struct GoalOptions {
   FaceChoice face{FaceChoice::kAuto};

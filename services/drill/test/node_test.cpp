@@ -1,0 +1,59 @@
+// The drill service's DDS adapter: a mission message written again (same id and stamp, as
+// `concert drill run` does until a status names it) is taken once; a new stamp is a new request.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "concert/common/clock.hpp"
+#include "concert/dds/endpoint.hpp"
+#include "concert/dds/participant.hpp"
+#include "dds/drill_node.hpp"
+
+namespace concert::drill::dds {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST(DrillNode, AMissionWrittenAgainIsTakenOnce) {
+  concert::dds::Participant participant({.name = "drill_node_test"});
+  std::ostringstream log;
+  DrillNode node(participant, NodeParams{}, log);
+  std::atomic<bool> stop{false};
+  std::thread spinner([&] { node.spin(stop); });
+  concert::dds::Writer<msg::DrillMission> missions(participant, concert::dds::topics::drill_mission);
+  ASSERT_TRUE(missions.wait_for_readers(1, 5s));
+
+  // No robot model: the service refuses the mission, once for the three copies.
+  msg::DrillMission m;
+  m.mission_id(7);
+  m.stamp_ns(now_ns());
+  m.source("test");
+  m.name("twice");
+  m.yaml("areas:\n  - {point: [2.2, 0.0, 1.2]}\n");
+  for (int i = 0; i < 3; ++i) {
+    missions.write(m);
+    std::this_thread::sleep_for(200ms);
+  }
+  // The same mission id sent anew (a new stamp) is a new request: refused again.
+  m.stamp_ns(m.stamp_ns() + 1);
+  missions.write(m);
+  for (int i = 0; i < 50 && count(log.str(), "mission 7 refused") < 2; ++i)
+    std::this_thread::sleep_for(100ms);
+  std::this_thread::sleep_for(300ms);
+  stop = true;
+  spinner.join();
+  EXPECT_EQ(count(log.str(), "mission 7 refused: no robot model yet"), 2u) << log.str();
+}
+
+}  // namespace
+}  // namespace concert::drill::dds
