@@ -11,7 +11,8 @@
 #      and visual servoing; the report, and the hole the simulator's wall records
 #   4. hot swap: the drill is replaced by the sanding tool -> new scan -> tree -> model
 #      version 2 -> every service ready again, with the time of each stage
-# Usage: deploy/demo.sh [BUILD_DIR]    Domain: CONCERT_DOMAIN_ID (default 0).
+# Usage: deploy/demo.sh [BUILD_DIR]    Domain: CONCERT_DOMAIN_ID (default 0). DEMO_KEEP=1: keep the stack
+#        (and the operator GUI, whose address it prints) up after the demo, until Ctrl-C.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -64,6 +65,10 @@ stage "scan -> module tree -> robot model v1 -> every service reconfigures"
 stage "concert status"
 "$concert" status --timeout 1 | sed 's/^/  /'
 
+gui=$(grep -o 'operator GUI: http://[^ ]*' "$log" | head -1 || true)
+stage "${gui:-operator GUI: not built (services/gui)}"
+[ -n "$gui" ] && echo "  open it in a browser on this machine while the demo runs (DEMO_KEEP=1: the stack stays up at the end)"
+
 stage "the live model"
 "$concert" model show --timeout 5 | sed -n '1,8p;/^end-effectors/,$p' | sed 's/^/  /'
 
@@ -91,9 +96,22 @@ stage "model version 2 live in every service (stage times above count from the s
 "$concert" status --timeout 1 | sed 's/^/  /'
 "$concert" model show --timeout 5 | sed -n '/^end-effectors/,$p' | sed 's/^/  /'
 
+stage "spraying (services/surface_finish): a 0.4 m x 0.4 m area in MuJoCo, coverage from the true TCP"
+spray_bench=$build/services/surface_finish/bench_surface_finish
+if [ -x "$spray_bench" ]; then
+  "$spray_bench" --short --out "${XDG_RUNTIME_DIR:-/tmp}/concert-d$CONCERT_DOMAIN_ID/spray" | sed 's/^/  /' ||
+    fail "the spraying run missed its aims (coverage >= 99 %, |dh| <= 5 mm, coats 100 +- 5 mm)"
+else
+  echo "  (not built: $spray_bench)"
+fi
+
 stage "topics on the domain"
 "$concert" topic list --timeout 1 | sed 's/^/  /'
 
 stage "end state: safety RUNNING, every service ready at model version 2, nothing refused"
 check_end_state "at the end"
 echo "demo: OK"
+if [ "${DEMO_KEEP:-0}" = 1 ] && [ -n "$gui" ]; then
+  echo "demo: the stack stays up (${gui}); Ctrl-C stops it"
+  wait "$up_pid" || true
+fi

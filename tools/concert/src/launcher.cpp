@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <fstream>
@@ -298,6 +299,12 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
     nav_args = {"--ifc", fs::absolute(o.ifc).string(), "--storey", o.storey, "--initial-pose", x.str(), y.str(),
                 yaw.str()};
   }
+  // The operator GUI's gateway: its address, and the module databases whose meshes it serves.
+  // Its port follows the domain by default, so stacks on other domains of one machine (tests,
+  // other users) do not fight over one port.
+  const int gui_port = o.gui_port >= 0 ? o.gui_port : 8080 + domain;
+  std::vector<std::string> gui_args = {"--port", std::to_string(gui_port), "--bind", o.gui_bind};
+  gui_args.insert(gui_args.end(), db_args.begin(), db_args.end());
   // The safety service keeps its latched state (a stop, its causes, the inputs, the services it
   // watches) in the run folder, so a safety service killed and restarted holds the same stop;
   // a new `concert up` starts from none.
@@ -311,6 +318,9 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
       {"planner", "concert_planner", {}, false},
       {"nav", "concert_nav", nav_args, false},
       {"drill", "concert_drill", {}, false},
+      {"collab", "concert_collab", {}, false},
+      {"surface_finish", "concert_surface_finish", {"--out-dir", (dir / "finish").string()}, false},
+      {"gui", "concert_gui", gui_args, false},
   };
   std::vector<ServiceSpec> services;
   for (const auto& p : plan) {
@@ -324,12 +334,24 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
     spec.argv.insert(spec.argv.end(), p.args.begin(), p.args.end());
     services.push_back(std::move(spec));
   }
+  // With the safety service up, the robot moves only while it hears it (a robot that cannot
+  // hear the safety layer cannot hear its stops either): it holds until the first safety
+  // state and whenever none came for 1 s (5 re-publications; the safety service's own
+  // liveliness bound).
+  if (std::any_of(services.begin(), services.end(), [](const ServiceSpec& s) { return s.name == "safety"; })) {
+    for (auto& s : services) {
+      if (s.name == "robot") s.argv.insert(s.argv.end(), {"--safety-timeout", "1.0"});
+    }
+  }
 
   setenv("CONCERT_DOMAIN_ID", std::to_string(domain).c_str(), 1);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   out << "concert up: domain " << domain << ", run folder " << dir.string() << "\n"
       << "  hot swap: concert sim swap FILE    status: concert status    stop: Ctrl-C" << std::endl;
+  for (const auto& s : services) {
+    if (s.name == "gui") out << "  operator GUI: http://" << (o.gui_bind == "0.0.0.0" ? "<this host>" : o.gui_bind) << ":" << gui_port << "/" << std::endl;
+  }
   Supervisor supervisor(std::move(services), dir / "logs", out);
   supervisor.start_all();
   const auto until = std::chrono::steady_clock::now() +
@@ -406,10 +428,19 @@ int run_sim(const SimOptions& o, std::ostream& out, std::ostream& /*err*/) {
     throw Failure("no simulator on domain " + std::to_string(participant.domain_id()) +
                   " (start one with `concert up`)");
   }
-  commands.write(c);
+  // The reader matched may be another tool's (the GUI's gateway, a recorder) before the
+  // simulator's: the command is written again every second until the reply comes (the
+  // simulator answers a command it has seen again without applying it twice).
   std::unique_lock lock(m);
-  if (!cv.wait_until(lock, deadline, [&] { return reply.has_value(); })) {
-    throw Failure("the simulator did not answer within " + std::to_string(o.dds.timeout_s) + " s");
+  while (!reply) {
+    lock.unlock();
+    commands.write(c);
+    lock.lock();
+    const auto next = std::min(deadline, std::chrono::steady_clock::now() + std::chrono::seconds(1));
+    if (!cv.wait_until(lock, next, [&] { return reply.has_value(); }) &&
+        std::chrono::steady_clock::now() >= deadline) {
+      throw Failure("the simulator did not answer within " + std::to_string(o.dds.timeout_s) + " s");
+    }
   }
   if (!reply->accepted()) throw Failure(reply->message());
   if (o.dds.json) {
@@ -460,6 +491,14 @@ void register_launcher_verbs(cli::Cli& concert) {
   up_verb.add_option("--duration", up->duration_s, "stop after S seconds (0: run until Ctrl-C)")
       ->type_name("S")
       ->check(cli::seconds());
+  up_verb.add_option("--gui-port", up->gui_port, "the operator GUI's port (concert_gui)")
+      ->type_name("N")
+      ->check(cli::number(0, 65535, true))
+      ->default_str("8080 + domain");
+  up_verb.add_option("--gui-bind", up->gui_bind,
+                     "the operator GUI's address (default: this machine only; 0.0.0.0: the robot's network)")
+      ->type_name("ADDR")
+      ->default_str("127.0.0.1");
   cli::Cli::add_domain_option(up_verb, up->domain);
 
   CLI::App& sim =

@@ -92,6 +92,8 @@ struct UpOptions {
   std::string bin_dir;                  ///< "" = CONCERT_BIN_DIR, the build tree, PATH
   double duration_s = 0.0;              ///< 0 = until Ctrl-C
   std::optional<int32_t> domain;
+  int gui_port = -1;                    ///< the operator GUI's port (services/gui); -1: 8080 + domain
+  std::string gui_bind = "127.0.0.1";   ///< the operator GUI's address (localhost only by default)
 };
 
 /// `concert sim assemble|swap|world FILE`.
