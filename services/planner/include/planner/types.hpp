@@ -67,6 +67,11 @@ struct Params {
   double nspg_time = 1.6;            ///< NSPG time budget per goal [s CPU] (of planning_time)
   int nspg_enough = 1;               ///< stop after this many valid postures
   double warm_up_time = 2.0;         ///< service: per height of the background warm-up after each model [s] (0: none)
+  /// Warm-up: the arm's way from the parked arm to each remembered posture [s CPU]. A search that
+  /// runs out stores the posture without a way, and later plans near it cannot replay one; on
+  /// morphology B's low postures the searches took 0.23-4.4 s (0.43-0.46 s for some), so with a
+  /// budget near those times what is remembered depends on the machine's speed.
+  double warm_up_path_time = 0.5;
   int nspg_memory = 128;             ///< goal postures remembered per model version as seeds for similar heights (0: off)
   double nspg_tolerance = 1e-3;      ///< task error accepted [m, rad]
   double nspg_distance_weight = 1.0; ///< cost of the distance to the start [1/rad]

@@ -31,6 +31,7 @@ Params read_params(config::Document& doc) {
       {"path_attempt_time", &p.path_attempt_time},
       {"nspg_time", &p.nspg_time},
       {"warm_up_time", &p.warm_up_time},
+      {"warm_up_path_time", &p.warm_up_path_time},
       {"nspg_tolerance", &p.nspg_tolerance},
       {"nspg_distance_weight", &p.nspg_distance_weight},
       {"nspg_singularity_weight", &p.nspg_singularity_weight},

@@ -27,8 +27,6 @@ using detail::ThreadCpuClock;  // what budgets are measured in (see cpu_clock.hp
 constexpr double kHintHeight = 0.3;
 constexpr std::size_t kHints = 8;
 
-// Warm-up: search time for the arm's path to each remembered posture.
-constexpr double kWarmUpPathTime = 0.5;
 // A remembered arm path serves a goal whose arm joints after the first are this close [rad].
 constexpr double kArmPathReuse = 0.6;
 // Arm postures whose joints after the first are this close [rad] have the same shape (the
@@ -106,7 +104,7 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
         parked.head<3>() = q.head<3>();
         std::vector<Eigen::VectorXd> path = detail::subspace_rrt(
             *model, checker, start, params.check_resolution, 3, model->dof() - 3, model->lower(),
-            model->upper(), parked, q, kWarmUpPathTime, seed, nullptr);
+            model->upper(), parked, q, params.warm_up_path_time, seed, nullptr);
         std::vector<Eigen::VectorXd> arms;
         for (const Eigen::VectorXd& w : path) arms.push_back(w.tail(w.size() - 3));
         remember(*model, height, q, std::move(arms));
