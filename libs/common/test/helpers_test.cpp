@@ -1,12 +1,16 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <string>
-#include <unistd.h>
+#include <thread>
 
+#include "concert/common/command_once.hpp"
 #include "concert/common/error_text.hpp"
+#include "concert/common/resend.hpp"
 #include "concert/common/source_text.hpp"
 
 namespace concert {
@@ -46,6 +50,53 @@ TEST(SourceText, ParsesYamlOrSaysWhereItCameFrom) {
   const std::string error =
       error_text<ReadError>([] { (void)parse_yaml<ReadError>("b: [2, 3\n", "bad.yaml"); });
   EXPECT_EQ(error.rfind("bad.yaml: not valid YAML: ", 0), 0u) << error;
+}
+
+TEST(CommandOnce, TakesEachIdAndStampOnceAndForgetsTheOldest) {
+  CommandOnce once(3);
+  EXPECT_TRUE(once.first_time(7, 100));
+  EXPECT_FALSE(once.first_time(7, 100));  // written again by a client that had not heard us
+  EXPECT_TRUE(once.first_time(7, 101));   // the same id sent anew is a new command
+  EXPECT_TRUE(once.first_time(8, 100));
+  EXPECT_FALSE(once.first_time(8, 100));
+  EXPECT_TRUE(once.first_time(9, 100));  // the fourth key pushes (7, 100) out
+  EXPECT_TRUE(once.first_time(7, 100));
+  EXPECT_FALSE(once.first_time(9, 100));
+}
+
+TEST(ResendUntilAnswered, WritesAgainEachPeriodUntilTheAnswerOrTheDeadline) {
+  using Clock = std::chrono::steady_clock;
+  using namespace std::chrono_literals;
+  int writes = 0;
+  // Answered at the third write: each unanswered wait lasts until its period ends.
+  const auto t0 = Clock::now();
+  EXPECT_TRUE(resend_until_answered([&] { ++writes; },
+                                    [&](Clock::time_point until) {
+                                      if (writes == 3) return true;
+                                      std::this_thread::sleep_until(until);
+                                      return false;
+                                    },
+                                    t0 + 5s, 20ms));
+  EXPECT_EQ(writes, 3);
+  EXPECT_GE(Clock::now() - t0, 40ms);
+
+  // Never answered: written again after each period (at most deadline / period + 1 times, at
+  // least twice unless one wait overshot by most of a second), then false.
+  writes = 0;
+  EXPECT_FALSE(resend_until_answered([&] { ++writes; },
+                                     [&](Clock::time_point until) {
+                                       std::this_thread::sleep_until(until);
+                                       return false;
+                                     },
+                                     Clock::now() + 1s, 20ms));
+  EXPECT_GE(writes, 2);
+  EXPECT_LE(writes, 51);
+
+  // A deadline already past still writes once.
+  writes = 0;
+  EXPECT_FALSE(resend_until_answered([&] { ++writes; }, [](Clock::time_point) { return false; },
+                                     Clock::now() - 1s));
+  EXPECT_EQ(writes, 1);
 }
 
 }  // namespace

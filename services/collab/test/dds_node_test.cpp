@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -232,6 +233,49 @@ TEST_F(CollabDds, InStopItCommandsNothing) {
   EXPECT_EQ(say("hey concert stop").state(), "stop");
   std::this_thread::sleep_for(300ms);  // the stop transition's zero velocity and hold arrive
   EXPECT_TRUE(quiet_for(1500ms)) << "collab kept commanding the robot after stop\n" << log_.str();
+}
+
+// `concert collab say` writes its command again every second until the state answering it
+// comes: the service takes each (command id, stamp) once, so a repeated "open" cannot act twice.
+TEST_F(CollabDds, ACommandWrittenAgainIsTakenOnce) {
+  ready_at(1);
+  msg::CollabCommand c;
+  c.command_id(500);
+  c.stamp_ns(now_ns());
+  c.source("test");
+  c.text("hey concert teaching");
+  c.direct(false);
+  ASSERT_TRUE(commands_->write(c));
+  std::optional<msg::CollabState> first;
+  for (int i = 0; i < 50 && !first; ++i) {
+    const auto s = states_->wait(100ms);
+    if (s && s->command_id() == 500) first = s;
+  }
+  ASSERT_TRUE(first) << log_.str();
+  EXPECT_TRUE(first->accepted());
+  EXPECT_EQ(first->state(), "teaching/general");
+
+  ASSERT_TRUE(commands_->write(c));  // the same command again: no answer, no transition
+  msg::CollabCommand next = c;       // then a new one; the service takes commands in order
+  next.command_id(501);
+  next.stamp_ns(now_ns());
+  next.text("hey concert close");
+  ASSERT_TRUE(commands_->write(next));
+  std::optional<msg::CollabState> answer;
+  for (int i = 0; i < 50 && !answer; ++i) {
+    const auto s = states_->wait(100ms);
+    if (s && s->command_id() == 501) answer = s;
+  }
+  ASSERT_TRUE(answer) << log_.str();
+  // The state topic keeps the last sample only, so the log tells what was taken: "teaching"
+  // once (a repeat would log "teaching: teaching/general -> teaching/general (ignored: ...)").
+  const std::string log = log_.str();
+  std::size_t taken = 0;
+  for (auto at = log.find("collab: teaching: "); at != std::string::npos;
+       at = log.find("collab: teaching: ", at + 1))
+    ++taken;
+  EXPECT_EQ(taken, 1u) << "the repeated command was taken again\n" << log;
+  EXPECT_EQ(answer->state(), "teaching/close");
 }
 
 }  // namespace

@@ -149,6 +149,55 @@ TEST_F(SafetyNodeTest, EStopLatchesUntilReleasedAndReset) {
   EXPECT_TRUE(running) << log_.str();
 }
 
+// A client that has not heard the answer writes its reset again (concert safety reset resends
+// every second): the copy is the same press and must not clear a stop that came after it.
+TEST_F(SafetyNodeTest, AResetWrittenAgainIsTakenOnceAndCannotClearALaterStop) {
+  Writer<msg::EStopInput> inputs(participant_, topics::estop);
+  Writer<msg::SafetyReset> resets(participant_, topics::safety_reset);
+  ASSERT_TRUE(wait_state(
+      states_, [](const auto& s) { return s.mode() == msg::SAFETY_RUNNING; }, 10s));
+  const auto stop_and_release = [&] {
+    ASSERT_TRUE(inputs.write(estop(msg::ESTOP_WIRELESS, true)));
+    ASSERT_TRUE(eventually([&] { return node_->status().mode == Mode::kStopped; }, 10s));
+    ASSERT_TRUE(inputs.write(estop(msg::ESTOP_WIRELESS, false)));
+  };
+  stop_and_release();
+  msg::SafetyReset reset;
+  reset.source("unit test");
+  reset.stamp_ns(1'000'000);
+  // The operator's press (request ids from 100, as often as the release needs to be heard).
+  bool running = false;
+  uint32_t id = 100;
+  for (; id < 120 && !running; ++id) {
+    reset.request_id(id);
+    ASSERT_TRUE(resets.write(reset));
+    running = eventually([&] { return node_->status().mode == Mode::kRunning; }, 500ms);
+  }
+  ASSERT_TRUE(running) << log_.str();
+  const uint32_t accepted = id - 1;
+
+  log_.str("");
+  stop_and_release();
+  reset.request_id(accepted);  // the accepted press, written again
+  ASSERT_TRUE(resets.write(reset));
+  EXPECT_TRUE(eventually(
+      [&] {
+        return log_.str().find("reset " + std::to_string(accepted) +
+                               " by unit test seen again, ignored") != std::string::npos;
+      },
+      10s))
+      << log_.str();
+  EXPECT_EQ(node_->status().mode, Mode::kStopped) << log_.str();
+  // A new press (a new stamp; again until the release has been heard) resets it.
+  running = false;
+  for (int64_t stamp = 2'000'000; stamp < 2'000'020 && !running; ++stamp) {
+    reset.stamp_ns(stamp);
+    ASSERT_TRUE(resets.write(reset));
+    running = eventually([&] { return node_->status().mode == Mode::kRunning; }, 500ms);
+  }
+  EXPECT_TRUE(running) << log_.str();
+}
+
 TEST_F(SafetyNodeTest, SilentTaskServiceStopsWithItsName) {
   Writer<msg::ServiceStatus> statuses(participant_, topics::status);
   msg::ServiceStatus beat;

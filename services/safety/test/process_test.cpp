@@ -129,12 +129,14 @@ TEST(SafetyProcess, KilledHardItComesBackWithItsLatchedStop) {
   const auto state = temp_file("safety_state", "");
   std::filesystem::remove(state);
   Participant p({.name = "safety_process_test"});
-  Writer<msg::EStopInput> inputs(p, topics::estop);
   auto stopped_by_wireless = [](const msg::SafetyState& s) {
     return s.mode() == msg::SAFETY_STOPPED && s.causes().size() == 1 &&
            s.causes()[0] == "estop: wireless engaged (operator)";
   };
   {
+    // The input's writer goes with this block: its latched "engaged" sample would otherwise
+    // reach every later safety process, and the stop they hold must come from the state file.
+    Writer<msg::EStopInput> inputs(p, topics::estop);
     testing::Process safety({SAFETY_BINARY, "--state", state.string()});
     Reader<msg::SafetyState> states(p, topics::safety_state);
     ASSERT_TRUE(wait_state(

@@ -5,11 +5,13 @@
 #include <chrono>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 
 #include "collab/command_parser.hpp"
 #include "collab/voice.hpp"
 #include "concert/common/clock.hpp"
+#include "concert/common/resend.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/participant.hpp"
 
@@ -69,15 +71,25 @@ int send(cdds::Participant& participant, const std::string& text, bool direct, c
   c.source(source);
   c.text(text);
   c.direct(direct);
-  commands.write(c);
-  while (left_until(deadline).count() > 0) {
-    const auto s = states.wait(left_until(deadline));
-    if (!s || s->command_id() != c.command_id()) continue;
-    print_state(*s, dds.json, out);
-    return s->accepted() ? 0 : 1;
+  // The reader matched first may be another tool's (the GUI's gateway, a recorder) before the
+  // collab service's: the command is written again every second until the state answering it
+  // comes (the service takes a command it has seen, same id and stamp, once).
+  std::optional<msg::CollabState> answer;
+  resend_until_answered([&] { commands.write(c); },
+                        [&](Clock::time_point until) {
+                          while (!answer && Clock::now() < until) {
+                            const auto s = states.wait(left_until(until));
+                            if (s && s->command_id() == c.command_id()) answer = s;
+                          }
+                          return answer.has_value();
+                        },
+                        deadline);
+  if (!answer) {
+    err << "concert collab: the collab service did not answer within " << dds.timeout_s << " s\n";
+    return 1;
   }
-  err << "concert collab: the collab service did not answer within " << dds.timeout_s << " s\n";
-  return 1;
+  print_state(*answer, dds.json, out);
+  return answer->accepted() ? 0 : 1;
 }
 
 bool known_mode(const std::string& m) {

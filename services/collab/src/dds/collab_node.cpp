@@ -107,6 +107,9 @@ CollabNode::CollabNode(cdds::Participant& participant, NodeParams params, std::o
       commands_in_(participant, cdds::topics::collab_command,
                    [this](const msg::CollabCommand& c, const auto&) {
                      std::lock_guard lock(mutex_);
+                     // Written again by a client that had not heard the answer: the same
+                     // command, taken once (a second "open" or "lift" would act twice).
+                     if (!commands_seen_.first_time(c.command_id(), c.stamp_ns())) return;
                      if (commands_.size() < 64) commands_.push_back(c);
                    }),
       safety_in_(participant, cdds::topics::safety_state,

@@ -25,6 +25,7 @@
 #include "collab/follow_me_mpc.hpp"
 #include "collab/obstacle_map.hpp"
 #include "collab/state_machine.hpp"
+#include "concert/common/command_once.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 #include "concert/model/robot_model.hpp"
@@ -83,6 +84,7 @@ class CollabNode {
   mutable std::mutex mutex_;
   std::optional<msg::RobotModel> model_in_;
   std::deque<msg::CollabCommand> commands_;
+  concert::CommandOnce commands_seen_;  // (command id, stamp) of the commands taken; under mutex_
   std::optional<msg::SafetyState> safety_;
   std::optional<msg::JointState> joints_;
   std::optional<msg::Odometry> odometry_;

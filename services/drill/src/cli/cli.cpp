@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "concert/common/clock.hpp"
+#include "concert/common/resend.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/participant.hpp"
 
@@ -169,14 +170,15 @@ int run_mission(const RunOptions& o, std::ostream& out, std::ostream& err) {
   // service's: the mission is written again every second until a status names it (the service
   // takes a mission it has seen, same id and stamp, once). --no-wait writes it once.
   std::optional<msg::DrillStatus> first;
-  do {
-    missions.write(m);
-    const auto next = std::min(deadline, Clock::now() + std::chrono::seconds(1));
-    while (!o.no_wait && !first && Clock::now() < next) {
-      const auto s = statuses.wait(left_until(next));
-      if (s && s->mission_id() == o.mission_id) first = s;
-    }
-  } while (!o.no_wait && !first && left_until(deadline).count() > 0);
+  resend_until_answered([&] { missions.write(m); },
+                        [&](Clock::time_point until) {
+                          while (!o.no_wait && !first && Clock::now() < until) {
+                            const auto s = statuses.wait(left_until(until));
+                            if (s && s->mission_id() == o.mission_id) first = s;
+                          }
+                          return o.no_wait || first.has_value();
+                        },
+                        deadline);
   if (!o.dds.json) out << "mission " << o.mission_id << " sent (" << m.name() << ")" << std::endl;
   if (o.no_wait) return 0;
   if (!first) {

@@ -449,9 +449,8 @@ void DrillNode::apply_model(const msg::RobotModel& m) {
 }
 
 void DrillNode::start_mission(const msg::DrillMission& m) {
-  const std::pair<std::uint32_t, std::int64_t> key{m.mission_id(), m.stamp_ns()};
-  if (key == last_mission_key_) return;  // written again by a sender that had not heard us yet
-  last_mission_key_ = key;
+  // Written again by a sender that had not heard us yet: the same mission, taken once.
+  if (!missions_seen_.first_time(m.mission_id(), m.stamp_ns())) return;
   const auto refuse = [&](const std::string& why) {
     status_.refused("mission " + std::to_string(m.mission_id()) + ": " + why);
     MissionReport report;

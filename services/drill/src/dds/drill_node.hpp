@@ -19,6 +19,7 @@
 #include <string>
 #include <utility>
 
+#include "concert/common/command_once.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 #include "concert/hardware/sensors.hpp"
@@ -178,9 +179,9 @@ class DrillNode final : public MissionPorts {
   std::unique_ptr<MissionTree> tree_;
   std::unique_ptr<Mission> mission_;
   std::uint32_t mission_id_{0};
-  // (id, stamp) of the last mission message taken: `concert drill run` writes a mission again
+  // `concert drill run` writes a mission again
   // every second until a status names it, and each is taken once.
-  std::pair<std::uint32_t, std::int64_t> last_mission_key_{0, 0};
+  concert::CommandOnce missions_seen_;                 // (mission id, stamp) of the missions taken
   std::map<std::string, MissionReport> last_reports_;  // by mission name, for resume
   std::optional<PatternTable> patterns_;
   std::chrono::steady_clock::time_point last_status_{};

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "concert/common/clock.hpp"
+#include "concert/common/resend.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/participant.hpp"
 
@@ -141,7 +142,19 @@ int run_goto(const GotoOptions& o, std::ostream& out, std::ostream& err) {
     g.pose().y(o.pose[1]);
     g.pose().yaw(o.pose[2]);
   }
-  goals.write(g);
+  // The reader matched first may be another tool's (the GUI's gateway, a recorder) before the
+  // nav service's: the goal is written again every second until a status names it (the
+  // service takes a goal it has seen, same id and stamp, once). --no-wait writes it once.
+  std::optional<msg::NavStatus> first;
+  const bool taken = resend_until_answered([&] { goals.write(g); },
+                                           [&](Clock::time_point until) {
+                                             while (!o.no_wait && !first && Clock::now() < until) {
+                                               const auto s = statuses.wait(left_until(until));
+                                               if (s && s->request_id() == o.request_id) first = s;
+                                             }
+                                             return o.no_wait || first.has_value();
+                                           },
+                                           deadline);
   if (o.dds.json) {
     out << nlohmann::ordered_json{{"request_id", o.request_id}, {"model_version", model->version()}}
                .dump()
@@ -150,10 +163,16 @@ int run_goto(const GotoOptions& o, std::ostream& out, std::ostream& err) {
     out << "goal " << o.request_id << " sent for model version " << model->version() << "\n";
   }
   if (o.no_wait) return 0;
+  if (!taken) {
+    err << "concert nav goto: the nav service did not take goal " << o.request_id << " within "
+        << o.dds.timeout_s << " s\n";
+    return 1;
+  }
   msg::NavState printed = msg::NAV_IDLE;
   auto last_print = Clock::now();
-  while (left_until(deadline).count() > 0) {
-    const auto s = statuses.wait(left_until(deadline));
+  while (first || left_until(deadline).count() > 0) {
+    const auto s = first ? first : statuses.wait(left_until(deadline));
+    first.reset();
     if (!s || s->request_id() != o.request_id) continue;
     // Progress arrives several times a second: a line per state change, else every 2 s.
     const bool changed = s->state() != printed;

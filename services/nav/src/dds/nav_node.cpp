@@ -181,7 +181,10 @@ NavNode::NavNode(cdds::Participant& participant, Navigator& navigator, std::stri
       goals_in_(participant, cdds::topics::nav_goal,
                 [this](const msg::NavGoal& g, const auto&) {
                   std::lock_guard lock(mutex_);
-                  inbox_.goals.push_back(g);
+                  // A goal written again by a client that had not heard us yet is the same
+                  // goal: taken once (a second submit would restart it).
+                  if (goals_seen_.first_time(g.request_id(), g.stamp_ns()))
+                    inbox_.goals.push_back(g);
                 }),
       cancels_in_(participant, cdds::topics::nav_cancel,
                   [this](const msg::NavCancel& c, const auto&) {

@@ -18,6 +18,7 @@
 #include <ostream>
 #include <thread>
 
+#include "concert/common/command_once.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 #include "nav/navigator.hpp"
@@ -77,6 +78,7 @@ class NavNode {
   std::mutex log_mutex_;
   std::mutex mutex_;
   Inbox inbox_;
+  concert::CommandOnce goals_seen_;  // (request id, stamp) of the goals taken; under mutex_
   std::int64_t last_stamp_ns_{0};  // robot clock: the latest odometry stamp
   std::atomic<std::uint64_t> late_samples_{0};
   std::uint64_t model_version_{0};

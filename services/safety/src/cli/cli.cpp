@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "concert/common/clock.hpp"
+#include "concert/common/resend.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 
@@ -116,29 +117,35 @@ int reset(const Options& o, dds::Participant& p, std::ostream& out, std::ostream
   // Heartbeats repeat the service's last message with a fresh stamp, so a refusal is
   // recognised by naming this request's source, not by its time.
   const std::string refusal = "reset by " + request.source() + " refused";
-  writer.write(request);
   // The service answers a reset with a state publication stamped after it, but it also
   // publishes states for other reasons (an input just released, a heartbeat): a STOPPED state
   // alone is no answer. Success is a RUNNING state; refusal is the service's status naming
-  // the reason. Wait (bounded) for either.
+  // the reason. The reset is written again every second until either is heard (the reader
+  // matched first may be another tool's; the service takes this request once).
   std::string why = "reset refused (no reason received)";
   std::optional<msg::SafetyState> last;
-  const auto deadline = std::chrono::steady_clock::now() + o.dds.timeout();
-  while (std::chrono::steady_clock::now() < deadline) {
-    while (auto st = states.take()) {
-      if (st->stamp_ns() < sent) continue;
-      last = *st;
-      if (st->mode() == msg::SAFETY_RUNNING) {
-        out << (o.dds.json ? json_of(*st).dump() : "safety: " + describe(*st)) << "\n";
-        return 0;
+  bool running = false;
+  const auto answered = [&](std::chrono::steady_clock::time_point until) {
+    while (std::chrono::steady_clock::now() < until) {
+      while (auto st = states.take()) {
+        if (st->stamp_ns() < sent) continue;
+        last = *st;
+        if (st->mode() == msg::SAFETY_RUNNING) return running = true;
+      }
+      const auto status = statuses.wait(20ms);
+      if (status && status->service() == "safety" && status->stamp_ns() >= sent &&
+          status->message().find(refusal) != std::string::npos) {
+        why = status->message();
+        return true;
       }
     }
-    const auto status = statuses.wait(20ms);
-    if (status && status->service() == "safety" && status->stamp_ns() >= sent &&
-        status->message().find(refusal) != std::string::npos) {
-      why = status->message();
-      break;
-    }
+    return false;
+  };
+  resend_until_answered([&] { writer.write(request); }, answered,
+                        std::chrono::steady_clock::now() + o.dds.timeout());
+  if (running) {
+    out << (o.dds.json ? json_of(*last).dump() : "safety: " + describe(*last)) << "\n";
+    return 0;
   }
   if (last) {
     out << (o.dds.json ? json_of(*last).dump() : "safety: " + describe(*last)) << "\n";

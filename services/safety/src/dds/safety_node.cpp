@@ -192,6 +192,13 @@ void SafetyNode::on_joint_state(const msg::JointState& state) {
 
 void SafetyNode::on_reset(const msg::SafetyReset& reset) {
   std::unique_lock lock(mutex_);
+  // A reset written again by a client that had not heard the answer is the same press: taken
+  // once, so that a copy arriving after a new stop cannot clear that stop.
+  if (!resets_seen_.first_time(reset.request_id(), reset.stamp_ns())) {
+    log_ << "safety: reset " << reset.request_id() << " by " << reset.source()
+         << " seen again, ignored (taken once)" << std::endl;
+    return;
+  }
   const auto outcome =
       monitor_.reset(reset.source().empty() ? "unnamed" : reset.source(), Clock::now());
   log_ << "safety: " << outcome.message << std::endl;

@@ -12,6 +12,7 @@
 #include <ostream>
 #include <string>
 
+#include "concert/common/command_once.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 #include "safety/safety_monitor.hpp"
@@ -83,6 +84,7 @@ class SafetyNode {
   concert::dds::Reader<msg::RobotModel> models_;
   concert::dds::Reader<msg::JointState> joint_states_;
   concert::dds::Reader<msg::SafetyReset> resets_;
+  concert::CommandOnce resets_seen_;  // (request id, stamp) of the resets taken; under mutex_
 };
 
 }  // namespace concert::safety::dds
