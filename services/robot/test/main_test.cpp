@@ -141,13 +141,18 @@ TEST(RobotMain, SimCommandsSwapTheAssemblyAndChangeTheWorld) {
   ASSERT_TRUE(reply.has_value());
   EXPECT_EQ(reply->message(), answer);
   // Standalone: the service takes the new hardware's own model and reports ready at version 2.
+  // Bounded by time (30 s), the last status shown: a loaded fresh-clone run ended the old loop
+  // (200 samples or 100 ms waits) without READY v2, and nothing said what the robot reported.
   bool ready_v2 = false;
-  for (int i = 0; i < 200 && !ready_v2; ++i) {
-    if (auto s = status.wait(100ms)) {
-      ready_v2 = s->service() == "robot" && s->state() == concert::msg::SERVICE_READY && s->model_version() == 2u;
+  std::string last_status = "(none)";
+  for (const auto until = std::chrono::steady_clock::now() + 30s; !ready_v2 && std::chrono::steady_clock::now() < until;) {
+    if (auto s = status.wait(100ms); s && s->service() == "robot") {
+      ready_v2 = s->state() == concert::msg::SERVICE_READY && s->model_version() == 2u;
+      last_status = "state " + std::to_string(static_cast<int>(s->state())) + " at model version " +
+                    std::to_string(s->model_version()) + ": " + s->message();
     }
   }
-  EXPECT_TRUE(ready_v2);
+  EXPECT_TRUE(ready_v2) << "the last robot status: " << last_status;
 
   // A world change: refused when malformed, else simulated and republished.
   concert::msg::SimCommand w = bad;
