@@ -4,14 +4,17 @@
 // deploy/demo/sand_site.yaml (bumps and holes); `concert finish sand --area centre --force 30`
 // asks for the run; the service plans the serpentine, moves to the approach pose with a joint
 // trajectory and sands with Cartesian impedance and the robot service's admittance along the
-// TCP's z, judged on the robot's force estimate from the joint torques. Refusals name why.
+// TCP's z, judged on the robot's force estimate from the joint torques. Refusals name why; an
+// e-stop while stroking ends the run aborted, naming the stop.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 
 #include "concert/common/clock.hpp"
@@ -136,9 +139,45 @@ TEST(SandSystem, CentreAreaAt30NOverTheStack) {
   EXPECT_EQ(st.code, 0) << st.err;
   EXPECT_NE(st.out.find("within +-3.0 N"), std::string::npos) << st.out;
 
-  std::lock_guard lock(safety_mutex);
-  ASSERT_FALSE(modes.empty()) << "no safety state heard";
-  for (const msg::SafetyMode m : modes) EXPECT_EQ(m, msg::SAFETY_RUNNING);
+  {
+    std::lock_guard lock(safety_mutex);
+    ASSERT_FALSE(modes.empty()) << "no safety state heard";
+    for (const msg::SafetyMode m : modes) EXPECT_EQ(m, msg::SAFETY_RUNNING);
+  }
+
+  // An e-stop while stroking ends the run at once, aborted, naming the stop.
+  c.request_id(5153);
+  c.stamp_ns(now_ns());
+  c.verb(msg::FINISH_SAND);
+  c.force(30.0);
+  commands.write(c);
+  bool stroking = false;
+  for (const auto until = std::chrono::steady_clock::now() + 120s;
+       !stroking && std::chrono::steady_clock::now() < until;) {
+    const auto s = statuses.wait(500ms);
+    if (!s || s->request_id() != 5153) continue;
+    ASSERT_EQ(s->state(), msg::FINISH_RUNNING) << s->reason() << logs();
+    stroking = s->reason() == "sanding: strokes";
+  }
+  ASSERT_TRUE(stroking) << logs();
+  const testing::Outcome estop =
+      testing::run(dies_with_test({CONCERT_BINARY, "safety", "estop", "--source", "front-left",
+                                   "--reason", "sand test"}),
+                   30s);
+  ASSERT_EQ(estop.code, 0) << estop.out << estop.err;
+  std::optional<msg::FinishStatus> stopped;
+  for (const auto until = std::chrono::steady_clock::now() + 30s;
+       std::chrono::steady_clock::now() < until;) {
+    const auto s = statuses.wait(500ms);
+    if (s && s->request_id() == 5153 && s->state() != msg::FINISH_RUNNING) {
+      stopped = s;
+      break;
+    }
+  }
+  ASSERT_TRUE(stopped) << logs();
+  EXPECT_EQ(stopped->state(), msg::FINISH_ABORTED);
+  EXPECT_NE(stopped->reason().find("safety stop (estop"), std::string::npos) << stopped->reason();
+  std::printf("e-stop while stroking: %s\n", stopped->reason().c_str());
 }
 
 }  // namespace

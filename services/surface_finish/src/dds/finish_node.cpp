@@ -450,14 +450,18 @@ void FinishNode::follow_sand() {
     end_run(msg::FINISH_ABORTED, seq.reason());
     return;
   }
-  if (!wrenches.empty()) run.last_wrench = now;
+  const double tick =
+      run.last_tick == std::chrono::steady_clock::time_point{}
+          ? 0.0
+          : std::min(0.1, std::chrono::duration<double>(now - run.last_tick).count());
+  run.last_tick = now;
+  run.silence = wrenches.empty() ? run.silence + tick : 0.0;
   const Eigen::Vector3d& z = seq.normal();
   if (seq.phase() == SandPhase::kMove) {
     if (ts) seq.set_move_progress(ts->progress());
     if (ts && ts->state() == msg::TRAJECTORY_SUCCEEDED) {
       if (wrenches.empty()) return;  // the robot's time: from its next estimate
       seq.start(static_cast<double>(wrenches.back().stamp_ns) * 1e-9);
-      run.last_wrench = now;
     } else if (ts &&
                (ts->state() == msg::TRAJECTORY_ABORTED || ts->state() == msg::TRAJECTORY_REFUSED)) {
       seq.stop("the robot stopped the move to the approach pose: " + ts->reason());
@@ -470,7 +474,7 @@ void FinishNode::follow_sand() {
     }
   }
   if (seq.phase() != SandPhase::kMove) {
-    if (std::chrono::duration<double>(now - run.last_wrench).count() > params_.wrench_timeout) {
+    if (run.silence > params_.wrench_timeout) {
       char b[120];
       std::snprintf(b, sizeof b,
                     "no force estimate from the robot (concert/robot/ee_wrench) for %.1f s",

@@ -44,7 +44,9 @@ struct NodeParams {
   /// offline run, SandRunParams::path).
   PathParams sand_path{0.1, 0.5, 0.02, 0.05, 0.05, 0.0, 0.0, 0.8};
   SandParams sanding;          ///< the sequence (its force is the request's)
-  double wrench_timeout{0.5};  ///< a sand run stops when no force estimate came for this long [s]
+  /// A sand run stops when no force estimate came for this long [s], counted over this node's
+  /// ticks (each at most 0.1 s: a stall of this process is not the robot's silence).
+  double wrench_timeout{2.0};
   double distance_tolerance{0.15};  ///< measured wall distance vs the working distance [m]
   double scan_max_age{2.0};         ///< [s]
   std::string out_dir;              ///< where each run's report JSON and PNG go ("" = nowhere)
@@ -84,7 +86,8 @@ class FinishNode {
     double wall_distance{0.0};
     std::chrono::steady_clock::time_point sent{};
     std::unique_ptr<SandSequence> sand;  // a sand run (no deposition)
-    std::chrono::steady_clock::time_point last_wrench{}, last_status{};
+    std::chrono::steady_clock::time_point last_tick{}, last_status{};
+    double silence{0.0};  // [s] without a force estimate (see NodeParams::wrench_timeout)
   };
   struct Wrench {
     std::int64_t stamp_ns{0};
