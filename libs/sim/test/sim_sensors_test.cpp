@@ -331,6 +331,10 @@ TEST(SimAssembly, TheSandingToolsLinksAreFoundForTheDiscFriction) {
   } catch (const hardware::HardwareError& e) {
     EXPECT_NE(std::string(e.what()).find("no_such_link"), std::string::npos) << e.what();
   }
+  // A hot swap drill -> sanding tool -> drill: each robot's own links (the drill has none).
+  SimHardware swapped(drill.urdf, w, params, {}, {}, drill.sanding_links);
+  EXPECT_TRUE(swapped.swap_model(sanding.urdf, {}, {}, sanding.sanding_links));
+  EXPECT_TRUE(swapped.swap_model(drill.urdf, {}, {}, drill.sanding_links));
   // The tool's TCP link is among them (the subtree of the last joint moving it).
   bool tcp = false;
   for (const std::string& l : sanding.sanding_links)
