@@ -1,14 +1,16 @@
 #include "concert/sim/sim_assembly.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
 
+#include "concert/kinematics/model.hpp"
+#include "concert/model_generation/generator.hpp"
 #include "concert/module_db/module_db.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/esc_catalog.hpp"
-#include "concert/model_generation/generator.hpp"
 
 namespace concert::sim {
 namespace {
@@ -28,6 +30,35 @@ std::vector<DrillBit> drill_bits(const std::vector<model_generation::EndEffector
     bits.push_back(bit);
   }
   return bits;
+}
+
+/// The links moved with the sanding end-effectors: the subtree of the last movable joint above
+/// each one's TCP link.
+std::vector<std::string> sanding_links(
+    const std::string& urdf, const std::vector<model_generation::EndEffectorInfo>& end_effectors) {
+  std::vector<std::string> links;
+  bool any = false;
+  for (const auto& ee : end_effectors) any = any || ee.kind == model::EndEffectorKind::kSanding;
+  if (!any) return links;
+  const kinematics::Model k = kinematics::Model::from_urdf_string(urdf);
+  for (const auto& ee : end_effectors) {
+    if (ee.kind != model::EndEffectorKind::kSanding) continue;
+    int last = -1;
+    std::size_t smallest = 0;
+    for (int j = 0; j < k.dof(); ++j) {
+      const std::vector<std::string> sub = k.subtree_links(j);
+      if (std::find(sub.begin(), sub.end(), ee.frame) == sub.end()) continue;
+      if (last < 0 || sub.size() < smallest) {
+        last = j;
+        smallest = sub.size();
+      }
+    }
+    if (last < 0) continue;  // a sanding tool on the root: nothing moves it
+    for (const std::string& l : k.subtree_links(last)) {
+      if (std::find(links.begin(), links.end(), l) == links.end()) links.push_back(l);
+    }
+  }
+  return links;
 }
 
 }  // namespace
@@ -101,6 +132,7 @@ SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const s
     out.urdf = model.urdf;
     out.sensors = sensor_mounts(model.sensor_frames);
     out.drill_bits = drill_bits(model.end_effectors);
+    out.sanding_links = sanding_links(model.urdf, model.end_effectors);
   } catch (const std::exception& e) {
     throw std::runtime_error("assembly '" + source + "': model generation failed: " + e.what());
   }

@@ -351,10 +351,18 @@ struct Instance {
 
 namespace {
 
-std::unique_ptr<Instance> make_instance(const std::string& urdf, const std::vector<SensorMount>& sensors,
+std::unique_ptr<Instance> make_instance(const std::string& urdf,
+                                        const std::vector<SensorMount>& sensors,
                                         const std::vector<DrillBit>& drill_bits, const World& world,
-                                        const SimParams& params) {
+                                        const SimParams& robot_params,
+                                        const std::vector<std::string>& sanding_links = {}) {
   world::validate_world(world, "sim world");
+  // The running sanding disc's friction on the sanding tools' links (link_friction wins).
+  SimParams params = robot_params;
+  if (params.sanding_disc_friction >= 0.0) {
+    for (const std::string& link : sanding_links)
+      params.link_friction.emplace(link, params.sanding_disc_friction);
+  }
   auto in = std::make_unique<Instance>();
   in->built = build_mjcf(urdf, world, params, sensors);
   in->sensors = sensors;
@@ -441,6 +449,7 @@ struct SimHardware::Impl {
   std::string latest_urdf;
   std::vector<SensorMount> latest_sensors;
   std::vector<DrillBit> latest_drill_bits;
+  std::vector<std::string> latest_sanding_links;
   World latest_world;
   // The sensors: the scene of the running instance (published by the control thread at each
   // switch) and the threads that read it (made on the first sink).
@@ -518,19 +527,21 @@ struct SimHardware::Impl {
   }
 };
 
-SimHardware::SimHardware(const std::string& urdf, World world, SimParams params, std::vector<SensorMount> sensors,
-                         std::vector<DrillBit> drill_bits)
+SimHardware::SimHardware(const std::string& urdf, World world, SimParams params,
+                         std::vector<SensorMount> sensors, std::vector<DrillBit> drill_bits,
+                         std::vector<std::string> sanding_links)
     : impl_(std::make_unique<Impl>()) {
   impl_->params = std::move(params);
   impl_->rng.seed(impl_->params.seed);
   if (impl_->params.timestep <= 0.0) {
     throw HardwareError("sim: timestep must be positive");
   }
-  impl_->active = make_instance(urdf, sensors, drill_bits, world, impl_->params);
+  impl_->active = make_instance(urdf, sensors, drill_bits, world, impl_->params, sanding_links);
   impl_->active->generation = 1;
   impl_->latest_urdf = urdf;
   impl_->latest_sensors = std::move(sensors);
   impl_->latest_drill_bits = std::move(drill_bits);
+  impl_->latest_sanding_links = std::move(sanding_links);
   impl_->latest_world = std::move(world);
   impl_->mounted = {1, impl_->active->built.joints};
   impl_->active_scene.store(impl_->active->scene);
@@ -654,7 +665,8 @@ void SimHardware::step(double dt) {
 }
 
 bool SimHardware::swap_model(const std::string& urdf, std::vector<SensorMount> sensors,
-                             std::vector<DrillBit> drill_bits) {
+                             std::vector<DrillBit> drill_bits,
+                             std::vector<std::string> sanding_links) {
   // Preparations are serialised (each builds on the latest robot and world); mounted() and
   // world() stay answerable meanwhile, as they only take `mutex`.
   std::lock_guard preparing(impl_->preparing);
@@ -666,12 +678,13 @@ bool SimHardware::swap_model(const std::string& urdf, std::vector<SensorMount> s
     }
     world = impl_->latest_world;
   }
-  auto next = make_instance(urdf, sensors, drill_bits, world, impl_->params);
+  auto next = make_instance(urdf, sensors, drill_bits, world, impl_->params, sanding_links);
   std::lock_guard lock(impl_->mutex);
   next->generation = impl_->mounted.generation + 1;
   impl_->latest_urdf = urdf;
   impl_->latest_sensors = std::move(sensors);
   impl_->latest_drill_bits = std::move(drill_bits);
+  impl_->latest_sanding_links = std::move(sanding_links);
   impl_->mounted = {next->generation, next->built.joints};
   impl_->submit(std::move(next));
   return true;
@@ -682,13 +695,15 @@ void SimHardware::set_world(const World& world) {
   std::string urdf;
   std::vector<SensorMount> sensors;
   std::vector<DrillBit> drill_bits;
+  std::vector<std::string> sanding_links;
   {
     std::lock_guard lock(impl_->mutex);
     urdf = impl_->latest_urdf;
     sensors = impl_->latest_sensors;
     drill_bits = impl_->latest_drill_bits;
+    sanding_links = impl_->latest_sanding_links;
   }
-  auto next = make_instance(urdf, sensors, drill_bits, world, impl_->params);
+  auto next = make_instance(urdf, sensors, drill_bits, world, impl_->params, sanding_links);
   next->same_robot = true;
   std::lock_guard lock(impl_->mutex);
   next->generation = impl_->mounted.generation;  // same robot: no new hardware generation

@@ -308,3 +308,41 @@ TEST(SimSensors, DrillCameraSeesTheMarksWhereTheWorldPutsThem) {
 
 }  // namespace
 }  // namespace concert::sim
+
+namespace concert::sim {
+namespace {
+
+// The sanding tool's links get the running disc's friction (SimParams::sanding_disc_friction):
+// the links moved with it are found from its end-effector, and they are links of the robot
+// (a name that is none is refused by the simulator, as below).
+TEST(SimAssembly, TheSandingToolsLinksAreFoundForTheDiscFriction) {
+  const SimulatedRobot sanding = demo_robot("sanding_robot.yaml");
+  ASSERT_FALSE(sanding.sanding_links.empty());
+  const SimulatedRobot drill = demo_robot("drill_robot.yaml");
+  EXPECT_TRUE(drill.sanding_links.empty());
+  SimParams params;
+  params.sensors.enabled = false;
+  const world::World w =
+      world::load_world_file(std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/sand_site.yaml");
+  EXPECT_NO_THROW(SimHardware(sanding.urdf, w, params, {}, {}, sanding.sanding_links));
+  try {
+    SimHardware hw(sanding.urdf, w, params, {}, {}, {"no_such_link"});
+    FAIL() << "a sanding link that is no link was taken";
+  } catch (const hardware::HardwareError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_link"), std::string::npos) << e.what();
+  }
+  // A hot swap drill -> sanding tool -> drill: each robot's own links (the drill has none).
+  SimHardware swapped(drill.urdf, w, params, {}, {}, drill.sanding_links);
+  EXPECT_TRUE(swapped.swap_model(sanding.urdf, {}, {}, sanding.sanding_links));
+  EXPECT_TRUE(swapped.swap_model(drill.urdf, {}, {}, drill.sanding_links));
+  // The tool's TCP link is among them (the subtree of the last joint moving it).
+  bool tcp = false;
+  for (const std::string& l : sanding.sanding_links)
+    tcp = tcp || l.find("tcp") != std::string::npos;
+  std::string all;
+  for (const std::string& l : sanding.sanding_links) all += l + " ";
+  EXPECT_TRUE(tcp) << all;
+}
+
+}  // namespace
+}  // namespace concert::sim

@@ -200,7 +200,8 @@ int run(const Options& options) {
     for (const auto& [name, dir] : options.packages) {
       sim_params.package_paths[name] = dir;
     }
-    sim::SimHardware sim(simulated.urdf, world, sim_params, simulated.sensors, simulated.drill_bits);
+    sim::SimHardware sim(simulated.urdf, world, sim_params, simulated.sensors, simulated.drill_bits,
+                         simulated.sanding_links);
     robot::RobotParams& params = service.robot;
     if (!options.ee_frame.empty()) {
       params.end_effector_frame = options.ee_frame;

@@ -91,6 +91,26 @@ TEST(SpraySystem, ShortAreaOverTheStackMeetsTheAims) {
   ASSERT_TRUE(refused);
   EXPECT_EQ(refused->state(), msg::FINISH_FAILED);
   EXPECT_NE(refused->reason().find("not inside area 'all'"), std::string::npos) << refused->reason();
+
+  // Sanding with the spraying tool is refused with the reason.
+  c.request_id(4244);
+  c.stamp_ns(now_ns());
+  c.verb(msg::FINISH_SAND);
+  c.force(30.0);
+  commands.write(c);
+  refused.reset();
+  for (const auto until = std::chrono::steady_clock::now() + 10s;
+       std::chrono::steady_clock::now() < until;) {
+    const auto s = statuses.wait(500ms);
+    if (s && s->request_id() == 4244) {
+      refused = s;
+      break;
+    }
+  }
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->state(), msg::FINISH_FAILED);
+  EXPECT_NE(refused->reason().find("no sanding tool (it sprays)"), std::string::npos)
+      << refused->reason();
 }
 
 }  // namespace

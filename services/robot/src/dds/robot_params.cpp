@@ -36,6 +36,7 @@ ServiceParams read_service_params(config::Document& doc) {
   sim.number("damping_scale", p.sim.damping_scale, non_negative);
   sim.number("wheel_friction", p.sim.wheel_friction, non_negative);
   sim.number("robot_friction", p.sim.robot_friction, non_negative);
+  sim.number("sanding_disc_friction", p.sim.sanding_disc_friction);
   sim.boolean_or_auto("floating_base", p.sim.floating_base);
   std::vector<double> base_position(p.sim.base_position.data(), p.sim.base_position.data() + 3);
   sim.numbers("base_position", base_position, 3);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -68,6 +69,22 @@ void print_status(const msg::FinishStatus& s, std::ostream& out) {
   const auto r = nlohmann::json::parse(s.report_json(), nullptr, false);
   if (r.is_discarded()) return;
   char b[200];
+  if (r.value("task", "") == "sand") {
+    if (!r.contains("mean_n")) {
+      out << "no stroke sanded\n";
+      return;
+    }
+    std::snprintf(b, sizeof b,
+                  "force (the robot's estimate) mean %.2f N, min %.2f N, max %.2f N; within +-%.1f "
+                  "N of %.1f N for "
+                  "%.1f %% of %.1f s of strokes (%.2f s outside)\n",
+                  r.value("mean_n", 0.0), r.value("min_n", 0.0), r.value("max_n", 0.0),
+                  r.value("tolerance_n", 0.0), r.value("force_setpoint_n", 0.0),
+                  r.value("within_tolerance_percent", 0.0), r.value("stroke_time_s", 0.0),
+                  r.value("time_outside_s", 0.0));
+    out << b;
+    return;
+  }
   std::snprintf(b, sizeof b, "coverage %.2f %%, overspray %.3f m^2, max |dh| %.1f mm, max coat width error %.1f mm\n",
                 r.value("coverage_percent", 0.0), r.value("overspray_m2", 0.0), r.value("max_abs_delta_h_mm", 0.0),
                 r.value("max_width_error_mm", 0.0));
@@ -151,11 +168,29 @@ int run_request(msg::FinishVerb verb, const RunOptions& o, std::ostream& out, st
   }
   c.speed(o.speed);
   c.force(o.force);
-  commands.write(c);
+  // The command topic is volatile and the reader matched may be another tool's (the GUI's
+  // gateway, a recorder) before the service's: the command is written again every second until
+  // a status names the request (the service takes a request it has seen, same id and stamp,
+  // once). --no-wait writes it once.
+  std::optional<msg::FinishStatus> first;
+  do {
+    commands.write(c);
+    const auto next = std::min(deadline, Clock::now() + std::chrono::seconds(1));
+    while (!o.no_wait && !first && Clock::now() < next) {
+      const auto s = statuses.wait(left_until(next));
+      if (s && s->request_id() == c.request_id()) first = s;
+    }
+  } while (!o.no_wait && !first && left_until(deadline).count() > 0);
   if (!o.dds.json) out << "request " << c.request_id() << " sent (" << name << " area '" << o.area << "')" << std::endl;
   if (o.no_wait) return 0;
-  while (left_until(deadline).count() > 0) {
-    const auto s = statuses.wait(left_until(deadline));
+  if (!first) {
+    err << "concert finish " << name << ": the surface finishing service did not take request "
+        << c.request_id() << " within " << o.dds.timeout_s << " s\n";
+    return 1;
+  }
+  while (first || left_until(deadline).count() > 0) {
+    const auto s = first ? first : statuses.wait(left_until(deadline));
+    first.reset();
     if (!s || s->request_id() != c.request_id() || s->state() == msg::FINISH_RUNNING) continue;
     if (o.dds.json) {
       out << status_json(*s).dump() << std::endl;

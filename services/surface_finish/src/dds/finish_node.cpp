@@ -8,6 +8,7 @@
 
 #include "concert/common/clock.hpp"
 #include "concert/model/dds/conversions.hpp"
+#include "concert/model/dds/pose.hpp"
 
 namespace concert::surface_finish::dds {
 
@@ -28,6 +29,7 @@ FinishNode::FinishNode(cdds::Participant& participant, NodeParams params, std::o
       areas_writer_(participant, topics::finish_areas),
       status_writer_(participant, topics::finish_status),
       trajectories_(participant, topics::trajectory_command),
+      cartesian_(participant, topics::cartesian_command),
       model_reader_(participant, topics::robot_model,
                     [this](const msg::RobotModel& m, const auto&) {
                       std::lock_guard lock(mutex_);
@@ -54,11 +56,26 @@ FinishNode::FinishNode(cdds::Participant& participant, NodeParams params, std::o
                         std::lock_guard lock(mutex_);
                         commands_.push_back(c);
                       }),
-      trajectory_reader_(participant, topics::trajectory_status, [this](const msg::TrajectoryStatus& s, const auto&) {
-        if (s.source() != kSource) return;
-        std::lock_guard lock(mutex_);
-        trajectory_statuses_[s.request_id()] = s;
-      }) {
+      trajectory_reader_(participant, topics::trajectory_status,
+                         [this](const msg::TrajectoryStatus& s, const auto&) {
+                           if (s.source() != kSource) return;
+                           std::lock_guard lock(mutex_);
+                           trajectory_statuses_[s.request_id()] = s;
+                         }),
+      wrench_reader_(
+          participant, topics::ee_wrench,
+          [this](const msg::EndEffectorWrench& w, const auto&) {
+            if (!run_active_.load()) return;
+            const auto& f = w.wrench().force();
+            std::lock_guard lock(mutex_);
+            wrenches_.push_back(Wrench{w.stamp_ns(), Eigen::Vector3d(f.x(), f.y(), f.z())});
+            if (wrenches_.size() > kMaxMeasured) wrenches_.pop_front();
+          }),
+      safety_reader_(participant, topics::safety_state,
+                     [this](const msg::SafetyState& st, const auto&) {
+                       std::lock_guard lock(mutex_);
+                       safety_ = st;
+                     }) {
   status_.report(msg::SERVICE_STARTING, 0u, "waiting for the robot model");
 }
 
@@ -185,6 +202,13 @@ void FinishNode::refuse(const msg::FinishCommand& c, const std::string& why) {
 }
 
 void FinishNode::handle(const msg::FinishCommand& c) {
+  // A sender writes its command again until a status names it (the topic is volatile): each
+  // (request id, stamp, source) is taken once.
+  const CommandKey key{c.request_id(), c.stamp_ns(), c.source()};
+  if (std::find(taken_.begin(), taken_.end(), key) != taken_.end()) return;
+  taken_.push_back(key);
+  constexpr std::size_t kTakenKept = 64;
+  if (taken_.size() > kTakenKept) taken_.pop_front();
   if (c.verb() == msg::FINISH_ABORT) {
     if (run_) abort_run("aborted by " + (c.source().empty() ? std::string("a client") : c.source()));
     return;
@@ -199,7 +223,14 @@ void FinishNode::handle(const msg::FinishCommand& c) {
   if (run_) return refuse(c, "a run is in progress (request " + std::to_string(run_->request_id) + ")");
   if (c.verb() == msg::FINISH_SAND) {
     if (current_.task != Task::kSand) return refuse(c, "the arm carries no sanding tool (it sprays)");
-    return refuse(c, "sanding through the robot service is not in the DDS adapter yet; the sanding run works in the simulator without DDS (bench_surface_finish --sand; services/surface_finish README)");
+    try {
+      start_sand(c);
+    } catch (const std::exception& e) {
+      run_.reset();
+      run_active_.store(false);
+      refuse(c, e.what());
+    }
+    return;
   }
   if (current_.task != Task::kSpray) return refuse(c, "the arm carries no spraying tool (it sands)");
   try {
@@ -279,7 +310,26 @@ void FinishNode::start_spray(const msg::FinishCommand& c) {
   run.plan = plan_serpentine(*current_.reach, fit.wall, rect, tool, areas.roll, path, q_now,
                              &areas.posture_near(strokes.front().x, strokes.front().y_start));
   run.deposition = std::make_unique<SprayDeposition>(fit.wall, rect, tool, path.speed, static_cast<int>(run.plan.strokes.size()));
-  // One joint trajectory of the arm's joints.
+  {
+    std::lock_guard lock(mutex_);
+    measured_.clear();
+  }
+  run_active_.store(true);
+  send_trajectory(run, run.plan.samples.size() - 1);
+  char b[200];
+  std::snprintf(
+      b, sizeof b,
+      "request %u: spraying %s of area '%s': %zu strokes, %.1f s, wall %.3f m (scan, %d points)",
+      c.request_id(), rect.str().c_str(), area.id.c_str(), run.plan.strokes.size(),
+      run.plan.duration(), d, fit.inliers);
+  log_line(std::string("surface_finish: ") + b);
+  run_ = std::move(run);
+  publish(run_->request_id, msg::FINISH_RUNNING, "", &*run_);
+}
+
+void FinishNode::send_trajectory(Run& run, std::size_t last_sample) {
+  // One joint trajectory of the arm's joints: the plan's samples [0, last_sample], at rest at
+  // its end.
   const kinematics::Model& k = current_.model->kinematics();
   msg::JointTrajectoryCommand t;
   run.trajectory_id = next_trajectory_++;
@@ -289,33 +339,198 @@ void FinishNode::start_spray(const msg::FinishCommand& c) {
   t.source(kSource);
   const std::vector<int>& arm = current_.reach->arm_joints();
   for (int j : arm) t.joint_names().push_back(k.joint_names()[static_cast<std::size_t>(j)]);
-  for (const PathSample& s : run.plan.samples) {
+  for (std::size_t i = 0; i <= last_sample && i < run.plan.samples.size(); ++i) {
+    const PathSample& s = run.plan.samples[i];
     msg::JointTrajectorySample out;
     out.time(s.t);
     for (int j : arm) {
       out.position().push_back(s.q[j]);
-      out.velocity().push_back(s.qd[j]);
+      out.velocity().push_back(i == last_sample ? 0.0 : s.qd[j]);
     }
     t.samples().push_back(out);
   }
+  run.sent = std::chrono::steady_clock::now();
+  trajectories_.write(t);
+}
+
+void FinishNode::start_sand(const msg::FinishCommand& c) {
+  const double force = c.force();
+  if (!(force > 0.0) || !std::isfinite(force)) {
+    char b[120];
+    std::snprintf(b, sizeof b, "the force setpoint must be positive (got %g N)", force);
+    throw FinishError(b);
+  }
+  if (force > params_.sand_force + 1e-9) {
+    char b[200];
+    std::snprintf(b, sizeof b,
+                  "force %.1f N refused: the areas keep the joint torques within their continuous "
+                  "torques for up to "
+                  "%.1f N",
+                  force, params_.sand_force);
+    throw FinishError(b);
+  }
+  {
+    std::lock_guard lock(mutex_);
+    if (safety_ && safety_->mode() != msg::SAFETY_RUNNING) {
+      std::string causes;
+      for (const auto& cause : safety_->causes()) causes += (causes.empty() ? "" : ", ") + cause;
+      throw FinishError("the robot is safety-stopped (" + causes + ")");
+    }
+  }
+  const AreaMap& areas = *current_.areas;
+  const Area& area = areas.area(c.area());
+  const Rect rect = c.has_rect() ? reshape(area, Rect{c.x0(), c.x1(), c.y0(), c.y1()}) : area.rect;
+  const WallFit fit = measure_wall();
+  const double d = fit.wall.distance();
+  if (std::abs(d - areas.wall_distance) > params_.distance_tolerance) {
+    char b[200];
+    std::snprintf(b, sizeof b,
+                  "the wall is %.2f m from the base (scan), the areas need the base %.2f m +- %.2f "
+                  "m from it: move the base first",
+                  d, areas.wall_distance, params_.distance_tolerance);
+    throw FinishError(b);
+  }
+  std::optional<Measured> latest;
+  {
+    std::lock_guard lock(mutex_);
+    latest = latest_;
+  }
+  const Eigen::VectorXd q_now = q_of(*latest);
+  const ToolSpec tool = params_.sand;
+  PathParams path = params_.sand_path;
+  if (c.speed() > 0.0) path.speed = c.speed();
+  const auto strokes = serpentine_strokes(rect, tool, path.visible);
+  Run run;
+  run.request_id = c.request_id();
+  run.wall = fit.wall;
+  run.wall_distance = d;
+  run.plan = plan_serpentine(*current_.reach, fit.wall, rect, tool, areas.roll, path, q_now,
+                             &areas.posture_near(strokes.front().x, strokes.front().y_start));
+  SandParams sp = params_.sanding;
+  sp.force = force;
+  run.sand = std::make_unique<SandSequence>(run.plan, sp);
   {
     std::lock_guard lock(mutex_);
     measured_.clear();
+    wrenches_.clear();
   }
   run_active_.store(true);
-  run.sent = std::chrono::steady_clock::now();
-  trajectories_.write(t);
-  char b[200];
-  std::snprintf(b, sizeof b, "request %u: spraying %s of area '%s': %zu strokes, %.1f s, wall %.3f m (scan, %d points)",
-                c.request_id(), rect.str().c_str(), area.id.c_str(), run.plan.strokes.size(), run.plan.duration(), d,
-                fit.inliers);
+  send_trajectory(run, run.sand->approach_index());
+  run.last_status = std::chrono::steady_clock::now();
+  char b[220];
+  std::snprintf(b, sizeof b,
+                "request %u: sanding %s of area '%s' at %.1f N: %zu strokes, %.1f s, wall %.3f m "
+                "(scan, %d points)",
+                c.request_id(), rect.str().c_str(), area.id.c_str(), force, run.plan.strokes.size(),
+                run.plan.duration(), d, fit.inliers);
   log_line(std::string("surface_finish: ") + b);
   run_ = std::move(run);
   publish(run_->request_id, msg::FINISH_RUNNING, "", &*run_);
 }
 
+void FinishNode::follow_sand() {
+  Run& run = *run_;
+  SandSequence& seq = *run.sand;
+  std::deque<Wrench> wrenches;
+  std::optional<msg::TrajectoryStatus> ts;
+  std::optional<msg::SafetyState> safety;
+  {
+    std::lock_guard lock(mutex_);
+    wrenches.swap(wrenches_);
+    measured_.clear();
+    safety = safety_;
+    if (auto it = trajectory_statuses_.find(run.trajectory_id); it != trajectory_statuses_.end())
+      ts = it->second;
+  }
+  const auto now = std::chrono::steady_clock::now();
+  if (safety && safety->mode() != msg::SAFETY_RUNNING) {
+    std::string causes;
+    for (const auto& cause : safety->causes()) causes += (causes.empty() ? "" : ", ") + cause;
+    seq.stop("safety stop (" + causes + ")");
+    end_run(msg::FINISH_ABORTED, seq.reason());
+    return;
+  }
+  const double tick =
+      run.last_tick == std::chrono::steady_clock::time_point{}
+          ? 0.0
+          : std::min(0.1, std::chrono::duration<double>(now - run.last_tick).count());
+  run.last_tick = now;
+  run.silence = wrenches.empty() ? run.silence + tick : 0.0;
+  const Eigen::Vector3d& z = seq.normal();
+  if (seq.phase() == SandPhase::kMove) {
+    if (ts) seq.set_move_progress(ts->progress());
+    if (ts && ts->state() == msg::TRAJECTORY_SUCCEEDED) {
+      if (wrenches.empty()) return;  // the robot's time: from its next estimate
+      seq.start(static_cast<double>(wrenches.back().stamp_ns) * 1e-9);
+    } else if (ts &&
+               (ts->state() == msg::TRAJECTORY_ABORTED || ts->state() == msg::TRAJECTORY_REFUSED)) {
+      seq.stop("the robot stopped the move to the approach pose: " + ts->reason());
+      end_run(msg::FINISH_FAILED, seq.reason());
+      return;
+    } else if (!ts && now - run.sent > std::chrono::seconds(10)) {
+      seq.stop("the robot service did not answer the move's trajectory within 10 s");
+      end_run(msg::FINISH_FAILED, seq.reason());
+      return;
+    }
+  }
+  if (seq.phase() != SandPhase::kMove) {
+    if (run.silence > params_.wrench_timeout) {
+      char b[120];
+      std::snprintf(b, sizeof b,
+                    "no force estimate from the robot (concert/robot/ee_wrench) for %.1f s",
+                    params_.wrench_timeout);
+      seq.stop(b);
+      end_run(msg::FINISH_ABORTED, seq.reason());
+      return;
+    }
+    for (const Wrench& w : wrenches) {
+      const double t = static_cast<double>(w.stamp_ns) * 1e-9;
+      (void)seq.update(t);
+      seq.add_force(t, -w.force.dot(z));  // the force the disc pushes along z_ee
+      if (seq.finished()) break;
+    }
+    if (!wrenches.empty() && !seq.finished()) {
+      const SandCommand sc = seq.update(static_cast<double>(wrenches.back().stamp_ns) * 1e-9);
+      if (!seq.finished()) {
+        msg::CartesianImpedanceCommand m;
+        m.model_version(static_cast<std::uint32_t>(current_version_));
+        m.stamp_ns(now_ns());
+        m.source(kSource);
+        m.end_effector(current_.reach->tcp_frame());
+        m.target(model::dds::to_pose_msg(sc.target));
+        m.target_twist().linear().x(sc.velocity.x());
+        m.target_twist().linear().y(sc.velocity.y());
+        m.target_twist().linear().z(sc.velocity.z());
+        for (std::size_t i = 0; i < 6; ++i) {
+          m.stiffness()[i] = sc.stiffness[i];
+          m.damping()[i] = sc.damping[i];
+        }
+        m.admittance_axis(sc.admittance ? 2 : 255);  // the TCP's z
+        m.admittance_force(sc.force_setpoint);
+        m.admittance_gain(sc.admittance ? sc.admittance_gain : 0.0);
+        m.payload_mass(0.0);
+        cartesian_.write(m);
+      }
+    }
+  }
+  run.progress = seq.progress();
+  if (seq.phase() == SandPhase::kDone) {
+    end_run(msg::FINISH_SUCCEEDED, "");
+  } else if (seq.phase() == SandPhase::kAborted) {
+    end_run(msg::FINISH_ABORTED, seq.reason());
+  } else if (now - run.last_status > std::chrono::seconds(1)) {
+    run.last_status = now;
+    publish(run.request_id, msg::FINISH_RUNNING, std::string("sanding: ") + to_string(seq.phase()),
+            &run);
+  }
+}
+
 void FinishNode::follow_run() {
   Run& run = *run_;
+  if (run.sand) {
+    follow_sand();
+    return;
+  }
   std::deque<Measured> measured;
   std::optional<msg::TrajectoryStatus> ts;
   {
@@ -361,6 +576,43 @@ void FinishNode::follow_run() {
 void FinishNode::end_run(msg::FinishState state, const std::string& reason) {
   Run& run = *run_;
   run_active_.store(false);
+  if (run.sand) {
+    const SandSequence& seq = *run.sand;
+    // The arm from the Cartesian hold to a joint hold where it is (off the wall when done).
+    hold_here();
+    const std::string json = seq.report_json();
+    const bool strokes = std::any_of(seq.trace().begin(), seq.trace().end(),
+                                     [](const ForceSample& f) { return f.stroke; });
+    if (!params_.out_dir.empty()) {
+      try {
+        std::filesystem::create_directories(params_.out_dir);
+        const std::string stem = params_.out_dir + "/sand_" + std::to_string(run.request_id);
+        std::ofstream(stem + ".json") << json << "\n";
+        if (strokes)
+          write_force_png(seq.trace(), seq.params().force, seq.params().tolerance, stem + ".png");
+      } catch (const std::exception& e) {
+        log_line(std::string("surface_finish: cannot write the report: ") + e.what());
+      }
+    }
+    char b[260];
+    if (strokes) {
+      const ForceStats st = seq.stats();
+      std::snprintf(b, sizeof b,
+                    "request %u: %s: force (robot's estimate) mean %.2f N, min %.2f N, max %.2f N, "
+                    "within +-%.1f N for "
+                    "%.1f %% of %.1f s of strokes (%.2f s outside)",
+                    run.request_id, state == msg::FINISH_SUCCEEDED ? "done" : "stopped", st.mean,
+                    st.min, st.max, seq.params().tolerance, st.within_fraction * 100.0, st.duration,
+                    st.time_outside);
+    } else {
+      std::snprintf(b, sizeof b, "request %u: stopped before the strokes", run.request_id);
+    }
+    log_line(std::string("surface_finish: ") + b + (reason.empty() ? "" : " (" + reason + ")"));
+    if (state == msg::FINISH_SUCCEEDED) run.progress = 1.0;
+    publish(run.request_id, state, reason, &run, json);
+    run_.reset();
+    return;
+  }
   std::vector<double> xs;
   std::vector<bool> ups;
   for (const Stroke& s : run.plan.strokes) {
@@ -417,7 +669,11 @@ void FinishNode::hold_here() {
 }
 
 void FinishNode::abort_run(const std::string& why) {
-  hold_here();
+  if (run_ && run_->sand) {
+    run_->sand->stop(why);  // end_run holds the arm
+  } else {
+    hold_here();
+  }
   end_run(msg::FINISH_ABORTED, why);
 }
 

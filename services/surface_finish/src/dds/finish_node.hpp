@@ -4,7 +4,10 @@
 // "cannot finish: ..."), joint states, the lidars' planar scan (the wall and its normal) and the
 // robot's trajectory statuses in; commands in; the areas (latched) and every run's status and
 // report out. A spray run is executed as one joint trajectory through the robot service; the
-// deposition model is fed the TCP of every measured joint state.
+// deposition model is fed the TCP of every measured joint state. A sand run (SandSequence) is
+// a joint trajectory to the approach pose, then Cartesian impedance commands at the control
+// rate with the robot service's admittance along the TCP's z; the robot's wrench estimate
+// (concert/robot/ee_wrench) gives the statistics and the stops, the safety state stops it.
 //
 // DDS callbacks only queue; one control thread does the rest.
 #include <atomic>
@@ -17,11 +20,13 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <tuple>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 #include "surface_finish/areas.hpp"
 #include "surface_finish/deposition.hpp"
+#include "surface_finish/sand_sequence.hpp"
 #include "surface_finish/serpentine.hpp"
 #include "surface_finish/wall_fit.hpp"
 
@@ -33,7 +38,15 @@ struct NodeParams {
   PathParams path;
   ToolSpec spray{Task::kSpray, 0.3, 0.1, 0.1};   ///< 0.3 m standoff, 0.1 m coats (paper 6.2)
   ToolSpec sand{Task::kSand, 0.0, 0.23, 0.1};    ///< disc diameter: an estimate
-  double sand_force{30.0};          ///< [N] the sanding areas keep the torques for this force
+  double sand_force{
+      30.0};  ///< [N] the sanding areas keep the torques for this force (the largest taken)
+  /// Sanding path: 0.1 m/s strokes, no settling hold, the approach from 5 cm at 5 cm/s (as the
+  /// offline run, SandRunParams::path).
+  PathParams sand_path{0.1, 0.5, 0.02, 0.05, 0.05, 0.0, 0.0, 0.8};
+  SandParams sanding;          ///< the sequence (its force is the request's)
+  /// A sand run stops when no force estimate came for this long [s], counted over this node's
+  /// ticks (each at most 0.1 s: a stall of this process is not the robot's silence).
+  double wrench_timeout{2.0};
   double distance_tolerance{0.15};  ///< measured wall distance vs the working distance [m]
   double scan_max_age{2.0};         ///< [s]
   std::string out_dir;              ///< where each run's report JSON and PNG go ("" = nowhere)
@@ -72,6 +85,13 @@ class FinishNode {
     double progress{0.0};
     double wall_distance{0.0};
     std::chrono::steady_clock::time_point sent{};
+    std::unique_ptr<SandSequence> sand;  // a sand run (no deposition)
+    std::chrono::steady_clock::time_point last_tick{}, last_status{};
+    double silence{0.0};  // [s] without a force estimate (see NodeParams::wrench_timeout)
+  };
+  struct Wrench {
+    std::int64_t stamp_ns{0};
+    Eigen::Vector3d force{0.0, 0.0, 0.0};
   };
 
   void tick();
@@ -79,6 +99,9 @@ class FinishNode {
   void finish_preparation();
   void handle(const msg::FinishCommand& c);
   void start_spray(const msg::FinishCommand& c);
+  void start_sand(const msg::FinishCommand& c);
+  void follow_sand();
+  void send_trajectory(Run& run, std::size_t last_sample);
   void abort_run(const std::string& why);
   void follow_run();
   void end_run(msg::FinishState state, const std::string& reason);
@@ -96,6 +119,7 @@ class FinishNode {
   concert::dds::Writer<msg::FinishAreas> areas_writer_;
   concert::dds::Writer<msg::FinishStatus> status_writer_;
   concert::dds::Writer<msg::JointTrajectoryCommand> trajectories_;
+  concert::dds::Writer<msg::CartesianImpedanceCommand> cartesian_;
 
   std::mutex mutex_;  // the inbox below
   std::optional<msg::RobotModel> new_model_;
@@ -105,12 +129,17 @@ class FinishNode {
   std::optional<msg::LaserScan> scan_;
   std::chrono::steady_clock::time_point scan_seen_{};
   std::map<std::uint32_t, msg::TrajectoryStatus> trajectory_statuses_;
+  std::deque<Wrench> wrenches_;  // force estimates since the last tick, while a run is on (bounded)
+  std::optional<msg::SafetyState> safety_;
 
   std::uint64_t version_seen_{0};
   std::future<Prepared> preparing_;
   std::uint64_t preparing_version_{0};
   Prepared current_;
   std::uint64_t current_version_{0};
+  using CommandKey =
+      std::tuple<std::uint32_t, std::int64_t, std::string>;  // request id, stamp, source
+  std::deque<CommandKey> taken_;  // the commands taken (a resent one is ignored)
   std::optional<Run> run_;
   std::atomic<bool> run_active_{false};  // joint states are queued only while a run is on
   std::uint32_t next_trajectory_{0x46000001};
@@ -121,6 +150,8 @@ class FinishNode {
   concert::dds::Reader<msg::LaserScan> scan_reader_;
   concert::dds::Reader<msg::FinishCommand> command_reader_;
   concert::dds::Reader<msg::TrajectoryStatus> trajectory_reader_;
+  concert::dds::Reader<msg::EndEffectorWrench> wrench_reader_;
+  concert::dds::Reader<msg::SafetyState> safety_reader_;
 };
 
 }  // namespace concert::surface_finish::dds

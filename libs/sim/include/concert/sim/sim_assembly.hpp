@@ -20,6 +20,9 @@ struct SimulatedRobot {
   std::string source;           ///< assembly file
   std::vector<SensorMount> sensors;  ///< the sensors its modules carry (sensor frames of its model)
   std::vector<DrillBit> drill_bits;  ///< the bits of its drill end-effectors (their TCP links)
+  /// The links moved with its sanding tools (the subtree of the last joint moving each sanding
+  /// end-effector's TCP: the tool and its flange), for SimParams::sanding_disc_friction.
+  std::vector<std::string> sanding_links;
 };
 
 /// The simulated sensors of a model's sensor frames: cameras (RGB-D), lidars, sonars, IMUs;

@@ -35,6 +35,12 @@ struct SimParams {
   /// larger of the two geoms'). For a tool whose contact is not a dry block sliding on the
   /// wall, e.g. a running sanding disc (surface_finish). A name that is no link is an error.
   std::map<std::string, double> link_friction;
+  /// Sliding friction of the sanding tools' links (SimHardware's `sanding_links`, unless
+  /// link_friction names them): a running sanding disc, whose abrasive slides at the rim speed
+  /// omega R, drags against the stroke with about mu v / (omega R): 0.8 x 0.1 m/s / 12 m/s =
+  /// 0.007 for a 0.23 m disc at 1000 rpm and 0.1 m/s strokes (services/surface_finish README;
+  /// MuJoCo's disc does not spin). Negative: not applied (a standing disc, robot_friction).
+  double sanding_disc_friction{0.007};
   /// Floating (free) base: default true iff the model has steering+wheel legs.
   std::optional<bool> floating_base;
   Eigen::Vector3d base_position{0.0, 0.0, 0.0};  ///< [m]; z is computed for a floating base on the floor
@@ -63,8 +69,11 @@ class SimHardware final : public hardware::Hardware {
   /// params.sensors.enabled and delivered to the sink given to set_sensor_sink().
   /// `drill_bits`: the drill bits it carries (SimulatedRobot::drill_bits), which cut holes
   /// in the world's walls (drilling.hpp).
-  SimHardware(const std::string& urdf, World world, SimParams params = {}, std::vector<SensorMount> sensors = {},
-              std::vector<DrillBit> drill_bits = {});
+  /// `sanding_links`: the links of its sanding tools (SimulatedRobot::sanding_links), whose
+  /// contacts get SimParams::sanding_disc_friction.
+  SimHardware(const std::string& urdf, World world, SimParams params = {},
+              std::vector<SensorMount> sensors = {}, std::vector<DrillBit> drill_bits = {},
+              std::vector<std::string> sanding_links = {});
   ~SimHardware() override;
   SimHardware(const SimHardware&) = delete;
   SimHardware& operator=(const SimHardware&) = delete;
@@ -93,7 +102,8 @@ class SimHardware final : public hardware::Hardware {
   /// `sensors` and `drill_bits` are the new robot's (the old robot's sensors stop, the new
   /// ones start). Holes already drilled stay in the walls.
   bool swap_model(const std::string& urdf, std::vector<SensorMount> sensors = {},
-                  std::vector<DrillBit> drill_bits = {});
+                  std::vector<DrillBit> drill_bits = {},
+                  std::vector<std::string> sanding_links = {});
   /// Replaces the world the same way (keeps the robot state and the hardware generation).
   void set_world(const World& world);
   /// The latest world given (any thread).

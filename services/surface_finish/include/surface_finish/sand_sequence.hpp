@@ -1,0 +1,137 @@
+#pragma once
+// A sanding run through the robot service, as a sequence of what is commanded when (no DDS):
+// the planned serpentine's joint-space part (the move to the approach pose, 5 cm off the wall)
+// is one joint trajectory; from the approach pose on, Cartesian impedance targets of the
+// plan's TCP with the robot service's admittance along the TCP's z (into the wall):
+//
+//   approach   to the nominal surface along the plan (impedance only)
+//   contact    held at the first stroke's start, the force setpoint ramped from 0 (ramp_time),
+//              then held (start_delay)
+//   strokes    the serpentine in contact, the force held by the admittance along z_ee, the
+//              other directions under impedance
+//   unload     held at the last stroke's end, the setpoint ramped back to 0 (unload_time)
+//   retreat    admittance off, the plan's retreat off the wall
+//
+// The time is the robot's (the stamps of its estimates). The force samples (the robot's
+// estimate from the joint torques, the force pushed along z_ee) give the statistics of the
+// stroke time and stop the run when far outside the band: above abort_force for abort_time, or
+// (while stroking) below lost_contact_fraction x setpoint for lost_contact_time; the run then
+// leaves the wall straight along the normal (leaving) and ends aborted.
+#include <Eigen/Geometry>
+#include <array>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "surface_finish/admittance.hpp"
+#include "surface_finish/serpentine.hpp"
+
+namespace concert::surface_finish {
+
+struct SandParams {
+  double force{30.0};       ///< setpoint [N]
+  double tolerance{3.0};    ///< band of the statistics [N]
+  double ramp_time{2.0};    ///< setpoint ramp from 0 in contact [s]
+  double start_delay{1.0};  ///< held at the setpoint before the strokes [s]
+  double unload_time{1.0};  ///< setpoint ramp back to 0 before the retreat [s]
+  /// Admittance compliance of the robot service's law along z_ee [m/(N s)]: 0.01, the offline
+  /// run's (a 15 /s force loop on the 1.5 kN/m impedance).
+  double admittance_gain{0.01};
+  /// Cartesian impedance: translation [N/m], rotation [N m/rad], critically damped (damping
+  /// ratio) for 10 kg and 0.5 kg m^2, as the offline run (SandRunParams).
+  double stiffness{1500.0}, rot_stiffness{150.0}, damping_ratio{1.0};
+  /// Stop: the estimate above this for abort_time [N]; NaN: 2 x force + 20 N.
+  double abort_force{std::numeric_limits<double>::quiet_NaN()};
+  double abort_time{0.05};             ///< [s]
+  double lost_contact_fraction{0.25};  ///< of the setpoint, while stroking
+  double lost_contact_time{1.0};       ///< [s]
+  double leave_time{1.0};  ///< after a stop: back off the wall by the plan's approach over this [s]
+};
+
+enum class SandPhase {
+  kMove,
+  kApproach,
+  kContact,
+  kStrokes,
+  kUnload,
+  kRetreat,
+  kLeaving,
+  kDone,
+  kAborted
+};
+
+const char* to_string(SandPhase phase);
+
+/// What to command the robot now (Cartesian impedance of the TCP, base frame).
+struct SandCommand {
+  Eigen::Isometry3d target{Eigen::Isometry3d::Identity()};
+  Eigen::Vector3d velocity{0.0, 0.0, 0.0};  ///< the path's TCP velocity [m/s]
+  std::array<double, 6> stiffness{};
+  std::array<double, 6> damping{};
+  bool admittance{false};      ///< along the TCP's z (into the wall)
+  double force_setpoint{0.0};  ///< [N], pushed along z_ee
+  double admittance_gain{0.0};
+};
+
+class SandSequence {
+ public:
+  /// Throws FinishError for a force <= 0 or not finite, bad parameters, or a plan without
+  /// approach pose or stroke (`approach`: the plan's PathParams::approach).
+  SandSequence(SerpentinePlan plan, SandParams params);
+
+  [[nodiscard]] const SerpentinePlan& plan() const { return plan_; }
+  [[nodiscard]] const SandParams& params() const { return params_; }
+  /// The plan's samples [0, approach_index()] are the joint move to the approach pose.
+  [[nodiscard]] std::size_t approach_index() const { return i_app_; }
+  /// The TCP's z (into the wall), base frame.
+  [[nodiscard]] const Eigen::Vector3d& normal() const { return z_ee_; }
+
+  /// The arm is at the approach pose at robot time t [s]: the Cartesian phases begin.
+  void start(double t);
+  /// Advances the phases to robot time t and returns what to command (valid from kApproach to
+  /// kLeaving; kMove: the joint trajectory runs, nothing else).
+  SandCommand update(double t);
+  /// One estimate sample: the force pushed along z_ee at robot time t [N]. Recorded (stroke
+  /// samples give the statistics), checked against the stop limits.
+  void add_force(double t, double pushed);
+  /// Stops now without moving (e-stop, safety stop, the robot's refusal): kAborted.
+  void stop(const std::string& reason);
+
+  [[nodiscard]] SandPhase phase() const { return phase_; }
+  [[nodiscard]] bool finished() const {
+    return phase_ == SandPhase::kDone || phase_ == SandPhase::kAborted;
+  }
+  [[nodiscard]] const std::string& reason() const { return reason_; }
+  /// Executed fraction of the plan's time (0 during the joint move) [0, 1].
+  [[nodiscard]] double progress() const;
+  /// Sets the joint move's progress (the robot's trajectory status) [0, 1].
+  void set_move_progress(double p) { move_progress_ = p; }
+  [[nodiscard]] const std::vector<ForceSample>& trace() const { return trace_; }
+  /// The statistics of the stroke samples; throws FinishError when there is none.
+  [[nodiscard]] ForceStats stats() const;
+  /// JSON of the run (state, reason, plan, statistics in N, s, %).
+  [[nodiscard]] std::string report_json() const;
+
+ private:
+  [[nodiscard]] double abort_force() const;
+  [[nodiscard]] const PathSample& at(double plan_t, Eigen::Vector3d& p, Eigen::Vector3d& v) const;
+  [[nodiscard]] bool stroking(double t) const;
+  void leave(const std::string& reason);
+
+  SerpentinePlan plan_;
+  SandParams params_;
+  std::size_t i_app_{0}, i_wall_{0}, i_last_{0};
+  Eigen::Vector3d z_ee_{0.0, 0.0, 1.0};
+  SandPhase phase_{SandPhase::kMove};
+  double phase_start_{0.0};  // robot time the phase began
+  double now_{0.0};
+  double plan_t_{0.0};
+  double move_progress_{0.0};
+  double over_since_{-1.0}, under_since_{-1.0};
+  Eigen::Isometry3d leave_from_{Eigen::Isometry3d::Identity()};
+  SandCommand last_;
+  std::string reason_;
+  std::vector<ForceSample> trace_;
+};
+
+}  // namespace concert::surface_finish
