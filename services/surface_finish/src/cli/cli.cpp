@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "concert/common/resend.hpp"
 #include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/participant.hpp"
@@ -173,14 +174,16 @@ int run_request(msg::FinishVerb verb, const RunOptions& o, std::ostream& out, st
   // a status names the request (the service takes a request it has seen, same id and stamp,
   // once). --no-wait writes it once.
   std::optional<msg::FinishStatus> first;
-  do {
-    commands.write(c);
-    const auto next = std::min(deadline, Clock::now() + std::chrono::seconds(1));
-    while (!o.no_wait && !first && Clock::now() < next) {
-      const auto s = statuses.wait(left_until(next));
-      if (s && s->request_id() == c.request_id()) first = s;
-    }
-  } while (!o.no_wait && !first && left_until(deadline).count() > 0);
+  resend_until_answered(
+      [&] { commands.write(c); },
+      [&](Clock::time_point until) {
+        while (!o.no_wait && !first && Clock::now() < until) {
+          const auto s = statuses.wait(left_until(until));
+          if (s && s->request_id() == c.request_id()) first = s;
+        }
+        return o.no_wait || first.has_value();
+      },
+      deadline);
   if (!o.dds.json) out << "request " << c.request_id() << " sent (" << name << " area '" << o.area << "')" << std::endl;
   if (o.no_wait) return 0;
   if (!first) {

@@ -203,12 +203,8 @@ void FinishNode::refuse(const msg::FinishCommand& c, const std::string& why) {
 
 void FinishNode::handle(const msg::FinishCommand& c) {
   // A sender writes its command again until a status names it (the topic is volatile): each
-  // (request id, stamp, source) is taken once.
-  const CommandKey key{c.request_id(), c.stamp_ns(), c.source()};
-  if (std::find(taken_.begin(), taken_.end(), key) != taken_.end()) return;
-  taken_.push_back(key);
-  constexpr std::size_t kTakenKept = 64;
-  if (taken_.size() > kTakenKept) taken_.pop_front();
+  // (request id, stamp) is taken once.
+  if (!taken_.first_time(c.request_id(), c.stamp_ns())) return;
   if (c.verb() == msg::FINISH_ABORT) {
     if (run_) abort_run("aborted by " + (c.source().empty() ? std::string("a client") : c.source()));
     return;

@@ -22,6 +22,7 @@
 #include <string>
 #include <tuple>
 
+#include "concert/common/command_once.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
 #include "surface_finish/areas.hpp"
@@ -137,9 +138,7 @@ class FinishNode {
   std::uint64_t preparing_version_{0};
   Prepared current_;
   std::uint64_t current_version_{0};
-  using CommandKey =
-      std::tuple<std::uint32_t, std::int64_t, std::string>;  // request id, stamp, source
-  std::deque<CommandKey> taken_;  // the commands taken (a resent one is ignored)
+  concert::CommandOnce taken_;  // (request id, stamp) of the commands taken (a resent one is ignored)
   std::optional<Run> run_;
   std::atomic<bool> run_active_{false};  // joint states are queued only while a run is on
   std::uint32_t next_trajectory_{0x46000001};
