@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <charconv>
 #include <set>
 #include <utility>
@@ -192,13 +193,18 @@ void Map::integer_value(std::string_view key, long long& value, long long min, l
   record(*state_, path(key), node, before, std::to_string(value));
 }
 
-void Map::duration_value(std::string_view key, double& seconds, Range range, double tick_s) {
+void Map::duration_value(std::string_view key, double& seconds, Range range, double tick_s, double max_s) {
   const YAML::Node node = lookup(*state_, index_, key);
   const std::string before = text_of(seconds);
   if (node && !node.IsNull()) {
     const double v = scalar_number(*this, key, node, range, "duration in seconds");
     if (v > 0.0 && v < tick_s / 2) {
       fail(key, "expected a duration of at least " + text_of(tick_s) + " s, got " + got(node));
+    }
+    // Converting a longer one to an integer count of ticks is undefined (found by fuzz_params:
+    // 1e56 s into nanoseconds). max_s is the duration type's largest, rounded up as a double.
+    if (std::abs(v) >= max_s) {
+      fail(key, "expected a duration shorter than " + text_of(max_s) + " s, got " + got(node));
     }
     seconds = v;
   }

@@ -120,6 +120,10 @@ TEST(Config, WrongValuesNameFileKeyExpectationAndLine) {
   EXPECT_EQ(error_of("name: ''\n"), "robot.yaml: name: expected a non-empty string (line 1)");
   EXPECT_EQ(error_of("timeout: 0.0001\n"),
             "robot.yaml: timeout: expected a duration of at least 0.001 s, got '0.0001' (line 1)");
+  // Longer than the duration type holds: converting it would be undefined (fuzz_params).
+  const std::string too_long = error_of("timeout: 1e300\n");
+  EXPECT_EQ(too_long.rfind("robot.yaml: timeout: expected a duration shorter than ", 0), 0u) << too_long;
+  EXPECT_NE(too_long.find(" s, got '1e300' (line 1)"), std::string::npos) << too_long;
   EXPECT_EQ(error_of("sim: 5\n"),
             "robot.yaml: sim: expected a map of parameters, got '5' (line 1)");
   EXPECT_EQ(error_of("- a\n- b\n"), "robot.yaml: expected a map of parameters, got a list");

@@ -84,11 +84,13 @@ class Map {
   /// One of `choices`.
   void choice(std::string_view key, std::string& value, const std::vector<std::string>& choices);
   /// A duration given in seconds in the file, each within `seconds`; a positive value shorter
-  /// than one tick of Duration is an error.
+  /// than one tick of Duration, or one longer than Duration holds (292 years in nanoseconds),
+  /// is an error.
   template <class Duration>
   void duration(std::string_view key, Duration& value, Range seconds = Range::non_negative()) {
     double s = std::chrono::duration<double>(value).count();
-    duration_value(key, s, seconds, std::chrono::duration<double>(Duration(1)).count());
+    duration_value(key, s, seconds, std::chrono::duration<double>(Duration(1)).count(),
+                   std::chrono::duration<double>(Duration::max()).count());
     if constexpr (std::chrono::treat_as_floating_point_v<typename Duration::rep>) {
       value = std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s));
     } else {
@@ -118,7 +120,7 @@ class Map {
   Map(std::shared_ptr<detail::State> state, size_t index)
       : state_(std::move(state)), index_(index) {}
   void integer_value(std::string_view key, long long& value, long long min, long long max);
-  void duration_value(std::string_view key, double& seconds, Range range, double tick_s);
+  void duration_value(std::string_view key, double& seconds, Range range, double tick_s, double max_s);
 
   std::shared_ptr<detail::State> state_;
   size_t index_;
