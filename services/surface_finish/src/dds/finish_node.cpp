@@ -277,24 +277,36 @@ WallFit FinishNode::measure_wall() {
   return fit_wall(pts, current_.reach->standing_height());
 }
 
-void FinishNode::start_spray(const msg::FinishCommand& c) {
-  const AreaMap& areas = *current_.areas;
-  const Area& area = areas.area(c.area());
-  const Rect rect = c.has_rect() ? reshape(area, Rect{c.x0(), c.x1(), c.y0(), c.y1()}) : area.rect;
+WallFit FinishNode::measure_wall_for(const AreaMap& areas) {
   const WallFit fit = measure_wall();
   const double d = fit.wall.distance();
   if (std::abs(d - areas.wall_distance) > params_.distance_tolerance) {
     char b[200];
-    std::snprintf(b, sizeof b, "the wall is %.2f m from the base (scan), the areas need the base %.2f m +- %.2f m from it: move the base first",
+    std::snprintf(b, sizeof b,
+                  "the wall is %.2f m from the base (scan), the areas need the base %.2f m +- %.2f "
+                  "m from it: move the base first",
                   d, areas.wall_distance, params_.distance_tolerance);
     throw FinishError(b);
   }
+  return fit;
+}
+
+Eigen::VectorXd FinishNode::q_now_measured() {
   std::optional<Measured> latest;
   {
     std::lock_guard lock(mutex_);
     latest = latest_;
   }
-  const Eigen::VectorXd q_now = q_of(*latest);
+  return q_of(*latest);
+}
+
+void FinishNode::start_spray(const msg::FinishCommand& c) {
+  const AreaMap& areas = *current_.areas;
+  const Area& area = areas.area(c.area());
+  const Rect rect = c.has_rect() ? reshape(area, Rect{c.x0(), c.x1(), c.y0(), c.y1()}) : area.rect;
+  const WallFit fit = measure_wall_for(areas);
+  const double d = fit.wall.distance();
+  const Eigen::VectorXd q_now = q_now_measured();
   ToolSpec tool = params_.spray;
   PathParams path = params_.path;
   if (c.speed() > 0.0) path.speed = c.speed();
@@ -376,22 +388,9 @@ void FinishNode::start_sand(const msg::FinishCommand& c) {
   const AreaMap& areas = *current_.areas;
   const Area& area = areas.area(c.area());
   const Rect rect = c.has_rect() ? reshape(area, Rect{c.x0(), c.x1(), c.y0(), c.y1()}) : area.rect;
-  const WallFit fit = measure_wall();
+  const WallFit fit = measure_wall_for(areas);
   const double d = fit.wall.distance();
-  if (std::abs(d - areas.wall_distance) > params_.distance_tolerance) {
-    char b[200];
-    std::snprintf(b, sizeof b,
-                  "the wall is %.2f m from the base (scan), the areas need the base %.2f m +- %.2f "
-                  "m from it: move the base first",
-                  d, areas.wall_distance, params_.distance_tolerance);
-    throw FinishError(b);
-  }
-  std::optional<Measured> latest;
-  {
-    std::lock_guard lock(mutex_);
-    latest = latest_;
-  }
-  const Eigen::VectorXd q_now = q_of(*latest);
+  const Eigen::VectorXd q_now = q_now_measured();
   const ToolSpec tool = params_.sand;
   PathParams path = params_.sand_path;
   if (c.speed() > 0.0) path.speed = c.speed();

@@ -111,6 +111,10 @@ class FinishNode {
   void refuse(const msg::FinishCommand& c, const std::string& why);
   [[nodiscard]] Eigen::VectorXd q_of(const Measured& m) const;
   [[nodiscard]] WallFit measure_wall();
+  /// measure_wall(), refused (FinishError) unless the wall is where `areas` were computed for.
+  [[nodiscard]] WallFit measure_wall_for(const AreaMap& areas);
+  /// The arm's joints from the latest joint state (the caller checked there is one).
+  [[nodiscard]] Eigen::VectorXd q_now_measured();
   void hold_here();
   void log_line(const std::string& line);
 
