@@ -189,6 +189,11 @@ TEST(Planner, ClearErrorsForBadRequests) {
   EXPECT_EQ(bad_tool.status, Status::kInvalidRequest);
   EXPECT_NE(bad_tool.reason.find("sander_E"), std::string::npos) << bad_tool.reason;
   EXPECT_EQ(planner.plan(req, Eigen::VectorXd::Zero(4), {}).status, Status::kInvalidStart);
+  PlanRequest nan_tip = req;
+  nan_tip.tip_distance = std::nan("");
+  const PlanResult bad_tip = planner.plan(nan_tip, start, {});
+  EXPECT_EQ(bad_tip.status, Status::kInvalidRequest);
+  EXPECT_NE(bad_tip.reason.find("tip_distance"), std::string::npos) << bad_tip.reason;
 
   // Start state in collision: the base stands inside the wall.
   Environment env(params.octomap_resolution);
@@ -205,6 +210,89 @@ TEST(Planner, ClearErrorsForBadRequests) {
   broken.urdf = "<robot name=\"x\"/>";
   EXPECT_THROW(planner.set_model(broken), PlannerError);
   EXPECT_EQ(planner.model_version(), 1u);
+}
+
+// The drill's hole postures (PlanRequest::tip_distance): the bit's tip, not the camera, goes on
+// the hole's axis, so the posture checked against the torque limits with the drilling force is
+// the one drilled from. With the camera on the axis the bit stood 0.11 m beside the hole (the
+// drill module's camera sits above the bit), and the alignment's Cartesian move reached out to
+// an unchecked posture: on morphology A the shoulder J2_E then needed its peak torque in the
+// BIM scenario and the safety layer stopped the robot.
+TEST(Planner, ATipTaskPutsTheBitOnTheHolesAxisAndChecksItsTorques) {
+  Params params = generous(23);
+  auto planner = planner_at_site(params, 'a', 3);
+  const auto model = planner->model();
+  const Eigen::VectorXd start = start_state(*model);
+  const Eigen::Isometry3d hole = fixtures::drilling_area(2.2, 0.1, 1.2);
+  const Eigen::Vector3d n = hole.linear().col(2);
+  const EndEffectorInfo& tool = model->tool("");
+  const auto lateral = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d d = p - hole.translation();
+    return (d - d.dot(n) * n).norm();
+  };
+  for (const bool tip : {false, true}) {
+    SCOPED_TRACE(tip ? "tip task" : "camera task");
+    PlanRequest req{9, 3, "", {{hole}}};
+    if (tip) req.tip_distance = 0.07;
+    else req.camera_distance = 0.23;
+    const PlanResult res = planner->plan(req, start, {});
+    ASSERT_EQ(res.status, Status::kSucceeded) << res.reason;
+    const Eigen::VectorXd end = model->to_full(res.goals[0].trajectory.points.back().q, start);
+    const Eigen::Isometry3d bit = model->link_pose(end, tool.frame);
+    const Eigen::Isometry3d camera = model->link_pose(end, model->camera_frame(tool));
+    if (tip) {
+      EXPECT_LT(lateral(bit.translation()), 5e-3) << "the bit is off the hole's axis";
+      EXPECT_NEAR((bit.translation() - hole.translation()).dot(n), 0.07, 5e-3);
+      EXPECT_GT(bit.linear().col(2).dot(-n), std::cos(5e-3)) << "the bit does not point into the wall";
+      // The camera looks along the bit from beside it.
+      EXPECT_GT(lateral(camera.translation()), 0.08);
+    } else {
+      EXPECT_LT(lateral(camera.translation()), 5e-3);
+      EXPECT_GT(lateral(bit.translation()), 0.08) << "the camera task leaves the bit beside the hole";
+    }
+    // The posture holds with the drilling force on the bit.
+    StateChecker exact(model, environment_of(site(2.2), params), params, 0.0);
+    const Validity v = exact.check(end, tool.frame);
+    EXPECT_TRUE(v.valid()) << to_string(v.constraint) << ": " << v.detail;
+  }
+  // With the bit's reach: the arm's torques hold where the bit ends, 0.1 m on into the wall,
+  // the base standing (the torques computed here by the checker at that posture).
+  PlanRequest reach{11, 3, "", {{hole}}};
+  reach.tip_distance = 0.07;
+  reach.tip_reach = 0.1;
+  const PlanResult reached = planner->plan(reach, start, {});
+  ASSERT_EQ(reached.status, Status::kSucceeded) << reached.reason;
+  const Eigen::VectorXd posture = model->to_full(reached.goals[0].trajectory.points.back().q, start);
+  const std::optional<Eigen::VectorXd> in_hole = reached_posture(*model, posture, tool.frame, -n, 0.1);
+  ASSERT_TRUE(in_hole.has_value());
+  const Eigen::Isometry3d bit = model->link_pose(*in_hole, tool.frame);
+  EXPECT_NEAR((bit.translation() - hole.translation()).dot(n), -0.03, 1e-3) << "the bit is not 3 cm into the wall";
+  EXPECT_LT(lateral(bit.translation()), 1e-3);
+  EXPECT_TRUE(model->to_planned(*in_hole).head(3).isApprox(model->to_planned(posture).head(3)))
+      << "the base moved";
+  StateChecker torques(model, environment_of(site(2.2), params), params, 0.0);
+  for (const std::string& contact : {tool.frame, std::string()}) {
+    const Eigen::VectorXd tau = torques.required_torques(*in_hole, contact);
+    for (Eigen::Index i = 0; i < tau.size(); ++i) {
+      const double limit = model->torque_limits()[i];
+      if (limit > 0.0) {
+        EXPECT_LE(std::abs(tau[i]), limit * params.torque_margin) << "joint " << i << contact;
+      }
+    }
+  }
+  // A reach the arm cannot make is refused with the reason.
+  reach.tip_reach = 0.9;
+  const PlanResult too_far = planner->plan(reach, start, {});
+  EXPECT_EQ(too_far.status, Status::kUnreachable);
+  EXPECT_NE(too_far.reason.find("bit reach x"), std::string::npos) << too_far.reason;
+  reach.tip_reach = -0.1;
+  EXPECT_EQ(planner->plan(reach, start, {}).status, Status::kInvalidRequest);
+
+  PlanRequest unreachable{10, 3, "", {{fixtures::drilling_area(2.2, 0.0, 6.0)}}};
+  unreachable.tip_distance = 0.07;
+  const PlanResult far = planner->plan(unreachable, start, {});
+  EXPECT_EQ(far.status, Status::kUnreachable);
+  EXPECT_NE(far.reason.find("tip 'tcp_E'"), std::string::npos) << far.reason;
 }
 
 TEST(Planner, ObstacleFromAPointCloudIsAvoided) {

@@ -43,6 +43,14 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
 std::pair<double, double> task_error(const PlanningModel& model, const Params& params, const EndEffectorInfo& tool,
                                      const Eigen::VectorXd& q_full, const Eigen::Isometry3d& area);
 
+/// The full q with `frame` moved `reach` [m] along the world direction `axis` (unit), its
+/// orientation kept, by the arm joints alone within their limits (damped least squares; the
+/// base and every other joint stand); nullopt when the arm cannot get within 0.1 mm and 0.1 mrad.
+/// The drilling posture's reach (Params::tip_reach): where the bit ends in the hole.
+std::optional<Eigen::VectorXd> reached_posture(const PlanningModel& model, const Eigen::VectorXd& q_full,
+                                               const std::string& frame, const Eigen::Vector3d& axis,
+                                               double reach);
+
 /// The planner of the planner service. Thread-safe: set_model/set_environment may come from
 /// one thread while plan() runs in another (plan() uses the model it started with).
 class Planner {

@@ -82,6 +82,10 @@ class PlanningModel {
   [[nodiscard]] const EndEffectorInfo& tool(const std::string& name) const;
   /// Frame of the camera sensor on a tool; throws PlannerError naming what the tool carries.
   [[nodiscard]] std::string camera_frame(const EndEffectorInfo& tool) const;
+  /// Frame the posture task places: the tool's TCP frame when `tip`, else its camera frame.
+  [[nodiscard]] std::string task_frame(const EndEffectorInfo& tool, bool tip) const {
+    return tip ? tool.frame : camera_frame(tool);
+  }
 
   /// World pose of every link (links() order) for a full q [m, rad].
   void link_poses(const Eigen::VectorXd& q_full, std::vector<Eigen::Isometry3d>& poses) const;

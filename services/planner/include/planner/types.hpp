@@ -50,6 +50,12 @@ struct Params {
   double base_range = 3.0;           ///< base x, y sampled within start +- this [m]
   bool fixed_base = false;           ///< per request (PlanRequest::fixed_base): the base keeps its start pose
   double base_travel = 0.0;          ///< per request (PlanRequest::base_travel) [m and rad]; 0: no bound
+  /// per request (PlanRequest::tip_distance > 0): the task puts the tool's tip (its TCP frame)
+  /// at camera_distance on the area's normal, z along -normal, instead of its camera
+  bool tip_task = false;
+  /// per request (PlanRequest::tip_reach), with tip_task: the static torques are also checked
+  /// with the tip moved this far [m] along the task axis (into the wall), the base standing
+  double tip_reach = 0.0;
 
   // Planning. Time budgets are CPU seconds of the planning thread, not wall seconds, so a plan
   // does not depend on what else loads the machine.
@@ -155,6 +161,17 @@ struct PlanRequest {
   /// Camera frame to each area along its normal [m]; 0: Params::camera_distance. The drill
   /// service asks for the camera close to the wall to put the bit at a hole.
   double camera_distance = 0.0;
+  /// > 0: the tool's tip (its TCP frame), not its camera, goes this far [m] in front of each
+  /// area on its normal, z along -normal; camera_distance is then unused. The drill service's
+  /// hole postures: the posture the planner checks (torques with the drilling force, clearance)
+  /// is then the one the bit drills from. With the camera on the hole's normal instead, the
+  /// bit stood beside it (the drill's camera is 0.11 m off the bit) and the alignment's
+  /// Cartesian move reached out to a posture nobody had checked: on morphology A the shoulder
+  /// J2_E then needed its peak torque and the safety layer stopped the robot.
+  double tip_distance = 0.0;
+  /// With tip_distance: how far [m] the bit goes on from the posture along -normal (to the wall
+  /// and into it); the static torques are checked there too, the base standing. 0: not checked.
+  double tip_reach = 0.0;
   /// The base keeps its start pose: only the arm moves (the drill service's hole postures:
   /// a base that moves lets odometry drift between holes).
   bool fixed_base = false;

@@ -23,6 +23,8 @@
 #include <map>
 #include <optional>
 #include <random>
+#include <sstream>
+#include <string>
 
 #include "cpu_clock.hpp"
 #include "planner/planner.hpp"
@@ -49,6 +51,75 @@ double manipulability(const PlanningModel& model, kinematics::Data& data,
   return std::sqrt(std::max(0.0, (j * j.transpose()).determinant()));
 }
 
+}  // namespace
+
+std::optional<Eigen::VectorXd> reached_posture(const PlanningModel& model, const Eigen::VectorXd& q_full,
+                                               const std::string& frame, const Eigen::Vector3d& axis,
+                                               double reach) {
+  const auto& idx = model.planned_indices();
+  const auto arm = static_cast<Eigen::Index>(idx.size()) - 3;
+  kinematics::Data data = model.kinematics().make_data();
+  Eigen::VectorXd q = q_full;
+  Eigen::Isometry3d target = model.link_pose(q, frame);
+  target.translation() += reach * axis;
+  Eigen::MatrixXd j(6, arm);
+  Eigen::Matrix<double, 6, 1> e;
+  for (int it = 0; it < 50; ++it) {
+    const Eigen::Isometry3d now = model.link_pose(q, frame);
+    e.head<3>() = target.translation() - now.translation();
+    const Eigen::AngleAxisd turn(target.linear() * now.linear().transpose());
+    e.tail<3>() = turn.angle() * turn.axis();
+    if (e.head<3>().norm() < 1e-4 && e.tail<3>().norm() < 1e-4) return q;
+    const Eigen::MatrixXd j_full = model.kinematics().frame_jacobian(data, q, frame);
+    for (Eigen::Index i = 0; i < arm; ++i) j.col(i) = j_full.col(idx[static_cast<std::size_t>(i) + 3]);
+    Eigen::Matrix<double, 6, 6> jjt = j * j.transpose();
+    jjt.diagonal().array() += 1e-4;
+    const Eigen::VectorXd step = j.transpose() * jjt.ldlt().solve(e);
+    for (Eigen::Index i = 0; i < arm; ++i) {
+      const int fi = idx[static_cast<std::size_t>(i) + 3];
+      q[fi] = std::clamp(q[fi] + step[i], model.lower()[i + 3], model.upper()[i + 3]);
+    }
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// The drill's reach beyond a drilling posture (Params::tip_reach): the bit moved that far along
+// the task axis (reached_posture). Returns why the static torques there (with and without the
+// contact force, within Params::torque_margin of the continuous torque) fail, or "" when they
+// hold. The posture is where the planner can check collisions; the bit then goes into the wall,
+// where only the arm's load can be checked. Without this, morphology A's shoulder J2_E went past
+// its continuous torque while drilling from postures that held it at 0.7 of it.
+std::string reach_torque_failure(const PlanningModel& model, StateChecker& checker,
+                                 const Eigen::VectorXd& full, const EndEffectorInfo& tool,
+                                 const Task& task, const Params& params) {
+  const auto& idx = model.planned_indices();
+  const std::optional<Eigen::VectorXd> reached =
+      reached_posture(model, full, tool.frame, task.axis, params.tip_reach);
+  if (!reached) {
+    std::ostringstream s;
+    s << "the bit cannot reach " << params.tip_reach << " m along the hole from the posture";
+    return s.str();
+  }
+  const Eigen::VectorXd& q = *reached;
+  const Eigen::VectorXd& limit = model.torque_limits();
+  for (const std::string& contact : {tool.frame, std::string()}) {
+    const Eigen::VectorXd tau = checker.required_torques(q, contact);
+    for (std::size_t i = 3; i < idx.size(); ++i) {
+      const int fi = idx[i];
+      if (limit[fi] > 0.0 && std::abs(tau[fi]) > params.torque_margin * limit[fi]) {
+        std::ostringstream s;
+        s << model.joint_names()[i] << " needs " << std::abs(tau[fi]) << " N m > "
+          << params.torque_margin * limit[fi] << " N m continuous with the bit "
+          << params.tip_reach << " m further" << (contact.empty() ? "" : " (with contact force)");
+        return s.str();
+      }
+    }
+  }
+  return {};
+}
+
 // Turned seeds: the first arm joint turned by +-kTurnStep, +-2 kTurnStep, ... (kTurns each way).
 // On one of the benchmark's low areas beside a pillar (seed 7, #01; A) 34 of 234 turned
 // bare-wall postures converged to valid ones, 1 of 150 random arm postures.
@@ -61,7 +132,7 @@ std::pair<double, double> task_error(const PlanningModel& model, const Params& p
                                      const EndEffectorInfo& tool, const Eigen::VectorXd& q_full,
                                      const Eigen::Isometry3d& area) {
   const Task task = make_task(params, area);
-  const Eigen::Isometry3d pose = model.link_pose(q_full, model.camera_frame(tool));
+  const Eigen::Isometry3d pose = model.link_pose(q_full, model.task_frame(tool, params.tip_task));
   const double angle = std::acos(std::clamp(pose.linear().col(2).dot(task.axis), -1.0, 1.0));
   return {(pose.translation() - task.position).norm(), angle};
 }
@@ -93,7 +164,7 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   const double yaw_hint = start[2];
 
   PostureProblem problem(model, params, &tool, q_start_full, task, checker.distance_field());
-  const std::string camera = model.camera_frame(tool);
+  const std::string camera = model.task_frame(tool, params.tip_task);
   kinematics::Data data = model.kinematics().make_data();
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -204,6 +275,13 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
       reject(to_string(v.constraint), v.detail);
       continue;
     }
+    if (params.tip_task && params.tip_reach > 0.0) {
+      const std::string why = reach_torque_failure(model, checker, full, tool, task, params);
+      if (!why.empty()) {
+        reject(why.rfind("the bit cannot reach", 0) == 0 ? "bit reach" : to_string(Constraint::kTorqueLimit), why);
+        continue;
+      }
+    }
     valid_found += 1;
     out.valid.push_back(q);
     const double cost =
@@ -219,7 +297,7 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   if (out.found) {
     out.reason.clear();
   } else if (on_task == 0 && rejections.size() == 1 && rejections.count("off the task") > 0) {
-    out.reason = "camera frame cannot reach the task pose (kinematically unreachable)";
+    out.reason = std::string(params.tip_task ? "tip" : "camera") + " frame cannot reach the task pose (kinematically unreachable)";
   } else {
     std::string counts;
     for (const auto& [what, count] : rejections)

@@ -344,6 +344,12 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
                     " but the planner runs model version " + std::to_string(model->version()));
   }
   if (request.goals.empty()) return fail(Status::kInvalidRequest, "request has no goals");
+  if (std::isnan(request.tip_distance) || std::isinf(request.tip_distance)) {
+    return fail(Status::kInvalidRequest, "tip_distance must be a finite number of metres");
+  }
+  if (!(request.tip_reach >= 0.0 && request.tip_reach <= 1.0)) {
+    return fail(Status::kInvalidRequest, "tip_reach must be within [0, 1] m");
+  }
   if (q_start_full.size() != model->full_dof() || !q_start_full.allFinite()) {
     return fail(Status::kInvalidStart, "start state has " + std::to_string(q_start_full.size()) +
                                            " joints, model version " +
@@ -501,8 +507,10 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     // postures sit in torque-feasible pockets no path reaches.
     GoalResult r;
     double nspg = 0.0;
-    const double distance =
-        request.camera_distance > 0.0 ? request.camera_distance : params_.camera_distance;
+    const bool tip = request.tip_distance > 0.0;
+    const double distance = tip                            ? request.tip_distance
+                            : request.camera_distance > 0.0 ? request.camera_distance
+                                                            : params_.camera_distance;
     const double height = (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, distance)).z();
     const std::vector<Eigen::VectorXd> hints = hints_for(*model, height);
     int next_seed = 0;
@@ -522,6 +530,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       attempt_params.camera_distance = distance;
       attempt_params.fixed_base = request.fixed_base;
       attempt_params.base_travel = request.base_travel;
+      attempt_params.tip_task = tip;
+      attempt_params.tip_reach = tip ? request.tip_reach : 0.0;
       PostureResult posture;
       do {
         attempt_params.nspg_time =
@@ -536,7 +546,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       if (!posture.found) {
         if (attempt > 0) break;  // keep the previous attempt's "no path"
         r.status = Status::kUnreachable;
-        r.reason = "no feasible posture puts camera '" + model->camera_frame(*tool) + "' " +
+        r.reason = std::string("no feasible posture puts ") + (tip ? "tip '" : "camera '") +
+                   model->task_frame(*tool, tip) + "' " +
                    std::to_string(distance) + " m in front of the drilling area (" +
                    std::to_string(posture.candidates) + " seeds solved; " + posture.reason + ")";
         break;

@@ -147,7 +147,7 @@ PostureProblem::PostureProblem(const PlanningModel& model, const Params& params,
         template_(full_template),
         task_(std::move(task)),
         field_(std::move(field)) {
-    camera_ = tool != nullptr ? model.link_index(model.camera_frame(*tool)) : -1;
+    camera_ = tool != nullptr ? model.link_index(model.task_frame(*tool, params.tip_task)) : -1;
     const auto& links = model.links();
     // The surface term keeps the robot in front of the drilled surface; legs stand on the
     // floor, so they are left out when the surface is the floor itself.

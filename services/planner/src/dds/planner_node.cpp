@@ -358,6 +358,8 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   core.model_version = request.model_version();
   core.end_effector = request.end_effector();
   core.camera_distance = request.camera_distance();
+  core.tip_distance = request.tip_distance();
+  core.tip_reach = request.tip_reach();
   core.fixed_base = request.fixed_base();
   core.environment_padding = request.environment_padding();
   core.base_travel = request.base_travel();
