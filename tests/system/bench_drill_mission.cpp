@@ -9,7 +9,7 @@
 //             building's model, two blue blobs 0.1 m apart drawn there; the robot (morphology A)
 //             starts in another part of the room, navigates to the BIM base pose, then drills
 //   demo      the demo wall's pattern (deploy/demo/drill_site.yaml)
-// Usage: bench_drill_mission [--scenario blobs|patterns|bim|demo|all] [--runs N] [--assembly FILE]
+// Usage: bench_drill_mission [--scenario blobs|patterns|bim|demo|all] [--runs N] [--assembly FILE] [--logs]
 //        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
@@ -54,7 +54,7 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
-int bench(const std::string& which, int runs, const std::string& assembly) {
+int bench(const std::string& which, int runs, const std::string& assembly, bool logs) {
   const std::vector<Scenario> all{
       {"blobs", source("services/planner/data/morphology_b.yaml"),
        source("deploy/bench/drill_blobs_site.yaml"), source("deploy/bench/drill_blobs_mission.yaml")},
@@ -98,7 +98,7 @@ int bench(const std::string& which, int runs, const std::string& assembly) {
                   s.state() == concert::msg::DRILL_SUCCEEDED ? "succeeded" : "did not succeed",
                   s.holes_drilled(), s.holes_marked(), run.safety_running ? "RUNNING" : "STOPPED",
                   s.reason().empty() ? "" : ": ", s.reason().c_str());
-      if (s.state() != concert::msg::DRILL_SUCCEEDED) {
+      if (logs || s.state() != concert::msg::DRILL_SUCCEEDED) {
         std::cerr << sc.name << " run " << r + 1 << ": the services' logs" << run.logs << "\n";
       }
       for (const Target& t : targets) {
@@ -159,6 +159,8 @@ int main(int argc, char** argv) {
   app.add_option("--runs", runs, "runs per scenario")
       ->capture_default_str()
       ->check(concert::cli::number(1, 1e6, true));
-  cli.on_run(app, [&] { return bench(which, runs, assembly); });
+  bool logs = false;
+  app.add_flag("--logs", logs, "print the services' logs after every run (default: after a failed one)");
+  cli.on_run(app, [&] { return bench(which, runs, assembly, logs); });
   return cli.run(argc, argv);
 }

@@ -38,10 +38,13 @@ constexpr double kRobotRadius = 0.55;
 // Cartesian alignment does the rest) [m]; the way back first takes this long to reach the
 // posture's path [s].
 constexpr double kAlignMargin = 0.03;
-// A hole's drilling posture, in the order it is asked for: the arm alone with the camera at the
-// hole's distance, then 3, 7 and 12 cm further from the wall (the alignment's Cartesian move gets
-// that much longer); then the whole body with the base moving at most 0.3 m and 0.3 rad, again
-// further out; last the whole body anywhere. The base stays where the area's approach put it as
+// A hole's drilling posture, in the order it is asked for: the arm alone with the bit's tip on
+// the hole's axis at the standoff plus kAlignMargin, then 3 and 7 cm further from the wall (the
+// alignment's Cartesian move gets that much longer); then the whole body with the base moving at
+// most 0.3 m and 0.3 rad, again further out; last the whole body anywhere. The planner checks the
+// arm's torques at the posture and with the bit at the hole's depth (set_tip): with the camera
+// on the hole's axis instead, the bit stood 11 cm beside it, and the alignment reached out to a
+// posture nobody had checked (morphology A's shoulder J2_E then needed its peak torque). The base stays where the area's approach put it as
 // long as the arm reaches, and moves as little as it can: odometry drifts with every centimetre
 // and degree the base moves, and an ArUco pattern is drilled by the kinematics alone (on the demo
 // wall, holes drilled after unbounded whole-body moves were 5-100 mm off; one posture spun the
@@ -49,11 +52,11 @@ constexpr double kAlignMargin = 0.03;
 struct HoleAttempt {
   bool fixed_base;
   double base_travel;  // [m, rad] for the whole body; 0: anywhere
-  double further;      // [m] beyond the hole's camera distance
+  double further;      // [m] beyond the hole's tip distance
 };
 constexpr HoleAttempt kHoleAttempts[] = {
-    {true, 0.0, 0.0},  {true, 0.0, 0.03},  {true, 0.0, 0.07},  {true, 0.0, 0.12},
-    {false, 0.3, 0.0}, {false, 0.3, 0.03}, {false, 0.3, 0.07}, {false, 0.3, 0.12},
+    {true, 0.0, 0.0},  {true, 0.0, 0.03},  {true, 0.0, 0.07},
+    {false, 0.3, 0.0}, {false, 0.3, 0.03}, {false, 0.3, 0.07},
     {false, 0.0, 0.0}, {false, 0.0, 0.07}};
 constexpr double kSettleBack = 1.0;
 // Robot shapes grown against the map in the areas' approach plans [m]: the planner's map is the
@@ -74,6 +77,14 @@ constexpr int kReanchorFrames = 3;
 // posture reached (the arm only shifts across the wall), then this much further out [m], in turn.
 constexpr double kMarkerViewFurther[] = {0.0, 0.1, 0.2};
 constexpr double kReanchorDistance = 0.06;
+// Hole depth the drilling posture's reach is checked to when no mission is loaded [m].
+constexpr double kDefaultDepth = 0.05;
+// A hole found this much away from where odometry put it after a whole-body move [m] gets its
+// drilling posture planned again, the arm alone, from where the base now stands: the alignment
+// would otherwise reach that much further than the posture the planner checked (odometry drifts
+// 2-8 cm over such a move; with morphology A's arm at the BIM area the shoulder J2_E then went
+// past its continuous torque while drilling).
+constexpr double kReplanShift = 0.01;
 // Blobs of one area matched as a set: a predicted blob lies this close to a seen one [m]
 // (6 deg of odometry yaw over 0.1 m between blobs moves them 1 cm).
 constexpr double kBlobMatch = 0.02;
@@ -933,6 +944,7 @@ void DrillNode::align(const DrillPoint& point) {
   }
   point_ = point;
   marker_looked_ = false;
+  hole_replanned_ = false;
   // The pattern as its marker was last seen (after a base move), not as first detected.
   if (const auto it = markers_seen_.find(point.marker); it != markers_seen_.end() && patterns_) {
     if (const std::optional<Eigen::Isometry3d> f = hole_of(point, it->second, *patterns_))
@@ -951,17 +963,27 @@ void DrillNode::align(const DrillPoint& point) {
   r.end_effector(rig_->tool());
   r.goals().push_back(model::dds::to_pose_msg(point_.frame));
   r.execute(true);
-  hole_distance_ = camera_to_tip + params_.motion.standoff + kAlignMargin;
+  // The bit's tip is put on the hole's axis (PlanRequest.tip_distance), so the posture the
+  // planner checks is the one the bit drills from; the camera sees the hole from beside it.
+  camera_to_tip_ = camera_to_tip;
+  hole_distance_ = params_.motion.standoff + kAlignMargin;
   // The arm alone first (kHoleAttempts): the base stays where the area's approach put it, so
   // odometry does not drift between holes (3.5 deg over one whole-body move on the demo).
   hole_attempt_ = 0;
-  r.camera_distance(hole_distance_ + kHoleAttempts[0].further);
+  set_tip(r, hole_distance_ + kHoleAttempts[0].further);
   r.fixed_base(kHoleAttempts[0].fixed_base);
   r.base_travel(kHoleAttempts[0].base_travel);
   plan_requests_.write(r);
   hole_request_ = r;
   hole_path_ = {};
   motion_ = Motion::kApproachHole;
+}
+
+// A hole's drilling posture puts the bit's tip `distance` in front of the hole; the planner
+// also checks the arm's torques with the bit where it ends, at the hole's depth.
+void DrillNode::set_tip(msg::PlanRequest& r, double distance) const {
+  r.tip_distance(distance);
+  r.tip_reach(distance + (mission_ ? mission_->depth : kDefaultDepth));
 }
 
 void DrillNode::start_align(const Sample& s) {
@@ -1074,7 +1096,7 @@ void DrillNode::look_at_marker() {
     return;
   }
   look_goal_ = *marker;
-  hole_reached_ = hole_request_.camera_distance();
+  hole_reached_ = hole_request_.tip_distance();
   request_marker_view(0);
 }
 
@@ -1086,7 +1108,9 @@ void DrillNode::request_marker_view(std::size_t attempt) {
   r.stamp_ns(now_ns());
   r.goals().clear();
   r.goals().push_back(model::dds::to_pose_msg(look_goal_));
-  r.camera_distance(hole_reached_ + kMarkerViewFurther[attempt]);
+  r.tip_distance(0.0);  // the camera looks at the marker
+  r.tip_reach(0.0);
+  r.camera_distance(hole_reached_ + camera_to_tip_ + kMarkerViewFurther[attempt]);
   r.fixed_base(true);
   plan_requests_.write(r);
   look_path_ = {};
@@ -1109,6 +1133,14 @@ void DrillNode::control_motion() {
     if (!r->trajectory().empty()) hole_path_ = {r->joint_names(), r->trajectory()};
     if (r->state() == msg::PLAN_SUCCEEDED && !hole_path_.samples.empty())
       hole_chain_.push_back(hole_path_);
+    if (r->state() == msg::PLAN_FAILED && hole_replanned_) {
+      // Planned again after the re-measure, the arm alone found none: the alignment's Cartesian
+      // move covers the shift from the posture reached.
+      log_line("drill: " + point_.label + ": no posture for the arm alone at the hole measured " +
+               "again (" + r->reason() + "); aligning from the whole body's posture");
+      if (const std::optional<Sample> s = latest_sample()) start_align(*s);
+      return;
+    }
     if (r->state() == msg::PLAN_FAILED &&
         (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH) &&
         hole_attempt_ + 1 < std::size(kHoleAttempts)) {
@@ -1121,8 +1153,8 @@ void DrillNode::control_motion() {
         return w.str();
       };
       line << "drill: " << point_.label << ": no drilling posture for "
-           << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with the camera "
-           << hole_request_.camera_distance() << " m from the wall (" << r->reason()
+           << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with the bit "
+           << hole_request_.tip_distance() << " m from the wall (" << r->reason()
            << "); asking for " << who(next.fixed_base, next.base_travel) << " at "
            << hole_distance_ + next.further << " m";
       log_line(line.str());
@@ -1130,7 +1162,7 @@ void DrillNode::control_motion() {
       hole_request_.request_id(hole_plan_request_);
       hole_request_.fixed_base(next.fixed_base);
       hole_request_.base_travel(next.base_travel);
-      hole_request_.camera_distance(hole_distance_ + next.further);
+      set_tip(hole_request_, hole_distance_ + next.further);
       plan_requests_.write(hole_request_);
     } else if (r->state() == msg::PLAN_FAILED) {
       motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());
@@ -1208,7 +1240,7 @@ void DrillNode::control_motion() {
     hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
     hole_request_.fixed_base(true);
     hole_request_.base_travel(0.0);
-    hole_request_.camera_distance(reached);
+    set_tip(hole_request_, reached);
     hole_request_.stamp_ns(now_ns());
     plan_requests_.write(hole_request_);
     hole_path_ = {};
@@ -1243,7 +1275,25 @@ void DrillNode::control_motion() {
                   180.0 / M_PI
            << " deg from the prediction";
       log_line(line.str());
+      const double shift = (seen->translation() - point_.frame.translation()).norm();
       point_.frame = *seen;
+      if (!hole_request_.fixed_base() && !hole_replanned_ && shift > kReplanShift) {
+        // The base moved and odometry drifted: the posture again, the arm alone, for the hole
+        // where the camera sees it now.
+        hole_replanned_ = true;
+        hole_plan_request_ = next_request_++;
+        hole_request_.request_id(hole_plan_request_);
+        hole_request_.goals().clear();
+        hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
+        hole_request_.fixed_base(true);
+        hole_request_.base_travel(0.0);
+        set_tip(hole_request_, hole_distance_);
+        hole_request_.stamp_ns(now_ns());
+        plan_requests_.write(hole_request_);
+        hole_path_ = {};
+        motion_ = Motion::kApproachHole;
+        return;
+      }
     }
     if (const std::optional<Sample> s = latest_sample()) start_align(*s);
     return;

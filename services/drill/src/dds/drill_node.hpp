@@ -126,6 +126,7 @@ class DrillNode final : public MissionPorts {
   void send_cartesian(const CartesianReference& r);
   void send_hold();
   void start_align(const Sample& s);
+  void set_tip(msg::PlanRequest& r, double distance) const;
   void start_reanchor(Motion next);
   void look_at_marker();
   void request_marker_view(std::size_t attempt);
@@ -212,7 +213,8 @@ class DrillNode final : public MissionPorts {
   std::int64_t servo_since_ns_{0};
   std::uint32_t hole_plan_request_{0};
   msg::PlanRequest hole_request_;
-  double hole_distance_{0.0};  // the camera's distance from the wall a hole's posture asks for [m]
+  double hole_distance_{0.0};  // the bit tip's distance from the wall a hole's posture asks for [m]
+  double camera_to_tip_{0.0};  // the tool's camera to its tip along the camera's axis [m]
   std::size_t hole_attempt_{0};  // which of kHoleAttempts the hole's posture request is
   std::int64_t reanchor_since_ns_{0};
   std::vector<DrillPoint> area_points_;  // the current area's holes as detected
@@ -224,9 +226,10 @@ class DrillNode final : public MissionPorts {
   PlannedPath look_path_;                // of the camera turned to the hole's marker
   std::uint32_t look_request_{0};        // the plan request turning the camera to the marker
   bool marker_looked_{false};            // the marker was looked at for the hole being approached
+  bool hole_replanned_{false};           // the hole's posture was planned again after its re-measure
   std::size_t look_attempt_{0};          // which of kMarkerViewFurther the look request is
   Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the marker as predicted (world)
-  double hole_reached_{0.0};             // camera distance of the hole's posture reached [m]
+  double hole_reached_{0.0};             // tip distance of the hole's posture reached [m]
   std::map<int, Eigen::Isometry3d> markers_seen_;  // marker id -> where last seen (world), this area
   std::vector<PlannedPath> hole_chain_;  // the area's hole postures as reached, first to last
   bool returning_{false};                // execute(): the way back runs before the approach
