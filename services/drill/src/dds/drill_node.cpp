@@ -38,26 +38,32 @@ constexpr double kRobotRadius = 0.55;
 // Cartesian alignment does the rest) [m]; the way back first takes this long to reach the
 // posture's path [s].
 constexpr double kAlignMargin = 0.03;
-// A hole's drilling posture, in the order it is asked for: the arm alone with the bit's tip on
-// the hole's axis at the standoff plus kAlignMargin, then 3 and 7 cm further from the wall (the
-// alignment's Cartesian move gets that much longer); then the whole body with the base moving at
-// most 0.3 m and 0.3 rad, again further out; last the whole body anywhere. The planner checks the
-// arm's torques at the posture and with the bit at the hole's depth (set_tip): with the camera
-// on the hole's axis instead, the bit stood 11 cm beside it, and the alignment reached out to a
-// posture nobody had checked (morphology A's shoulder J2_E then needed its peak torque). The base stays where the area's approach put it as
-// long as the arm reaches, and moves as little as it can: odometry drifts with every centimetre
-// and degree the base moves, and an ArUco pattern is drilled by the kinematics alone (on the demo
-// wall, holes drilled after unbounded whole-body moves were 5-100 mm off; one posture spun the
-// base by 2.3 rad).
+// A hole's drilling posture, in the order it is asked for. First with the bit's tip on the
+// hole's axis (PlanRequest.tip_distance, the standoff plus kAlignMargin, then 3 and 7 cm further
+// out), the planner checking the arm's torques there and with the bit at the hole's depth
+// (tip_reach): the arm alone, then the whole body with the base moving at most 0.3 m and 0.3 rad,
+// then the whole body anywhere. Without such a posture, as before those checks existed: the
+// camera on the hole's axis (the bit 11 cm beside it), 0, 3, 7 and 12 cm further out, the same
+// three ways; the alignment's Cartesian move then reaches a posture nobody checked (on morphology
+// A at the BIM area the shoulder J2_E needed its peak torque; the demo robot's arm finds no tip
+// posture at the system test's blobs and drills them this way). The base stays where the area's
+// approach put it as long as the arm reaches, and moves as little as it can: odometry drifts with
+// every centimetre and degree the base moves, and an ArUco pattern is drilled by the kinematics
+// alone (on the demo wall, holes drilled after unbounded whole-body moves were 5-100 mm off; one
+// posture spun the base by 2.3 rad).
 struct HoleAttempt {
+  bool tip;  // the bit's tip on the hole's axis (else the camera)
   bool fixed_base;
   double base_travel;  // [m, rad] for the whole body; 0: anywhere
-  double further;      // [m] beyond the hole's tip distance
+  double further;      // [m] beyond the hole's distance
 };
 constexpr HoleAttempt kHoleAttempts[] = {
-    {true, 0.0, 0.0},  {true, 0.0, 0.03},  {true, 0.0, 0.07},
-    {false, 0.3, 0.0}, {false, 0.3, 0.03}, {false, 0.3, 0.07},
-    {false, 0.0, 0.0}, {false, 0.0, 0.07}};
+    {true, true, 0.0, 0.0},    {true, true, 0.0, 0.03},   {true, true, 0.0, 0.07},
+    {true, false, 0.3, 0.0},   {true, false, 0.3, 0.03},  {true, false, 0.3, 0.07},
+    {true, false, 0.0, 0.0},   {true, false, 0.0, 0.07},  {false, true, 0.0, 0.0},
+    {false, true, 0.0, 0.03},  {false, true, 0.0, 0.07},  {false, true, 0.0, 0.12},
+    {false, false, 0.3, 0.0},  {false, false, 0.3, 0.03}, {false, false, 0.3, 0.07},
+    {false, false, 0.3, 0.12}, {false, false, 0.0, 0.0},  {false, false, 0.0, 0.07}};
 constexpr double kSettleBack = 1.0;
 // Robot shapes grown against the map in the areas' approach plans [m]: the planner's map is the
 // world, its start pose the wheel odometry, which drifts 4-6 cm over a whole-body move near the
@@ -140,6 +146,20 @@ msg::DrillHoleState to_msg(HoleState s) {
 }
 
 Eigen::Vector3d odometry_of(const msg::Odometry& o) { return {o.x(), o.y(), o.yaw()}; }
+
+// A hole's posture request for attempt `a`: the bit's tip `further` beyond the hole's distance
+// in front of it, the planner also checking the arm's torques with the bit at the hole's depth;
+// or the camera on the hole's axis as far out.
+// (`hole_distance`: the bit's tip from the wall the posture asks for before `further`.)
+void set_hole_task(msg::PlanRequest& r, const HoleAttempt& a, double hole_distance,
+                   double camera_to_tip, double depth) {
+  const double tip = hole_distance + a.further;
+  r.tip_distance(a.tip ? tip : 0.0);
+  r.tip_reach(a.tip ? tip + depth : 0.0);
+  r.camera_distance(a.tip ? 0.0 : camera_to_tip + tip);
+  r.fixed_base(a.fixed_base);
+  r.base_travel(a.base_travel);
+}
 
 }  // namespace
 
@@ -244,12 +264,12 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
                 std::lock_guard lock(mutex_);
                 nav_statuses_[s.request_id()] = s;
               }),
-      localisation_in_(participant, cdds::topics::nav_localisation,
-                       [this](const msg::NavLocalisation& l, const auto&) {
-                         if (l.state() != msg::LOCALISATION_TRACKING) return;
-                         map_frame_.on_localisation(l.stamp_ns(),
-                                                    {l.pose().x(), l.pose().y(), l.pose().yaw()});
-                       }),
+      localisation_in_(
+          participant, cdds::topics::nav_localisation,
+          [this](const msg::NavLocalisation& l, const auto&) {
+            if (l.state() != msg::LOCALISATION_TRACKING) return;
+            map_frame_.on_localisation(l.stamp_ns(), {l.pose().x(), l.pose().y(), l.pose().yaw()});
+          }),
       rgb_in_(participant, cdds::topics::camera_rgb,
               [this](const msg::Image& i, const auto&) { on_image(i, false); }),
       depth_in_(participant, cdds::topics::camera_depth,
@@ -677,7 +697,8 @@ Outcome DrillNode::navigation() {
 void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& located,
                      std::optional<std::size_t> after) {
   const auto bim = bim_frames_.find(area);
-  const Eigen::Isometry3d frame = bim == bim_frames_.end() ? located : map_frame_.to_odom(bim->second);
+  const Eigen::Isometry3d frame =
+      bim == bim_frames_.end() ? located : map_frame_.to_odom(bim->second);
   Plan p;
   p.request_id = next_request_++;
   msg::PlanRequest r;
@@ -970,20 +991,23 @@ void DrillNode::align(const DrillPoint& point) {
   // The arm alone first (kHoleAttempts): the base stays where the area's approach put it, so
   // odometry does not drift between holes (3.5 deg over one whole-body move on the demo).
   hole_attempt_ = 0;
-  set_tip(r, hole_distance_ + kHoleAttempts[0].further);
-  r.fixed_base(kHoleAttempts[0].fixed_base);
-  r.base_travel(kHoleAttempts[0].base_travel);
+  set_hole_task(r, kHoleAttempts[0], hole_distance_, camera_to_tip_, hole_depth());
   plan_requests_.write(r);
   hole_request_ = r;
   hole_path_ = {};
   motion_ = Motion::kApproachHole;
 }
 
-// A hole's drilling posture puts the bit's tip `distance` in front of the hole; the planner
-// also checks the arm's torques with the bit where it ends, at the hole's depth.
-void DrillNode::set_tip(msg::PlanRequest& r, double distance) const {
-  r.tip_distance(distance);
-  r.tip_reach(distance + (mission_ ? mission_->depth : kDefaultDepth));
+double DrillNode::hole_depth() const { return mission_ ? mission_->depth : kDefaultDepth; }
+
+// "the bit 0.07 m" or "the camera 0.23 m" (from the wall), for the log.
+std::string hole_task_text(const msg::PlanRequest& r) {
+  std::ostringstream t;
+  if (r.tip_distance() > 0.0)
+    t << "the bit " << r.tip_distance() << " m";
+  else
+    t << "the camera " << r.camera_distance() << " m";
+  return t.str();
 }
 
 void DrillNode::start_align(const Sample& s) {
@@ -1096,7 +1120,9 @@ void DrillNode::look_at_marker() {
     return;
   }
   look_goal_ = *marker;
-  hole_reached_ = hole_request_.tip_distance();
+  // The camera's distance at the hole's posture.
+  hole_reached_ = hole_request_.tip_distance() > 0.0 ? hole_request_.tip_distance() + camera_to_tip_
+                                                     : hole_request_.camera_distance();
   request_marker_view(0);
 }
 
@@ -1110,7 +1136,7 @@ void DrillNode::request_marker_view(std::size_t attempt) {
   r.goals().push_back(model::dds::to_pose_msg(look_goal_));
   r.tip_distance(0.0);  // the camera looks at the marker
   r.tip_reach(0.0);
-  r.camera_distance(hole_reached_ + camera_to_tip_ + kMarkerViewFurther[attempt]);
+  r.camera_distance(hole_reached_ + kMarkerViewFurther[attempt]);
   r.fixed_base(true);
   plan_requests_.write(r);
   look_path_ = {};
@@ -1153,16 +1179,14 @@ void DrillNode::control_motion() {
         return w.str();
       };
       line << "drill: " << point_.label << ": no drilling posture for "
-           << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with the bit "
-           << hole_request_.tip_distance() << " m from the wall (" << r->reason()
-           << "); asking for " << who(next.fixed_base, next.base_travel) << " at "
-           << hole_distance_ + next.further << " m";
-      log_line(line.str());
+           << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with "
+           << hole_task_text(hole_request_) << " from the wall (" << r->reason() << "); asking for "
+           << who(next.fixed_base, next.base_travel) << " with ";
       hole_plan_request_ = next_request_++;
       hole_request_.request_id(hole_plan_request_);
-      hole_request_.fixed_base(next.fixed_base);
-      hole_request_.base_travel(next.base_travel);
-      set_tip(hole_request_, hole_distance_ + next.further);
+      set_hole_task(hole_request_, next, hole_distance_, camera_to_tip_, hole_depth());
+      line << hole_task_text(hole_request_);
+      log_line(line.str());
       plan_requests_.write(hole_request_);
     } else if (r->state() == msg::PLAN_FAILED) {
       motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());
@@ -1189,7 +1213,8 @@ void DrillNode::control_motion() {
     if (r->state() == msg::PLAN_SUCCEEDED) {
       if (!look_path_.samples.empty()) hole_chain_.push_back(look_path_);
       start_reanchor(Motion::kMarkerReanchor);
-    } else if (r->state() == msg::PLAN_FAILED && look_attempt_ + 1 < std::size(kMarkerViewFurther)) {
+    } else if (r->state() == msg::PLAN_FAILED &&
+               look_attempt_ + 1 < std::size(kMarkerViewFurther)) {
       request_marker_view(look_attempt_ + 1);
     } else if (r->state() == msg::PLAN_FAILED) {
       log_line("drill: " + point_.label + ": the camera cannot be turned to marker " +
@@ -1228,19 +1253,21 @@ void DrillNode::control_motion() {
     }
     // Back to the hole's drilling posture with the arm alone (the base stands where the whole
     // body put it), at the distance that reached it.
-    const double reached = hole_reached_;
+    const HoleAttempt reached = kHoleAttempts[hole_attempt_];
+    const std::size_t from = hole_attempt_;
     hole_attempt_ = 0;
     while (hole_attempt_ + 1 < std::size(kHoleAttempts) &&
            !(kHoleAttempts[hole_attempt_].fixed_base &&
-             hole_distance_ + kHoleAttempts[hole_attempt_].further >= reached - 1e-6))
+             kHoleAttempts[hole_attempt_].tip == reached.tip &&
+             kHoleAttempts[hole_attempt_].further >= reached.further - 1e-6))
       ++hole_attempt_;
+    if (hole_attempt_ < from && !kHoleAttempts[hole_attempt_].fixed_base) hole_attempt_ = from;
     hole_plan_request_ = next_request_++;
     hole_request_.request_id(hole_plan_request_);
     hole_request_.goals().clear();
     hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
-    hole_request_.fixed_base(true);
-    hole_request_.base_travel(0.0);
-    set_tip(hole_request_, reached);
+    set_hole_task(hole_request_, {reached.tip, true, 0.0, reached.further}, hole_distance_,
+                  camera_to_tip_, hole_depth());
     hole_request_.stamp_ns(now_ns());
     plan_requests_.write(hole_request_);
     hole_path_ = {};
@@ -1277,7 +1304,8 @@ void DrillNode::control_motion() {
       log_line(line.str());
       const double shift = (seen->translation() - point_.frame.translation()).norm();
       point_.frame = *seen;
-      if (!hole_request_.fixed_base() && !hole_replanned_ && shift > kReplanShift) {
+      if (!hole_request_.fixed_base() && kHoleAttempts[hole_attempt_].tip && !hole_replanned_ &&
+          shift > kReplanShift) {
         // The base moved and odometry drifted: the posture again, the arm alone, for the hole
         // where the camera sees it now.
         hole_replanned_ = true;
@@ -1285,9 +1313,8 @@ void DrillNode::control_motion() {
         hole_request_.request_id(hole_plan_request_);
         hole_request_.goals().clear();
         hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
-        hole_request_.fixed_base(true);
-        hole_request_.base_travel(0.0);
-        set_tip(hole_request_, hole_distance_);
+        set_hole_task(hole_request_, {true, true, 0.0, 0.0}, hole_distance_, camera_to_tip_,
+                      hole_depth());
         hole_request_.stamp_ns(now_ns());
         plan_requests_.write(hole_request_);
         hole_path_ = {};

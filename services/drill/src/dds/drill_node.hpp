@@ -126,7 +126,8 @@ class DrillNode final : public MissionPorts {
   void send_cartesian(const CartesianReference& r);
   void send_hold();
   void start_align(const Sample& s);
-  void set_tip(msg::PlanRequest& r, double distance) const;
+  /// The mission's hole depth [m] (kDefaultDepth before a mission).
+  [[nodiscard]] double hole_depth() const;
   void start_reanchor(Motion next);
   void look_at_marker();
   void request_marker_view(std::size_t attempt);
@@ -222,15 +223,16 @@ class DrillNode final : public MissionPorts {
     std::vector<std::string> names;
     std::vector<msg::TrajectorySample> samples;
   };
-  PlannedPath hole_path_;                // of the hole being approached
-  PlannedPath look_path_;                // of the camera turned to the hole's marker
-  std::uint32_t look_request_{0};        // the plan request turning the camera to the marker
-  bool marker_looked_{false};            // the marker was looked at for the hole being approached
-  bool hole_replanned_{false};           // the hole's posture was planned again after its re-measure
-  std::size_t look_attempt_{0};          // which of kMarkerViewFurther the look request is
+  PlannedPath hole_path_;          // of the hole being approached
+  PlannedPath look_path_;          // of the camera turned to the hole's marker
+  std::uint32_t look_request_{0};  // the plan request turning the camera to the marker
+  bool marker_looked_{false};      // the marker was looked at for the hole being approached
+  bool hole_replanned_{false};     // the hole's posture was planned again after its re-measure
+  std::size_t look_attempt_{0};    // which of kMarkerViewFurther the look request is
   Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the marker as predicted (world)
-  double hole_reached_{0.0};             // tip distance of the hole's posture reached [m]
-  std::map<int, Eigen::Isometry3d> markers_seen_;  // marker id -> where last seen (world), this area
+  double hole_reached_{0.0};  // camera distance of the hole's posture reached [m]
+  std::map<int, Eigen::Isometry3d>
+      markers_seen_;                     // marker id -> where last seen (world), this area
   std::vector<PlannedPath> hole_chain_;  // the area's hole postures as reached, first to last
   bool returning_{false};                // execute(): the way back runs before the approach
   std::optional<Outcome> motion_outcome_;
