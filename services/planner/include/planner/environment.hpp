@@ -58,6 +58,16 @@ class Environment {
   /// the cells along the rays free. Points farther than `max_range` [m] are cut (< 0: no cut).
   /// Non-finite points are errors naming their index.
   void insert_point_cloud(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& origin, double max_range = -1.0);
+  /// Ray-casts from `origin` (map frame, [m]) with OctoMap's key rays: every cell along a ray to
+  /// a point of `hits` or of `clears` is a miss, the cell of each hit a hit (a cell both passed
+  /// and hit in the same call counts as hit, as in OctoMap's insertPointCloud); the end cells of
+  /// `clears` are misses too (returns that must never become obstacles: the floor, beams cut at
+  /// a maximum range). Non-finite input throws PlannerError naming it, the map unchanged.
+  void insert_rays(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& hits,
+                   const std::vector<Eigen::Vector3d>& clears);
+  /// Marks the centre of every occupied leaf of `other` occupied here (the union of two maps,
+  /// e.g. the world's and the sensors'). Throws PlannerError if the resolutions differ.
+  void add_occupied(const Environment& other);
 
   [[nodiscard]] double resolution() const { return resolution_; }
   /// Number of occupied leaf cells.
