@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <cmath>
+#include <functional>
 #include <sstream>
 #include <thread>
 
@@ -12,6 +14,7 @@
 #include "concert/common/text.hpp"
 #include "concert/dds/participant.hpp"
 #include "concert/mobile_base/map_frame.hpp"
+#include "concert/sensors_dds/conversions.hpp"
 #include "concert/world/world_dds.hpp"
 #include "dds/planner_node.hpp"
 #include "model_message.hpp"
@@ -463,4 +466,117 @@ TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {
   err.str("");
   EXPECT_EQ(plan({"drill", "--at", "2.0", "0", "7.0", "--request-id", "32", "--timeout", "20"}), 1);
   EXPECT_NE(err.str().find("camera_E"), std::string::npos) << err.str();
+}
+
+namespace {
+
+// A lidar revolution (16 rings over +-15 deg, 360 columns) of a wall whose face is at
+// x = `wall_x` in the map (6 m wide, 3 m high) and of the floor, from `map_T_sensor`.
+msg::LidarScan wall_scan_msg(const std::string& sensor, const std::string& frame, uint32_t version,
+                             const Eigen::Isometry3d& map_T_sensor, double wall_x) {
+  hardware::LidarScan s;
+  s.sensor = sensor;
+  s.frame = frame;
+  for (int r = 0; r < 16; ++r) s.elevations.push_back(static_cast<float>((-15.0 + 2.0 * r) * M_PI / 180.0));
+  s.columns = 360;
+  s.azimuth_min = -M_PI;
+  s.azimuth_increment = 2.0 * M_PI / s.columns;
+  s.range_min = 0.1F;
+  s.range_max = 100.0F;
+  s.ranges.assign(16 * s.columns, 0.0F);
+  const Eigen::Vector3d o = map_T_sensor.translation();
+  for (std::size_t r = 0; r < 16; ++r) {
+    for (uint32_t c = 0; c < s.columns; ++c) {
+      const double e = s.elevations[r], a = s.azimuth_min + s.azimuth_increment * c;
+      const Eigen::Vector3d d = map_T_sensor.linear() * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+      double t = std::numeric_limits<double>::infinity();
+      if (d.x() > 1e-9) {
+        const double tw = (wall_x - o.x()) / d.x();
+        const Eigen::Vector3d p = o + tw * d;
+        if (std::abs(p.y()) <= 3.0 && p.z() >= 0.0 && p.z() <= 3.0) t = tw;
+      }
+      if (d.z() < -1e-9) t = std::min(t, -o.z() / d.z());
+      if (std::isfinite(t)) s.ranges[r * s.columns + c] = static_cast<float>(t);
+    }
+  }
+  return sensors_dds::to_msg(s, version);
+}
+
+}  // namespace
+
+TEST(PlannerNodeSensors, LidarScansOnTheTopicBecomeThePlannersMapOnlyWhileTheBaseIsStill) {
+  Params params;
+  params.environment_source = "sensors";
+  params.sensor_map_period = 0.2;
+  params.warm_up_time = 0.0;
+  Planner planner(params);
+  {
+    // What a --world file would have given: replaced by the sensor map.
+    Environment env(params.octomap_resolution);
+    World w;
+    w.boxes.push_back(fixtures::wall_at(3.0));
+    env.add_world(w);
+    planner.set_environment(env);
+  }
+  std::ostringstream log;
+  concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "planner_sensor_test"});
+  planner::dds::PlannerNode node(participant, planner, planner::dds::NodeOptions{}, log);
+  EXPECT_EQ(planner.environment().occupied_cells(), 0u) << "the world file's wall must not be the map";
+  concert::dds::Writer<msg::RobotModel> models(participant, concert::dds::topics::robot_model);
+  concert::dds::Writer<msg::JointState> joint_state(participant, concert::dds::topics::joint_state);
+  concert::dds::Writer<msg::Odometry> odometry(participant, concert::dds::topics::odometry);
+  concert::dds::Writer<msg::LidarScan> lidar(participant, concert::dds::topics::lidar);
+  models.write(planner::testing::model_message(fixtures::data_dir() / "morphology_a.yaml", 4));
+  const auto model_deadline = std::chrono::steady_clock::now() + 10s;
+  while (node.model_version() != 4 && std::chrono::steady_clock::now() < model_deadline) std::this_thread::sleep_for(10ms);
+  ASSERT_EQ(node.model_version(), 4u) << log.str();
+  const auto model = planner.model();
+  const auto lidars = model->robot().sensor_frames(model::SensorKind::kLidar);
+  ASSERT_FALSE(lidars.empty());
+  const model::SensorFrame& front = *lidars.front();
+
+  msg::JointState js;
+  js.model_version(4);
+  for (int i = 3; i < model->full_dof(); ++i) {
+    js.name().push_back(model->kinematics().joint_names()[static_cast<std::size_t>(i)]);
+    js.position().push_back(0.0);
+  }
+  // The robot's odometry: the base 0.3 m along y, still (or moving at 0.3 m/s).
+  auto odom = [](double vx) {
+    msg::Odometry o;
+    o.stamp_ns(now_ns());
+    o.y(0.3);
+    o.vx(vx);
+    return o;
+  };
+  const Eigen::VectorXd q = model->full_from_named({}, {}, Eigen::Vector3d(0.0, 0.3, 0.0));
+  const Eigen::Isometry3d map_T_lidar = model->link_pose(q, front.frame);
+  // The lidar's own height: a wall voxel the front lidar's level beam hits.
+  auto wall_seen = [&](double wall_x) {
+    return planner.environment().occupied(Eigen::Vector3d(wall_x + 0.025, map_T_lidar.translation().y(), map_T_lidar.translation().z()));
+  };
+  // Plays the robot for `seconds`: joint state, odometry and the lidar's revolution of a wall at
+  // `wall_x`, at 10 Hz; stops early once `until` holds.
+  auto play = [&](double wall_x, double vx, double seconds, const std::function<bool()>& until) {
+    const msg::LidarScan scan = wall_scan_msg(front.name, front.frame, 4, map_T_lidar, wall_x);
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end && !until()) {
+      joint_state.write(js);
+      odometry.write(odom(vx));
+      lidar.write(scan);
+      std::this_thread::sleep_for(100ms);
+    }
+  };
+  play(1.6, 0.0, 10.0, [&] { return wall_seen(1.6); });
+  ASSERT_TRUE(wall_seen(1.6)) << "the lidar's wall did not reach the planner's map within 10 s\n" << log.str();
+  EXPECT_FALSE(wall_seen(3.0));
+  EXPECT_NE(log.str().find("planner: sensor map: 1 scans used (" + front.name + ")"), std::string::npos) << log.str();
+
+  // While the base moves the scans are held back (motion blur across a revolution); once it
+  // stops they are used, and the line says how many waited.
+  play(1.2, 0.3, 1.5, [] { return false; });
+  EXPECT_FALSE(wall_seen(1.2)) << "a scan taken while the base moved was integrated";
+  play(1.2, 0.0, 10.0, [&] { return wall_seen(1.2); });
+  EXPECT_TRUE(wall_seen(1.2)) << log.str();
+  EXPECT_NE(log.str().find("scans skipped while the base moved"), std::string::npos) << log.str();
 }
