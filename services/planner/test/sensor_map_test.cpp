@@ -147,7 +147,7 @@ TEST(SensorMap, LidarScanOfAWallMarksTheWallFreesTheSpaceBeforeItAndNothingBehin
   EXPECT_EQ(found, hits);
 }
 
-TEST(SensorMap, ReturnsFarterThanTheMaximumRangeClearTheirRayAndMarkNothing) {
+TEST(SensorMap, ReturnsFartherThanTheMaximumRangeClearTheirRayAndMarkNothing) {
   Params p;
   p.sensor_max_range = 2.0;  // the wall is 3.5 m away
   const auto model = model_a(p);
@@ -351,4 +351,26 @@ TEST(SensorMap, AveragedDepthFramesPutTheWallInOneVoxelLayerWhereSingleFramesSca
   const std::size_t averaged = scattered(frames);
   EXPECT_GT(single, 50u);   // 3 cm noise: some returns land two voxels off the face
   EXPECT_EQ(averaged, 0u);  // 8 frames: 1 cm
+}
+
+TEST(SensorMap, TheWorldsMapAndTheSensorsTogetherHoldTheOccupiedCellsOfBoth) {
+  Params p;
+  const auto model = model_a(p);
+  Environment world(kRes);
+  World w;
+  w.boxes.push_back({"crate", Eigen::Vector3d(0.4, 0.4, 0.4), Eigen::Vector3d(1.0, -1.5, 0.2), 0.0});
+  world.add_world(w);  // pruned into 0.1 m and 0.2 m leaves where it can
+  Environment sensors(kRes);
+  std::mt19937 rng(10u);
+  const Eigen::Isometry3d sensor = at({-1.5, 0.0, 1.0});
+  (void)SensorMapper(model, p).insert_lidar(sensors, wall_scan(sensor, 0.0, rng), sensor, Eigen::VectorXd::Zero(model->full_dof()));
+  Environment both = world;
+  both.add_occupied(sensors);
+  for (const Environment* part : {&world, &sensors}) {
+    for (const Eigen::Vector3d& c : occupied_centres(*part)) EXPECT_TRUE(both.occupied(c)) << c.transpose();
+  }
+  // Every cell of the crate, not only the centres of pruned leaves.
+  for (double x = 0.825; x < 1.2; x += kRes) EXPECT_TRUE(both.occupied(Eigen::Vector3d(x, -1.325, 0.025))) << x;
+  EXPECT_FALSE(both.occupied(Eigen::Vector3d(0.5, 0.0, 1.0)));
+  EXPECT_THROW(both.add_occupied(Environment(0.1)), PlannerError);
 }

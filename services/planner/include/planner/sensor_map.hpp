@@ -71,6 +71,16 @@ class SensorMapper {
   [[nodiscard]] const PlanningModel& model() const { return *model_; }
 
  private:
+  /// A robot collision shape grown by the padding, placed in the map for one insert.
+  struct PaddedShape {
+    LinkShape::Type type = LinkShape::Type::kBox;
+    Eigen::Isometry3d shape_T_map = Eigen::Isometry3d::Identity();
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // map frame
+    Eigen::Vector3d half = Eigen::Vector3d::Zero();    // box: half extents; cylinder: r, r, half length; sphere: r
+    double radius = 0.0;                               // bounding sphere
+  };
+  [[nodiscard]] std::vector<PaddedShape> padded_shapes(const std::vector<Eigen::Isometry3d>& link_poses) const;
+  [[nodiscard]] static bool inside(const std::vector<PaddedShape>& shapes, const Eigen::Vector3d& p);
   /// Sorts map-frame returns into hits and clears and ray-casts them.
   SensorMapStats insert(Environment& environment, const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& ends,
                         const Eigen::VectorXd& q_full) const;

@@ -41,33 +41,63 @@ Eigen::Isometry3d SensorMapper::sensor_pose(const Eigen::VectorXd& q_full, const
   return model_->link_pose(q_full, frame);
 }
 
-bool SensorMapper::on_robot(const Eigen::Vector3d& p, const std::vector<Eigen::Isometry3d>& link_poses) const {
+std::vector<SensorMapper::PaddedShape> SensorMapper::padded_shapes(const std::vector<Eigen::Isometry3d>& link_poses) const {
   const double pad = params_.sensor_self_padding;
   const auto& links = model_->links();
+  std::vector<PaddedShape> out;
   for (std::size_t i = 0; i < links.size() && i < link_poses.size(); ++i) {
     for (const LinkShape& s : links[i].shapes) {
-      // The point in the shape's frame; primitives are centred on their origin (URDF).
-      const Eigen::Vector3d l = (link_poses[i] * s.origin).inverse() * p;
+      PaddedShape p;
+      p.type = s.type;
+      const Eigen::Isometry3d map_T_shape = link_poses[i] * s.origin;
+      p.shape_T_map = map_T_shape.inverse();
+      p.centre = map_T_shape.translation();
+      // Primitives are centred on their origin (URDF); half extents grown by the padding.
       switch (s.type) {
         case LinkShape::Type::kBox:
-          if ((l.cwiseAbs().array() <= (0.5 * s.size).array() + pad).all()) return true;
+          p.half = 0.5 * s.size + Eigen::Vector3d::Constant(pad);
           break;
         case LinkShape::Type::kCylinder:
-          if (l.head<2>().norm() <= s.size.x() + pad && std::abs(l.z()) <= 0.5 * s.size.z() + pad) return true;
+          p.half = Eigen::Vector3d(s.size.x() + pad, s.size.x() + pad, 0.5 * s.size.z() + pad);
           break;
         case LinkShape::Type::kSphere:
-          if (l.norm() <= s.size.x() + pad) return true;
+          p.half = Eigen::Vector3d::Constant(s.size.x() + pad);
           break;
       }
+      p.radius = p.type == LinkShape::Type::kSphere ? p.half.x() : p.half.norm();
+      out.push_back(p);
+    }
+  }
+  return out;
+}
+
+bool SensorMapper::inside(const std::vector<PaddedShape>& shapes, const Eigen::Vector3d& p) {
+  for (const PaddedShape& s : shapes) {
+    if ((p - s.centre).squaredNorm() > s.radius * s.radius) continue;  // outside its bounding sphere
+    const Eigen::Vector3d l = s.shape_T_map * p;
+    switch (s.type) {
+      case LinkShape::Type::kBox:
+        if ((l.cwiseAbs().array() <= s.half.array()).all()) return true;
+        break;
+      case LinkShape::Type::kCylinder:
+        if (l.head<2>().norm() <= s.half.x() && std::abs(l.z()) <= s.half.z()) return true;
+        break;
+      case LinkShape::Type::kSphere:
+        return true;  // within the sphere's radius
     }
   }
   return false;
+}
+
+bool SensorMapper::on_robot(const Eigen::Vector3d& p, const std::vector<Eigen::Isometry3d>& link_poses) const {
+  return inside(padded_shapes(link_poses), p);
 }
 
 SensorMapStats SensorMapper::insert(Environment& environment, const Eigen::Vector3d& origin,
                                     const std::vector<Eigen::Vector3d>& ends, const Eigen::VectorXd& q_full) const {
   std::vector<Eigen::Isometry3d> poses;
   model_->link_poses(q_full, poses);
+  const std::vector<PaddedShape> robot = padded_shapes(poses);
   SensorMapStats stats;
   stats.returns = ends.size();
   std::vector<Eigen::Vector3d> hits, clears;
@@ -79,7 +109,7 @@ SensorMapStats SensorMapper::insert(Environment& environment, const Eigen::Vecto
     if (range > params_.sensor_max_range) {
       clears.push_back(origin + ray * (params_.sensor_max_range / range));
       stats.cut += 1;
-    } else if (on_robot(end, poses)) {
+    } else if (inside(robot, end)) {
       stats.self += 1;
     } else if (end.z() < floor_top) {
       clears.push_back(end);
