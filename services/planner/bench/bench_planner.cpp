@@ -103,19 +103,6 @@ struct Options {
   int sensor_map = 0;
 };
 
-// Distance along a map-frame ray to a wall's face at x = wall_x (6 m wide, 3 m high) or to the
-// floor; infinity for neither.
-double wall_or_floor(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double wall_x) {
-  double t = std::numeric_limits<double>::infinity();
-  if (d.x() > 1e-9) {
-    const double tw = (wall_x - o.x()) / d.x();
-    const Eigen::Vector3d p = o + tw * d;
-    if (std::abs(p.y()) <= 3.0 && p.z() >= 0.0 && p.z() <= 3.0) t = tw;
-  }
-  if (d.z() < -1e-9) t = std::min(t, -o.z() / d.z());
-  return t;
-}
-
 int bench_sensor_map(const Options& options) {
   using namespace concert;
   using clock = std::chrono::steady_clock;
@@ -125,7 +112,6 @@ int bench_sensor_map(const Options& options) {
   const planner::SensorMapper mapper(model, params);
   const auto lidars = model->robot().sensor_frames(model::SensorKind::kLidar);
   std::mt19937 rng(static_cast<unsigned>(options.seed));
-  std::normal_distribution<double> noise(0.0, 0.015);
   std::uniform_real_distribution<double> jitter(-0.05, 0.05);
   constexpr double kWallX = 2.2;
   planner::Environment map(params.octomap_resolution);
@@ -134,25 +120,10 @@ int bench_sensor_map(const Options& options) {
   for (int n = 0; n < options.sensor_map; ++n) {
     const Eigen::VectorXd q = model->full_from_named({}, {}, Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng)));
     for (const model::SensorFrame* f : lidars) {
-      hardware::LidarScan scan;
+      const Eigen::Isometry3d pose = mapper.sensor_pose(q, f->frame);
+      hardware::LidarScan scan = planner::fixtures::wall_scan(pose, kWallX, 0.015, rng);
       scan.sensor = f->name;
       scan.frame = f->frame;
-      for (int r = 0; r < 16; ++r) scan.elevations.push_back(static_cast<float>((-15.0 + 2.0 * r) * M_PI / 180.0));
-      scan.columns = 900;
-      scan.azimuth_min = -M_PI;
-      scan.azimuth_increment = 2.0 * M_PI / 900.0;
-      scan.range_min = 0.1F;
-      scan.range_max = 100.0F;
-      scan.ranges.assign(16 * 900, 0.0F);
-      const Eigen::Isometry3d pose = mapper.sensor_pose(q, f->frame);
-      for (std::size_t r = 0; r < 16; ++r) {
-        for (std::uint32_t c = 0; c < 900; ++c) {
-          const double e = scan.elevations[r], a = scan.azimuth_min + scan.azimuth_increment * c;
-          const Eigen::Vector3d d = pose.linear() * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
-          const double t = wall_or_floor(pose.translation(), d, kWallX);
-          if (std::isfinite(t)) scan.ranges[r * 900 + c] = static_cast<float>(t + noise(rng));
-        }
-      }
       const auto t0 = clock::now();
       returns += mapper.insert_lidar(map, scan, pose, q).returns;
       lidar_ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());

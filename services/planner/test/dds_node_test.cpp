@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
-#include <cmath>
 #include <functional>
+#include <random>
 #include <sstream>
 #include <thread>
 
@@ -468,42 +468,6 @@ TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {
   EXPECT_NE(err.str().find("camera_E"), std::string::npos) << err.str();
 }
 
-namespace {
-
-// A lidar revolution (16 rings over +-15 deg, 360 columns) of a wall whose face is at
-// x = `wall_x` in the map (6 m wide, 3 m high) and of the floor, from `map_T_sensor`.
-msg::LidarScan wall_scan_msg(const std::string& sensor, const std::string& frame, uint32_t version,
-                             const Eigen::Isometry3d& map_T_sensor, double wall_x) {
-  hardware::LidarScan s;
-  s.sensor = sensor;
-  s.frame = frame;
-  for (int r = 0; r < 16; ++r) s.elevations.push_back(static_cast<float>((-15.0 + 2.0 * r) * M_PI / 180.0));
-  s.columns = 360;
-  s.azimuth_min = -M_PI;
-  s.azimuth_increment = 2.0 * M_PI / s.columns;
-  s.range_min = 0.1F;
-  s.range_max = 100.0F;
-  s.ranges.assign(16 * s.columns, 0.0F);
-  const Eigen::Vector3d o = map_T_sensor.translation();
-  for (std::size_t r = 0; r < 16; ++r) {
-    for (uint32_t c = 0; c < s.columns; ++c) {
-      const double e = s.elevations[r], a = s.azimuth_min + s.azimuth_increment * c;
-      const Eigen::Vector3d d = map_T_sensor.linear() * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
-      double t = std::numeric_limits<double>::infinity();
-      if (d.x() > 1e-9) {
-        const double tw = (wall_x - o.x()) / d.x();
-        const Eigen::Vector3d p = o + tw * d;
-        if (std::abs(p.y()) <= 3.0 && p.z() >= 0.0 && p.z() <= 3.0) t = tw;
-      }
-      if (d.z() < -1e-9) t = std::min(t, -o.z() / d.z());
-      if (std::isfinite(t)) s.ranges[r * s.columns + c] = static_cast<float>(t);
-    }
-  }
-  return sensors_dds::to_msg(s, version);
-}
-
-}  // namespace
-
 TEST(PlannerNodeSensors, LidarScansOnTheTopicBecomeThePlannersMapOnlyWhileTheBaseIsStill) {
   Params params;
   params.environment_source = "sensors";
@@ -558,7 +522,11 @@ TEST(PlannerNodeSensors, LidarScansOnTheTopicBecomeThePlannersMapOnlyWhileTheBas
   // Plays the robot for `seconds`: joint state, odometry and the lidar's revolution of a wall at
   // `wall_x`, at 10 Hz; stops early once `until` holds.
   auto play = [&](double wall_x, double vx, double seconds, const std::function<bool()>& until) {
-    const msg::LidarScan scan = wall_scan_msg(front.name, front.frame, 4, map_T_lidar, wall_x);
+    std::mt19937 rng(1u);
+    hardware::LidarScan revolution = fixtures::wall_scan(map_T_lidar, wall_x, 0.0, rng, 360);
+    revolution.sensor = front.name;
+    revolution.frame = front.frame;
+    const msg::LidarScan scan = sensors_dds::to_msg(revolution, 4);
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
     while (std::chrono::steady_clock::now() < end && !until()) {
       joint_state.write(js);

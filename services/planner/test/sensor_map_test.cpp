@@ -34,51 +34,15 @@ Eigen::Isometry3d at(const Eigen::Vector3d& xyz, double yaw = 0.0) {
   return t;
 }
 
-// A VLP-16-like revolution: 16 rings over +-15 deg, `columns` azimuths over the full turn.
-LidarScan empty_scan(std::uint32_t columns = 900) {
-  LidarScan s;
+// The wall's scan with the test's sensor names.
+LidarScan wall_scan(const Eigen::Isometry3d& map_T_sensor, double sigma, std::mt19937& rng, std::uint32_t columns = 900) {
+  LidarScan s = fixtures::wall_scan(map_T_sensor, kWallX, sigma, rng, columns);
   s.sensor = "test_lidar";
   s.frame = "test_lidar_frame";
-  for (int r = 0; r < 16; ++r) s.elevations.push_back(static_cast<float>((-15.0 + 2.0 * r) * std::numbers::pi / 180.0));
-  s.columns = columns;
-  s.azimuth_min = -std::numbers::pi;
-  s.azimuth_increment = 2.0 * std::numbers::pi / columns;
-  s.ranges.assign(s.elevations.size() * columns, 0.0F);
-  s.range_min = 0.1F;
-  s.range_max = 100.0F;
   return s;
 }
 
-Eigen::Vector3d beam(const LidarScan& s, std::size_t r, std::uint32_t c) {
-  const double e = s.elevations[r], a = s.azimuth_min + s.azimuth_increment * c;
-  return {std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)};
-}
-
-// Distance along a map-frame ray to the wall's front face (6 m wide, 3 m high) or the floor;
-// infinity if neither.
-double wall_or_floor(const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
-  double t = std::numeric_limits<double>::infinity();
-  if (d.x() > 1e-9) {
-    const double tw = (kWallX - o.x()) / d.x();
-    const Eigen::Vector3d p = o + tw * d;
-    if (std::abs(p.y()) <= 3.0 && p.z() >= 0.0 && p.z() <= 3.0) t = tw;
-  }
-  if (d.z() < -1e-9) t = std::min(t, -o.z() / d.z());
-  return t;
-}
-
-// The scan of the wall and floor from `map_T_sensor`, range noise of std-dev `sigma` [m].
-LidarScan wall_scan(const Eigen::Isometry3d& map_T_sensor, double sigma, std::mt19937& rng, std::uint32_t columns = 900) {
-  LidarScan s = empty_scan(columns);
-  std::normal_distribution<double> noise(0.0, sigma);
-  for (std::size_t r = 0; r < s.elevations.size(); ++r) {
-    for (std::uint32_t c = 0; c < s.columns; ++c) {
-      const double t = wall_or_floor(map_T_sensor.translation(), map_T_sensor.linear() * beam(s, r, c));
-      if (std::isfinite(t) && t < s.range_max) s.ranges[r * s.columns + c] = static_cast<float>(t + noise(rng));
-    }
-  }
-  return s;
-}
+using fixtures::beam;
 
 std::vector<Eigen::Vector3d> occupied_centres(const Environment& env) {
   std::vector<Eigen::Vector3d> out;
@@ -263,7 +227,7 @@ TEST(SensorMap, BadInputIsRefusedNamingTheFieldAndTheMapIsUnchanged) {
     return std::string("accepted");
   };
   // A scan that clears everything the map had, if accepted.
-  LidarScan good = empty_scan();
+  LidarScan good = wall_scan(sensor, 0.0, rng);
   for (float& r : good.ranges) r = 10.0F;
   LidarScan short_ranges = good;
   short_ranges.ranges.pop_back();

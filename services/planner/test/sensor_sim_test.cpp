@@ -9,13 +9,13 @@
 #include <mujoco/mujoco.h>
 #include <octomap/OcTree.h>
 
-#include <cstring>
 #include <iostream>
 #include <random>
 #include <sstream>
 
 #include "concert/sim/ray_sensors.hpp"
 #include "concert/world/world.hpp"
+#include "mujoco_scene.hpp"  // libs/sim's test helper: a MuJoCo model + data from MJCF text
 #include "planner/fixtures.hpp"
 #include "planner/sensor_map.hpp"
 #include "planner/state_checker.hpp"
@@ -44,7 +44,7 @@ World planner_world(const world::World& w) {
 std::string mjcf_of(const world::World& w) {
   std::ostringstream x;
   x.precision(17);
-  x << "<mujoco><worldbody>\n<geom type=\"plane\" size=\"50 50 0.1\" pos=\"0 0 " << w.floor_height << "\"/>\n";
+  x << "<geom type=\"plane\" size=\"50 50 0.1\" pos=\"0 0 " << w.floor_height << "\"/>\n";
   for (const auto* list : {&w.walls, &w.obstacles}) {
     for (const world::WorldShape& s : *list) {
       const Eigen::Vector3d& p = s.position;
@@ -57,38 +57,8 @@ std::string mjcf_of(const world::World& w) {
       }
     }
   }
-  x << "</worldbody></mujoco>\n";
-  return x.str();
+  return sim::test::mjcf_document(x.str());
 }
-
-class Scene {
- public:
-  explicit Scene(const std::string& mjcf) {
-    mjVFS vfs;
-    mj_defaultVFS(&vfs);
-    const char* file = "scene.xml";
-    if (mj_makeEmptyFileVFS(&vfs, file, static_cast<int>(mjcf.size())) != 0) throw std::runtime_error("no virtual file");
-    std::memcpy(vfs.filedata[0], mjcf.data(), mjcf.size());
-    char error[1000] = "";
-    m_ = mj_loadXML(file, &vfs, error, sizeof(error));
-    mj_deleteVFS(&vfs);
-    if (m_ == nullptr) throw std::runtime_error(std::string("MuJoCo rejected the scene: ") + error);
-    d_ = mj_makeData(m_);
-    mj_forward(m_, d_);
-  }
-  ~Scene() {
-    mj_deleteData(d_);
-    mj_deleteModel(m_);
-  }
-  Scene(const Scene&) = delete;
-  Scene& operator=(const Scene&) = delete;
-  [[nodiscard]] const mjModel* m() const { return m_; }
-  [[nodiscard]] const mjData* d() const { return d_; }
-
- private:
-  mjModel* m_ = nullptr;
-  mjData* d_ = nullptr;
-};
 
 Eigen::VectorXd at_base(const PlanningModel& m, double x, double y, double yaw) {
   Eigen::VectorXd q = Eigen::VectorXd::Zero(m.full_dof());
@@ -112,7 +82,7 @@ TEST(SensorMapSim, SimulatedLidarScansOfTheDemoSiteMapItsWallLikeTheWorldDescrip
   from_world.add_world(planner_world(site));
 
   // The robot drives along the wall and stops at five places; both lidars scan at each.
-  const Scene scene(mjcf_of(site));
+  const sim::test::MujocoScene scene(mjcf_of(site));
   const sim::LidarSimulator lidar{sim::LidarParams{}};
   std::mt19937_64 rng(42);
   const SensorMapper mapper(model, params);
