@@ -468,7 +468,7 @@ TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {
   EXPECT_NE(err.str().find("camera_E"), std::string::npos) << err.str();
 }
 
-TEST(PlannerNodeSensors, LidarScansOnTheTopicBecomeThePlannersMapOnlyWhileTheBaseIsStill) {
+TEST(PlannerNodeSensors, LidarScansAndDepthFramesOnTheTopicsBecomeThePlannersMapOnlyWhileTheRobotIsStill) {
   Params params;
   params.environment_source = "sensors";
   params.sensor_map_period = 0.2;
@@ -538,7 +538,7 @@ TEST(PlannerNodeSensors, LidarScansOnTheTopicBecomeThePlannersMapOnlyWhileTheBas
   play(1.6, 0.0, 10.0, [&] { return wall_seen(1.6); });
   ASSERT_TRUE(wall_seen(1.6)) << "the lidar's wall did not reach the planner's map within 10 s\n" << log.str();
   EXPECT_FALSE(wall_seen(3.0));
-  EXPECT_NE(log.str().find("planner: sensor map: 1 scans used (" + front.name + ")"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("planner: sensor map: used " + front.name + " in "), std::string::npos) << log.str();
 
   // While the base moves the scans are held back (motion blur across a revolution); once it
   // stops they are used, and the line says how many waited.
@@ -546,5 +546,43 @@ TEST(PlannerNodeSensors, LidarScansOnTheTopicBecomeThePlannersMapOnlyWhileTheBas
   EXPECT_FALSE(wall_seen(1.2)) << "a scan taken while the base moved was integrated";
   play(1.2, 0.0, 10.0, [&] { return wall_seen(1.2); });
   EXPECT_TRUE(wall_seen(1.2)) << log.str();
-  EXPECT_NE(log.str().find("scans skipped while the base moved"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("revolutions or frames skipped: the robot moved"), std::string::npos) << log.str();
+
+  // The tool's depth camera: a burst of frames of a board 1.2 m ahead of it (1 cm noise each),
+  // averaged into the map.
+  const model::SensorFrame& camera = model->robot().sensor(model->tool(""), model::SensorKind::kCamera);
+  const Eigen::Isometry3d map_T_camera = model->link_pose(q, camera.frame);
+  const Eigen::Vector3d board = map_T_camera * Eigen::Vector3d(0.0, 0.0, 1.2);
+  ASSERT_GT(board.z(), 0.3) << "the camera must see the board, not the floor";
+  auto board_seen = [&] {
+    const Eigen::Vector3d axis = map_T_camera.linear().col(2);
+    const Environment env = planner.environment();
+    return env.occupied(board) || env.occupied(board + 0.05 * axis) || env.occupied(board - 0.05 * axis);
+  };
+  ASSERT_FALSE(board_seen());
+  concert::dds::Writer<msg::Image> depth(participant, concert::dds::topics::camera_depth);
+  concert::dds::Writer<msg::CameraInfo> info(participant, concert::dds::topics::camera_info);
+  hardware::RgbdFrame frame;
+  frame.sensor = camera.name;
+  frame.frame = camera.frame;
+  frame.intrinsics = {80, 60, 60.0, 60.0, 39.5, 29.5};
+  std::mt19937 rng(2u);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const auto depth_deadline = std::chrono::steady_clock::now() + 10s;
+  while (std::chrono::steady_clock::now() < depth_deadline && !board_seen()) {
+    joint_state.write(js);
+    odometry.write(odom(0.0));
+    info.write(sensors_dds::to_camera_info(frame, 4));
+    for (int i = 0; i < 5; ++i) {
+      frame.depth.assign(80 * 60, 0);
+      for (auto& d : frame.depth) d = static_cast<std::uint16_t>(std::lround((1.2 + noise(rng)) * 1000.0));
+      msg::Image image;
+      sensors_dds::to_depth_image(frame, 4, image);
+      depth.write(image);
+    }
+    std::this_thread::sleep_for(300ms);
+  }
+  EXPECT_TRUE(board_seen()) << log.str();
+  EXPECT_NE(log.str().find(camera.name + " ("), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("depth frames averaged)"), std::string::npos) << log.str();
 }

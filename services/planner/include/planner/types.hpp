@@ -59,7 +59,10 @@ struct Params {
   double sensor_max_range = 6.0;     ///< returns farther than this [m] clear their ray up to it and mark nothing
   double sensor_self_padding = 0.05; ///< robot shapes grown by this [m]: returns inside them are the robot's own
   double sensor_floor_band = 0.05;   ///< returns below floor_height + this [m] are the floor: they clear, never occupy
-  double sensor_max_base_speed = 0.05;  ///< service: scans are integrated only while the base moves slower [m/s, rad/s]
+  /// service: a period's lidar revolutions and depth frames are used only if the base and every
+  /// joint moved slower than this all along it [m/s, rad/s]
+  double sensor_max_speed = 0.05;
+  int sensor_depth_frames = 5;       ///< service: the latest depth frames of a camera averaged per map update (>= 1)
   int sensor_depth_stride = 4;       ///< depth images: every n-th pixel in u and v is ray-cast (>= 1)
   double sensor_depth_min_valid = 0.5;  ///< depth averaging: fraction of the frames that must read a pixel (0..1]
 

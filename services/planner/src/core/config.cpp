@@ -45,7 +45,7 @@ Params read_params(config::Document& doc) {
       {"sensor_map_period", &p.sensor_map_period},
       {"sensor_self_padding", &p.sensor_self_padding},
       {"sensor_floor_band", &p.sensor_floor_band},
-      {"sensor_max_base_speed", &p.sensor_max_base_speed},
+      {"sensor_max_speed", &p.sensor_max_speed},
   };
   const std::pair<const char*, double*> positive[] = {
       {"octomap_resolution", &p.octomap_resolution},
@@ -67,6 +67,7 @@ Params read_params(config::Document& doc) {
   for (const auto& [key, value] : positive) root.number(key, *value, config::Range::positive());
   for (const auto& [key, value] : counts) root.integer(key, *value, 0);
   root.integer("sensor_depth_stride", p.sensor_depth_stride, 1);
+  root.integer("sensor_depth_frames", p.sensor_depth_frames, 1);
   root.number("sensor_depth_min_valid", p.sensor_depth_min_valid, config::Range{0.0, 1.0, true});
   root.choice("environment_source", p.environment_source, {"world", "sensors", "both"});
   root.number("floor_height", p.floor_height);

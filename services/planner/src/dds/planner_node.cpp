@@ -113,13 +113,15 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
       models_(participant, concert::dds::topics::robot_model,
               [this](const auto& s, const auto&) { on_model(s); }),
       joint_states_(participant, concert::dds::topics::joint_state,
-                    [this](const auto& s, const auto&) {
+                    [this](const msg::JointState& s, const auto&) {
+                      if (use_sensors_) note_motion(s);
                       std::lock_guard lock(mutex_);
                       joint_state_ = s;
                     }),
       odometries_(participant, concert::dds::topics::odometry,
-                  [this](const auto& s, const auto&) {
+                  [this](const msg::Odometry& s, const auto&) {
                     map_frame_.on_odometry(s.stamp_ns(), {s.x(), s.y(), s.yaw()});
+                    if (use_sensors_) note_motion(s);
                     std::lock_guard lock(mutex_);
                     odometry_ = s;
                   }),
@@ -154,11 +156,23 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
           std::lock_guard lock(map_mutex_);
           pending_scans_[scan.sensor()] = scan;
         });
+    camera_info_reader_ = std::make_unique<concert::dds::Reader<msg::CameraInfo>>(
+        participant, concert::dds::topics::camera_info, [this](const msg::CameraInfo& info, const auto&) {
+          std::lock_guard lock(map_mutex_);
+          camera_infos_[info.sensor()] = info;
+        });
+    depth_reader_ = std::make_unique<concert::dds::Reader<msg::Image>>(
+        participant, concert::dds::topics::camera_depth, [this](const msg::Image& image, const auto&) {
+          std::lock_guard lock(map_mutex_);
+          auto& frames = pending_depth_[image.sensor()];
+          frames.push_back(image);
+          while (frames.size() > static_cast<std::size_t>(planner_.params().sensor_depth_frames)) frames.pop_front();
+        });
     publish_environment();
     std::ostringstream line;
-    line << "planner: map from " << source << " (lidar revolutions every "
-         << planner_.params().sensor_map_period << " s at most, while the base is slower than "
-         << planner_.params().sensor_max_base_speed << " m/s)";
+    line << "planner: map from " << source << " (lidar revolutions and depth frames every "
+         << planner_.params().sensor_map_period << " s at most, of periods the base and joints stayed slower than "
+         << planner_.params().sensor_max_speed << " m/s, rad/s)";
     log_line(line.str());
     sensor_mapper_ = std::thread([this] { sensor_map_loop(); });
   }
@@ -178,6 +192,8 @@ PlannerNode::~PlannerNode() {
   if (warmer_.joinable()) warmer_.join();
   if (sensor_mapper_.joinable()) sensor_mapper_.join();
   lidars_.reset();
+  depth_reader_.reset();
+  camera_info_reader_.reset();
 }
 
 void PlannerNode::log_line(const std::string& line) {
@@ -606,13 +622,37 @@ void PlannerNode::sensor_map_loop() {
   }
 }
 
+void PlannerNode::note_motion(const msg::Odometry& odometry) {
+  const double limit = planner_.params().sensor_max_speed;
+  if (std::hypot(odometry.vx(), odometry.vy()) <= limit && std::abs(odometry.wz()) <= limit) return;
+  std::lock_guard lock(map_mutex_);
+  moved_ = true;
+}
+
+void PlannerNode::note_motion(const msg::JointState& joints) {
+  const double limit = planner_.params().sensor_max_speed;
+  for (const double v : joints.velocity()) {
+    if (std::abs(v) > limit) {
+      std::lock_guard lock(map_mutex_);
+      moved_ = true;
+      return;
+    }
+  }
+}
+
 void PlannerNode::update_sensor_map() {
   const Params& params = planner_.params();
   const auto model = planner_.model();
   std::map<std::string, msg::LidarScan> scans;
+  std::map<std::string, std::deque<msg::Image>> depth;
+  std::map<std::string, msg::CameraInfo> infos;
+  bool moved = false;
   {
     std::lock_guard lock(map_mutex_);
     scans.swap(pending_scans_);
+    depth.swap(pending_depth_);
+    infos = camera_infos_;
+    moved = std::exchange(moved_, false);
   }
   if (!model) return;  // no model: no sensor frames, no self filter
   if (!mapper_ || mapper_->model().version() != model->version()) {
@@ -620,7 +660,9 @@ void PlannerNode::update_sensor_map() {
     mapper_ = std::make_shared<const SensorMapper>(model, params);
     log_line("planner: sensor map: self filter on model version " + std::to_string(model->version()));
   }
-  if (scans.empty()) return;
+  std::size_t inputs = scans.size();
+  for (const auto& [name, frames] : depth) inputs += frames.size();
+  if (inputs == 0) return;
   std::optional<msg::JointState> js;
   std::optional<msg::Odometry> odom;
   {
@@ -630,13 +672,13 @@ void PlannerNode::update_sensor_map() {
   }
   if (!js || js->model_version() != model->version() || !odom) {
     std::lock_guard lock(map_mutex_);
-    scans_skipped_version_ += scans.size();  // no robot state of this model to place them with
+    skipped_version_ += inputs;  // no robot state of this model to place them with
     return;
   }
-  if (std::hypot(odom->vx(), odom->vy()) > params.sensor_max_base_speed ||
-      std::abs(odom->wz()) > params.sensor_max_base_speed) {
+  if (moved) {
+    // Something moved during the period: its revolutions and frames may be smeared.
     std::lock_guard lock(map_mutex_);
-    scans_skipped_moving_ += scans.size();
+    skipped_moving_ += inputs;
     return;
   }
   const Eigen::Vector3d base =
@@ -645,6 +687,11 @@ void PlannerNode::update_sensor_map() {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> used, refused;
   SensorMapStats total;
+  auto add = [&](const SensorMapStats& s) {
+    total.occupied += s.occupied;
+    total.self += s.self;
+    total.floor += s.floor;
+  };
   std::size_t stale = 0;
   Environment map = [&] {
     std::lock_guard lock(map_mutex_);
@@ -657,12 +704,27 @@ void PlannerNode::update_sensor_map() {
     }
     try {
       const hardware::LidarScan scan = sensors_dds::from_msg(m);
-      const SensorMapStats s = mapper_->insert_lidar(map, scan, mapper_->sensor_pose(q, scan.frame), q);
-      total.returns += s.returns;
-      total.occupied += s.occupied;
-      total.self += s.self;
-      total.floor += s.floor;
+      add(mapper_->insert_lidar(map, scan, mapper_->sensor_pose(q, scan.frame), q));
       used.push_back(name);
+    } catch (const std::exception& e) {
+      refused.push_back(name + ": " + e.what());
+    }
+  }
+  for (const auto& [name, images] : depth) {
+    try {
+      const auto info = infos.find(name);
+      if (info == infos.end()) throw PlannerError("no camera info");
+      std::vector<hardware::RgbdFrame> frames;
+      for (const msg::Image& image : images) {
+        if (image.model_version() != model->version()) {
+          stale += 1;
+          continue;
+        }
+        frames.push_back(sensors_dds::to_depth_frame(image, info->second));
+      }
+      if (frames.empty()) continue;
+      add(mapper_->insert_depth(map, frames, mapper_->sensor_pose(q, frames.front().frame), q));
+      used.push_back(name + " (" + std::to_string(frames.size()) + " depth frames averaged)");
     } catch (const std::exception& e) {
       refused.push_back(name + ": " + e.what());
     }
@@ -672,20 +734,21 @@ void PlannerNode::update_sensor_map() {
     std::lock_guard lock(map_mutex_);
     sensor_map_ = map;
     if (used.empty() && refused.empty()) {
-      scans_skipped_version_ += stale;  // nothing to report yet: counted into the next line
+      skipped_version_ += stale;  // nothing to report yet: counted into the next line
       return;
     }
-    moving = std::exchange(scans_skipped_moving_, 0);
-    version = std::exchange(scans_skipped_version_, 0) + stale;
+    moving = std::exchange(skipped_moving_, 0);
+    version = std::exchange(skipped_version_, 0) + stale;
   }
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   std::ostringstream line;
-  line << "planner: sensor map: " << used.size() << " scans used";
-  for (std::size_t i = 0; i < used.size(); ++i) line << (i == 0 ? " (" : ", ") << used[i] << (i + 1 == used.size() ? ")" : "");
+  line << "planner: sensor map: used ";
+  for (std::size_t i = 0; i < used.size(); ++i) line << (i == 0 ? "" : ", ") << used[i];
+  if (used.empty()) line << "nothing";
   line << " in " << std::lround(ms) << " ms, " << total.occupied << " hits, " << total.self << " on the robot, "
        << total.floor << " floor; map " << map.occupied_cells() << " occupied cells";
-  if (moving > 0) line << "; " << moving << " scans skipped while the base moved";
-  if (version > 0) line << "; " << version << " scans skipped: not of model version " << model->version() << " or no joint state";
+  if (moving > 0) line << "; " << moving << " revolutions or frames skipped: the robot moved";
+  if (version > 0) line << "; " << version << " skipped: not of model version " << model->version() << " or no joint state";
   for (const std::string& r : refused) line << "; refused " << r;
   log_line(line.str());
   // After the line, so whoever sees the new map finds the line that reports it.

@@ -16,10 +16,11 @@
 // localisation the two frames are one (a world without a building).
 //
 // Map source (Params::environment_source): "world" (default) builds the map from the world
-// topic; "sensors" from the robot's lidar revolutions (concert/sensors/lidar), ray-cast every
-// sensor_map_period from each lidar's model pose at the latest joint state and the odometry
-// placed in the map, while the base is nearly still (SensorMapper); "both" publishes the
-// world's obstacles and the sensors' together.
+// topic; "sensors" from the robot's lidar revolutions (concert/sensors/lidar) and depth images
+// (concert/sensors/camera/depth + info, the latest frames of each camera averaged), ray-cast
+// every sensor_map_period from each sensor's model pose at the latest joint state and the
+// odometry placed in the map, of periods in which the base and the joints stayed nearly still
+// (SensorMapper); "both" publishes the world's obstacles and the sensors' together.
 
 #include <atomic>
 #include <chrono>
@@ -104,6 +105,9 @@ class PlannerNode {
   /// Integrates the pending lidar scans into the sensor map and publishes the map (sensor map
   /// thread only).
   void update_sensor_map();
+  /// Marks the period as moved if the base or a joint is faster than sensor_max_speed.
+  void note_motion(const msg::Odometry& odometry);
+  void note_motion(const msg::JointState& joints);
   /// Gives the planner the map of the configured source (world, sensors or both).
   void publish_environment();
 
@@ -125,10 +129,13 @@ class PlannerNode {
   const bool use_sensors_;
   std::mutex map_mutex_;  // guards the members below
   std::map<std::string, msg::LidarScan> pending_scans_;  // newest revolution of each lidar not yet used
+  std::map<std::string, std::deque<msg::Image>> pending_depth_;  // latest depth frames per camera
+  std::map<std::string, msg::CameraInfo> camera_infos_;          // latest per camera
+  bool moved_ = false;  // the base or a joint moved since the last map update
   Environment world_map_;
   Environment sensor_map_;
-  std::size_t scans_skipped_moving_ = 0;  // since the last map update line
-  std::size_t scans_skipped_version_ = 0;
+  std::size_t skipped_moving_ = 0;  // revolutions and frames, since the last map update line
+  std::size_t skipped_version_ = 0;
   std::shared_ptr<const SensorMapper> mapper_;  // sensor map thread only
   uint64_t warm_version_ = 0;  // model version the warm-up thread should prepare (0: none)
   concert::dds::Writer<msg::PlanResult> results_;
@@ -145,6 +152,8 @@ class PlannerNode {
   concert::dds::Reader<msg::World> worlds_;
   concert::dds::Reader<msg::PlanRequest> request_reader_;
   std::unique_ptr<concert::dds::Reader<msg::LidarScan>> lidars_;
+  std::unique_ptr<concert::dds::Reader<msg::CameraInfo>> camera_info_reader_;
+  std::unique_ptr<concert::dds::Reader<msg::Image>> depth_reader_;
 
 
   std::thread executor_;
