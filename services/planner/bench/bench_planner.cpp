@@ -115,10 +115,13 @@ int bench_sensor_map(const Options& options) {
   std::uniform_real_distribution<double> jitter(-0.05, 0.05);
   constexpr double kWallX = 2.2;
   planner::Environment map(params.octomap_resolution);
-  std::vector<double> lidar_ms;
+  std::vector<double> lidar_ms, both_ms;
+  planner::Environment both_map(params.octomap_resolution);  // the two lidars in one insert, as the service does
   std::size_t returns = 0;
   for (int n = 0; n < options.sensor_map; ++n) {
     const Eigen::VectorXd q = model->full_from_named({}, {}, Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng)));
+    std::vector<planner::RayBundle> bundles;
+    double sort_ms = 0.0;
     for (const model::SensorFrame* f : lidars) {
       const Eigen::Isometry3d pose = mapper.sensor_pose(q, f->frame);
       hardware::LidarScan scan = planner::fixtures::wall_scan(pose, kWallX, 0.015, rng);
@@ -127,7 +130,13 @@ int bench_sensor_map(const Options& options) {
       const auto t0 = clock::now();
       returns += mapper.insert_lidar(map, scan, pose, q).returns;
       lidar_ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
+      const auto t1 = clock::now();
+      bundles.push_back(mapper.lidar_rays(scan, pose, q).rays);
+      sort_ms += std::chrono::duration<double, std::milli>(clock::now() - t1).count();
     }
+    const auto t2 = clock::now();
+    both_map.insert_rays(bundles);
+    both_ms.push_back(sort_ms + std::chrono::duration<double, std::milli>(clock::now() - t2).count());
   }
   // Depth: the camera 1.2 m before the wall, looking at it.
   hardware::RgbdFrame frame;
@@ -159,6 +168,7 @@ int bench_sensor_map(const Options& options) {
   std::printf("sensor map, morphology A, %zu lidars, resolution %.3f m, max range %.1f m, self padding %.3f m\n",
               lidars.size(), params.octomap_resolution, params.sensor_max_range, params.sensor_self_padding);
   row("lidar revolution (16 x 900 beams)", lidar_ms);
+  row("both lidars' revolutions in one insert", both_ms);
   row("depth (10 frames of 640 x 480 averaged)", depth_ms);
   std::printf("lidar map: %zu returns, %zu occupied cells; depth map: %zu occupied cells (stride %d)\n", returns,
               map.occupied_cells(), depth_map.occupied_cells(), params.sensor_depth_stride);

@@ -338,3 +338,47 @@ TEST(SensorMap, TheWorldsMapAndTheSensorsTogetherHoldTheOccupiedCellsOfBoth) {
   EXPECT_FALSE(both.occupied(Eigen::Vector3d(0.5, 0.0, 1.0)));
   EXPECT_THROW(both.add_occupied(Environment(0.1)), PlannerError);
 }
+
+TEST(SensorMap, SeveralSensorsInOneInsertMapWhatEachSees) {
+  Params p;
+  p.sensor_max_range = 4.0;
+  const auto model = model_a(p);
+  const SensorMapper mapper(model, p);
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(model->full_dof());
+  std::mt19937 rng(11u);
+  // Two lidars on either side of the robot; within 4 m each reaches only its own end of the wall.
+  const Eigen::Isometry3d left = at({-1.0, 2.0, 1.0}), right = at({-1.0, -2.0, 1.0});
+  LidarScan a = wall_scan(left, 0.0, rng), b = wall_scan(right, 0.0, rng);
+  const SensorRays ra = mapper.lidar_rays(a, left, q), rb = mapper.lidar_rays(b, right, q);
+  Environment env(kRes);
+  env.insert_rays({ra.rays, rb.rays});
+  Environment one_by_one(kRes);
+  (void)mapper.insert_lidar(one_by_one, a, left, q);
+  (void)mapper.insert_lidar(one_by_one, b, right, q);
+  // Each end of the wall is in the map (somewhere up its face).
+  auto end_seen = [&](double y) {
+    for (double z = 0.525; z < 2.0; z += kRes) {
+      if (env.occupied({kWallX - 0.025, y, z}) || env.occupied({kWallX + 0.025, y, z})) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(end_seen(2.825));
+  EXPECT_TRUE(end_seen(-2.825));
+  // Where only one sensor reaches, one insert and two give the same cells.
+  for (const Eigen::Vector3d& c : occupied_centres(one_by_one)) {
+    if (std::abs(c.y()) > 1.5) {
+      EXPECT_TRUE(env.occupied(c)) << c.transpose();
+    }
+  }
+  // A bad bundle is named and nothing is inserted.
+  const auto before = env.octree();
+  RayBundle bad = rb.rays;
+  bad.hits[3].x() = std::numeric_limits<double>::quiet_NaN();
+  try {
+    env.insert_rays({ra.rays, bad});
+    ADD_FAILURE() << "a non-finite hit was accepted";
+  } catch (const PlannerError& e) {
+    EXPECT_EQ(std::string(e.what()), "rays of bundle 1: hit 3 is not finite");
+  }
+  EXPECT_EQ(env.octree(), before);
+}

@@ -44,6 +44,13 @@ class DistanceField {
   std::vector<float> values_;  // signed distance of each cell centre [m]
 };
 
+/// Rays from one sensor origin (map frame, [m]) for Environment::insert_rays.
+struct RayBundle {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> hits;    ///< ends that become occupied
+  std::vector<Eigen::Vector3d> clears;  ///< ends that only clear their ray (their cell too)
+};
+
 /// Occupancy map. Cheap to copy (the tree is shared and never modified after it is published
 /// to a StateChecker: every insert makes a new tree).
 class Environment {
@@ -65,6 +72,9 @@ class Environment {
   /// a maximum range). Non-finite input throws PlannerError naming it, the map unchanged.
   void insert_rays(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& hits,
                    const std::vector<Eigen::Vector3d>& clears);
+  /// The same for several sensors at once: one copy of the tree for all of them (a cell passed
+  /// by one sensor's ray and hit by another's counts as hit). Errors name the bundle.
+  void insert_rays(const std::vector<RayBundle>& bundles);
   /// Marks the centre of every occupied leaf of `other` occupied here (the union of two maps,
   /// e.g. the world's and the sensors'). Throws PlannerError if the resolutions differ.
   void add_occupied(const Environment& other);

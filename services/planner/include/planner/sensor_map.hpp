@@ -30,6 +30,12 @@ struct SensorMapStats {
   std::size_t no_return = 0;  ///< beams or pixels without a return: skipped
 };
 
+/// One sensor's returns sorted into rays, ready for Environment::insert_rays.
+struct SensorRays {
+  RayBundle rays;
+  SensorMapStats stats;
+};
+
 /// Ray-casts sensor data into an Environment. Immutable; one per model version (the self
 /// filter uses that model's shapes). Parameters: Params::sensor_* and floor_height.
 ///
@@ -55,6 +61,11 @@ class SensorMapper {
   SensorMapStats insert_lidar(Environment& environment, const hardware::LidarScan& scan,
                               const Eigen::Isometry3d& map_T_sensor, const Eigen::VectorXd& q_full) const;
 
+  /// The rays insert_lidar() would cast, without touching a map (to insert several sensors with
+  /// one copy of the tree). Same checks and errors.
+  [[nodiscard]] SensorRays lidar_rays(const hardware::LidarScan& scan, const Eigen::Isometry3d& map_T_sensor,
+                                      const Eigen::VectorXd& q_full) const;
+
   /// Successive depth frames of one camera (same size and intrinsics) from `map_T_optical`
   /// (optical frame: z forward, x right, y down), averaged per pixel: a pixel counts when at
   /// least sensor_depth_min_valid of the frames read it, and its depth is the mean of those
@@ -63,6 +74,10 @@ class SensorMapper {
   /// depth not width x height, bad intrinsics or scale, frames that differ); map unchanged.
   SensorMapStats insert_depth(Environment& environment, const std::vector<hardware::RgbdFrame>& frames,
                               const Eigen::Isometry3d& map_T_optical, const Eigen::VectorXd& q_full) const;
+
+  /// The rays insert_depth() would cast, without touching a map. Same checks and errors.
+  [[nodiscard]] SensorRays depth_rays(const std::vector<hardware::RgbdFrame>& frames, const Eigen::Isometry3d& map_T_optical,
+                                      const Eigen::VectorXd& q_full) const;
 
   /// True if map point `p` lies in a robot collision shape grown by sensor_self_padding at the
   /// link poses `link_poses` (PlanningModel::link_poses).
@@ -81,9 +96,9 @@ class SensorMapper {
   };
   [[nodiscard]] std::vector<PaddedShape> padded_shapes(const std::vector<Eigen::Isometry3d>& link_poses) const;
   [[nodiscard]] static bool inside(const std::vector<PaddedShape>& shapes, const Eigen::Vector3d& p);
-  /// Sorts map-frame returns into hits and clears and ray-casts them.
-  SensorMapStats insert(Environment& environment, const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& ends,
-                        const Eigen::VectorXd& q_full) const;
+  /// Sorts map-frame returns into hits and clears.
+  [[nodiscard]] SensorRays sort(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& ends,
+                                const Eigen::VectorXd& q_full) const;
   void check_q(const Eigen::VectorXd& q_full, const std::string& what) const;
 
   std::shared_ptr<const PlanningModel> model_;

@@ -223,29 +223,39 @@ void Environment::insert_point_cloud(const std::vector<Eigen::Vector3d>& points,
 
 void Environment::insert_rays(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& hits,
                               const std::vector<Eigen::Vector3d>& clears) {
-  if (!origin.allFinite()) throw PlannerError("rays: sensor origin is not finite");
-  for (std::size_t i = 0; i < hits.size(); ++i) {
-    if (!hits[i].allFinite()) throw PlannerError("rays: hit " + std::to_string(i) + " is not finite");
-  }
-  for (std::size_t i = 0; i < clears.size(); ++i) {
-    if (!clears[i].allFinite()) throw PlannerError("rays: cleared end " + std::to_string(i) + " is not finite");
+  insert_rays(std::vector<RayBundle>{RayBundle{origin, hits, clears}});
+}
+
+void Environment::insert_rays(const std::vector<RayBundle>& bundles) {
+  for (std::size_t b = 0; b < bundles.size(); ++b) {
+    const RayBundle& bundle = bundles[b];
+    const std::string which = bundles.size() > 1 ? "rays of bundle " + std::to_string(b) : "rays";
+    if (!bundle.origin.allFinite()) throw PlannerError(which + ": sensor origin is not finite");
+    for (std::size_t i = 0; i < bundle.hits.size(); ++i) {
+      if (!bundle.hits[i].allFinite()) throw PlannerError(which + ": hit " + std::to_string(i) + " is not finite");
+    }
+    for (std::size_t i = 0; i < bundle.clears.size(); ++i) {
+      if (!bundle.clears[i].allFinite()) throw PlannerError(which + ": cleared end " + std::to_string(i) + " is not finite");
+    }
   }
   auto tree = mutable_copy();
-  const octomap::point3d o(float(origin.x()), float(origin.y()), float(origin.z()));
   octomap::KeySet free_cells, occupied_cells;
   octomap::KeyRay ray;
-  auto pass = [&](const Eigen::Vector3d& end) {
-    const octomap::point3d e(float(end.x()), float(end.y()), float(end.z()));
-    if (tree->computeRayKeys(o, e, ray)) free_cells.insert(ray.begin(), ray.end());
-    return e;
-  };
-  for (const Eigen::Vector3d& h : hits) {
-    octomap::OcTreeKey key;
-    if (tree->coordToKeyChecked(pass(h), key)) occupied_cells.insert(key);
-  }
-  for (const Eigen::Vector3d& c : clears) {
-    octomap::OcTreeKey key;
-    if (tree->coordToKeyChecked(pass(c), key)) free_cells.insert(key);
+  for (const RayBundle& bundle : bundles) {
+    const octomap::point3d o(float(bundle.origin.x()), float(bundle.origin.y()), float(bundle.origin.z()));
+    auto pass = [&](const Eigen::Vector3d& end) {
+      const octomap::point3d e(float(end.x()), float(end.y()), float(end.z()));
+      if (tree->computeRayKeys(o, e, ray)) free_cells.insert(ray.begin(), ray.end());
+      return e;
+    };
+    for (const Eigen::Vector3d& h : bundle.hits) {
+      octomap::OcTreeKey key;
+      if (tree->coordToKeyChecked(pass(h), key)) occupied_cells.insert(key);
+    }
+    for (const Eigen::Vector3d& c : bundle.clears) {
+      octomap::OcTreeKey key;
+      if (tree->coordToKeyChecked(pass(c), key)) free_cells.insert(key);
+    }
   }
   for (const octomap::OcTreeKey& key : free_cells) {
     if (occupied_cells.count(key) == 0) tree->updateNode(key, false, true);

@@ -93,14 +93,17 @@ bool SensorMapper::on_robot(const Eigen::Vector3d& p, const std::vector<Eigen::I
   return inside(padded_shapes(link_poses), p);
 }
 
-SensorMapStats SensorMapper::insert(Environment& environment, const Eigen::Vector3d& origin,
-                                    const std::vector<Eigen::Vector3d>& ends, const Eigen::VectorXd& q_full) const {
+SensorRays SensorMapper::sort(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& ends,
+                              const Eigen::VectorXd& q_full) const {
   std::vector<Eigen::Isometry3d> poses;
   model_->link_poses(q_full, poses);
   const std::vector<PaddedShape> robot = padded_shapes(poses);
-  SensorMapStats stats;
+  SensorRays out;
+  out.rays.origin = origin;
+  SensorMapStats& stats = out.stats;
   stats.returns = ends.size();
-  std::vector<Eigen::Vector3d> hits, clears;
+  std::vector<Eigen::Vector3d>& hits = out.rays.hits;
+  std::vector<Eigen::Vector3d>& clears = out.rays.clears;
   hits.reserve(ends.size());
   const double floor_top = params_.floor_height + params_.sensor_floor_band;
   for (const Eigen::Vector3d& end : ends) {
@@ -119,12 +122,25 @@ SensorMapStats SensorMapper::insert(Environment& environment, const Eigen::Vecto
       stats.occupied += 1;
     }
   }
-  environment.insert_rays(origin, hits, clears);
-  return stats;
+  return out;
 }
 
 SensorMapStats SensorMapper::insert_lidar(Environment& environment, const hardware::LidarScan& scan,
                                           const Eigen::Isometry3d& map_T_sensor, const Eigen::VectorXd& q_full) const {
+  const SensorRays r = lidar_rays(scan, map_T_sensor, q_full);
+  environment.insert_rays({r.rays});
+  return r.stats;
+}
+
+SensorMapStats SensorMapper::insert_depth(Environment& environment, const std::vector<hardware::RgbdFrame>& frames,
+                                          const Eigen::Isometry3d& map_T_optical, const Eigen::VectorXd& q_full) const {
+  const SensorRays r = depth_rays(frames, map_T_optical, q_full);
+  environment.insert_rays({r.rays});
+  return r.stats;
+}
+
+SensorRays SensorMapper::lidar_rays(const hardware::LidarScan& scan, const Eigen::Isometry3d& map_T_sensor,
+                                    const Eigen::VectorXd& q_full) const {
   const std::string what = "lidar '" + scan.sensor + "' (frame '" + scan.frame + "')";
   const std::size_t rings = scan.elevations.size();
   if (rings == 0) throw PlannerError(what + ": elevations: no rings");
@@ -168,13 +184,13 @@ SensorMapStats SensorMapper::insert_lidar(Environment& environment, const hardwa
       ends.push_back(map_T_sensor * (range * Eigen::Vector3d(ce * ca[c], ce * sa[c], se)));
     }
   }
-  SensorMapStats stats = insert(environment, map_T_sensor.translation(), ends, q_full);
-  stats.no_return = no_return;
-  return stats;
+  SensorRays out = sort(map_T_sensor.translation(), ends, q_full);
+  out.stats.no_return = no_return;
+  return out;
 }
 
-SensorMapStats SensorMapper::insert_depth(Environment& environment, const std::vector<hardware::RgbdFrame>& frames,
-                                          const Eigen::Isometry3d& map_T_optical, const Eigen::VectorXd& q_full) const {
+SensorRays SensorMapper::depth_rays(const std::vector<hardware::RgbdFrame>& frames, const Eigen::Isometry3d& map_T_optical,
+                                    const Eigen::VectorXd& q_full) const {
   if (frames.empty()) throw PlannerError("depth: no frames");
   const hardware::RgbdFrame& first = frames.front();
   const std::string what = "camera '" + first.sensor + "' (frame '" + first.frame + "')";
@@ -221,9 +237,9 @@ SensorMapStats SensorMapper::insert_depth(Environment& environment, const std::v
       ends.push_back(map_T_optical * p);
     }
   }
-  SensorMapStats stats = insert(environment, map_T_optical.translation(), ends, q_full);
-  stats.no_return = no_return;
-  return stats;
+  SensorRays out = sort(map_T_optical.translation(), ends, q_full);
+  out.stats.no_return = no_return;
+  return out;
 }
 
 }  // namespace concert::planner

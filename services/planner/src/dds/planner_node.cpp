@@ -693,10 +693,7 @@ void PlannerNode::update_sensor_map() {
     total.floor += s.floor;
   };
   std::size_t stale = 0;
-  Environment map = [&] {
-    std::lock_guard lock(map_mutex_);
-    return sensor_map_;
-  }();
+  std::vector<RayBundle> bundles;  // every sensor's rays, cast with one copy of the map
   for (const auto& [name, m] : scans) {
     if (m.model_version() != model->version()) {
       stale += 1;
@@ -704,7 +701,9 @@ void PlannerNode::update_sensor_map() {
     }
     try {
       const hardware::LidarScan scan = sensors_dds::from_msg(m);
-      add(mapper_->insert_lidar(map, scan, mapper_->sensor_pose(q, scan.frame), q));
+      SensorRays r = mapper_->lidar_rays(scan, mapper_->sensor_pose(q, scan.frame), q);
+      add(r.stats);
+      bundles.push_back(std::move(r.rays));
       used.push_back(name);
     } catch (const std::exception& e) {
       refused.push_back(name + ": " + e.what());
@@ -723,12 +722,19 @@ void PlannerNode::update_sensor_map() {
         frames.push_back(sensors_dds::to_depth_frame(image, info->second));
       }
       if (frames.empty()) continue;
-      add(mapper_->insert_depth(map, frames, mapper_->sensor_pose(q, frames.front().frame), q));
+      SensorRays r = mapper_->depth_rays(frames, mapper_->sensor_pose(q, frames.front().frame), q);
+      add(r.stats);
+      bundles.push_back(std::move(r.rays));
       used.push_back(name + " (" + std::to_string(frames.size()) + " depth frames averaged)");
     } catch (const std::exception& e) {
       refused.push_back(name + ": " + e.what());
     }
   }
+  Environment map = [&] {
+    std::lock_guard lock(map_mutex_);
+    return sensor_map_;
+  }();
+  if (!bundles.empty()) map.insert_rays(bundles);
   std::size_t moving = 0, version = 0;
   {
     std::lock_guard lock(map_mutex_);
