@@ -17,6 +17,7 @@
 #include "concert/world/world.hpp"
 #include "mujoco_scene.hpp"  // libs/sim's test helper: a MuJoCo model + data from MJCF text
 #include "planner/fixtures.hpp"
+#include "planner/planner.hpp"
 #include "planner/sensor_map.hpp"
 #include "planner/state_checker.hpp"
 
@@ -153,5 +154,31 @@ TEST(SensorMapSim, SimulatedLidarScansOfTheDemoSiteMapItsWallLikeTheWorldDescrip
     EXPECT_NE(free.constraint, Constraint::kEnvironmentCollision) << which << ": " << free.detail;
     const Validity in_wall = checker.check(at_base(*model, face - 0.1, 0.0, 0.0));
     EXPECT_EQ(in_wall.constraint, Constraint::kEnvironmentCollision) << which << ": " << to_string(in_wall.constraint);
+  }
+
+  // The planner itself on the sensor map: a drilling area on the wall's face at 0.8 m (where the
+  // lidars saw it) is planned, and every state of its trajectory is clear of the true wall (the
+  // world map, no padding).
+  const Params plan_params = fixtures::generous(3);
+  Planner planner(plan_params);
+  planner.set_model(fixtures::model_from_assembly(fixtures::data_dir() / "morphology_a.yaml", 1));
+  planner.set_environment(from_sensors);
+  const Eigen::VectorXd start = at_base(*planner.model(), 0.0, 0.0, 0.0);
+  StateChecker truth(planner.model(), from_world, plan_params, 0.0);
+  {
+    const Eigen::Isometry3d area = fixtures::drilling_area(face, 0.0, 0.8);
+    const PlanResult plan = planner.plan(PlanRequest{1, 1, "", {{area}}}, start);
+    ASSERT_EQ(plan.status, Status::kSucceeded) << plan.reason;
+    const GoalResult& goal = plan.goals.front();
+    std::size_t states = 0;
+    for (const TrajectoryPoint& pt : goal.trajectory.points) {
+      const Validity v = truth.check(planner.model()->to_full(pt.q, start));
+      EXPECT_NE(v.constraint, Constraint::kEnvironmentCollision) << "at t = " << pt.time << " s: " << v.detail;
+      states += 1;
+    }
+    EXPECT_GT(states, 10u);
+    std::cout << "area at x = " << area.translation().x() << " m planned on the sensor map (" << goal.path_method << ", "
+              << goal.trajectory.points.back().time << " s of motion, base ends at " << goal.goal_q.head<3>().transpose()
+              << "): " << states << " states clear of the true wall" << std::endl;
   }
 }
