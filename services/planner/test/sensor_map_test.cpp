@@ -21,10 +21,12 @@ namespace {
 
 constexpr double kWallX = 2.0;  // front face of the wall (normal -x)
 constexpr double kRes = 0.05;
-constexpr double kPitch = -0.6;  // [rad] of the arm's second joint in the self-filter test: leaning back towards the lidar
+constexpr double kPitch = -0.6;  // [rad] of the arm's second joint in the self-filter test: leaning
+                                 // back towards the lidar
 
 std::shared_ptr<const PlanningModel> model_a(const Params& p) {
-  return PlanningModel::build(fixtures::model_from_assembly(fixtures::data_dir() / "morphology_a.yaml", 3), p);
+  return PlanningModel::build(
+      fixtures::model_from_assembly(fixtures::data_dir() / "morphology_a.yaml", 3), p);
 }
 
 Eigen::Isometry3d at(const Eigen::Vector3d& xyz, double yaw = 0.0) {
@@ -35,7 +37,8 @@ Eigen::Isometry3d at(const Eigen::Vector3d& xyz, double yaw = 0.0) {
 }
 
 // The wall's scan with the test's sensor names.
-LidarScan wall_scan(const Eigen::Isometry3d& map_T_sensor, double sigma, std::mt19937& rng, std::uint32_t columns = 900) {
+LidarScan wall_scan(const Eigen::Isometry3d& map_T_sensor, double sigma, std::mt19937& rng,
+                    std::uint32_t columns = 900) {
   LidarScan s = fixtures::wall_scan(map_T_sensor, kWallX, sigma, rng, columns);
   s.sensor = "test_lidar";
   s.frame = "test_lidar_frame";
@@ -72,7 +75,7 @@ TEST(SensorMap, LidarScanOfAWallMarksTheWallFreesTheSpaceBeforeItAndNothingBehin
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(model->full_dof());
   const SensorMapStats stats = mapper.insert_lidar(env, scan, sensor, q);
   EXPECT_GT(stats.occupied, 1000u);
-  EXPECT_GT(stats.floor, 1000u);  // the lower rings reach the floor
+  EXPECT_GT(stats.floor, 1000u);      // the lower rings reach the floor
   EXPECT_GT(stats.no_return, 1000u);  // the rear half sees nothing
 
   const auto cells = occupied_centres(env);
@@ -96,15 +99,19 @@ TEST(SensorMap, LidarScanOfAWallMarksTheWallFreesTheSpaceBeforeItAndNothingBehin
       if (pt.z() < 0.1 || std::abs(pt.x() - kWallX) > 0.05) continue;
       hits += 1;
       bool any = false;
-      for (double dx : {-kRes, 0.0, kRes}) any = any || env.occupied(pt + Eigen::Vector3d(dx, 0.0, 0.0));
+      for (double dx : {-kRes, 0.0, kRes})
+        any = any || env.occupied(pt + Eigen::Vector3d(dx, 0.0, 0.0));
       found += any ? 1 : 0;
       // Free before the wall along the beam (up to two voxels short of it), unknown behind.
       for (double s = 0.5; s < range - 2.0 * kRes; s += 0.25) {
-        EXPECT_TRUE(known_free(env, sensor * (s * beam(scan, r, c)))) << "not free at " << s << " m along beam " << r << "," << c;
+        EXPECT_TRUE(known_free(env, sensor * (s * beam(scan, r, c))))
+            << "not free at " << s << " m along beam " << r << "," << c;
       }
       const Eigen::Vector3d behind = sensor * ((range + 0.3) * beam(scan, r, c));
-      if (std::abs(behind.y()) > 2.5) continue;  // beams past the wall's edge reach the floor behind it
-      EXPECT_EQ(env.octree()->search(behind.x(), behind.y(), behind.z()), nullptr) << "known behind the wall at " << behind.transpose();
+      if (std::abs(behind.y()) > 2.5)
+        continue;  // beams past the wall's edge reach the floor behind it
+      EXPECT_EQ(env.octree()->search(behind.x(), behind.y(), behind.z()), nullptr)
+          << "known behind the wall at " << behind.transpose();
     }
   }
   EXPECT_GT(hits, 1000u);
@@ -118,8 +125,8 @@ TEST(SensorMap, ReturnsFartherThanTheMaximumRangeClearTheirRayAndMarkNothing) {
   Environment env(kRes);
   std::mt19937 rng(6u);
   const Eigen::Isometry3d sensor = at({-1.5, 0.0, 1.6});
-  const SensorMapStats stats = SensorMapper(model, p).insert_lidar(env, wall_scan(sensor, 0.0, rng), sensor,
-                                                                   Eigen::VectorXd::Zero(model->full_dof()));
+  const SensorMapStats stats = SensorMapper(model, p).insert_lidar(
+      env, wall_scan(sensor, 0.0, rng), sensor, Eigen::VectorXd::Zero(model->full_dof()));
   EXPECT_GT(stats.cut, 1000u);
   EXPECT_EQ(env.occupied_cells(), 0u);
   EXPECT_TRUE(known_free(env, sensor * Eigen::Vector3d(1.8, 0.0, 0.0)));
@@ -129,13 +136,16 @@ TEST(SensorMap, ReturnsFartherThanTheMaximumRangeClearTheirRayAndMarkNothing) {
 namespace {
 
 // Independent of the mapper: whether p lies in one of the robot's unpadded shapes at q.
-bool in_robot(const PlanningModel& m, const std::vector<Eigen::Isometry3d>& poses, const Eigen::Vector3d& p) {
+bool in_robot(const PlanningModel& m, const std::vector<Eigen::Isometry3d>& poses,
+              const Eigen::Vector3d& p) {
   for (std::size_t i = 0; i < m.links().size(); ++i) {
     for (const LinkShape& s : m.links()[i].shapes) {
       const Eigen::Vector3d l = (poses[i] * s.origin).inverse() * p;
-      const bool in = s.type == LinkShape::Type::kBox        ? (l.cwiseAbs().array() <= 0.5 * s.size.array()).all()
-                      : s.type == LinkShape::Type::kCylinder ? l.head<2>().norm() <= s.size.x() && std::abs(l.z()) <= 0.5 * s.size.z()
-                                                             : l.norm() <= s.size.x();
+      const bool in = s.type == LinkShape::Type::kBox
+                          ? (l.cwiseAbs().array() <= 0.5 * s.size.array()).all()
+                      : s.type == LinkShape::Type::kCylinder
+                          ? l.head<2>().norm() <= s.size.x() && std::abs(l.z()) <= 0.5 * s.size.z()
+                          : l.norm() <= s.size.x();
       if (in) return true;
     }
   }
@@ -144,7 +154,8 @@ bool in_robot(const PlanningModel& m, const std::vector<Eigen::Isometry3d>& pose
 
 // The wall scan with the robot at q in front of it: each beam stops at the robot's first
 // shape it meets (marched in 5 mm steps).
-LidarScan scan_with_robot(const PlanningModel& m, const Eigen::VectorXd& q, const Eigen::Isometry3d& sensor, std::size_t& on_robot) {
+LidarScan scan_with_robot(const PlanningModel& m, const Eigen::VectorXd& q,
+                          const Eigen::Isometry3d& sensor, std::size_t& on_robot) {
   std::mt19937 rng(7u);
   LidarScan s = wall_scan(sensor, 0.0, rng, 360);
   std::vector<Eigen::Isometry3d> poses;
@@ -181,7 +192,8 @@ TEST(SensorMap, BeamsThatHitTheRobotsOwnArmMarkNothingOnIt) {
     if (names[i] == model->joint_names()[4]) q[static_cast<Eigen::Index>(i)] = kPitch;
   }
   const Eigen::Isometry3d sensor = at({-1.2, 0.05, 1.0});
-  ASSERT_TRUE(StateChecker(model, Environment(kRes), p, 0.0).check(q).valid()) << "the posture itself must be valid";
+  ASSERT_TRUE(StateChecker(model, Environment(kRes), p, 0.0).check(q).valid())
+      << "the posture itself must be valid";
   std::size_t on_robot = 0;
   const LidarScan scan = scan_with_robot(*model, q, sensor, on_robot);
   ASSERT_GT(on_robot, 100u) << "the test's beams must hit the robot";
@@ -194,7 +206,8 @@ TEST(SensorMap, BeamsThatHitTheRobotsOwnArmMarkNothingOnIt) {
   StateChecker exact(model, env, p, 0.0);
   const Validity v = exact.check(q);
   EXPECT_TRUE(v.valid()) << to_string(v.constraint) << ": " << v.detail;
-  for (const Eigen::Vector3d& c : occupied_centres(env)) EXPECT_NEAR(c.x(), kWallX, kRes) << c.transpose();
+  for (const Eigen::Vector3d& c : occupied_centres(env))
+    EXPECT_NEAR(c.x(), kWallX, kRes) << c.transpose();
 
   // The same scan filtered with a stale joint state (the arm elsewhere) leaves the arm in the map:
   // the filter follows the joints.
@@ -232,13 +245,16 @@ TEST(SensorMap, BadInputIsRefusedNamingTheFieldAndTheMapIsUnchanged) {
   LidarScan short_ranges = good;
   short_ranges.ranges.pop_back();
   EXPECT_EQ(refused(short_ranges, sensor, q),
-            "lidar 'test_lidar' (frame 'test_lidar_frame'): ranges has 14399 values, rings x columns = 16 x 900 = 14400");
+            "lidar 'test_lidar' (frame 'test_lidar_frame'): ranges has 14399 values, rings x "
+            "columns = 16 x 900 = 14400");
   LidarScan nan_range = good;
   nan_range.ranges[905] = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_NE(refused(nan_range, sensor, q).find("range 905 (ring 1, column 5) is nan"), std::string::npos);
+  EXPECT_NE(refused(nan_range, sensor, q).find("range 905 (ring 1, column 5) is nan"),
+            std::string::npos);
   LidarScan negative = good;
   negative.ranges[3] = -1.0F;
-  EXPECT_NE(refused(negative, sensor, q).find("range 3 (ring 0, column 3) is -1"), std::string::npos);
+  EXPECT_NE(refused(negative, sensor, q).find("range 3 (ring 0, column 3) is -1"),
+            std::string::npos);
   LidarScan no_rings = good;
   no_rings.elevations.clear();
   EXPECT_NE(refused(no_rings, sensor, q).find("elevations: no rings"), std::string::npos);
@@ -248,8 +264,10 @@ TEST(SensorMap, BadInputIsRefusedNamingTheFieldAndTheMapIsUnchanged) {
   Eigen::Isometry3d bad_pose = sensor;
   bad_pose.translation().x() = std::numeric_limits<double>::infinity();
   EXPECT_NE(refused(good, bad_pose, q).find("sensor pose is not finite"), std::string::npos);
-  EXPECT_NE(refused(good, sensor, Eigen::VectorXd::Zero(3)).find("joint vector has 3 values"), std::string::npos);
-  EXPECT_NE(refused(good, sensor, q).find("accepted"), std::string::npos);  // the check itself can pass
+  EXPECT_NE(refused(good, sensor, Eigen::VectorXd::Zero(3)).find("joint vector has 3 values"),
+            std::string::npos);
+  EXPECT_NE(refused(good, sensor, q).find("accepted"),
+            std::string::npos);  // the check itself can pass
   EXPECT_NE(env.octree(), before);
 
   // Depth: wrong size, bad intrinsics, frames of different cameras.
@@ -270,13 +288,17 @@ TEST(SensorMap, BadInputIsRefusedNamingTheFieldAndTheMapIsUnchanged) {
   };
   RgbdFrame small = f;
   small.depth.resize(10);
-  EXPECT_EQ(depth_refused({f, small}), "camera 'cam' (frame 'cam_optical'): frame 1: depth has 10 values, width x height = 3072");
+  EXPECT_EQ(
+      depth_refused({f, small}),
+      "camera 'cam' (frame 'cam_optical'): frame 1: depth has 10 values, width x height = 3072");
   RgbdFrame no_focal = f;
   no_focal.intrinsics.fx = 0.0;
-  EXPECT_NE(depth_refused({no_focal}).find("intrinsics: fx, fy must be finite and > 0"), std::string::npos);
+  EXPECT_NE(depth_refused({no_focal}).find("intrinsics: fx, fy must be finite and > 0"),
+            std::string::npos);
   RgbdFrame other = f;
   other.sensor = "cam2";
-  EXPECT_NE(depth_refused({f, other}).find("frame 1: another camera or other intrinsics"), std::string::npos);
+  EXPECT_NE(depth_refused({f, other}).find("frame 1: another camera or other intrinsics"),
+            std::string::npos);
   EXPECT_EQ(depth_refused({}), "depth: no frames");
 }
 
@@ -298,12 +320,14 @@ TEST(SensorMap, AveragedDepthFramesPutTheWallInOneVoxelLayerWhereSingleFramesSca
   std::vector<RgbdFrame> frames;
   for (int i = 0; i < 8; ++i) {
     f.depth.assign(160 * 120, 0);
-    for (auto& d : f.depth) d = static_cast<std::uint16_t>(std::lround((1.2 + noise(rng)) * 1000.0));
+    for (auto& d : f.depth)
+      d = static_cast<std::uint16_t>(std::lround((1.2 + noise(rng)) * 1000.0));
     frames.push_back(f);
   }
   auto scattered = [&](const std::vector<RgbdFrame>& use) {
     Environment env(kRes);
-    const SensorMapStats s = mapper.insert_depth(env, use, cam, Eigen::VectorXd::Zero(model->full_dof()));
+    const SensorMapStats s =
+        mapper.insert_depth(env, use, cam, Eigen::VectorXd::Zero(model->full_dof()));
     EXPECT_EQ(s.returns, 80u * 60u);
     std::size_t off = 0;
     const auto cells = occupied_centres(env);
@@ -322,19 +346,23 @@ TEST(SensorMap, TheWorldsMapAndTheSensorsTogetherHoldTheOccupiedCellsOfBoth) {
   const auto model = model_a(p);
   Environment world(kRes);
   World w;
-  w.boxes.push_back({"crate", Eigen::Vector3d(0.4, 0.4, 0.4), Eigen::Vector3d(1.0, -1.5, 0.2), 0.0});
+  w.boxes.push_back(
+      {"crate", Eigen::Vector3d(0.4, 0.4, 0.4), Eigen::Vector3d(1.0, -1.5, 0.2), 0.0});
   world.add_world(w);  // pruned into 0.1 m and 0.2 m leaves where it can
   Environment sensors(kRes);
   std::mt19937 rng(10u);
   const Eigen::Isometry3d sensor = at({-1.5, 0.0, 1.0});
-  (void)SensorMapper(model, p).insert_lidar(sensors, wall_scan(sensor, 0.0, rng), sensor, Eigen::VectorXd::Zero(model->full_dof()));
+  (void)SensorMapper(model, p).insert_lidar(sensors, wall_scan(sensor, 0.0, rng), sensor,
+                                            Eigen::VectorXd::Zero(model->full_dof()));
   Environment both = world;
   both.add_occupied(sensors);
   for (const Environment* part : {&world, &sensors}) {
-    for (const Eigen::Vector3d& c : occupied_centres(*part)) EXPECT_TRUE(both.occupied(c)) << c.transpose();
+    for (const Eigen::Vector3d& c : occupied_centres(*part))
+      EXPECT_TRUE(both.occupied(c)) << c.transpose();
   }
   // Every cell of the crate, not only the centres of pruned leaves.
-  for (double x = 0.825; x < 1.2; x += kRes) EXPECT_TRUE(both.occupied(Eigen::Vector3d(x, -1.325, 0.025))) << x;
+  for (double x = 0.825; x < 1.2; x += kRes)
+    EXPECT_TRUE(both.occupied(Eigen::Vector3d(x, -1.325, 0.025))) << x;
   EXPECT_FALSE(both.occupied(Eigen::Vector3d(0.5, 0.0, 1.0)));
   EXPECT_THROW(both.add_occupied(Environment(0.1)), PlannerError);
 }

@@ -50,11 +50,12 @@ std::string mjcf_of(const world::World& w) {
     for (const world::WorldShape& s : *list) {
       const Eigen::Vector3d& p = s.position;
       if (s.type == world::WorldShape::Type::kCylinder) {
-        x << "<geom type=\"cylinder\" size=\"" << s.size.x() << " " << 0.5 * s.size.z() << "\" pos=\"" << p.x() << " " << p.y()
-          << " " << p.z() << "\"/>\n";
+        x << "<geom type=\"cylinder\" size=\"" << s.size.x() << " " << 0.5 * s.size.z()
+          << "\" pos=\"" << p.x() << " " << p.y() << " " << p.z() << "\"/>\n";
       } else {
-        x << "<geom type=\"box\" size=\"" << 0.5 * s.size.x() << " " << 0.5 * s.size.y() << " " << 0.5 * s.size.z() << "\" pos=\""
-          << p.x() << " " << p.y() << " " << p.z() << "\" euler=\"0 0 " << s.yaw << "\"/>\n";
+        x << "<geom type=\"box\" size=\"" << 0.5 * s.size.x() << " " << 0.5 * s.size.y() << " "
+          << 0.5 * s.size.z() << "\" pos=\"" << p.x() << " " << p.y() << " " << p.z()
+          << "\" euler=\"0 0 " << s.yaw << "\"/>\n";
       }
     }
   }
@@ -72,10 +73,12 @@ Eigen::VectorXd at_base(const PlanningModel& m, double x, double y, double yaw) 
 }  // namespace
 
 TEST(SensorMapSim, SimulatedLidarScansOfTheDemoSiteMapItsWallLikeTheWorldDescription) {
-  const world::World site = world::load_world_file(std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_site.yaml");
+  const world::World site =
+      world::load_world_file(std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_site.yaml");
   ASSERT_FALSE(site.walls.empty());
   Params params;
-  const auto model = PlanningModel::build(fixtures::model_from_assembly(fixtures::data_dir() / "morphology_a.yaml", 1), params);
+  const auto model = PlanningModel::build(
+      fixtures::model_from_assembly(fixtures::data_dir() / "morphology_a.yaml", 1), params);
   const auto lidars = model->robot().sensor_frames(model::SensorKind::kLidar);
   ASSERT_EQ(lidars.size(), 2u) << "morphology A's base carries two lidars";
 
@@ -90,8 +93,10 @@ TEST(SensorMapSim, SimulatedLidarScansOfTheDemoSiteMapItsWallLikeTheWorldDescrip
   Environment from_sensors(params.octomap_resolution);
   hardware::LidarScan scan;
   std::size_t scans = 0;
-  for (const Eigen::Vector3d& base : {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.2, -1.2, 0.3), Eigen::Vector3d(0.2, 1.2, -0.3),
-                                      Eigen::Vector3d(0.8, 0.0, 0.0), Eigen::Vector3d(-0.5, 0.5, 0.8)}) {
+  for (const Eigen::Vector3d& base :
+       {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.2, -1.2, 0.3),
+        Eigen::Vector3d(0.2, 1.2, -0.3), Eigen::Vector3d(0.8, 0.0, 0.0),
+        Eigen::Vector3d(-0.5, 0.5, 0.8)}) {
     const Eigen::VectorXd q = at_base(*model, base.x(), base.y(), base.z());
     for (const model::SensorFrame* s : lidars) {
       const Eigen::Isometry3d pose = mapper.sensor_pose(q, s->frame);
@@ -117,7 +122,8 @@ TEST(SensorMapSim, SimulatedLidarScansOfTheDemoSiteMapItsWallLikeTheWorldDescrip
     bool near = false;
     for (int dx = -1; dx <= 1 && !near; ++dx) {
       for (int dy = -1; dy <= 1 && !near; ++dy) {
-        for (int dz = -1; dz <= 1 && !near; ++dz) near = from_world.occupied(c + r * Eigen::Vector3d(dx, dy, dz));
+        for (int dz = -1; dz <= 1 && !near; ++dz)
+          near = from_world.occupied(c + r * Eigen::Vector3d(dx, dy, dz));
       }
     }
     within_one += near ? 1 : 0;
@@ -133,13 +139,17 @@ TEST(SensorMapSim, SimulatedLidarScansOfTheDemoSiteMapItsWallLikeTheWorldDescrip
       const Eigen::Vector3d p((std::floor((face + 0.25 * r) / r) + 0.5) * r, y, z);
       if (!from_world.occupied(p)) continue;
       face_cells += 1;
-      face_seen += from_sensors.occupied(p) || from_sensors.occupied(p - Eigen::Vector3d(r, 0, 0)) ? 1 : 0;
+      face_seen +=
+          from_sensors.occupied(p) || from_sensors.occupied(p - Eigen::Vector3d(r, 0, 0)) ? 1 : 0;
     }
   }
-  std::cout << "sensor map: " << cells << " occupied voxels from " << scans << " simulated revolutions; " << same
-            << " occupied in the world map (" << 100.0 * static_cast<double>(same) / static_cast<double>(cells) << " %), "
-            << within_one << " within one voxel (" << 100.0 * static_cast<double>(within_one) / static_cast<double>(cells)
-            << " %); wall face 0.05-0.9 m, |y| < 2.5 m: " << face_seen << " of " << face_cells << " voxels seen" << std::endl;
+  std::cout << "sensor map: " << cells << " occupied voxels from " << scans
+            << " simulated revolutions; " << same << " occupied in the world map ("
+            << 100.0 * static_cast<double>(same) / static_cast<double>(cells) << " %), "
+            << within_one << " within one voxel ("
+            << 100.0 * static_cast<double>(within_one) / static_cast<double>(cells)
+            << " %); wall face 0.05-0.9 m, |y| < 2.5 m: " << face_seen << " of " << face_cells
+            << " voxels seen" << std::endl;
   ASSERT_GT(cells, 500u);
   EXPECT_GE(static_cast<double>(same) / static_cast<double>(cells), 0.9);
   EXPECT_GE(static_cast<double>(within_one) / static_cast<double>(cells), 0.99);
@@ -153,7 +163,8 @@ TEST(SensorMapSim, SimulatedLidarScansOfTheDemoSiteMapItsWallLikeTheWorldDescrip
     const Validity free = checker.check(at_base(*model, 0.0, 0.0, 0.0));
     EXPECT_NE(free.constraint, Constraint::kEnvironmentCollision) << which << ": " << free.detail;
     const Validity in_wall = checker.check(at_base(*model, face - 0.1, 0.0, 0.0));
-    EXPECT_EQ(in_wall.constraint, Constraint::kEnvironmentCollision) << which << ": " << to_string(in_wall.constraint);
+    EXPECT_EQ(in_wall.constraint, Constraint::kEnvironmentCollision)
+        << which << ": " << to_string(in_wall.constraint);
   }
 
   // The planner itself on the sensor map: a drilling area on the wall's face at 0.8 m (where the
@@ -173,12 +184,14 @@ TEST(SensorMapSim, SimulatedLidarScansOfTheDemoSiteMapItsWallLikeTheWorldDescrip
     std::size_t states = 0;
     for (const TrajectoryPoint& pt : goal.trajectory.points) {
       const Validity v = truth.check(planner.model()->to_full(pt.q, start));
-      EXPECT_NE(v.constraint, Constraint::kEnvironmentCollision) << "at t = " << pt.time << " s: " << v.detail;
+      EXPECT_NE(v.constraint, Constraint::kEnvironmentCollision)
+          << "at t = " << pt.time << " s: " << v.detail;
       states += 1;
     }
     EXPECT_GT(states, 10u);
-    std::cout << "area at x = " << area.translation().x() << " m planned on the sensor map (" << goal.path_method << ", "
-              << goal.trajectory.points.back().time << " s of motion, base ends at " << goal.goal_q.head<3>().transpose()
+    std::cout << "area at x = " << area.translation().x() << " m planned on the sensor map ("
+              << goal.path_method << ", " << goal.trajectory.points.back().time
+              << " s of motion, base ends at " << goal.goal_q.head<3>().transpose()
               << "): " << states << " states clear of the true wall" << std::endl;
   }
 }

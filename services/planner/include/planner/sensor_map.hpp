@@ -5,13 +5,12 @@
 // the current joint state, grown by a padding) never become obstacles, nor do returns from the
 // floor (the state checker's floor constraint covers it).
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 #include "concert/hardware/sensors.hpp"
 #include "planner/environment.hpp"
@@ -52,18 +51,21 @@ class SensorMapper {
   /// Map pose of a sensor frame (a URDF link) at the full joint vector `q_full` (base x, y, yaw
   /// in the map frame first, PlanningModel::full_from_named). Throws PlannerError naming an
   /// unknown frame or a q of the wrong size.
-  [[nodiscard]] Eigen::Isometry3d sensor_pose(const Eigen::VectorXd& q_full, const std::string& frame) const;
+  [[nodiscard]] Eigen::Isometry3d sensor_pose(const Eigen::VectorXd& q_full,
+                                              const std::string& frame) const;
 
   /// One lidar revolution taken from `map_T_sensor` while the robot stood at `q_full` (for the
   /// self filter). Throws PlannerError naming the lidar and the bad field (non-finite pose,
   /// ranges not rings x columns, no rings or columns, non-finite or negative range...); the
   /// map is then unchanged.
   SensorMapStats insert_lidar(Environment& environment, const hardware::LidarScan& scan,
-                              const Eigen::Isometry3d& map_T_sensor, const Eigen::VectorXd& q_full) const;
+                              const Eigen::Isometry3d& map_T_sensor,
+                              const Eigen::VectorXd& q_full) const;
 
   /// The rays insert_lidar() would cast, without touching a map (to insert several sensors with
   /// one copy of the tree). Same checks and errors.
-  [[nodiscard]] SensorRays lidar_rays(const hardware::LidarScan& scan, const Eigen::Isometry3d& map_T_sensor,
+  [[nodiscard]] SensorRays lidar_rays(const hardware::LidarScan& scan,
+                                      const Eigen::Isometry3d& map_T_sensor,
                                       const Eigen::VectorXd& q_full) const;
 
   /// Successive depth frames of one camera (same size and intrinsics) from `map_T_optical`
@@ -72,16 +74,20 @@ class SensorMapper {
   /// readings (the sensor's noise is independent per frame). Every sensor_depth_stride-th pixel
   /// in u and v is ray-cast. Throws PlannerError naming the camera and the fault (no frames,
   /// depth not width x height, bad intrinsics or scale, frames that differ); map unchanged.
-  SensorMapStats insert_depth(Environment& environment, const std::vector<hardware::RgbdFrame>& frames,
-                              const Eigen::Isometry3d& map_T_optical, const Eigen::VectorXd& q_full) const;
+  SensorMapStats insert_depth(Environment& environment,
+                              const std::vector<hardware::RgbdFrame>& frames,
+                              const Eigen::Isometry3d& map_T_optical,
+                              const Eigen::VectorXd& q_full) const;
 
   /// The rays insert_depth() would cast, without touching a map. Same checks and errors.
-  [[nodiscard]] SensorRays depth_rays(const std::vector<hardware::RgbdFrame>& frames, const Eigen::Isometry3d& map_T_optical,
+  [[nodiscard]] SensorRays depth_rays(const std::vector<hardware::RgbdFrame>& frames,
+                                      const Eigen::Isometry3d& map_T_optical,
                                       const Eigen::VectorXd& q_full) const;
 
   /// True if map point `p` lies in a robot collision shape grown by sensor_self_padding at the
   /// link poses `link_poses` (PlanningModel::link_poses).
-  [[nodiscard]] bool on_robot(const Eigen::Vector3d& p, const std::vector<Eigen::Isometry3d>& link_poses) const;
+  [[nodiscard]] bool on_robot(const Eigen::Vector3d& p,
+                              const std::vector<Eigen::Isometry3d>& link_poses) const;
 
   [[nodiscard]] const PlanningModel& model() const { return *model_; }
 
@@ -91,13 +97,17 @@ class SensorMapper {
     LinkShape::Type type = LinkShape::Type::kBox;
     Eigen::Isometry3d shape_T_map = Eigen::Isometry3d::Identity();
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // map frame
-    Eigen::Vector3d half = Eigen::Vector3d::Zero();    // box: half extents; cylinder: r, r, half length; sphere: r
-    double radius = 0.0;                               // bounding sphere
+    Eigen::Vector3d half =
+        Eigen::Vector3d::Zero();  // box: half extents; cylinder: r, r, half length; sphere: r
+    double radius = 0.0;          // bounding sphere
   };
-  [[nodiscard]] std::vector<PaddedShape> padded_shapes(const std::vector<Eigen::Isometry3d>& link_poses) const;
-  [[nodiscard]] static bool inside(const std::vector<PaddedShape>& shapes, const Eigen::Vector3d& p);
+  [[nodiscard]] std::vector<PaddedShape> padded_shapes(
+      const std::vector<Eigen::Isometry3d>& link_poses) const;
+  [[nodiscard]] static bool inside(const std::vector<PaddedShape>& shapes,
+                                   const Eigen::Vector3d& p);
   /// Sorts map-frame returns into hits and clears.
-  [[nodiscard]] SensorRays sort(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& ends,
+  [[nodiscard]] SensorRays sort(const Eigen::Vector3d& origin,
+                                const std::vector<Eigen::Vector3d>& ends,
                                 const Eigen::VectorXd& q_full) const;
   void check_q(const Eigen::VectorXd& q_full, const std::string& what) const;
 
