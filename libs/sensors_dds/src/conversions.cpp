@@ -143,6 +143,34 @@ void check_image(const msg::Image& image, std::string_view encoding) {
   }
 }
 
+hardware::RgbdFrame to_depth_frame(const msg::Image& depth, const msg::CameraInfo& info) {
+  check_image(depth, kDepth16);
+  const std::string who = camera(depth.sensor());
+  if (info.sensor() != depth.sensor()) {
+    throw std::invalid_argument(who + ": camera info of '" + info.sensor() + "' is not the same camera's");
+  }
+  if (info.width() != depth.width() || info.height() != depth.height()) {
+    throw std::invalid_argument(who + ": sizes differ: depth " + std::to_string(depth.width()) + "x" +
+                                std::to_string(depth.height()) + ", camera info " +
+                                std::to_string(info.width()) + "x" + std::to_string(info.height()));
+  }
+  hardware::RgbdFrame frame;
+  frame.sensor = depth.sensor();
+  frame.frame = depth.frame();
+  frame.stamp = from_stamp_ns(depth.stamp_ns());
+  frame.intrinsics = {depth.width(), depth.height(), info.fx(), info.fy(), info.cx(), info.cy()};
+  const size_t depth_row = static_cast<size_t>(depth.width()) * 2;
+  frame.depth.resize(static_cast<size_t>(depth.width()) * depth.height());
+  for (size_t v = 0; v < depth.height(); ++v) {
+    std::memcpy(reinterpret_cast<uint8_t*>(frame.depth.data()) + v * depth_row,
+                depth.data().data() + v * depth.step(), depth_row);
+  }
+  frame.depth_scale = depth.depth_scale();
+  frame.depth_min = info.depth_min();
+  frame.depth_max = info.depth_max();
+  return frame;
+}
+
 hardware::RgbdFrame to_rgbd_frame(const msg::Image& rgb, const msg::Image& depth,
                                   const msg::CameraInfo& info) {
   check_image(rgb, kRgb8);
@@ -166,25 +194,14 @@ hardware::RgbdFrame to_rgbd_frame(const msg::Image& rgb, const msg::Image& depth
                                 std::to_string(depth.height()) + ", camera info " +
                                 std::to_string(info.width()) + "x" + std::to_string(info.height()));
   }
-  hardware::RgbdFrame frame;
-  frame.sensor = rgb.sensor();
+  hardware::RgbdFrame frame = to_depth_frame(depth, info);
   frame.frame = rgb.frame();
   frame.stamp = from_stamp_ns(rgb.stamp_ns());
-  frame.intrinsics = {rgb.width(), rgb.height(), info.fx(), info.fy(), info.cx(), info.cy()};
   const size_t row = static_cast<size_t>(rgb.width()) * 3;
   frame.rgb.resize(row * rgb.height());
   for (size_t v = 0; v < rgb.height(); ++v) {
     std::memcpy(frame.rgb.data() + v * row, rgb.data().data() + v * rgb.step(), row);
   }
-  const size_t depth_row = static_cast<size_t>(depth.width()) * 2;
-  frame.depth.resize(static_cast<size_t>(depth.width()) * depth.height());
-  for (size_t v = 0; v < depth.height(); ++v) {
-    std::memcpy(reinterpret_cast<uint8_t*>(frame.depth.data()) + v * depth_row,
-                depth.data().data() + v * depth.step(), depth_row);
-  }
-  frame.depth_scale = depth.depth_scale();
-  frame.depth_min = info.depth_min();
-  frame.depth_max = info.depth_max();
   return frame;
 }
 

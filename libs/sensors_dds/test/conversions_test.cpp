@@ -92,6 +92,32 @@ TEST(Camera, MalformedImagesAreRefusedNamingTheCamera) {
   EXPECT_THROW(to_depth_image(frame, 1, depth), std::invalid_argument);
 }
 
+TEST(Camera, DepthFramesComeWithoutColourAndRefuseAnotherEncodingOrCamera) {
+  const auto frame = testing::synthetic_rgbd_frame("camera_E", 8, 6, 3);
+  msg::Image rgb, depth;
+  to_rgb_image(frame, 1, rgb);
+  to_depth_image(frame, 1, depth);
+  const auto info = to_camera_info(frame, 1);
+  const hardware::RgbdFrame back = to_depth_frame(depth, info);
+  EXPECT_EQ(back.sensor, frame.sensor);
+  EXPECT_EQ(back.intrinsics, frame.intrinsics);
+  EXPECT_EQ(back.depth, frame.depth);
+  EXPECT_TRUE(back.rgb.empty());
+  EXPECT_DOUBLE_EQ(back.depth_scale, frame.depth_scale);
+  try {
+    (void)to_depth_frame(rgb, info);
+    FAIL() << "a colour image was read as depth";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("camera 'camera_E': image encoding is 'rgb8', expected '16UC1'"));
+  }
+  auto other = info;
+  other.sensor("camera_F");
+  EXPECT_THROW((void)to_depth_frame(depth, other), std::invalid_argument);
+  auto smaller = info;
+  smaller.width(4);
+  EXPECT_THROW((void)to_depth_frame(depth, smaller), std::invalid_argument);
+}
+
 TEST(Camera, ReusedBuffersTakeTheNewFrame) {
   msg::Image rgb;
   to_rgb_image(testing::synthetic_rgbd_frame("cam", 16, 16, 1), 1, rgb);

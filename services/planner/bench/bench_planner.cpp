@@ -6,6 +6,7 @@
 //
 //   bench_planner [--problems N] [--seed S] [--contact-force NEWTON] [--params FILE] [--only I]
 //                 [--morphology abc] [--warm-up] [--oracle SECONDS] [--verbose]
+//   bench_planner --sensor-map N [--seed S] [--params FILE]
 //
 // Morphologies A, B (paper section 6.1) and C (B on the Passive Base Link), every problem on
 // each, then the paper's assignment: C for areas at 2.4 m and above, A below.
@@ -14,6 +15,12 @@
 // limit) and reports the success rate again over the problems known to be solvable: those
 // solved in either run. A problem neither run solves may still have a solution; the oracle
 // only shows which failures were the 2 s budget's.
+//
+// --sensor-map N times the map from the sensors instead (SensorMapper, paper section 5.4.1):
+// N revolutions of each of morphology A's two VLP-16 lidars (16 x 900 beams, 1.5 cm range
+// noise, seeded) of a wall 2.2 m ahead and the floor, from base poses a few cm apart, ray-cast
+// into one map; then N depth integrations of 10 averaged 640 x 480 frames of the wall
+// (RealSense D435-like intrinsics, 1 cm noise). Reports median / p95 / max per insert.
 
 #include <algorithm>
 #include <chrono>
@@ -28,6 +35,7 @@
 #include "planner/config.hpp"
 #include "planner/fixtures.hpp"
 #include "planner/planner.hpp"
+#include "planner/sensor_map.hpp"
 
 using namespace concert::planner;
 
@@ -92,7 +100,80 @@ struct Options {
   bool warm = false;
   std::string morphologies = "abc";
   double oracle = 0.0;
+  int sensor_map = 0;
 };
+
+int bench_sensor_map(const Options& options) {
+  using namespace concert;
+  using clock = std::chrono::steady_clock;
+  planner::Params params = options.params_file.empty() ? planner::Params{} : planner::load_params(options.params_file);
+  const auto model = planner::PlanningModel::build(
+      planner::fixtures::model_from_assembly(planner::fixtures::data_dir() / "morphology_a.yaml", 1), params);
+  const planner::SensorMapper mapper(model, params);
+  const auto lidars = model->robot().sensor_frames(model::SensorKind::kLidar);
+  std::mt19937 rng(static_cast<unsigned>(options.seed));
+  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+  constexpr double kWallX = 2.2;
+  planner::Environment map(params.octomap_resolution);
+  std::vector<double> lidar_ms, both_ms;
+  planner::Environment both_map(params.octomap_resolution);  // the two lidars in one insert, as the service does
+  std::size_t returns = 0;
+  for (int n = 0; n < options.sensor_map; ++n) {
+    const Eigen::VectorXd q = model->full_from_named({}, {}, Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng)));
+    std::vector<planner::RayBundle> bundles;
+    double sort_ms = 0.0;
+    for (const model::SensorFrame* f : lidars) {
+      const Eigen::Isometry3d pose = mapper.sensor_pose(q, f->frame);
+      hardware::LidarScan scan = planner::fixtures::wall_scan(pose, kWallX, 0.015, rng);
+      scan.sensor = f->name;
+      scan.frame = f->frame;
+      const auto t0 = clock::now();
+      returns += mapper.insert_lidar(map, scan, pose, q).returns;
+      lidar_ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
+      const auto t1 = clock::now();
+      bundles.push_back(mapper.lidar_rays(scan, pose, q).rays);
+      sort_ms += std::chrono::duration<double, std::milli>(clock::now() - t1).count();
+    }
+    const auto t2 = clock::now();
+    both_map.insert_rays(bundles);
+    both_ms.push_back(sort_ms + std::chrono::duration<double, std::milli>(clock::now() - t2).count());
+  }
+  // Depth: the camera 1.2 m before the wall, looking at it.
+  hardware::RgbdFrame frame;
+  frame.sensor = "camera";
+  frame.frame = "camera_optical";
+  frame.intrinsics = {640, 480, 615.0, 615.0, 319.5, 239.5};
+  Eigen::Isometry3d cam = Eigen::Isometry3d::Identity();
+  cam.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  cam.translation() = Eigen::Vector3d(kWallX - 1.2, 0.0, 1.2);
+  std::normal_distribution<double> depth_noise(0.0, 0.01);
+  std::vector<hardware::RgbdFrame> frames(10, frame);
+  for (auto& f : frames) {
+    f.depth.resize(640 * 480);
+    for (auto& d : f.depth) d = static_cast<std::uint16_t>(std::lround((1.2 + depth_noise(rng)) * 1000.0));
+  }
+  planner::Environment depth_map(params.octomap_resolution);
+  std::vector<double> depth_ms;
+  const Eigen::VectorXd q0 = model->full_from_named({}, {}, Eigen::Vector3d::Zero());
+  for (int n = 0; n < options.sensor_map; ++n) {
+    const auto t0 = clock::now();
+    (void)mapper.insert_depth(depth_map, frames, cam, q0);
+    depth_ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
+  }
+  auto row = [](const char* what, std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    std::printf("%-44s %6zu inserts  median %7.1f ms  p95 %7.1f ms  max %7.1f ms\n", what, v.size(), percentile(v, 0.5),
+                percentile(v, 0.95), v.back());
+  };
+  std::printf("sensor map, morphology A, %zu lidars, resolution %.3f m, max range %.1f m, self padding %.3f m\n",
+              lidars.size(), params.octomap_resolution, params.sensor_max_range, params.sensor_self_padding);
+  row("lidar revolution (16 x 900 beams)", lidar_ms);
+  row("both lidars' revolutions in one insert", both_ms);
+  row("depth (10 frames of 640 x 480 averaged)", depth_ms);
+  std::printf("lidar map: %zu returns, %zu occupied cells; depth map: %zu occupied cells (stride %d)\n", returns,
+              map.occupied_cells(), depth_map.occupied_cells(), params.sensor_depth_stride);
+  return 0;
+}
 
 int bench(const Options& options) {
   const int count = options.count;
@@ -273,6 +354,10 @@ int main(int argc, char** argv) {
       ->type_name("SECONDS")
       ->check(concert::cli::seconds());
   app.add_flag("--verbose", o.verbose, "one line per problem")->disable_flag_override();
-  cli.on_run(app, [&o] { return bench(o); });
+  app.add_option("--sensor-map", o.sensor_map,
+                 "time N lidar revolutions and depth integrations into the sensor map instead (0: off)")
+      ->type_name("N")
+      ->check(concert::cli::count());
+  cli.on_run(app, [&o] { return o.sensor_map > 0 ? bench_sensor_map(o) : bench(o); });
   return cli.run(argc, argv);
 }

@@ -2,7 +2,9 @@
 // every RobotModel, plans PlanRequests (NSPG + RRT-Connect) and executes them through the
 // robot service.
 //   concert_planner [--params FILE] [--world FILE]
-// The latched world topic (concert/world/world) replaces the map whenever it changes.
+// The latched world topic (concert/world/world) replaces the map whenever it changes; with
+// environment_source: sensors (or both) the map comes from the robot's lidars (README, "Map from
+// the sensors").
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
 #include <atomic>
 #include <iostream>

@@ -21,7 +21,7 @@ TEST(Config, ShippedParamsFileListsEveryParameterWithItsDefault) {
   auto doc = concert::config::Document::load(std::string(CONCERT_SOURCE_DIR) +
                                              "/services/planner/config/planner.yaml");
   (void)read_params(doc);
-  EXPECT_EQ(doc.keys().size(), 35u);  // every parameter of Params
+  EXPECT_EQ(doc.keys().size(), 44u);  // every parameter of Params
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
 }
@@ -47,6 +47,11 @@ TEST(Config, ParamErrorsNameFileAndField) {
             "p.yaml: nspg_seeds: expected a whole number >= 0, got '1.5' (line 1)");
   EXPECT_EQ(message("base_height: low"),
             "p.yaml: base_height: expected a number or auto, got 'low' (line 1)");
+  EXPECT_NE(message("environment_source: lidar").find("p.yaml: environment_source:"), std::string::npos)
+      << message("environment_source: lidar");
+  EXPECT_NE(message("sensor_depth_stride: 0").find("p.yaml: sensor_depth_stride:"), std::string::npos);
+  EXPECT_NE(message("sensor_max_range: 0").find("p.yaml: sensor_max_range: expected a positive number"), std::string::npos);
+  EXPECT_EQ(parse_params("environment_source: both", "p.yaml").environment_source, "both");
   EXPECT_TRUE(std::isnan(parse_params("base_height: auto", "p.yaml").base_height));
   EXPECT_DOUBLE_EQ(parse_params("base_height: 0.4", "p.yaml").base_height, 0.4);
   EXPECT_THROW((void)load_params("/nonexistent/planner.yaml"), PlannerError);

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <functional>
+#include <random>
 #include <sstream>
 #include <thread>
 
@@ -12,6 +14,7 @@
 #include "concert/common/text.hpp"
 #include "concert/dds/participant.hpp"
 #include "concert/mobile_base/map_frame.hpp"
+#include "concert/sensors_dds/conversions.hpp"
 #include "concert/world/world_dds.hpp"
 #include "dds/planner_node.hpp"
 #include "model_message.hpp"
@@ -463,4 +466,155 @@ TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {
   err.str("");
   EXPECT_EQ(plan({"drill", "--at", "2.0", "0", "7.0", "--request-id", "32", "--timeout", "20"}), 1);
   EXPECT_NE(err.str().find("camera_E"), std::string::npos) << err.str();
+}
+
+namespace {
+
+// The planner node with a map from the sensors, and the robot around it: model A (version 4),
+// its joint state and odometry (the base 0.3 m along y) and its front lidar.
+class PlannerNodeSensors : public ::testing::Test {
+ protected:
+  void start(const std::string& source) {
+    Params params;
+    params.environment_source = source;
+    params.sensor_map_period = 0.2;
+    params.warm_up_time = 0.0;
+    planner_ = std::make_unique<Planner>(params);
+    // What a --world file gives: a wall at x = 3 m.
+    Environment env(params.octomap_resolution);
+    World w;
+    w.boxes.push_back(fixtures::wall_at(3.0));
+    env.add_world(w);
+    planner_->set_environment(env);
+    participant_ = std::make_unique<concert::dds::Participant>(
+        concert::dds::ParticipantOptions{.name = "planner_sensor_test"});
+    node_ = std::make_unique<planner::dds::PlannerNode>(*participant_, *planner_,
+                                                        planner::dds::NodeOptions{}, log_);
+    joint_state_ = std::make_unique<concert::dds::Writer<msg::JointState>>(*participant_, concert::dds::topics::joint_state);
+    odometry_ = std::make_unique<concert::dds::Writer<msg::Odometry>>(*participant_, concert::dds::topics::odometry);
+    lidar_ = std::make_unique<concert::dds::Writer<msg::LidarScan>>(*participant_, concert::dds::topics::lidar);
+    concert::dds::Writer<msg::RobotModel> models(*participant_, concert::dds::topics::robot_model);
+    models.write(planner::testing::model_message(fixtures::data_dir() / "morphology_a.yaml", 4));
+    const auto deadline = std::chrono::steady_clock::now() + 10s;
+    while (node_->model_version() != 4 && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(10ms);
+    ASSERT_EQ(node_->model_version(), 4u) << log_.str();
+    model_ = planner_->model();
+    const auto lidars = model_->robot().sensor_frames(model::SensorKind::kLidar);
+    ASSERT_FALSE(lidars.empty());
+    front_ = *lidars.front();
+    js_.model_version(4);
+    for (int i = 3; i < model_->full_dof(); ++i) {
+      js_.name().push_back(model_->kinematics().joint_names()[static_cast<std::size_t>(i)]);
+      js_.position().push_back(0.0);
+    }
+    q_ = model_->full_from_named({}, {}, Eigen::Vector3d(0.0, 0.3, 0.0));
+    map_T_lidar_ = model_->link_pose(q_, front_.frame);
+  }
+  // The robot's odometry: still, or moving at `vx`.
+  static msg::Odometry odom(double vx) {
+    msg::Odometry o;
+    o.stamp_ns(now_ns());
+    o.y(0.3);
+    o.vx(vx);
+    return o;
+  }
+  // A wall voxel at the lidar's own height, which its level beams hit.
+  bool wall_seen(double wall_x) const {
+    return planner_->environment().occupied(
+        Eigen::Vector3d(wall_x + 0.025, map_T_lidar_.translation().y(), map_T_lidar_.translation().z()));
+  }
+  // Plays the robot for `seconds`: joint state, odometry and the front lidar's revolution of a
+  // wall at `wall_x`, at 10 Hz; stops early once `until` holds.
+  void play(double wall_x, double vx, double seconds, const std::function<bool()>& until) {
+    std::mt19937 rng(1u);
+    hardware::LidarScan revolution = fixtures::wall_scan(map_T_lidar_, wall_x, 0.0, rng, 360);
+    revolution.sensor = front_.name;
+    revolution.frame = front_.frame;
+    const msg::LidarScan scan = sensors_dds::to_msg(revolution, 4);
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end && !until()) {
+      joint_state_->write(js_);
+      odometry_->write(odom(vx));
+      lidar_->write(scan);
+      std::this_thread::sleep_for(100ms);
+    }
+  }
+
+  std::ostringstream log_;
+  std::unique_ptr<Planner> planner_;
+  std::unique_ptr<concert::dds::Participant> participant_;
+  std::unique_ptr<planner::dds::PlannerNode> node_;
+  std::unique_ptr<concert::dds::Writer<msg::JointState>> joint_state_;
+  std::unique_ptr<concert::dds::Writer<msg::Odometry>> odometry_;
+  std::unique_ptr<concert::dds::Writer<msg::LidarScan>> lidar_;
+  std::shared_ptr<const PlanningModel> model_;
+  model::SensorFrame front_;
+  msg::JointState js_;
+  Eigen::VectorXd q_;
+  Eigen::Isometry3d map_T_lidar_ = Eigen::Isometry3d::Identity();
+};
+
+}  // namespace
+
+TEST_F(PlannerNodeSensors, LidarScansAndDepthFramesOnTheTopicsBecomeThePlannersMapOnlyWhileTheRobotIsStill) {
+  start("sensors");
+  EXPECT_EQ(planner_->environment().occupied_cells(), 0u) << "the world file's wall must not be the map";
+  play(1.6, 0.0, 10.0, [&] { return wall_seen(1.6); });
+  ASSERT_TRUE(wall_seen(1.6)) << "the lidar's wall did not reach the planner's map within 10 s\n" << log_.str();
+  EXPECT_FALSE(wall_seen(3.0));
+  EXPECT_NE(log_.str().find("planner: sensor map: used " + front_.name + " in "), std::string::npos) << log_.str();
+
+  // While the base moves the scans are held back (motion blur across a revolution); once it
+  // stops they are used, and the line says how many waited.
+  play(1.2, 0.3, 1.5, [] { return false; });
+  EXPECT_FALSE(wall_seen(1.2)) << "a scan taken while the base moved was integrated";
+  play(1.2, 0.0, 10.0, [&] { return wall_seen(1.2); });
+  EXPECT_TRUE(wall_seen(1.2)) << log_.str();
+  EXPECT_NE(log_.str().find("revolutions or frames skipped: the robot moved"), std::string::npos) << log_.str();
+
+  // The tool's depth camera: a burst of frames of a board 1.2 m ahead of it (1 cm noise each),
+  // averaged into the map.
+  const model::SensorFrame& camera = model_->robot().sensor(model_->tool(""), model::SensorKind::kCamera);
+  const Eigen::Isometry3d map_T_camera = model_->link_pose(q_, camera.frame);
+  const Eigen::Vector3d board = map_T_camera * Eigen::Vector3d(0.0, 0.0, 1.2);
+  ASSERT_GT(board.z(), 0.3) << "the camera must see the board, not the floor";
+  auto board_seen = [&] {
+    const Eigen::Vector3d axis = map_T_camera.linear().col(2);
+    const Environment env = planner_->environment();
+    return env.occupied(board) || env.occupied(board + 0.05 * axis) || env.occupied(board - 0.05 * axis);
+  };
+  ASSERT_FALSE(board_seen());
+  concert::dds::Writer<msg::Image> depth(*participant_, concert::dds::topics::camera_depth);
+  concert::dds::Writer<msg::CameraInfo> info(*participant_, concert::dds::topics::camera_info);
+  hardware::RgbdFrame frame;
+  frame.sensor = camera.name;
+  frame.frame = camera.frame;
+  frame.intrinsics = {80, 60, 60.0, 60.0, 39.5, 29.5};
+  std::mt19937 rng(2u);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const auto depth_deadline = std::chrono::steady_clock::now() + 10s;
+  while (std::chrono::steady_clock::now() < depth_deadline && !board_seen()) {
+    joint_state_->write(js_);
+    odometry_->write(odom(0.0));
+    info.write(sensors_dds::to_camera_info(frame, 4));
+    for (int i = 0; i < 5; ++i) {
+      frame.depth.assign(80 * 60, 0);
+      for (auto& d : frame.depth) d = static_cast<std::uint16_t>(std::lround((1.2 + noise(rng)) * 1000.0));
+      msg::Image image;
+      sensors_dds::to_depth_image(frame, 4, image);
+      depth.write(image);
+    }
+    std::this_thread::sleep_for(300ms);
+  }
+  EXPECT_TRUE(board_seen()) << log_.str();
+  EXPECT_NE(log_.str().find(camera.name + " ("), std::string::npos) << log_.str();
+  EXPECT_NE(log_.str().find("depth frames averaged)"), std::string::npos) << log_.str();
+}
+
+TEST_F(PlannerNodeSensors, WithBothTheWorldsWallAndTheLidarsAreInTheMap) {
+  start("both");
+  EXPECT_TRUE(wall_seen(3.0)) << "the world file's wall is part of the map";
+  play(1.6, 0.0, 10.0, [&] { return wall_seen(1.6); });
+  EXPECT_TRUE(wall_seen(1.6)) << log_.str();
+  EXPECT_TRUE(wall_seen(3.0)) << "the sensors' map must not replace the world's";
 }

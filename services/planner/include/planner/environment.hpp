@@ -44,6 +44,13 @@ class DistanceField {
   std::vector<float> values_;  // signed distance of each cell centre [m]
 };
 
+/// Rays from one sensor origin (map frame, [m]) for Environment::insert_rays.
+struct RayBundle {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> hits;    ///< ends that become occupied
+  std::vector<Eigen::Vector3d> clears;  ///< ends that only clear their ray (their cell too)
+};
+
 /// Occupancy map. Cheap to copy (the tree is shared and never modified after it is published
 /// to a StateChecker: every insert makes a new tree).
 class Environment {
@@ -58,6 +65,19 @@ class Environment {
   /// the cells along the rays free. Points farther than `max_range` [m] are cut (< 0: no cut).
   /// Non-finite points are errors naming their index.
   void insert_point_cloud(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& origin, double max_range = -1.0);
+  /// Ray-casts from `origin` (map frame, [m]) with OctoMap's key rays: every cell along a ray to
+  /// a point of `hits` or of `clears` is a miss, the cell of each hit a hit (a cell both passed
+  /// and hit in the same call counts as hit, as in OctoMap's insertPointCloud); the end cells of
+  /// `clears` are misses too (returns that must never become obstacles: the floor, beams cut at
+  /// a maximum range). Non-finite input throws PlannerError naming it, the map unchanged.
+  void insert_rays(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& hits,
+                   const std::vector<Eigen::Vector3d>& clears);
+  /// The same for several sensors at once: one copy of the tree for all of them (a cell passed
+  /// by one sensor's ray and hit by another's counts as hit). Errors name the bundle.
+  void insert_rays(const std::vector<RayBundle>& bundles);
+  /// Marks the centre of every occupied leaf of `other` occupied here (the union of two maps,
+  /// e.g. the world's and the sensors'). Throws PlannerError if the resolutions differ.
+  void add_occupied(const Environment& other);
 
   [[nodiscard]] double resolution() const { return resolution_; }
   /// Number of occupied leaf cells.

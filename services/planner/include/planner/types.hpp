@@ -57,6 +57,21 @@ struct Params {
   /// with the tip moved this far [m] along the task axis (into the wall), the base standing
   double tip_reach = 0.0;
 
+  // Map from the sensors (paper section 5.4.1; planner/sensor_map.hpp).
+  /// What the service's map is built from: "world" (the world topic / --world file), "sensors"
+  /// (the robot's lidars, ray-cast), "both" (the world's obstacles and the sensors' together).
+  std::string environment_source = "world";
+  double sensor_map_period = 1.0;    ///< service: the sensor map is updated and published at most this often [s]
+  double sensor_max_range = 6.0;     ///< returns farther than this [m] clear their ray up to it and mark nothing
+  double sensor_self_padding = 0.05; ///< robot shapes grown by this [m]: returns inside them are the robot's own
+  double sensor_floor_band = 0.05;   ///< returns below floor_height + this [m] are the floor: they clear, never occupy
+  /// service: a period's lidar revolutions and depth frames are used only if the base and every
+  /// joint moved slower than this all along it [m/s, rad/s]
+  double sensor_max_speed = 0.05;
+  int sensor_depth_frames = 5;       ///< service: the latest depth frames of a camera averaged per map update (>= 1)
+  int sensor_depth_stride = 4;       ///< depth images: every n-th pixel in u and v is ray-cast (>= 1)
+  double sensor_depth_min_valid = 0.5;  ///< depth averaging: fraction of the frames that must read a pixel (0..1]
+
   // Planning. Time budgets are CPU seconds of the planning thread, not wall seconds, so a plan
   // does not depend on what else loads the machine.
   double planning_time = 2.0;        ///< per goal, NSPG included [s CPU]

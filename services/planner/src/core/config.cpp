@@ -42,11 +42,16 @@ Params read_params(config::Document& doc) {
       {"base_angular_velocity", &p.base_angular_velocity},
       {"base_angular_acceleration", &p.base_angular_acceleration},
       {"sample_period", &p.sample_period},
+      {"sensor_map_period", &p.sensor_map_period},
+      {"sensor_self_padding", &p.sensor_self_padding},
+      {"sensor_floor_band", &p.sensor_floor_band},
+      {"sensor_max_speed", &p.sensor_max_speed},
   };
   const std::pair<const char*, double*> positive[] = {
       {"octomap_resolution", &p.octomap_resolution},
       {"planning_time", &p.planning_time},
       {"check_resolution", &p.check_resolution},
+      {"sensor_max_range", &p.sensor_max_range},
   };
   const std::pair<const char*, int*> counts[] = {
       {"simplify_iterations", &p.simplify_iterations},
@@ -61,6 +66,10 @@ Params read_params(config::Document& doc) {
     root.number(key, *value, config::Range::non_negative());
   for (const auto& [key, value] : positive) root.number(key, *value, config::Range::positive());
   for (const auto& [key, value] : counts) root.integer(key, *value, 0);
+  root.integer("sensor_depth_stride", p.sensor_depth_stride, 1);
+  root.integer("sensor_depth_frames", p.sensor_depth_frames, 1);
+  root.number("sensor_depth_min_valid", p.sensor_depth_min_valid, config::Range{0.0, 1.0, true});
+  root.choice("environment_source", p.environment_source, {"world", "sensors", "both"});
   root.number("floor_height", p.floor_height);
   root.number_or_auto("base_height", p.base_height);
   root.integer("seed", p.seed);

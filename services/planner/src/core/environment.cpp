@@ -221,6 +221,80 @@ void Environment::insert_point_cloud(const std::vector<Eigen::Vector3d>& points,
   field_ = std::make_shared<LazyField>();
 }
 
+void Environment::insert_rays(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3d>& hits,
+                              const std::vector<Eigen::Vector3d>& clears) {
+  insert_rays(std::vector<RayBundle>{RayBundle{origin, hits, clears}});
+}
+
+void Environment::insert_rays(const std::vector<RayBundle>& bundles) {
+  for (std::size_t b = 0; b < bundles.size(); ++b) {
+    const RayBundle& bundle = bundles[b];
+    const std::string which = bundles.size() > 1 ? "rays of bundle " + std::to_string(b) : "rays";
+    if (!bundle.origin.allFinite()) throw PlannerError(which + ": sensor origin is not finite");
+    for (std::size_t i = 0; i < bundle.hits.size(); ++i) {
+      if (!bundle.hits[i].allFinite()) throw PlannerError(which + ": hit " + std::to_string(i) + " is not finite");
+    }
+    for (std::size_t i = 0; i < bundle.clears.size(); ++i) {
+      if (!bundle.clears[i].allFinite()) throw PlannerError(which + ": cleared end " + std::to_string(i) + " is not finite");
+    }
+  }
+  auto tree = mutable_copy();
+  octomap::KeySet free_cells, occupied_cells;
+  octomap::KeyRay ray;
+  for (const RayBundle& bundle : bundles) {
+    const octomap::point3d o(float(bundle.origin.x()), float(bundle.origin.y()), float(bundle.origin.z()));
+    auto pass = [&](const Eigen::Vector3d& end) {
+      const octomap::point3d e(float(end.x()), float(end.y()), float(end.z()));
+      if (tree->computeRayKeys(o, e, ray)) free_cells.insert(ray.begin(), ray.end());
+      return e;
+    };
+    for (const Eigen::Vector3d& h : bundle.hits) {
+      octomap::OcTreeKey key;
+      if (tree->coordToKeyChecked(pass(h), key)) occupied_cells.insert(key);
+    }
+    for (const Eigen::Vector3d& c : bundle.clears) {
+      octomap::OcTreeKey key;
+      if (tree->coordToKeyChecked(pass(c), key)) free_cells.insert(key);
+    }
+  }
+  for (const octomap::OcTreeKey& key : free_cells) {
+    if (occupied_cells.count(key) == 0) tree->updateNode(key, false, true);
+  }
+  for (const octomap::OcTreeKey& key : occupied_cells) tree->updateNode(key, true, true);
+  tree->updateInnerOccupancy();
+  tree->prune();
+  tree_ = tree;
+  field_ = std::make_shared<LazyField>();
+}
+
+void Environment::add_occupied(const Environment& other) {
+  if (other.resolution_ != resolution_) {
+    throw PlannerError("environment: cannot add a map of resolution " + std::to_string(other.resolution_) +
+                       " m to one of " + std::to_string(resolution_) + " m");
+  }
+  auto tree = mutable_copy();
+  const octomap::OcTree& src = *other.tree_;
+  for (auto it = src.begin_leafs(); it != src.end_leafs(); ++it) {
+    if (!src.isNodeOccupied(*it)) continue;
+    // A pruned leaf covers several cells: mark each of them.
+    const double size = it.getSize();
+    const int n = std::max(1, static_cast<int>(std::lround(size / resolution_)));
+    const Eigen::Vector3d lo = Eigen::Vector3d(it.getX(), it.getY(), it.getZ()) - Eigen::Vector3d::Constant(0.5 * size - 0.5 * resolution_);
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        for (int k = 0; k < n; ++k) {
+          const Eigen::Vector3d c = lo + resolution_ * Eigen::Vector3d(i, j, k);
+          tree->updateNode(octomap::point3d(float(c.x()), float(c.y()), float(c.z())), true, true);
+        }
+      }
+    }
+  }
+  tree->updateInnerOccupancy();
+  tree->prune();
+  tree_ = tree;
+  field_ = std::make_shared<LazyField>();
+}
+
 std::size_t Environment::occupied_cells() const {
   std::size_t n = 0;
   for (auto it = tree_->begin_leafs(); it != tree_->end_leafs(); ++it) {

@@ -13,6 +13,7 @@
 #include "concert/common/enum_map.hpp"
 #include "concert/model/dds/conversions.hpp"
 #include "concert/model/dds/pose.hpp"
+#include "concert/sensors_dds/conversions.hpp"
 #include "concert/world/world_dds.hpp"
 
 namespace concert::planner::dds {
@@ -102,19 +103,25 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
     : planner_(planner),
       options_(options),
       log_(log),
+      use_world_(planner.params().environment_source != "sensors"),
+      use_sensors_(planner.params().environment_source != "world"),
+      world_map_(planner.environment()),
+      sensor_map_(planner.params().octomap_resolution),
       results_(participant, concert::dds::topics::plan_result),
       trajectory_commands_(participant, concert::dds::topics::trajectory_command),
       status_(participant, "planner"),
       models_(participant, concert::dds::topics::robot_model,
               [this](const auto& s, const auto&) { on_model(s); }),
       joint_states_(participant, concert::dds::topics::joint_state,
-                    [this](const auto& s, const auto&) {
+                    [this](const msg::JointState& s, const auto&) {
+                      if (use_sensors_) note_motion(s);
                       std::lock_guard lock(mutex_);
                       joint_state_ = s;
                     }),
       odometries_(participant, concert::dds::topics::odometry,
-                  [this](const auto& s, const auto&) {
+                  [this](const msg::Odometry& s, const auto&) {
                     map_frame_.on_odometry(s.stamp_ns(), {s.x(), s.y(), s.yaw()});
+                    if (use_sensors_) note_motion(s);
                     std::lock_guard lock(mutex_);
                     odometry_ = s;
                   }),
@@ -142,6 +149,33 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
                         }
                         wake_.notify_all();
                       }) {
+  const std::string& source = planner_.params().environment_source;
+  if (use_sensors_) {
+    lidars_ = std::make_unique<concert::dds::Reader<msg::LidarScan>>(
+        participant, concert::dds::topics::lidar, [this](const msg::LidarScan& scan, const auto&) {
+          std::lock_guard lock(map_mutex_);
+          pending_scans_[scan.sensor()] = scan;
+        });
+    camera_info_reader_ = std::make_unique<concert::dds::Reader<msg::CameraInfo>>(
+        participant, concert::dds::topics::camera_info, [this](const msg::CameraInfo& info, const auto&) {
+          std::lock_guard lock(map_mutex_);
+          camera_infos_[info.sensor()] = info;
+        });
+    depth_reader_ = std::make_unique<concert::dds::Reader<msg::Image>>(
+        participant, concert::dds::topics::camera_depth, [this](const msg::Image& image, const auto&) {
+          std::lock_guard lock(map_mutex_);
+          auto& frames = pending_depth_[image.sensor()];
+          frames.push_back(image);
+          while (frames.size() > static_cast<std::size_t>(planner_.params().sensor_depth_frames)) frames.pop_front();
+        });
+    publish_environment();
+    std::ostringstream line;
+    line << "planner: map from " << source << " (lidar revolutions and depth frames every "
+         << planner_.params().sensor_map_period << " s at most, of periods the base and joints stayed slower than "
+         << planner_.params().sensor_max_speed << " m/s, rad/s)";
+    log_line(line.str());
+    sensor_mapper_ = std::thread([this] { sensor_map_loop(); });
+  }
   if (planner_.model_version() == 0)
     status_.report(msg::SERVICE_STARTING, 0, "waiting for a robot model");
   executor_ = std::thread([this] { execute_loop(); });
@@ -156,6 +190,10 @@ PlannerNode::~PlannerNode() {
   wake_.notify_all();
   executor_.join();
   if (warmer_.joinable()) warmer_.join();
+  if (sensor_mapper_.joinable()) sensor_mapper_.join();
+  lidars_.reset();
+  depth_reader_.reset();
+  camera_info_reader_.reset();
 }
 
 void PlannerNode::log_line(const std::string& line) {
@@ -531,11 +569,20 @@ std::string PlannerNode::execute(Execution& e) {
 }
 
 void PlannerNode::on_world(const msg::World& w) {
+  if (!use_world_) {
+    log_line("planner: world version " + std::to_string(w.version()) +
+             " not used: the map comes from the sensors (environment_source: sensors)");
+    return;
+  }
   try {
     const World world = to_planner_world(world::from_msg(w));
     Environment env(planner_.params().octomap_resolution);
     env.add_world(world);
-    planner_.set_environment(env);
+    {
+      std::lock_guard lock(map_mutex_);
+      world_map_ = env;
+    }
+    publish_environment();
     std::ostringstream line;
     line << "planner: world version " << w.version() << " from " << w.source() << ": "
          << world.boxes.size() << " boxes, " << world.cylinders.size() << " cylinders, map "
@@ -545,6 +592,175 @@ void PlannerNode::on_world(const msg::World& w) {
     log_line(std::string("planner: world version ") + std::to_string(w.version()) +
              " refused: " + e.what());
   }
+}
+
+void PlannerNode::publish_environment() {
+  std::lock_guard lock(map_mutex_);
+  if (!use_sensors_) {
+    planner_.set_environment(world_map_);
+  } else if (!use_world_) {
+    planner_.set_environment(sensor_map_);
+  } else {
+    Environment both = world_map_;
+    both.add_occupied(sensor_map_);
+    planner_.set_environment(both);
+  }
+}
+
+void PlannerNode::sensor_map_loop() {
+  const auto period = std::chrono::duration_cast<std::chrono::milliseconds>(
+      std::chrono::duration<double>(planner_.params().sensor_map_period));
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    wake_.wait_for(lock, std::max(period, std::chrono::milliseconds(10)), [&] { return stopping_; });
+    if (stopping_) return;
+    lock.unlock();
+    try {
+      update_sensor_map();
+    } catch (const std::exception& e) {
+      log_line(std::string("planner: sensor map update failed: ") + e.what());
+    }
+    lock.lock();
+  }
+}
+
+void PlannerNode::note_motion(const msg::Odometry& odometry) {
+  const double limit = planner_.params().sensor_max_speed;
+  if (std::hypot(odometry.vx(), odometry.vy()) <= limit && std::abs(odometry.wz()) <= limit) return;
+  std::lock_guard lock(map_mutex_);
+  moved_ = true;
+}
+
+void PlannerNode::note_motion(const msg::JointState& joints) {
+  const double limit = planner_.params().sensor_max_speed;
+  for (const double v : joints.velocity()) {
+    if (std::abs(v) > limit) {
+      std::lock_guard lock(map_mutex_);
+      moved_ = true;
+      return;
+    }
+  }
+}
+
+void PlannerNode::update_sensor_map() {
+  const Params& params = planner_.params();
+  const auto model = planner_.model();
+  std::map<std::string, msg::LidarScan> scans;
+  std::map<std::string, std::deque<msg::Image>> depth;
+  std::map<std::string, msg::CameraInfo> infos;
+  bool moved = false;
+  {
+    std::lock_guard lock(map_mutex_);
+    scans.swap(pending_scans_);
+    depth.swap(pending_depth_);
+    infos = camera_infos_;
+    moved = std::exchange(moved_, false);
+  }
+  if (!model) return;  // no model: no sensor frames, no self filter
+  if (!mapper_ || mapper_->model().version() != model->version()) {
+    // A new model: its sensor frames and its shapes for the self filter.
+    mapper_ = std::make_shared<const SensorMapper>(model, params);
+    log_line("planner: sensor map: self filter on model version " + std::to_string(model->version()));
+  }
+  std::size_t inputs = scans.size();
+  for (const auto& [name, frames] : depth) inputs += frames.size();
+  if (inputs == 0) return;
+  std::optional<msg::JointState> js;
+  std::optional<msg::Odometry> odom;
+  {
+    std::lock_guard lock(mutex_);
+    js = joint_state_;
+    odom = odometry_;
+  }
+  if (!js || js->model_version() != model->version() || !odom) {
+    std::lock_guard lock(map_mutex_);
+    skipped_version_ += inputs;  // no robot state of this model to place them with
+    return;
+  }
+  if (moved) {
+    // Something moved during the period: its revolutions and frames may be smeared.
+    std::lock_guard lock(map_mutex_);
+    skipped_moving_ += inputs;
+    return;
+  }
+  const Eigen::Vector3d base =
+      mobile_base::compose(map_frame_.map_T_odom(), Eigen::Vector3d(odom->x(), odom->y(), odom->yaw()));
+  const Eigen::VectorXd q = model->full_from_named(js->name(), js->position(), base);
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::string> used, refused;
+  SensorMapStats total;
+  auto add = [&](const SensorMapStats& s) {
+    total.occupied += s.occupied;
+    total.self += s.self;
+    total.floor += s.floor;
+  };
+  std::size_t stale = 0;
+  std::vector<RayBundle> bundles;  // every sensor's rays, cast with one copy of the map
+  for (const auto& [name, m] : scans) {
+    if (m.model_version() != model->version()) {
+      stale += 1;
+      continue;
+    }
+    try {
+      const hardware::LidarScan scan = sensors_dds::from_msg(m);
+      SensorRays r = mapper_->lidar_rays(scan, mapper_->sensor_pose(q, scan.frame), q);
+      add(r.stats);
+      bundles.push_back(std::move(r.rays));
+      used.push_back(name);
+    } catch (const std::exception& e) {
+      refused.push_back(name + ": " + e.what());
+    }
+  }
+  for (const auto& [name, images] : depth) {
+    try {
+      const auto info = infos.find(name);
+      if (info == infos.end()) throw PlannerError("no camera info");
+      std::vector<hardware::RgbdFrame> frames;
+      for (const msg::Image& image : images) {
+        if (image.model_version() != model->version()) {
+          stale += 1;
+          continue;
+        }
+        frames.push_back(sensors_dds::to_depth_frame(image, info->second));
+      }
+      if (frames.empty()) continue;
+      SensorRays r = mapper_->depth_rays(frames, mapper_->sensor_pose(q, frames.front().frame), q);
+      add(r.stats);
+      bundles.push_back(std::move(r.rays));
+      used.push_back(name + " (" + std::to_string(frames.size()) + " depth frames averaged)");
+    } catch (const std::exception& e) {
+      refused.push_back(name + ": " + e.what());
+    }
+  }
+  Environment map = [&] {
+    std::lock_guard lock(map_mutex_);
+    return sensor_map_;
+  }();
+  if (!bundles.empty()) map.insert_rays(bundles);
+  std::size_t moving = 0, version = 0;
+  {
+    std::lock_guard lock(map_mutex_);
+    sensor_map_ = map;
+    if (used.empty() && refused.empty()) {
+      skipped_version_ += stale;  // nothing to report yet: counted into the next line
+      return;
+    }
+    moving = std::exchange(skipped_moving_, 0);
+    version = std::exchange(skipped_version_, 0) + stale;
+  }
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  std::ostringstream line;
+  line << "planner: sensor map: used ";
+  for (std::size_t i = 0; i < used.size(); ++i) line << (i == 0 ? "" : ", ") << used[i];
+  if (used.empty()) line << "nothing";
+  line << " in " << std::lround(ms) << " ms, " << total.occupied << " hits, " << total.self << " on the robot, "
+       << total.floor << " floor; map " << map.occupied_cells() << " occupied cells";
+  if (moving > 0) line << "; " << moving << " revolutions or frames skipped: the robot moved";
+  if (version > 0) line << "; " << version << " skipped: not of model version " << model->version() << " or no joint state";
+  for (const std::string& r : refused) line << "; refused " << r;
+  log_line(line.str());
+  // After the line, so whoever sees the new map finds the line that reports it.
+  if (!used.empty()) publish_environment();
 }
 
 }  // namespace concert::planner::dds

@@ -14,6 +14,13 @@
 // (NavLocalisation), the planner plans in the map frame: start and goals go in through
 // map_T_odom (mobile_base::MapFrame), trajectories come out through its inverse. Without a
 // localisation the two frames are one (a world without a building).
+//
+// Map source (Params::environment_source): "world" (default) builds the map from the world
+// topic; "sensors" from the robot's lidar revolutions (concert/sensors/lidar) and depth images
+// (concert/sensors/camera/depth + info, the latest frames of each camera averaged), ray-cast
+// every sensor_map_period from each sensor's model pose at the latest joint state and the
+// odometry placed in the map, of periods in which the base and the joints stayed nearly still
+// (SensorMapper); "both" publishes the world's obstacles and the sensors' together.
 
 #include <atomic>
 #include <chrono>
@@ -30,6 +37,8 @@
 #include "concert/mobile_base/map_frame.hpp"
 #include "concert/world/world.hpp"
 #include "planner/planner.hpp"
+#include "planner/sensor_map.hpp"
+#include "sensors.h"
 
 namespace concert::planner::dds {
 
@@ -92,6 +101,15 @@ class PlannerNode {
   /// Empty on success, else why the robot did not execute it.
   std::string execute(Execution& e);
   void on_world(const msg::World& world);
+  void sensor_map_loop();
+  /// Integrates the pending lidar scans into the sensor map and publishes the map (sensor map
+  /// thread only).
+  void update_sensor_map();
+  /// Marks the period as moved if the base or a joint is faster than sensor_max_speed.
+  void note_motion(const msg::Odometry& odometry);
+  void note_motion(const msg::JointState& joints);
+  /// Gives the planner the map of the configured source (world, sensors or both).
+  void publish_environment();
 
   Planner& planner_;
   NodeOptions options_;
@@ -105,6 +123,20 @@ class PlannerNode {
   std::optional<msg::Odometry> odometry_;
   bool stopping_ = false;
   mobile_base::MapFrame map_frame_;
+  // Map from the sensors (environment_source sensors or both); before the readers, whose
+  // callbacks (the latched world) may run while the node is being built.
+  const bool use_world_;
+  const bool use_sensors_;
+  std::mutex map_mutex_;  // guards the members below
+  std::map<std::string, msg::LidarScan> pending_scans_;  // newest revolution of each lidar not yet used
+  std::map<std::string, std::deque<msg::Image>> pending_depth_;  // latest depth frames per camera
+  std::map<std::string, msg::CameraInfo> camera_infos_;          // latest per camera
+  bool moved_ = false;  // the base or a joint moved since the last map update
+  Environment world_map_;
+  Environment sensor_map_;
+  std::size_t skipped_moving_ = 0;  // revolutions and frames, since the last map update line
+  std::size_t skipped_version_ = 0;
+  std::shared_ptr<const SensorMapper> mapper_;  // sensor map thread only
   uint64_t warm_version_ = 0;  // model version the warm-up thread should prepare (0: none)
   concert::dds::Writer<msg::PlanResult> results_;
   concert::dds::Writer<msg::JointTrajectoryCommand> trajectory_commands_;
@@ -119,8 +151,14 @@ class PlannerNode {
   concert::dds::Reader<msg::TrajectoryStatus> trajectory_statuses_;
   concert::dds::Reader<msg::World> worlds_;
   concert::dds::Reader<msg::PlanRequest> request_reader_;
+  std::unique_ptr<concert::dds::Reader<msg::LidarScan>> lidars_;
+  std::unique_ptr<concert::dds::Reader<msg::CameraInfo>> camera_info_reader_;
+  std::unique_ptr<concert::dds::Reader<msg::Image>> depth_reader_;
+
+
   std::thread executor_;
   std::thread warmer_;
+  std::thread sensor_mapper_;
 };
 
 }  // namespace concert::planner::dds

@@ -43,6 +43,10 @@ void check_image(const msg::Image& image, std::string_view encoding);
 /// stamp, same size). Throws std::invalid_argument naming what does not match.
 hardware::RgbdFrame to_rgbd_frame(const msg::Image& rgb, const msg::Image& depth,
                                   const msg::CameraInfo& info);
+/// One depth frame (rgb left empty) from a depth image and its camera info (same camera, same
+/// size), for readers that need no colour. Throws std::invalid_argument naming the camera and
+/// what does not match (encoding, size, step, another camera's info).
+hardware::RgbdFrame to_depth_frame(const msg::Image& depth, const msg::CameraInfo& info);
 
 msg::LidarScan to_msg(const hardware::LidarScan& scan, uint32_t model_version);
 /// Throws std::invalid_argument naming the lidar when ranges is not rings * columns long.
