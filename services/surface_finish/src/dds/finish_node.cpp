@@ -300,24 +300,33 @@ Eigen::VectorXd FinishNode::q_now_measured() {
   return q_of(*latest);
 }
 
-void FinishNode::start_spray(const msg::FinishCommand& c) {
+FinishNode::Run FinishNode::plan_run(const msg::FinishCommand& c, const ToolSpec& tool,
+                                     PathParams path, std::string& target, int& inliers) {
   const AreaMap& areas = *current_.areas;
   const Area& area = areas.area(c.area());
   const Rect rect = c.has_rect() ? reshape(area, Rect{c.x0(), c.x1(), c.y0(), c.y1()}) : area.rect;
   const WallFit fit = measure_wall_for(areas);
-  const double d = fit.wall.distance();
   const Eigen::VectorXd q_now = q_now_measured();
-  ToolSpec tool = params_.spray;
-  PathParams path = params_.path;
   if (c.speed() > 0.0) path.speed = c.speed();
   const auto strokes = serpentine_strokes(rect, tool, path.visible);
   Run run;
   run.request_id = c.request_id();
   run.wall = fit.wall;
-  run.wall_distance = d;
+  run.wall_distance = fit.wall.distance();
   run.plan = plan_serpentine(*current_.reach, fit.wall, rect, tool, areas.roll, path, q_now,
                              &areas.posture_near(strokes.front().x, strokes.front().y_start));
-  run.deposition = std::make_unique<SprayDeposition>(fit.wall, rect, tool, path.speed, static_cast<int>(run.plan.strokes.size()));
+  target = rect.str() + " of area '" + area.id + "'";
+  inliers = fit.inliers;
+  return run;
+}
+
+void FinishNode::start_spray(const msg::FinishCommand& c) {
+  std::string target;
+  int inliers = 0;
+  Run run = plan_run(c, params_.spray, params_.path, target, inliers);
+  run.deposition = std::make_unique<SprayDeposition>(run.wall, run.plan.rect, params_.spray,
+                                                     c.speed() > 0.0 ? c.speed() : params_.path.speed,
+                                                     static_cast<int>(run.plan.strokes.size()));
   {
     std::lock_guard lock(mutex_);
     measured_.clear();
@@ -327,9 +336,9 @@ void FinishNode::start_spray(const msg::FinishCommand& c) {
   char b[200];
   std::snprintf(
       b, sizeof b,
-      "request %u: spraying %s of area '%s': %zu strokes, %.1f s, wall %.3f m (scan, %d points)",
-      c.request_id(), rect.str().c_str(), area.id.c_str(), run.plan.strokes.size(),
-      run.plan.duration(), d, fit.inliers);
+      "request %u: spraying %s: %zu strokes, %.1f s, wall %.3f m (scan, %d points)",
+      c.request_id(), target.c_str(), run.plan.strokes.size(), run.plan.duration(),
+      run.wall_distance, inliers);
   log_line(std::string("surface_finish: ") + b);
   run_ = std::move(run);
   publish(run_->request_id, msg::FINISH_RUNNING, "", &*run_);
@@ -385,22 +394,9 @@ void FinishNode::start_sand(const msg::FinishCommand& c) {
       throw FinishError("the robot is safety-stopped (" + causes + ")");
     }
   }
-  const AreaMap& areas = *current_.areas;
-  const Area& area = areas.area(c.area());
-  const Rect rect = c.has_rect() ? reshape(area, Rect{c.x0(), c.x1(), c.y0(), c.y1()}) : area.rect;
-  const WallFit fit = measure_wall_for(areas);
-  const double d = fit.wall.distance();
-  const Eigen::VectorXd q_now = q_now_measured();
-  const ToolSpec tool = params_.sand;
-  PathParams path = params_.sand_path;
-  if (c.speed() > 0.0) path.speed = c.speed();
-  const auto strokes = serpentine_strokes(rect, tool, path.visible);
-  Run run;
-  run.request_id = c.request_id();
-  run.wall = fit.wall;
-  run.wall_distance = d;
-  run.plan = plan_serpentine(*current_.reach, fit.wall, rect, tool, areas.roll, path, q_now,
-                             &areas.posture_near(strokes.front().x, strokes.front().y_start));
+  std::string target;
+  int inliers = 0;
+  Run run = plan_run(c, params_.sand, params_.sand_path, target, inliers);
   SandParams sp = params_.sanding;
   sp.force = force;
   run.sand = std::make_unique<SandSequence>(run.plan, sp);
@@ -414,10 +410,10 @@ void FinishNode::start_sand(const msg::FinishCommand& c) {
   run.last_status = std::chrono::steady_clock::now();
   char b[220];
   std::snprintf(b, sizeof b,
-                "request %u: sanding %s of area '%s' at %.1f N: %zu strokes, %.1f s, wall %.3f m "
+                "request %u: sanding %s at %.1f N: %zu strokes, %.1f s, wall %.3f m "
                 "(scan, %d points)",
-                c.request_id(), rect.str().c_str(), area.id.c_str(), force, run.plan.strokes.size(),
-                run.plan.duration(), d, fit.inliers);
+                c.request_id(), target.c_str(), force, run.plan.strokes.size(),
+                run.plan.duration(), run.wall_distance, inliers);
   log_line(std::string("surface_finish: ") + b);
   run_ = std::move(run);
   publish(run_->request_id, msg::FINISH_RUNNING, "", &*run_);

@@ -115,6 +115,11 @@ class FinishNode {
   [[nodiscard]] WallFit measure_wall_for(const AreaMap& areas);
   /// The arm's joints from the latest joint state (the caller checked there is one).
   [[nodiscard]] Eigen::VectorXd q_now_measured();
+  /// A run of command `c` planned for `tool` (the area or its rect, the wall measured now, the
+  /// serpentine from the arm's current joints); `target` gets "<rect> of area '<id>'" and
+  /// `inliers` the wall fit's point count, for the log. Spray and sand share it.
+  [[nodiscard]] Run plan_run(const msg::FinishCommand& c, const ToolSpec& tool, PathParams path,
+                             std::string& target, int& inliers);
   void hold_here();
   void log_line(const std::string& line);
 
