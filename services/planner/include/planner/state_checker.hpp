@@ -26,6 +26,9 @@ class StateChecker {
   /// Returns the first constraint violated, in the order joint limit, torque, floor,
   /// environment, self collision.
   [[nodiscard]] Validity check(const Eigen::VectorXd& q_full, const std::string& contact_frame = {});
+  /// The torque check of check() alone (no joint limits, no collisions): a posture whose
+  /// shapes are meant to be in contact, e.g. the drill's bit in its hole.
+  [[nodiscard]] Validity check_torques(const Eigen::VectorXd& q_full, const std::string& contact_frame);
   /// Joint torques the state needs (gravity + contact) [N m], full q order
   /// (PlanningModel::static_torques). Throws PlannerError for an unknown contact frame.
   [[nodiscard]] Eigen::VectorXd required_torques(const Eigen::VectorXd& q_full, const std::string& contact_frame);
@@ -39,6 +42,8 @@ class StateChecker {
 
  private:
   void torques_at_poses(const std::string& contact_frame, Eigen::VectorXd& tau);
+  /// The torque limits against impl_->tau (torques_at_poses' result).
+  [[nodiscard]] Validity torque_validity(const std::string& contact_frame) const;
   std::shared_ptr<const PlanningModel> model_;
   Environment environment_;
   Params params_;

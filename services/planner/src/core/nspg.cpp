@@ -94,7 +94,6 @@ namespace {
 std::string reach_torque_failure(const PlanningModel& model, StateChecker& checker,
                                  const Eigen::VectorXd& full, const EndEffectorInfo& tool,
                                  const Task& task, const Params& params) {
-  const auto& idx = model.planned_indices();
   const std::optional<Eigen::VectorXd> reached =
       reached_posture(model, full, tool.frame, task.axis, params.tip_reach);
   if (!reached) {
@@ -102,19 +101,11 @@ std::string reach_torque_failure(const PlanningModel& model, StateChecker& check
     s << "the bit cannot reach " << params.tip_reach << " m along the hole from the posture";
     return s.str();
   }
-  const Eigen::VectorXd& q = *reached;
-  const Eigen::VectorXd& limit = model.torque_limits();
   for (const std::string& contact : {tool.frame, std::string()}) {
-    const Eigen::VectorXd tau = checker.required_torques(q, contact);
-    for (std::size_t i = 3; i < idx.size(); ++i) {
-      const int fi = idx[i];
-      if (limit[fi] > 0.0 && std::abs(tau[fi]) > params.torque_margin * limit[fi]) {
-        std::ostringstream s;
-        s << model.joint_names()[i] << " needs " << std::abs(tau[fi]) << " N m > "
-          << params.torque_margin * limit[fi] << " N m continuous with the bit "
-          << params.tip_reach << " m further" << (contact.empty() ? "" : " (with contact force)");
-        return s.str();
-      }
+    if (const Validity v = checker.check_torques(*reached, contact); !v.valid()) {
+      std::ostringstream s;
+      s << v.detail << " with the bit " << params.tip_reach << " m further";
+      return s.str();
     }
   }
   return {};

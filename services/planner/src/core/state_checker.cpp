@@ -99,6 +99,29 @@ void StateChecker::torques_at_poses(const std::string& contact_frame, Eigen::Vec
   model_->static_torques(impl_->poses, link, force, tau);
 }
 
+Validity StateChecker::torque_validity(const std::string& contact_frame) const {
+  const PlanningModel& m = *model_;
+  const auto& planned = m.planned_indices();
+  const Eigen::VectorXd& tau = impl_->tau;
+  const Eigen::VectorXd& limit = m.torque_limits();
+  for (std::size_t i = 3; i < planned.size(); ++i) {
+    const int fi = planned[i];
+    if (limit[fi] > 0.0 && std::abs(tau[fi]) > params_.torque_margin * limit[fi]) {
+      std::ostringstream s;
+      s << m.joint_names()[i] << " needs " << std::abs(tau[fi]) << " N m > " << params_.torque_margin * limit[fi]
+        << " N m continuous" << (contact_frame.empty() ? "" : " (with contact force)");
+      return {Constraint::kTorqueLimit, s.str()};
+    }
+  }
+  return {};
+}
+
+Validity StateChecker::check_torques(const Eigen::VectorXd& q, const std::string& contact_frame) {
+  model_->link_poses(q, impl_->poses);
+  torques_at_poses(contact_frame, impl_->tau);
+  return torque_validity(contact_frame);
+}
+
 Validity StateChecker::check(const Eigen::VectorXd& q, const std::string& contact_frame) {
   checks_ += 1;
   const PlanningModel& m = *model_;
@@ -113,18 +136,8 @@ Validity StateChecker::check(const Eigen::VectorXd& q, const std::string& contac
     }
   }
   m.link_poses(q, impl_->poses);
-  Eigen::VectorXd& tau = impl_->tau;
-  torques_at_poses(contact_frame, tau);
-  const Eigen::VectorXd& limit = m.torque_limits();
-  for (std::size_t i = 3; i < planned.size(); ++i) {
-    const int fi = planned[i];
-    if (limit[fi] > 0.0 && std::abs(tau[fi]) > params_.torque_margin * limit[fi]) {
-      std::ostringstream s;
-      s << m.joint_names()[i] << " needs " << std::abs(tau[fi]) << " N m > " << params_.torque_margin * limit[fi]
-        << " N m continuous" << (contact_frame.empty() ? "" : " (with contact force)");
-      return {Constraint::kTorqueLimit, s.str()};
-    }
-  }
+  torques_at_poses(contact_frame, impl_->tau);
+  if (Validity v = torque_validity(contact_frame); !v.valid()) return v;
 
   const auto& links = m.links();
   for (ShapeObject& o : impl_->shapes) {
