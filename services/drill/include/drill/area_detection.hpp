@@ -76,15 +76,15 @@ std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,
 /// How far the blobs of an area appear from where they were predicted (world frame, [m]): the
 /// shift that lays the most predicted blob positions of `area_points` onto blobs seen in the
 /// view (within `tolerance`), among the shifts no longer than `max_shift` (the most odometry
-/// can have drifted since the area was detected) that put `target` on a seen blob; ties go to
-/// the smallest shift. Blobs 0.1 m apart and a prediction off by 5 cm are told apart this way
-/// where the nearest blob would be the wrong one. None when no blob is in view within
-/// `max_shift`: a neighbour seen alone (the target's own blob out of the image or missed by the
-/// detector) is not taken for it.
+/// can have drifted since the area was detected); ties go to the smallest shift. Blobs 0.1 m
+/// apart and a prediction off by 5 cm are told apart this way where the nearest blob would be
+/// the wrong one; a hole's own blob out of the image is placed by its neighbours. None when no
+/// blob is in view within `max_shift`, or when two different shifts explain the view equally
+/// well (one blob seen alone, within `max_shift` of two predicted ones): a neighbour is not
+/// taken for the target.
 std::optional<Eigen::Vector3d> blob_shift(const CameraView& view,
                                           const std::vector<DrillPoint>& area_points,
-                                          const DrillPoint& target, double tolerance,
-                                          double max_shift);
+                                          double tolerance, double max_shift);
 
 /// The blob nearest to `hole` in a view (world frame, within `max_distance` [m]), as a hole
 /// frame with the observed position and normal; none if no blob is that close.

@@ -76,12 +76,14 @@ constexpr int kPlanAttempts = 3;
 // Re-measuring a hole from its drilling posture: frames averaged, and how far from the predicted
 // position the mark may be found [m] (odometry drift over the base's move).
 constexpr int kReanchorFrames = 3;
-// After the whole body moved to an ArUco hole's drilling posture, the arm alone turns the camera
-// to the marker and the pattern is measured again from there: the pattern is drilled by the
-// kinematics alone, and the base's odometry drifts 2-4 cm over such a move (the demo wall's
-// pattern: holes 20-37 mm off without this). The camera is asked for at the distance the hole's
-// posture reached (the arm only shifts across the wall), then this much further out [m], in turn.
-constexpr double kMarkerViewFurther[] = {0.0, 0.1, 0.2};
+// After the whole body moved to a hole's drilling posture, the arm alone turns the camera onto the
+// hole's mark and the hole is measured again from there: for an ArUco hole always (the pattern
+// is drilled by the kinematics alone, and the base's odometry drifts 2-4 cm over such a move:
+// the demo wall's pattern was drilled 20-37 mm off without this), for a blob hole when the view
+// from its drilling posture, the camera 11 cm beside the bit, cannot tell its blob from a
+// neighbour (blob_shift). The camera is asked for at the distance the hole's posture reached
+// (the arm only shifts across the wall), then this much further out [m], in turn.
+constexpr double kLookFurther[] = {0.0, 0.1, 0.2};
 constexpr double kReanchorDistance = 0.06;
 // Hole depth the drilling posture's reach is checked to when no mission is loaded [m].
 constexpr double kDefaultDepth = 0.05;
@@ -94,6 +96,13 @@ constexpr double kReplanShift = 0.01;
 // Blobs of one area matched as a set: a predicted blob lies this close to a seen one [m]
 // (6 deg of odometry yaw over 0.1 m between blobs moves them 1 cm).
 constexpr double kBlobMatch = 0.02;
+// While the whole body moves to a blob hole's posture, the area's blobs are followed from camera
+// frame to frame (track_area): odometry drifts 2-6 cm over such a move (recorded on morphology
+// A at the BIM area: 27 mm over 0.45 m and 0.75 rad of base motion), more than half the 10 cm
+// between blobs, so the drilling posture's view alone, the camera 11 cm beside the bit, could
+// take a neighbour for the blob. From one frame to the next the drift grows by millimetres: a
+// seen blob is taken for a predicted one at most this far [m].
+constexpr double kTrackWindow = 0.02;
 
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
@@ -964,8 +973,19 @@ void DrillNode::align(const DrillPoint& point) {
     return;
   }
   point_ = point;
-  marker_looked_ = false;
+  looked_ = false;
+  look_pushed_ = false;
   hole_replanned_ = false;
+  tracked_frames_ = 0;
+  tracked_.setZero();
+  {
+    std::lock_guard lock(mutex_);
+    track_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
+  }
+  // A blob where the area's last re-measure puts it (shift_area: odometry drifted since).
+  for (const DrillPoint& p : area_points_) {
+    if (p.marker < 0 && p.label == point.label) point_.frame = p.frame;
+  }
   // The pattern as its marker was last seen (after a base move), not as first detected.
   if (const auto it = markers_seen_.find(point.marker); it != markers_seen_.end() && patterns_) {
     if (const std::optional<Eigen::Isometry3d> f = hole_of(point, it->second, *patterns_))
@@ -1109,24 +1129,82 @@ void DrillNode::start_reanchor(Motion next) {
   motion_ = next;
 }
 
-// The whole body moved to an ArUco hole's drilling posture: the arm alone turns the camera to
-// the hole's marker (kMarkerViewFurther), where the pattern is measured again.
-void DrillNode::look_at_marker() {
-  marker_looked_ = true;
-  const std::optional<Eigen::Isometry3d> marker =
-      patterns_ ? marker_of(point_, *patterns_) : std::nullopt;
-  if (!marker) {
+// The whole body moved to the hole's drilling posture: the arm alone turns the camera onto the
+// hole's mark (an ArUco hole's marker, a blob hole's blob as predicted; kLookFurther), where the
+// hole is measured again.
+void DrillNode::look_at_hole() {
+  looked_ = true;
+  std::optional<Eigen::Isometry3d> mark;
+  if (point_.marker < 0)
+    mark = point_.frame;
+  else if (patterns_)
+    mark = marker_of(point_, *patterns_);
+  if (!mark) {
     start_reanchor(Motion::kReanchor);
     return;
   }
-  look_goal_ = *marker;
+  look_goal_ = *mark;
   // The camera's distance at the hole's posture.
   hole_reached_ = hole_request_.tip_distance() > 0.0 ? hole_request_.tip_distance() + camera_to_tip_
                                                      : hole_request_.camera_distance();
-  request_marker_view(0);
+  request_look(0);
 }
 
-void DrillNode::request_marker_view(std::size_t attempt) {
+void DrillNode::shift_area(const Eigen::Vector3d& shift) {
+  for (DrillPoint& p : area_points_) {
+    if (p.marker < 0) p.frame.translation() += shift;
+  }
+}
+
+// The blobs a view shows, in the predicted hole's frame (x, y on the wall, z out of it) [mm],
+// for the log of a re-measure.
+std::string blobs_seen(const CameraView& view, const Eigen::Isometry3d& predicted) {
+  std::ostringstream t;
+  t.setf(std::ios::fixed);
+  t.precision(1);
+  const std::vector<Blob> blobs = detect_blobs(*view.frame);
+  t << blobs.size() << " blob" << (blobs.size() == 1 ? "" : "s") << " in view";
+  for (const Blob& b : blobs) {
+    const Eigen::Vector3d p = predicted.inverse() * (view.world_T_optical * b.position);
+    t << " (" << p.x() * 1e3 << ", " << p.y() * 1e3 << ", " << p.z() * 1e3 << ")";
+  }
+  t << " mm from the prediction";
+  return t.str();
+}
+
+void DrillNode::track_area() {
+  if (point_.marker >= 0 || hole_request_.fixed_base() || area_points_.empty()) return;
+  std::optional<CameraFrame> newest;  // the newest only: detection costs, and the drift is slow
+  {
+    std::lock_guard lock(mutex_);
+    if (!frames_.empty() && frames_.back().stamp_ns > track_since_ns_) newest = frames_.back();
+  }
+  if (!newest) return;
+  track_since_ns_ = newest->stamp_ns;
+  const std::optional<Eigen::Vector3d> shift =
+      blob_shift(CameraView{&newest->frame, newest->world_T_optical}, area_points_, kBlobMatch,
+                 kTrackWindow);
+  if (!shift) return;
+  shift_area(*shift);
+  point_.frame.translation() += *shift;
+  tracked_ += *shift;
+  ++tracked_frames_;
+}
+
+void DrillNode::replan_hole(bool tip, double further) {
+  hole_plan_request_ = next_request_++;
+  hole_request_.request_id(hole_plan_request_);
+  hole_request_.goals().clear();
+  hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
+  set_hole_task(hole_request_, {tip, true, 0.0, further}, hole_distance_, camera_to_tip_,
+                hole_depth());
+  hole_request_.stamp_ns(now_ns());
+  plan_requests_.write(hole_request_);
+  hole_path_ = {};
+  motion_ = Motion::kApproachHole;
+}
+
+void DrillNode::request_look(std::size_t attempt) {
   look_attempt_ = attempt;
   msg::PlanRequest r = hole_request_;
   look_request_ = next_request_++;
@@ -1134,13 +1212,13 @@ void DrillNode::request_marker_view(std::size_t attempt) {
   r.stamp_ns(now_ns());
   r.goals().clear();
   r.goals().push_back(model::dds::to_pose_msg(look_goal_));
-  r.tip_distance(0.0);  // the camera looks at the marker
+  r.tip_distance(0.0);  // the camera looks at the mark
   r.tip_reach(0.0);
-  r.camera_distance(hole_reached_ + kMarkerViewFurther[attempt]);
+  r.camera_distance(hole_reached_ + kLookFurther[attempt]);
   r.fixed_base(true);
   plan_requests_.write(r);
   look_path_ = {};
-  motion_ = Motion::kLookAtMarker;
+  motion_ = Motion::kLookAtHole;
 }
 
 // Every control period while a hole is worked on: the servo's new estimate of the blob from
@@ -1154,6 +1232,7 @@ void DrillNode::control_motion() {
       const auto it = plan_results_.find(hole_plan_request_);
       if (it != plan_results_.end()) r = it->second;
     }
+    track_area();
     if (!r) return;
     // The trajectory comes with PLANNED and the execution updates; SUCCEEDED may arrive alone.
     if (!r->trajectory().empty()) hole_path_ = {r->joint_names(), r->trajectory()};
@@ -1164,7 +1243,23 @@ void DrillNode::control_motion() {
       // move covers the shift from the posture reached.
       log_line("drill: " + point_.label + ": no posture for the arm alone at the hole measured " +
                "again (" + r->reason() + "); aligning from the whole body's posture");
-      if (const std::optional<Sample> s = latest_sample()) start_align(*s);
+      const std::optional<Sample> s = latest_sample();
+      if (!s) return;
+      if (looked_ && look_pushed_ && hole_chain_.size() > 1) {
+        // The camera looks at the hole: back onto the whole body's posture first (the way back
+        // from the hole then skips the look).
+        hole_chain_.pop_back();
+        look_pushed_ = false;
+        const PlannedPath& p = hole_chain_.back();
+        const msg::TrajectorySample here = sample_here(p.names, *s);
+        msg::TrajectorySample end = p.samples.back();
+        end.time(settle_time(p.names, here, end));
+        for (double& v : end.velocity()) v = 0.0;
+        trajectory_request_ = send_trajectory(p.names, {here, end});
+        motion_ = Motion::kBackToPosture;
+        return;
+      }
+      start_align(*s);
       return;
     }
     if (r->state() == msg::PLAN_FAILED &&
@@ -1192,8 +1287,19 @@ void DrillNode::control_motion() {
       motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());
       motion_ = Motion::kNone;
     } else if (r->state() == msg::PLAN_SUCCEEDED) {
-      if (point_.marker >= 0 && !hole_request_.fixed_base() && !marker_looked_) {
-        look_at_marker();
+      if (tracked_frames_ > 0) {
+        std::ostringstream line;
+        line.setf(std::ios::fixed);
+        line.precision(1);
+        line << "drill: " << point_.label << ": the area's blobs followed in " << tracked_frames_
+             << " camera frames while the base moved: odometry drifted " << tracked_.norm() * 1e3
+             << " mm";
+        log_line(line.str());
+        tracked_frames_ = 0;
+        tracked_.setZero();
+      }
+      if (point_.marker >= 0 && !hole_request_.fixed_base() && !looked_) {
+        look_at_hole();
       } else {
         // The base moved: measure the hole again in frames taken from here.
         start_reanchor(Motion::kReanchor);
@@ -1201,7 +1307,7 @@ void DrillNode::control_motion() {
     }
     return;
   }
-  if (motion_ == Motion::kLookAtMarker) {
+  if (motion_ == Motion::kLookAtHole) {
     std::optional<msg::PlanResult> r;
     {
       std::lock_guard lock(mutex_);
@@ -1211,32 +1317,63 @@ void DrillNode::control_motion() {
     if (!r) return;
     if (!r->trajectory().empty()) look_path_ = {r->joint_names(), r->trajectory()};
     if (r->state() == msg::PLAN_SUCCEEDED) {
-      if (!look_path_.samples.empty()) hole_chain_.push_back(look_path_);
-      start_reanchor(Motion::kMarkerReanchor);
+      look_pushed_ = !look_path_.samples.empty();
+      if (look_pushed_) hole_chain_.push_back(look_path_);
+      start_reanchor(Motion::kLookReanchor);
     } else if (r->state() == msg::PLAN_FAILED &&
-               look_attempt_ + 1 < std::size(kMarkerViewFurther)) {
-      request_marker_view(look_attempt_ + 1);
+               look_attempt_ + 1 < std::size(kLookFurther)) {
+      request_look(look_attempt_ + 1);
     } else if (r->state() == msg::PLAN_FAILED) {
-      log_line("drill: " + point_.label + ": the camera cannot be turned to marker " +
-               std::to_string(point_.marker) + " from here (" + r->reason() +
-               "); the hole is drilled where odometry puts it");
+      log_line("drill: " + point_.label + ": the camera cannot be turned onto " +
+               (point_.marker >= 0 ? "marker " + std::to_string(point_.marker) : "the blob") +
+               " from here (" + r->reason() + "); the hole is measured from its posture");
       start_reanchor(Motion::kReanchor);
     }
     return;
   }
-  if (motion_ == Motion::kMarkerReanchor) {
+  if (motion_ == Motion::kLookReanchor) {
     const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, kReanchorFrames);
     if (!view) return;
     const CameraView camera{&view->frame, view->world_T_optical};
+    if (point_.marker < 0) {
+      // The camera on the blob's axis sees its neighbours too: the area matched as a set.
+      Eigen::Isometry3d predicted = point_.frame;
+      double within = kBlobMatch;  // no neighbour is taken for it
+      if (const std::optional<Eigen::Vector3d> shift =
+              blob_shift(camera, area_points_, kBlobMatch, kReanchorDistance)) {
+        predicted.translation() += *shift;
+        within = kBlobMatch;
+      }
+      if (const std::optional<Eigen::Isometry3d> blob = track_blob(camera, predicted, within)) {
+        const Eigen::Vector3d moved = blob->translation() - point_.frame.translation();
+        std::ostringstream line;
+        line.setf(std::ios::fixed);
+        line.precision(1);
+        line << "drill: " << point_.label
+             << ": the blob seen again with the camera on it after the base moved: "
+             << moved.norm() * 1e3 << " mm from where odometry put it ("
+             << blobs_seen(camera, point_.frame) << ")";
+        log_line(line.str());
+        shift_area(moved);
+        point_.frame = *blob;
+      } else {
+        log_line("drill: " + point_.label +
+                 ": the blob not seen from the look posture; measured from its drilling posture");
+      }
+      // Without a posture for the arm alone there, the arm goes back onto the whole body's.
+      hole_replanned_ = true;
+    }
     std::optional<Eigen::Isometry3d> marker;
     try {
-      if (patterns_) marker = find_marker(camera, point_.marker, *patterns_);
+      if (patterns_ && point_.marker >= 0) marker = find_marker(camera, point_.marker, *patterns_);
     } catch (const DrillError&) {
       marker.reset();
     }
     std::optional<Eigen::Isometry3d> hole;
     if (marker) hole = hole_of(point_, *marker, *patterns_);
-    if (hole) {
+    if (point_.marker < 0) {
+      // Measured above.
+    } else if (hole) {
       std::ostringstream line;
       line.setf(std::ios::fixed);
       line.precision(1);
@@ -1262,16 +1399,7 @@ void DrillNode::control_motion() {
              kHoleAttempts[hole_attempt_].further >= reached.further - 1e-6))
       ++hole_attempt_;
     if (hole_attempt_ < from && !kHoleAttempts[hole_attempt_].fixed_base) hole_attempt_ = from;
-    hole_plan_request_ = next_request_++;
-    hole_request_.request_id(hole_plan_request_);
-    hole_request_.goals().clear();
-    hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
-    set_hole_task(hole_request_, {reached.tip, true, 0.0, reached.further}, hole_distance_,
-                  camera_to_tip_, hole_depth());
-    hole_request_.stamp_ns(now_ns());
-    plan_requests_.write(hole_request_);
-    hole_path_ = {};
-    motion_ = Motion::kApproachHole;
+    replan_hole(reached.tip, reached.further);
     return;
   }
   if (motion_ == Motion::kReanchor) {
@@ -1284,9 +1412,18 @@ void DrillNode::control_motion() {
     if (point_.marker < 0 && area_points_.size() > 1) {
       // Several blobs: which one is this hole's is told by the pattern they make together.
       if (const std::optional<Eigen::Vector3d> shift =
-              blob_shift(camera, area_points_, point_, kBlobMatch, kReanchorDistance)) {
+              blob_shift(camera, area_points_, kBlobMatch, kReanchorDistance)) {
         predicted.frame.translation() += *shift;
         within = kBlobMatch;
+      } else if (!hole_request_.fixed_base() && !looked_) {
+        // The base moved and the camera, beside the bit, cannot tell the blob from a neighbour.
+        log_line("drill: " + point_.label +
+                 ": its blob is not told from a neighbour from its drilling posture (" +
+                 blobs_seen(camera, point_.frame) + "); the camera is turned onto it");
+        look_at_hole();
+        return;
+      } else if (!hole_request_.fixed_base()) {
+        within = kBlobMatch;  // no neighbour is taken for it: the prediction stands
       }
     }
     const std::optional<Eigen::Isometry3d> seen =
@@ -1301,28 +1438,38 @@ void DrillNode::control_motion() {
                   std::clamp(seen->linear().col(2).dot(point_.frame.linear().col(2)), -1.0, 1.0)) *
                   180.0 / M_PI
            << " deg from the prediction";
+      if (point_.marker < 0) line << " (" << blobs_seen(camera, point_.frame) << ")";
       log_line(line.str());
-      const double shift = (seen->translation() - point_.frame.translation()).norm();
+      const Eigen::Vector3d moved = seen->translation() - point_.frame.translation();
+      if (point_.marker < 0) shift_area(moved);  // the area's other blobs moved as much
       point_.frame = *seen;
       if (!hole_request_.fixed_base() && kHoleAttempts[hole_attempt_].tip && !hole_replanned_ &&
-          shift > kReplanShift) {
+          moved.norm() > kReplanShift) {
         // The base moved and odometry drifted: the posture again, the arm alone, for the hole
         // where the camera sees it now.
         hole_replanned_ = true;
-        hole_plan_request_ = next_request_++;
-        hole_request_.request_id(hole_plan_request_);
-        hole_request_.goals().clear();
-        hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
-        set_hole_task(hole_request_, {true, true, 0.0, 0.0}, hole_distance_, camera_to_tip_,
-                      hole_depth());
-        hole_request_.stamp_ns(now_ns());
-        plan_requests_.write(hole_request_);
-        hole_path_ = {};
-        motion_ = Motion::kApproachHole;
+        replan_hole(true, 0.0);
         return;
       }
     }
     if (const std::optional<Sample> s = latest_sample()) start_align(*s);
+    return;
+  }
+  if (motion_ == Motion::kBackToPosture) {
+    std::optional<msg::TrajectoryStatus> status;
+    {
+      std::lock_guard lock(mutex_);
+      const auto it = trajectory_statuses_.find(trajectory_request_);
+      if (it != trajectory_statuses_.end()) status = it->second;
+    }
+    if (!status || status->state() == msg::TRAJECTORY_EXECUTING) return;
+    if (status->state() != msg::TRAJECTORY_SUCCEEDED) {
+      motion_outcome_ =
+          Outcome::failed("robot: back onto the hole's drilling posture: " + status->reason());
+      motion_ = Motion::kNone;
+    } else if (const std::optional<Sample> s = latest_sample()) {
+      start_align(*s);
+    }
     return;
   }
   if (motion_ == Motion::kSettle) {

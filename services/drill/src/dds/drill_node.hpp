@@ -108,13 +108,14 @@ class DrillNode final : public MissionPorts {
   enum class Motion {
     kNone,
     kApproachHole,
-    kLookAtMarker,
-    kMarkerReanchor,
+    kLookAtHole,
+    kLookReanchor,
     kReanchor,
     kAlign,
     kDrill,
     kRetractOut,
-    kSettle
+    kSettle,
+    kBackToPosture
   };
 
   void tick();
@@ -129,8 +130,16 @@ class DrillNode final : public MissionPorts {
   /// The mission's hole depth [m] (kDefaultDepth before a mission).
   [[nodiscard]] double hole_depth() const;
   void start_reanchor(Motion next);
-  void look_at_marker();
-  void request_marker_view(std::size_t attempt);
+  void look_at_hole();
+  /// Moves the area's blob holes by `shift` (world frame): odometry drifted by that much.
+  void shift_area(const Eigen::Vector3d& shift);
+  /// While the whole body moves to a blob hole's posture: the area's blobs followed in the
+  /// newest camera frame (shift_area), odometry's drift taken out as it grows.
+  void track_area();
+  /// Plans the hole's drilling posture again at point_, the arm alone: the bit's tip (else the
+  /// camera) on the hole's axis, `further` [m] beyond the hole's distance.
+  void replan_hole(bool tip, double further);
+  void request_look(std::size_t attempt);
   [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
   // The measured state of `names` (base joints from odometry) as a trajectory sample at t = 0.
   [[nodiscard]] static double settle_time(const std::vector<std::string>& names,
@@ -224,12 +233,16 @@ class DrillNode final : public MissionPorts {
     std::vector<msg::TrajectorySample> samples;
   };
   PlannedPath hole_path_;          // of the hole being approached
-  PlannedPath look_path_;          // of the camera turned to the hole's marker
+  PlannedPath look_path_;          // of the camera turned to the hole's mark
   std::uint32_t look_request_{0};  // the plan request turning the camera to the marker
-  bool marker_looked_{false};      // the marker was looked at for the hole being approached
+  bool looked_{false};             // the hole's mark was looked at from its posture's base
+  bool look_pushed_{false};        // the look's path is the last of hole_chain_
+  std::int64_t track_since_ns_{0};  // track_area(): the last frame looked at
+  int tracked_frames_{0};            // frames track_area() moved the area by, this hole
+  Eigen::Vector3d tracked_{Eigen::Vector3d::Zero()};  // how far it moved the area, this hole [m]
   bool hole_replanned_{false};     // the hole's posture was planned again after its re-measure
-  std::size_t look_attempt_{0};    // which of kMarkerViewFurther the look request is
-  Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the marker as predicted (world)
+  std::size_t look_attempt_{0};    // which of kLookFurther the look request is
+  Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the mark as predicted (world)
   double hole_reached_{0.0};  // camera distance of the hole's posture reached [m]
   std::map<int, Eigen::Isometry3d>
       markers_seen_;                     // marker id -> where last seen (world), this area
