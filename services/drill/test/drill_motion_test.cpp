@@ -30,6 +30,7 @@ struct Plant {
   double wall_threshold = 20.0;  // [N]
   double wall_damping = 6000.0;  // [N s/m]
   double hole_bottom = 0.0;      // x of the deepest point drilled [m]
+  double wall_x = 1.0;           // x of the wall's face [m]
 
   // One step under the reference (translational impedance only; the orientation follows).
   void step(const CartesianReference& r) {
@@ -37,7 +38,8 @@ struct Plant {
         r.stiffness.head<3>().cwiseProduct(r.pose.translation() - tip.translation()) +
         r.damping.head<3>().cwiseProduct(r.twist.head<3>() - velocity);
     const double x = tip.translation().x();
-    const bool cutting = x >= 1.0 && x >= hole_bottom - 1e-9 && (f.x() > 0.0 || velocity.x() > 0.0);
+    const bool cutting =
+        x >= wall_x && x >= hole_bottom - 1e-9 && (f.x() > 0.0 || velocity.x() > 0.0);
     if (cutting) {
       // At the bottom of the hole: the wall takes up to the threshold, and its feed damping
       // is taken implicitly so the step is stable.
@@ -123,6 +125,54 @@ TEST(DrillMotion, DrillsToDepthWithBoundedThrust) {
   run(m, p, now, 10.0);
   EXPECT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
   EXPECT_LT(p.tip.translation().x(), 1.0 - params.standoff + 2 * params.align_tolerance);
+}
+
+// The camera's surface off along the normal (a re-measure after a base move: holes came out
+// up to 20 mm short): the depth is counted from where the bit meets the wall.
+TEST(DrillMotion, TheDepthIsCountedFromWhereTheBitMeetsTheWall) {
+  for (const double wall : {1.015, 0.99}) {  // 15 mm behind the camera's surface, 10 mm before
+    DrillParams params;
+    DrillMotion m(params);
+    Plant p = plant_in_front(1.0 - params.standoff);
+    p.tip.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    p.wall_x = wall;
+    p.hole_bottom = wall;
+    double now = 0.0;
+    m.start_align(hole_at(0.25, 1.05), p.tip, now);  // the camera's surface: x = 1
+    run(m, p, now, 10.0);
+    ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << wall;
+    m.start_drill(0.03, false, p.tip, now);
+    run(m, p, now, 30.0);
+    ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << wall << ": " << m.reason();
+    EXPECT_TRUE(m.contact());
+    EXPECT_NEAR(m.contact_offset(), wall - 1.0, 0.002) << wall;
+    EXPECT_GE(p.hole_bottom - wall, 0.03) << wall;
+    EXPECT_LT(p.hole_bottom - wall, 0.034) << wall;
+    // The hole frame now starts on the wall: the retract ends the standoff in front of it.
+    EXPECT_NEAR(m.hole().translation().x(), wall, 0.002);
+    m.start_retract(p.tip, now);
+    run(m, p, now, 10.0);
+    EXPECT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
+    EXPECT_LT(p.tip.translation().x(), wall - params.standoff + 2 * params.align_tolerance);
+  }
+}
+
+TEST(DrillMotion, NoWallWhereTheCameraSawItFailsWithTheReason) {
+  DrillParams params;
+  DrillMotion m(params);
+  Plant p = plant_in_front(1.0 - params.standoff);
+  p.tip.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  p.wall_x = 1.2;
+  p.hole_bottom = 1.2;
+  double now = 0.0;
+  m.start_align(hole_at(0.25, 1.05), p.tip, now);
+  run(m, p, now, 10.0);
+  m.start_drill(0.03, false, p.tip, now);
+  run(m, p, now, 30.0);
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kFailed);
+  EXPECT_FALSE(m.contact());
+  EXPECT_NE(m.reason().find("no wall felt 60 mm behind"), std::string::npos) << m.reason();
+  EXPECT_LT(p.tip.translation().x(), 1.0 + 0.06 + 0.002);  // it did not feed on
 }
 
 TEST(DrillMotion, AWallHarderThanTheArmPushesFailsWithTheReason) {

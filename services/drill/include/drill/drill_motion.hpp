@@ -34,6 +34,14 @@ struct DrillParams {
   double max_lead{0.015};          ///< [m] reference ahead of the tip along the bit at most
   double servo_jump{
       0.02};  ///< [m] an observed hole further than this from the current estimate is an outlier
+  /// The surface is where the bit feels it: the reference leads the tip by at least this much
+  /// [m] (stiffness x 4 mm = 32 N, over the wall's 20 N threshold) while the tip advances at
+  /// less than half the feed rate. The depth is counted from there, not from the surface the
+  /// camera measured (off by 2-20 mm after a base move: holes came out that much short).
+  double contact_lead{0.004};
+  /// [m] beyond the depth asked (from the camera's surface) the bit feeds looking for the wall
+  /// before the hole fails.
+  double contact_search{0.03};
   double align_timeout{15.0};    ///< [s]
   double drill_timeout{30.0};    ///< [s]
   double retract_timeout{15.0};  ///< [s]
@@ -63,7 +71,9 @@ class DrillMotion {
 
   /// Aligns the tip `standoff` in front of `hole`, the bit along -z of the hole frame.
   void start_align(const Eigen::Isometry3d& hole, const Eigen::Isometry3d& tip, double now);
-  /// Drills to `depth` [m] behind the surface; `servo`: observe() moves the hole.
+  /// Drills to `depth` [m] behind the surface, the surface taken where the bit first meets it
+  /// (DrillParams::contact_lead: the hole frame moves along its axis there); `servo`:
+  /// observe() moves the hole until then.
   void start_drill(double depth, bool servo, const Eigen::Isometry3d& tip, double now);
   /// Pulls the tip back to `standoff` in front of the surface.
   void start_retract(const Eigen::Isometry3d& tip, double now);
@@ -86,6 +96,10 @@ class DrillMotion {
   [[nodiscard]] double lateral_error(const Eigen::Isometry3d& tip) const;
   /// Deepest depth reached in this drilling [m].
   [[nodiscard]] double reached() const { return reached_; }
+  /// Whether the bit has felt the surface in this drilling, and how far from where the camera
+  /// put it [m] (positive: further into the wall).
+  [[nodiscard]] bool contact() const { return contact_; }
+  [[nodiscard]] double contact_offset() const { return contact_offset_; }
 
  private:
   [[nodiscard]] Eigen::Isometry3d axis_pose(double depth, const Eigen::Isometry3d& tip) const;
@@ -104,6 +118,10 @@ class DrillMotion {
   double settled_since_{-1.0};
   double reached_{0.0};
   bool servo_{false};
+  bool contact_{false};
+  double contact_offset_{0.0};
+  double last_depth_{0.0};
+  double axial_speed_{0.0};  ///< the tip's feed along the bit, filtered [m/s]
 };
 
 const char* to_string(DrillMotion::Phase phase);

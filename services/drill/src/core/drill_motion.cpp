@@ -57,7 +57,11 @@ void DrillMotion::start_drill(double depth, bool servo, const Eigen::Isometry3d&
   started_ = last_ = now;
   target_depth_ = depth;
   servo_ = servo;
+  contact_ = false;
+  contact_offset_ = 0.0;
+  axial_speed_ = 0.0;
   depth_ref_ = depth_of(tip);
+  last_depth_ = depth_ref_;
   reached_ = depth_ref_;
 }
 
@@ -74,8 +78,8 @@ void DrillMotion::start_retract(const Eigen::Isometry3d& tip, double now) {
 }
 
 bool DrillMotion::observe(const Eigen::Isometry3d& hole) {
-  const bool before_surface =
-      phase_ == Phase::kAligning || (phase_ == Phase::kDrilling && servo_ && reached_ < 0.0);
+  const bool before_surface = phase_ == Phase::kAligning ||
+                              (phase_ == Phase::kDrilling && servo_ && !contact_ && reached_ < 0.0);
   if (!before_surface) return false;
   if ((hole.translation() - hole_.translation()).norm() > params_.servo_jump) return false;
   hole_ = hole;
@@ -148,12 +152,34 @@ CartesianReference DrillMotion::update(const Eigen::Isometry3d& tip, double now)
       return r;
     }
     case Phase::kDrilling: {
-      reached_ = std::max(reached_, depth);
-      // Eq. 3: the reference advances at v_drill, never more than max_lead ahead of the tip.
-      depth_ref_ = std::min(
-          {depth_ref_ + params_.feed_rate * dt, depth + params_.max_lead, target_depth_ + 0.002});
-      if (depth >= target_depth_) {
+      double d = depth;
+      if (dt > 0.0) {
+        // Filtered over about 50 ms: the tip's pose comes at the control rate, with noise.
+        axial_speed_ += ((d - last_depth_) / dt - axial_speed_) * std::min(1.0, dt / 0.05);
+      }
+      last_depth_ = d;
+      if (!contact_ && depth_ref_ - d >= params_.contact_lead &&
+          axial_speed_ < 0.5 * params_.feed_rate) {
+        // The bit pushes and hardly advances: it is on the surface. The hole starts here.
+        contact_ = true;
+        contact_offset_ = d;
+        hole_.translation() -= d * hole_.linear().col(2);
+        depth_ref_ -= d;
+        last_depth_ = 0.0;
+        d = 0.0;
+      }
+      reached_ = std::max(reached_, d);
+      // Eq. 3: the reference advances at v_drill, never more than max_lead ahead of the tip;
+      // before the bit meets the wall, at most contact_search beyond the depth asked.
+      const double limit = target_depth_ + (contact_ ? 0.002 : params_.contact_search);
+      depth_ref_ = std::min({depth_ref_ + params_.feed_rate * dt, d + params_.max_lead, limit});
+      if (contact_ && d >= target_depth_) {
         phase_ = Phase::kDone;
+      } else if (!contact_ && d >= limit - params_.contact_lead) {
+        std::ostringstream s;
+        s << "no wall felt " << (target_depth_ + params_.contact_search) * 1000.0
+          << " mm behind the surface the camera measured: the wall is not where it was seen";
+        fail(s.str());
       } else if (elapsed > params_.drill_timeout) {
         std::ostringstream s;
         s << "hole " << std::max(0.0, reached_) * 1000.0 << " of " << target_depth_ * 1000.0
