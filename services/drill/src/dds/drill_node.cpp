@@ -1191,6 +1191,20 @@ void DrillNode::track_area() {
   ++tracked_frames_;
 }
 
+// The camera looks at the hole: back onto the whole body's posture (the way back from the hole
+// then skips the look), where the alignment starts.
+void DrillNode::back_to_posture(const Sample& s) {
+  hole_chain_.pop_back();
+  look_pushed_ = false;
+  const PlannedPath& p = hole_chain_.back();
+  const msg::TrajectorySample here = sample_here(p.names, s);
+  msg::TrajectorySample end = p.samples.back();
+  end.time(settle_time(p.names, here, end));
+  for (double& v : end.velocity()) v = 0.0;
+  trajectory_request_ = send_trajectory(p.names, {here, end});
+  motion_ = Motion::kBackToPosture;
+}
+
 void DrillNode::replan_hole(bool tip, double further) {
   hole_plan_request_ = next_request_++;
   hole_request_.request_id(hole_plan_request_);
@@ -1246,17 +1260,7 @@ void DrillNode::control_motion() {
       const std::optional<Sample> s = latest_sample();
       if (!s) return;
       if (looked_ && look_pushed_ && hole_chain_.size() > 1) {
-        // The camera looks at the hole: back onto the whole body's posture first (the way back
-        // from the hole then skips the look).
-        hole_chain_.pop_back();
-        look_pushed_ = false;
-        const PlannedPath& p = hole_chain_.back();
-        const msg::TrajectorySample here = sample_here(p.names, *s);
-        msg::TrajectorySample end = p.samples.back();
-        end.time(settle_time(p.names, here, end));
-        for (double& v : end.velocity()) v = 0.0;
-        trajectory_request_ = send_trajectory(p.names, {here, end});
-        motion_ = Motion::kBackToPosture;
+        back_to_posture(*s);
         return;
       }
       start_align(*s);
@@ -1356,6 +1360,14 @@ void DrillNode::control_motion() {
         log_line(line.str());
         shift_area(moved);
         point_.frame = *blob;
+        const std::optional<Sample> s = latest_sample();
+        if (moved.norm() <= kReplanShift && look_pushed_ && hole_chain_.size() > 1 && s) {
+          // Where the whole body's posture was planned for: back onto it, no new posture (the
+          // arm waiting in the look posture while one is sought held J3_E at its continuous
+          // torque long enough for a safety stop).
+          back_to_posture(*s);
+          return;
+        }
       } else {
         log_line("drill: " + point_.label +
                  ": the blob not seen from the look posture; measured from its drilling posture");
@@ -1521,6 +1533,15 @@ void DrillNode::control_motion() {
     trajectory_request_ = send_trajectory(p.names, {here, end});
     motion_ = Motion::kSettle;
   } else if (drill_motion_.phase() == DrillMotion::Phase::kDone) {
+    if (motion_ == Motion::kDrill && drill_motion_.contact()) {
+      std::ostringstream line;
+      line.setf(std::ios::fixed);
+      line.precision(1);
+      line << "drill: " << point_.label << ": drilled " << drill_motion_.reached() * 1e3
+           << " mm from where the bit met the wall, " << drill_motion_.contact_offset() * 1e3
+           << " mm behind the surface the camera measured";
+      log_line(line.str());
+    }
     motion_outcome_ = Outcome::succeeded();
     // Keep holding the reference until the next motion (the loop re-sends the last one).
   }

@@ -139,6 +139,8 @@ class DrillNode final : public MissionPorts {
   /// Plans the hole's drilling posture again at point_, the arm alone: the bit's tip (else the
   /// camera) on the hole's axis, `further` [m] beyond the hole's distance.
   void replan_hole(bool tip, double further);
+  /// From the look posture back onto the whole body's posture, then the alignment.
+  void back_to_posture(const Sample& s);
   void request_look(std::size_t attempt);
   [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
   // The measured state of `names` (base joints from odometry) as a trajectory sample at t = 0.
