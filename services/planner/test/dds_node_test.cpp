@@ -332,11 +332,12 @@ TEST_F(PlannerNodeTest, ExecutionGoesThroughTheRobotsTrajectoryCommand) {
 TEST_F(PlannerNodeTest, AnObstacleOnTheWorldTopicChangesThePlan) {
   publish_model('a', 9);
   ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
-  // A drilling area 1.6 m to the side: the base drives there.
+  // A drilling area 2.6 m to the side: the base drives there (far enough that a crate where it
+  // stood leaves the start free).
   auto plan = [&](uint32_t id) {
     std::vector<msg::PlanResult> seen;
     msg::PlanRequest req = request(id, 9, 1.2, false);
-    req.goals()[0] = planner::dds::to_msg(fixtures::drilling_area(2.0, 1.6, 1.2));
+    req.goals()[0] = planner::dds::to_msg(fixtures::drilling_area(2.0, 2.6, 1.2));
     requests_->write(req);
     const auto r = wait_final(*results_, id, &seen);
     EXPECT_TRUE(r.has_value());
@@ -348,6 +349,7 @@ TEST_F(PlannerNodeTest, AnObstacleOnTheWorldTopicChangesThePlan) {
   ASSERT_GT(open.trajectory().size(), 1u);
   const double open_y = open.trajectory().back().position()[1];
   const double open_x = open.trajectory().back().position()[0];
+  ASSERT_GT(std::hypot(open_x, open_y), 1.2) << "the base should drive to the area";
 
   // The world now has a crate where the base stood to drill: the same wall, plus an obstacle.
   concert::dds::Writer<msg::World> worlds(*participant_, concert::dds::topics::world);
@@ -426,12 +428,13 @@ TEST_F(PlannerNodeTest, ALocalisedBaseIsPlannedInTheMapAndAnsweredInOdometry) {
   EXPECT_NEAR(first[0], base_odom.x(), 1e-6);
   EXPECT_NEAR(first[1], base_odom.y(), 1e-6);
   EXPECT_NEAR(first[2], base_odom.z(), 1e-6);
-  // ...and ends, seen in the map, in front of the wall at x = 2 m, facing it.
+  // ...and ends, seen in the map, in front of the wall at x = 2 m, within the arm's reach of
+  // the area (a wrong frame puts it metres away: the odometry frame is 2.2 m off, turned 90 deg).
   const auto& last = r->trajectory().back().position();
   const Eigen::Vector3d end_map = mobile_base::compose(map_T_odom, {last[0], last[1], last[2]});
   EXPECT_LT(end_map.x(), 1.6) << end_map.transpose();
   EXPECT_GT(end_map.x(), 0.0) << end_map.transpose();
-  EXPECT_LT(std::abs(end_map.y()), 0.8) << end_map.transpose();
+  EXPECT_LT(std::abs(end_map.y()), 1.5) << end_map.transpose();
 }
 
 TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {

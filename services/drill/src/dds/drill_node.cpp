@@ -43,7 +43,7 @@ constexpr double kAlignMargin = 0.03;
 // out), the planner checking the arm's torques there and with the bit at the hole's depth
 // (tip_reach): the arm alone, then the whole body with the base moving at most 0.3 m and 0.3 rad,
 // then the whole body anywhere. Without such a posture, as before those checks existed: the
-// camera on the hole's axis (the bit 11 cm beside it), 0, 3, 7 and 12 cm further out, the same
+// camera on the hole's axis (the bit beside it), 0, 3, 7 and 12 cm further out, the same
 // three ways; the alignment's Cartesian move then reaches a posture nobody checked (on morphology
 // A at the BIM area the shoulder J2_E needed its peak torque; the demo robot's arm finds no tip
 // posture at the system test's blobs and drills them this way). The base stays where the area's
@@ -80,8 +80,8 @@ constexpr int kReanchorFrames = 3;
 // hole's mark and the hole is measured again from there: for an ArUco hole always (the pattern
 // is drilled by the kinematics alone, and the base's odometry drifts 2-4 cm over such a move:
 // the demo wall's pattern was drilled 20-37 mm off without this), for a blob hole when the view
-// from its drilling posture, the camera 11 cm beside the bit, cannot tell its blob from a
-// neighbour (blob_shift). The camera is asked for at the distance the hole's posture reached
+// from its drilling posture cannot tell its blob from a neighbour (blob_shift; before the drill
+// camera was pitched towards the bit it saw one blob or none from there). The camera is asked for at the distance the hole's posture reached
 // (the arm only shifts across the wall), then this much further out [m], in turn.
 constexpr double kLookFurther[] = {0.0, 0.1, 0.2};
 constexpr double kReanchorDistance = 0.06;
@@ -99,8 +99,8 @@ constexpr double kBlobMatch = 0.02;
 // While the whole body moves to a blob hole's posture, the area's blobs are followed from camera
 // frame to frame (track_area): odometry drifts 2-6 cm over such a move (recorded on morphology
 // A at the BIM area: 27 mm over 0.45 m and 0.75 rad of base motion), more than half the 10 cm
-// between blobs, so the drilling posture's view alone, the camera 11 cm beside the bit, could
-// take a neighbour for the blob. From one frame to the next the drift grows by millimetres: a
+// between blobs, so a drilling posture's view showing one blob alone could take a neighbour
+// for it. From one frame to the next the drift grows by millimetres: a
 // seen blob is taken for a predicted one at most this far [m].
 constexpr double kTrackWindow = 0.02;
 
