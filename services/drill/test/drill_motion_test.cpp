@@ -78,6 +78,18 @@ Plant plant_in_front(double x) {
   return p;
 }
 
+// The bit square to a wall whose face is at `wall` [m], aligned on the hole the camera put at
+// x = 1 (hole_at(0.25, 1.05)).
+Plant aligned(DrillMotion& m, const DrillParams& params, double& now, double wall = 1.0) {
+  Plant p = plant_in_front(1.0 - params.standoff);
+  p.tip.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  p.wall_x = wall;
+  p.hole_bottom = wall;
+  m.start_align(hole_at(0.25, 1.05), p.tip, now);
+  run(m, p, now, 10.0);
+  return p;
+}
+
 TEST(DrillMotion, AlignsOnTheHolesAxisAtTheStandoffWithoutJumps) {
   DrillParams params;
   DrillMotion m(params);
@@ -133,13 +145,8 @@ TEST(DrillMotion, TheDepthIsCountedFromWhereTheBitMeetsTheWall) {
   for (const double wall : {1.015, 0.99}) {  // 15 mm behind the camera's surface, 10 mm before
     DrillParams params;
     DrillMotion m(params);
-    Plant p = plant_in_front(1.0 - params.standoff);
-    p.tip.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-    p.wall_x = wall;
-    p.hole_bottom = wall;
     double now = 0.0;
-    m.start_align(hole_at(0.25, 1.05), p.tip, now);  // the camera's surface: x = 1
-    run(m, p, now, 10.0);
+    Plant p = aligned(m, params, now, wall);  // the camera's surface: x = 1
     ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << wall;
     m.start_drill(0.03, false, p.tip, now);
     run(m, p, now, 30.0);
@@ -160,13 +167,8 @@ TEST(DrillMotion, TheDepthIsCountedFromWhereTheBitMeetsTheWall) {
 TEST(DrillMotion, NoWallWhereTheCameraSawItFailsWithTheReason) {
   DrillParams params;
   DrillMotion m(params);
-  Plant p = plant_in_front(1.0 - params.standoff);
-  p.tip.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  p.wall_x = 1.2;
-  p.hole_bottom = 1.2;
   double now = 0.0;
-  m.start_align(hole_at(0.25, 1.05), p.tip, now);
-  run(m, p, now, 10.0);
+  Plant p = aligned(m, params, now, 1.2);
   m.start_drill(0.03, false, p.tip, now);
   run(m, p, now, 30.0);
   ASSERT_EQ(m.phase(), DrillMotion::Phase::kFailed);
@@ -179,12 +181,9 @@ TEST(DrillMotion, AWallHarderThanTheArmPushesFailsWithTheReason) {
   DrillParams params;
   params.drill_timeout = 3.0;
   DrillMotion m(params);
-  Plant p = plant_in_front(1.0 - params.standoff);
-  p.tip.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  p.wall_threshold = 1000.0;  // more than stiffness x max_lead
   double now = 0.0;
-  m.start_align(hole_at(0.25, 1.05), p.tip, now);
-  run(m, p, now, 10.0);
+  Plant p = aligned(m, params, now);
+  p.wall_threshold = 1000.0;  // more than stiffness x max_lead
   m.start_drill(0.05, false, p.tip, now);
   run(m, p, now, 10.0);
   ASSERT_EQ(m.phase(), DrillMotion::Phase::kFailed);
