@@ -57,3 +57,39 @@ TEST(DrillNode, AMissionWrittenAgainIsTakenOnce) {
 
 }  // namespace
 }  // namespace concert::drill::dds
+
+namespace concert::drill::dds {
+namespace {
+
+// An executed plan's trajectory comes once, with PLANNED; the execution's updates and SUCCEEDED
+// come without it. The service keeps it (it records the holes' postures from it).
+TEST(DrillNode, AnExecutedPlansTrajectoryOutlivesItsUpdates) {
+  msg::PlanResult planned;
+  planned.request_id(17);
+  planned.state(msg::PLAN_PLANNED);
+  planned.joint_names({"base_x", "J1_E"});
+  msg::TrajectorySample s;
+  s.position({0.1, 0.2});
+  planned.trajectory().push_back(s);
+  planned.trajectory().push_back(s);
+  msg::PlanResult kept;
+  keep_result(kept, planned);
+  msg::PlanResult update;
+  update.request_id(17);
+  update.state(msg::PLAN_EXECUTING);
+  keep_result(kept, update);
+  update.state(msg::PLAN_SUCCEEDED);
+  keep_result(kept, update);
+  EXPECT_EQ(kept.state(), msg::PLAN_SUCCEEDED);
+  ASSERT_EQ(kept.trajectory().size(), 2u);
+  EXPECT_EQ(kept.joint_names().size(), 2u);
+  // A result with a trajectory of its own replaces the kept one.
+  msg::PlanResult again = planned;
+  again.trajectory().pop_back();
+  keep_result(kept, again);
+  EXPECT_EQ(kept.trajectory().size(), 1u);
+  EXPECT_EQ(kept.state(), msg::PLAN_PLANNED);
+}
+
+}  // namespace
+}  // namespace concert::drill::dds

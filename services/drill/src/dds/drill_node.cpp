@@ -172,6 +172,19 @@ void set_hole_task(msg::PlanRequest& r, const HoleAttempt& a, double hole_distan
 
 }  // namespace
 
+void keep_result(msg::PlanResult& kept, const msg::PlanResult& incoming) {
+  if (incoming.trajectory().empty() && !kept.trajectory().empty() &&
+      kept.request_id() == incoming.request_id()) {
+    auto trajectory = std::move(kept.trajectory());
+    auto names = std::move(kept.joint_names());
+    kept = incoming;
+    kept.trajectory(std::move(trajectory));
+    kept.joint_names(std::move(names));
+    return;
+  }
+  kept = incoming;
+}
+
 msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
                         const MissionReport& report) {
   msg::DrillStatus out;
@@ -261,7 +274,7 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
       plans_in_(participant, cdds::topics::plan_result,
                 [this](const msg::PlanResult& r, const auto&) {
                   std::lock_guard lock(mutex_);
-                  plan_results_[r.request_id()] = r;
+                  keep_result(plan_results_[r.request_id()], r);
                 }),
       trajectories_in_(participant, cdds::topics::trajectory_status,
                        [this](const msg::TrajectoryStatus& s, const auto&) {
