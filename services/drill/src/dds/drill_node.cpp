@@ -38,21 +38,22 @@ constexpr double kRobotRadius = 0.55;
 // Cartesian alignment does the rest) [m]; the way back first takes this long to reach the
 // posture's path [s].
 constexpr double kAlignMargin = 0.03;
-// A hole's drilling posture, in the order it is asked for. First with the bit's tip on the
-// hole's axis (PlanRequest.tip_distance, the standoff plus kAlignMargin, then 3 and 7 cm further
-// out), the planner checking the arm's torques there and with the bit at the hole's depth
-// (tip_reach): the arm alone, then the whole body with the base moving at most 0.3 m and 0.3 rad,
-// then the whole body anywhere. Without such a posture, as before those checks existed: the
-// camera on the hole's axis (the bit beside it), 0, 3, 7 and 12 cm further out, the same
-// three ways; the alignment's Cartesian move then reaches a posture nobody checked (on morphology
-// A at the BIM area the shoulder J2_E needed its peak torque; the demo robot's arm finds no tip
-// posture at the system test's blobs and drills them this way). The base stays where the area's
-// approach put it as long as the arm reaches, and moves as little as it can: odometry drifts with
-// every centimetre and degree the base moves, and an ArUco pattern is drilled by the kinematics
-// alone (on the demo wall, holes drilled after unbounded whole-body moves were 5-100 mm off; one
-// posture spun the base by 2.3 rad).
+// A hole's drilling posture, in the order it is asked for: always the bit's tip on the hole's
+// axis (PlanRequest.tip_distance, the standoff plus kAlignMargin, then further out). First with
+// its reach checked (tip_reach: the arm's torques also with the bit at the hole's depth), at 0, 3
+// and 7 cm further out: the arm alone, then the whole body with the base moving at most 0.3 m and
+// 0.3 rad, then the whole body anywhere. Without such a posture, the same without the reach
+// check (0, 3, 7 and 12 cm out): the drilling then moves the bit on through postures nobody
+// checked. (Until the drill camera was pitched towards the bit the fallback put the camera on
+// the axis, the bit 11 cm beside it; pitched, that left the bit 30 deg off the axis, and the
+// alignment's turn held J3_E past its continuous torque on the demo's pattern. Before the reach
+// check on morphology A at the BIM area the shoulder J2_E needed its peak torque.) The base stays
+// where the area's approach put it as long as the arm reaches, and moves as little as it can:
+// odometry drifts with every centimetre and degree the base moves, and an ArUco pattern is
+// drilled by the kinematics alone (on the demo wall, holes drilled after unbounded whole-body
+// moves were 5-100 mm off; one posture spun the base by 2.3 rad).
 struct HoleAttempt {
-  bool tip;  // the bit's tip on the hole's axis (else the camera)
+  bool reach;  // the bit's reach to the hole's depth checked
   bool fixed_base;
   double base_travel;  // [m, rad] for the whole body; 0: anywhere
   double further;      // [m] beyond the hole's distance
@@ -161,11 +162,11 @@ Eigen::Vector3d odometry_of(const msg::Odometry& o) { return {o.x(), o.y(), o.ya
 // or the camera on the hole's axis as far out.
 // (`hole_distance`: the bit's tip from the wall the posture asks for before `further`.)
 void set_hole_task(msg::PlanRequest& r, const HoleAttempt& a, double hole_distance,
-                   double camera_to_tip, double depth) {
+                   double depth) {
   const double tip = hole_distance + a.further;
-  r.tip_distance(a.tip ? tip : 0.0);
-  r.tip_reach(a.tip ? tip + depth : 0.0);
-  r.camera_distance(a.tip ? 0.0 : camera_to_tip + tip);
+  r.tip_distance(tip);
+  r.tip_reach(a.reach ? tip + depth : 0.0);
+  r.camera_distance(0.0);
   r.fixed_base(a.fixed_base);
   r.base_travel(a.base_travel);
 }
@@ -1024,7 +1025,7 @@ void DrillNode::align(const DrillPoint& point) {
   // The arm alone first (kHoleAttempts): the base stays where the area's approach put it, so
   // odometry does not drift between holes (3.5 deg over one whole-body move on the demo).
   hole_attempt_ = 0;
-  set_hole_task(r, kHoleAttempts[0], hole_distance_, camera_to_tip_, hole_depth());
+  set_hole_task(r, kHoleAttempts[0], hole_distance_, hole_depth());
   plan_requests_.write(r);
   hole_request_ = r;
   hole_path_ = {};
@@ -1033,11 +1034,12 @@ void DrillNode::align(const DrillPoint& point) {
 
 double DrillNode::hole_depth() const { return mission_ ? mission_->depth : kDefaultDepth; }
 
-// "the bit 0.07 m" or "the camera 0.23 m" (from the wall), for the log.
+// "the bit 0.07 m", "the bit (reach unchecked) 0.07 m" or "the camera 0.23 m" (from the wall),
+// for the log.
 std::string hole_task_text(const msg::PlanRequest& r) {
   std::ostringstream t;
   if (r.tip_distance() > 0.0)
-    t << "the bit " << r.tip_distance() << " m";
+    t << "the bit " << (r.tip_reach() > 0.0 ? "" : "(reach unchecked) ") << r.tip_distance() << " m";
   else
     t << "the camera " << r.camera_distance() << " m";
   return t.str();
@@ -1218,13 +1220,12 @@ void DrillNode::back_to_posture(const Sample& s) {
   motion_ = Motion::kBackToPosture;
 }
 
-void DrillNode::replan_hole(bool tip, double further) {
+void DrillNode::replan_hole(bool reach, double further) {
   hole_plan_request_ = next_request_++;
   hole_request_.request_id(hole_plan_request_);
   hole_request_.goals().clear();
   hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
-  set_hole_task(hole_request_, {tip, true, 0.0, further}, hole_distance_, camera_to_tip_,
-                hole_depth());
+  set_hole_task(hole_request_, {reach, true, 0.0, further}, hole_distance_, hole_depth());
   hole_request_.stamp_ns(now_ns());
   plan_requests_.write(hole_request_);
   hole_path_ = {};
@@ -1296,7 +1297,7 @@ void DrillNode::control_motion() {
            << who(next.fixed_base, next.base_travel) << " with ";
       hole_plan_request_ = next_request_++;
       hole_request_.request_id(hole_plan_request_);
-      set_hole_task(hole_request_, next, hole_distance_, camera_to_tip_, hole_depth());
+      set_hole_task(hole_request_, next, hole_distance_, hole_depth());
       line << hole_task_text(hole_request_);
       log_line(line.str());
       plan_requests_.write(hole_request_);
@@ -1420,11 +1421,11 @@ void DrillNode::control_motion() {
     hole_attempt_ = 0;
     while (hole_attempt_ + 1 < std::size(kHoleAttempts) &&
            !(kHoleAttempts[hole_attempt_].fixed_base &&
-             kHoleAttempts[hole_attempt_].tip == reached.tip &&
+             kHoleAttempts[hole_attempt_].reach == reached.reach &&
              kHoleAttempts[hole_attempt_].further >= reached.further - 1e-6))
       ++hole_attempt_;
     if (hole_attempt_ < from && !kHoleAttempts[hole_attempt_].fixed_base) hole_attempt_ = from;
-    replan_hole(reached.tip, reached.further);
+    replan_hole(reached.reach, reached.further);
     return;
   }
   if (motion_ == Motion::kReanchor) {
@@ -1468,12 +1469,11 @@ void DrillNode::control_motion() {
       const Eigen::Vector3d moved = seen->translation() - point_.frame.translation();
       if (point_.marker < 0) shift_area(moved);  // the area's other blobs moved as much
       point_.frame = *seen;
-      if (!hole_request_.fixed_base() && kHoleAttempts[hole_attempt_].tip && !hole_replanned_ &&
-          moved.norm() > kReplanShift) {
+      if (!hole_request_.fixed_base() && !hole_replanned_ && moved.norm() > kReplanShift) {
         // The base moved and odometry drifted: the posture again, the arm alone, for the hole
         // where the camera sees it now.
         hole_replanned_ = true;
-        replan_hole(true, 0.0);
+        replan_hole(kHoleAttempts[hole_attempt_].reach, 0.0);
         return;
       }
     }

@@ -144,9 +144,9 @@ class DrillNode final : public MissionPorts {
   /// While the whole body moves to a blob hole's posture: the area's blobs followed in the
   /// newest camera frame (shift_area), odometry's drift taken out as it grows.
   void track_area();
-  /// Plans the hole's drilling posture again at point_, the arm alone: the bit's tip (else the
-  /// camera) on the hole's axis, `further` [m] beyond the hole's distance.
-  void replan_hole(bool tip, double further);
+  /// Plans the hole's drilling posture again at point_, the arm alone: the bit's tip on the
+  /// hole's axis, `further` [m] beyond the hole's distance, its reach checked if `reach`.
+  void replan_hole(bool reach, double further);
   /// From the look posture back onto the whole body's posture, then the alignment.
   void back_to_posture(const Sample& s);
   void request_look(std::size_t attempt);
