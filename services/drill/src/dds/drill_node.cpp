@@ -45,7 +45,7 @@ constexpr double kAlignMargin = 0.03;
 // 0.3 rad, then the whole body anywhere. Without such a posture, the same without the reach
 // check (0, 3, 7 and 12 cm out): the drilling then moves the bit on through postures nobody
 // checked. (Until the drill camera was pitched towards the bit the fallback put the camera on
-// the axis, the bit 11 cm beside it; pitched, that left the bit 30 deg off the axis, and the
+// the axis, the bit 11 cm beside it; pitched 30 deg, that left the bit 30 deg off the axis, and the
 // alignment's turn held J3_E past its continuous torque on the demo's pattern. Before the reach
 // check on morphology A at the BIM area the shoulder J2_E needed its peak torque.) The base stays
 // where the area's approach put it as long as the arm reaches, and moves as little as it can:
