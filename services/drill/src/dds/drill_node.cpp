@@ -1249,6 +1249,71 @@ void DrillNode::request_look(std::size_t attempt) {
   motion_ = Motion::kLookAtHole;
 }
 
+// A blob hole measured again with the camera turned onto it; true when the arm was sent back
+// onto the whole body's posture (else the posture is planned again, the arm alone).
+bool DrillNode::remeasure_looked_blob(const CameraView& camera) {
+  // The camera on the blob's axis sees its neighbours too: the area matched as a set.
+  Eigen::Isometry3d predicted = point_.frame;
+  if (const std::optional<Eigen::Vector3d> shift =
+          blob_shift(camera, area_points_, kBlobMatch, kReanchorDistance))
+    predicted.translation() += *shift;
+  // Within kBlobMatch of the prediction: no neighbour is taken for it.
+  if (const std::optional<Eigen::Isometry3d> blob = track_blob(camera, predicted, kBlobMatch)) {
+    const Eigen::Vector3d moved = blob->translation() - point_.frame.translation();
+    std::ostringstream line;
+    line.setf(std::ios::fixed);
+    line.precision(1);
+    line << "drill: " << point_.label
+         << ": the blob seen again with the camera on it after the base moved: "
+         << moved.norm() * 1e3 << " mm from where odometry put it ("
+         << blobs_seen(camera, point_.frame) << ")";
+    log_line(line.str());
+    shift_area(moved);
+    point_.frame = *blob;
+    const std::optional<Sample> s = latest_sample();
+    if (moved.norm() <= kReplanShift && look_pushed_ && hole_chain_.size() > 1 && s) {
+      // Where the whole body's posture was planned for: back onto it, no new posture (the
+      // arm waiting in the look posture while one is sought held J3_E at its continuous
+      // torque long enough for a safety stop).
+      back_to_posture(*s);
+      return true;
+    }
+  } else {
+    log_line("drill: " + point_.label +
+             ": the blob not seen from the look posture; measured from its drilling posture");
+  }
+  // Without a posture for the arm alone there, the arm goes back onto the whole body's.
+  hole_replanned_ = true;
+  return false;
+}
+
+// An ArUco hole's pattern measured again with the camera turned onto its marker.
+void DrillNode::remeasure_looked_marker(const CameraView& camera) {
+  std::optional<Eigen::Isometry3d> marker;
+  try {
+    if (patterns_) marker = find_marker(camera, point_.marker, *patterns_);
+  } catch (const DrillError&) {
+    marker.reset();
+  }
+  std::optional<Eigen::Isometry3d> hole;
+  if (marker) hole = hole_of(point_, *marker, *patterns_);
+  if (hole) {
+    std::ostringstream line;
+    line.setf(std::ios::fixed);
+    line.precision(1);
+    line << "drill: " << point_.label << ": marker " << point_.marker
+         << " seen again after the base moved: the hole is "
+         << (hole->translation() - point_.frame.translation()).norm() * 1e3
+         << " mm from where odometry put it";
+    log_line(line.str());
+    markers_seen_[point_.marker] = *marker;
+    point_.frame = *hole;
+  } else {
+    log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
+             " not seen from the look posture; the hole is drilled where odometry puts it");
+  }
+}
+
 // Every control period while a hole is worked on: the servo's new estimate of the blob from
 // each new camera frame, the motion's reference to the robot, and the phase's outcome.
 void DrillNode::control_motion() {
@@ -1354,65 +1419,9 @@ void DrillNode::control_motion() {
     if (!view) return;
     const CameraView camera{&view->frame, view->world_T_optical};
     if (point_.marker < 0) {
-      // The camera on the blob's axis sees its neighbours too: the area matched as a set.
-      Eigen::Isometry3d predicted = point_.frame;
-      double within = kBlobMatch;  // no neighbour is taken for it
-      if (const std::optional<Eigen::Vector3d> shift =
-              blob_shift(camera, area_points_, kBlobMatch, kReanchorDistance)) {
-        predicted.translation() += *shift;
-        within = kBlobMatch;
-      }
-      if (const std::optional<Eigen::Isometry3d> blob = track_blob(camera, predicted, within)) {
-        const Eigen::Vector3d moved = blob->translation() - point_.frame.translation();
-        std::ostringstream line;
-        line.setf(std::ios::fixed);
-        line.precision(1);
-        line << "drill: " << point_.label
-             << ": the blob seen again with the camera on it after the base moved: "
-             << moved.norm() * 1e3 << " mm from where odometry put it ("
-             << blobs_seen(camera, point_.frame) << ")";
-        log_line(line.str());
-        shift_area(moved);
-        point_.frame = *blob;
-        const std::optional<Sample> s = latest_sample();
-        if (moved.norm() <= kReplanShift && look_pushed_ && hole_chain_.size() > 1 && s) {
-          // Where the whole body's posture was planned for: back onto it, no new posture (the
-          // arm waiting in the look posture while one is sought held J3_E at its continuous
-          // torque long enough for a safety stop).
-          back_to_posture(*s);
-          return;
-        }
-      } else {
-        log_line("drill: " + point_.label +
-                 ": the blob not seen from the look posture; measured from its drilling posture");
-      }
-      // Without a posture for the arm alone there, the arm goes back onto the whole body's.
-      hole_replanned_ = true;
-    }
-    std::optional<Eigen::Isometry3d> marker;
-    try {
-      if (patterns_ && point_.marker >= 0) marker = find_marker(camera, point_.marker, *patterns_);
-    } catch (const DrillError&) {
-      marker.reset();
-    }
-    std::optional<Eigen::Isometry3d> hole;
-    if (marker) hole = hole_of(point_, *marker, *patterns_);
-    if (point_.marker < 0) {
-      // Measured above.
-    } else if (hole) {
-      std::ostringstream line;
-      line.setf(std::ios::fixed);
-      line.precision(1);
-      line << "drill: " << point_.label << ": marker " << point_.marker
-           << " seen again after the base moved: the hole is "
-           << (hole->translation() - point_.frame.translation()).norm() * 1e3
-           << " mm from where odometry put it";
-      log_line(line.str());
-      markers_seen_[point_.marker] = *marker;
-      point_.frame = *hole;
+      if (remeasure_looked_blob(camera)) return;
     } else {
-      log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
-               " not seen from the look posture; the hole is drilled where odometry puts it");
+      remeasure_looked_marker(camera);
     }
     // Back to the hole's drilling posture with the arm alone (the base stands where the whole
     // body put it), at the distance that reached it.
@@ -1480,7 +1489,9 @@ void DrillNode::control_motion() {
     if (const std::optional<Sample> s = latest_sample()) start_align(*s);
     return;
   }
-  if (motion_ == Motion::kBackToPosture) {
+  if (motion_ == Motion::kSettle || motion_ == Motion::kBackToPosture) {
+    // Back onto a planned posture: after a retract (then the hole is done), or from the look
+    // posture (then the alignment starts).
     std::optional<msg::TrajectoryStatus> status;
     {
       std::lock_guard lock(mutex_);
@@ -1489,25 +1500,13 @@ void DrillNode::control_motion() {
     }
     if (!status || status->state() == msg::TRAJECTORY_EXECUTING) return;
     if (status->state() != msg::TRAJECTORY_SUCCEEDED) {
-      motion_outcome_ =
-          Outcome::failed("robot: back onto the hole's drilling posture: " + status->reason());
+      motion_outcome_ = Outcome::failed("robot: back onto the drilling posture: " + status->reason());
       motion_ = Motion::kNone;
-    } else if (const std::optional<Sample> s = latest_sample()) {
-      start_align(*s);
-    }
-    return;
-  }
-  if (motion_ == Motion::kSettle) {
-    std::lock_guard lock(mutex_);
-    const auto it = trajectory_statuses_.find(trajectory_request_);
-    if (it == trajectory_statuses_.end()) return;
-    if (it->second.state() == msg::TRAJECTORY_SUCCEEDED) {
+    } else if (motion_ == Motion::kSettle) {
       motion_outcome_ = Outcome::succeeded();
       motion_ = Motion::kNone;
-    } else if (it->second.state() != msg::TRAJECTORY_EXECUTING) {
-      motion_outcome_ =
-          Outcome::failed("robot: back onto the drilling posture: " + it->second.reason());
-      motion_ = Motion::kNone;
+    } else if (const std::optional<Sample> here = latest_sample()) {
+      start_align(*here);
     }
     return;
   }

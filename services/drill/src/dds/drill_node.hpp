@@ -147,6 +147,9 @@ class DrillNode final : public MissionPorts {
   /// Plans the hole's drilling posture again at point_, the arm alone: the bit's tip on the
   /// hole's axis, `further` [m] beyond the hole's distance, its reach checked if `reach`.
   void replan_hole(bool reach, double further);
+  /// A hole measured again with the camera turned onto its blob / marker (kLookReanchor).
+  bool remeasure_looked_blob(const CameraView& camera);
+  void remeasure_looked_marker(const CameraView& camera);
   /// From the look posture back onto the whole body's posture, then the alignment.
   void back_to_posture(const Sample& s);
   void request_look(std::size_t attempt);
