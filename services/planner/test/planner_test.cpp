@@ -6,6 +6,7 @@
 
 #include <octomap/OcTree.h>
 
+#include <cmath>
 #include <memory>
 #include <random>
 
@@ -300,6 +301,46 @@ TEST(Planner, ATipTaskPutsTheBitOnTheHolesAxisAndChecksItsTorques) {
   const PlanResult far = planner->plan(unreachable, start, {});
   EXPECT_EQ(far.status, Status::kUnreachable);
   EXPECT_NE(far.reason.find("tip 'tcp_E'"), std::string::npos) << far.reason;
+}
+
+// The drilling force comes with the request (PlanRequest::contact_force; the drill service
+// sends its thrust bound, 125 N): the posture found holds with it, a force no arm holds leaves
+// no posture, and a force that is no sane number of newtons is refused. The result names the
+// posture's heaviest load.
+TEST(Planner, TheRequestsContactForceIsTheOneChecked) {
+  Params params = generous(23);
+  auto planner = planner_at_site(params, 'a', 3);
+  const auto model = planner->model();
+  const Eigen::VectorXd start = start_state(*model);
+  const Eigen::Isometry3d hole = fixtures::drilling_area(2.2, 0.1, 1.2);
+  const EndEffectorInfo& tool = model->tool("");
+  PlanRequest req{12, 3, "", {{hole}}};
+  req.tip_distance = 0.07;
+  req.contact_force = 125.0;
+  const PlanResult res = planner->plan(req, start, {});
+  ASSERT_EQ(res.status, Status::kSucceeded) << res.reason;
+  const Eigen::VectorXd end = model->to_full(res.goals[0].trajectory.points.back().q, start);
+  Params at_force = params;
+  at_force.contact_force = 125.0;
+  StateChecker exact(model, environment_of(site(2.2), at_force), at_force, 0.0);
+  const Validity v = exact.check(end, tool.frame);
+  EXPECT_TRUE(v.valid()) << to_string(v.constraint) << ": " << v.detail;
+  EXPECT_NE(res.goals[0].load.find("with the drilling force"), std::string::npos)
+      << res.goals[0].load;
+  EXPECT_EQ(res.goals[0].load.rfind("J", 0), 0u) << "no joint named: " << res.goals[0].load;
+
+  req.request_id = 13;
+  req.contact_force = 1900.0;
+  const PlanResult heavy = planner->plan(req, start, {});
+  EXPECT_EQ(heavy.status, Status::kUnreachable) << "1900 N held?";
+  EXPECT_NE(heavy.reason.find("torque"), std::string::npos) << heavy.reason;
+
+  for (const double bad : {std::nan(""), 2500.0}) {
+    req.contact_force = bad;
+    const PlanResult refused = planner->plan(req, start, {});
+    EXPECT_EQ(refused.status, Status::kInvalidRequest) << bad;
+    EXPECT_NE(refused.reason.find("contact_force"), std::string::npos) << refused.reason;
+  }
 }
 
 TEST(Planner, ObstacleFromAPointCloudIsAvoided) {

@@ -53,6 +53,13 @@ struct DrillParams {
   double angular_damping{20.0};     ///< [N m s/rad]
 };
 
+/// The most the bit pushes on the wall along its axis [N]: the axial stiffness times the
+/// reference's largest lead, plus the damping at the feed rate (125 N with the defaults). The
+/// planner checks the arm's torques with it at every posture the drill asks for.
+inline double thrust_bound(const DrillParams& p) {
+  return p.stiffness * p.max_lead + p.damping * p.feed_rate;
+}
+
 /// A Cartesian impedance reference for the tip, in the fixed frame.
 struct CartesianReference {
   Eigen::Isometry3d pose{Eigen::Isometry3d::Identity()};

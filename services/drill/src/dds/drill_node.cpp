@@ -733,6 +733,7 @@ void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& located,
   r.goals().push_back(model::dds::to_pose_msg(frame));
   r.execute(false);
   r.environment_padding(kPlanPadding);
+  r.contact_force(thrust_bound(params_.motion));
   if (after) {
     const auto prev = plans_.find(*after);
     if (prev != plans_.end() && prev->second.end.size() > 0) {
@@ -1018,6 +1019,7 @@ void DrillNode::align(const DrillPoint& point) {
   r.end_effector(rig_->tool());
   r.goals().push_back(model::dds::to_pose_msg(point_.frame));
   r.execute(true);
+  r.contact_force(thrust_bound(params_.motion));
   // The bit's tip is put on the hole's axis (PlanRequest.tip_distance), so the posture the
   // planner checks is the one the bit drills from; the camera sees the hole from beside it.
   camera_to_tip_ = camera_to_tip;

@@ -187,6 +187,11 @@ struct PlanRequest {
   /// With tip_distance: how far [m] the bit goes on from the posture along -normal (to the wall
   /// and into it); the static torques are checked there too, the base standing. 0: not checked.
   double tip_reach = 0.0;
+  /// Force the tool pushes along its axis at the goal postures [N], checked against the torques;
+  /// 0: Params::contact_force. The drill service sends its thrust bound (the impedance's
+  /// stiffness times the reference's largest lead, 125 N), less than the planner's 200 N:
+  /// checked with 200 N the demo robot found no drilling posture for its blobs whose reach held.
+  double contact_force = 0.0;
   /// The base keeps its start pose: only the arm moves (the drill service's hole postures:
   /// a base that moves lets odometry drift between holes).
   bool fixed_base = false;
@@ -209,6 +214,7 @@ struct GoalResult {
   Trajectory trajectory;
   double nspg_seconds = 0.0;      ///< goal posture generation time [s]
   double plan_seconds = 0.0;      ///< path search + simplification + timing [s]
+  std::string load;               ///< the goal posture's heaviest joint load (fraction of its continuous torque), e.g. "J2_E 0.91 with the drilling force"
   std::string path_method;        ///< how the path was found: "direct", "projected line", "arm, then drive", "drive, then arm" (or
                                   ///< with a "remembered arm path"), "RRT-Connect"
 };

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -43,6 +44,48 @@ double shape_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// The goal posture's heaviest static load, as a fraction of the joint's continuous torque
+// (Params::torque_margin applies on top), with or without the drilling force, whichever is
+// heavier: for the log and the result, e.g. "J2_E 0.91 with the drilling force, 0.97 with the
+// bit 0.1 m further". What an operator looks at when the safety layer stops a joint on its
+// sustained torque.
+std::string load_summary(const PlanningModel& model, StateChecker& checker,
+                         const Eigen::VectorXd& q_full, const EndEffectorInfo& tool,
+                         const Eigen::Isometry3d& area, const Params& params) {
+  const auto heaviest = [&](const Eigen::VectorXd& q) {
+    struct Load {
+      double use = 0.0;
+      std::string joint;
+      bool drilling = false;
+    } worst;
+    const auto& planned = model.planned_indices();
+    for (const bool drilling : {true, false}) {
+      if (drilling && params.contact_force == 0.0) continue;
+      const Eigen::VectorXd tau = checker.required_torques(q, drilling ? tool.frame : std::string());
+      for (std::size_t i = 3; i < planned.size(); ++i) {
+        const double limit = model.torque_limits()[planned[i]];
+        if (limit <= 0.0) continue;
+        const double use = std::abs(tau[planned[i]]) / limit;
+        if (use > worst.use) worst = {use, model.joint_names()[i], drilling};
+      }
+    }
+    std::ostringstream s;
+    s << worst.joint << " " << std::fixed << std::setprecision(2) << worst.use
+      << (worst.drilling ? " with the drilling force" : " without the drilling force");
+    return s.str();
+  };
+  std::string s = heaviest(q_full);
+  if (params.tip_task && params.tip_reach > 0.0) {
+    const Eigen::Vector3d axis = -(area.linear().col(2));
+    if (const auto reached = reached_posture(model, q_full, tool.frame, axis, params.tip_reach)) {
+      std::ostringstream r;
+      r << ", " << heaviest(*reached) << " with the bit " << params.tip_reach << " m further";
+      s += r.str();
+    }
+  }
+  return s;
 }
 
 }  // namespace
@@ -350,6 +393,12 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   if (!(request.tip_reach >= 0.0 && request.tip_reach <= 1.0)) {
     return fail(Status::kInvalidRequest, "tip_reach must be within [0, 1] m");
   }
+  // A drill or a sander pushes with tens to a few hundred newtons; more is a unit error.
+  constexpr double kMaxContactForce = 2000.0;
+  if (std::isnan(request.contact_force) || request.contact_force > kMaxContactForce) {
+    return fail(Status::kInvalidRequest, "contact_force must be a number of newtons up to " +
+                                             std::to_string(static_cast<int>(kMaxContactForce)));
+  }
   if (q_start_full.size() != model->full_dof() || !q_start_full.allFinite()) {
     return fail(Status::kInvalidStart, "start state has " + std::to_string(q_start_full.size()) +
                                            " joints, model version " +
@@ -374,7 +423,10 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
 
   const double padding =
       request.environment_padding > 0.0 ? request.environment_padding : params_.environment_padding;
-  auto checker_ptr = std::make_unique<StateChecker>(model, env, params_, padding);
+  // The request's force on the tool, else the configured one, in every torque check.
+  Params request_params = params_;
+  if (request.contact_force > 0.0) request_params.contact_force = request.contact_force;
+  auto checker_ptr = std::make_unique<StateChecker>(model, env, request_params, padding);
   Validity start_ok = checker_ptr->check(q_start_full);
   // A start a few centimetres inside the map or its padding (the base's odometry drifts: on the
   // demo a leg was found 2-4 cm inside the wall after a hole's whole-body move), or with two
@@ -462,7 +514,7 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       add_note(*note);
       start_ok = {};
     } else if (padding > 0.0) {
-      auto unpadded = std::make_unique<StateChecker>(model, env, params_, 0.0);
+      auto unpadded = std::make_unique<StateChecker>(model, env, request_params, 0.0);
       if (const Validity v = unpadded->check(q_from); v.valid()) {
         add_note("the start is within the environment padding (" + start_ok.detail +
                  "): planned without it");
@@ -481,7 +533,7 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     // raised by kStartTorqueTolerance, inside the 10 % the safety service allows on the RMS
     // torque, rather than refusing every request from there for ever.
     constexpr double kStartTorqueTolerance = 0.05;
-    Params lenient_params = params_;
+    Params lenient_params = request_params;
     lenient_params.torque_margin *= 1.0 + kStartTorqueTolerance;
     auto lenient = std::make_unique<StateChecker>(model, env, lenient_params, padding);
     if (const Validity v = lenient->check(q_from); v.valid()) {
@@ -526,7 +578,7 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     };
     for (int attempt = 0;; ++attempt) {
       const auto t_posture = Clock::now();
-      Params attempt_params = params_;
+      Params attempt_params = request_params;
       attempt_params.camera_distance = distance;
       attempt_params.fixed_base = request.fixed_base;
       attempt_params.base_travel = request.base_travel;
@@ -557,7 +609,11 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
                     std::min(remaining, params_.path_attempt_time), seed, request.fixed_base,
                     g == 0 && lead_in ? &*lead_in : nullptr);
       r.nspg_seconds = nspg;
-      if (r.status == Status::kSucceeded) remember(*model, height, posture.q);
+      if (r.status == Status::kSucceeded) {
+        remember(*model, height, posture.q);
+        r.load = load_summary(*model, checker, model->to_full(posture.q, current), *tool,
+                              request.goals[g].area, attempt_params);
+      }
       if (r.status == Status::kNoPath) unreached.push_back(posture.q.tail(posture.q.size() - 3));
       if (r.status != Status::kNoPath || params_.planning_time - cpu_seconds_since(t0) < 0.05)
         break;

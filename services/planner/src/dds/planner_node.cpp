@@ -398,6 +398,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   core.camera_distance = request.camera_distance();
   core.tip_distance = request.tip_distance();
   core.tip_reach = request.tip_reach();
+  core.contact_force = request.contact_force();
   core.fixed_base = request.fixed_base();
   core.environment_padding = request.environment_padding();
   core.base_travel = request.base_travel();
@@ -448,7 +449,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
       if (g.status != Status::kSucceeded) continue;
       line << "; goal " << g.index << " in "
            << static_cast<int>(1e3 * (g.nspg_seconds + g.plan_seconds)) << " ms (" << g.path_method
-           << ")";
+           << (g.load.empty() ? "" : "; load " + g.load) << ")";
     }
     log_line(line.str());
   }
