@@ -111,6 +111,16 @@ std::string reach_torque_failure(const PlanningModel& model, StateChecker& check
   return {};
 }
 
+// True when the solved residuals `r` are off the task and a torque row is the largest
+// inequality holding them off.
+bool off_task_by_torques(const PostureProblem& problem, const Eigen::VectorXd& r,
+                         double tolerance) {
+  if (r.head<6>().norm() < kTaskWeight * tolerance) return false;
+  Eigen::Index row = 0;
+  return r.tail(r.size() - 6).maxCoeff(&row) > 0.0 &&
+         problem.term_of_row(static_cast<int>(row) + 6) == Term::kTorque;
+}
+
 // Turned seeds: the first arm joint turned by +-kTurnStep, +-2 kTurnStep, ... (kTurns each way).
 // On one of the benchmark's low areas beside a pillar (seed 7, #01; A) 34 of 234 turned
 // bare-wall postures converged to valid ones, 1 of 150 random arm postures.
@@ -219,12 +229,23 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   for (; k < params.nspg_seeds && valid_found < params.nspg_enough && !out_of_time(); ++k) {
     const auto hint = static_cast<std::size_t>(k - 2);  // index into arms[1...]
     const std::size_t turn = hint - (arms.size() - 1);
+    // The preferred load first (seeds screened and solved); when the torques alone held the
+    // seed off the task, the seed again with the mode's limit
+    // (PostureProblem::kPreferredTorqueTarget). (Going on from where the preferred load had
+    // pulled the base lost the demo robot's approach at 1.4 m: the base stood in the wall.)
+    problem.set_torque_target(PostureProblem::kPreferredTorqueTarget);
     Eigen::VectorXd q = k == 0                   ? problem.place(arms[0], yaw_hint)
                         : k == 1                 ? start
                         : hint + 1 < arms.size() ? problem.place(arms[hint + 1], yaw_hint)
                         : turn < turned.size()   ? problem.place(turned[turn], yaw_hint)
                                                  : random_seed();
+    const Eigen::VectorXd seed_q = q;
     solve(problem, q, lo, hi, params.nspg_iterations, params.nspg_tolerance, r);
+    if (off_task_by_torques(problem, r, params.nspg_tolerance)) {
+      problem.set_torque_target(problem.limit_torque_target());
+      q = seed_q;
+      solve(problem, q, lo, hi, params.nspg_iterations, params.nspg_tolerance, r);
+    }
     out.candidates += 1;
     if (r.head<6>().norm() >= kTaskWeight * params.nspg_tolerance) {
       // Off the task: name the inequality that held it off, if any.

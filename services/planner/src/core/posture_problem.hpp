@@ -58,6 +58,17 @@ class PostureProblem {
   /// Fraction of the contact force in the "drilling" torque rows (0: both rows gravity only,
   /// as for states on a path).
   void set_force_scale(double scale) { force_scale_ = scale; }
+  /// Torque utilisation (fraction of Params::torque_margin x continuous torque) the torque rows
+  /// pull the joints under, capped at the mode's limit (0.97; 0.9 for a drilling posture whose
+  /// reach is checked, the bit then going on into the wall).
+  void set_torque_target(double target) { torque_target_ = target; }
+  [[nodiscard]] double limit_torque_target() const;
+  /// What a goal posture aims under first: a posture is where the arm waits (an area's approach
+  /// held the demo robot's J2_E at 0.89 of its continuous torque for 17 s while the drill
+  /// asked for its holes' postures) and whence the arm alone must still reach the holes at a
+  /// fraction of that load (from that approach it reached none). generate_posture() solves a
+  /// seed again with the limit when the torques alone kept it off the task.
+  static constexpr double kPreferredTorqueTarget = 0.8;
 
   // The planned q for arm joints `arm`: the base is placed where that arm posture reaches the
   // task (yaw turns the camera axis onto the task axis about the vertical, x/y then bring the
@@ -94,6 +105,7 @@ class PostureProblem {
   std::shared_ptr<const DistanceField> field_;
   double obstacle_clearance_ = 0.0;
   double force_scale_ = 1.0;
+  double torque_target_ = 1.0;  // capped at limit_torque_target()
   Eigen::VectorXd tau_;
   std::vector<Eigen::Isometry3d> poses_;
   std::vector<Eigen::Vector3d> world_spheres_;
