@@ -73,6 +73,7 @@ constexpr double kSettleBack = 1.0;
 // sustained load while drilling exceeds the static model's by more than 10 % (not explained
 // yet: lateral forces of the bit held in its hole are one candidate).
 constexpr double kThrustChecked = 1.6;
+double checked_thrust(const DrillParams& p) { return kThrustChecked * thrust_bound(p); }
 // Robot shapes grown against the map in the areas' approach plans [m]: the planner's map is the
 // world, its start pose the wheel odometry, which drifts 4-6 cm over a whole-body move near the
 // wall; a base planned 3 cm from the wall was found inside it by the next plan. (The holes'
@@ -740,7 +741,7 @@ void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& located,
   r.goals().push_back(model::dds::to_pose_msg(frame));
   r.execute(false);
   r.environment_padding(kPlanPadding);
-  r.contact_force(kThrustChecked * thrust_bound(params_.motion));
+  r.contact_force(checked_thrust(params_.motion));
   if (after) {
     const auto prev = plans_.find(*after);
     if (prev != plans_.end() && prev->second.end.size() > 0) {
@@ -1026,7 +1027,7 @@ void DrillNode::align(const DrillPoint& point) {
   r.end_effector(rig_->tool());
   r.goals().push_back(model::dds::to_pose_msg(point_.frame));
   r.execute(true);
-  r.contact_force(kThrustChecked * thrust_bound(params_.motion));
+  r.contact_force(checked_thrust(params_.motion));
   // The bit's tip is put on the hole's axis (PlanRequest.tip_distance), so the posture the
   // planner checks is the one the bit drills from; the camera sees the hole from beside it.
   camera_to_tip_ = camera_to_tip;

@@ -32,6 +32,13 @@ class StateChecker {
   /// Joint torques the state needs (gravity + contact) [N m], full q order
   /// (PlanningModel::static_torques). Throws PlannerError for an unknown contact frame.
   [[nodiscard]] Eigen::VectorXd required_torques(const Eigen::VectorXd& q_full, const std::string& contact_frame);
+  /// The planned joint whose static torque (gravity, plus the contact force with
+  /// `contact_frame`) is the largest fraction of its continuous torque, and that fraction.
+  struct TorqueUse {
+    double fraction = 0.0;
+    std::string joint;
+  };
+  [[nodiscard]] TorqueUse heaviest_torque(const Eigen::VectorXd& q_full, const std::string& contact_frame);
   /// Number of check() calls so far.
   [[nodiscard]] std::size_t checks() const { return checks_; }
   [[nodiscard]] const PlanningModel& model() const { return *model_; }

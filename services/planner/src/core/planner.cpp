@@ -55,25 +55,15 @@ std::string load_summary(const PlanningModel& model, StateChecker& checker,
                          const Eigen::VectorXd& q_full, const EndEffectorInfo& tool,
                          const Eigen::Isometry3d& area, const Params& params) {
   const auto heaviest = [&](const Eigen::VectorXd& q) {
-    struct Load {
-      double use = 0.0;
-      std::string joint;
-      bool drilling = false;
-    } worst;
-    const auto& planned = model.planned_indices();
-    for (const bool drilling : {true, false}) {
-      if (drilling && params.contact_force == 0.0) continue;
-      const Eigen::VectorXd tau = checker.required_torques(q, drilling ? tool.frame : std::string());
-      for (std::size_t i = 3; i < planned.size(); ++i) {
-        const double limit = model.torque_limits()[planned[i]];
-        if (limit <= 0.0) continue;
-        const double use = std::abs(tau[planned[i]]) / limit;
-        if (use > worst.use) worst = {use, model.joint_names()[i], drilling};
-      }
-    }
+    const StateChecker::TorqueUse without = checker.heaviest_torque(q, std::string());
+    const StateChecker::TorqueUse with = params.contact_force != 0.0
+                                             ? checker.heaviest_torque(q, tool.frame)
+                                             : StateChecker::TorqueUse{};
+    const bool drilling = with.fraction > without.fraction;
+    const StateChecker::TorqueUse& worst = drilling ? with : without;
     std::ostringstream s;
-    s << worst.joint << " " << std::fixed << std::setprecision(2) << worst.use
-      << (worst.drilling ? " with the drilling force" : " without the drilling force");
+    s << worst.joint << " " << std::fixed << std::setprecision(2) << worst.fraction
+      << (drilling ? " with the drilling force" : " without the drilling force");
     return s.str();
   };
   std::string s = heaviest(q_full);

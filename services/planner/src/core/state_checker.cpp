@@ -116,6 +116,22 @@ Validity StateChecker::torque_validity(const std::string& contact_frame) const {
   return {};
 }
 
+StateChecker::TorqueUse StateChecker::heaviest_torque(const Eigen::VectorXd& q, const std::string& contact_frame) {
+  model_->link_poses(q, impl_->poses);
+  torques_at_poses(contact_frame, impl_->tau);
+  const PlanningModel& m = *model_;
+  const auto& planned = m.planned_indices();
+  TorqueUse worst;
+  for (std::size_t i = 3; i < planned.size(); ++i) {
+    const int fi = planned[i];
+    const double limit = m.torque_limits()[fi];
+    if (limit <= 0.0) continue;
+    const double use = std::abs(impl_->tau[fi]) / limit;
+    if (use > worst.fraction) worst = {use, m.joint_names()[i]};
+  }
+  return worst;
+}
+
 Validity StateChecker::check_torques(const Eigen::VectorXd& q, const std::string& contact_frame) {
   model_->link_poses(q, impl_->poses);
   torques_at_poses(contact_frame, impl_->tau);
