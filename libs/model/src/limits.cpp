@@ -27,6 +27,14 @@ double ThermalLoad::add(double tau, double dt) {
   return rms();
 }
 
+double folded_back_torque(const JointLimits& j, double rms) {
+  const double start = kFoldbackStart * j.continuous_torque;
+  if (!(rms > start)) return j.peak_torque;
+  if (rms >= j.continuous_torque) return j.continuous_torque;
+  const double s = (rms - start) / (j.continuous_torque - start);
+  return j.peak_torque + s * (j.continuous_torque - j.peak_torque);
+}
+
 double ThermalLoad::rms() const { return std::sqrt(mean_square_); }
 
 LimitsTable::LimitsTable(std::vector<JointLimits> rows, const std::string& where)

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace concert::model {
@@ -71,6 +72,35 @@ TEST(ThermalLoad, ConvergesToTheRmsOfASteadyLoadWithTheWindowAsTimeConstant) {
   for (int i = 0; i < 10000; ++i) rms = load.add(i % 2 ? 50.0 : -50.0, 0.01);
   EXPECT_NEAR(rms, 50.0, 0.1);
   EXPECT_THROW(ThermalLoad(0.0), ModelError);
+}
+
+TEST(FoldedBackTorque, PeakWhileCoolThenDownToTheContinuousTorque) {
+  // The wheel drive of the demo robot (Table 1, Small B): peak 24, continuous 17.5 N m.
+  const JointLimits wheel = joint(17.5, 24.0);
+  EXPECT_DOUBLE_EQ(folded_back_torque(wheel, 0.0), 24.0);
+  EXPECT_DOUBLE_EQ(folded_back_torque(wheel, 0.9 * 17.5), 24.0);
+  EXPECT_NEAR(folded_back_torque(wheel, 0.95 * 17.5), 20.75, 1e-9);  // half way
+  EXPECT_DOUBLE_EQ(folded_back_torque(wheel, 17.5), 17.5);
+  EXPECT_DOUBLE_EQ(folded_back_torque(wheel, 30.0), 17.5);
+}
+
+TEST(FoldedBackTorque, AStalledDriveNeverReachesSafetysSustainedBound) {
+  // A wheel scrubbing against the others asks its peak torque for a minute; the drive
+  // delivers what the foldback allows. Its RMS over the thermal window must stay within the
+  // continuous torque (safety stops at 1.1 x), yet the peak is there while the drive is cool.
+  const JointLimits wheel = joint(17.5, 24.0);
+  ThermalLoad load;
+  load.add(0.0, 0.0);
+  double largest = 0.0, first_second = 0.0;
+  for (int k = 1; k <= 60000; ++k) {  // 60 s at 1 kHz
+    const double tau = std::min(24.0, folded_back_torque(wheel, load.rms()));
+    if (k <= 1000) first_second += tau / 1000.0;
+    largest = std::max(largest, load.add(tau, 0.001));
+  }
+  EXPECT_NEAR(first_second, 24.0, 1e-9);
+  EXPECT_LE(largest, 17.5 * 1.001);
+  EXPECT_GT(load.rms(), 17.5 * 0.99);  // it still delivers its continuous torque
+  EXPECT_LT(largest, sustained_torque_bound(wheel, 0.1));
 }
 
 }  // namespace

@@ -338,6 +338,7 @@ struct Instance {
   ObstacleMotion obstacles;  ///< moves the world's moving obstacles (mocap bodies)
   std::vector<int> qpos_adr, dof_adr;
   std::vector<DriveCommand> commands;
+  std::vector<double> rated_effort;  ///< each actuator's forcerange from the URDF (0: none)
   std::uint64_t generation{0};
   std::vector<SensorMount> sensors;
   std::vector<DrillBit> drill_bits;
@@ -388,6 +389,9 @@ std::unique_ptr<Instance> make_instance(const std::string& urdf,
   in->d = mj_makeData(in->m);
   in->obstacles.apply(in->d, 0.0);
   in->commands.assign(in->built.joints.size(), DriveCommand{});
+  for (int a = 0; a < in->m->nu; ++a) {
+    in->rated_effort.push_back(in->m->actuator_forcelimited[a] ? in->m->actuator_forcerange[2 * a + 1] : 0.0);
+  }
   for (std::size_t i = 0; i < in->built.joints.size(); ++i) {
     const int jid = mj_name2id(in->m, mjOBJ_JOINT, in->built.joints[i].c_str());
     in->qpos_adr.push_back(in->m->jnt_qposadr[jid]);
@@ -520,6 +524,12 @@ struct SimHardware::Impl {
       const double pos_term = c.mode == DriveMode::kVelocity ? 0.0 : kp * c.position;
       // General actuator: force = ctrl + biasprm[1] q + biasprm[2] qd, saturated at forcerange.
       // The velocity-dependent part stays inside MuJoCo so the implicit integrator damps it stably.
+      // The drive's torque limit this cycle: its rated peak, or less when the command says so.
+      const double rated = in.rated_effort[i];
+      const double limit = c.max_effort > 0.0 && (rated <= 0.0 || c.max_effort < rated) ? c.max_effort : rated;
+      in.m->actuator_forcelimited[i] = limit > 0.0 ? 1 : 0;
+      in.m->actuator_forcerange[2 * i] = -limit;
+      in.m->actuator_forcerange[2 * i + 1] = limit;
       in.m->actuator_biasprm[i * mjNBIAS + 1] = -kp;
       in.m->actuator_biasprm[i * mjNBIAS + 2] = -kd;
       in.d->ctrl[i] = pos_term + kd * c.velocity + ff;

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <iostream>
 #include <thread>
 
 #include "test_helpers.hpp"
@@ -155,6 +157,53 @@ TEST_F(RobotCoreTest, SafetyStopHoldsAndRefusesCommands) {
   }
   core_.set_safety_stop(false);
   EXPECT_NO_THROW(core_.command_base({1, 0.1, 0, 0}));
+}
+
+// The drive's I^2 t foldback (model::folded_back_torque): an arm holding a load above a
+// joint's continuous torque gets its peak while the drive is cool, then the drive folds back,
+// the joint yields, and its RMS torque never reaches the safety layer's sustained bound.
+TEST(RobotCore, AnOverloadedDriveFoldsBackInsteadOfOverheating) {
+  const auto hold_for = [](const model::LimitsTable& limits, double seconds, double* held_torque,
+                           double* rms_max, double* q_at_half_second) {
+    SimParams params;
+    params.initial_positions = {{"J2_A", 1.0}, {"J3_A", 0.3}};
+    SimHardware sim(read_fixture("arm_drill.urdf"), World{}, params);
+    RobotCore core(sim);
+    core.set_model(read_fixture("arm_drill.urdf"), 1, "", limits);
+    model::ThermalLoad measured;  // the safety layer's model, on what the drive reports
+    *rms_max = 0.0;
+    const int cycles = static_cast<int>(seconds / core.params().period);
+    for (int k = 0; k < cycles; ++k) {
+      core.cycle();
+      const RobotState s = core.state();
+      if (!s.ready) continue;
+      const std::size_t j = hw_index(s, "J2_A");
+      *rms_max = std::max(*rms_max, measured.add(s.effort[j], core.params().period));
+      if (k == cycles / 20 || (k == static_cast<int>(0.5 / core.params().period))) {
+        if (k == cycles / 20) *held_torque = std::abs(s.effort[j]);
+        if (k == static_cast<int>(0.5 / core.params().period)) *q_at_half_second = s.position[j];
+      }
+    }
+    return core.state();
+  };
+  // Without a limits table: the rated peak only, the arm holds its posture.
+  double held = 0.0, rms_free = 0.0, q_half = 0.0;
+  const RobotState free = hold_for({}, 20.0, &held, &rms_free, &q_half);
+  const std::size_t j = hw_index(free, "J2_A");
+  ASSERT_GT(held, 20.0);
+  EXPECT_NEAR(free.position[j], 1.0, 0.01);
+  EXPECT_DOUBLE_EQ(free.torque_limit[j], 150.0);  // the URDF's effort
+  // J2_A rated for only 60 % of that load continuously (peak 150 N m as in the URDF).
+  const double continuous = 0.6 * held;
+  const model::LimitsTable limits({{"J2_A", "A", -2.0, 2.0, 1.5, 150.0, continuous}}, "test");
+  double held_again = 0.0, rms_max = 0.0;
+  const RobotState folded = hold_for(limits, 20.0, &held_again, &rms_max, &q_half);
+  EXPECT_GT(rms_free, model::sustained_torque_bound(limits.at("J2_A"), 0.1));
+  EXPECT_NEAR(q_half, 1.0, 0.01) << "the peak torque while the drive is cool";
+  EXPECT_LE(rms_max, continuous * 1.02) << "safety's bound is " << continuous * 1.1;
+  EXPECT_NEAR(folded.torque_limit[j], continuous, 1e-6);
+  EXPECT_GT(std::abs(folded.position[j] - 1.0), 0.05) << "the joint yields";
+  std::cout << "held " << held << " N m, RMS without foldback " << rms_free << ", with " << rms_max << " (continuous " << continuous << "), J2_A yielded to " << folded.position[j] << " rad\n";
 }
 
 // What DDS clients use for teaching mode (README): no stiffness, no damping.

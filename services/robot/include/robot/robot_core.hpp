@@ -12,6 +12,7 @@
 
 #include "concert/hardware/sensors.hpp"
 #include "concert/kinematics/model.hpp"
+#include "concert/model/limits.hpp"
 #include "robot/base_kinematics.hpp"
 #include "robot/hardware.hpp"
 
@@ -173,6 +174,9 @@ struct RobotState {
   std::vector<std::string> joint_names;   ///< hardware order
   std::vector<double> position, velocity, effort;
   std::vector<JointOwner> owners;         ///< hardware order: the ownership record
+  /// Hardware order: each drive's torque limit this cycle [Nm]: its rated peak, less while it
+  /// is folded back (0: no limit known).
+  std::vector<double> torque_limit;
   bool has_base{false};
   Odometry odometry;
   std::string end_effector_frame;
@@ -207,7 +211,13 @@ class RobotCore {
   /// from the mounted hardware (Hardware::mounted(): what the loop runs after its pending
   /// switch), or the version is older. `end_effector_frame` (e.g. the tool end-effector of
   /// the model message) overrides RobotParams::end_effector_frame when not empty.
-  void set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame = "");
+  ///
+  /// `limits` (the model's limits table, by joint name) gives each joint's continuous torque:
+  /// a joint listed there has its drive's torque limit folded back as its RMS torque over the
+  /// thermal window nears the continuous torque (model::folded_back_torque); a joint not
+  /// listed keeps its rated peak.
+  void set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame = "",
+                 const model::LimitsTable& limits = {});
 
   void command_joints(const JointCommandSet& command);
   void command_cartesian(const CartesianCommand& command);

@@ -74,6 +74,7 @@ void reserve_state(RobotState& s) {
   s.velocity.reserve(kReservedJoints);
   s.effort.reserve(kReservedJoints);
   s.owners.reserve(kReservedJoints);
+  s.torque_limit.reserve(kReservedJoints);
 }
 
 RobotState reserved_state() {
@@ -142,6 +143,9 @@ struct RobotCore::Slot {
   std::vector<int> arm;
   std::vector<Leg> legs;
   std::vector<int> hw_to_model;
+  /// Model order: each joint's limits from the model's table; continuous torque 0 when the
+  /// table does not list it (no foldback).
+  std::vector<model::JointLimits> limits;
   CycleData cycle;
   HoldController hold;
   JointController joint;
@@ -187,11 +191,16 @@ struct RobotCore::Loop {
     hw_state.velocity.reserve(kReservedJoints);
     hw_state.effort.reserve(kReservedJoints);
     drive.reserve(kReservedJoints);
+    thermal.reserve(kReservedJoints);
   }
   ~Loop() { delete active; }
   Slot* active{nullptr};
   HardwareState hw_state;
   std::vector<DriveCommand> drive;  // hardware order
+  // Hardware order: each drive's RMS torque over the thermal window (measured), kept across
+  // model versions of the same hardware, restarted cold with new hardware.
+  std::vector<model::ThermalLoad> thermal;
+  std::uint64_t thermal_generation{0};
   bool holding_hw{false};
   std::uint64_t holding_generation{0};
   bool stop_seen{false};
@@ -213,7 +222,8 @@ RobotCore::RobotCore(Hardware& hardware, RobotParams params)
 
 RobotCore::~RobotCore() = default;
 
-void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame) {
+void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame,
+                          const model::LimitsTable& limits) {
   const std::string what = "model version " + std::to_string(version);
   std::shared_ptr<const kinematics::Model> model;
   try {
@@ -269,6 +279,15 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
   slot->ready_message = "ready at model version " + std::to_string(version);
   for (const auto& name : mounted.joint_names) {
     slot->hw_to_model.push_back(model->joint_index_or_throw(name));
+  }
+  slot->limits.resize(static_cast<std::size_t>(model->dof()));
+  for (int j = 0; j < model->dof(); ++j) {
+    const std::string& name = model->joint_names()[static_cast<std::size_t>(j)];
+    if (const model::JointLimits* row = limits.find(name)) {
+      slot->limits[static_cast<std::size_t>(j)] = *row;
+    } else {
+      slot->limits[static_cast<std::size_t>(j)].name = name;
+    }
   }
   std::lock_guard lock(shared_->mutex);
   if (shared_->accepted != nullptr && version < shared_->accepted->version) {
@@ -640,6 +659,14 @@ void RobotCore::cycle() {
   hw_.switch_prepared();
   hw_.read(L.hw_state);
   const std::size_t nh = L.hw_state.position.size();
+  // Every drive's thermal load, from its measured torque (new hardware starts cold).
+  if (L.thermal.size() != nh || L.thermal_generation != hw_.generation()) {
+    L.thermal.assign(nh, model::ThermalLoad{});
+    L.thermal_generation = hw_.generation();
+  }
+  for (std::size_t h = 0; h < nh && h < L.hw_state.effort.size(); ++h) {
+    L.thermal[h].add(L.hw_state.effort[h], dt);
+  }
   Slot* s = L.active;
   const bool stopped = L.safety_stopped.load(std::memory_order_acquire);
   const bool matching = s != nullptr && s->generation == hw_.generation() && s->hw_to_model.size() == nh;
@@ -738,6 +765,17 @@ void RobotCore::cycle() {
       if (lim.effort > 0.0) {
         d.effort = std::clamp(d.effort, -lim.effort, lim.effort);
       }
+      // The drive's I^2 t protection: its torque limit folds back to the continuous torque as
+      // its RMS torque nears it, so a load nobody planned (wheels scrubbing while the steering
+      // turns, a drilling load above the static model's) makes the joint yield, not the
+      // safety layer stop the robot on the sustained-torque rule.
+      const model::JointLimits& rated = s->limits[static_cast<std::size_t>(i)];
+      if (rated.continuous_torque > 0.0) {
+        d.max_effort = model::folded_back_torque(rated, L.thermal[h].rms());
+        d.effort = std::clamp(d.effort, -d.max_effort, d.max_effort);
+      } else {
+        d.max_effort = lim.effort;  // no continuous torque known: the rated peak
+      }
       L.drive[h] = d;
     }
     hw_.write(L.drive);
@@ -752,6 +790,10 @@ void RobotCore::cycle() {
   out.velocity = L.hw_state.velocity;
   out.effort = L.hw_state.effort;
   out.owners.resize(nh);
+  out.torque_limit.resize(nh);
+  for (std::size_t h = 0; h < nh; ++h) {
+    out.torque_limit[h] = h < L.drive.size() ? L.drive[h].max_effort : 0.0;
+  }
   if (matching) {
     const CycleData& c = s->cycle;
     out.model_version = s->version;

@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <iostream>
 
 #include "concert/common/clock.hpp"
 #include "concert/model/dds/conversions.hpp"
@@ -139,16 +141,27 @@ void RobotNode::on_model(const msg::RobotModel& m) {
   if (core_.ready() && core_.model_version() == m.version() &&
       status_.model().hash == m.content_hash())
     return;
-  apply_model(m.urdf(), m.version(), tool_end_effector(m), m.content_hash());
+  // The limits table gives the drives their continuous torques (their torque foldback); a
+  // message whose description does not parse still runs, on the rated peaks alone.
+  model::LimitsTable limits;
+  try {
+    limits = model::RobotModel::build(model::dds::to_description(m))->limits();
+  } catch (const std::exception&) {
+  }
+  apply_model(m.urdf(), m.version(), tool_end_effector(m), m.content_hash(), limits);
 }
 
 void RobotNode::apply_model(const std::string& urdf, std::uint64_t version,
                             const std::string& end_effector_frame,
-                            const std::string& content_hash) {
+                            const std::string& content_hash, const model::LimitsTable& limits) {
   try {
     status_.report(msg::SERVICE_RECONFIGURING, status_.model_version(),
                    "reconfiguring to model version " + std::to_string(version));
-    core_.set_model(urdf, version, end_effector_frame);
+    core_.set_model(urdf, version, end_effector_frame, limits);
+    {
+      std::lock_guard lock(mutex_);
+      limits_ = limits;
+    }
     status_.report(msg::SERVICE_READY,
                    concert::dds::ModelId{static_cast<uint32_t>(version), content_hash},
                    "ready at model version " + std::to_string(version));
@@ -202,7 +215,35 @@ void RobotNode::publish(const RobotState& s) {
     status_.report(msg::SERVICE_RECONFIGURING, static_cast<uint32_t>(s.model_version), s.message);
   }
   last_ready_ = s.ready;
+  log_foldback(s);
   ++cycles_;
+}
+
+void RobotNode::log_foldback(const RobotState& s) {
+  if (cycles_ % 50 != 0) return;  // a drive heats over seconds
+  const auto fixed = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", v);
+    return std::string(text);
+  };
+  folded_.resize(s.joint_names.size(), false);
+  std::lock_guard lock(mutex_);
+  for (std::size_t h = 0; h < s.joint_names.size() && h < s.torque_limit.size(); ++h) {
+    const model::JointLimits* row = limits_.find(s.joint_names[h]);
+    if (row == nullptr || s.torque_limit[h] <= 0.0) continue;
+    const double halfway = 0.5 * (row->peak_torque + row->continuous_torque);
+    if (!folded_[h] && s.torque_limit[h] <= halfway) {
+      folded_[h] = true;
+      std::cerr << "concert_robot: " << row->name << " folds its torque back to "
+                << fixed(s.torque_limit[h]) << " N m (peak " << fixed(row->peak_torque)
+                << ", continuous " << fixed(row->continuous_torque)
+                << "): its RMS torque over the thermal window nears the continuous torque\n";
+    } else if (folded_[h] && s.torque_limit[h] >= row->peak_torque) {
+      folded_[h] = false;
+      std::cerr << "concert_robot: " << row->name << " back at its peak torque "
+                << fixed(row->peak_torque) << " N m\n";
+    }
+  }
 }
 
 void RobotNode::publish_trajectory(const TrajectoryProgress& p, std::uint64_t model_version) {

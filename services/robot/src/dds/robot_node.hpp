@@ -53,8 +53,10 @@ class RobotNode {
 
   /// Reconfigures the core to a model (from the model topic, or the sim's own model in
   /// standalone mode) and reports the outcome on the status topic. Never throws.
+  /// `limits` (the model's limits table) folds each listed drive's torque back as it heats.
   void apply_model(const std::string& urdf, std::uint64_t version,
-                   const std::string& end_effector_frame, const std::string& content_hash = "");
+                   const std::string& end_effector_frame, const std::string& content_hash = "",
+                   const model::LimitsTable& limits = {});
 
   /// Counters for tests and diagnostics.
   [[nodiscard]] std::uint64_t refused_commands() const { return refused_.load(); }
@@ -102,6 +104,11 @@ class RobotNode {
   std::string last_error_;
   bool last_ready_{false};
   std::uint64_t cycles_{0};
+  model::LimitsTable limits_;       // of the model last applied (under mutex_)
+  std::vector<bool> folded_;        // hardware order: a drive said to be folded back (publisher)
+  /// Logs each drive whose torque limit folds back (to halfway between its peak and its
+  /// continuous torque) and when it is back at its peak.
+  void log_foldback(const RobotState& state);
   std::uint32_t scan_id_{0};
   double distance_{0.0};
   double last_x_{0.0}, last_y_{0.0};

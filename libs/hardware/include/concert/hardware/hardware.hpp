@@ -32,6 +32,9 @@ struct DriveCommand {
   double effort{0.0};     ///< feed-forward [Nm] or [N]
   double stiffness{0.0};  ///< [Nm/rad] (impedance mode)
   double damping{0.0};    ///< [Nm s/rad] (impedance mode)
+  /// Torque limit for this cycle [Nm] or [N] (a drive's max-torque object, CiA 402 0x6072),
+  /// below its rated peak; 0: the rated peak. The robot core folds it back as a drive heats.
+  double max_effort{0.0};
 };
 
 /// What the drives report, in the hardware's joint order.

@@ -8,10 +8,11 @@
 //    [lower - tolerance, upper + tolerance]; the planner keeps every state within [lower, upper].
 //  * velocity: the robot saturates commands at the velocity limit; safety stops beyond
 //    velocity x (1 + margin); the planner plans within velocity x velocity_scale (<= 1).
-//  * torque: the robot's drives saturate at the PEAK torque; safety stops at once beyond
-//    peak x (1 + margin), and when the RMS of the torque over the thermal window exceeds
-//    CONTINUOUS x (1 + margin); the planner keeps static/planned torques within the
-//    CONTINUOUS torque (x torque_margin <= 1).
+//  * torque: the robot's drives saturate at the PEAK torque, folded back to the CONTINUOUS
+//    torque as their RMS over the thermal window nears it (folded_back_torque, the I^2 t
+//    protection of a servo drive); safety stops at once beyond peak x (1 + margin), and when
+//    the RMS of the torque over the thermal window exceeds CONTINUOUS x (1 + margin); the
+//    planner keeps static/planned torques within the CONTINUOUS torque (x torque_margin <= 1).
 //
 // Why: the peak torque is what a drive can deliver for a short time, the continuous torque
 // what it can deliver without overheating. A transient above the continuous torque (an arm
@@ -19,7 +20,10 @@
 // the peak cannot come from a healthy drive, and a load above the continuous torque held for
 // the thermal window overheats the drive: both stop. The planner keeps what it controls (the
 // static load of every planned posture) within the continuous torque, so the robot can hold
-// any planned posture indefinitely.
+// any planned posture indefinitely. What the planner cannot foresee (wheels scrubbing while
+// the steering turns, a drilling load the static model underestimates) meets the drive's
+// foldback first: the joint yields (its tracking error shows it) instead of the whole robot
+// being stopped; the safety layer's sustained bound stays for a drive that does not fold back.
 
 #include <cstddef>
 #include <string>
@@ -36,6 +40,16 @@ inline constexpr double kThermalWindow = 5.0;
 
 /// Torque the robot's drives saturate at [N m]: the peak torque.
 inline double drive_torque_limit(const JointLimits& j) { return j.peak_torque; }
+/// RMS torque over the thermal window, as a fraction of the continuous torque, from which a
+/// drive folds its torque limit back [-].
+inline constexpr double kFoldbackStart = 0.9;
+/// The torque limit of a drive whose RMS torque over the thermal window is `rms` [N m]: the
+/// peak torque up to kFoldbackStart x continuous, then falling linearly to the continuous
+/// torque, reached when the RMS is the continuous torque (and kept above it). A drive held to
+/// it keeps its RMS within the continuous torque (plus one sample's share of the peak), so the
+/// safety layer's sustained bound, continuous x (1 + margin), is never reached by the load
+/// alone. Servo drives protect their motors this way (I^2 t foldback).
+double folded_back_torque(const JointLimits& j, double rms);
 /// Torque the planner keeps static/planned loads within [N m]: the continuous torque.
 inline double planning_torque_limit(const JointLimits& j) { return j.continuous_torque; }
 /// |tau| beyond which safety stops at once [N m]: peak x (1 + margin).
