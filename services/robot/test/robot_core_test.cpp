@@ -159,51 +159,53 @@ TEST_F(RobotCoreTest, SafetyStopHoldsAndRefusesCommands) {
   EXPECT_NO_THROW(core_.command_base({1, 0.1, 0, 0}));
 }
 
-// The drive's I^2 t foldback (model::folded_back_torque): an arm holding a load above a
-// joint's continuous torque gets its peak while the drive is cool, then the drive folds back,
-// the joint yields, and its RMS torque never reaches the safety layer's sustained bound.
-TEST(RobotCore, AnOverloadedDriveFoldsBackInsteadOfOverheating) {
-  const auto hold_for = [](const model::LimitsTable& limits, double seconds, double* held_torque,
-                           double* rms_max, double* q_at_half_second) {
-    SimParams params;
-    params.initial_positions = {{"J2_A", 1.0}, {"J3_A", 0.3}};
-    SimHardware sim(read_fixture("arm_drill.urdf"), World{}, params);
+// The legs' I^2 t foldback (model::folded_back_torque): a base driven into a wall keeps its
+// wheels pushing; with the wheels' continuous torque in the limits table their drives fold back
+// and their RMS torque never reaches the safety layer's sustained bound, while the arm's
+// joints keep their peak torque (a yielding arm joint moves the tool).
+TEST(RobotCore, WheelsPushingAWallFoldTheirTorqueBackTheArmDoesNot) {
+  const std::vector<std::string> wheels = {"J_wheel_fl", "J_wheel_fr", "J_wheel_rl", "J_wheel_rr"};
+  const auto push = [&](const model::LimitsTable& limits, double* rms_max) {
+    World world;
+    WorldShape wall;
+    wall.name = "wall";
+    wall.size = {0.2, 4.0, 1.0};
+    wall.position = {1.2, 0.0, 0.5};
+    world.walls.push_back(wall);
+    SimHardware sim(read_fixture("mobile_drill.urdf"), world, {});
     RobotCore core(sim);
-    core.set_model(read_fixture("arm_drill.urdf"), 1, "", limits);
-    model::ThermalLoad measured;  // the safety layer's model, on what the drive reports
+    core.set_model(read_fixture("mobile_drill.urdf"), 1, "", limits);
+    run_cycles(core, 200);
+    std::vector<model::ThermalLoad> measured(wheels.size());  // safety's model, on the drives' report
     *rms_max = 0.0;
-    const int cycles = static_cast<int>(seconds / core.params().period);
-    for (int k = 0; k < cycles; ++k) {
+    const double dt = core.params().period;
+    for (int k = 0; k < 25000; ++k) {  // 25 s at 0.3 m/s: the wall is 0.5 m ahead
+      if (k % 100 == 0) core.command_base({1, 0.3, 0.0, 0.0});
       core.cycle();
       const RobotState s = core.state();
-      if (!s.ready) continue;
-      const std::size_t j = hw_index(s, "J2_A");
-      *rms_max = std::max(*rms_max, measured.add(s.effort[j], core.params().period));
-      if (k == cycles / 20 || (k == static_cast<int>(0.5 / core.params().period))) {
-        if (k == cycles / 20) *held_torque = std::abs(s.effort[j]);
-        if (k == static_cast<int>(0.5 / core.params().period)) *q_at_half_second = s.position[j];
-      }
+      for (std::size_t w = 0; w < wheels.size(); ++w)
+        *rms_max = std::max(*rms_max, measured[w].add(s.effort[hw_index(s, wheels[w])], dt));
     }
     return core.state();
   };
-  // Without a limits table: the rated peak only, the arm holds its posture.
-  double held = 0.0, rms_free = 0.0, q_half = 0.0;
-  const RobotState free = hold_for({}, 20.0, &held, &rms_free, &q_half);
-  const std::size_t j = hw_index(free, "J2_A");
-  ASSERT_GT(held, 20.0);
-  EXPECT_NEAR(free.position[j], 1.0, 0.01);
-  EXPECT_DOUBLE_EQ(free.torque_limit[j], 150.0);  // the URDF's effort
-  // J2_A rated for only 60 % of that load continuously (peak 150 N m as in the URDF).
-  const double continuous = 0.6 * held;
-  const model::LimitsTable limits({{"J2_A", "A", -2.0, 2.0, 1.5, 150.0, continuous}}, "test");
-  double held_again = 0.0, rms_max = 0.0;
-  const RobotState folded = hold_for(limits, 20.0, &held_again, &rms_max, &q_half);
-  EXPECT_GT(rms_free, model::sustained_torque_bound(limits.at("J2_A"), 0.1));
-  EXPECT_NEAR(q_half, 1.0, 0.01) << "the peak torque while the drive is cool";
+  double rms_free = 0.0;
+  const RobotState free = push({}, &rms_free);
+  ASSERT_GT(rms_free, 5.0) << "the wheels push the wall";
+  EXPECT_DOUBLE_EQ(free.torque_limit[hw_index(free, "J_wheel_fl")], 60.0);  // the URDF's effort
+  // The wheels rated for 60 % of that push continuously (peak 60 N m as in the URDF); J2_A too.
+  const double continuous = 0.6 * rms_free;
+  std::vector<model::JointLimits> rows;
+  for (const auto& w : wheels) rows.push_back({w, "B", -1e9, 1e9, 10.0, 60.0, continuous});
+  rows.push_back({"J2_A", "A", -2.0, 2.0, 1.5, 150.0, 1.0});
+  const model::LimitsTable limits(rows, "test");
+  double rms_max = 0.0;
+  const RobotState folded = push(limits, &rms_max);
+  EXPECT_GT(rms_free, model::sustained_torque_bound(limits.at("J_wheel_fl"), 0.1));
   EXPECT_LE(rms_max, continuous * 1.02) << "safety's bound is " << continuous * 1.1;
-  EXPECT_NEAR(folded.torque_limit[j], continuous, 1e-6);
-  EXPECT_GT(std::abs(folded.position[j] - 1.0), 0.05) << "the joint yields";
-  std::cout << "held " << held << " N m, RMS without foldback " << rms_free << ", with " << rms_max << " (continuous " << continuous << "), J2_A yielded to " << folded.position[j] << " rad\n";
+  for (const auto& w : wheels) EXPECT_NEAR(folded.torque_limit[hw_index(folded, w)], continuous, 1e-6) << w;
+  EXPECT_DOUBLE_EQ(folded.torque_limit[hw_index(folded, "J2_A")], 150.0) << "the arm keeps its peak";
+  std::cout << "wheels pushing the wall: RMS " << rms_free << " N m without foldback, " << rms_max
+            << " with (continuous " << continuous << ")\n";
 }
 
 // What DDS clients use for teaching mode (README): no stiffness, no damping.

@@ -213,9 +213,9 @@ class RobotCore {
   /// the model message) overrides RobotParams::end_effector_frame when not empty.
   ///
   /// `limits` (the model's limits table, by joint name) gives each joint's continuous torque:
-  /// a joint listed there has its drive's torque limit folded back as its RMS torque over the
-  /// thermal window nears the continuous torque (model::folded_back_torque); a joint not
-  /// listed keeps its rated peak.
+  /// a leg joint (steering, wheel) listed there has its drive's torque limit folded back as its
+  /// RMS torque over the thermal window nears the continuous torque
+  /// (model::folded_back_torque); arm joints and joints not listed keep their rated peak.
   void set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame = "",
                  const model::LimitsTable& limits = {});
 

@@ -280,10 +280,16 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
   for (const auto& name : mounted.joint_names) {
     slot->hw_to_model.push_back(model->joint_index_or_throw(name));
   }
+  // The legs' drives fold their torque back as they heat; the arm's keep their peak torque. A
+  // wheel or a steering that yields slips or lags (the base slows); an arm joint that yields
+  // moves the tool: with J2_E folded back at its continuous torque while the demo arm moved
+  // off a drilled hole, J5_E ran into its limit and J6_E past its velocity limit (a safety stop
+  // anyway). For the arm, safety's sustained-torque stop is the better end.
   slot->limits.resize(static_cast<std::size_t>(model->dof()));
   for (int j = 0; j < model->dof(); ++j) {
     const std::string& name = model->joint_names()[static_cast<std::size_t>(j)];
-    if (const model::JointLimits* row = limits.find(name)) {
+    const model::JointLimits* row = limits.find(name);
+    if (row != nullptr && leg_joints.count(j) != 0) {
       slot->limits[static_cast<std::size_t>(j)] = *row;
     } else {
       slot->limits[static_cast<std::size_t>(j)].name = name;
@@ -765,10 +771,10 @@ void RobotCore::cycle() {
       if (lim.effort > 0.0) {
         d.effort = std::clamp(d.effort, -lim.effort, lim.effort);
       }
-      // The drive's I^2 t protection: its torque limit folds back to the continuous torque as
-      // its RMS torque nears it, so a load nobody planned (wheels scrubbing while the steering
-      // turns, a drilling load above the static model's) makes the joint yield, not the
-      // safety layer stop the robot on the sustained-torque rule.
+      // A leg drive's I^2 t protection: its torque limit folds back to the continuous torque as
+      // its RMS torque nears it, so a load nobody planned (wheels scrubbing while the legs
+      // steer, a base pushing an obstacle) makes it slip or lag, not the safety layer stop the
+      // robot on the sustained-torque rule. Arm joints: continuous torque 0 here (set_model).
       const model::JointLimits& rated = s->limits[static_cast<std::size_t>(i)];
       if (rated.continuous_torque > 0.0) {
         d.max_effort = model::folded_back_torque(rated, L.thermal[h].rms());

@@ -8,9 +8,9 @@
 //    [lower - tolerance, upper + tolerance]; the planner keeps every state within [lower, upper].
 //  * velocity: the robot saturates commands at the velocity limit; safety stops beyond
 //    velocity x (1 + margin); the planner plans within velocity x velocity_scale (<= 1).
-//  * torque: the robot's drives saturate at the PEAK torque, folded back to the CONTINUOUS
-//    torque as their RMS over the thermal window nears it (folded_back_torque, the I^2 t
-//    protection of a servo drive); safety stops at once beyond peak x (1 + margin), and when
+//  * torque: the robot's drives saturate at the PEAK torque; the legs' (steering, wheels) fold
+//    back to the CONTINUOUS torque as their RMS over the thermal window nears it
+//    (folded_back_torque, the I^2 t protection of a servo drive); safety stops at once beyond peak x (1 + margin), and when
 //    the RMS of the torque over the thermal window exceeds CONTINUOUS x (1 + margin); the
 //    planner keeps static/planned torques within the CONTINUOUS torque (x torque_margin <= 1).
 //
@@ -20,10 +20,10 @@
 // the peak cannot come from a healthy drive, and a load above the continuous torque held for
 // the thermal window overheats the drive: both stop. The planner keeps what it controls (the
 // static load of every planned posture) within the continuous torque, so the robot can hold
-// any planned posture indefinitely. What the planner cannot foresee (wheels scrubbing while
-// the steering turns, a drilling load the static model underestimates) meets the drive's
-// foldback first: the joint yields (its tracking error shows it) instead of the whole robot
-// being stopped; the safety layer's sustained bound stays for a drive that does not fold back.
+// any planned posture indefinitely. What the planner cannot foresee on the base (wheels
+// scrubbing while the legs steer, a base pushing an obstacle) meets the leg drive's foldback
+// first: the wheel slips or the steering lags instead of the whole robot being stopped. An arm
+// joint keeps its peak: one that yields moves the tool, so there safety's stop is the end.
 
 #include <cstddef>
 #include <string>
