@@ -10,8 +10,7 @@
 // The point is picked on blob_1, 5 mm from its centre, as a user clicks the blob to drill. One CI
 // run drilled blob_2 (100.5 mm off) for a pick 2 cm beside blob_1, towards blob_2: odometry drifts
 // over the approach, or the re-measure took blob_2 seen alone for blob_1 (since bounded, see
-// BlobShift.*); the drill log now names the blobs it saw, nearest first, with their distances,
-// and the pick follows the blobs the camera saw around it at the pick, found again as a set.
+// BlobShift.*); the drill log now names the blobs it saw, nearest first, with their distances.
 // Judged against the simulator's truth: the holes its
 // wall records (concert/sim/holes) against the blobs' true positions (libs/world); not against
 // the service's own report. The ArUco pattern of the same wall is a scenario of the benchmark
@@ -69,9 +68,6 @@ TEST(DrillMission, DrillsTheBlobsOnTheDemoWallWithVisualServoing) {
   const std::vector<HoleError> errors = score(run, "blob_1");
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_LT(errors[0].norm(), 0.005) << run.logs;  // the paper's aim with visual servoing: max 5 mm
-  // The picked blob was found again as one of the set seen at the pick, not by odometry alone.
-  EXPECT_NE(run.logs.find("2 blob(s) seen around the pick"), std::string::npos) << run.logs;
-  EXPECT_NE(run.logs.find("the pick follows them"), std::string::npos) << run.logs;
   if (std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr) std::cout << run.logs << std::endl;
   // The end state: the robot never stopped by the safety layer.
   EXPECT_TRUE(run.safety_running) << run.logs;

@@ -105,10 +105,6 @@ constexpr double kReplanShift = 0.01;
 // Blobs of one area matched as a set: a predicted blob lies this close to a seen one [m]
 // (6 deg of odometry yaw over 0.1 m between blobs moves them 1 cm).
 constexpr double kBlobMatch = 0.02;
-// How far the blobs around a picked point may appear, after the approach, from where the camera
-// saw them at the pick [m]: odometry drifted 6 cm sideways and 9.4 cm towards the wall over the
-// system test's approach in one run of 15 (the pick then lay nearer the neighbouring blob).
-constexpr double kPickDrift = 0.12;
 // While the whole body moves to a blob hole's posture, the area's blobs are followed from camera
 // frame to frame (track_area): odometry drifts 2-6 cm over such a move (recorded on morphology
 // A at the BIM area: 27 mm over 0.45 m and 0.75 rad of base motion), more than half the 10 cm
@@ -548,7 +544,6 @@ void DrillNode::start_mission(const msg::DrillMission& m) {
   mission_id_ = m.mission_id();
   resolving_.clear();
   bim_frames_.clear();
-  picked_blobs_.clear();
   plans_.clear();
   hole_chain_.clear();
   returning_ = false;
@@ -692,20 +687,6 @@ Outcome DrillNode::resolution(std::size_t area, ResolvedArea& out) {
     out = locate_area(spec, camera);
   } catch (const DrillError& e) {
     return Outcome::failed(e.what());
-  }
-  picked_blobs_.erase(area);
-  if (spec.marks == MarkKind::kBlobs) {
-    // The blobs around the pick as seen from here: after the approach the picked one is found
-    // among them by the set's shift (blob_shift), not by odometry alone.
-    try {
-      static const PatternTable kNone;
-      picked_blobs_[area] = find_holes(spec, out, camera, kNone,
-                                       area_radius(params_.camera_distance, params_.camera_fov));
-      log_line("drill: area '" + spec.name + "': " + std::to_string(picked_blobs_[area].size()) +
-               " blob(s) seen around the pick from here");
-    } catch (const DrillError&) {
-      // None seen from afar: the approach's view alone decides.
-    }
   }
   return Outcome::succeeded();
 }
@@ -957,25 +938,6 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
     // The area's surface as the drill camera sees it now, 0.6 m in front of it (a BIM wall or
     // a point located from afar may be a few centimetres off).
     ResolvedArea located = detection_.located;
-    if (const auto picked = picked_blobs_.find(detection_.area); picked != picked_blobs_.end()) {
-      // The blobs seen at the pick, found again as a set: the pick follows them (odometry drifts
-      // over the approach; the nearest blob to the drifted pick can be the neighbour).
-      const std::optional<Eigen::Vector3d> shift =
-          blob_shift(camera, picked->second, kBlobMatch, kPickDrift);
-      std::ostringstream line;
-      line.setf(std::ios::fixed);
-      line.precision(1);
-      line << "drill: area '" << detection_.spec.name << "': ";
-      if (shift) {
-        located.frame.translation() += *shift;
-        line << "the blobs seen at the pick appear " << shift->norm() * 1e3
-             << " mm from where odometry puts them: the pick follows them";
-      } else {
-        line << "the blobs seen at the pick are not found again as a set: the pick stays where "
-                "odometry puts it";
-      }
-      log_line(line.str());
-    }
     if (!detection_.spec.pixel && in_view(camera, located.frame.translation())) {
       AreaSpec here = detection_.spec;
       here.point = located.frame.translation();

@@ -215,9 +215,6 @@ class DrillNode final : public MissionPorts {
   std::map<std::size_t, std::int64_t> resolve_since_;
   std::map<std::size_t, AreaSpec> resolve_specs_;
   std::map<std::size_t, Eigen::Isometry3d> bim_frames_;  // BIM wall areas' frames in the map
-  // Blob areas located from a picked point or pixel: the blobs the camera saw around the pick
-  // then (odometry frame), to find the picked one again after the approach's drift.
-  std::map<std::size_t, std::vector<DrillPoint>> picked_blobs_;
   std::uint32_t nav_request_{0};
   std::map<std::size_t, Plan> plans_;
   std::optional<std::size_t> executing_area_;
