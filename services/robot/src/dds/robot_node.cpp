@@ -56,6 +56,25 @@ std::string tool_end_effector(const msg::RobotModel& m) {
   }
 }
 
+namespace {
+/// The tool end-effector and the limits table of a model message, from one parse: "" and an
+/// empty table where the description does not parse (the core's own end-effector, the drives'
+/// rated peaks), "" alone where it has no arm tool.
+std::pair<std::string, model::LimitsTable> tool_and_limits(const msg::RobotModel& m) {
+  std::shared_ptr<const model::RobotModel> built;
+  try {
+    built = model::RobotModel::build(model::dds::to_description(m));
+  } catch (const std::exception&) {
+    return {};
+  }
+  try {
+    return {built->tool().frame, built->limits()};
+  } catch (const std::exception&) {
+    return {"", built->limits()};
+  }
+}
+}  // namespace
+
 void RobotNode::on_safety(const msg::SafetyState& s) {
   const bool stopped = s.mode() == msg::SAFETY_STOPPED;
   std::string causes;
@@ -141,14 +160,9 @@ void RobotNode::on_model(const msg::RobotModel& m) {
   if (core_.ready() && core_.model_version() == m.version() &&
       status_.model().hash == m.content_hash())
     return;
-  // The limits table gives the drives their continuous torques (their torque foldback); a
-  // message whose description does not parse still runs, on the rated peaks alone.
-  model::LimitsTable limits;
-  try {
-    limits = model::RobotModel::build(model::dds::to_description(m))->limits();
-  } catch (const std::exception&) {
-  }
-  apply_model(m.urdf(), m.version(), tool_end_effector(m), m.content_hash(), limits);
+  // The limits table gives the legs' drives their continuous torques (their torque foldback).
+  const auto [tool, limits] = tool_and_limits(m);
+  apply_model(m.urdf(), m.version(), tool, m.content_hash(), limits);
 }
 
 void RobotNode::apply_model(const std::string& urdf, std::uint64_t version,
