@@ -13,6 +13,7 @@
 #include "concert/sim/scene_camera.hpp"
 #include "concert/world/geometry.hpp"
 #include "drill/mission.hpp"
+#include "drill/patterns.hpp"
 
 namespace concert::drill {
 namespace {
@@ -176,6 +177,45 @@ TEST(BlobShift, OneBlobWithinTheWindowOfTwoPredictionsIsAmbiguous) {
   const std::optional<Eigen::Vector3d> set = blob_shift(both.view(), area, 0.02, 0.06);
   ASSERT_TRUE(set);
   EXPECT_NEAR(set->y(), 0.045, 0.005);
+}
+
+// A pattern hole (pattern 0: a 60 cm row 15 cm below the marker) moved by its marker seen
+// again: by the marker centre's shift only; the orientation the marker was seen with (a few
+// degrees off from aside) is not applied, which would move the row's end by the turn times
+// 0.34 m.
+TEST(HoleOfSeenMarker, TheMarkersShiftMovesTheHoleItsTurnDoesNot) {
+  const PatternTable patterns = parse_patterns(
+      "dictionary: DICT_4X4_50\nmarker_size: 0.1\npatterns:\n"
+      "  0: {centre: [0.0, -0.15], direction: 0.0, count: 4, spacing: 0.2}\n",
+      "test");
+  // The marker on a wall facing -x (z out of it, x to the robot's right, y up) at (2, 0, 1.65).
+  Eigen::Isometry3d marker = Eigen::Isometry3d::Identity();
+  marker.linear().col(0) = Eigen::Vector3d(0, -1, 0);
+  marker.linear().col(1) = Eigen::Vector3d(0, 0, 1);
+  marker.linear().col(2) = Eigen::Vector3d(-1, 0, 0);
+  marker.translation() = Eigen::Vector3d(2.0, 0.0, 1.65);
+  DrillPoint end;  // the row's first hole: 0.3 m left of the marker, 0.15 m below
+  end.marker = 0;
+  end.pattern_index = 0;
+  end.frame = *hole_of(end, marker, patterns);
+  EXPECT_LT((end.frame.translation() - Eigen::Vector3d(2.0, 0.3, 1.5)).norm(), 1e-9);
+  ASSERT_TRUE(marker_of(end, patterns));
+  EXPECT_LT((marker_of(end, patterns)->translation() - marker.translation()).norm(), 1e-9);
+  // Seen again 2 cm to the right and 1 cm up, turned 3 deg about its normal.
+  Eigen::Isometry3d seen = marker;
+  seen.translation() += Eigen::Vector3d(0.0, -0.02, 0.01);
+  seen.linear() = seen.linear() * Eigen::AngleAxisd(3.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ());
+  const std::optional<Eigen::Isometry3d> moved = hole_of_seen_marker(end, seen, patterns);
+  ASSERT_TRUE(moved);
+  EXPECT_LT((moved->translation() - Eigen::Vector3d(2.0, 0.28, 1.51)).norm(), 1e-9);
+  EXPECT_TRUE(moved->linear().isApprox(end.frame.linear(), 1e-12));
+  // The seen orientation applied would have put it 17.6 mm further.
+  EXPECT_NEAR((hole_of(end, seen, patterns)->translation() - moved->translation()).norm(),
+              2.0 * std::sin(1.5 * M_PI / 180.0) * std::hypot(0.3, 0.15), 1e-9);
+  // A blob hole has no marker.
+  DrillPoint blob;
+  blob.frame = end.frame;
+  EXPECT_FALSE(hole_of_seen_marker(blob, seen, patterns));
 }
 
 }  // namespace

@@ -53,7 +53,8 @@ std::vector<DrillPoint> find_holes(const AreaSpec& area, const ResolvedArea& loc
 /// A hole re-measured in a fresh view (the base moved since it was detected, and odometry
 /// drifts: 3.5 deg of yaw over the demo's approach): a blob hole at the blob nearest its
 /// predicted position (within `max_distance` [m]), the frame from the surface there; an ArUco
-/// hole from its marker when the marker is in view (the pattern applied again); else the
+/// hole from its marker when the marker is in view (moved by the marker's shift,
+/// hole_of_seen_marker); else the
 /// surface under the predicted position (its normal and distance corrected, the position in
 /// the wall's plane kept). None when the view shows neither the mark nor the wall there.
 std::optional<Eigen::Isometry3d> reanchor(const CameraView& view, const DrillPoint& hole,
@@ -68,6 +69,18 @@ std::optional<Eigen::Isometry3d> marker_of(const DrillPoint& hole, const Pattern
 std::optional<Eigen::Isometry3d> hole_of(const DrillPoint& hole,
                                          const Eigen::Isometry3d& world_T_marker,
                                          const PatternTable& patterns);
+
+/// An ArUco hole moved by its marker seen again (`seen`: where the marker stands now, world
+/// frame): by the shift of the marker's centre only, the pattern's orientation kept from the
+/// hole's frame. After a base move the marker is seen from aside, near the image's edge, and its
+/// orientation comes out a few degrees off, while the row's ends lie 0.34 m from it: applied with
+/// the seen orientation, holes on morphology A came out 7-14 mm off (a system test run); the
+/// centre, on the depth image's plane, is good to a millimetre, and the orientation measured
+/// first (straight on, 0.6 m away, frames averaged) moves with the odometry's yaw (the gyro's).
+/// None for a blob hole or a marker without a pattern.
+std::optional<Eigen::Isometry3d> hole_of_seen_marker(const DrillPoint& hole,
+                                                     const Eigen::Isometry3d& seen,
+                                                     const PatternTable& patterns);
 
 /// Where marker `id` stands in a view (world frame, depth-refined), if it is detected.
 std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,

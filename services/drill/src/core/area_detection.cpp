@@ -190,7 +190,7 @@ std::optional<Eigen::Isometry3d> reanchor(const CameraView& view, const DrillPoi
         return view.world_T_optical * area_frame(surface_at(frame, best->pixel), up);
     } else if (const std::optional<Eigen::Isometry3d> marker =
                    find_marker(view, hole.marker, patterns)) {
-      const std::optional<Eigen::Isometry3d> seen = hole_of(hole, *marker, patterns);
+      const std::optional<Eigen::Isometry3d> seen = hole_of_seen_marker(hole, *marker, patterns);
       if (seen && (seen->translation() - predicted).norm() <= max_distance) return seen;
     }
     if (!in_view(view, predicted)) return std::nullopt;
@@ -223,6 +223,15 @@ std::optional<Eigen::Isometry3d> marker_of(const DrillPoint& hole, const Pattern
       hole_of(hole, Eigen::Isometry3d::Identity(), patterns);
   if (!marker_T_hole) return std::nullopt;
   return hole.frame * marker_T_hole->inverse();
+}
+
+std::optional<Eigen::Isometry3d> hole_of_seen_marker(const DrillPoint& hole,
+                                                     const Eigen::Isometry3d& seen,
+                                                     const PatternTable& patterns) {
+  std::optional<Eigen::Isometry3d> marker = marker_of(hole, patterns);
+  if (!marker) return std::nullopt;
+  marker->translation() = seen.translation();
+  return hole_of(hole, *marker, patterns);
 }
 
 std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,
