@@ -8,8 +8,10 @@
 //   bim       scenario 2: the FZK house's ground floor (IFC), an area picked on a wall of the
 //             building's model, two blue blobs 0.1 m apart drawn there; the robot (morphology A)
 //             starts in another part of the room, navigates to the BIM base pose, then drills
+//   row       one row of scenario 3 (the marker at 1.65 m of deploy/bench/drill_patterns_site.yaml,
+//             morphology A): the patterns scenario in two minutes, to measure its spread
 //   demo      the demo wall's pattern (deploy/demo/drill_site.yaml)
-// Usage: bench_drill_mission [--scenario blobs|patterns|bim|demo|all] [--runs N] [--assembly FILE] [--logs]
+// Usage: bench_drill_mission [--scenario blobs|patterns|row|bim|demo|all] [--runs N] [--assembly FILE] [--logs]
 //        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
@@ -60,6 +62,9 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
        source("deploy/bench/drill_blobs_site.yaml"), source("deploy/bench/drill_blobs_mission.yaml")},
       {"patterns", source("services/planner/data/morphology_a.yaml"),
        source("deploy/bench/drill_patterns_site.yaml"), source("deploy/bench/drill_patterns_mission.yaml")},
+      {"row", source("services/planner/data/morphology_a.yaml"),
+       source("deploy/bench/drill_patterns_site.yaml"),
+       "name: bench row\ndepth: 0.03\nareas:\n  - {name: row_150, marks: aruco, point: [2.2, -0.3, 1.65]}\n"},
       {"bim", source("services/planner/data/morphology_a.yaml"), "", bim_mission("bench bim area"),
        fzk_living_room()},
       {"demo", source("deploy/demo/drill_robot.yaml"), source("deploy/demo/drill_site.yaml"), ""},
@@ -68,10 +73,10 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
       concert::drill::load_patterns(source("services/drill/config/patterns.yaml"));
   bool known = false;
   for (const Scenario& sc : all) {
-    if (which != "all" && which != sc.name) continue;
+    if (which == "all" ? sc.name == "row" : which != sc.name) continue;  // all: row is in patterns
     known = true;
     const std::string mission =
-        sc.building            ? sc.mission
+        sc.building || sc.mission.rfind("name:", 0) == 0 ? sc.mission  // the mission's text
         : sc.mission.empty() ? "name: bench demo pattern\ndepth: 0.03\nareas:\n"
                                "  - {name: pattern, marks: aruco, point: [2.2, -0.9, 1.45]}\n"
                              : read(sc.mission);
@@ -79,6 +84,9 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
     std::vector<Target> targets = targets_of(concert::world::load_world_file(site), patterns);
     if (sc.name == "demo") {  // the demo wall's blobs are another mission's
       std::erase_if(targets, [](const Target& t) { return t.name.rfind("blob", 0) == 0; });
+    }
+    if (sc.name == "row") {  // the wall's other rows are the patterns scenario's
+      std::erase_if(targets, [](const Target& t) { return t.name.rfind("row_150", 0) != 0; });
     }
     std::vector<double> errors;
     std::size_t drilled = 0, marked = 0;
@@ -132,7 +140,7 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
   }
   if (!known) {
     std::cerr << "bench_drill_mission: unknown scenario '" << which
-              << "' (blobs, patterns, bim, demo or all)\n";
+              << "' (blobs, patterns, row, bim, demo or all)\n";
     return 2;
   }
   return 0;
@@ -148,7 +156,7 @@ int main(int argc, char** argv) {
   std::string which = "all";
   int runs = 1;
   auto& app = cli.app();
-  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "bim", "demo", "all"},
+  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "row", "bim", "demo", "all"},
                                 "scenario to run")
       ->capture_default_str();
   std::string assembly;

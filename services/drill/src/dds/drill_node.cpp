@@ -91,8 +91,23 @@ constexpr int kReanchorFrames = 3;
 // the demo wall's pattern was drilled 20-37 mm off without this), for a blob hole when the view
 // from its drilling posture cannot tell its blob from a neighbour (blob_shift; before the drill
 // camera was pitched towards the bit it saw one blob or none from there). The camera is asked for at the distance the hole's posture reached
-// (the arm only shifts across the wall), then this much further out [m], in turn.
-constexpr double kLookFurther[] = {0.0, 0.1, 0.2};
+// (the arm only shifts across the wall), then this much further out [m], in turn. For an ArUco
+// hole, then, the camera centred between the hole and its marker (further out, so both are in
+// view: the marker 0.15 m above the row and up to 0.3 m beside it needs 0.4 m or more), a
+// posture nearer the hole's, for when none centred on the marker exists (on morphology A the
+// arm's links in each other, or its torques, kept the camera off the marker, and the hole
+// stayed where odometry put it: 33 mm off in a run).
+struct LookAttempt {
+  bool between;    // centred between the hole and its marker, not on the mark
+  double further;  // beyond the camera's distance at the hole's posture [m]
+};
+constexpr LookAttempt kLooks[] = {{false, 0.0}, {false, 0.1}, {false, 0.2}, {true, 0.2}, {true, 0.3}};
+// An ArUco hole whose marker was last seen longer ago than this [s] gets the look too, even
+// with the base standing: the odometry's yaw comes from the base's gyro, whose bias walks while
+// the arm works (the simulated BMI055); on morphology A it drifted 0.5 deg over the 100 s of a
+// pattern's four holes with the base standing (the simulator's truth: 0.1 deg), and the holes,
+// about 1 m from the base, came out 2-3 mm further off with each.
+constexpr double kMarkerStale = 15.0;
 constexpr double kReanchorDistance = 0.06;
 // Hole depth the drilling posture's reach is checked to when no mission is loaded [m].
 constexpr double kDefaultDepth = 0.05;
@@ -947,6 +962,9 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
                         area_radius(params_.camera_distance, params_.camera_fov));
     area_points_ = points;
     markers_seen_.clear();
+    markers_seen_at_.clear();
+    for (const DrillPoint& p : points)
+      if (p.marker >= 0) markers_seen_at_[p.marker] = now_;
     if (detection_.spec.marks == MarkKind::kBlobs && !points.empty()) {
       // Which blob is drilled first, and by what margin (odometry drifts over the approach: a
       // pick between two blobs can land nearer the other one).
@@ -1155,7 +1173,7 @@ void DrillNode::start_reanchor(Motion next) {
 }
 
 // The whole body moved to the hole's drilling posture: the arm alone turns the camera onto the
-// hole's mark (an ArUco hole's marker, a blob hole's blob as predicted; kLookFurther), where the
+// hole's mark (an ArUco hole's marker, a blob hole's blob as predicted; kLooks), where the
 // hole is measured again.
 void DrillNode::look_at_hole() {
   looked_ = true;
@@ -1249,10 +1267,13 @@ void DrillNode::request_look(std::size_t attempt) {
   r.request_id(look_request_);
   r.stamp_ns(now_ns());
   r.goals().clear();
-  r.goals().push_back(model::dds::to_pose_msg(look_goal_));
+  Eigen::Isometry3d goal = look_goal_;
+  if (kLooks[attempt].between)
+    goal.translation() = 0.5 * (look_goal_.translation() + point_.frame.translation());
+  r.goals().push_back(model::dds::to_pose_msg(goal));
   r.tip_distance(0.0);  // the camera looks at the mark
   r.tip_reach(0.0);
-  r.camera_distance(hole_reached_ + kLookFurther[attempt]);
+  r.camera_distance(hole_reached_ + kLooks[attempt].further);
   r.fixed_base(true);
   plan_requests_.write(r);
   look_path_ = {};
@@ -1306,7 +1327,7 @@ void DrillNode::remeasure_looked_marker(const CameraView& camera) {
     marker.reset();
   }
   std::optional<Eigen::Isometry3d> hole;
-  if (marker) hole = hole_of(point_, *marker, *patterns_);
+  if (marker) hole = hole_of_seen_marker(point_, *marker, *patterns_);
   if (hole) {
     std::ostringstream line;
     line.setf(std::ios::fixed);
@@ -1316,8 +1337,10 @@ void DrillNode::remeasure_looked_marker(const CameraView& camera) {
          << (hole->translation() - point_.frame.translation()).norm() * 1e3
          << " mm from where odometry put it";
     log_line(line.str());
-    markers_seen_[point_.marker] = *marker;
     point_.frame = *hole;
+    if (const std::optional<Eigen::Isometry3d> m = marker_of(point_, *patterns_))
+      markers_seen_[point_.marker] = *m;
+    markers_seen_at_[point_.marker] = now_;
   } else {
     log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
              " not seen from the look posture; the hole is drilled where odometry puts it");
@@ -1391,7 +1414,9 @@ void DrillNode::control_motion() {
         tracked_frames_ = 0;
         tracked_.setZero();
       }
-      if (point_.marker >= 0 && !hole_request_.fixed_base() && !looked_) {
+      const auto seen_at = markers_seen_at_.find(point_.marker);
+      const bool stale = seen_at == markers_seen_at_.end() || now_ - seen_at->second > kMarkerStale;
+      if (point_.marker >= 0 && !looked_ && (!hole_request_.fixed_base() || stale)) {
         look_at_hole();
       } else {
         // The base moved: measure the hole again in frames taken from here.
@@ -1414,7 +1439,8 @@ void DrillNode::control_motion() {
       if (look_pushed_) hole_chain_.push_back(look_path_);
       start_reanchor(Motion::kLookReanchor);
     } else if (r->state() == msg::PLAN_FAILED &&
-               look_attempt_ + 1 < std::size(kLookFurther)) {
+               look_attempt_ + 1 < std::size(kLooks) &&
+               (point_.marker >= 0 || !kLooks[look_attempt_ + 1].between)) {
       request_look(look_attempt_ + 1);
     } else if (r->state() == msg::PLAN_FAILED) {
       log_line("drill: " + point_.label + ": the camera cannot be turned onto " +
@@ -1483,6 +1509,9 @@ void DrillNode::control_motion() {
                   std::clamp(seen->linear().col(2).dot(point_.frame.linear().col(2)), -1.0, 1.0)) *
                   180.0 / M_PI
            << " deg from the prediction";
+      const Eigen::Vector3d along = point_.frame.inverse() * seen->translation();
+      line << " (" << along.x() * 1e3 << ", " << along.y() * 1e3 << " mm on the wall, "
+           << along.z() * 1e3 << " mm out of it)";
       if (point_.marker < 0) line << " (" << blobs_seen(camera, point_.frame) << ")";
       log_line(line.str());
       const Eigen::Vector3d moved = seen->translation() - point_.frame.translation();

@@ -254,11 +254,12 @@ class DrillNode final : public MissionPorts {
   int tracked_frames_{0};            // frames track_area() moved the area by, this hole
   Eigen::Vector3d tracked_{Eigen::Vector3d::Zero()};  // how far it moved the area, this hole [m]
   bool hole_replanned_{false};     // the hole's posture was planned again after its re-measure
-  std::size_t look_attempt_{0};    // which of kLookFurther the look request is
+  std::size_t look_attempt_{0};    // which of kLooks the look request is
   Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the mark as predicted (world)
   double hole_reached_{0.0};  // camera distance of the hole's posture reached [m]
   std::map<int, Eigen::Isometry3d>
       markers_seen_;                     // marker id -> where last seen (world), this area
+  std::map<int, double> markers_seen_at_;  // marker id -> when last seen (now_) [s], this area
   std::vector<PlannedPath> hole_chain_;  // the area's hole postures as reached, first to last
   bool returning_{false};                // execute(): the way back runs before the approach
   std::optional<Outcome> motion_outcome_;
