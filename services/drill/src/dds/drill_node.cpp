@@ -1268,12 +1268,30 @@ void DrillNode::request_look(std::size_t attempt) {
   r.stamp_ns(now_ns());
   r.goals().clear();
   Eigen::Isometry3d goal = look_goal_;
-  if (kLooks[attempt].between)
+  double distance = hole_reached_ + kLooks[attempt].further;
+  if (kLooks[attempt].between) {
     goal.translation() = 0.5 * (look_goal_.translation() + point_.frame.translation());
+    // The planner leaves the camera's roll about its axis free: the marker (its centre half
+    // the hole's distance from the goal, plus its half-diagonal) must fit in the image's
+    // smaller half-angle whichever way the image turns. Nearer, the marker was "not seen"
+    // from every such look of two rows of scenario 3.
+    double half_angle = 0.5 * params_.camera_fov;
+    {
+      std::lock_guard lock(mutex_);
+      if (!frames_.empty()) {
+        const hardware::CameraIntrinsics& k = frames_.back().frame.intrinsics;
+        if (k.fx > 0.0 && k.fy > 0.0)
+          half_angle = std::min(std::atan(0.5 * k.width / k.fx), std::atan(0.5 * k.height / k.fy));
+      }
+    }
+    const double reach = (goal.translation() - look_goal_.translation()).norm() +
+                         (patterns_ ? std::sqrt(0.5) * patterns_->marker_size() : 0.0);
+    distance = std::max(distance, reach / std::tan(0.9 * half_angle));
+  }
   r.goals().push_back(model::dds::to_pose_msg(goal));
   r.tip_distance(0.0);  // the camera looks at the mark
   r.tip_reach(0.0);
-  r.camera_distance(hole_reached_ + kLooks[attempt].further);
+  r.camera_distance(distance);
   r.fixed_base(true);
   plan_requests_.write(r);
   look_path_ = {};
