@@ -179,6 +179,26 @@ TEST(BlobShift, OneBlobWithinTheWindowOfTwoPredictionsIsAmbiguous) {
   EXPECT_NEAR(set->y(), 0.045, 0.005);
 }
 
+// The D435i's colour image (69.4 x 42.5 deg; 640 x 480 at fx = fy = 615 px here: 42.6 deg
+// high): a look must stand about 0.6 m out for a marker 0.17 m from where it looks, plus its
+// half-diagonal, to stay in the image however the camera rolls.
+TEST(AnyRollDistance, TheMarkerStaysInTheImagesSmallerHalfAngle) {
+  hardware::CameraIntrinsics k;
+  k.width = 640;
+  k.height = 480;
+  k.fx = k.fy = 615.0;
+  k.cx = 320.0;
+  k.cy = 240.0;
+  EXPECT_NEAR(smaller_fov(k) * 180.0 / M_PI, 42.64, 0.01);
+  const double reach = 0.5 * std::hypot(0.3, 0.15) + std::sqrt(0.5) * 0.1;
+  const double d = any_roll_distance(reach, smaller_fov(k));
+  EXPECT_GT(d, 0.6);
+  EXPECT_LT(d, 0.7);
+  // At that distance the point lies at 90 % of the half-angle, whichever way the image turns.
+  EXPECT_NEAR(std::atan(reach / d), 0.9 * 0.5 * smaller_fov(k), 1e-12);
+  EXPECT_GT(area_radius(d, smaller_fov(k)), reach);
+}
+
 // A pattern hole (pattern 0: a 60 cm row 15 cm below the marker) moved by its marker seen
 // again: by the marker centre's shift only; the orientation the marker was seen with (a few
 // degrees off from aside) is not applied, which would move the row's end by the turn times

@@ -28,6 +28,15 @@ struct CameraView {
 /// `distance` [m] from the wall: rho = d tan(fov / 2) (0.6 m, 55 deg: 0.31 m).
 double area_radius(double distance, double fov);
 
+/// The smaller field of view of a pinhole image [rad] (its height's for a landscape one).
+double smaller_fov(const hardware::CameraIntrinsics& k);
+
+/// How far out [m] a camera with smaller field of view `fov` [rad] must stand for every point
+/// within `radius` [m] of where it looks to be in its image however it rolls about its axis
+/// (area_radius's inverse, with 10 % of the half-angle kept as margin): the planner leaves a
+/// looking camera's roll free.
+double any_roll_distance(double radius, double fov);
+
 /// Whether a world point projects into the view's image (in front of the camera).
 bool in_view(const CameraView& view, const Eigen::Vector3d& point);
 

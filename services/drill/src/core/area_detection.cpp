@@ -38,6 +38,12 @@ double in_area(const ResolvedArea& area, const Eigen::Vector3d& p) {
 
 double area_radius(double distance, double fov) { return distance * std::tan(0.5 * fov); }
 
+double smaller_fov(const hardware::CameraIntrinsics& k) {
+  return 2.0 * std::min(std::atan(0.5 * k.width / k.fx), std::atan(0.5 * k.height / k.fy));
+}
+
+double any_roll_distance(double radius, double fov) { return radius / std::tan(0.45 * fov); }
+
 bool in_view(const CameraView& view, const Eigen::Vector3d& point) {
   const Eigen::Vector3d p = view.world_T_optical.inverse() * point;
   if (p.z() <= 0.0) return false;

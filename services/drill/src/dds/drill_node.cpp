@@ -1275,18 +1275,16 @@ void DrillNode::request_look(std::size_t attempt) {
     // the hole's distance from the goal, plus its half-diagonal) must fit in the image's
     // smaller half-angle whichever way the image turns. Nearer, the marker was "not seen"
     // from every such look of two rows of scenario 3.
-    double half_angle = 0.5 * params_.camera_fov;
+    double fov = params_.camera_fov;
     {
       std::lock_guard lock(mutex_);
-      if (!frames_.empty()) {
-        const hardware::CameraIntrinsics& k = frames_.back().frame.intrinsics;
-        if (k.fx > 0.0 && k.fy > 0.0)
-          half_angle = std::min(std::atan(0.5 * k.width / k.fx), std::atan(0.5 * k.height / k.fy));
-      }
+      if (!frames_.empty() && frames_.back().frame.intrinsics.fx > 0.0 &&
+          frames_.back().frame.intrinsics.fy > 0.0)
+        fov = smaller_fov(frames_.back().frame.intrinsics);
     }
     const double reach = (goal.translation() - look_goal_.translation()).norm() +
                          (patterns_ ? std::sqrt(0.5) * patterns_->marker_size() : 0.0);
-    distance = std::max(distance, reach / std::tan(0.9 * half_angle));
+    distance = std::max(distance, any_roll_distance(reach, fov));
   }
   r.goals().push_back(model::dds::to_pose_msg(goal));
   r.tip_distance(0.0);  // the camera looks at the mark
