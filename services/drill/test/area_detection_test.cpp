@@ -142,10 +142,11 @@ TEST(BlobShift, BlobsMatchedAsASetFindTheTargetsOwnBlobWhereTheNearestIsTheNeigh
   const TwoBlobs s(false);
   // Predicted 6 cm towards blob 2: blob 2's centre is 4 cm from blob 1's prediction, blob 1's 6.
   const std::vector<DrillPoint> area = predicted_blobs({0.0, -0.06, 0.0});
-  const std::optional<Eigen::Vector3d> shift = blob_shift(s.view(), area, 0.02, 0.07);
+  const std::optional<AreaShift> shift = blob_shift(s.view(), area, 0.02, 0.07);
   ASSERT_TRUE(shift);
-  EXPECT_LT((area[0].frame.translation() + *shift - Eigen::Vector3d(2.0, 0.05, 1.2)).norm(), 0.005)
-      << shift->transpose();
+  EXPECT_EQ(shift->blobs, 2);
+  EXPECT_LT((area[0].frame.translation() + shift->by - Eigen::Vector3d(2.0, 0.05, 1.2)).norm(), 0.005)
+      << shift->by.transpose();
 }
 
 TEST(BlobShift, TheNeighbourSeenAlonePlacesTheTargetBesideIt) {
@@ -153,10 +154,11 @@ TEST(BlobShift, TheNeighbourSeenAlonePlacesTheTargetBesideIt) {
   const std::vector<DrillPoint> area = predicted_blobs({0.0, 0.01, 0.0});
   // Blob 1 is not in the image; blob 2, 0.1 m from blob 1's prediction, can only be blob 2
   // within 6 cm: the shift (1 cm) puts blob 1 where it truly is, not on blob 2.
-  const std::optional<Eigen::Vector3d> shift = blob_shift(s.view(), area, 0.02, 0.06);
+  const std::optional<AreaShift> shift = blob_shift(s.view(), area, 0.02, 0.06);
   ASSERT_TRUE(shift);
-  EXPECT_NEAR(shift->y(), -0.01, 0.005);
-  EXPECT_LT((area[0].frame.translation() + *shift - Eigen::Vector3d(2.0, 0.05, 1.2)).norm(), 0.005);
+  EXPECT_EQ(shift->blobs, 1);
+  EXPECT_NEAR(shift->by.y(), -0.01, 0.005);
+  EXPECT_LT((area[0].frame.translation() + shift->by - Eigen::Vector3d(2.0, 0.05, 1.2)).norm(), 0.005);
   // Nothing seen within the window: no shift.
   EXPECT_FALSE(blob_shift(s.view(), predicted_blobs({0.0, 0.08, 0.0}), 0.02, 0.06));
 }
@@ -169,14 +171,38 @@ TEST(BlobShift, OneBlobWithinTheWindowOfTwoPredictionsIsAmbiguous) {
   const std::vector<DrillPoint> area = predicted_blobs({0.0, -0.045, 0.0});
   EXPECT_FALSE(blob_shift(s.view(), area, 0.02, 0.06));
   // A 5 cm window (the most the odometry is trusted to have drifted) leaves one explanation.
-  const std::optional<Eigen::Vector3d> shift = blob_shift(s.view(), area, 0.02, 0.05);
+  const std::optional<AreaShift> shift = blob_shift(s.view(), area, 0.02, 0.05);
   ASSERT_TRUE(shift);
-  EXPECT_NEAR(shift->y(), 0.045, 0.005);
+  EXPECT_NEAR(shift->by.y(), 0.045, 0.005);
   // Both blobs in view tell it apart within the 6 cm window.
   const TwoBlobs both(false);
-  const std::optional<Eigen::Vector3d> set = blob_shift(both.view(), area, 0.02, 0.06);
+  const std::optional<AreaShift> set = blob_shift(both.view(), area, 0.02, 0.06);
   ASSERT_TRUE(set);
-  EXPECT_NEAR(set->y(), 0.045, 0.005);
+  EXPECT_NEAR(set->by.y(), 0.045, 0.005);
+}
+
+TEST(BlobShift, TheSetNamesItsBlobsBeyondTheWindowOneBlobAloneDoesNot) {
+  // Predicted 0.1 m towards blob 2 (a whole-body move on the demo drifted odometry 87 mm): blob
+  // 1's prediction lies on blob 2. Within a 6 cm window that is all there is to see: blob 2
+  // taken for blob 1, 0 mm from its prediction.
+  const std::vector<DrillPoint> area = predicted_blobs({0.0, -0.1, 0.0});
+  const TwoBlobs both(false);
+  const std::optional<AreaShift> window = blob_shift(both.view(), area, 0.02, 0.06);
+  ASSERT_TRUE(window);
+  EXPECT_LT(window->by.norm(), 0.005);
+  EXPECT_EQ(window->blobs, 1);
+  // Both blobs laid onto the two seen, 0.1 m further: the set names them.
+  const std::optional<AreaShift> set = blob_shift(both.view(), area, 0.02, 0.06, 0.15);
+  ASSERT_TRUE(set);
+  EXPECT_EQ(set->blobs, 2);
+  EXPECT_LT((area[0].frame.translation() + set->by - Eigen::Vector3d(2.0, 0.05, 1.2)).norm(), 0.005)
+      << set->by.transpose();
+  // Blob 2 seen alone is no set: the window's answer stands (the drill then looks for more).
+  const TwoBlobs alone(true);
+  const std::optional<AreaShift> one = blob_shift(alone.view(), area, 0.02, 0.06, 0.15);
+  ASSERT_TRUE(one);
+  EXPECT_EQ(one->blobs, 1);
+  EXPECT_LT(one->by.norm(), 0.005);
 }
 
 // The D435i's colour image (69.4 x 42.5 deg; 640 x 480 at fx = fy = 615 px here: 42.6 deg

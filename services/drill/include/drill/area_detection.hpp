@@ -95,6 +95,12 @@ std::optional<Eigen::Isometry3d> hole_of_seen_marker(const DrillPoint& hole,
 std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,
                                              const PatternTable& patterns);
 
+/// How an area's blobs appear in a view against where they were predicted (blob_shift).
+struct AreaShift {
+  Eigen::Vector3d by{Eigen::Vector3d::Zero()};  ///< world frame [m]
+  int blobs{0};  ///< predicted blobs it lays onto seen ones (2 or more: the set confirms it)
+};
+
 /// How far the blobs of an area appear from where they were predicted (world frame, [m]): the
 /// shift that lays the most predicted blob positions of `area_points` onto blobs seen in the
 /// view (within `tolerance`), among the shifts no longer than `max_shift` (the most odometry
@@ -104,9 +110,13 @@ std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,
 /// blob is in view within `max_shift`, or when two different shifts explain the view equally
 /// well (one blob seen alone, within `max_shift` of two predicted ones): a neighbour is not
 /// taken for the target.
-std::optional<Eigen::Vector3d> blob_shift(const CameraView& view,
-                                          const std::vector<DrillPoint>& area_points,
-                                          double tolerance, double max_shift);
+///
+/// A shift that lays two or more blobs onto seen ones may be as long as `max_set_shift` (when
+/// longer than `max_shift`): the set's own geometry names each blob, where one blob seen alone
+/// 0.1 m from a prediction off by 0.1 m is the neighbour as well as anything (on the demo a
+/// whole-body move drifted odometry 87 mm, and blob 1's hole was cut on blob 2).
+std::optional<AreaShift> blob_shift(const CameraView& view, const std::vector<DrillPoint>& area_points,
+                                    double tolerance, double max_shift, double max_set_shift = 0.0);
 
 /// The blob nearest to `hole` in a view (world frame, within `max_distance` [m]), as a hole
 /// frame with the observed position and normal; none if no blob is that close.

@@ -251,25 +251,21 @@ std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,
   return std::nullopt;
 }
 
-std::optional<Eigen::Vector3d> blob_shift(const CameraView& view,
-                                          const std::vector<DrillPoint>& area_points,
-                                          double tolerance, double max_shift) {
+std::optional<AreaShift> blob_shift(const CameraView& view, const std::vector<DrillPoint>& area_points,
+                                    double tolerance, double max_shift, double max_set_shift) {
   std::vector<Eigen::Vector3d> seen;
   for (const Blob& b : detect_blobs(*view.frame)) seen.push_back(view.world_T_optical * b.position);
   // Every seen blob taken for every predicted one is a candidate shift; it scores the predicted
   // blobs it lays onto seen ones.
-  struct Candidate {
-    Eigen::Vector3d shift;
-    int score{0};
-  };
-  std::vector<Candidate> candidates;
+  std::vector<AreaShift> candidates;
+  const double longest = std::max(max_shift, max_set_shift);
   for (const Eigen::Vector3d& s : seen) {
     for (const DrillPoint& p : area_points) {
       if (p.marker >= 0) continue;
       const Eigen::Vector3d shift = s - p.frame.translation();
       // Unbounded, the neighbour 0.1 m away seen alone scored like the target's own blob and
       // the hole was drilled there (a CI run: 100.5 mm off).
-      if (shift.norm() > max_shift) continue;
+      if (shift.norm() > longest) continue;
       int score = 0;
       for (const DrillPoint& o : area_points) {
         if (o.marker >= 0) continue;
@@ -278,23 +274,37 @@ std::optional<Eigen::Vector3d> blob_shift(const CameraView& view,
                         [&](const Eigen::Vector3d& v) { return (v - moved).norm() <= tolerance; }))
           ++score;
       }
-      candidates.push_back({shift, score});
+      // Beyond max_shift only a set of blobs is taken for the area.
+      if (shift.norm() <= max_shift || score >= 2) candidates.push_back({shift, score});
     }
   }
-  const Candidate* best = nullptr;
-  for (const Candidate& c : candidates) {
-    if (best == nullptr || c.score > best->score ||
-        (c.score == best->score && c.shift.norm() < best->shift.norm()))
-      best = &c;
+  // The best explanation within max_shift, unless a longer shift lays more blobs onto seen ones
+  // (the set beyond the window); ties go to the smallest shift.
+  const auto best_of = [&](bool within) {
+    const AreaShift* best = nullptr;
+    for (const AreaShift& c : candidates) {
+      if (within && c.by.norm() > max_shift) continue;
+      if (best == nullptr || c.blobs > best->blobs ||
+          (c.blobs == best->blobs && c.by.norm() < best->by.norm()))
+        best = &c;
+    }
+    return best;
+  };
+  const AreaShift* best = best_of(true);
+  bool within = true;
+  if (const AreaShift* any = best_of(false); any != nullptr && (best == nullptr || any->blobs > best->blobs)) {
+    best = any;
+    within = false;
   }
   if (best == nullptr) return std::nullopt;
   // Another explanation as good as the best one: one blob seen alone within the window of two
   // predicted ones (on morphology A a re-measure 55.6 mm off took blob 2 for blob 1 this way,
   // and blob 1's hole was cut on blob 2).
-  for (const Candidate& c : candidates) {
-    if (c.score == best->score && (c.shift - best->shift).norm() > tolerance) return std::nullopt;
+  for (const AreaShift& c : candidates) {
+    if (within && c.by.norm() > max_shift) continue;
+    if (c.blobs == best->blobs && (c.by - best->by).norm() > tolerance) return std::nullopt;
   }
-  return best->shift;
+  return *best;
 }
 
 std::optional<Eigen::Isometry3d> track_blob(const CameraView& view, const Eigen::Isometry3d& hole,

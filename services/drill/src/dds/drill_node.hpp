@@ -147,6 +147,10 @@ class DrillNode final : public MissionPorts {
   /// Plans the hole's drilling posture again at point_, the arm alone: the bit's tip on the
   /// hole's axis, `further` [m] beyond the hole's distance, its reach checked if `reach`.
   void replan_hole(bool reach, double further);
+  /// Plans the hole's whole-body posture again at point_ (the hole measured again), with the
+  /// request that reached the first one: when no arm-alone posture reaches it from there.
+  void replan_body();
+  [[nodiscard]] double camera_fov() const;
   /// A hole measured again with the camera turned onto its blob / marker (kLookReanchor).
   bool remeasure_looked_blob(const CameraView& camera);
   void remeasure_looked_marker(const CameraView& camera);
@@ -254,8 +258,14 @@ class DrillNode final : public MissionPorts {
   int tracked_frames_{0};            // frames track_area() moved the area by, this hole
   Eigen::Vector3d tracked_{Eigen::Vector3d::Zero()};  // how far it moved the area, this hole [m]
   bool hole_replanned_{false};     // the hole's posture was planned again after its re-measure
+  // The whole body's posture the hole was reached with: which of kHoleAttempts, the hole it was
+  // planned for (world), and whether it was planned once more at the hole measured again.
+  std::size_t body_attempt_{0};
+  Eigen::Vector3d body_goal_{Eigen::Vector3d::Zero()};
+  bool body_replanned_{false};
   std::size_t look_attempt_{0};    // which of kLooks the look request is
   Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the mark as predicted (world)
+  double look_reach_{0.0};  // how far from look_goal_ the look must see, any roll [m]; 0: the mark
   double hole_reached_{0.0};  // camera distance of the hole's posture reached [m]
   std::map<int, Eigen::Isometry3d>
       markers_seen_;                     // marker id -> where last seen (world), this area
