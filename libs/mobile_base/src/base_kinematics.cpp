@@ -92,6 +92,7 @@ std::vector<Leg> detect_legs(const kinematics::Model& model, const std::map<std:
     leg.steering_sign = steer_axis.z() > 0.0 ? 1.0 : -1.0;
     const Eigen::Vector3d rolling = wheel_axis.cross(Eigen::Vector3d::UnitZ());
     leg.heading_offset = std::atan2(rolling.y(), rolling.x());
+    leg.axle_offset = (wheel_frame.translation().head<2>() - leg.position).dot(wheel_axis.head<2>().normalized());
     const auto& limits = model.joint_limits()[static_cast<std::size_t>(s)];
     if (limits.has_position_limits) {
       leg.steering_lower = limits.lower;
@@ -107,13 +108,11 @@ BaseKinematics::BaseKinematics(std::vector<Leg> legs) : legs_(std::move(legs)) {
     throw std::invalid_argument("a steerable base needs at least 2 steering+wheel legs, found " +
                                 std::to_string(legs_.size()));
   }
-  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-  for (const auto& leg : legs_) {
-    Eigen::Matrix<double, 2, 3> a;
-    a << 1.0, 0.0, -leg.position.y(), 0.0, 1.0, leg.position.x();
-    ata += a.transpose() * a;
-  }
-  normal_inverse_ = ata.inverse();
+}
+
+double BaseKinematics::steering_rolling(std::size_t i, double steering_rate) const {
+  const Leg& leg = legs_.at(i);
+  return -leg.axle_offset * leg.steering_sign * steering_rate / leg.wheel_radius;
 }
 
 std::vector<LegSetpoint> BaseKinematics::leg_setpoints(const Eigen::Vector3d& twist,
@@ -150,8 +149,10 @@ void BaseKinematics::leg_setpoints(const Eigen::Vector3d& twist, const std::vect
     const double current = current_steering[i];
     const Eigen::Vector2d v = contact_velocity(leg);
     const double speed = v.norm();
+    // The base's turn rolls a wheel beside its steering axis by itself (Leg::axle_offset).
+    const double turning = -leg.axle_offset * twist.z() / leg.wheel_radius;
     if (speed < 1e-6) {
-      out[i] = {current, 0.0};
+      out[i] = {current, turning};
       continue;
     }
     const double heading = std::atan2(v.y(), v.x());
@@ -174,25 +175,39 @@ void BaseKinematics::leg_setpoints(const Eigen::Vector3d& twist, const std::vect
       angle = flipped;
       direction = -direction;
     }
-    out[i] = {angle, direction * speed / leg.wheel_radius};
+    out[i] = {angle, direction * speed / leg.wheel_radius + turning};
   }
 }
 
 Eigen::Vector3d BaseKinematics::twist_from_legs(const std::vector<double>& steering,
-                                                const std::vector<double>& wheel_velocity) const {
-  if (steering.size() != legs_.size() || wheel_velocity.size() != legs_.size()) {
+                                                const std::vector<double>& wheel_velocity,
+                                                const std::vector<double>& steering_rate) const {
+  if (steering.size() != legs_.size() || wheel_velocity.size() != legs_.size() ||
+      (!steering_rate.empty() && steering_rate.size() != legs_.size())) {
     throw std::invalid_argument("twist_from_legs: expected " + std::to_string(legs_.size()) + " legs");
   }
-  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  // Per leg, its wheel centre's velocity (v + wz x centre, plus the steering's own turn) along
+  // its heading is what the wheel rolls, across it nothing (no side slip); the least-squares
+  // twist of all legs. With the wheel beside its axis the heading row gains -axle_offset in wz:
+  // the normal matrix depends on the steering angles, so it is built per call (3 x 3).
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < legs_.size(); ++i) {
     const Leg& leg = legs_[i];
     const double heading = leg.heading_offset + leg.steering_sign * steering[i];
-    const Eigen::Vector2d v = wheel_velocity[i] * leg.wheel_radius * Eigen::Vector2d(std::cos(heading), std::sin(heading));
-    Eigen::Matrix<double, 2, 3> a;
-    a << 1.0, 0.0, -leg.position.y(), 0.0, 1.0, leg.position.x();
-    atb += a.transpose() * v;
+    const Eigen::Vector2d h(std::cos(heading), std::sin(heading));
+    const Eigen::Vector2d axle(-h.y(), h.x());
+    const auto row = [&](const Eigen::Vector2d& d, double turn) {
+      return Eigen::Vector3d(d.x(), d.y(), -d.x() * leg.position.y() + d.y() * leg.position.x() + turn);
+    };
+    const Eigen::Vector3d along = row(h, -leg.axle_offset);
+    const Eigen::Vector3d across = row(axle, 0.0);
+    const double rate = steering_rate.empty() ? 0.0 : steering_rate[i];
+    const double rolled = wheel_velocity[i] * leg.wheel_radius + leg.axle_offset * leg.steering_sign * rate;
+    normal += along * along.transpose() + across * across.transpose();
+    rhs += along * rolled;
   }
-  return normal_inverse_ * atb;
+  return normal.ldlt().solve(rhs);
 }
 
 void BaseKinematics::integrate(Odometry& odometry, const std::vector<double>& steering,

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <tuple>
 
 
 namespace concert::mobile_base {
@@ -137,6 +138,68 @@ TEST(BaseKinematics, OdometryRecoversTheCommandedTwist) {
   EXPECT_NEAR(odom.x, 1.0, 2e-3);
   EXPECT_NEAR(odom.y, 1.0, 2e-3);
   EXPECT_NEAR(odom.yaw, M_PI / 2, 2e-3);
+}
+
+
+// CONCERT's leg module carries its wheel 0.1 m beside the steering axis, along the wheel's axis
+// (the demo robot's legs: +-0.1 m). Judged against the geometry itself: each wheel centre's
+// velocity differentiated numerically from its pose (base pose, steering axis, offset along the
+// steered axle), not from the formulas under test.
+TEST(BaseKinematics, WheelsBesideTheirSteeringAxesRollAsTheBaseTurnsAndTheLegsSteer) {
+  std::vector<Leg> legs;
+  for (const auto& [x, y, e] : {std::tuple{0.45, 0.3, -0.1}, std::tuple{0.45, -0.3, 0.1},
+                                std::tuple{-0.45, 0.3, 0.1}, std::tuple{-0.45, -0.3, -0.1}}) {
+    Leg leg;
+    leg.position = {x, y};
+    leg.axle_offset = e;
+    leg.wheel_radius = 0.2;
+    leg.steering_sign = -1.0;  // the module's steering axis points down
+    legs.push_back(leg);
+  }
+  const BaseKinematics base(legs);
+  // Wheel centre of leg `l` in the world: base pose (x, y, yaw), the leg steered to `steering`.
+  const auto centre = [](const Leg& l, const Eigen::Vector3d& pose, double steering) {
+    const double heading = l.heading_offset + l.steering_sign * steering;
+    const Eigen::Vector2d axle(-std::sin(heading), std::cos(heading));  // rolling = axle x z
+    const Eigen::Vector2d in_base = l.position + l.axle_offset * axle;
+    const Eigen::Rotation2Dd r(pose.z());
+    return Eigen::Vector2d(pose.head<2>() + r * in_base);
+  };
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 30; ++k) {
+    const Eigen::Vector3d twist(0.3 * u(rng), 0.3 * u(rng), 0.6 * u(rng));
+    const auto sp = base.leg_setpoints(twist, std::vector<double>(4, 0.5 * u(rng)));
+    std::vector<double> steering, rate, wheel;
+    for (std::size_t i = 0; i < legs.size(); ++i) {
+      steering.push_back(sp[i].steering_angle);
+      rate.push_back(2.0 * u(rng));  // the legs still swinging round
+      wheel.push_back(sp[i].wheel_velocity + base.steering_rolling(i, rate[i]));
+    }
+    // The geometry: the centres' velocities over 1 us, the base at the origin.
+    constexpr double dt = 1e-6;
+    const Eigen::Vector3d pose(0.0, 0.0, 0.0);
+    const Eigen::Vector3d next = pose + twist * dt;  // the base frame is the world's at t = 0
+    for (std::size_t i = 0; i < legs.size(); ++i) {
+      const Eigen::Vector2d v =
+          (centre(legs[i], next, steering[i] + rate[i] * dt) - centre(legs[i], pose, steering[i])) / dt;
+      const double heading = legs[i].heading_offset + legs[i].steering_sign * steering[i];
+      const Eigen::Vector2d h(std::cos(heading), std::sin(heading));
+      const Eigen::Vector2d axle(-h.y(), h.x());
+      // What the wheel rolls is its centre's speed along its heading; across it, nothing slides.
+      EXPECT_NEAR(wheel[i] * legs[i].wheel_radius, v.dot(h), 1e-5) << "leg " << i;
+      EXPECT_NEAR(v.dot(axle), 0.0, 1e-5) << "leg " << i;
+    }
+    // The odometry reads the twist back from those wheels and steering rates.
+    EXPECT_TRUE(base.twist_from_legs(steering, wheel, rate).isApprox(twist, 1e-9))
+        << base.twist_from_legs(steering, wheel, rate).transpose() << " for " << twist.transpose();
+    // Read as wheels on their axes (the old model), the same legs give another twist.
+    if (std::abs(twist.z()) > 0.1) {
+      std::vector<Leg> on_axis = legs;
+      for (Leg& l : on_axis) l.axle_offset = 0.0;
+      EXPECT_GT((BaseKinematics(on_axis).twist_from_legs(steering, wheel, rate) - twist).norm(), 1e-3);
+    }
+  }
 }
 
 }  // namespace

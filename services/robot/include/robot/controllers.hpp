@@ -163,7 +163,7 @@ class BaseController final : public Controller {
   double trajectory_steering_rate_;
   Eigen::Vector3d twist_{Eigen::Vector3d::Zero()};
   double command_time_{-1e9};
-  std::vector<double> steering_, wheel_velocity_;
+  std::vector<double> steering_, wheel_velocity_, steering_rate_;
   std::vector<LegSetpoint> setpoints_;
   double gyro_bias_{0.0};  // [rad/s], learnt while the whole robot stands still
   double bias_samples_{0.0};  // samples the bias was learnt from

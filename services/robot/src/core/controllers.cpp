@@ -201,6 +201,7 @@ BaseController::BaseController(std::vector<Leg> legs, double command_timeout, do
       trajectory_steering_rate_(trajectory_steering_rate),
       steering_(kinematics_.legs().size(), 0.0),
       wheel_velocity_(kinematics_.legs().size(), 0.0),
+      steering_rate_(kinematics_.legs().size(), 0.0),
       setpoints_(kinematics_.legs().size()) {}
 
 void BaseController::set(const BaseCommand& command, double time) {
@@ -213,8 +214,9 @@ void BaseController::estimate(CycleData& data) {
   for (std::size_t k = 0; k < legs.size(); ++k) {
     steering_[k] = data.q(legs[k].steering_index);
     wheel_velocity_[k] = data.qd(legs[k].wheel_index);
+    steering_rate_[k] = data.qd(legs[k].steering_index);
   }
-  const Eigen::Vector3d twist = kinematics_.twist_from_legs(steering_, wheel_velocity_);
+  const Eigen::Vector3d twist = kinematics_.twist_from_legs(steering_, wheel_velocity_, steering_rate_);
   double yaw_rate = twist.z();
   if (std::isfinite(data.base_yaw_rate)) {
     constexpr double kStill = 1e-3;     // wheel twist and joint speeds below this: still [m/s, rad/s]
@@ -265,12 +267,16 @@ void BaseController::drive_legs(CycleData& data, const Eigen::Vector3d& twist, J
     }
     if (data.owner[static_cast<std::size_t>(w)] == owner) {
       DriveCommand& d = data.new_drive(w, DriveMode::kVelocity);
-      d.velocity = clamp_abs(setpoints_[k].wheel_velocity, data.limits(w).velocity);
+      double rolling = setpoints_[k].wheel_velocity;
       if (owner == JointOwner::kTrajectory) {
         // Roll only as fast as the steering points the right way (swerve practice): steering a
         // rolling loaded wheel scrubs, which costs the steering more than its continuous torque.
-        d.velocity *= std::max(0.0, std::cos(setpoints_[k].steering_angle - data.q(s)));
+        rolling *= std::max(0.0, std::cos(setpoints_[k].steering_angle - data.q(s)));
       }
+      // A wheel beside its steering axis rolls as its leg steers (Leg::axle_offset); held, it
+      // dragged the base along (35-40 mm at each start of the demo's moves, unseen by odometry).
+      rolling += kinematics_.steering_rolling(k, data.qd(s));
+      d.velocity = clamp_abs(rolling, data.limits(w).velocity);
       data.follow(w);
     }
   }

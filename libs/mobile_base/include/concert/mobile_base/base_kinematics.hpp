@@ -20,6 +20,10 @@ struct Leg {
   double wheel_radius{0.0};                      ///< [m]
   double steering_sign{1.0};                     ///< +1 if the steering axis points up, -1 if down
   double heading_offset{0.0};  ///< base-frame heading of positive wheel rolling at steering 0 [rad]
+  /// The wheel centre's horizontal offset from the steering axis along the wheel's own axis [m]
+  /// (CONCERT's leg module: 0.1 m). Such a wheel rolls as its leg steers or the base turns,
+  /// with no motion of the steering axis: e (wz + steering_sign x steering rate) of rolling.
+  double axle_offset{0.0};
   double wheel_center_height{0.0};               ///< wheel centre z in the base frame at q = 0 [m]
   double steering_lower{-1e9};                   ///< [rad]
   double steering_upper{1e9};                    ///< [rad]
@@ -64,7 +68,10 @@ class BaseKinematics {
 
   [[nodiscard]] const std::vector<Leg>& legs() const { return legs_; }
 
-  /// Steering angles and wheel speeds for the base twist (vx, vy [m/s], wz [rad/s]).
+  /// Steering angles and wheel speeds for the base twist (vx, vy [m/s], wz [rad/s]): each wheel
+  /// rolls its steering axis's speed along its heading, less what the base's turn rolls it
+  /// about that axis (Leg::axle_offset; the steering's own rate is the caller's to add:
+  /// steering_rolling()).
   /// Each steering angle is chosen closest to `current_steering`: if the wheel would turn
   /// by more than 90 degrees, it turns by the supplement and rolls backwards (the 180
   /// degree flip); steering limits are respected by flipping too. A leg with ~zero contact
@@ -76,10 +83,17 @@ class BaseKinematics {
   void leg_setpoints(const Eigen::Vector3d& twist, const std::vector<double>& current_steering,
                      std::vector<LegSetpoint>& out) const;
 
-  /// Least-squares base twist (vx, vy, wz) from measured steering angles [rad] and wheel
-  /// speeds [rad/s] (rolling without slip).
+  /// Wheel speed [rad/s] leg `i` rolls with as it steers at `steering_rate` [rad/s], its
+  /// steering axis standing (Leg::axle_offset; 0 for a wheel on its axis).
+  [[nodiscard]] double steering_rolling(std::size_t i, double steering_rate) const;
+
+  /// Least-squares base twist (vx, vy, wz) from measured steering angles [rad], wheel speeds
+  /// [rad/s] and steering rates [rad/s] (rolling without slip; each wheel's centre, beside its
+  /// steering axis by Leg::axle_offset, moves along its heading only). No steering rates
+  /// (empty): the legs hold their angles.
   [[nodiscard]] Eigen::Vector3d twist_from_legs(const std::vector<double>& steering,
-                                                const std::vector<double>& wheel_velocity) const;
+                                                const std::vector<double>& wheel_velocity,
+                                                const std::vector<double>& steering_rate = {}) const;
 
   /// Integrates the odometry by `dt` [s] with the twist measured from the legs.
   void integrate(Odometry& odometry, const std::vector<double>& steering, const std::vector<double>& wheel_velocity,
@@ -91,7 +105,6 @@ class BaseKinematics {
 
  private:
   std::vector<Leg> legs_;
-  Eigen::Matrix3d normal_inverse_;  // (A^T A)^-1 of the rigid-body constraint matrix
 };
 
 }  // namespace concert::mobile_base
