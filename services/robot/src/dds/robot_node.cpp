@@ -194,6 +194,8 @@ void RobotNode::apply_model(const std::string& urdf, std::uint64_t version,
                    static_cast<uint32_t>(core_.model_version()), e.what());
     status_.refused(std::string("model version ") + std::to_string(version) +
                     " refused: " + e.what());
+    // Also in the service's log: the heartbeat's status soon says only that the robot waits.
+    std::cerr << "concert_robot: model version " << version << " refused: " << e.what() << "\n";
   }
 }
 
