@@ -313,6 +313,34 @@ TEST_F(RobotNodeDds, TrajectoriesOverDdsWithProgressResultRefusalAndEstop) {
   EXPECT_LT(log.of(43)->progress(), 0.9);
 }
 
+// A hot swap in standalone mode on a loaded machine: the swap's own model is applied (READY at
+// version 2) before the publishing thread has seen the hardware change, whose "hardware
+// changed" RECONFIGURING then comes last. Ready again, the node says READY at version 2 again
+// (it stood at RECONFIGURING for good: robot_main_test waited 30 s in two fresh-clone CI runs).
+TEST_F(RobotNodeDds, ReadyAgainAfterAHardwareChangeSeenLateSaysReady) {
+  cdds::Reader<msg::ServiceStatus> status(client, cdds::topics::status);
+  node.apply_model(test::read_fixture("mobile_drill.urdf"), 1, "", "hash1", {});
+  ASSERT_TRUE(run_until(core, node, [&] { return core.ready(); }));
+  // The swap: the loop switches the hardware at its next cycle, the publisher not told yet.
+  ASSERT_TRUE(sim.swap_model(test::read_fixture("mobile_three_legs.urdf")));
+  core.cycle();
+  ASSERT_FALSE(core.state().ready);
+  node.apply_model(test::read_fixture("mobile_three_legs.urdf"), 2, "", "hash2", {});  // READY v2 said here
+  node.publish(core.state());  // the publisher sees the change now: RECONFIGURING
+  ASSERT_TRUE(run_until(core, node, [&] { return core.ready() && core.model_version() == 2u; }));
+  // The last status heard: READY at version 2 (the heartbeat repeats whatever stands).
+  std::optional<msg::ServiceStatus> last;
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  while (std::chrono::steady_clock::now() < until &&
+         !(last && last->state() == msg::SERVICE_READY && last->model_version() == 2u)) {
+    if (auto s = status.wait(100ms); s && s->service() == "robot") last = s;
+    node.publish(core.state());
+  }
+  ASSERT_TRUE(last.has_value());
+  EXPECT_EQ(last->state(), msg::SERVICE_READY) << last->message();
+  EXPECT_EQ(last->model_version(), 2u);
+}
+
 TEST(RobotNode, ToolEndEffectorNeedsAParsableDescription) {
   // A message with only a URDF (no SRDF, no chains): the core picks its default frame.
   EXPECT_EQ(dds::tool_end_effector(model_msg(test::read_fixture("mobile_drill.urdf"), 1)), "");

@@ -105,6 +105,7 @@ class RobotNode {
   bool last_ready_{false};
   std::uint64_t cycles_{0};
   model::LimitsTable limits_;       // of the model last applied (under mutex_)
+  concert::dds::ModelId applied_;   // the model last applied (under mutex_)
   std::vector<bool> folded_;        // hardware order: a drive said to be folded back (publisher)
   /// Logs each drive whose torque limit folds back (to halfway between its peak and its
   /// continuous torque) and when it is back at its peak.
