@@ -205,6 +205,29 @@ TEST(BlobShift, TheSetNamesItsBlobsBeyondTheWindowOneBlobAloneDoesNot) {
   EXPECT_LT(one->by.norm(), 0.005);
 }
 
+// The demo's pair (0.1 m apart) framed from midway, with 0.1 m of room for drift: 0.43 m
+// out for the D435i's colour image (42.6 deg high) whatever the camera's roll. An area of one
+// blob has no pair.
+TEST(BlobPairView, FramesTheHolesBlobAndItsNearestNeighbour) {
+  std::vector<DrillPoint> area = predicted_blobs({0.0, 0.0, 0.0});
+  DrillPoint far = area[1];
+  far.label = "blob 3";
+  far.frame.translation().y() = -0.4;
+  area.push_back(far);
+  const std::optional<BlobPairView> pair = blob_pair_view(area[0], area, 0.1);
+  ASSERT_TRUE(pair);
+  EXPECT_TRUE(pair->centre.isApprox(Eigen::Vector3d(2.0, 0.0, 1.2), 1e-12)) << pair->centre.transpose();
+  EXPECT_NEAR(pair->radius, 0.15, 1e-12);
+  hardware::CameraIntrinsics k;
+  k.width = 640;
+  k.height = 480;
+  k.fx = k.fy = 615.0;
+  k.cx = 320.0;
+  k.cy = 240.0;
+  EXPECT_NEAR(any_roll_distance(pair->radius, smaller_fov(k)), 0.43, 0.005);
+  EXPECT_FALSE(blob_pair_view(area[0], {area[0]}, 0.1));
+}
+
 // The D435i's colour image (69.4 x 42.5 deg; 640 x 480 at fx = fy = 615 px here: 42.6 deg
 // high): a look must stand about 0.6 m out for a marker 0.17 m from where it looks, plus its
 // half-diagonal, to stay in the image however the camera rolls.

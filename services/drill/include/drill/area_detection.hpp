@@ -37,6 +37,19 @@ double smaller_fov(const hardware::CameraIntrinsics& k);
 /// looking camera's roll free.
 double any_roll_distance(double radius, double fov);
 
+/// Where a camera looks to see a blob hole and its nearest neighbour of the area together.
+struct BlobPairView {
+  Eigen::Vector3d centre;  ///< midway between the two blobs (world) [m]
+  double radius{0.0};      ///< half their distance plus the room for drift [m]
+};
+
+/// The view framing `hole`'s blob and the area's blob nearest to it (markers and the hole
+/// itself skipped, told by label), with `drift` [m] of room around both; none without a
+/// neighbour. Seen together, the pair names each blob (blob_shift) where one blob seen alone
+/// could be the neighbour; any_roll_distance(radius, fov) is how far out to look from.
+std::optional<BlobPairView> blob_pair_view(const DrillPoint& hole, const std::vector<DrillPoint>& area_points,
+                                           double drift);
+
 /// Whether a world point projects into the view's image (in front of the camera).
 bool in_view(const CameraView& view, const Eigen::Vector3d& point);
 

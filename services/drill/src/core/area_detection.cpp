@@ -307,6 +307,21 @@ std::optional<AreaShift> blob_shift(const CameraView& view, const std::vector<Dr
   return *best;
 }
 
+std::optional<BlobPairView> blob_pair_view(const DrillPoint& hole, const std::vector<DrillPoint>& area_points,
+                                           double drift) {
+  const Eigen::Vector3d at = hole.frame.translation();
+  const DrillPoint* nearest = nullptr;
+  for (const DrillPoint& p : area_points) {
+    if (p.marker >= 0 || p.label == hole.label) continue;
+    if (nearest == nullptr ||
+        (p.frame.translation() - at).norm() < (nearest->frame.translation() - at).norm())
+      nearest = &p;
+  }
+  if (nearest == nullptr) return std::nullopt;
+  return BlobPairView{0.5 * (at + nearest->frame.translation()),
+                      0.5 * (nearest->frame.translation() - at).norm() + drift};
+}
+
 std::optional<Eigen::Isometry3d> track_blob(const CameraView& view, const Eigen::Isometry3d& hole,
                                             double max_distance) {
   std::optional<Eigen::Isometry3d> best;

@@ -1200,16 +1200,9 @@ void DrillNode::look_at_hole() {
   look_reach_ = 0.0;
   if (point_.marker < 0) {
     // The hole's blob and its nearest neighbour framed together, room left for the drift.
-    const DrillPoint* nearest = nullptr;
-    for (const DrillPoint& p : area_points_) {
-      if (p.marker >= 0 || p.label == point_.label) continue;
-      if (nearest == nullptr || (p.frame.translation() - mark->translation()).norm() <
-                                    (nearest->frame.translation() - mark->translation()).norm())
-        nearest = &p;
-    }
-    if (nearest != nullptr) {
-      look_goal_.translation() = 0.5 * (mark->translation() + nearest->frame.translation());
-      look_reach_ = 0.5 * (nearest->frame.translation() - mark->translation()).norm() + kSetLookDrift;
+    if (const std::optional<BlobPairView> pair = blob_pair_view(point_, area_points_, kSetLookDrift)) {
+      look_goal_.translation() = pair->centre;
+      look_reach_ = pair->radius;
     }
   }
   // The camera's distance at the hole's posture.
@@ -1274,11 +1267,16 @@ void DrillNode::back_to_posture(const Sample& s) {
 }
 
 void DrillNode::replan_hole(bool reach, double further) {
+  set_hole_task(hole_request_, {reach, true, 0.0, further}, hole_distance_, hole_depth());
+  request_hole_posture();
+}
+
+// The hole's posture (hole_request_'s task) asked for again at point_, where it was measured last.
+void DrillNode::request_hole_posture() {
   hole_plan_request_ = next_request_++;
   hole_request_.request_id(hole_plan_request_);
   hole_request_.goals().clear();
   hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
-  set_hole_task(hole_request_, {reach, true, 0.0, further}, hole_distance_, hole_depth());
   hole_request_.stamp_ns(now_ns());
   plan_requests_.write(hole_request_);
   hole_path_ = {};
@@ -1294,21 +1292,14 @@ void DrillNode::replan_body() {
   looked_ = false;
   look_pushed_ = false;
   hole_attempt_ = body_attempt_;
-  hole_plan_request_ = next_request_++;
-  hole_request_.request_id(hole_plan_request_);
-  hole_request_.goals().clear();
-  hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
-  set_hole_task(hole_request_, kHoleAttempts[hole_attempt_], hole_distance_, hole_depth());
-  hole_request_.stamp_ns(now_ns());
-  plan_requests_.write(hole_request_);
-  hole_path_ = {};
   tracked_frames_ = 0;
   tracked_.setZero();
   {
     std::lock_guard lock(mutex_);
     track_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
   }
-  motion_ = Motion::kApproachHole;
+  set_hole_task(hole_request_, kHoleAttempts[hole_attempt_], hole_distance_, hole_depth());
+  request_hole_posture();
 }
 
 // The camera's smaller field-of-view angle: from its newest frame's intrinsics, else the

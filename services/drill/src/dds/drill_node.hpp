@@ -147,6 +147,7 @@ class DrillNode final : public MissionPorts {
   /// Plans the hole's drilling posture again at point_, the arm alone: the bit's tip on the
   /// hole's axis, `further` [m] beyond the hole's distance, its reach checked if `reach`.
   void replan_hole(bool reach, double further);
+  void request_hole_posture();
   /// Plans the hole's whole-body posture again at point_ (the hole measured again), with the
   /// request that reached the first one: when no arm-alone posture reaches it from there.
   void replan_body();
