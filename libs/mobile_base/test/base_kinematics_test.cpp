@@ -141,8 +141,8 @@ TEST(BaseKinematics, OdometryRecoversTheCommandedTwist) {
 }
 
 
-// CONCERT's leg module carries its wheel 0.1 m beside the steering axis, along the wheel's axis
-// (the demo robot's legs: +-0.1 m). Judged against the geometry itself: each wheel centre's
+// The steering modules of the project's database (data/module_db, the demo robot) carry their
+// wheel 0.1 m beside the steering axis, along the wheel's axis (+-0.1 m). Judged against the geometry itself: each wheel centre's
 // velocity differentiated numerically from its pose (base pose, steering axis, offset along the
 // steered axle), not from the formulas under test.
 TEST(BaseKinematics, WheelsBesideTheirSteeringAxesRollAsTheBaseTurnsAndTheLegsSteer) {

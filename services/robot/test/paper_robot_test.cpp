@@ -41,6 +41,9 @@ TEST(PaperRobot, GeneratedModelRunsInTheSimulator) {
   RobotCore core(sim);
   core.set_model(urdf, 1);
   EXPECT_EQ(core.legs().size(), 4u);
+  // The public database's steering modules hang the wheel under the steering axis (0.37 m
+  // down): no offset along the axle, unlike data/module_db's (0.1 m).
+  for (const auto& leg : core.legs()) EXPECT_NEAR(leg.axle_offset, 0.0, 1e-6) << leg.steering_joint;
   EXPECT_EQ(core.arm_joints().size(), 6u);
   test::run_cycles(core, 1500);
   const RobotState s = core.state();
@@ -196,7 +199,8 @@ TEST(PaperRobot, TheOdometrySeesTheStandingBaseTurnedByTheArm) {
 
 // The odometry's position against the simulator's truth on the demo's drill robot over the kind
 // of moves a whole-body posture makes near a wall: turns with translations, the legs steering
-// anew at each change. Its wheels sit 0.1 m beside their steering axes (CONCERT's leg module):
+// anew at each change. Its wheels sit 0.1 m beside their steering axes (the steering modules of
+// data/module_db; the public CONCERT database hangs them under the axis):
 // a leg steering, or the base turning, rolls the wheel with no motion of the steering axis. Read
 // as the axis moving, that drifted the demo's odometry 87 mm over one such move (wheel rolling
 // taken for translation: 20 % too little forward motion while turning at 0.5 rad/s, 35-40 mm at

@@ -21,7 +21,7 @@ struct Leg {
   double steering_sign{1.0};                     ///< +1 if the steering axis points up, -1 if down
   double heading_offset{0.0};  ///< base-frame heading of positive wheel rolling at steering 0 [rad]
   /// The wheel centre's horizontal offset from the steering axis along the wheel's own axis [m]
-  /// (CONCERT's leg module: 0.1 m). Such a wheel rolls as its leg steers or the base turns,
+  /// (the demo robot's steering modules, data/module_db: 0.1 m; the public CONCERT database's: 0). Such a wheel rolls as its leg steers or the base turns,
   /// with no motion of the steering axis: e (wz + steering_sign x steering rate) of rolling.
   double axle_offset{0.0};
   double wheel_center_height{0.0};               ///< wheel centre z in the base frame at q = 0 [m]
