@@ -1,7 +1,7 @@
 // concert_planner: whole-body planning for drilling (paper section 5.4.2). Reconfigures on
 // every RobotModel, plans PlanRequests (NSPG + RRT-Connect) and executes them through the
 // robot service.
-//   concert_planner [--params FILE] [--world FILE]
+//   concert_planner [--params FILE] [--world FILE] [--map world|sensors|both]
 // The latched world topic (concert/world/world) replaces the map whenever it changes; with
 // environment_source: sensors (or both) the map comes from the robot's lidars (README, "Map from
 // the sensors").
@@ -22,6 +22,7 @@ namespace {
 struct Options {
   std::string params;
   std::string world;
+  std::string map;  // environment_source over the parameters file's
 };
 
 int run(const Options& options) {
@@ -29,6 +30,7 @@ int run(const Options& options) {
   planner::Params params;
   planner::World world;
   if (!options.params.empty()) params = planner::load_params(options.params);
+  if (!options.map.empty()) params.environment_source = options.map;
   // The world file (libs/world format) is the map until the world topic brings another.
   if (!options.world.empty()) {
     world = planner::dds::to_planner_world(world::load_world_file(options.world));
@@ -58,6 +60,8 @@ int main(int argc, char** argv) {
                   "parameters file (config/planner.yaml lists every key)")
       ->type_name("FILE");
   cli.app().add_option("--world", options.world, "the world (walls, obstacles)")->type_name("FILE");
+  concert::cli::Cli::add_choice(cli.app(), "--map", options.map, {"world", "sensors", "both"},
+                                "what the map is built from (the parameters' environment_source; default world)");
   cli.on_run(cli.app(), [&options] { return run(options); });
   return cli.run(argc, argv);
 }

@@ -477,7 +477,7 @@ namespace {
 // its joint state and odometry (the base 0.3 m along y) and its front lidar.
 class PlannerNodeSensors : public ::testing::Test {
  protected:
-  void start(const std::string& source) {
+  void start(const std::string& source, planner::dds::NodeOptions options = {}) {
     Params params;
     params.environment_source = source;
     params.sensor_map_period = 0.2;
@@ -491,8 +491,7 @@ class PlannerNodeSensors : public ::testing::Test {
     planner_->set_environment(env);
     participant_ = std::make_unique<concert::dds::Participant>(
         concert::dds::ParticipantOptions{.name = "planner_sensor_test"});
-    node_ = std::make_unique<planner::dds::PlannerNode>(*participant_, *planner_,
-                                                        planner::dds::NodeOptions{}, log_);
+    node_ = std::make_unique<planner::dds::PlannerNode>(*participant_, *planner_, options, log_);
     joint_state_ = std::make_unique<concert::dds::Writer<msg::JointState>>(*participant_, concert::dds::topics::joint_state);
     odometry_ = std::make_unique<concert::dds::Writer<msg::Odometry>>(*participant_, concert::dds::topics::odometry);
     lidar_ = std::make_unique<concert::dds::Writer<msg::LidarScan>>(*participant_, concert::dds::topics::lidar);
@@ -612,6 +611,42 @@ TEST_F(PlannerNodeSensors, LidarScansAndDepthFramesOnTheTopicsBecomeThePlannersM
   EXPECT_TRUE(board_seen()) << log_.str();
   EXPECT_NE(log_.str().find(camera.name + " ("), std::string::npos) << log_.str();
   EXPECT_NE(log_.str().find("depth frames averaged)"), std::string::npos) << log_.str();
+}
+
+// With the map from the sensors alone nothing is planned in an empty map: a request waits for
+// the first integrated data (map_wait), and fails naming the map when none comes.
+TEST_F(PlannerNodeSensors, ARequestWaitsForTheFirstMapFromTheSensorsAndFailsWithoutOne) {
+  planner::dds::NodeOptions options;
+  options.map_wait = 3s;
+  start("sensors", options);
+  concert::dds::Writer<msg::PlanRequest> requests(*participant_, concert::dds::topics::plan_request);
+  concert::dds::Reader<msg::PlanResult> results(*participant_, concert::dds::topics::plan_result);
+  std::atomic<bool> stop{false};
+  std::thread spinner([&] { node_->spin(stop, 20ms); });
+  // A request without goals: past the map check it fails with its own reason, at once.
+  msg::PlanRequest r;
+  r.request_id(71);
+  r.model_version(4);
+  r.source("test");
+  requests.write(r);
+  const std::optional<msg::PlanResult> before = wait_final(results, 71);
+  ASSERT_TRUE(before) << log_.str();
+  EXPECT_EQ(before->state(), msg::PLAN_FAILED);
+  EXPECT_NE(before->reason().find("no map from the sensors yet"), std::string::npos) << before->reason();
+  EXPECT_EQ(before->reason().find("no goals"), std::string::npos) << before->reason();
+
+  // Sent before the first revolution, the next request waits for it and is then planned.
+  r.request_id(72);
+  requests.write(r);
+  play(1.6, 0.0, 10.0, [&] { return wall_seen(1.6); });
+  ASSERT_TRUE(wall_seen(1.6)) << log_.str();
+  const std::optional<msg::PlanResult> after = wait_final(results, 72);
+  stop = true;
+  spinner.join();
+  ASSERT_TRUE(after) << log_.str();
+  EXPECT_EQ(after->state(), msg::PLAN_FAILED);
+  EXPECT_NE(after->reason().find("no goals"), std::string::npos) << after->reason();
+  EXPECT_EQ(after->reason().find("no map"), std::string::npos) << after->reason();
 }
 
 TEST_F(PlannerNodeSensors, WithBothTheWorldsWallAndTheLidarsAreInTheMap) {

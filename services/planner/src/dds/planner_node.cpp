@@ -325,6 +325,19 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
       return stopping_ || planner_.model_version() >= request.model_version();
     });
   }
+  // The map from the sensors alone: nothing is planned before they were first integrated.
+  std::string map_error;
+  if (use_sensors_ && !use_world_) {
+    std::unique_lock lock(mutex_);
+    if (!wake_.wait_for(lock, options_.map_wait, [&] { return stopping_ || sensor_maps_ > 0; })) {
+      std::ostringstream why;
+      why << "no map from the sensors yet (environment_source: sensors): no lidar revolution or "
+             "depth frame integrated within "
+          << std::chrono::duration<double>(options_.map_wait).count()
+          << " s (are the sensors publishing? the map takes only data of periods the robot stood still)";
+      map_error = why.str();
+    }
+  }
   msg::PlanResult base;
   base.request_id(request.request_id());
   base.model_version(static_cast<uint32_t>(planner_.model_version()));
@@ -365,6 +378,14 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     } catch (const std::exception& e) {
       start_error = e.what();
     }
+  }
+  if (!map_error.empty()) {
+    base.state(msg::PLAN_FAILED);
+    base.failure(msg::PLAN_INVALID_REQUEST);
+    base.reason(map_error);
+    publish(base);
+    log_line("planner: request " + std::to_string(request.request_id()) + " failed: " + map_error);
+    return;
   }
   if (!start_error.empty()) {
     base.state(msg::PLAN_FAILED);
@@ -761,7 +782,13 @@ void PlannerNode::update_sensor_map() {
   for (const std::string& r : refused) line << "; refused " << r;
   log_line(line.str());
   // After the line, so whoever sees the new map finds the line that reports it.
-  if (!used.empty()) publish_environment();
+  if (used.empty()) return;
+  publish_environment();
+  {
+    std::lock_guard lock(mutex_);
+    ++sensor_maps_;
+  }
+  wake_.notify_all();
 }
 
 }  // namespace concert::planner::dds

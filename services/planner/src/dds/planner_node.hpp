@@ -61,6 +61,10 @@ struct NodeOptions {
   /// A request for a model version the planner does not have yet (it races the model after a
   /// hot swap) waits this long for that version before it is answered.
   std::chrono::milliseconds model_wait{5000};
+  /// With the map from the sensors alone (environment_source: sensors), a request that comes
+  /// before any lidar revolution or depth frame was integrated waits this long for the first
+  /// one, then fails: planned in an empty map, the base could be sent into a wall.
+  std::chrono::milliseconds map_wait{10000};
 };
 
 class PlannerNode {
@@ -136,6 +140,7 @@ class PlannerNode {
   Environment sensor_map_;
   std::size_t skipped_moving_ = 0;  // revolutions and frames, since the last map update line
   std::size_t skipped_version_ = 0;
+  std::size_t sensor_maps_ = 0;  // map updates that integrated something (under mutex_)
   std::shared_ptr<const SensorMapper> mapper_;  // sensor map thread only
   uint64_t warm_version_ = 0;  // model version the warm-up thread should prepare (0: none)
   concert::dds::Writer<msg::PlanResult> results_;
