@@ -11,7 +11,7 @@
 //   row       one row of scenario 3 (the marker at 1.65 m of deploy/bench/drill_patterns_site.yaml,
 //             morphology A): the patterns scenario in two minutes, to measure its spread
 //   demo      the demo wall's pattern (deploy/demo/drill_site.yaml)
-// Usage: bench_drill_mission [--scenario blobs|patterns|row|bim|demo|all] [--runs N] [--assembly FILE] [--logs]
+// Usage: bench_drill_mission [--scenario blobs|patterns|row|bim|demo|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
 //        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
@@ -58,7 +58,8 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
-int bench(const std::string& which, int runs, const std::string& assembly, bool logs) {
+int bench(const std::string& which, int runs, const std::string& assembly, bool logs,
+          const std::string& map) {
   const std::vector<Scenario> all{
       {"blobs", source("services/planner/data/morphology_b.yaml"),
        source("deploy/bench/drill_blobs_site.yaml"), source("deploy/bench/drill_blobs_mission.yaml")},
@@ -95,7 +96,7 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
     double t_nav = 0, t_plan = 0, t_exec = 0, t_drill = 0, t_total = 0;
     for (int r = 0; r < runs; ++r) {
       const MissionRun run = run_mission(assembly.empty() ? sc.assembly : assembly, site, mission,
-                                         std::chrono::seconds(3600), sc.building);
+                                         std::chrono::seconds(3600), sc.building, map);
       if (!run.status) {
         std::cerr << sc.name << " run " << r + 1 << ": no status from the drill service" << run.logs
                   << "\n";
@@ -172,8 +173,13 @@ int main(int argc, char** argv) {
   app.add_option("--runs", runs, "runs per scenario")
       ->capture_default_str()
       ->check(concert::cli::number(1, 1e6, true));
+  std::string map = "world";
+  concert::cli::Cli::add_choice(app, "--map", map, {"world", "sensors", "both"},
+                                "the planner's map: the simulated world's description, the robot's lidars and "
+                                "depth cameras, or both (concert_planner --map)")
+      ->capture_default_str();
   bool logs = false;
   app.add_flag("--logs", logs, "print the services' logs after every run (default: after a failed one, or one with a hole past 5 mm)");
-  cli.on_run(app, [&] { return bench(which, runs, assembly, logs); });
+  cli.on_run(app, [&] { return bench(which, runs, assembly, logs, map); });
   return cli.run(argc, argv);
 }

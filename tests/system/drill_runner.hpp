@@ -176,10 +176,12 @@ inline std::string building_site(const Building& b) {
 
 /// Runs `mission` (a mission file's text) with the robot of `assembly` in the world `site`, and
 /// waits for its end (bounded by `timeout`) and for the holes the status counts. With a
-/// `building`, the nav service runs too (started only when NAV_BINARY is defined).
+/// `building`, the nav service runs too (started only when NAV_BINARY is defined). `map`: what
+/// the planner's map is built from (concert_planner --map: world, sensors or both).
 inline MissionRun run_mission(const std::string& assembly, const std::string& site,
                               const std::string& mission, std::chrono::seconds timeout,
-                              const std::optional<Building>& building = std::nullopt) {
+                              const std::optional<Building>& building = std::nullopt,
+                              const std::string& map = "world") {
   using namespace std::chrono_literals;
   MissionRun run;
   std::vector<std::string> robot_args = {ROBOT_BINARY, "--assembly", assembly, "--world", site};
@@ -204,7 +206,7 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   testing::Process discovery(dies_with_test({DISCOVERY_BINARY}));
   testing::Process modelgen(dies_with_test({MODELGEN_BINARY}));
   testing::Process robot(dies_with_test(robot_args));
-  testing::Process planner(dies_with_test({PLANNER_BINARY}));
+  testing::Process planner(dies_with_test({PLANNER_BINARY, "--map", map}));
   testing::Process drill(dies_with_test({DRILL_BINARY}));
   std::optional<testing::Process> nav;
   if (!nav_args.empty()) nav.emplace(dies_with_test(nav_args));

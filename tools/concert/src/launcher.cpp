@@ -305,6 +305,9 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
   const int gui_port = o.gui_port >= 0 ? o.gui_port : 8080 + domain;
   std::vector<std::string> gui_args = {"--port", std::to_string(gui_port), "--bind", o.gui_bind};
   gui_args.insert(gui_args.end(), db_args.begin(), db_args.end());
+  // The planner's map: from the simulated world's description, the robot's own sensors, or both.
+  std::vector<std::string> planner_args;
+  if (!o.map.empty()) planner_args = {"--map", o.map};
   // The safety service keeps its latched state (a stop, its causes, the inputs, the services it
   // watches) in the run folder, so a safety service killed and restarted holds the same stop;
   // a new `concert up` starts from none.
@@ -315,7 +318,7 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
       {"discovery", "concert_discovery", db_args, true},
       {"modelgen", "concert_modelgen", db_args, true},
       {"robot", "concert_robot", robot_args, true},
-      {"planner", "concert_planner", {}, false},
+      {"planner", "concert_planner", planner_args, false},
       {"nav", "concert_nav", nav_args, false},
       {"drill", "concert_drill", {}, false},
       {"collab", "concert_collab", {}, false},
@@ -499,6 +502,9 @@ void register_launcher_verbs(cli::Cli& concert) {
                      "the operator GUI's address (default: this machine only; 0.0.0.0: the robot's network)")
       ->type_name("ADDR")
       ->default_str("127.0.0.1");
+  cli::Cli::add_choice(up_verb, "--map", up->map, {"world", "sensors", "both"},
+                       "the planner's map: the simulated world's description, the robot's lidars and "
+                       "depth cameras (paper 5.4.1), or both (default: the planner's, world)");
   cli::Cli::add_domain_option(up_verb, up->domain);
 
   CLI::App& sim =

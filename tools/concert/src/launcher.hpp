@@ -94,6 +94,7 @@ struct UpOptions {
   std::optional<int32_t> domain;
   int gui_port = -1;                    ///< the operator GUI's port (services/gui); -1: 8080 + domain
   std::string gui_bind = "127.0.0.1";   ///< the operator GUI's address (localhost only by default)
+  std::string map;                      ///< the planner's map: world, sensors or both ("" = its default)
 };
 
 /// `concert sim assemble|swap|world FILE`.
