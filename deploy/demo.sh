@@ -6,7 +6,8 @@
 #      tree; modelgen publishes robot model version 1; every service reconfigures to it
 #   3. the main job: a drilling mission on the wall of deploy/demo/drill_site.yaml (two blue
 #      blobs): the area is located from a picked point, the planner plans the whole-body
-#      approach (NSPG goal posture + path, 200 N checked), the robot executes it, the drill
+#      approach (NSPG goal posture + path, 200 N checked) in the map it builds from the robot's
+#      lidars and depth cameras (`concert up --map sensors`), the robot executes it, the drill
 #      service detects the blobs and drills the one nearest the point with Cartesian impedance
 #      and visual servoing; the report, and the hole the simulator's wall records
 #   4. hot swap: the drill is replaced by the sanding tool -> new scan -> tree -> model
@@ -54,7 +55,7 @@ check_end_state() {
 }
 
 stage "concert up: every service on this machine, domain $CONCERT_DOMAIN_ID, drill robot mounted"
-"$concert" up --assembly deploy/demo/drill_robot.yaml --world deploy/demo/drill_site.yaml > "$log" 2>&1 &
+"$concert" up --assembly deploy/demo/drill_robot.yaml --world deploy/demo/drill_site.yaml --map sensors > "$log" 2>&1 &
 up_pid=$!
 sleep 0.5
 sed 's/^/  /' "$log"
@@ -84,6 +85,11 @@ stage "drilling mission: concert drill run --mission deploy/demo/drill_mission.y
   fail "the drilling mission failed (report above)"
 holes=$("$concert" topic echo concert/sim/holes --count 1 --timeout 5 --json) || fail "no hole in the simulator's wall"
 echo "  the simulator's wall: $(echo "$holes" | grep -o '"wall"' | wc -l) holes cut"
+# The map the planner planned in: built from the robot's lidars and depth cameras.
+run_dir=$(grep -o 'run folder [^ ]*' "$log" | head -1 | cut -d' ' -f3)
+map_line=$(grep 'planner: sensor map: used' "$run_dir/logs/planner.log" 2>/dev/null | tail -1 | cut -c1-200 || true)
+[ -n "$map_line" ] || fail "the planner built no map from the sensors ($run_dir/logs/planner.log)"
+echo "  the planner's map: ${map_line#planner: sensor map: }"
 
 stage "after the drilling mission: safety RUNNING, one model everywhere, nothing refused"
 check_end_state "after the drilling mission"

@@ -11,6 +11,8 @@
 // run drilled blob_2 (100.5 mm off) for a pick 2 cm beside blob_1, towards blob_2: odometry drifts
 // over the approach, or the re-measure took blob_2 seen alone for blob_1 (since bounded, see
 // BlobShift.*); the drill log now names the blobs it saw, nearest first, with their distances.
+// The planner's map is built from the robot's own lidars and depth cameras (concert_planner --map
+// sensors, paper 5.4.1), not from the simulator's description of the world.
 // Judged against the simulator's truth: the holes its
 // wall records (concert/sim/holes) against the blobs' true positions (libs/world); not against
 // the service's own report. The ArUco pattern of the same wall is a scenario of the benchmark
@@ -58,7 +60,7 @@ TEST(DrillMission, DrillsTheBlobsOnTheDemoWallWithVisualServoing) {
                                      "depth: 0.03\n"
                                      "areas:\n"
                                      "  - {name: blobs, marks: blobs, point: [2.2, 0.045, 1.2], expected: 1}\n",
-                                     600s);
+                                     600s, std::nullopt, "sensors");
   ASSERT_TRUE(run.status) << "no status from the drill service" << run.logs;
   EXPECT_EQ(run.status->state(), msg::DRILL_SUCCEEDED) << run.status->reason() << run.logs;
   EXPECT_EQ(run.status->holes_drilled(), 1u) << run.logs;
@@ -69,6 +71,10 @@ TEST(DrillMission, DrillsTheBlobsOnTheDemoWallWithVisualServoing) {
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_LT(errors[0].norm(), 0.005) << run.logs;  // the paper's aim with visual servoing: max 5 mm
   if (std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr) std::cout << run.logs << std::endl;
+  // The planner's map came from the robot's lidars and depth cameras (paper 5.4.1), not from
+  // the simulator's description of the world.
+  EXPECT_NE(run.logs.find("planner: sensor map: used lidar"), std::string::npos) << run.logs;
+  EXPECT_NE(run.logs.find("not used: the map comes from the sensors"), std::string::npos) << run.logs;
   // The end state: the robot never stopped by the safety layer.
   EXPECT_TRUE(run.safety_running) << run.logs;
 }
