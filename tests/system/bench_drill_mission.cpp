@@ -5,13 +5,15 @@
 //             (deploy/bench/drill_blobs_*.yaml; visual servoing)
 //   patterns  scenario 3, the part morphology A reaches: four ArUco 60 cm rows at 0.5-2.0 m
 //             (deploy/bench/drill_patterns_*.yaml; the kinematics alone)
+//   high      scenario 3 above 2.4 m: two ArUco 60 cm rows at 2.5 and 2.9 m, morphology C (the
+//             Passive Base Link, as the paper drills there; deploy/bench/drill_high_*.yaml)
 //   bim       scenario 2: the FZK house's ground floor (IFC), an area picked on a wall of the
 //             building's model, two blue blobs 0.1 m apart drawn there; the robot (morphology A)
 //             starts in another part of the room, navigates to the BIM base pose, then drills
 //   row       one row of scenario 3 (the marker at 1.65 m of deploy/bench/drill_patterns_site.yaml,
 //             morphology A): the patterns scenario in two minutes, to measure its spread
 //   demo      the demo wall's pattern (deploy/demo/drill_site.yaml)
-// Usage: bench_drill_mission [--scenario blobs|patterns|row|bim|demo|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
+// Usage: bench_drill_mission [--scenario blobs|patterns|high|row|bim|demo|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
 //        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
@@ -65,6 +67,8 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
        source("deploy/bench/drill_blobs_site.yaml"), source("deploy/bench/drill_blobs_mission.yaml")},
       {"patterns", source("services/planner/data/morphology_a.yaml"),
        source("deploy/bench/drill_patterns_site.yaml"), source("deploy/bench/drill_patterns_mission.yaml")},
+      {"high", source("services/planner/data/morphology_c.yaml"),
+       source("deploy/bench/drill_high_site.yaml"), source("deploy/bench/drill_high_mission.yaml")},
       {"row", source("services/planner/data/morphology_a.yaml"),
        source("deploy/bench/drill_patterns_site.yaml"),
        "name: bench row\ndepth: 0.03\nareas:\n  - {name: row_150, marks: aruco, point: [2.2, -0.3, 1.65]}\n",
@@ -146,7 +150,7 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
   }
   if (!known) {
     std::cerr << "bench_drill_mission: unknown scenario '" << which
-              << "' (blobs, patterns, row, bim, demo or all)\n";
+              << "' (blobs, patterns, high, row, bim, demo or all)\n";
     return 2;
   }
   return 0;
@@ -162,7 +166,7 @@ int main(int argc, char** argv) {
   std::string which = "all";
   int runs = 1;
   auto& app = cli.app();
-  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "row", "bim", "demo", "all"},
+  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "high", "row", "bim", "demo", "all"},
                                 "scenario to run")
       ->capture_default_str();
   std::string assembly;
