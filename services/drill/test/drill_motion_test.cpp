@@ -139,6 +139,35 @@ TEST(DrillMotion, DrillsToDepthWithBoundedThrust) {
   EXPECT_LT(p.tip.translation().x(), 1.0 - params.standoff + 2 * params.align_tolerance);
 }
 
+// The light drilling (light_drilling: for holes where the arm cannot hold the full thrust)
+// feels the wall where it is and cuts it to depth, its thrust about half the full bound.
+TEST(DrillMotion, ALightDrillingCutsTheWallAtAboutHalfTheThrust) {
+  const DrillParams full;
+  const DrillParams params = light_drilling(full);
+  EXPECT_LT(thrust_bound(params), 0.55 * thrust_bound(full));
+  DrillMotion m(params);
+  double now = 0.0;
+  Plant p = aligned(m, params, now);
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
+  m.start_drill(0.03, false, p.tip, now);
+  double largest_lead = 0.0;
+  const double started = now;
+  while (m.phase() == DrillMotion::Phase::kDrilling && now < 60.0) {
+    const CartesianReference r = m.update(p.tip, now);
+    largest_lead = std::max(largest_lead, r.pose.translation().x() - p.tip.translation().x());
+    p.step(r);
+    now += kDt;
+  }
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
+  ASSERT_TRUE(m.contact());
+  EXPECT_LT(std::abs(m.contact_offset()), 0.002);  // the wall is where the camera put it
+  EXPECT_GE(p.hole_bottom - 1.0, 0.03);
+  EXPECT_LT(p.hole_bottom - 1.0, 0.036);
+  EXPECT_LE(params.stiffness * largest_lead, 0.5 * params.stiffness * full.max_lead + 1e-6);
+  // Slower than the feed rate: the wall resists more than the light thrust feeds at 10 mm/s.
+  EXPECT_GT(now - started, 0.03 / full.feed_rate);
+}
+
 // The camera's surface off along the normal (a re-measure after a base move: holes came out
 // up to 20 mm short): the depth is counted from where the bit meets the wall.
 TEST(DrillMotion, TheDepthIsCountedFromWhereTheBitMeetsTheWall) {
