@@ -12,8 +12,10 @@
 //             starts in another part of the room, navigates to the BIM base pose, then drills
 //   row       one row of scenario 3 (the marker at 1.65 m of deploy/bench/drill_patterns_site.yaml,
 //             morphology A): the patterns scenario in two minutes, to measure its spread
+//   low       the row at 0.5 m of the same site alone (morphology A): no posture holds the full
+//             thrust there, the holes are drilled at half of it (light_drilling)
 //   demo      the demo wall's pattern (deploy/demo/drill_site.yaml)
-// Usage: bench_drill_mission [--scenario blobs|patterns|high|row|bim|demo|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
+// Usage: bench_drill_mission [--scenario blobs|patterns|high|row|low|bim|demo|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
 //        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
@@ -73,6 +75,10 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
        source("deploy/bench/drill_patterns_site.yaml"),
        "name: bench row\ndepth: 0.03\nareas:\n  - {name: row_150, marks: aruco, point: [2.2, -0.3, 1.65]}\n",
        true},
+      {"low", source("services/planner/data/morphology_a.yaml"),
+       source("deploy/bench/drill_patterns_site.yaml"),
+       "name: bench low\ndepth: 0.03\nareas:\n  - {name: row_050, marks: aruco, point: [2.2, 0.9, 0.65]}\n",
+       true},
       {"bim", source("services/planner/data/morphology_a.yaml"), "", bim_mission("bench bim area"),
        true, fzk_living_room()},
       {"demo", source("deploy/demo/drill_robot.yaml"), source("deploy/demo/drill_site.yaml"),
@@ -84,7 +90,8 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
       concert::drill::load_patterns(source("services/drill/config/patterns.yaml"));
   bool known = false;
   for (const Scenario& sc : all) {
-    if (which == "all" ? sc.name == "row" : which != sc.name) continue;  // all: row is in patterns
+    // all: row and low are in patterns
+    if (which == "all" ? sc.name == "row" || sc.name == "low" : which != sc.name) continue;
     known = true;
     const std::string mission = sc.text ? sc.mission : read(sc.mission);
     const std::string site = sc.building ? building_site(*sc.building) : sc.site;
@@ -92,8 +99,9 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
     if (sc.name == "demo") {  // the demo wall's blobs are another mission's
       std::erase_if(targets, [](const Target& t) { return t.name.rfind("blob", 0) == 0; });
     }
-    if (sc.name == "row") {  // the wall's other rows are the patterns scenario's
-      std::erase_if(targets, [](const Target& t) { return t.name.rfind("row_150", 0) != 0; });
+    if (sc.name == "row" || sc.name == "low") {  // the wall's other rows are the patterns scenario's
+      const std::string row = sc.name == "row" ? "row_150" : "row_050";
+      std::erase_if(targets, [&row](const Target& t) { return t.name.rfind(row, 0) != 0; });
     }
     std::vector<double> errors;
     std::size_t drilled = 0, marked = 0;
@@ -150,7 +158,7 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
   }
   if (!known) {
     std::cerr << "bench_drill_mission: unknown scenario '" << which
-              << "' (blobs, patterns, high, row, bim, demo or all)\n";
+              << "' (blobs, patterns, high, row, low, bim, demo or all)\n";
     return 2;
   }
   return 0;
@@ -166,7 +174,7 @@ int main(int argc, char** argv) {
   std::string which = "all";
   int runs = 1;
   auto& app = cli.app();
-  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "high", "row", "bim", "demo", "all"},
+  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "high", "row", "low", "bim", "demo", "all"},
                                 "scenario to run")
       ->capture_default_str();
   std::string assembly;

@@ -57,11 +57,18 @@ struct HoleAttempt {
   bool fixed_base;
   double base_travel;  // [m, rad] for the whole body; 0: anywhere
   double further;      // [m] beyond the hole's distance
+  bool light = false;  // drilled at about half the thrust (light_drilling), the torques checked with it
 };
 constexpr HoleAttempt kHoleAttempts[] = {
     {true, true, 0.0, 0.0},    {true, true, 0.0, 0.03},   {true, true, 0.0, 0.07},
     {true, false, 0.3, 0.0},   {true, false, 0.3, 0.03},  {true, false, 0.3, 0.07},
-    {true, false, 0.0, 0.0},   {true, false, 0.0, 0.07},  {false, true, 0.0, 0.0},
+    {true, false, 0.0, 0.0},   {true, false, 0.0, 0.07},
+    // No posture holds the full thrust (morphology A's row at 0.5 m: none for 200 N checked,
+    // the whole body's at 100-150 N): the same at about half the thrust, still with the bit's
+    // reach checked, before postures whose reach nobody checked.
+    {true, true, 0.0, 0.0, true},  {true, true, 0.0, 0.07, true},  {true, false, 0.3, 0.0, true},
+    {true, false, 0.3, 0.07, true}, {true, false, 0.0, 0.0, true},
+    {false, true, 0.0, 0.0},
     {false, true, 0.0, 0.03},  {false, true, 0.0, 0.07},  {false, true, 0.0, 0.12},
     {false, false, 0.3, 0.0},  {false, false, 0.3, 0.03}, {false, false, 0.3, 0.07},
     {false, false, 0.3, 0.12}, {false, false, 0.0, 0.0},  {false, false, 0.0, 0.07}};
@@ -194,8 +201,9 @@ Eigen::Vector3d odometry_of(const msg::Odometry& o) { return {o.x(), o.y(), o.ya
 // or the camera on the hole's axis as far out.
 // (`hole_distance`: the bit's tip from the wall the posture asks for before `further`.)
 void set_hole_task(msg::PlanRequest& r, const HoleAttempt& a, double hole_distance,
-                   double depth) {
+                   double depth, const DrillParams& motion) {
   const double tip = hole_distance + a.further;
+  r.contact_force(checked_thrust(a.light ? light_drilling(motion) : motion));
   r.tip_distance(tip);
   r.tip_reach(a.reach ? tip + depth : 0.0);
   r.camera_distance(0.0);
@@ -1055,7 +1063,6 @@ void DrillNode::align(const DrillPoint& point) {
   r.end_effector(rig_->tool());
   r.goals().push_back(model::dds::to_pose_msg(point_.frame));
   r.execute(true);
-  r.contact_force(checked_thrust(params_.motion));
   // The bit's tip is put on the hole's axis (PlanRequest.tip_distance), so the posture the
   // planner checks is the one the bit drills from; the camera sees the hole from beside it.
   camera_to_tip_ = camera_to_tip;
@@ -1063,7 +1070,8 @@ void DrillNode::align(const DrillPoint& point) {
   // The arm alone first (kHoleAttempts): the base stays where the area's approach put it, so
   // odometry does not drift between holes (3.5 deg over one whole-body move on the demo).
   hole_attempt_ = 0;
-  set_hole_task(r, kHoleAttempts[0], hole_distance_, hole_depth());
+  drilling_light_ = false;
+  set_hole_task(r, kHoleAttempts[0], hole_distance_, hole_depth(), params_.motion);
   plan_requests_.write(r);
   hole_request_ = r;
   hole_path_ = {};
@@ -1085,6 +1093,10 @@ std::string hole_task_text(const msg::PlanRequest& r) {
 
 void DrillNode::start_align(const Sample& s) {
   base_T_world_ = rig_->base_in_world(s.odometry).inverse();
+  drill_motion_ = DrillMotion(drilling_light_ ? light_drilling(params_.motion) : params_.motion);
+  if (drilling_light_)
+    log_line("drill: " + point_.label + ": drilled at about half the thrust (the lead halved): " +
+             "the arm's torques hold no more in any posture found");
   drill_motion_.start_align(base_T_world_ * point_.frame, rig_->tip_in_base(rig_->q(s.joints)),
                             now_);
   motion_ = Motion::kAlign;
@@ -1266,8 +1278,9 @@ void DrillNode::back_to_posture(const Sample& s) {
   motion_ = Motion::kBackToPosture;
 }
 
-void DrillNode::replan_hole(bool reach, double further) {
-  set_hole_task(hole_request_, {reach, true, 0.0, further}, hole_distance_, hole_depth());
+void DrillNode::replan_hole(bool reach, double further, bool light) {
+  set_hole_task(hole_request_, {reach, true, 0.0, further, light}, hole_distance_, hole_depth(),
+                params_.motion);
   request_hole_posture();
 }
 
@@ -1298,7 +1311,8 @@ void DrillNode::replan_body() {
     std::lock_guard lock(mutex_);
     track_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
   }
-  set_hole_task(hole_request_, kHoleAttempts[hole_attempt_], hole_distance_, hole_depth());
+  set_hole_task(hole_request_, kHoleAttempts[hole_attempt_], hole_distance_, hole_depth(),
+                params_.motion);
   request_hole_posture();
 }
 
@@ -1459,6 +1473,7 @@ void DrillNode::control_motion() {
     if (r->state() == msg::PLAN_FAILED &&
         (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH) &&
         hole_attempt_ + 1 < std::size(kHoleAttempts)) {
+      const bool was_light = kHoleAttempts[hole_attempt_].light;
       const HoleAttempt& next = kHoleAttempts[++hole_attempt_];
       std::ostringstream line;
       const auto who = [](bool fixed, double travel) {
@@ -1469,18 +1484,22 @@ void DrillNode::control_motion() {
       };
       line << "drill: " << point_.label << ": no drilling posture for "
            << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with "
-           << hole_task_text(hole_request_) << " from the wall (" << r->reason() << "); asking for "
-           << who(next.fixed_base, next.base_travel) << " with ";
+           << hole_task_text(hole_request_) << " from the wall" << (was_light ? ", about half the thrust" : "")
+           << " (" << r->reason() << "); asking for " << who(next.fixed_base, next.base_travel)
+           << " with ";
       hole_plan_request_ = next_request_++;
       hole_request_.request_id(hole_plan_request_);
-      set_hole_task(hole_request_, next, hole_distance_, hole_depth());
-      line << hole_task_text(hole_request_);
+      set_hole_task(hole_request_, next, hole_distance_, hole_depth(), params_.motion);
+      line << hole_task_text(hole_request_) << (next.light ? ", about half the thrust" : "");
       log_line(line.str());
       plan_requests_.write(hole_request_);
     } else if (r->state() == msg::PLAN_FAILED) {
       motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());
       motion_ = Motion::kNone;
     } else if (r->state() == msg::PLAN_SUCCEEDED) {
+      // The posture holds the thrust it was checked with: drilled from it (or from the posture
+      // it leads to) at that thrust.
+      drilling_light_ = hole_request_.contact_force() < checked_thrust(params_.motion) - 1e-6;
       if (!hole_request_.fixed_base()) {
         body_attempt_ = hole_attempt_;
         body_goal_ = model::dds::to_isometry(hole_request_.goals().front()).translation();
@@ -1549,10 +1568,11 @@ void DrillNode::control_motion() {
     while (hole_attempt_ + 1 < std::size(kHoleAttempts) &&
            !(kHoleAttempts[hole_attempt_].fixed_base &&
              kHoleAttempts[hole_attempt_].reach == reached.reach &&
+             kHoleAttempts[hole_attempt_].light == reached.light &&
              kHoleAttempts[hole_attempt_].further >= reached.further - 1e-6))
       ++hole_attempt_;
     if (hole_attempt_ < from && !kHoleAttempts[hole_attempt_].fixed_base) hole_attempt_ = from;
-    replan_hole(reached.reach, reached.further);
+    replan_hole(reached.reach, reached.further, reached.light);
     return;
   }
   if (motion_ == Motion::kReanchor) {
@@ -1613,7 +1633,7 @@ void DrillNode::control_motion() {
         // The base moved and odometry drifted: the posture again, the arm alone, for the hole
         // where the camera sees it now.
         hole_replanned_ = true;
-        replan_hole(kHoleAttempts[hole_attempt_].reach, 0.0);
+        replan_hole(kHoleAttempts[hole_attempt_].reach, 0.0, kHoleAttempts[hole_attempt_].light);
         return;
       }
     }
