@@ -15,7 +15,11 @@ DrillRig::DrillRig(std::shared_ptr<const model::RobotModel> model)
     camera_ = camera.name;
     camera_frame_ = camera.frame;
   } catch (const model::ModelError& e) {
-    throw DrillError(model_->where() + " cannot drill: " + e.what());
+    // The model's errors begin with where they are ("model version 2: no drill tool ..."):
+    // said once.
+    std::string why = e.what();
+    if (const std::string at = model_->where() + ": "; why.rfind(at, 0) == 0) why.erase(0, at.size());
+    throw DrillError(model_->where() + " cannot drill: " + why);
   }
   const auto legs = mobile_base::detect_legs(
       model_->kinematics(), mobile_base::collision_cylinder_radii(model_->description().urdf));

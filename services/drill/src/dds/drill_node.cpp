@@ -516,8 +516,10 @@ void DrillNode::apply_model(const msg::RobotModel& m) {
   std::string error;
   try {
     rig = std::make_shared<const DrillRig>(model::RobotModel::build(model::dds::to_description(m)));
+  } catch (const DrillError& e) {
+    error = e.what();  // "model version N cannot drill: ..." (DrillRig)
   } catch (const std::exception& e) {
-    error = e.what();
+    error = "model version " + std::to_string(m.version()) + " cannot drill: " + e.what();
   }
   {
     std::lock_guard lock(mutex_);
@@ -536,9 +538,8 @@ void DrillNode::apply_model(const msg::RobotModel& m) {
     log_line("drill: model version " + std::to_string(m.version()) + ": drill " + rig->tool() +
              " at " + rig->tcp_frame() + ", camera " + rig->camera());
   } else {
-    status_.report(msg::SERVICE_READY, cdds::ModelId{m.version(), m.content_hash()},
-                   "cannot drill: " + error);
-    log_line("drill: model version " + std::to_string(m.version()) + ": cannot drill: " + error);
+    status_.report(msg::SERVICE_READY, cdds::ModelId{m.version(), m.content_hash()}, error);
+    log_line("drill: " + error);
   }
 }
 
@@ -562,7 +563,7 @@ void DrillNode::start_mission(const msg::DrillMission& m) {
                   "') is running; abort it first");
   }
   if (!rig_)
-    return refuse(rig_error_.empty() ? "no robot model yet" : "cannot drill: " + rig_error_);
+    return refuse(rig_error_.empty() ? "no robot model yet" : rig_error_);
   Mission mission;
   try {
     mission = parse_mission(
@@ -605,8 +606,7 @@ void DrillNode::publish_status(bool force) {
 Outcome DrillNode::health() {
   std::lock_guard lock(mutex_);
   if (!rig_)
-    return Outcome::failed("the robot model cannot drill" +
-                           (rig_error_.empty() ? "" : ": " + rig_error_));
+    return Outcome::failed(rig_error_.empty() ? "the robot model cannot drill" : rig_error_);
   // A service not heard yet when the mission began (a stack just started: its status or the
   // joint states not matched yet) is waited for, kServiceLost at most.
   const bool starting = seconds_since(mission_started_) < kServiceLost;
