@@ -68,6 +68,19 @@ double run(DrillMotion& m, Plant& p, double& now, double seconds) {
   return now - t0;
 }
 
+// Drills (the motion in its drilling phase) until it leaves it or 60 s pass; returns the
+// reference's largest lead on the tip along the bit [m].
+double drill_until_done(DrillMotion& m, Plant& p, double& now) {
+  double largest_lead = 0.0;
+  while (m.phase() == DrillMotion::Phase::kDrilling && now < 60.0) {
+    const CartesianReference r = m.update(p.tip, now);
+    largest_lead = std::max(largest_lead, r.pose.translation().x() - p.tip.translation().x());
+    p.step(r);
+    now += kDt;
+  }
+  return largest_lead;
+}
+
 Plant plant_in_front(double x) {
   Plant p;
   p.tip.translation() = Eigen::Vector3d(x, 0.25, 1.05);
@@ -122,13 +135,7 @@ TEST(DrillMotion, DrillsToDepthWithBoundedThrust) {
   run(m, p, now, 10.0);
   ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone);
   m.start_drill(0.05, false, p.tip, now);
-  double largest_lead = 0.0;
-  while (m.phase() == DrillMotion::Phase::kDrilling && now < 60.0) {
-    const CartesianReference r = m.update(p.tip, now);
-    largest_lead = std::max(largest_lead, r.pose.translation().x() - p.tip.translation().x());
-    p.step(r);
-    now += kDt;
-  }
+  const double largest_lead = drill_until_done(m, p, now);
   ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
   EXPECT_GE(p.hole_bottom - 1.0, 0.05);
   EXPECT_LT(p.hole_bottom - 1.0, 0.056);
@@ -150,14 +157,8 @@ TEST(DrillMotion, ALightDrillingCutsTheWallAtAboutHalfTheThrust) {
   Plant p = aligned(m, params, now);
   ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
   m.start_drill(0.03, false, p.tip, now);
-  double largest_lead = 0.0;
   const double started = now;
-  while (m.phase() == DrillMotion::Phase::kDrilling && now < 60.0) {
-    const CartesianReference r = m.update(p.tip, now);
-    largest_lead = std::max(largest_lead, r.pose.translation().x() - p.tip.translation().x());
-    p.step(r);
-    now += kDt;
-  }
+  const double largest_lead = drill_until_done(m, p, now);
   ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
   ASSERT_TRUE(m.contact());
   EXPECT_LT(std::abs(m.contact_offset()), 0.002);  // the wall is where the camera put it
