@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <string>
 
 namespace concert::drill {
@@ -60,14 +61,19 @@ inline double thrust_bound(const DrillParams& p) {
   return p.stiffness * p.max_lead + p.damping * p.feed_rate;
 }
 
-/// The same drilling with half the largest lead: about half the thrust (65 N with the
-/// defaults, of 125 N; the simulated wall then lets the bit advance at about 7 mm/s instead of
-/// 10). For the holes the arm cannot hold the full thrust at: morphology A reaches a row at
-/// 0.5 m with the whole body only under 100-150 N checked, not 200 N. The feed rate stays: at
-/// half of it too the bit's contact with the wall (contact_lead reached while the tip advances
-/// at under half the feed rate) was missed once and a hole went 77.5 mm deep for 30 mm asked.
-inline DrillParams light_drilling(DrillParams p) {
-  p.max_lead *= 0.5;
+/// The same drilling with the largest lead scaled by `lead` (0 < lead <= 1), about that
+/// fraction of the thrust, for the holes the arm cannot hold the full thrust at: half the lead
+/// (the default) pushes 65 N with the defaults, of 125 N, and the simulated wall then lets the
+/// bit advance at about 7 mm/s instead of 10; morphology A reaches a row at 0.5 m with the whole
+/// body only under 100-150 N checked, not 200 N, and its row at 0.35 m only under 50-100 N
+/// (kLightestLead). The lead stays kLeadOverContact above contact_lead, or the bit would no
+/// longer feel the wall. The feed rate stays: at half of it too the bit's contact with the wall
+/// (contact_lead reached while the tip advances at under half the feed rate) was missed once
+/// and a hole went 77.5 mm deep for 30 mm asked.
+inline constexpr double kLeadOverContact = 0.0015;  // [m]
+inline constexpr double kLightestLead = 0.35;
+inline DrillParams light_drilling(DrillParams p, double lead = 0.5) {
+  p.max_lead = std::max(p.max_lead * lead, p.contact_lead + kLeadOverContact);
   return p;
 }
 

@@ -57,7 +57,8 @@ struct HoleAttempt {
   bool fixed_base;
   double base_travel;  // [m, rad] for the whole body; 0: anywhere
   double further;      // [m] beyond the hole's distance
-  bool light = false;  // drilled at about half the thrust (light_drilling), the torques checked with it
+  double lead = 1.0;  // the largest lead's fraction the hole is drilled with (light_drilling), the
+                     // torques checked with its thrust
 };
 constexpr HoleAttempt kHoleAttempts[] = {
     {true, true, 0.0, 0.0},    {true, true, 0.0, 0.03},   {true, true, 0.0, 0.07},
@@ -66,8 +67,13 @@ constexpr HoleAttempt kHoleAttempts[] = {
     // No posture holds the full thrust (morphology A's row at 0.5 m: none for 200 N checked,
     // the whole body's at 100-150 N): the same at about half the thrust, still with the bit's
     // reach checked, before postures whose reach nobody checked.
-    {true, true, 0.0, 0.0, true},  {true, true, 0.0, 0.07, true},  {true, false, 0.3, 0.0, true},
-    {true, false, 0.3, 0.07, true}, {true, false, 0.0, 0.0, true},
+    {true, true, 0.0, 0.0, 0.5},  {true, true, 0.0, 0.07, 0.5},  {true, false, 0.3, 0.0, 0.5},
+    {true, false, 0.3, 0.07, 0.5}, {true, false, 0.0, 0.0, 0.5},
+    // Lighter still (kLightestLead: 49 N, 78 N checked): morphology A's row at 0.35 m, the
+    // paper's lowest, had no posture under 104 N checked in one run of two (the base's legs in
+    // the wall, the arm in its own links, the torques), and all four holes failed.
+    {true, true, 0.0, 0.0, kLightestLead}, {true, false, 0.3, 0.0, kLightestLead},
+    {true, false, 0.0, 0.0, kLightestLead},
     {false, true, 0.0, 0.0},
     {false, true, 0.0, 0.03},  {false, true, 0.0, 0.07},  {false, true, 0.0, 0.12},
     {false, false, 0.3, 0.0},  {false, false, 0.3, 0.03}, {false, false, 0.3, 0.07},
@@ -81,6 +87,19 @@ constexpr double kSettleBack = 1.0;
 // yet: lateral forces of the bit held in its hole are one candidate).
 constexpr double kThrustChecked = 1.6;
 double checked_thrust(const DrillParams& p) { return kThrustChecked * thrust_bound(p); }
+// The lead a posture request's thrust was checked with (kHoleAttempts' leads; 1: the full one).
+double lead_checked(const msg::PlanRequest& r, const DrillParams& p) {
+  for (const HoleAttempt& a : kHoleAttempts) {
+    if (std::abs(checked_thrust(light_drilling(p, a.lead)) - r.contact_force()) < 1e-6) return a.lead;
+  }
+  return 1.0;
+}
+// ", at 52 % of the thrust" for a light drilling's lead, "" for the full one, for the log.
+std::string thrust_text(double lead, const DrillParams& p) {
+  if (lead >= 1.0) return "";
+  return ", at " + std::to_string(std::lround(100.0 * thrust_bound(light_drilling(p, lead)) / thrust_bound(p))) +
+         " % of the thrust";
+}
 // Robot shapes grown against the map in the areas' approach plans [m]: the planner's map is the
 // world, its start pose the wheel odometry, which drifts 4-6 cm over a whole-body move near the
 // wall; a base planned 3 cm from the wall was found inside it by the next plan. (The holes'
@@ -203,7 +222,7 @@ Eigen::Vector3d odometry_of(const msg::Odometry& o) { return {o.x(), o.y(), o.ya
 void set_hole_task(msg::PlanRequest& r, const HoleAttempt& a, double hole_distance,
                    double depth, const DrillParams& motion) {
   const double tip = hole_distance + a.further;
-  r.contact_force(checked_thrust(a.light ? light_drilling(motion) : motion));
+  r.contact_force(checked_thrust(light_drilling(motion, a.lead)));
   r.tip_distance(tip);
   r.tip_reach(a.reach ? tip + depth : 0.0);
   r.camera_distance(0.0);
@@ -1070,7 +1089,7 @@ void DrillNode::align(const DrillPoint& point) {
   // The arm alone first (kHoleAttempts): the base stays where the area's approach put it, so
   // odometry does not drift between holes (3.5 deg over one whole-body move on the demo).
   hole_attempt_ = 0;
-  drilling_light_ = false;
+  drilling_lead_ = 1.0;
   set_hole_task(r, kHoleAttempts[0], hole_distance_, hole_depth(), params_.motion);
   plan_requests_.write(r);
   hole_request_ = r;
@@ -1093,10 +1112,11 @@ std::string hole_task_text(const msg::PlanRequest& r) {
 
 void DrillNode::start_align(const Sample& s) {
   base_T_world_ = rig_->base_in_world(s.odometry).inverse();
-  drill_motion_ = DrillMotion(drilling_light_ ? light_drilling(params_.motion) : params_.motion);
-  if (drilling_light_)
-    log_line("drill: " + point_.label + ": drilled at about half the thrust (the lead halved): " +
-             "the arm's torques hold no more in any posture found");
+  drill_motion_ = DrillMotion(drilling_lead_ < 1.0 ? light_drilling(params_.motion, drilling_lead_)
+                                                  : params_.motion);
+  if (drilling_lead_ < 1.0)
+    log_line("drill: " + point_.label + ": drilled" + thrust_text(drilling_lead_, params_.motion) +
+             ": the arm's torques hold no more in any posture found");
   drill_motion_.start_align(base_T_world_ * point_.frame, rig_->tip_in_base(rig_->q(s.joints)),
                             now_);
   motion_ = Motion::kAlign;
@@ -1278,8 +1298,8 @@ void DrillNode::back_to_posture(const Sample& s) {
   motion_ = Motion::kBackToPosture;
 }
 
-void DrillNode::replan_hole(bool reach, double further, bool light) {
-  set_hole_task(hole_request_, {reach, true, 0.0, further, light}, hole_distance_, hole_depth(),
+void DrillNode::replan_hole(bool reach, double further, double lead) {
+  set_hole_task(hole_request_, {reach, true, 0.0, further, lead}, hole_distance_, hole_depth(),
                 params_.motion);
   request_hole_posture();
 }
@@ -1473,7 +1493,7 @@ void DrillNode::control_motion() {
     if (r->state() == msg::PLAN_FAILED &&
         (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH) &&
         hole_attempt_ + 1 < std::size(kHoleAttempts)) {
-      const bool was_light = kHoleAttempts[hole_attempt_].light;
+      const double was_lead = kHoleAttempts[hole_attempt_].lead;
       const HoleAttempt& next = kHoleAttempts[++hole_attempt_];
       std::ostringstream line;
       const auto who = [](bool fixed, double travel) {
@@ -1484,13 +1504,13 @@ void DrillNode::control_motion() {
       };
       line << "drill: " << point_.label << ": no drilling posture for "
            << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with "
-           << hole_task_text(hole_request_) << " from the wall" << (was_light ? ", about half the thrust" : "")
+           << hole_task_text(hole_request_) << " from the wall" << thrust_text(was_lead, params_.motion)
            << " (" << r->reason() << "); asking for " << who(next.fixed_base, next.base_travel)
            << " with ";
       hole_plan_request_ = next_request_++;
       hole_request_.request_id(hole_plan_request_);
       set_hole_task(hole_request_, next, hole_distance_, hole_depth(), params_.motion);
-      line << hole_task_text(hole_request_) << (next.light ? ", about half the thrust" : "");
+      line << hole_task_text(hole_request_) << thrust_text(next.lead, params_.motion);
       log_line(line.str());
       plan_requests_.write(hole_request_);
     } else if (r->state() == msg::PLAN_FAILED) {
@@ -1499,7 +1519,7 @@ void DrillNode::control_motion() {
     } else if (r->state() == msg::PLAN_SUCCEEDED) {
       // The posture holds the thrust it was checked with: drilled from it (or from the posture
       // it leads to) at that thrust.
-      drilling_light_ = hole_request_.contact_force() < checked_thrust(params_.motion) - 1e-6;
+      drilling_lead_ = lead_checked(hole_request_, params_.motion);
       if (!hole_request_.fixed_base()) {
         body_attempt_ = hole_attempt_;
         body_goal_ = model::dds::to_isometry(hole_request_.goals().front()).translation();
@@ -1568,11 +1588,11 @@ void DrillNode::control_motion() {
     while (hole_attempt_ + 1 < std::size(kHoleAttempts) &&
            !(kHoleAttempts[hole_attempt_].fixed_base &&
              kHoleAttempts[hole_attempt_].reach == reached.reach &&
-             kHoleAttempts[hole_attempt_].light == reached.light &&
+             kHoleAttempts[hole_attempt_].lead == reached.lead &&
              kHoleAttempts[hole_attempt_].further >= reached.further - 1e-6))
       ++hole_attempt_;
     if (hole_attempt_ < from && !kHoleAttempts[hole_attempt_].fixed_base) hole_attempt_ = from;
-    replan_hole(reached.reach, reached.further, reached.light);
+    replan_hole(reached.reach, reached.further, reached.lead);
     return;
   }
   if (motion_ == Motion::kReanchor) {
@@ -1633,7 +1653,7 @@ void DrillNode::control_motion() {
         // The base moved and odometry drifted: the posture again, the arm alone, for the hole
         // where the camera sees it now.
         hole_replanned_ = true;
-        replan_hole(kHoleAttempts[hole_attempt_].reach, 0.0, kHoleAttempts[hole_attempt_].light);
+        replan_hole(kHoleAttempts[hole_attempt_].reach, 0.0, kHoleAttempts[hole_attempt_].lead);
         return;
       }
     }

@@ -145,9 +145,9 @@ class DrillNode final : public MissionPorts {
   /// newest camera frame (shift_area), odometry's drift taken out as it grows.
   void track_area();
   /// Plans the hole's drilling posture again at point_, the arm alone: the bit's tip on the
-  /// hole's axis, `further` [m] beyond the hole's distance, its reach checked if `reach`, at half
-  /// the thrust if `light`.
-  void replan_hole(bool reach, double further, bool light);
+  /// hole's axis, `further` [m] beyond the hole's distance, its reach checked if `reach`, the
+  /// thrust of `lead` (light_drilling) checked.
+  void replan_hole(bool reach, double further, double lead);
   void request_hole_posture();
   /// Plans the hole's whole-body posture again at point_ (the hole measured again), with the
   /// request that reached the first one: when no arm-alone posture reaches it from there.
@@ -245,7 +245,7 @@ class DrillNode final : public MissionPorts {
   double hole_distance_{0.0};  // the bit tip's distance from the wall a hole's posture asks for [m]
   double camera_to_tip_{0.0};  // the tool's camera to its tip along the camera's axis [m]
   std::size_t hole_attempt_{0};  // which of kHoleAttempts the hole's posture request is
-  bool drilling_light_{false};   // the hole's posture holds about half the thrust (light_drilling)
+  double drilling_lead_{1.0};    // the lead the hole's posture holds the thrust of (light_drilling)
   std::int64_t reanchor_since_ns_{0};
   std::vector<DrillPoint> area_points_;  // the current area's holes as detected
   struct PlannedPath {
