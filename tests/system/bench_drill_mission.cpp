@@ -13,9 +13,11 @@
 //   row       one row of scenario 3 (the marker at 1.65 m of deploy/bench/drill_patterns_site.yaml,
 //             morphology A): the patterns scenario in two minutes, to measure its spread
 //   low       the row at 0.5 m of the same site alone (morphology A): no posture holds the full
-//             thrust there, the holes are drilled at half of it (light_drilling)
+//             thrust there, the holes are drilled at half of it or less (light_drilling)
+//   lowest    scenario 3's lowest row, 0.35 m (the marker at 0.5 m, morphology A;
+//             deploy/bench/drill_lowest_site.yaml): drilled at 39-52 % of the thrust
 //   demo      the demo wall's pattern (deploy/demo/drill_site.yaml)
-// Usage: bench_drill_mission [--scenario blobs|patterns|high|row|low|bim|demo|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
+// Usage: bench_drill_mission [--scenario blobs|patterns|high|row|low|lowest|bim|demo|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
 //        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
@@ -78,6 +80,10 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
       {"low", source("services/planner/data/morphology_a.yaml"),
        source("deploy/bench/drill_patterns_site.yaml"),
        "name: bench low\ndepth: 0.03\nareas:\n  - {name: row_050, marks: aruco, point: [2.2, 0.9, 0.65]}\n",
+       true},
+      {"lowest", source("services/planner/data/morphology_a.yaml"),
+       source("deploy/bench/drill_lowest_site.yaml"),
+       "name: bench lowest\ndepth: 0.03\nareas:\n  - {name: row_035, marks: aruco, point: [2.2, 0.9, 0.50]}\n",
        true},
       {"bim", source("services/planner/data/morphology_a.yaml"), "", bim_mission("bench bim area"),
        true, fzk_living_room()},
@@ -158,7 +164,7 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
   }
   if (!known) {
     std::cerr << "bench_drill_mission: unknown scenario '" << which
-              << "' (blobs, patterns, high, row, low, bim, demo or all)\n";
+              << "' (blobs, patterns, high, row, low, lowest, bim, demo or all)\n";
     return 2;
   }
   return 0;
@@ -174,7 +180,7 @@ int main(int argc, char** argv) {
   std::string which = "all";
   int runs = 1;
   auto& app = cli.app();
-  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "high", "row", "low", "bim", "demo", "all"},
+  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "high", "row", "low", "lowest", "bim", "demo", "all"},
                                 "scenario to run")
       ->capture_default_str();
   std::string assembly;
