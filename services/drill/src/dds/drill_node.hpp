@@ -123,7 +123,10 @@ class DrillNode final : public MissionPorts {
     kDrill,
     kRetractOut,
     kSettle,
-    kBackToPosture
+    kBackToPosture,
+    kCheckLook,   // a marker hole's whole-body posture planned, not executed: is a look possible from it?
+    kBodyToHole,  // that posture's path sent to the robot by the drill itself
+    kCheckedLook  // then the look's path check_look() planned, sent likewise
   };
 
   void tick();
@@ -138,7 +141,12 @@ class DrillNode final : public MissionPorts {
   /// The mission's hole depth [m] (kDefaultDepth before a mission).
   [[nodiscard]] double hole_depth() const;
   void start_reanchor(Motion next);
-  void look_at_hole();
+  void look_at_hole(std::size_t first = 0);
+  bool prepare_look();
+  msg::PlanRequest look_plan(std::size_t attempt) const;
+  void check_look(std::size_t attempt);
+  void posture_reached();
+  void hole_request_write();
   /// Moves the area's blob holes by `shift` (world frame): odometry drifted by that much.
   void shift_area(const Eigen::Vector3d& shift);
   /// While the whole body moves to a blob hole's posture: the area's blobs followed in the
@@ -267,6 +275,17 @@ class DrillNode final : public MissionPorts {
   Eigen::Vector3d body_goal_{Eigen::Vector3d::Zero()};
   bool body_replanned_{false};
   std::size_t look_attempt_{0};    // which of kLooks the look request is
+  // A marker hole's whole-body posture is planned without executing it, and a look at the marker
+  // planned from its end (check_look) before the base moves: without a look there the hole is
+  // drilled where odometry puts it. The candidate path, the draws of it so far, the check's
+  // request and which of kLooks it is.
+  PlannedPath body_candidate_;
+  std::size_t body_draws_{0};
+  std::uint32_t check_request_{0};
+  std::size_t check_attempt_{0};
+  std::size_t checked_look_{0};  // the kLooks attempt the check found (the look starts there)
+  PlannedPath checked_path_;     // its path from the candidate's end; empty: none found
+  bool trajectory_ran(const std::string& what);
   Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the mark as predicted (world)
   double look_reach_{0.0};  // how far from look_goal_ the look must see, any roll [m]; 0: the mark
   double hole_reached_{0.0};  // camera distance of the hole's posture reached [m]
