@@ -126,7 +126,8 @@ class DrillNode final : public MissionPorts {
     kBackToPosture,
     kCheckLook,   // a marker hole's whole-body posture planned, not executed: is a look possible from it?
     kBodyToHole,  // that posture's path sent to the robot by the drill itself
-    kCheckedLook  // then the look's path check_look() planned, sent likewise
+    kCheckedLook,  // then the look's path check_look() planned, sent likewise
+    kBackForLook   // the marker not seen from a look: back onto the posture for the next look
   };
 
   void tick();
@@ -163,9 +164,9 @@ class DrillNode final : public MissionPorts {
   [[nodiscard]] double camera_fov() const;
   /// A hole measured again with the camera turned onto its blob / marker (kLookReanchor).
   bool remeasure_looked_blob(const CameraView& camera);
-  void remeasure_looked_marker(const CameraView& camera);
+  bool remeasure_looked_marker(const CameraView& camera);
   /// From the look posture back onto the whole body's posture, then the alignment.
-  void back_to_posture(const Sample& s);
+  void back_to_posture(const Sample& s, Motion next = Motion::kBackToPosture);
   void request_look(std::size_t attempt);
   [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
   // The measured state of `names` (base joints from odometry) as a trajectory sample at t = 0.
@@ -254,6 +255,7 @@ class DrillNode final : public MissionPorts {
   double camera_to_tip_{0.0};  // the tool's camera to its tip along the camera's axis [m]
   std::size_t hole_attempt_{0};  // which of kHoleAttempts the hole's posture request is
   double drilling_lead_{1.0};    // the lead the hole's posture holds the thrust of (light_drilling)
+  std::string light_why_;        // why the hole is drilled at drilling_lead_ < 1 (the log)
   std::int64_t reanchor_since_ns_{0};
   std::vector<DrillPoint> area_points_;  // the current area's holes as detected
   struct PlannedPath {
@@ -273,7 +275,7 @@ class DrillNode final : public MissionPorts {
   // planned for (world), and whether it was planned once more at the hole measured again.
   std::size_t body_attempt_{0};
   Eigen::Vector3d body_goal_{Eigen::Vector3d::Zero()};
-  bool body_replanned_{false};
+  std::size_t body_replans_{0};
   std::size_t look_attempt_{0};    // which of kLooks the look request is
   // A marker hole's whole-body posture is planned without executing it, and a look at the marker
   // planned from its end (check_look) before the base moves: without a look there the hole is
