@@ -17,7 +17,7 @@
 // wall records (concert/sim/holes) against the blobs' true positions (libs/world); not against
 // the service's own report. The ArUco pattern of the same wall is a scenario of the benchmark
 // (bench_drill_mission --scenario demo), not a test: its four holes are drilled in some runs
-// only (services/drill/README.md).
+// only (services/drill/README.md); a pattern of scenario 3 is drill_pattern_test's.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
