@@ -55,13 +55,15 @@ SafetyNode::SafetyNode(concert::dds::Participant& participant, Params params, st
                     [this](const auto& s, const auto&) { on_joint_state(s); }),
       resets_(participant, concert::dds::topics::safety_reset,
               [this](const auto& s, const auto&) { on_reset(s); }) {
-  std::string text;
-  {
-    std::lock_guard lock(mutex_);
-    publish_locked(true);
-    text = summary(monitor_.status());
-  }
-  status_.report(msg::SERVICE_READY, 0, text);
+  // Reported under the lock, at the model the monitor holds: the model reader above may have
+  // delivered the model already (a restarted safety joining a running system), and a "ready at
+  // model 0" sent after on_model's report left a restarted safety looking model-less for good
+  // (a chaos test run in CI: its limits of v2 loaded, its status at v0).
+  std::lock_guard lock(mutex_);
+  publish_locked(true);
+  status_.report(msg::SERVICE_READY,
+                 concert::dds::ModelId{monitor_.model_version(), model_hash_},
+                 summary(monitor_.status()));
 }
 
 SafetyMonitor SafetyNode::restored_monitor(Params params, const std::string& state_file, std::ostream& log) {
@@ -158,8 +160,8 @@ void SafetyNode::on_model(const msg::RobotModel& message) {
   } catch (const concert::model::ModelError& e) {
     error = e.what();
   }
-  std::string text;
   {
+    // The status is reported under the lock too, so that it always follows the latest model.
     std::lock_guard lock(mutex_);
     if (limits) {
       monitor_.set_model(message.version(), std::move(*limits));
@@ -169,16 +171,16 @@ void SafetyNode::on_model(const msg::RobotModel& message) {
       log_ << "safety: model v" << message.version() << " refused, limits of model v" << monitor_.model_version()
            << " kept: " << error << std::endl;
     }
-    text = summary(monitor_.status());
-  }
-  if (limits) {
-    status_.report(msg::SERVICE_READY,
-                   concert::dds::ModelId{message.version(), message.content_hash()}, text);
-  } else {
-    const std::string refusal =
-        "model v" + std::to_string(message.version()) + " refused: " + error;
-    status_.report(msg::SERVICE_ERROR, monitor_.model_version(), refusal);
-    status_.refused(refusal);
+    if (limits) {
+      status_.report(msg::SERVICE_READY,
+                     concert::dds::ModelId{message.version(), message.content_hash()},
+                     summary(monitor_.status()));
+    } else {
+      const std::string refusal =
+          "model v" + std::to_string(message.version()) + " refused: " + error;
+      status_.report(msg::SERVICE_ERROR, monitor_.model_version(), refusal);
+      status_.refused(refusal);
+    }
   }
 }
 
