@@ -1496,6 +1496,20 @@ bool DrillNode::remeasure_looked_marker(const CameraView& camera) {
   return false;
 }
 
+// The latest result of plan request `id`, if any has come.
+std::optional<msg::PlanResult> DrillNode::plan_result(std::uint32_t id) const {
+  std::lock_guard lock(mutex_);
+  const auto it = plan_results_.find(id);
+  if (it == plan_results_.end()) return std::nullopt;
+  return it->second;
+}
+
+// The whole body's candidate posture (body_candidate_) sent to the robot by the drill.
+void DrillNode::move_to_candidate() {
+  trajectory_request_ = send_trajectory(body_candidate_.names, body_candidate_.samples);
+  motion_ = Motion::kBodyToHole;
+}
+
 // The drill's own trajectory (trajectory_request_): true once the robot ran it; refused or
 // aborted, the hole fails ("robot: <what>: <reason>").
 bool DrillNode::trajectory_ran(const std::string& what) {
@@ -1568,12 +1582,7 @@ void DrillNode::posture_reached() {
 void DrillNode::control_motion() {
   if (motion_ == Motion::kNone || motion_outcome_) return;
   if (motion_ == Motion::kApproachHole) {
-    std::optional<msg::PlanResult> r;
-    {
-      std::lock_guard lock(mutex_);
-      const auto it = plan_results_.find(hole_plan_request_);
-      if (it != plan_results_.end()) r = it->second;
-    }
+    const std::optional<msg::PlanResult> r = plan_result(hole_plan_request_);
     track_area();
     if (!r) return;
     // The trajectory comes with PLANNED and the execution updates; SUCCEEDED may arrive alone.
@@ -1652,8 +1661,7 @@ void DrillNode::control_motion() {
       checked_path_ = {};
       ++body_draws_;
       if (body_candidate_.samples.empty() || !prepare_look()) {
-        trajectory_request_ = send_trajectory(body_candidate_.names, body_candidate_.samples);
-        motion_ = Motion::kBodyToHole;
+        move_to_candidate();
       } else {
         check_look(0);
       }
@@ -1663,12 +1671,7 @@ void DrillNode::control_motion() {
     return;
   }
   if (motion_ == Motion::kCheckLook) {
-    std::optional<msg::PlanResult> r;
-    {
-      std::lock_guard lock(mutex_);
-      const auto it = plan_results_.find(check_request_);
-      if (it != plan_results_.end()) r = it->second;
-    }
+    const std::optional<msg::PlanResult> r = plan_result(check_request_);
     if (!r || (r->state() != msg::PLAN_SUCCEEDED && r->state() != msg::PLAN_FAILED)) return;
     const std::string marker = "marker " + std::to_string(point_.marker);
     if (r->state() == msg::PLAN_SUCCEEDED) {
@@ -1697,8 +1700,7 @@ void DrillNode::control_motion() {
                " from any of " + std::to_string(body_draws_) +
                " whole-body postures drawn; the last one taken");
     }
-    trajectory_request_ = send_trajectory(body_candidate_.names, body_candidate_.samples);
-    motion_ = Motion::kBodyToHole;
+    move_to_candidate();
     return;
   }
   if (motion_ == Motion::kBodyToHole) {
@@ -1717,12 +1719,7 @@ void DrillNode::control_motion() {
     return;
   }
   if (motion_ == Motion::kLookAtHole) {
-    std::optional<msg::PlanResult> r;
-    {
-      std::lock_guard lock(mutex_);
-      const auto it = plan_results_.find(look_request_);
-      if (it != plan_results_.end()) r = it->second;
-    }
+    const std::optional<msg::PlanResult> r = plan_result(look_request_);
     if (!r) return;
     if (!r->trajectory().empty()) look_path_ = {r->joint_names(), r->trajectory()};
     if (r->state() == msg::PLAN_SUCCEEDED) {

@@ -288,6 +288,8 @@ class DrillNode final : public MissionPorts {
   std::size_t checked_look_{0};  // the kLooks attempt the check found (the look starts there)
   PlannedPath checked_path_;     // its path from the candidate's end; empty: none found
   bool trajectory_ran(const std::string& what);
+  std::optional<msg::PlanResult> plan_result(std::uint32_t id) const;
+  void move_to_candidate();
   Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the mark as predicted (world)
   double look_reach_{0.0};  // how far from look_goal_ the look must see, any roll [m]; 0: the mark
   double hole_reached_{0.0};  // camera distance of the hole's posture reached [m]
