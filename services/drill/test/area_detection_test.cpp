@@ -287,5 +287,48 @@ TEST(HoleOfSeenMarker, TheMarkersShiftMovesTheHoleItsTurnDoesNot) {
   EXPECT_FALSE(hole_of_seen_marker(blob, seen, patterns));
 }
 
+// Scenario 3's wall carries several markers of one id (one pattern each): a hole's marker is
+// the one of its id nearest where it was expected, whichever the detector lists first.
+TEST(FindMarker, OfTwoMarkersWithTheHolesIdTheNearestIsTaken) {
+  world::World w;
+  world::WorldShape wall;
+  wall.name = "wall";
+  wall.size = {0.2, 5.0, 3.0};
+  wall.position = {2.1, 0.0, 1.5};
+  w.walls.push_back(wall);
+  for (const double u : {-0.13, 0.13}) {
+    world::Mark m;
+    m.name = u < 0 ? "left" : "right";
+    m.type = world::Mark::Type::kAruco;
+    m.wall = "wall";
+    m.face = world::Face::kMinusX;
+    m.at = {u, 1.2};
+    m.size = 0.1;
+    m.dictionary = "DICT_4X4_50";
+    m.id = 0;
+    w.marks.push_back(m);
+  }
+  const PatternTable patterns = parse_patterns(
+      "dictionary: DICT_4X4_50\nmarker_size: 0.1\npatterns:\n"
+      "  0: {centre: [0.0, -0.15], direction: 0.0, count: 4, spacing: 0.2}\n",
+      "test");
+  sim::CameraParams params;
+  params.noise = true;
+  const Eigen::Isometry3d camera =
+      sim::look_at(Eigen::Vector3d(1.4, 0.0, 1.2), Eigen::Vector3d(2.0, 0.0, 1.2));
+  const hardware::RgbdFrame frame = sim::SceneCamera(w, params, 5).render(camera);
+  const CameraView view{&frame, camera};
+  const auto truth = world::mark_truth(w);
+  ASSERT_EQ(truth.size(), 2u);
+  for (const auto& t : truth) {
+    // Expected 3 cm off (odometry's drift over an approach): still the nearer of the two.
+    const Eigen::Vector3d near = t.centre + Eigen::Vector3d(0.0, 0.02, -0.0224);
+    const std::optional<Eigen::Isometry3d> found = find_marker(view, 0, near, patterns);
+    ASSERT_TRUE(found);
+    EXPECT_LT((found->translation() - t.centre).norm(), 0.003) << found->translation().transpose();
+  }
+  EXPECT_FALSE(find_marker(view, 1, truth[0].centre, patterns));  // no marker of that id
+}
+
 }  // namespace
 }  // namespace concert::drill

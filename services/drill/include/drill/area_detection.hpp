@@ -104,8 +104,10 @@ std::optional<Eigen::Isometry3d> hole_of_seen_marker(const DrillPoint& hole,
                                                      const Eigen::Isometry3d& seen,
                                                      const PatternTable& patterns);
 
-/// Where marker `id` stands in a view (world frame, depth-refined), if it is detected.
+/// Where marker `id` stands in a view (world frame, depth-refined), if it is detected; of
+/// several markers with that id, the one nearest `near` (world frame).
 std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,
+                                             const Eigen::Vector3d& near,
                                              const PatternTable& patterns);
 
 /// How an area's blobs appear in a view against where they were predicted (blob_shift).

@@ -194,8 +194,9 @@ std::optional<Eigen::Isometry3d> reanchor(const CameraView& view, const DrillPoi
       }
       if (best != nullptr)
         return view.world_T_optical * area_frame(surface_at(frame, best->pixel), up);
-    } else if (const std::optional<Eigen::Isometry3d> marker =
-                   find_marker(view, hole.marker, patterns)) {
+    } else if (const std::optional<Eigen::Isometry3d> marker = find_marker(
+                   view, hole.marker, marker_of(hole, patterns).value_or(hole.frame).translation(),
+                   patterns)) {
       const std::optional<Eigen::Isometry3d> seen = hole_of_seen_marker(hole, *marker, patterns);
       if (seen && (seen->translation() - predicted).norm() <= max_distance) return seen;
     }
@@ -241,14 +242,21 @@ std::optional<Eigen::Isometry3d> hole_of_seen_marker(const DrillPoint& hole,
 }
 
 std::optional<Eigen::Isometry3d> find_marker(const CameraView& view, int id,
+                                             const Eigen::Vector3d& near,
                                              const PatternTable& patterns) {
   ArucoParams params;
   params.dictionary = patterns.dictionary();
   params.marker_size = patterns.marker_size();
+  // A wall can carry several markers of one id (scenario 3's wall: four of id 0, one pattern
+  // each): the one nearest where this one was expected, not the first the detector lists.
+  std::optional<Eigen::Isometry3d> best;
   for (const ArucoDetection& m : detect_aruco(*view.frame, params)) {
-    if (m.id == id) return view.world_T_optical * m.optical_T_marker;
+    if (m.id != id) continue;
+    const Eigen::Isometry3d world_T_marker = view.world_T_optical * m.optical_T_marker;
+    if (!best || (world_T_marker.translation() - near).norm() < (best->translation() - near).norm())
+      best = world_T_marker;
   }
-  return std::nullopt;
+  return best;
 }
 
 std::optional<AreaShift> blob_shift(const CameraView& view, const std::vector<DrillPoint>& area_points,

@@ -1472,7 +1472,10 @@ bool DrillNode::remeasure_looked_blob(const CameraView& camera) {
 bool DrillNode::remeasure_looked_marker(const CameraView& camera) {
   std::optional<Eigen::Isometry3d> marker;
   try {
-    if (patterns_) marker = find_marker(camera, point_.marker, *patterns_);
+    if (patterns_)
+      marker = find_marker(camera, point_.marker,
+                           marker_of(point_, *patterns_).value_or(point_.frame).translation(),
+                           *patterns_);
   } catch (const DrillError&) {
     marker.reset();
   }
