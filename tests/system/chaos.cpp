@@ -64,6 +64,7 @@ constexpr auto kAnswerBound = 120s;
 /// The planner publishes PLANNING as soon as it takes a request: nothing within this bound and
 /// the request never reached it (lost).
 constexpr auto kAckBound = 3s;
+constexpr auto kResendAfter = 1s;  // an unacknowledged request is sent again after this
 /// An operator's reset not answered within this bound (neither RUNNING nor a refusal) is lost.
 constexpr auto kResetAnswer = 1s;
 
@@ -97,6 +98,8 @@ struct Request {
   std::optional<msg::PlanResult> final;
   bool probe = false;
   bool with_planner = false;  // unanswered: the planner was down while it waited for it
+  msg::PlanRequest message;   // as sent (sent again, same id, while unacknowledged)
+  int resends = 0;
 };
 
 std::string state_name(msg::ServiceState s) {
@@ -411,6 +414,10 @@ struct Chaos::Impl {
     req.source(probe ? "chaos probe" : "chaos task");
     req.execute(true);
     req.goals().push_back(drilling_area(kAreas[area]));
+    {
+      std::lock_guard lock(m);
+      requests[req.request_id()].message = req;
+    }
     request_writer.write(req);
     return req.request_id();
   }
@@ -426,8 +433,21 @@ struct Chaos::Impl {
       return requests.at(id).sent;
     }();
     const auto gone = [&] { return task_stop || down_between("planner", sent, Clock::now()); };
-    const bool taken =
-        wait_until(sent + kAckBound, [&] { return requests.at(id).acknowledged || gone(); });
+    // Unacknowledged, sent again every kResendAfter as the drill does (a request written
+    // before this writer matched a restarted planner's reader is lost: PlanRequest is volatile).
+    bool taken = false;
+    for (auto slice = sent + kResendAfter;; slice += kResendAfter) {
+      const auto until = std::min(slice, sent + kAckBound);
+      taken = wait_until(until, [&] { return requests.at(id).acknowledged || gone(); });
+      if (taken || until >= sent + kAckBound) break;
+      msg::PlanRequest again;
+      {
+        std::lock_guard lock(m);
+        ++requests.at(id).resends;
+        again = requests.at(id).message;
+      }
+      request_writer.write(again);
+    }
     if (taken) {
       wait_until(sent + bound, [&] {
         result = requests.at(id).final;

@@ -93,3 +93,46 @@ TEST(DrillNode, AnExecutedPlansTrajectoryOutlivesItsUpdates) {
 
 }  // namespace
 }  // namespace concert::drill::dds
+
+namespace concert::drill::dds {
+namespace {
+
+// PlanRequest is volatile: a request written before the drill's writer matched the planner's
+// reader (a planner just restarted) is lost. The drill sends a plan request again, same id,
+// every 2 s until the planner acknowledges it (PLAN_PLANNING), and no more once it has.
+TEST(DrillNode, APlanRequestIsSentAgainUntilThePlannerAcknowledgesIt) {
+  concert::dds::Participant participant({.name = "drill_node_resend_test"});
+  std::ostringstream log;
+  DrillNode node(participant, NodeParams{}, log);
+  // Written before the test's reader exists: that first copy reaches nobody.
+  node.plan(0, Eigen::Isometry3d::Identity(), std::nullopt);
+  concert::dds::Reader<msg::PlanRequest> requests(participant, concert::dds::topics::plan_request);
+  concert::dds::Writer<msg::PlanResult> results(participant, concert::dds::topics::plan_result);
+  std::atomic<bool> stop{false};
+  std::thread spinner([&] { node.spin(stop); });
+  std::optional<msg::PlanRequest> first = requests.wait(6000ms);
+  ASSERT_TRUE(first) << "no plan request sent again within 6 s\n" << log.str();
+  EXPECT_EQ(first->source(), "drill");
+  // Acknowledged: no copy after the one in flight.
+  msg::PlanResult ack;
+  ack.request_id(first->request_id());
+  ack.state(msg::PLAN_PLANNING);
+  results.write(ack);
+  int copies = 0;
+  const auto until = std::chrono::steady_clock::now() + 5s;
+  while (std::chrono::steady_clock::now() < until) {
+    const auto r = requests.wait(200ms);
+    if (r && r->request_id() == first->request_id()) ++copies;
+  }
+  stop = true;
+  spinner.join();
+  EXPECT_LE(copies, 1) << log.str();
+  EXPECT_GE(count(log.str(), "plan request " + std::to_string(first->request_id()) +
+                                 " not acknowledged by the planner within 2 s; sent again (1 of 5)"),
+            1u)
+      << log.str();
+  EXPECT_EQ(count(log.str(), "sent again (4 of 5)"), 0u) << log.str();
+}
+
+}  // namespace
+}  // namespace concert::drill::dds

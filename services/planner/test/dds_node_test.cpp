@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <algorithm>
 #include <functional>
+#include <map>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -156,6 +158,58 @@ TEST_F(PlannerNodeTest, StaleVersionIsRefusedAndPlansCarryTheTrajectory) {
     EXPECT_EQ(r.trajectory().back().position().size(), 9u);
   }
   EXPECT_TRUE(planned) << "no update with the trajectory";
+}
+
+// A client that hears nothing of a request sends it again (PlanRequest is volatile: one
+// written before the writer matched a restarted planner is lost). The planner acknowledges each
+// request as it arrives, before it waits behind another, and takes a resend (same source, same
+// id) only once; the same id from another source is another request.
+TEST_F(PlannerNodeTest, ARequestIsAcknowledgedOnArrivalAndAResendIsNotPlannedAgain) {
+  publish_model('a', 5);
+  ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
+  requests_->write(request(31, 5, 2.2, false));
+  requests_->write(request(32, 5, 1.8, false));  // behind 31
+  requests_->write(request(31, 5, 2.2, false));  // a resend of 31
+  msg::PlanRequest other = request(31, 5, 1.8, false);
+  other.source("another client");
+  requests_->write(other);
+  std::vector<std::pair<uint32_t, msg::PlanState>> seen;  // in the order they came
+  int finals = 0;
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (finals < 3 && std::chrono::steady_clock::now() < deadline) {
+    const auto r = results_->wait(200ms);
+    if (!r) continue;
+    seen.emplace_back(r->request_id(), r->state());
+    if (r->state() == msg::PLAN_SUCCEEDED || r->state() == msg::PLAN_FAILED) ++finals;
+  }
+  ASSERT_EQ(finals, 3) << log_.str();
+  // 32 was acknowledged before 31's answer came.
+  const auto first = [&](uint32_t id, auto pred) {
+    return std::find_if(seen.begin(), seen.end(),
+                        [&](const auto& e) { return e.first == id && pred(e.second); }) -
+           seen.begin();
+  };
+  const auto ack32 = first(32, [](msg::PlanState st) { return st == msg::PLAN_PLANNING; });
+  const auto done31 = first(31, [](msg::PlanState st) {
+    return st == msg::PLAN_SUCCEEDED || st == msg::PLAN_FAILED;
+  });
+  EXPECT_LT(ack32, done31) << "request 32 was not acknowledged while 31 was planned";
+  // Planned three times: 31, 32 and the other client's 31; the resend not at all.
+  const std::string log = log_.str();
+  std::size_t planned = 0;
+  for (std::size_t at = log.find("planner: request 31: "); at != std::string::npos;
+       at = log.find("planner: request 31: ", at + 1))
+    ++planned;
+  EXPECT_EQ(planned, 2u) << log;
+  EXPECT_NE(log.find("planner: request 32: "), std::string::npos) << log;
+  // Nothing more comes for 31.
+  const auto quiet = std::chrono::steady_clock::now() + 1s;
+  while (std::chrono::steady_clock::now() < quiet) {
+    const auto r = results_->wait(100ms);
+    if (r && r->request_id() == 31) {
+      EXPECT_NE(r->state(), msg::PLAN_SUCCEEDED) << "request 31 answered a third time";
+    }
+  }
 }
 
 TEST_F(PlannerNodeTest, AGivenStartStateIsPlannedFromAndNotExecuted) {

@@ -22,6 +22,10 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 constexpr const char* kSource = "drill";
+// A plan request the planner has not acknowledged within this [s] is sent again, up to
+// kPlanResends times (resend_unacknowledged).
+constexpr double kPlanAckBound = 2.0;
+constexpr int kPlanResends = 5;
 // A service whose status was last seen longer ago than this is lost [s] (heartbeat 1 s).
 constexpr double kServiceLost = 5.0;
 // Joint states older than this mean the robot service is gone [s].
@@ -521,6 +525,7 @@ void DrillNode::tick() {
     log_line("drill: mission " + std::to_string(mission_id_) + " aborted");
   }
   for (const msg::DrillMission& m : in.missions) start_mission(m);
+  resend_unacknowledged();
   camera_wanted_.store(mission_active(), std::memory_order_relaxed);
   if (mission_active()) {
     control_motion();
@@ -534,6 +539,41 @@ void DrillNode::tick() {
     }
   }
   publish_status(false);
+}
+
+// A plan request to the planner, sent again (same id) while the planner acknowledges nothing
+// (resend_unacknowledged).
+void DrillNode::send_plan(const msg::PlanRequest& r) {
+  plan_requests_.write(r);
+  unacknowledged_[r.request_id()] = {r, now_, 0};
+}
+
+// PlanRequest is volatile: one written before this writer matched the reader of a planner that
+// just (re)started is lost, and the drill would wait for its answer for good. The planner
+// acknowledges each request as it arrives (PLAN_PLANNING) and takes a resend only once.
+void DrillNode::resend_unacknowledged() {
+  for (auto it = unacknowledged_.begin(); it != unacknowledged_.end();) {
+    if (plan_result(it->first)) {
+      it = unacknowledged_.erase(it);
+      continue;
+    }
+    Unacknowledged& u = it->second;
+    if (now_ - u.sent >= kPlanAckBound) {
+      if (u.resends >= kPlanResends) {
+        log_line("drill: plan request " + std::to_string(it->first) + " not acknowledged by the planner after " +
+                 std::to_string(kPlanResends + 1) + " sends; waiting for its answer");
+        it = unacknowledged_.erase(it);
+        continue;
+      }
+      ++u.resends;
+      u.sent = now_;
+      log_line("drill: plan request " + std::to_string(it->first) + " not acknowledged by the planner within " +
+               std::to_string(static_cast<int>(kPlanAckBound)) + " s; sent again (" +
+               std::to_string(u.resends) + " of " + std::to_string(kPlanResends) + ")");
+      plan_requests_.write(u.request);
+    }
+    ++it;
+  }
 }
 
 void DrillNode::apply_model(const msg::RobotModel& m) {
@@ -812,7 +852,7 @@ void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& located,
   }
   p.request = r;
   plans_[area] = p;
-  plan_requests_.write(r);
+  send_plan(r);
 }
 
 Outcome DrillNode::planning(std::size_t area) {
@@ -837,7 +877,7 @@ Outcome DrillNode::planning(std::size_t area) {
     log_line("drill: area " + std::to_string(area) + ": " + r->reason() +
              "; planning again (attempt " + std::to_string(p.attempts) + " of " +
              std::to_string(kPlanAttempts) + ")");
-    plan_requests_.write(p.request);
+    send_plan(p.request);
     return Outcome::running();
   }
   if (r->state() == msg::PLAN_FAILED) return Outcome::failed("planner: " + r->reason());
@@ -1113,7 +1153,7 @@ void DrillNode::align(const DrillPoint& point) {
 // base moves, check_look() asks whether the camera can be turned onto the marker from it.
 void DrillNode::hole_request_write() {
   hole_request_.execute(!(point_.marker >= 0 && patterns_ && !hole_request_.fixed_base()));
-  plan_requests_.write(hole_request_);
+  send_plan(hole_request_);
 }
 
 double DrillNode::hole_depth() const { return mission_ ? mission_->depth : kDefaultDepth; }
@@ -1381,7 +1421,7 @@ void DrillNode::request_look(std::size_t attempt) {
   look_request_ = next_request_++;
   r.request_id(look_request_);
   r.execute(true);
-  plan_requests_.write(r);
+  send_plan(r);
   look_path_ = {};
   motion_ = Motion::kLookAtHole;
 }
@@ -1396,7 +1436,7 @@ void DrillNode::check_look(std::size_t attempt) {
   r.execute(false);
   r.start_names(body_candidate_.names);
   r.start_position(body_candidate_.samples.back().position());
-  plan_requests_.write(r);
+  send_plan(r);
   motion_ = Motion::kCheckLook;
 }
 

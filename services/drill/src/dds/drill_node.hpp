@@ -16,6 +16,7 @@
 #include <mutex>
 #include <optional>
 #include <ostream>
+#include <random>
 #include <string>
 #include <utility>
 
@@ -225,7 +226,17 @@ class DrillNode final : public MissionPorts {
   std::optional<PatternTable> patterns_;
   std::chrono::steady_clock::time_point last_status_{};
   std::string last_active_;
-  std::uint32_t next_request_{1};
+  // Request ids (plan, trajectory, navigation) start anywhere: a restarted drill numbering from 1
+  // again would take the planner's latched results of its predecessor's requests for its own.
+  std::uint32_t next_request_{(std::random_device{}() & 0x3fffffffu) + 1u};
+  struct Unacknowledged {
+    msg::PlanRequest request;
+    double sent{0.0};  // last sent (now_) [s]
+    int resends{0};
+  };
+  std::map<std::uint32_t, Unacknowledged> unacknowledged_;  // plan requests by id
+  void send_plan(const msg::PlanRequest& r);
+  void resend_unacknowledged();
   std::map<std::size_t, std::future<ResolvedArea>> resolving_;
   std::map<std::size_t, std::int64_t> resolve_since_;
   std::map<std::size_t, AreaSpec> resolve_specs_;

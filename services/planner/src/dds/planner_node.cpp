@@ -142,13 +142,7 @@ PlannerNode::PlannerNode(concert::dds::Participant& participant, Planner& planne
       worlds_(participant, concert::dds::topics::world,
               [this](const msg::World& w, const auto&) { on_world(w); }),
       request_reader_(participant, concert::dds::topics::plan_request,
-                      [this](const auto& s, const auto&) {
-                        {
-                          std::lock_guard lock(mutex_);
-                          requests_.push_back(s);
-                        }
-                        wake_.notify_all();
-                      }) {
+                      [this](const msg::PlanRequest& s, const auto&) { take(s); }) {
   const std::string& source = planner_.params().environment_source;
   if (use_sensors_) {
     lidars_ = std::make_unique<concert::dds::Reader<msg::LidarScan>>(
@@ -293,6 +287,31 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
       log_line(line.str());
     }
   }
+}
+
+// A request is acknowledged as it arrives (PLAN_PLANNING), before it waits behind others: a
+// client that hears nothing sends it again (a request written before its writer matched a
+// restarted planner's reader is lost: PlanRequest is volatile). A request already taken, by
+// source and id, is not taken twice.
+void PlannerNode::take(const msg::PlanRequest& request) {
+  {
+    std::lock_guard lock(mutex_);
+    std::pair<std::string, std::uint32_t> key{request.source(), request.request_id()};
+    if (!taken_.insert(key).second) return;
+    taken_order_.push_back(std::move(key));
+    if (taken_order_.size() > kTakenKept) {
+      taken_.erase(taken_order_.front());
+      taken_order_.pop_front();
+    }
+    requests_.push_back(request);
+  }
+  msg::PlanResult ack;
+  ack.request_id(request.request_id());
+  ack.model_version(static_cast<uint32_t>(planner_.model_version()));
+  ack.goal_count(static_cast<uint32_t>(request.goals().size()));
+  ack.state(msg::PLAN_PLANNING);
+  publish(ack);
+  wake_.notify_all();
 }
 
 void PlannerNode::publish(msg::PlanResult result) {

@@ -30,7 +30,10 @@
 #include <mutex>
 #include <optional>
 #include <ostream>
+#include <set>
+#include <string>
 #include <thread>
+#include <utility>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
@@ -99,6 +102,8 @@ class PlannerNode {
   void on_model(const msg::RobotModel& model);
   void handle(const msg::PlanRequest& request);
   void publish(msg::PlanResult result);
+  /// A request as it arrives: queued and acknowledged, unless taken already.
+  void take(const msg::PlanRequest& request);
   void execute_loop();
   void warm_up_loop();
   void log_line(const std::string& line);
@@ -122,6 +127,10 @@ class PlannerNode {
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<msg::PlanRequest> requests_;
+  // The requests taken lately (source, id), oldest first: a client's resend is not taken again.
+  static constexpr std::size_t kTakenKept = 4096;
+  std::set<std::pair<std::string, std::uint32_t>> taken_;
+  std::deque<std::pair<std::string, std::uint32_t>> taken_order_;
   std::deque<Execution> executions_;
   std::optional<msg::JointState> joint_state_;
   std::optional<msg::Odometry> odometry_;
