@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <sstream>
 #include <string>
@@ -132,6 +133,40 @@ TEST(DrillNode, APlanRequestIsSentAgainUntilThePlannerAcknowledgesIt) {
             1u)
       << log.str();
   EXPECT_EQ(count(log.str(), "sent again (4 of 5)"), 0u) << log.str();
+}
+
+}  // namespace
+}  // namespace concert::drill::dds
+
+namespace concert::drill::dds {
+namespace {
+
+// The measured state a drill trajectory starts from: odometry's yaw is wrapped to (-pi, pi], a
+// plan's is not. A robot facing -x measured -3.14 where its posture said 3.13: the straight line
+// between them turned the base a whole turn with the bit at the wall (a CI run's safety stop).
+TEST(DrillNode, TheMeasuredYawIsTakenWithinHalfATurnOfThePlannedOne) {
+  const std::vector<std::string> names{"base_x", "base_y", "base_yaw", "J1_E"};
+  DrillNode::Sample s;
+  s.odometry = Eigen::Vector3d(1.5, -0.2, -3.14);
+  s.joints.names = {"J1_E", "J2_E"};
+  s.joints.positions = {0.4, -1.0};
+  msg::TrajectorySample planned;
+  planned.position({1.52, -0.21, 3.13, 0.5});
+  const msg::TrajectorySample here = DrillNode::sample_here(names, s, planned);
+  ASSERT_EQ(here.position().size(), 4u);
+  EXPECT_DOUBLE_EQ(here.position()[0], 1.5);
+  EXPECT_DOUBLE_EQ(here.position()[1], -0.2);
+  EXPECT_NEAR(here.position()[2], 2.0 * M_PI - 3.14, 1e-12);  // 3.1432: 0.013 rad from 3.13
+  EXPECT_DOUBLE_EQ(here.position()[3], 0.4);
+  EXPECT_EQ(here.velocity(), std::vector<double>(4, 0.0));
+  // A plan two turns on (the planner keeps yaw near its start's): the same yaw two turns on.
+  planned.position()[2] = 4.0 * M_PI + 0.1;
+  s.odometry.z() = 0.12;
+  EXPECT_NEAR(DrillNode::sample_here(names, s, planned).position()[2], 4.0 * M_PI + 0.12, 1e-12);
+  // Time to settle from there: 0.02 rad at 1/3 of 0.5 rad/s, at least a second.
+  planned.position()[2] = 3.13;
+  s.odometry.z() = -3.14;
+  EXPECT_LT(DrillNode::settle_time(names, DrillNode::sample_here(names, s, planned), planned), 1.01);
 }
 
 }  // namespace

@@ -931,7 +931,8 @@ void DrillNode::execute(std::size_t area) {
 
 // From the measured state back through every hole's planned path, reversed.
 std::vector<msg::TrajectorySample> DrillNode::return_path(const Sample& s) const {
-  std::vector<msg::TrajectorySample> back{sample_here(hole_chain_.front().names, s)};
+  std::vector<msg::TrajectorySample> back{
+      sample_here(hole_chain_.front().names, s, hole_chain_.back().samples.back())};
   double t = 0.0;
   for (auto path = hole_chain_.rbegin(); path != hole_chain_.rend(); ++path) {
     // Each path's end is the hole's posture, where the arm went back after its retract: a
@@ -966,12 +967,20 @@ double DrillNode::settle_time(const std::vector<std::string>& names,
 }
 
 msg::TrajectorySample DrillNode::sample_here(const std::vector<std::string>& names,
-                                             const Sample& s) {
+                                             const Sample& s, const msg::TrajectorySample& towards) {
   msg::TrajectorySample here;
   here.time(0.0);
-  for (const std::string& n : names) {
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const std::string& n = names[i];
     double v = 0.0;
-    if (n == "base_x" || n == "base_y" || n == "base_yaw") {
+    if (n == "base_yaw" && i < towards.position().size()) {
+      // Odometry's yaw is wrapped to (-pi, pi], the planner's is not (it is kept near the
+      // start's): a robot facing -x measures -3.14 where its plan says 3.13, and the straight
+      // line between them turned the base a whole turn with the bit at the wall (a CI run: a
+      // 38 s "settle" after a hole, then a safety stop on J1_E's sustained torque).
+      const double planned = towards.position()[i];
+      v = planned + std::remainder(s.odometry[2] - planned, 2.0 * M_PI);
+    } else if (n == "base_x" || n == "base_y" || n == "base_yaw") {
       v = s.odometry[n == "base_x" ? 0 : n == "base_y" ? 1 : 2];
     } else {
       const auto it = std::find(s.joints.names.begin(), s.joints.names.end(), n);
@@ -1356,7 +1365,7 @@ void DrillNode::back_to_posture(const Sample& s, Motion next) {
   hole_chain_.pop_back();
   look_pushed_ = false;
   const PlannedPath& p = hole_chain_.back();
-  const msg::TrajectorySample here = sample_here(p.names, s);
+  const msg::TrajectorySample here = sample_here(p.names, s, p.samples.back());
   msg::TrajectorySample end = p.samples.back();
   end.time(settle_time(p.names, here, end));
   for (double& v : end.velocity()) v = 0.0;
@@ -1602,7 +1611,8 @@ void DrillNode::posture_reached() {
     looked_ = true;
     // The arm alone: the base keeps the pose it stands at, not the one the check started from.
     std::vector<msg::TrajectorySample> path = checked_path_.samples;
-    const msg::TrajectorySample here = sample_here(checked_path_.names, *s);
+    const msg::TrajectorySample here =
+        sample_here(checked_path_.names, *s, checked_path_.samples.front());
     path.front() = here;
     for (msg::TrajectorySample& p : path) {
       for (std::size_t i = 0; i < checked_path_.names.size() && i < p.position().size(); ++i) {
@@ -1922,7 +1932,7 @@ void DrillNode::control_motion() {
     // Cartesian phases leave it a little off (up to 0.1 rad on the demo's arm, two of its links
     // then inside each other by the planner's shapes), and the next hole is planned from here.
     const PlannedPath& p = hole_chain_.back();
-    const msg::TrajectorySample here = sample_here(p.names, *s);
+    const msg::TrajectorySample here = sample_here(p.names, *s, p.samples.back());
     msg::TrajectorySample end = p.samples.back();
     const double t = settle_time(p.names, here, end);
     end.time(t);
@@ -1930,6 +1940,13 @@ void DrillNode::control_motion() {
     if (t > kSettleBack) {
       std::ostringstream line;
       line << "drill: " << point_.label << ": back onto the drilling posture over " << t << " s";
+      std::size_t far = 0;
+      for (std::size_t i = 1; i < p.names.size() && i < here.position().size(); ++i) {
+        if (std::abs(end.position()[i] - here.position()[i]) > std::abs(end.position()[far] - here.position()[far]))
+          far = i;
+      }
+      if (far < p.names.size() && far < here.position().size())
+        line << " (" << p.names[far] << " from " << here.position()[far] << " to " << end.position()[far] << ")";
       log_line(line.str());
     }
     trajectory_request_ = send_trajectory(p.names, {here, end});

@@ -88,17 +88,29 @@ class DrillNode final : public MissionPorts {
   Outcome retraction() override;
   void stop() override;
 
- private:
-  struct Inbox {
-    std::optional<msg::RobotModel> model;
-    std::deque<msg::DrillMission> missions;
-    std::deque<msg::DrillAbort> aborts;
-  };
   /// A joint state with its odometry, as received (robot clock).
   struct Sample {
     std::int64_t stamp_ns{0};
     JointPositions joints;
     Eigen::Vector3d odometry{0, 0, 0};
+  };
+  // The measured state of `names` (base joints from odometry) as a trajectory sample at t = 0,
+  // to go on to the planned sample `towards` (same names): its base_yaw within half a turn of
+  // that one's.
+  [[nodiscard]] static msg::TrajectorySample sample_here(const std::vector<std::string>& names,
+                                                         const Sample& s,
+                                                         const msg::TrajectorySample& towards);
+
+  // Time to go straight from `from` to `to` at a third of a slow joint speed (at least 1 s).
+  [[nodiscard]] static double settle_time(const std::vector<std::string>& names,
+                                          const msg::TrajectorySample& from,
+                                          const msg::TrajectorySample& to);
+
+ private:
+  struct Inbox {
+    std::optional<msg::RobotModel> model;
+    std::deque<msg::DrillMission> missions;
+    std::deque<msg::DrillAbort> aborts;
   };
   struct Plan {
     std::uint32_t request_id{0};
@@ -170,12 +182,6 @@ class DrillNode final : public MissionPorts {
   void back_to_posture(const Sample& s, Motion next = Motion::kBackToPosture);
   void request_look(std::size_t attempt);
   [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
-  // The measured state of `names` (base joints from odometry) as a trajectory sample at t = 0.
-  [[nodiscard]] static double settle_time(const std::vector<std::string>& names,
-                                          const msg::TrajectorySample& from,
-                                          const msg::TrajectorySample& to);
-  [[nodiscard]] static msg::TrajectorySample sample_here(const std::vector<std::string>& names,
-                                                         const Sample& s);
   std::uint32_t send_trajectory(const std::vector<std::string>& names,
                                 const std::vector<msg::TrajectorySample>& samples);
   [[nodiscard]] std::optional<Sample> latest_sample() const;
