@@ -305,13 +305,18 @@ void PlannerNode::take(const msg::PlanRequest& request) {
     }
     requests_.push_back(request);
   }
-  msg::PlanResult ack;
-  ack.request_id(request.request_id());
-  ack.model_version(static_cast<uint32_t>(planner_.model_version()));
-  ack.goal_count(static_cast<uint32_t>(request.goals().size()));
-  ack.state(msg::PLAN_PLANNING);
-  publish(ack);
+  publish(planning(request));
   wake_.notify_all();
+}
+
+// The result every answer to `request` starts from: PLAN_PLANNING at the current model.
+msg::PlanResult PlannerNode::planning(const msg::PlanRequest& request) const {
+  msg::PlanResult r;
+  r.request_id(request.request_id());
+  r.model_version(static_cast<uint32_t>(planner_.model_version()));
+  r.goal_count(static_cast<uint32_t>(request.goals().size()));
+  r.state(msg::PLAN_PLANNING);
+  return r;
 }
 
 void PlannerNode::publish(msg::PlanResult result) {
@@ -357,11 +362,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
       map_error = why.str();
     }
   }
-  msg::PlanResult base;
-  base.request_id(request.request_id());
-  base.model_version(static_cast<uint32_t>(planner_.model_version()));
-  base.goal_count(static_cast<uint32_t>(request.goals().size()));
-  base.state(msg::PLAN_PLANNING);
+  msg::PlanResult base = planning(request);
   publish(base);
   const auto model = planner_.model();
 

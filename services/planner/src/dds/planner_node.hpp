@@ -104,6 +104,7 @@ class PlannerNode {
   void publish(msg::PlanResult result);
   /// A request as it arrives: queued and acknowledged, unless taken already.
   void take(const msg::PlanRequest& request);
+  [[nodiscard]] msg::PlanResult planning(const msg::PlanRequest& request) const;
   void execute_loop();
   void warm_up_loop();
   void log_line(const std::string& line);
