@@ -135,6 +135,24 @@ TEST(DrillNode, APlanRequestIsSentAgainUntilThePlannerAcknowledgesIt) {
   EXPECT_EQ(count(log.str(), "sent again (4 of 5)"), 0u) << log.str();
 }
 
+// Stopped (an abort, a failure), the drill sends nothing again: a planner taking the request
+// then would still move the robot.
+TEST(DrillNode, AfterAStopNoPlanRequestIsSentAgain) {
+  concert::dds::Participant participant({.name = "drill_node_stop_test"});
+  std::ostringstream log;
+  DrillNode node(participant, NodeParams{}, log);
+  node.plan(0, Eigen::Isometry3d::Identity(), std::nullopt);
+  node.stop();
+  concert::dds::Reader<msg::PlanRequest> requests(participant, concert::dds::topics::plan_request);
+  std::atomic<bool> stop{false};
+  std::thread spinner([&] { node.spin(stop); });
+  const std::optional<msg::PlanRequest> r = requests.wait(4000ms);
+  stop = true;
+  spinner.join();
+  EXPECT_FALSE(r) << "request " << r->request_id() << " sent again after the stop\n" << log.str();
+  EXPECT_EQ(count(log.str(), "sent again"), 0u) << log.str();
+}
+
 }  // namespace
 }  // namespace concert::drill::dds
 

@@ -1229,6 +1229,7 @@ void DrillNode::stop() {
   if (nav_request_ != 0) nav_cancels_.write(c);
   nav_request_ = 0;
   motion_ = Motion::kNone;
+  unacknowledged_.clear();  // not sent again: a planner taking it now would move the robot
   send_hold();
 }
 
