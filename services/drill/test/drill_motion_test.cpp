@@ -32,6 +32,7 @@ struct Plant {
   double wall_damping = 6000.0;  // [N s/m]
   double hole_bottom = 0.0;      // x of the deepest point drilled [m]
   double wall_x = 1.0;           // x of the wall's face [m]
+  double at_bottom = 1e-9;       // the tip this close to the hole's bottom cuts [m]
 
   // One step under the reference (translational impedance only; the orientation follows).
   void step(const CartesianReference& r) {
@@ -40,7 +41,7 @@ struct Plant {
         r.damping.head<3>().cwiseProduct(r.twist.head<3>() - velocity);
     const double x = tip.translation().x();
     const bool cutting =
-        x >= wall_x && x >= hole_bottom - 1e-9 && (f.x() > 0.0 || velocity.x() > 0.0);
+        x >= wall_x && x >= hole_bottom - at_bottom && (f.x() > 0.0 || velocity.x() > 0.0);
     if (cutting) {
       // At the bottom of the hole: the wall takes up to the threshold, and its feed damping
       // is taken implicitly so the step is stable.
@@ -145,6 +146,33 @@ TEST(DrillMotion, DrillsToDepthWithBoundedThrust) {
   run(m, p, now, 10.0);
   EXPECT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
   EXPECT_LT(p.tip.translation().x(), 1.0 - params.standoff + 2 * params.align_tolerance);
+}
+
+// The base creeps back under the thrust (a wheel's velocity loop yields to a steady force;
+// odometry sees it): the hole, moved in the base frame as the base moves (move_base), is still
+// cut to depth. Held in the base frame it would recede with the base, 2 mm a second here.
+TEST(DrillMotion, ABaseCreepingBackUnderTheThrustIsFollowed) {
+  const DrillParams params;
+  DrillMotion m(params);
+  double now = 0.0;
+  Plant p = aligned(m, params, now);
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone);
+  m.start_drill(0.03, false, p.tip, now);
+  constexpr double kCreep = 0.002;  // [m/s]: in the base frame the wall recedes along +x
+  p.at_bottom = 2.0 * kCreep * kDt;  // the bottom recedes by this each step
+  double receded = 0.0;
+  while (m.phase() == DrillMotion::Phase::kDrilling && now < 60.0) {
+    p.wall_x += kCreep * kDt;
+    p.hole_bottom += kCreep * kDt;
+    receded += kCreep * kDt;
+    m.move_base(Eigen::Isometry3d(Eigen::Translation3d(kCreep * kDt, 0.0, 0.0)));
+    p.step(m.update(p.tip, now));
+    now += kDt;
+  }
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
+  EXPECT_GT(receded, 0.005);
+  EXPECT_GE(p.hole_bottom - p.wall_x, 0.03 - 1e-3) << "receded " << receded;
+  EXPECT_NEAR(m.hole().translation().y(), 0.25, 1e-9);  // on its axis still
 }
 
 // The light drillings (light_drilling: for holes where the arm cannot hold the full thrust;

@@ -107,6 +107,10 @@ class DrillMotion {
   /// whether it was used.
   bool observe(const Eigen::Isometry3d& hole);
 
+  /// The base moved (`new_T_old`: the old base frame in the new one, from odometry): the hole
+  /// and the reference, kept in the base frame, move with the world, not with the base.
+  void move_base(const Eigen::Isometry3d& new_T_old);
+
   /// The reference for now; advances the phase (kAligning -> kDone when settled, kDrilling ->
   /// kDone at depth, kRetracting -> kDone at the standoff; kFailed on a timeout, with reason()).
   CartesianReference update(const Eigen::Isometry3d& tip, double now);

@@ -86,6 +86,11 @@ bool DrillMotion::observe(const Eigen::Isometry3d& hole) {
   return true;
 }
 
+void DrillMotion::move_base(const Eigen::Isometry3d& new_T_old) {
+  hole_ = new_T_old * hole_;
+  ref_ = new_T_old * ref_;
+}
+
 void DrillMotion::fail(const std::string& why) {
   phase_ = Phase::kFailed;
   reason_ = why;

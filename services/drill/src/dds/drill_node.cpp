@@ -1913,6 +1913,14 @@ void DrillNode::control_motion() {
   }
   const std::optional<Sample> s = latest_sample();
   if (!s) return;
+  {
+    // The hole stays where the world has it as the base moves: the wheels' velocity loops
+    // yield to the drilling's steady thrust, and a base creeping back took the hole's depth
+    // with it (scenario 3 on A: one hole 12.4 mm deep where the arm had advanced 30 mm).
+    const Eigen::Isometry3d now_T_world = rig_->base_in_world(s->odometry).inverse();
+    drill_motion_.move_base(now_T_world * base_T_world_.inverse());
+    base_T_world_ = now_T_world;
+  }
   if (point_.servo && (motion_ == Motion::kAlign || motion_ == Motion::kDrill)) {
     for (const CameraFrame& f : frames_since(servo_since_ns_)) {
       servo_since_ns_ = f.stamp_ns;
