@@ -99,7 +99,6 @@ struct Request {
   bool probe = false;
   bool with_planner = false;  // unanswered: the planner was down while it waited for it
   msg::PlanRequest message;   // as sent (sent again, same id, while unacknowledged)
-  int resends = 0;
 };
 
 std::string state_name(msg::ServiceState s) {
@@ -443,7 +442,6 @@ struct Chaos::Impl {
       msg::PlanRequest again;
       {
         std::lock_guard lock(m);
-        ++requests.at(id).resends;
         again = requests.at(id).message;
       }
       request_writer.write(again);

@@ -976,8 +976,8 @@ msg::TrajectorySample DrillNode::sample_here(const std::vector<std::string>& nam
     if (n == "base_yaw" && i < towards.position().size()) {
       // Odometry's yaw is wrapped to (-pi, pi], the planner's is not (it is kept near the
       // start's): a robot facing -x measures -3.14 where its plan says 3.13, and the straight
-      // line between them turned the base a whole turn with the bit at the wall (a CI run: a
-      // 38 s "settle" after a hole, then a safety stop on J1_E's sustained torque).
+      // line between them turns the base a whole turn with the bit at the wall (the likely
+      // cause of a CI run's 38 s "settle" after a hole, then a safety stop on J1_E).
       const double planned = towards.position()[i];
       v = planned + std::remainder(s.odometry[2] - planned, 2.0 * M_PI);
     } else if (n == "base_x" || n == "base_y" || n == "base_yaw") {
