@@ -135,6 +135,42 @@ TEST(DrillNode, APlanRequestIsSentAgainUntilThePlannerAcknowledgesIt) {
   EXPECT_EQ(count(log.str(), "sent again (4 of 5)"), 0u) << log.str();
 }
 
+// A planner's acknowledgement (PLAN_PLANNING) that comes after its answer is not taken for
+// news: the area's plan, made, stays made.
+TEST(DrillNode, AnAcknowledgementAfterThePlanDoesNotUndoIt) {
+  concert::dds::Participant participant({.name = "drill_node_late_ack_test"});
+  std::ostringstream log;
+  DrillNode node(participant, NodeParams{}, log);
+  concert::dds::Reader<msg::PlanRequest> requests(participant, concert::dds::topics::plan_request);
+  concert::dds::Writer<msg::PlanResult> results(participant, concert::dds::topics::plan_result);
+  ASSERT_TRUE(results.wait_for_readers(1, 5s));
+  ASSERT_TRUE(requests.wait_for_writers(1, 5s));
+  node.plan(0, Eigen::Isometry3d::Identity(), std::nullopt);
+  std::atomic<bool> stop{false};
+  std::thread spinner([&] { node.spin(stop); });
+  const std::optional<msg::PlanRequest> request = requests.wait(6000ms);
+  ASSERT_TRUE(request) << log.str();
+  msg::PlanResult planned;
+  planned.request_id(request->request_id());
+  planned.state(msg::PLAN_SUCCEEDED);
+  planned.joint_names({"base_x", "base_y", "base_yaw"});
+  msg::TrajectorySample sample;
+  sample.position({0.1, 0.0, 0.0});
+  planned.trajectory().push_back(sample);
+  results.write(planned);
+  msg::PlanResult ack;
+  ack.request_id(request->request_id());
+  ack.state(msg::PLAN_PLANNING);
+  results.write(ack);
+  // Both in before the area is asked (delivery within the process is synchronous; the pause is
+  // a margin), so the acknowledgement is the last sample the drill got.
+  std::this_thread::sleep_for(300ms);
+  const Outcome outcome = node.planning(0);
+  stop = true;
+  spinner.join();
+  EXPECT_EQ(outcome.progress, Progress::kSucceeded) << outcome.reason << "\n" << log.str();
+}
+
 // Stopped (an abort, a failure), the drill sends nothing again: a planner taking the request
 // then would still move the robot.
 TEST(DrillNode, AfterAStopNoPlanRequestIsSentAgain) {

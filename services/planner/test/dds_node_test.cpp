@@ -256,6 +256,46 @@ TEST_F(PlannerNodeTest, AGivenStartStateIsPlannedFromAndNotExecuted) {
   EXPECT_NE(unknown->reason().find("no_such_joint"), std::string::npos) << unknown->reason();
 }
 
+// The result topic keeps a request's last sample: an acknowledgement written after the answer
+// would replace it, and a client that read late would wait for good (a CI run's "cannot be
+// executed" never seen). Requests answered at once (a start state cannot be executed), many in a
+// row; a reader joining afterwards gets each request's last sample: every one the answer.
+TEST_F(PlannerNodeTest, TheAcknowledgementNeverReplacesAnAnswerGivenAtOnce) {
+  publish_model('a', 8);
+  ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
+  constexpr uint32_t kRequests = 50;
+  for (uint32_t id = 100; id < 100 + kRequests; ++id) {
+    msg::PlanRequest r = request(id, 8, 1.2, true);
+    r.start_names({"base_x", "base_y", "base_yaw"});
+    r.start_position({0.0, 0.0, 0.0});
+    requests_->write(r);
+  }
+  // Bounded: every request answered in the log (each answer is logged after it is written).
+  const auto answered = [&] {
+    const std::string log = log_.str();
+    for (uint32_t id = 100; id < 100 + kRequests; ++id)
+      if (log.find("planner: request " + std::to_string(id) + " failed") == std::string::npos)
+        return false;
+    return true;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (!answered() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(answered()) << log_.str();
+  concert::dds::Reader<msg::PlanResult> late(*participant_, concert::dds::topics::plan_result);
+  std::map<uint32_t, msg::PlanState> last;
+  const auto read_by = std::chrono::steady_clock::now() + 10s;
+  while (std::chrono::steady_clock::now() < read_by) {
+    const auto r = late.wait(200ms);
+    if (r && r->request_id() >= 100 && r->request_id() < 100 + kRequests)
+      last[r->request_id()] = r->state();
+    if (!r && last.size() == kRequests) break;
+  }
+  ASSERT_EQ(last.size(), kRequests);
+  for (const auto& [id, state] : last)
+    EXPECT_EQ(state, msg::PLAN_FAILED) << "request " << id << ": the last sample is not the answer";
+}
+
 TEST_F(PlannerNodeTest, ExecutionGoesThroughTheRobotsTrajectoryCommand) {
   publish_model('a', 6);
   concert::dds::Reader<msg::JointTrajectoryCommand> commands(

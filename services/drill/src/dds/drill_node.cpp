@@ -246,6 +246,12 @@ void set_hole_task(msg::PlanRequest& r, const HoleAttempt& a, double hole_distan
 }  // namespace
 
 void keep_result(msg::PlanResult& kept, const msg::PlanResult& incoming) {
+  // PLAN_PLANNING only ever opens a request's answers: one coming after a later state is a
+  // stale acknowledgement (a planner that wrote it after its answer), never news. Kept, it
+  // would leave the area waiting on a plan already made.
+  if (incoming.state() == msg::PLAN_PLANNING && kept.request_id() == incoming.request_id() &&
+      kept.state() != msg::PLAN_PLANNING)
+    return;
   if (incoming.trajectory().empty() && !kept.trajectory().empty() &&
       kept.request_id() == incoming.request_id()) {
     auto trajectory = std::move(kept.trajectory());

@@ -292,7 +292,11 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
 // A request is acknowledged as it arrives (PLAN_PLANNING), before it waits behind others: a
 // client that hears nothing sends it again (a request written before its writer matched a
 // restarted planner's reader is lost: PlanRequest is volatile). A request already taken, by
-// source and id, is not taken twice.
+// source and id, is not taken twice. The acknowledgement is written before the request is
+// queued: queued first, the request loop could answer it (a start state refused takes
+// microseconds) before this thread wrote PLAN_PLANNING, and the result topic keeps only the
+// last sample of a request, so the late acknowledgement would replace the final answer (a CI
+// run: the answer "cannot be executed" never seen, the client waited 20 s).
 void PlannerNode::take(const msg::PlanRequest& request) {
   {
     std::lock_guard lock(mutex_);
@@ -303,9 +307,12 @@ void PlannerNode::take(const msg::PlanRequest& request) {
       taken_.erase(taken_order_.front());
       taken_order_.pop_front();
     }
-    requests_.push_back(request);
   }
   publish(planning(request));
+  {
+    std::lock_guard lock(mutex_);
+    requests_.push_back(request);
+  }
   wake_.notify_all();
 }
 
