@@ -20,8 +20,6 @@
 // only (services/drill/README.md); a pattern of scenario 3 is drill_pattern_test's.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <cctype>
 #include <cstdlib>
 #include <iostream>
 #include <sstream>
@@ -58,38 +56,6 @@ std::vector<HoleError> score(const MissionRun& run, const std::string& prefix) {
   return errors;
 }
 
-// What a failed run printed last: CI shows the head and the tail of the test output, and the
-// services' logs (thousands of lines) push gtest's own failure messages out of both. Printed when
-// the program ends, after gtest's summary, so the tail says why.
-struct FailureSummary {
-  std::string text;
-  ~FailureSummary() {
-    if (!text.empty()) std::cout << "\n==== why the drilling mission test failed ====\n" << text << std::flush;
-  }
-};
-FailureSummary failure_summary;
-
-// The lines of `logs` that say something went wrong (at most `max`, the last ones).
-std::string alarming_lines(const std::string& logs, std::size_t max) {
-  std::vector<std::string> found;
-  std::istringstream in(logs);
-  for (std::string line; std::getline(in, line);) {
-    for (const char* word : {"fail", "abort", "refus", "stop", "error", "timed out", "skipp", "lost"}) {
-      std::string lower = line;
-      std::transform(lower.begin(), lower.end(), lower.begin(),
-                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-      if (lower.find(word) != std::string::npos) {
-        found.push_back(line.substr(0, 300));
-        break;
-      }
-    }
-  }
-  std::string out;
-  for (std::size_t i = found.size() > max ? found.size() - max : 0; i < found.size(); ++i)
-    out += "  " + found[i] + "\n";
-  return out;
-}
-
 TEST(DrillMission, DrillsTheBlobsOnTheDemoWallWithVisualServoing) {
   const MissionRun run = run_mission(kAssembly, kSite,
                                      "name: system test\n"
@@ -100,9 +66,7 @@ TEST(DrillMission, DrillsTheBlobsOnTheDemoWallWithVisualServoing) {
   std::ostringstream summary;
   [&] {
     ASSERT_TRUE(run.status) << "no status from the drill service";
-    constexpr const char* kStates[] = {"idle", "running", "succeeded", "failed", "aborted"};
-    const auto state = static_cast<std::size_t>(run.status->state());
-    summary << "drill: " << (state < 5 ? kStates[state] : "?") << " (" << run.status->reason()
+    summary << "drill: " << state_name(run.status->state()) << " (" << run.status->reason()
             << "), " << run.status->holes_drilled() << " of " << run.status->holes_marked()
             << " holes\n";
     EXPECT_EQ(run.status->state(), msg::DRILL_SUCCEEDED) << run.status->reason();
@@ -126,7 +90,7 @@ TEST(DrillMission, DrillsTheBlobsOnTheDemoWallWithVisualServoing) {
   if (HasFailure() || std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr)
     std::cout << run.logs << std::endl;
   if (HasFailure())
-    failure_summary.text = summary.str() + "what the services' logs said went wrong (last 25):\n" +
+    failure_summary().text = summary.str() + "what the services' logs said went wrong (last 25):\n" +
                            alarming_lines(run.logs, 25);
 }
 

@@ -14,6 +14,8 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -35,35 +37,50 @@ TEST(DrillPattern, DrillsTheRowOfAnArucoMarkerByTheKinematicsAlone) {
                                      "areas:\n"
                                      "  - {name: row_150, marks: aruco, point: [2.2, -0.3, 1.65]}\n",
                                      900s);
-  if (std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr) std::cout << run.logs << std::endl;
-  ASSERT_TRUE(run.status) << "no status from the drill service" << run.logs;
-  EXPECT_EQ(run.status->state(), msg::DRILL_SUCCEEDED) << run.status->reason() << run.logs;
-  EXPECT_EQ(run.status->holes_drilled(), 4u) << run.logs;
-  EXPECT_EQ(run.status->holes_marked(), 4u) << run.logs;
-  const drill::PatternTable patterns =
-      drill::load_patterns(std::string(CONCERT_SOURCE_DIR) + "/services/drill/config/patterns.yaml");
-  std::vector<double> errors;
-  for (const Target& t : targets_of(world::load_world_file(kSite), patterns)) {
-    if (t.name.rfind("row_150", 0) != 0) continue;  // the wall's other rows: the benchmark's
-    const auto [hole, e] = nearest_hole(run.holes, t);
-    // A hole within 5 cm is this mark's (the next mark is 0.2 m away).
-    if (hole == nullptr || e.norm() > 0.05) {
-      ADD_FAILURE() << "no hole for " << t.name << run.logs;
-      continue;
+  std::ostringstream summary;
+  [&] {
+    ASSERT_TRUE(run.status) << "no status from the drill service";
+    summary << "drill: " << state_name(run.status->state()) << " (" << run.status->reason()
+            << "), " << run.status->holes_drilled() << " of " << run.status->holes_marked()
+            << " holes; the simulator recorded " << run.holes.size() << "\n";
+    EXPECT_EQ(run.status->state(), msg::DRILL_SUCCEEDED) << run.status->reason();
+    EXPECT_EQ(run.status->holes_drilled(), 4u);
+    EXPECT_EQ(run.status->holes_marked(), 4u);
+    const drill::PatternTable patterns = drill::load_patterns(
+        std::string(CONCERT_SOURCE_DIR) + "/services/drill/config/patterns.yaml");
+    std::vector<double> errors;
+    for (const Target& t : targets_of(world::load_world_file(kSite), patterns)) {
+      if (t.name.rfind("row_150", 0) != 0) continue;  // the wall's other rows: the benchmark's
+      const auto [hole, e] = nearest_hole(run.holes, t);
+      // A hole within 5 cm is this mark's (the next mark is 0.2 m away).
+      if (hole == nullptr || e.norm() > 0.05) {
+        ADD_FAILURE() << "no hole for " << t.name;
+        summary << "no hole within 5 cm of " << t.name << "\n";
+        continue;
+      }
+      std::ostringstream line;
+      line << "hole for " << t.name << ": x " << e.horizontal * 1e3 << " mm, y "
+           << e.vertical * 1e3 << " mm, depth " << hole->depth() * 1e3 << " mm";
+      std::cout << line.str() << std::endl;
+      summary << line.str() << "\n";
+      EXPECT_GT(hole->depth(), 0.022) << t.name;  // measured 27-29 mm of the 30 asked
+      // No hole where odometry alone put it: that drifts 5-35 mm over a whole-body move.
+      EXPECT_LT(e.norm(), 0.01) << t.name;
+      errors.push_back(e.norm());
     }
-    std::cout << "hole for " << t.name << ": x " << e.horizontal * 1e3 << " mm, y "
-              << e.vertical * 1e3 << " mm, depth " << hole->depth() * 1e3 << " mm" << std::endl;
-    EXPECT_GT(hole->depth(), 0.022) << t.name;  // measured 27-29 mm of the 30 asked
-    // No hole where odometry alone put it: that drifts 5-35 mm over a whole-body move.
-    EXPECT_LT(e.norm(), 0.01) << t.name << run.logs;
-    errors.push_back(e.norm());
-  }
-  ASSERT_EQ(errors.size(), 4u);
-  std::sort(errors.begin(), errors.end());
-  const double median = 0.5 * (errors[1] + errors[2]);
-  EXPECT_LE(median, 0.003) << run.logs;  // the paper's aim for patterns
+    ASSERT_EQ(errors.size(), 4u);
+    std::sort(errors.begin(), errors.end());
+    const double median = 0.5 * (errors[1] + errors[2]);
+    EXPECT_LE(median, 0.003);  // the paper's aim for patterns
+  }();
   // The end state: the robot never stopped by the safety layer.
-  EXPECT_TRUE(run.safety_running) << run.logs;
+  summary << "safety: " << (run.safety_running ? "RUNNING" : "not RUNNING") << "\n";
+  EXPECT_TRUE(run.safety_running);
+  if (HasFailure() || std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr)
+    std::cout << run.logs << std::endl;
+  if (HasFailure())
+    failure_summary().text = summary.str() + "what the services' logs said went wrong (last 25):\n" +
+                             alarming_lines(run.logs, 25);
 }
 
 }  // namespace
