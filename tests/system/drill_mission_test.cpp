@@ -21,11 +21,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
-#include <iostream>
 #include <sstream>
 #include <string>
 
-#include "drill_runner.hpp"
+#include "drill_test_report.hpp"
 
 namespace concert::system_test {
 namespace {
@@ -85,13 +84,7 @@ TEST(DrillMission, DrillsTheBlobsOnTheDemoWallWithVisualServoing) {
   EXPECT_NE(run.logs.find("planner: sensor map: used lidar"), std::string::npos);
   EXPECT_NE(run.logs.find("not used: the map comes from the sensors"), std::string::npos);
   // The end state: the robot never stopped by the safety layer.
-  summary << "safety: " << (run.safety_running ? "RUNNING" : "not RUNNING") << "\n";
-  EXPECT_TRUE(run.safety_running);
-  if (HasFailure() || std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr)
-    std::cout << run.logs << std::endl;
-  if (HasFailure())
-    failure_summary().text = summary.str() + "what the services' logs said went wrong (last 25):\n" +
-                           alarming_lines(run.logs, 25);
+  expect_safety_and_report(run, summary);
 }
 
 }  // namespace

@@ -14,12 +14,11 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "drill_runner.hpp"
+#include "drill_test_report.hpp"
 
 namespace concert::system_test {
 namespace {
@@ -74,13 +73,7 @@ TEST(DrillPattern, DrillsTheRowOfAnArucoMarkerByTheKinematicsAlone) {
     EXPECT_LE(median, 0.003);  // the paper's aim for patterns
   }();
   // The end state: the robot never stopped by the safety layer.
-  summary << "safety: " << (run.safety_running ? "RUNNING" : "not RUNNING") << "\n";
-  EXPECT_TRUE(run.safety_running);
-  if (HasFailure() || std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr)
-    std::cout << run.logs << std::endl;
-  if (HasFailure())
-    failure_summary().text = summary.str() + "what the services' logs said went wrong (last 25):\n" +
-                             alarming_lines(run.logs, 25);
+  expect_safety_and_report(run, summary);
 }
 
 }  // namespace

@@ -10,14 +10,12 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
-#include <iostream>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -276,41 +274,6 @@ inline const char* state_name(msg::DrillMissionState state) {
   constexpr const char* kNames[] = {"idle", "running", "succeeded", "failed", "aborted"};
   const auto i = static_cast<std::size_t>(state);
   return i < std::size(kNames) ? kNames[i] : "unknown";
-}
-
-// What a failed run printed last: CI shows the head and the tail of the test output, and the
-// services' logs (thousands of lines) push gtest's own failure messages out of both. Printed when
-// the program ends, after gtest's summary, so the tail says why.
-struct FailureSummary {
-  std::string text;
-  ~FailureSummary() {
-    if (!text.empty()) std::cout << "\n==== why the drilling test failed ====\n" << text << std::flush;
-  }
-};
-inline FailureSummary& failure_summary() {
-  static FailureSummary summary;
-  return summary;
-}
-
-// The lines of `logs` that say something went wrong (at most `max`, the last ones).
-inline std::string alarming_lines(const std::string& logs, std::size_t max) {
-  std::vector<std::string> found;
-  std::istringstream in(logs);
-  for (std::string line; std::getline(in, line);) {
-    std::string lower = line;
-    std::transform(lower.begin(), lower.end(), lower.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    for (const char* word : {"fail", "abort", "refus", "stop", "error", "timed out", "skipp", "lost"}) {
-      if (lower.find(word) != std::string::npos) {
-        found.push_back(line.substr(0, 300));
-        break;
-      }
-    }
-  }
-  std::string out;
-  for (std::size_t i = found.size() > max ? found.size() - max : 0; i < found.size(); ++i)
-    out += "  " + found[i] + "\n";
-  return out;
 }
 
 }  // namespace concert::system_test
