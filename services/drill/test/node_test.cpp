@@ -195,6 +195,40 @@ TEST(DrillNode, AfterAStopNoPlanRequestIsSentAgain) {
 namespace concert::drill::dds {
 namespace {
 
+// A settle onto a hole's posture leaves a base that stands within a few cm of the posture's
+// where it is (the legs would swing round for a move smaller than the disturbance they cause);
+// one farther off, or turned farther, is driven back.
+TEST(DrillNode, ASettleKeepsTheBaseWhereItStandsWhenItIsNearThePosture) {
+  const std::vector<std::string> names{"base_x", "base_y", "base_yaw", "J1_E"};
+  const auto sample = [](std::vector<double> q) {
+    msg::TrajectorySample s;
+    s.position(q);
+    s.velocity(std::vector<double>(q.size(), 0.1));
+    return s;
+  };
+  const msg::TrajectorySample here = sample({1.512, -0.205, 0.31, 0.2});
+  std::vector<msg::TrajectorySample> settle{here, sample({1.5, -0.2, 0.3, 0.5})};
+  ASSERT_TRUE(DrillNode::keep_base(names, here, settle, 0.03));
+  EXPECT_EQ(settle.back().position(), (std::vector<double>{1.512, -0.205, 0.31, 0.5}));
+  EXPECT_EQ(settle.back().velocity(), (std::vector<double>{0.0, 0.0, 0.0, 0.1}));
+  // 4 cm off: driven back.
+  std::vector<msg::TrajectorySample> far{here, sample({1.472, -0.2, 0.3, 0.5})};
+  EXPECT_FALSE(DrillNode::keep_base(names, here, far, 0.03));
+  EXPECT_EQ(far.back().position(), (std::vector<double>{1.472, -0.2, 0.3, 0.5}));
+  // Turned 0.05 rad: driven back.
+  std::vector<msg::TrajectorySample> turned{here, sample({1.5, -0.2, 0.36, 0.5})};
+  EXPECT_FALSE(DrillNode::keep_base(names, here, turned, 0.03));
+  EXPECT_DOUBLE_EQ(turned.back().position()[2], 0.36);
+  // A path whose base goes farther on the way, though it ends near: driven as planned.
+  std::vector<msg::TrajectorySample> out_and_back{here, sample({1.6, -0.2, 0.3, 0.4}),
+                                                  sample({1.5, -0.2, 0.3, 0.5})};
+  EXPECT_FALSE(DrillNode::keep_base(names, here, out_and_back, 0.03));
+  EXPECT_DOUBLE_EQ(out_and_back[1].position()[0], 1.6);
+  // No bound: always kept (the arm-alone look).
+  EXPECT_TRUE(DrillNode::keep_base(names, here, far));
+  EXPECT_DOUBLE_EQ(far.back().position()[0], 1.512);
+}
+
 // The measured state a drill trajectory starts from: odometry's yaw is wrapped to (-pi, pi], a
 // plan's is not. A robot facing -x measured -3.14 where its posture said 3.13: the straight line
 // between them turned the base a whole turn with the bit at the wall (a CI run's safety stop).

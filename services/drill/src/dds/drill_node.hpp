@@ -101,6 +101,13 @@ class DrillNode final : public MissionPorts {
                                                          const Sample& s,
                                                          const msg::TrajectorySample& towards);
 
+  // The base joints of every sample of `path` set to `here`'s: the base stays where it stands
+  // while the arm goes on. With `bound` > 0 only when `here`'s base is within `bound` [m, rad]
+  // of every sample's (a few mm of creep or tracking error, not a move); true when the base
+  // was kept.
+  static bool keep_base(const std::vector<std::string>& names, const msg::TrajectorySample& here,
+                        std::vector<msg::TrajectorySample>& path, double bound = 0.0);
+
   // Time to go straight from `from` to `to` at a third of a slow joint speed (at least 1 s).
   [[nodiscard]] static double settle_time(const std::vector<std::string>& names,
                                           const msg::TrajectorySample& from,
@@ -180,6 +187,11 @@ class DrillNode final : public MissionPorts {
   bool remeasure_looked_marker(const CameraView& camera);
   /// From the look posture back onto the whole body's posture, then the alignment.
   void back_to_posture(const Sample& s, Motion next = Motion::kBackToPosture);
+  struct PlannedPath;
+  // Straight from `here` onto `p`'s last posture, at rest there (settle_time); the base kept
+  // where it stands when within kBaseKept of the posture's (keep_base), said in the log.
+  std::vector<msg::TrajectorySample> settle_path(const PlannedPath& p,
+                                                 const msg::TrajectorySample& here);
   void request_look(std::size_t attempt);
   [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
   std::uint32_t send_trajectory(const std::vector<std::string>& names,
