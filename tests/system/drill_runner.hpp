@@ -13,10 +13,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -104,12 +107,63 @@ inline std::pair<const msg::SimHole*, HoleError> nearest_hole(const std::vector<
 
 /// What a mission run left: the final status (none: the service never answered), the holes the
 /// simulator's wall records, the safety state at the end, and every service's log.
+/// Odometry and the simulator's truth of the base at one moment of a run, with the drill's
+/// active node then.
+struct TrackPoint {
+  double t{0.0};                    // [s] from the mission's start
+  std::array<double, 3> odometry{};  // x, y [m], yaw [rad] in the odometry frame
+  std::array<double, 3> truth{};     // x, y [m], yaw [rad] in the world
+  std::string active;
+};
+
 struct MissionRun {
   std::optional<msg::DrillStatus> status;
   std::vector<msg::SimHole> holes;
   bool safety_running{false};
   std::string logs;
+  std::vector<TrackPoint> track;  // every half second or so while the mission ran
 };
+
+/// How odometry parted from the simulator's truth over `track`: odometry mapped into the world
+/// by their first pair, the position error at the end, its largest value, and the `count`
+/// largest growths between successive points with the drill's active node at each (where a
+/// drilling pattern's holes go wrong on kinematics alone).
+inline std::string odometry_drift(const std::vector<TrackPoint>& track, std::size_t count = 5) {
+  if (track.size() < 2) return "odometry against truth: not recorded\n";
+  const auto planar = [](const std::array<double, 3>& p) {
+    Eigen::Isometry2d t = Eigen::Isometry2d::Identity();
+    t.translation() = Eigen::Vector2d(p[0], p[1]);
+    t.linear() = Eigen::Rotation2Dd(p[2]).toRotationMatrix();
+    return t;
+  };
+  const Eigen::Isometry2d world_T_odom = planar(track.front().truth) * planar(track.front().odometry).inverse();
+  std::vector<Eigen::Vector3d> error;  // x, y [m], yaw [rad]: odometry's world pose minus the truth
+  for (const TrackPoint& p : track) {
+    const Eigen::Isometry2d seen = world_T_odom * planar(p.odometry);
+    const Eigen::Vector2d d = seen.translation() - Eigen::Vector2d(p.truth[0], p.truth[1]);
+    const double yaw = std::remainder(Eigen::Rotation2Dd(seen.linear()).angle() - p.truth[2], 2.0 * M_PI);
+    error.emplace_back(d.x(), d.y(), yaw);
+  }
+  std::vector<std::size_t> order(error.size() - 1);
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i + 1;
+  const auto growth = [&](std::size_t i) { return (error[i].head<2>() - error[i - 1].head<2>()).norm(); };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return growth(a) > growth(b); });
+  double largest = 0.0;
+  for (const Eigen::Vector3d& e : error) largest = std::max(largest, e.head<2>().norm());
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out << std::setprecision(1) << "odometry against truth over " << track.back().t << " s: "
+      << error.back().head<2>().norm() * 1e3 << " mm and " << error.back().z() * 1e3
+      << " mrad off at the end, at most " << largest * 1e3 << " mm; largest growths:\n";
+  for (std::size_t k = 0; k < order.size() && k < count; ++k) {
+    const std::size_t i = order[k];
+    out << "  " << track[i - 1].t << "-" << track[i].t << " s: " << growth(i) * 1e3 << " mm ("
+        << error[i - 1].head<2>().norm() * 1e3 << " -> " << error[i].head<2>().norm() * 1e3
+        << " mm, yaw " << error[i - 1].z() * 1e3 << " -> " << error[i].z() * 1e3 << " mrad; "
+        << track[i].active << ")\n";
+  }
+  return out.str();
+}
 
 /// A mission in a building (paper scenario 2): the nav service maps the IFC storey and
 /// localises the robot, which starts at `start` (x, y, theta in the map frame); the site is the
@@ -220,6 +274,21 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   concert::dds::Reader<msg::SafetyState> safety_states(p, concert::dds::topics::safety_state);
   concert::dds::Reader<msg::DrillStatus> statuses(p, concert::dds::topics::drill_status);
   concert::dds::Writer<msg::DrillMission> missions(p, concert::dds::topics::drill_mission);
+  // The base as odometry and as the simulator have it, the latest of each (a stream).
+  std::mutex base_mutex;
+  std::optional<msg::Odometry> odometry;
+  std::deque<msg::SimTruth> truths_kept;  // the last ones: paired with odometry by stamp
+  concert::dds::Reader<msg::Odometry> odometries(p, concert::dds::topics::odometry,
+                                                 [&](const msg::Odometry& o, const auto&) {
+                                                   std::lock_guard lock(base_mutex);
+                                                   odometry = o;
+                                                 });
+  concert::dds::Reader<msg::SimTruth> truths(p, concert::dds::topics::sim_truth,
+                                             [&](const msg::SimTruth& t, const auto&) {
+                                               std::lock_guard lock(base_mutex);
+                                               truths_kept.push_back(t);
+                                               if (truths_kept.size() > 500) truths_kept.pop_front();
+                                             });
   if (!wait_for_err(drill, "drill: model version 1: drill", 120s) ||
       !wait_for_err(planner, "planner: model version 1", 60s) || !missions.wait_for_readers(1, 10s)) {
     run.logs = logs();
@@ -248,9 +317,29 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   m.yaml(mission);
   m.base_dir(std::filesystem::temp_directory_path().string());
   missions.write(m);
-  for (const auto until = std::chrono::steady_clock::now() + timeout;
-       std::chrono::steady_clock::now() < until;) {
-    const auto s = statuses.wait(500ms);
+  const auto started = std::chrono::steady_clock::now();
+  auto recorded = started - 1s;
+  std::string active;
+  for (const auto until = started + timeout; std::chrono::steady_clock::now() < until;) {
+    const auto s = statuses.wait(250ms);
+    if (s && s->mission_id() == m.mission_id()) active = s->active();
+    const auto now = std::chrono::steady_clock::now();
+    if (now - recorded >= 500ms) {
+      recorded = now;
+      std::lock_guard lock(base_mutex);
+      // Both stamped in the simulator's time: the truth nearest the odometry's moment.
+      const msg::SimTruth* truth = nullptr;
+      for (const msg::SimTruth& t : truths_kept) {
+        if (odometry && (truth == nullptr || std::llabs(t.stamp_ns() - odometry->stamp_ns()) <
+                                                 std::llabs(truth->stamp_ns() - odometry->stamp_ns())))
+          truth = &t;
+      }
+      if (odometry && truth && std::llabs(truth->stamp_ns() - odometry->stamp_ns()) < 50'000'000)
+        run.track.push_back({std::chrono::duration<double>(now - started).count(),
+                             {odometry->x(), odometry->y(), odometry->yaw()},
+                             {truth->x(), truth->y(), truth->yaw()},
+                             active});
+    }
     if (!s || s->mission_id() != m.mission_id()) continue;
     run.status = s;
     if (s->state() != msg::DRILL_RUNNING && s->state() != msg::DRILL_IDLE) break;

@@ -52,16 +52,18 @@ inline std::string alarming_lines(const std::string& logs, std::size_t max) {
   return out;
 }
 
-/// Expects safety RUNNING at the end of `run`; on a failure of the test so far prints the logs
-/// and keeps `summary` (the test's own account: state, holes, errors) with the alarming log lines
+/// Expects safety RUNNING at the end of `run` and prints how odometry parted from the truth; on
+/// a failure of the test so far prints the logs and keeps `summary` (the test's own account: state, holes, errors) with the alarming log lines
 /// for the end of the output.
 inline void expect_safety_and_report(const MissionRun& run, std::ostringstream& summary) {
   summary << "safety: " << (run.safety_running ? "RUNNING" : "not RUNNING") << "\n";
   EXPECT_TRUE(run.safety_running);
+  std::cout << odometry_drift(run.track);
   const bool failed = ::testing::Test::HasFailure();
   if (failed || std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr) std::cout << run.logs << std::endl;
   if (failed)
-    failure_summary().text = summary.str() + "what the services' logs said went wrong (last 25):\n" +
+    failure_summary().text = summary.str() + odometry_drift(run.track) +
+                             "what the services' logs said went wrong (last 25):\n" +
                              alarming_lines(run.logs, 25);
 }
 
