@@ -114,6 +114,7 @@ struct TrackPoint {
   std::array<double, 3> odometry{};  // x, y [m], yaw [rad] in the odometry frame
   std::array<double, 3> truth{};     // x, y [m], yaw [rad] in the world
   std::string active;
+  Eigen::Vector3d gravity{Eigen::Vector3d::Zero()};  // the IMU's mean specific force (zero: none)
 };
 
 struct MissionRun {
@@ -155,12 +156,30 @@ inline std::string odometry_drift(const std::vector<TrackPoint>& track, std::siz
   out << std::setprecision(1) << "odometry against truth over " << track.back().t << " s: "
       << error.back().head<2>().norm() * 1e3 << " mm and " << error.back().z() * 1e3
       << " mrad off at the end, at most " << largest * 1e3 << " mm; largest growths:\n";
+  // The base's tilt from level: the angle between the IMU's mean specific force and its first.
+  const auto tilt = [&](std::size_t i) {
+    const Eigen::Vector3d& g0 = track.front().gravity;
+    const Eigen::Vector3d& g = track[i].gravity;
+    if (g0.isZero() || g.isZero()) return std::nan("");
+    return std::atan2(g0.cross(g).norm(), g0.dot(g));
+  };
+  double most_tilted = 0.0;
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    if (tilt(i) > most_tilted) {
+      most_tilted = tilt(i);
+      at = i;
+    }
+  }
+  out << "  the base tilted from its first attitude by at most " << most_tilted * 1e3 << " mrad (at "
+      << track[at].t << " s, " << track[at].active << "; the IMU's mean specific force, which also "
+      << "holds the base's acceleration)\n";
   for (std::size_t k = 0; k < order.size() && k < count; ++k) {
     const std::size_t i = order[k];
     out << "  " << track[i - 1].t << "-" << track[i].t << " s: " << growth(i) * 1e3 << " mm ("
         << error[i - 1].head<2>().norm() * 1e3 << " -> " << error[i].head<2>().norm() * 1e3
-        << " mm, yaw " << error[i - 1].z() * 1e3 << " -> " << error[i].z() * 1e3 << " mrad; "
-        << track[i].active << ")\n";
+        << " mm, yaw " << error[i - 1].z() * 1e3 << " -> " << error[i].z() * 1e3 << " mrad, base tilt "
+        << tilt(i - 1) * 1e3 << " -> " << tilt(i) * 1e3 << " mrad; " << track[i].active << ")\n";
   }
   return out.str();
 }
@@ -278,6 +297,8 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   std::mutex base_mutex;
   std::optional<msg::Odometry> odometry;
   std::deque<msg::SimTruth> truths_kept;  // the last ones: paired with odometry by stamp
+  std::deque<Eigen::Vector3d> forces;     // the IMU's last specific forces
+  std::string imu_name;
   concert::dds::Reader<msg::Odometry> odometries(p, concert::dds::topics::odometry,
                                                  [&](const msg::Odometry& o, const auto&) {
                                                    std::lock_guard lock(base_mutex);
@@ -289,6 +310,14 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
                                                truths_kept.push_back(t);
                                                if (truths_kept.size() > 500) truths_kept.pop_front();
                                              });
+  concert::dds::Reader<msg::Imu> imus(p, concert::dds::topics::imu, [&](const msg::Imu& m, const auto&) {
+    std::lock_guard lock(base_mutex);
+    if (imu_name.empty()) imu_name = m.sensor();
+    if (m.sensor() != imu_name) return;  // one IMU's axes
+    const auto& a = m.linear_acceleration();
+    forces.emplace_back(a.x(), a.y(), a.z());
+    if (forces.size() > 50) forces.pop_front();
+  });
   if (!wait_for_err(drill, "drill: model version 1: drill", 120s) ||
       !wait_for_err(planner, "planner: model version 1", 60s) || !missions.wait_for_readers(1, 10s)) {
     run.logs = logs();
@@ -317,6 +346,11 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   m.yaml(mission);
   m.base_dir(std::filesystem::temp_directory_path().string());
   missions.write(m);
+  const auto mean_force = [&] {  // under base_mutex
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& f : forces) sum += f;
+    return forces.empty() ? sum : Eigen::Vector3d(sum / static_cast<double>(forces.size()));
+  };
   const auto started = std::chrono::steady_clock::now();
   auto recorded = started - 1s;
   std::string active;
@@ -338,7 +372,8 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
         run.track.push_back({std::chrono::duration<double>(now - started).count(),
                              {odometry->x(), odometry->y(), odometry->yaw()},
                              {truth->x(), truth->y(), truth->yaw()},
-                             active});
+                             active,
+                             mean_force()});
     }
     if (!s || s->mission_id() != m.mission_id()) continue;
     run.status = s;
