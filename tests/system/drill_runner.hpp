@@ -33,6 +33,7 @@
 #include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/participant.hpp"
+#include "concert/mobile_base/map_frame.hpp"
 #include "concert/world/geometry.hpp"
 #include "concert/world/world.hpp"
 #include "drill/patterns.hpp"
@@ -105,8 +106,6 @@ inline std::pair<const msg::SimHole*, HoleError> nearest_hole(const std::vector<
   return {best, best_error};
 }
 
-/// What a mission run left: the final status (none: the service never answered), the holes the
-/// simulator's wall records, the safety state at the end, and every service's log.
 /// Odometry and the simulator's truth of the base at one moment of a run, with the drill's
 /// active node then.
 struct TrackPoint {
@@ -114,9 +113,12 @@ struct TrackPoint {
   std::array<double, 3> odometry{};  // x, y [m], yaw [rad] in the odometry frame
   std::array<double, 3> truth{};     // x, y [m], yaw [rad] in the world
   std::string active;
-  Eigen::Vector3d gravity{Eigen::Vector3d::Zero()};  // the IMU's mean specific force (zero: none)
+  Eigen::Vector3d force{Eigen::Vector3d::Zero()};  // the IMU's mean specific force (zero: none)
 };
 
+/// What a mission run left: the final status (none: the service never answered), the holes the
+/// simulator's wall records, the safety state at the end, every service's log and the base's
+/// track.
 struct MissionRun {
   std::optional<msg::DrillStatus> status;
   std::vector<msg::SimHole> holes;
@@ -131,19 +133,15 @@ struct MissionRun {
 /// drilling pattern's holes go wrong on kinematics alone).
 inline std::string odometry_drift(const std::vector<TrackPoint>& track, std::size_t count = 5) {
   if (track.size() < 2) return "odometry against truth: not recorded\n";
-  const auto planar = [](const std::array<double, 3>& p) {
-    Eigen::Isometry2d t = Eigen::Isometry2d::Identity();
-    t.translation() = Eigen::Vector2d(p[0], p[1]);
-    t.linear() = Eigen::Rotation2Dd(p[2]).toRotationMatrix();
-    return t;
-  };
-  const Eigen::Isometry2d world_T_odom = planar(track.front().truth) * planar(track.front().odometry).inverse();
+  const auto pose = [](const std::array<double, 3>& p) { return Eigen::Vector3d(p[0], p[1], p[2]); };
+  const Eigen::Vector3d world_T_odom = mobile_base::compose(
+      pose(track.front().truth), mobile_base::inverse(pose(track.front().odometry)));
   std::vector<Eigen::Vector3d> error;  // x, y [m], yaw [rad]: odometry's world pose minus the truth
   for (const TrackPoint& p : track) {
-    const Eigen::Isometry2d seen = world_T_odom * planar(p.odometry);
-    const Eigen::Vector2d d = seen.translation() - Eigen::Vector2d(p.truth[0], p.truth[1]);
-    const double yaw = std::remainder(Eigen::Rotation2Dd(seen.linear()).angle() - p.truth[2], 2.0 * M_PI);
-    error.emplace_back(d.x(), d.y(), yaw);
+    const Eigen::Vector3d seen = mobile_base::compose(world_T_odom, pose(p.odometry));
+    const Eigen::Vector3d truth = pose(p.truth);
+    error.emplace_back(seen.x() - truth.x(), seen.y() - truth.y(),
+                       std::remainder(seen.z() - truth.z(), 2.0 * M_PI));
   }
   std::vector<std::size_t> order(error.size() - 1);
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i + 1;
@@ -158,29 +156,29 @@ inline std::string odometry_drift(const std::vector<TrackPoint>& track, std::siz
       << " mrad off at the end, at most " << largest * 1e3 << " mm; largest growths:\n";
   // The angle between the IMU's mean specific force and its first: the base tilting, or
   // accelerating (the arm's weight alone tilts morphology A's standing base by 0.3 mrad at most).
-  const auto tilt = [&](std::size_t i) {
-    const Eigen::Vector3d& g0 = track.front().gravity;
-    const Eigen::Vector3d& g = track[i].gravity;
+  const auto turned = [&](std::size_t i) {
+    const Eigen::Vector3d& g0 = track.front().force;
+    const Eigen::Vector3d& g = track[i].force;
     if (g0.isZero() || g.isZero()) return std::nan("");
     return std::atan2(g0.cross(g).norm(), g0.dot(g));
   };
-  double most_tilted = 0.0;
+  double most_turned = 0.0;
   std::size_t at = 0;
   for (std::size_t i = 0; i < track.size(); ++i) {
-    if (tilt(i) > most_tilted) {
-      most_tilted = tilt(i);
+    if (turned(i) > most_turned) {
+      most_turned = turned(i);
       at = i;
     }
   }
   out << "  the IMU's mean specific force turned from its first direction by at most "
-      << most_tilted * 1e3 << " mrad (at " << track[at].t << " s, " << track[at].active
+      << most_turned * 1e3 << " mrad (at " << track[at].t << " s, " << track[at].active
       << "): the base tilting or accelerating\n";
   for (std::size_t k = 0; k < order.size() && k < count; ++k) {
     const std::size_t i = order[k];
     out << "  " << track[i - 1].t << "-" << track[i].t << " s: " << growth(i) * 1e3 << " mm ("
         << error[i - 1].head<2>().norm() * 1e3 << " -> " << error[i].head<2>().norm() * 1e3
         << " mm, yaw " << error[i - 1].z() * 1e3 << " -> " << error[i].z() * 1e3 << " mrad, IMU force turned "
-        << tilt(i - 1) * 1e3 << " -> " << tilt(i) * 1e3 << " mrad; " << track[i].active << ")\n";
+        << turned(i - 1) * 1e3 << " -> " << turned(i) * 1e3 << " mrad; " << track[i].active << ")\n";
   }
   return out.str();
 }
