@@ -240,6 +240,7 @@ struct Built {
   std::vector<std::string> joints;
   bool floating{false};
   std::string root;  ///< the root link's body (world bodies, e.g. moving obstacles, come first)
+  std::vector<std::string> leg_joints;  ///< every steering and wheel joint of the mobile base
 };
 
 Built build_mjcf(const std::string& urdf, const World& world, const SimParams& params,
@@ -257,10 +258,12 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
   const kinematics::Model model = kinematics::Model::from_urdf_string(urdf);
   std::vector<Leg> legs = detect_legs(model, radii);
   std::map<std::string, double> wheel_links;
+  Built out;
   for (const auto& leg : legs) {
     wheel_links[model.joint_child_link(model.joint_index_or_throw(leg.wheel_joint))] = leg.wheel_radius;
+    out.leg_joints.push_back(leg.steering_joint);
+    out.leg_joints.push_back(leg.wheel_joint);
   }
-  Built out;
   out.floating = params.floating_base.value_or(!legs.empty());
   double z = params.base_position.z();
   if (out.floating && !legs.empty()) {
@@ -348,6 +351,8 @@ struct Instance {
   /// Only the world changed: the running instance's whole state carries over.
   bool same_robot{false};
   int root_body{-1};  ///< MuJoCo body of the URDF root
+  std::vector<int> leg_dofs;  ///< the legs' steering and wheel joints' dof addresses
+  int still_steps{0};         ///< physics steps since a leg joint last moved (stand_grip)
 };
 
 namespace {
@@ -409,6 +414,10 @@ std::unique_ptr<Instance> make_instance(const std::string& urdf,
     in->scene = std::make_shared<SensorScene>(in->m, sensors, in->built.root, world.floor_height);
   }
   in->root_body = mj_name2id(in->m, mjOBJ_BODY, in->built.root.c_str());
+  for (const std::string& j : in->built.leg_joints) {
+    const int jid = mj_name2id(in->m, mjOBJ_JOINT, j.c_str());
+    if (jid >= 0) in->leg_dofs.push_back(in->m->jnt_dofadr[jid]);
+  }
   return in;
 }
 
@@ -438,6 +447,29 @@ void carry_state(const Instance& from, Instance& to) {
     }
   }
   mj_forward(to.m, to.d);
+}
+
+// MuJoCo's friction is soft: a contact below its friction limit still slides, at a speed in
+// proportion to the force. For a rolling wheel that is much what a tyre does (its lateral force
+// grows with the slip), but a base standing on its held wheels crept under any push: 0.9 mm/s
+// sideways under 150 N with 1000 N of friction to spare, 2.6 mm/s under 400 N (sim_test's
+// HeldWheelsStandUnderAPushBelowFrictionAndSlideAboveIt), unseen by wheel odometry. A drill's
+// thrust walked the standing base back from the wall (holes 28.3-29.7 mm deep of 30 asked)
+// and a pattern drilled by the kinematics alone inherited every push of the alignment.
+// A standing tyre grips: once no steering or wheel joint has moved for kStillTime, MuJoCo's
+// no-slip pass (mjOption::noslip_iterations) removes the contacts' slip within their friction
+// cones; a push above mu N still slides the base. Made stiff all the time instead (elliptic
+// cones, impratio 100), rolling wheels whose speeds disagree a little fought each other, the
+// steering and wheel drives at their continuous torque, and a whole-body move missed its goal.
+void stand_grip(Instance& in) {
+  constexpr double kStill = 0.01;     // leg joint speeds below this: standing [rad/s]
+  constexpr double kStillTime = 0.05;  // [s]
+  constexpr int kNoslipIterations = 10;
+  if (in.leg_dofs.empty()) return;
+  bool still = true;
+  for (const int dof : in.leg_dofs) still = still && std::abs(in.d->qvel[dof]) < kStill;
+  in.still_steps = still ? in.still_steps + 1 : 0;
+  in.m->opt.noslip_iterations = in.still_steps * in.m->opt.timestep >= kStillTime ? kNoslipIterations : 0;
 }
 
 }  // namespace
@@ -651,6 +683,7 @@ void SimHardware::step(double dt) {
         impl_->active->drilling.apply(impl_->active->m, impl_->active->d, impl_->holes)) {
       impl_->holes_dirty = true;
     }
+    stand_grip(*impl_->active);
     mj_step(impl_->active->m, impl_->active->d);
   }
   if (impl_->active->scene) {

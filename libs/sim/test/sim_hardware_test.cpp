@@ -111,6 +111,47 @@ TEST(SimHardware, ExternalForceIsAppliedUntilCleared) {
                HardwareError);
 }
 
+// Coulomb friction: a base standing on its held wheels stays where it is under a push well
+// below mu N, and slides under one above it. At MuJoCo's soft friction it crept (0.9 mm/s under
+// 150 N, 2.6 mm/s under 400 N, 1230 N of friction available), unseen by wheel odometry.
+TEST(SimHardware, HeldWheelsStandUnderAPushBelowFrictionAndSlideAboveIt) {
+  const double weight = 9.81 * (80.0 + 4 * 7.0 + 2.0 + 3.6 + 3.0 + 2.5 + 1.5 + 1.2 + 0.8 + 2.0);
+  const auto pushed = [&](const Eigen::Vector3d& push) {
+    SimHardware sim(read_fixture("mobile_drill.urdf"), World{}, {});
+    for (int i = 0; i < 500; ++i) sim.step(0.001);
+    HardwareState s;
+    sim.read(s);
+    std::vector<DriveCommand> hold(sim.joint_names().size());
+    for (std::size_t i = 0; i < hold.size(); ++i) {
+      hold[i].mode = DriveMode::kPosition;
+      hold[i].position = s.position[i];
+    }
+    sim.write(hold);
+    // At the floor's height: the push slides the base rather than tipping it over its wheels.
+    Eigen::Vector3d at = sim.base_pose().translation();
+    at.z() = 0.0;
+    sim.set_external_force("mobile_base", push, at);
+    for (int i = 0; i < 1000; ++i) sim.step(0.001);  // the wheels' drives and contacts take the load
+    const Eigen::Vector3d loaded = sim.base_pose().translation();
+    for (int i = 0; i < 2000; ++i) sim.step(0.001);
+    return std::pair{loaded, sim.base_pose().translation()};
+  };
+  const Eigen::Vector3d start = [] {
+    SimHardware sim(read_fixture("mobile_drill.urdf"), World{}, {});
+    for (int i = 0; i < 500; ++i) sim.step(0.001);
+    return sim.base_pose().translation();
+  }();
+  for (const Eigen::Vector3d& push : {Eigen::Vector3d(0.0, 400.0, 0.0), Eigen::Vector3d(400.0, 0.0, 0.0),
+                                      Eigen::Vector3d(-250.0, 250.0, 0.0)}) {
+    const auto [loaded, later] = pushed(push);
+    EXPECT_LT((later - loaded).norm(), 0.1e-3) << "a push of " << push.transpose() << " N made the base creep";
+    // The wheels' drives give a little under the load, no more (3000 N m/rad at 0.16 m: 1 mm).
+    EXPECT_LT((loaded - start).head<2>().norm(), 2e-3) << push.transpose();
+  }
+  const auto [loaded, later] = pushed(Eigen::Vector3d(0.0, 1.5 * weight, 0.0));
+  EXPECT_GT(later.y() - loaded.y(), 0.5) << "a push above mu N (mu 1.0) did not slide the base";
+}
+
 TEST(SimHardware, TorqueSaturatesAtTheUrdfEffortLimit) {
   SimHardware sim(read_fixture("arm_drill.urdf"), World{}, {});
   const auto j1 = index_of(sim.joint_names(), "J1_A");
