@@ -112,6 +112,7 @@ struct TrackPoint {
   double t{0.0};                    // [s] from the mission's start
   std::array<double, 3> odometry{};  // x, y [m], yaw [rad] in the odometry frame
   std::array<double, 3> truth{};     // x, y [m], yaw [rad] in the world
+  std::array<double, 3> lean{};      // the truth's z [m], roll and pitch [rad]
   std::string active;
   Eigen::Vector3d force{Eigen::Vector3d::Zero()};  // the IMU's mean specific force (zero: none)
 };
@@ -178,7 +179,10 @@ inline std::string odometry_drift(const std::vector<TrackPoint>& track, std::siz
     out << "  " << track[i - 1].t << "-" << track[i].t << " s: " << growth(i) * 1e3 << " mm ("
         << error[i - 1].head<2>().norm() * 1e3 << " -> " << error[i].head<2>().norm() * 1e3
         << " mm, yaw " << error[i - 1].z() * 1e3 << " -> " << error[i].z() * 1e3 << " mrad, IMU force turned "
-        << turned(i - 1) * 1e3 << " -> " << turned(i) * 1e3 << " mrad; " << track[i].active << ")\n";
+        << turned(i - 1) * 1e3 << " -> " << turned(i) * 1e3 << " mrad; base z " << track[i - 1].lean[0] * 1e3
+        << " -> " << track[i].lean[0] * 1e3 << " mm, roll " << track[i - 1].lean[1] * 1e3 << " -> "
+        << track[i].lean[1] * 1e3 << " mrad, pitch " << track[i - 1].lean[2] * 1e3 << " -> "
+        << track[i].lean[2] * 1e3 << " mrad; " << track[i].active << ")\n";
   }
   return out.str();
 }
@@ -371,6 +375,7 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
         run.track.push_back({std::chrono::duration<double>(now - started).count(),
                              {odometry->x(), odometry->y(), odometry->yaw()},
                              {truth->x(), truth->y(), truth->yaw()},
+                             {truth->z(), truth->roll(), truth->pitch()},
                              active,
                              mean_force()});
     }

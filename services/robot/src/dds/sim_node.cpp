@@ -1,5 +1,6 @@
 #include "sim_node.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -96,6 +97,8 @@ void SimNode::publish_truth() {
       t.y(truth.pose.translation().y());
       t.z(truth.pose.translation().z());
       t.yaw(std::atan2(r(1, 0), r(0, 0)));
+      t.pitch(std::asin(std::clamp(-r(2, 0), -1.0, 1.0)));
+      t.roll(std::atan2(r(2, 1), r(2, 2)));
       truth_.write(t);
       publish_holes(truth.time);
     }
