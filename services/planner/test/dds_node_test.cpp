@@ -174,15 +174,28 @@ TEST_F(PlannerNodeTest, ARequestIsAcknowledgedOnArrivalAndAResendIsNotPlannedAga
   other.source("another client");
   requests_->write(other);
   std::vector<std::pair<uint32_t, msg::PlanState>> seen;  // in the order they came
+  // The other client's 31 shares the first 31's instance (PlanResult's key is the request id,
+  // kept short for other vendors): under load its answer can replace the first's before this
+  // reader takes it, so the topic shows two or three answers; the log counts the plans (below).
   int finals = 0;
+  bool final31 = false, final32 = false;
   const auto deadline = std::chrono::steady_clock::now() + 30s;
+  auto last_sample = std::chrono::steady_clock::now();
   while (finals < 3 && std::chrono::steady_clock::now() < deadline) {
     const auto r = results_->wait(200ms);
-    if (!r) continue;
+    if (!r) {
+      if (final31 && final32 && std::chrono::steady_clock::now() - last_sample > 2s) break;
+      continue;
+    }
+    last_sample = std::chrono::steady_clock::now();
     seen.emplace_back(r->request_id(), r->state());
-    if (r->state() == msg::PLAN_SUCCEEDED || r->state() == msg::PLAN_FAILED) ++finals;
+    if (r->state() == msg::PLAN_SUCCEEDED || r->state() == msg::PLAN_FAILED) {
+      ++finals;
+      final31 = final31 || r->request_id() == 31;
+      final32 = final32 || r->request_id() == 32;
+    }
   }
-  ASSERT_EQ(finals, 3) << log_.str();
+  ASSERT_TRUE(final31 && final32) << log_.str();
   // 32 was acknowledged before 31's answer came.
   const auto first = [&](uint32_t id, auto pred) {
     return std::find_if(seen.begin(), seen.end(),
