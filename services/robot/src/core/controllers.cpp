@@ -223,9 +223,9 @@ void BaseController::estimate(CycleData& data) {
     constexpr double kBiasTime = 10.0;  // time constant of the bias estimate [s]
     // Still: no wheel rolls, no leg steers (a leg turning in place twists the base, with no
     // wheel speed to show it) and no arm joint moves. A moving arm, or one pushing a drill into
-    // a wall, turns the standing base on its wheels' contacts by a few mrad (3-4 mrad per hole
-    // on the demo wall, 4-5 mm at the next hole); that turn is the gyro's to see, not a bias to
-    // learn.
+    // a wall, can turn the standing base on its wheels' contacts (3-4 mrad per hole on the demo
+    // wall while the simulator let a standing base creep, libs/sim); that turn is the gyro's to
+    // see, not a bias to learn.
     bool still = twist.head<2>().norm() < kStill && std::abs(twist.z()) < kStill &&
                  data.qd.cwiseAbs().maxCoeff() < kStill;
     if (still) {
