@@ -196,6 +196,7 @@ struct Chaos::Impl {
   Clock::time_point truth_received{};
   Clock::time_point joints_received{};
   std::vector<double> joints;  // positions of the latest joint state at the current model
+  std::vector<std::string> joint_names;  // and their names
   std::map<uint32_t, Request> requests;
   std::vector<KillSeen> kills;
 
@@ -256,6 +257,7 @@ struct Chaos::Impl {
           std::lock_guard lock(m);
           if (j.model_version() != model_version) return;
           joints = j.position();
+          joint_names = j.name();
           joints_received = Clock::now();
         });
     result_reader = std::make_unique<dds::Reader<msg::PlanResult>>(
@@ -726,9 +728,13 @@ struct Chaos::Impl {
     auto watch = [&] {
       const auto now = pose_now();
       r.held_base_m = std::max(r.held_base_m, (now.first - reference.first).norm());
-      for (std::size_t i = 0; i < std::min(now.second.size(), reference.second.size()); ++i)
-        r.held_joint_rad =
-            std::max(r.held_joint_rad, std::abs(now.second[i] - reference.second[i]));
+      for (std::size_t i = 0; i < std::min(now.second.size(), reference.second.size()); ++i) {
+        const double moved = std::abs(now.second[i] - reference.second[i]);
+        if (moved <= r.held_joint_rad) continue;
+        r.held_joint_rad = moved;
+        std::lock_guard lock(m);
+        r.held_joint = i < joint_names.size() ? joint_names[i] : "joint " + std::to_string(i);
+      }
     };
     // A command sent now is refused, naming the stop (sent again if the planner never took it).
     uint32_t probe = send(0, true);
@@ -764,7 +770,7 @@ struct Chaos::Impl {
     if (r.held_base_m > kHoldBaseTolerance || r.held_joint_rad > kHoldJointTolerance) {
       std::ostringstream text;
       text << "the robot moved while stopped: base " << r.held_base_m << " m, a joint "
-           << r.held_joint_rad << " rad over " << r.hold_s << " s";
+           << r.held_joint_rad << " rad (" << r.held_joint << ") over " << r.hold_s << " s";
       fail(text.str());
     }
     {
@@ -942,7 +948,7 @@ struct Chaos::Impl {
       line << "; stopped:";
       for (const auto& c : r.causes) line << " [" << c << "]";
       line << "; held " << r.hold_s << " s (base " << r.held_base_m * 1e3 << " mm, joints "
-           << r.held_joint_rad << " rad)";
+           << r.held_joint_rad << " rad" << (r.held_joint.empty() ? "" : ", most " + r.held_joint) << ")";
     } else {
       line << "; no stop";
     }

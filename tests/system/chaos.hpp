@@ -54,6 +54,7 @@ struct RoundReport {
   std::vector<std::string> starved;
   double held_base_m = 0.0;     ///< largest base motion while stopped [m]
   double held_joint_rad = 0.0;  ///< largest joint motion while stopped [rad]
+  std::string held_joint;       ///< the joint that moved most while stopped
   double hold_s = 0.0;          ///< how long the hold was watched [s]
   int resets_lost = 0;          ///< operator resets that got no answer (sent again)
   std::vector<std::string> failures;

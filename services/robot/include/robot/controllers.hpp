@@ -57,6 +57,9 @@ struct CycleData {
   std::vector<double> hold_position;
   std::vector<double> position_ref;
   std::vector<DriveCommand> drive;
+  /// Per joint: a wheel of the base. Held, it brakes and stays where it comes to rest rather
+  /// than being driven back to where it was when the hold began (HoldController).
+  std::vector<char> wheel;
 
   [[nodiscard]] const kinematics::JointLimits& limits(int i) const {
     return model->joint_limits()[static_cast<std::size_t>(i)];

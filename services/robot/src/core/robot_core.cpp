@@ -124,6 +124,9 @@ struct RobotCore::Slot {
         commands(make_frame(model->dof())),
         applied_claim(static_cast<std::size_t>(model->dof()), 0) {
     controllers = {&hold, &joint, &cartesian, &gravity, base.get(), &trajectory};
+    if (base) {
+      for (const Leg& leg : legs) cycle.wheel[static_cast<std::size_t>(leg.wheel_index)] = 1;
+    }
   }
   ~Slot() { delete running; }
 
