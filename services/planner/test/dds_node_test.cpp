@@ -574,8 +574,12 @@ TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {
   EXPECT_EQ(nlohmann::json::parse(lines.front()).at("request_id"), 33);
   EXPECT_EQ(nlohmann::json::parse(lines.back()).at("state"), "succeeded");
   err.str("");
-  EXPECT_EQ(plan({"drill", "--at", "2.0", "0", "7.0", "--request-id", "32", "--timeout", "20"}), 1);
-  EXPECT_NE(err.str().find("camera_E"), std::string::npos) << err.str();
+  out.str("");
+  // Out of reach: the posture search spends its whole budget (1.6 s of CPU) before it fails,
+  // which under a loaded machine is many seconds of wall time.
+  EXPECT_EQ(plan({"drill", "--at", "2.0", "0", "7.0", "--request-id", "32", "--timeout", "60"}), 1);
+  EXPECT_NE(err.str().find("camera_E"), std::string::npos)
+      << err.str() << "the command printed:\n" << out.str() << "the planner logged:\n" << log_.str();
 }
 
 namespace {
