@@ -141,8 +141,9 @@ class GravityCompensationController final : public Controller {
 class BaseController final : public Controller {
  public:
   /// `trajectory_steering_rate`: fraction of the steering velocity limit used while a
-  /// trajectory drives the legs.
-  BaseController(std::vector<Leg> legs, double command_timeout, double trajectory_steering_rate);
+  /// trajectory drives the legs; `steering_acceleration`: of the steering's reference [rad/s^2].
+  BaseController(std::vector<Leg> legs, double command_timeout, double trajectory_steering_rate,
+                 double steering_acceleration = 20.0);
   [[nodiscard]] JointOwner kind() const override { return JointOwner::kBase; }
   /// New twist (base frame) at hardware time `time`.
   void set(const BaseCommand& command, double time);
@@ -161,9 +162,14 @@ class BaseController final : public Controller {
   [[nodiscard]] const std::vector<Leg>& legs() const { return kinematics_.legs(); }
 
  private:
+  /// Leg k's steering drive reference towards `target` at up to `rate` of its velocity limit.
+  void steer(CycleData& data, std::size_t k, double target, double rate, DriveCommand& d);
   BaseKinematics kinematics_;
   double timeout_;
   double trajectory_steering_rate_;
+  double steering_acceleration_;
+  std::vector<double> steering_ref_rate_;  // per leg: the steering reference's rate [rad/s]
+  std::vector<double> steered_at_;         // per leg: hardware time this controller last steered it
   Eigen::Vector3d twist_{Eigen::Vector3d::Zero()};
   double command_time_{-1e9};
   std::vector<double> steering_, wheel_velocity_, steering_rate_;

@@ -118,7 +118,8 @@ struct RobotCore::Slot {
         joint(model->dof()),
         cartesian(arm),
         base(leg_list.size() >= 2 ? std::make_unique<BaseController>(leg_list, params.base_command_timeout,
-                                                                   params.trajectory_steering_rate)
+                                                                   params.trajectory_steering_rate,
+                                                                   params.steering_acceleration)
                                   : nullptr),
         trajectory(model->dof(), params, base.get()),
         commands(make_frame(model->dof())),

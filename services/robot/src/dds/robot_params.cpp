@@ -25,6 +25,7 @@ ServiceParams read_service_params(config::Document& doc) {
   robot.number("trajectory_base_gain", p.robot.trajectory_base_gain, non_negative);
   robot.number("trajectory_base_deadband", p.robot.trajectory_base_deadband, non_negative);
   robot.number("trajectory_steering_rate", p.robot.trajectory_steering_rate, positive);
+  robot.number("steering_acceleration", p.robot.steering_acceleration, positive);
 
   config::Map sim = root.section("sim");
   sim.number("timestep", p.sim.timestep, positive);
