@@ -97,8 +97,14 @@ class Controller {
 /// Keeps joints where they were left (position mode, gravity feed-forward).
 class HoldController final : public Controller {
  public:
+  explicit HoldController(int dof)
+      : held_at_(static_cast<std::size_t>(dof), -1e9), braking_(static_cast<std::size_t>(dof), 0) {}
   [[nodiscard]] JointOwner kind() const override { return JointOwner::kHold; }
   void update(CycleData& data) override;
+
+ private:
+  std::vector<double> held_at_;  // per joint: hardware time this controller last held it
+  std::vector<char> braking_;    // per joint: a wheel rolling when its hold began, not yet stopped
 };
 
 /// Joint position / velocity / effort / impedance references, per joint.

@@ -81,12 +81,20 @@ DriveCommand& CycleData::new_drive(int i, DriveMode mode) {
 }
 
 void HoldController::update(CycleData& data) {
-  data.for_each_owned_by(JointOwner::kHold, [&data](int i) {
-    // A rolling wheel brakes (velocity 0) and is held where it comes to rest. Held where it was
-    // when the hold began (a safety stop while the base drove), it was driven back: the stopped
-    // base rolled 6 mm and a wheel 0.07 rad during the chaos test's watch of the hold.
+  data.for_each_owned_by(JointOwner::kHold, [this, &data](int i) {
+    // A wheel rolling when its hold begins brakes (velocity 0) and is held where it comes to
+    // rest. Held where it was when the hold began (a safety stop while the base drove), it was
+    // driven back: the stopped base rolled 6 mm and a wheel 0.07 rad during the chaos test's
+    // watch of the hold. Only then: a wheel that braked whenever it rolled let a pushed base
+    // roll away on its brakes' damping (300 N moved the paper's base 14 cm in 5 s).
     constexpr double kRolling = 0.05;  // [rad/s]
-    if (data.wheel[static_cast<std::size_t>(i)] != 0 && std::abs(data.qd(i)) > kRolling) {
+    const auto iu = static_cast<std::size_t>(i);
+    if (!(data.time - held_at_[iu] <= 1.5 * data.dt)) {
+      braking_[iu] = data.wheel[iu] != 0 && std::abs(data.qd(i)) > kRolling ? 1 : 0;
+    }
+    held_at_[iu] = data.time;
+    if (braking_[iu] != 0 && std::abs(data.qd(i)) <= kRolling) braking_[iu] = 0;
+    if (braking_[iu] != 0) {
       data.new_drive(i, DriveMode::kVelocity).velocity = 0.0;
       data.follow(i);
       return;

@@ -151,7 +151,7 @@ struct RobotCore::Slot {
   /// table does not list it (no foldback).
   std::vector<model::JointLimits> limits;
   CycleData cycle;
-  HoldController hold;
+  HoldController hold{model->dof()};
   JointController joint;
   CartesianController cartesian;
   GravityCompensationController gravity;
