@@ -117,6 +117,16 @@ struct TrackPoint {
   Eigen::Vector3d force{Eigen::Vector3d::Zero()};  // the IMU's mean specific force (zero: none)
 };
 
+/// The arm's and legs' torques over a quarter of a second of a run: each joint's largest |effort|
+/// and its last position, with the drill's active node then (what held a joint near its
+/// continuous torque before a safety stop on its RMS torque).
+struct TorqueSample {
+  double t{0.0};  // [s] from the mission's start
+  std::string active;
+  std::vector<double> peak;      // per MissionRun::joint_names: largest |effort| [N m]
+  std::vector<double> position;  // per MissionRun::joint_names: the last position [rad]
+};
+
 /// What a mission run left: the final status (none: the service never answered), the holes the
 /// simulator's wall records, the safety state at the end, every service's log and the base's
 /// track.
@@ -126,7 +136,26 @@ struct MissionRun {
   bool safety_running{false};
   std::string logs;
   std::vector<TrackPoint> track;  // every half second or so while the mission ran
+  std::vector<std::string> joint_names;
+  std::vector<TorqueSample> torques;  // every quarter second, the last 30 s of the run
 };
+
+/// `joint`'s torques over the last `seconds` of `run` (a line per quarter second).
+inline std::string torque_trace(const MissionRun& run, const std::string& joint, double seconds = 15.0) {
+  const auto it = std::find(run.joint_names.begin(), run.joint_names.end(), joint);
+  if (it == run.joint_names.end() || run.torques.empty()) return joint + ": no torques recorded\n";
+  const auto j = static_cast<std::size_t>(it - run.joint_names.begin());
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out << std::setprecision(1) << joint << "'s largest |torque| per quarter second over the last "
+      << seconds << " s (N m, its position in rad, the drill's active node):\n";
+  for (const TorqueSample& s : run.torques) {
+    if (s.t < run.torques.back().t - seconds || j >= s.peak.size()) continue;
+    out << "  " << s.t << " s: " << s.peak[j] << " N m at " << std::setprecision(3) << s.position[j]
+        << std::setprecision(1) << " rad; " << s.active << "\n";
+  }
+  return out.str();
+}
 
 /// How odometry parted from the simulator's truth over `track`: odometry mapped into the world
 /// by their first pair, the position error at the end, its largest value, and the `count`
@@ -302,6 +331,23 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   std::deque<msg::SimTruth> truths_kept;  // the last ones: paired with odometry by stamp
   std::deque<Eigen::Vector3d> forces;     // the IMU's last specific forces
   std::string imu_name;
+  // The joints' largest |effort| since the last torque sample, and their last positions.
+  std::vector<double> peaks, positions;
+  std::vector<std::string> joint_names;
+  concert::dds::Reader<msg::JointState> joint_states(
+      p, concert::dds::topics::joint_state, [&](const msg::JointState& js, const auto&) {
+        std::lock_guard lock(base_mutex);
+        if (joint_names.empty()) joint_names = js.name();
+        if (js.name() != joint_names || js.effort().size() != js.name().size() ||
+            js.position().size() != js.name().size())
+          return;  // another model's joints
+        peaks.resize(js.name().size(), 0.0);
+        positions.resize(js.name().size(), 0.0);
+        for (std::size_t i = 0; i < js.name().size(); ++i) {
+          peaks[i] = std::max(peaks[i], std::abs(js.effort()[i]));
+          positions[i] = js.position()[i];
+        }
+      });
   concert::dds::Reader<msg::Odometry> odometries(p, concert::dds::topics::odometry,
                                                  [&](const msg::Odometry& o, const auto&) {
                                                    std::lock_guard lock(base_mutex);
@@ -356,11 +402,22 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   };
   const auto started = std::chrono::steady_clock::now();
   auto recorded = started - 1s;
+  auto torque_recorded = started;
   std::string active;
   for (const auto until = started + timeout; std::chrono::steady_clock::now() < until;) {
     const auto s = statuses.wait(250ms);
     if (s && s->mission_id() == m.mission_id()) active = s->active();
     const auto now = std::chrono::steady_clock::now();
+    if (now - torque_recorded >= 250ms) {
+      torque_recorded = now;
+      std::lock_guard lock(base_mutex);
+      if (!peaks.empty()) {
+        if (run.joint_names.empty()) run.joint_names = joint_names;
+        run.torques.push_back({std::chrono::duration<double>(now - started).count(), active, peaks, positions});
+        if (run.torques.size() > 120) run.torques.erase(run.torques.begin());
+        std::fill(peaks.begin(), peaks.end(), 0.0);
+      }
+    }
     if (now - recorded >= 500ms) {
       recorded = now;
       std::lock_guard lock(base_mutex);
