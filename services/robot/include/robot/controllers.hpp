@@ -57,8 +57,8 @@ struct CycleData {
   std::vector<double> hold_position;
   std::vector<double> position_ref;
   std::vector<DriveCommand> drive;
-  /// Per joint: a wheel of the base. Held, it brakes and stays where it comes to rest rather
-  /// than being driven back to where it was when the hold began (HoldController).
+  /// Per joint: a wheel of the base. Rolling when its hold begins, it brakes and stays where it
+  /// comes to rest rather than being driven back to where the hold began (HoldController).
   std::vector<char> wheel;
 
   [[nodiscard]] const kinematics::JointLimits& limits(int i) const {
@@ -71,6 +71,13 @@ struct CycleData {
   double ramp(int i, double target, double rate = 1.0);
   /// Joint i leaves torque-level control: its references follow the measurement.
   void follow(int i);
+  /// Whether a controller that drives a joint each cycle and keeps `last` (the hardware time it
+  /// last did) drove it the cycle before too, not another owner; sets `last` to now.
+  bool continued(double& last) const {
+    const bool kept = time - last <= 1.5 * dt;
+    last = time;
+    return kept;
+  }
   /// Joint i's drive reference, reset to a fresh one in `mode` for its owner to fill in.
   DriveCommand& new_drive(int i, DriveMode mode);
   /// Calls `f(i)` for every joint i that `who` owns, in model order. No allocation.

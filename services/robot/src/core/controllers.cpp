@@ -89,10 +89,9 @@ void HoldController::update(CycleData& data) {
     // roll away on its brakes' damping (300 N moved the paper's base 14 cm in 5 s).
     constexpr double kRolling = 0.05;  // [rad/s]
     const auto iu = static_cast<std::size_t>(i);
-    if (!(data.time - held_at_[iu] <= 1.5 * data.dt)) {
+    if (!data.continued(held_at_[iu])) {
       braking_[iu] = data.wheel[iu] != 0 && std::abs(data.qd(i)) > kRolling ? 1 : 0;
     }
-    held_at_[iu] = data.time;
     if (braking_[iu] != 0 && std::abs(data.qd(i)) <= kRolling) braking_[iu] = 0;
     if (braking_[iu] != 0) {
       data.new_drive(i, DriveMode::kVelocity).velocity = 0.0;
@@ -278,8 +277,7 @@ void BaseController::steer(CycleData& data, std::size_t k, double target, double
   double& v = steering_ref_rate_[k];
   // Another owner had the leg last cycle (a hold, a stop): the profile starts from the steering's
   // own motion.
-  if (!(data.time - steered_at_[k] <= 1.5 * data.dt)) v = data.qd(s);
-  steered_at_[k] = data.time;
+  if (!data.continued(steered_at_[k])) v = data.qd(s);
   const double vmax = rate * data.limits(s).velocity;
   const double a = steering_acceleration_;
   const double left = data.clamp_position(s, target) - ref;
