@@ -17,20 +17,29 @@
 //   lowest    scenario 3's lowest row, 0.35 m (the marker at 0.5 m, morphology A;
 //             deploy/bench/drill_lowest_site.yaml): drilled at 39-52 % of the thrust
 //   demo      the demo wall's pattern (deploy/demo/drill_site.yaml)
-// Usage: bench_drill_mission [--scenario blobs|patterns|high|row|low|lowest|bim|demo|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
+//   experiments  scenario 3 as the paper ran it: 22 missions of one 60 cm row each, heights
+//             0.35-2.90 m evenly, morphology A up to 2.4 m and C above, a fresh stack each
+//             (not in all: about 90 minutes)
+// CONCERT_STACK_DIR=DIR runs the services' binaries of that name in DIR (a copy taken before a
+// long run, so that building on meanwhile does not change them).
+// Usage: bench_drill_mission [--scenario blobs|patterns|high|row|low|lowest|bim|demo|experiments|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
 //        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
-
-#include <optional>
 
 #include "concert/cli/cli.hpp"
 #include "drill_runner.hpp"
@@ -64,6 +73,124 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
+// Holes and times summed over runs.
+struct Tally {
+  std::vector<double> errors;  // [m] in the wall's plane, of the holes drilled
+  std::size_t drilled{0}, marked{0};
+  double nav{0}, plan{0}, exec{0}, drill{0}, total{0};  // [s]
+
+  void print(const std::string& what, int runs) const {
+    std::printf(
+        "== %s: %zu of %zu marked holes drilled; error median %.2f mm, p95 %.2f mm, max %.2f mm; "
+        "time per run: navigate %.0f s, plan %.0f s, execute %.0f s, drill %.0f s, total %.0f s\n",
+        what.c_str(), drilled, marked, percentile(errors, 0.5) * 1e3, percentile(errors, 0.95) * 1e3,
+        percentile(errors, 1.0) * 1e3, nav / runs, plan / runs, exec / runs, drill / runs, total / runs);
+    std::fflush(stdout);
+  }
+};
+
+// One run scored against its marks' truth: a line per mark, the services' logs when asked or
+// when something went wrong.
+void score(const std::string& what, const MissionRun& run, const std::vector<Target>& targets,
+           bool logs, Tally& tally) {
+  if (!run.status) {
+    std::cerr << what << ": no status from the drill service" << run.logs << "\n";
+    tally.marked += targets.size();
+    return;
+  }
+  const DrillStatus& s = *run.status;
+  std::printf("%s: mission %s, %u of %u marked holes drilled, safety %s%s%s\n", what.c_str(),
+              s.state() == concert::msg::DRILL_SUCCEEDED ? "succeeded" : "did not succeed",
+              s.holes_drilled(), s.holes_marked(), run.safety_running ? "RUNNING" : "STOPPED",
+              s.reason().empty() ? "" : ": ", s.reason().c_str());
+  bool off = false;  // a hole past 5 mm, or a mark not drilled: the logs say why
+  for (const Target& t : targets) {
+    tally.marked += 1;
+    const auto [hole, e] = nearest_hole(run.holes, t);
+    // A hole within 5 cm is this mark's; farther, the mark was not drilled.
+    if (hole == nullptr || e.norm() > 0.05) {
+      std::printf("  %-22s not drilled\n", t.name.c_str());
+      off = true;
+      continue;
+    }
+    off = off || e.norm() > 0.005;
+    tally.drilled += 1;
+    tally.errors.push_back(e.norm());
+    std::printf("  %-22s x %+6.2f mm  y %+6.2f mm  |e| %5.2f mm  depth %4.1f mm\n", t.name.c_str(),
+                e.horizontal * 1e3, e.vertical * 1e3, e.norm() * 1e3, hole->depth() * 1e3);
+  }
+  if (logs || off || s.state() != concert::msg::DRILL_SUCCEEDED) {
+    std::cerr << what << ": the services' logs" << run.logs << "\n";
+  }
+  tally.nav += s.time_navigate();
+  tally.plan += s.time_plan();
+  tally.exec += s.time_execute();
+  tally.drill += s.time_drill();
+  tally.total += s.time_total();
+  std::fflush(stdout);
+}
+
+// Scenario 3 as the paper ran it (section 6.1: "twenty-two experiments performing 60 cm wide
+// horizontal patterns at different heights ranging from 0.35 m to 2.90 m"): 22 missions of one
+// row each, on a fresh stack each, the rows' heights spread evenly over that range. Morphology A
+// up to 2.4 m (a marker of id 0, the row 15 cm below it), C above (id 1, the row 15 cm above it:
+// the marker stays within the wall). The marker stands 2.2 m in front of the robot's start,
+// 0.3 m left, ahead or right in turn. Each experiment's world is a file in the temp directory.
+int experiments(int runs, bool logs, const std::string& map, const concert::drill::PatternTable& patterns) {
+  constexpr int kExperiments = 22;
+  constexpr double kLowest = 0.35, kHighest = 2.90, kMorphologyC = 2.4;
+  Tally all, on_a, on_c;
+  int runs_a = 0, runs_c = 0;
+  for (int r = 0; r < runs; ++r) {
+    for (int k = 0; k < kExperiments; ++k) {
+      const double row = kLowest + (kHighest - kLowest) * k / (kExperiments - 1);
+      const bool c = row > kMorphologyC;
+      const double marker = c ? row - 0.15 : row + 0.15;
+      const double u = 0.3 * static_cast<double>(k % 3 - 1);  // along the wall, -y
+      char name[32];
+      std::snprintf(name, sizeof name, "row_%03d", static_cast<int>(std::lround(row * 100)));
+      const std::filesystem::path site = std::filesystem::temp_directory_path() /
+                                         ("bench_drill_experiment_" + std::to_string(::getpid()) + ".yaml");
+      std::ofstream(site) << std::setprecision(6)
+                          << "floor:\n  friction: 1.0\nwalls:\n"
+                             "  - name: bench_wall\n    size: [0.2, 6.0, 3.2]\n    position: [2.3, 0.0, 1.6]\n"
+                             "marks:\n  - {type: aruco, name: " << name
+                          << ", wall: bench_wall, face: -x, at: [" << u << ", " << marker
+                          << "], size: 0.1, dictionary: DICT_4X4_50, id: " << (c ? 1 : 0)
+                          << ", angle: 0.0}\n";
+      std::ostringstream mission;
+      mission << std::setprecision(6) << "name: bench " << name << "\ndepth: 0.03\nareas:\n  - {name: "
+              << name << ", marks: aruco, point: [2.2, " << -u << ", " << marker << "]}\n";
+      const std::vector<Target> targets = targets_of(concert::world::load_world_file(site.string()), patterns);
+      const std::string assembly =
+          source(c ? "services/planner/data/morphology_c.yaml" : "services/planner/data/morphology_a.yaml");
+      std::printf("experiment %d of %d (run %d): row at %.2f m, morphology %s\n", k + 1, kExperiments,
+                  r + 1, row, c ? "C" : "A");
+      std::fflush(stdout);
+      const MissionRun run =
+          run_mission(assembly, site.string(), mission.str(), std::chrono::seconds(1200), std::nullopt, map);
+      std::filesystem::remove(site);
+      Tally one;
+      score(std::string("  ") + name, run, targets, logs, one);
+      for (Tally* t : {&all, c ? &on_c : &on_a}) {
+        t->errors.insert(t->errors.end(), one.errors.begin(), one.errors.end());
+        t->drilled += one.drilled;
+        t->marked += one.marked;
+        t->nav += one.nav;
+        t->plan += one.plan;
+        t->exec += one.exec;
+        t->drill += one.drill;
+        t->total += one.total;
+      }
+      (c ? runs_c : runs_a) += 1;
+    }
+  }
+  on_a.print("experiments on morphology A (rows 0.35-2.4 m, " + std::to_string(runs_a) + " missions)", runs_a);
+  on_c.print("experiments on morphology C (rows above 2.4 m, " + std::to_string(runs_c) + " missions)", runs_c);
+  all.print("experiments (" + std::to_string(runs_a + runs_c) + " missions of one row)", runs_a + runs_c);
+  return 0;
+}
+
 int bench(const std::string& which, int runs, const std::string& assembly, bool logs,
           const std::string& map) {
   const std::vector<Scenario> all{
@@ -94,6 +221,7 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
   };
   const concert::drill::PatternTable patterns =
       concert::drill::load_patterns(source("services/drill/config/patterns.yaml"));
+  if (which == "experiments") return experiments(runs, logs, map, patterns);
   bool known = false;
   for (const Scenario& sc : all) {
     // all: row and low are in patterns
@@ -109,62 +237,17 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
       const std::string row = sc.name == "row" ? "row_150" : "row_050";
       std::erase_if(targets, [&row](const Target& t) { return t.name.rfind(row, 0) != 0; });
     }
-    std::vector<double> errors;
-    std::size_t drilled = 0, marked = 0;
-    double t_nav = 0, t_plan = 0, t_exec = 0, t_drill = 0, t_total = 0;
+    Tally tally;
     for (int r = 0; r < runs; ++r) {
       const MissionRun run = run_mission(assembly.empty() ? sc.assembly : assembly, site, mission,
                                          std::chrono::seconds(3600), sc.building, map);
-      if (!run.status) {
-        std::cerr << sc.name << " run " << r + 1 << ": no status from the drill service" << run.logs
-                  << "\n";
-        marked += targets.size();
-        continue;
-      }
-      const DrillStatus& s = *run.status;
-      std::printf("%s run %d: mission %s, %u of %u marked holes drilled, safety %s%s%s\n",
-                  sc.name.c_str(), r + 1,
-                  s.state() == concert::msg::DRILL_SUCCEEDED ? "succeeded" : "did not succeed",
-                  s.holes_drilled(), s.holes_marked(), run.safety_running ? "RUNNING" : "STOPPED",
-                  s.reason().empty() ? "" : ": ", s.reason().c_str());
-      bool off = false;  // a hole past 5 mm, or a mark not drilled: the logs say why
-      for (const Target& t : targets) {
-        marked += 1;
-        const auto [hole, e] = nearest_hole(run.holes, t);
-        // A hole within 5 cm is this mark's; farther, the mark was not drilled.
-        if (hole == nullptr || e.norm() > 0.05) {
-          std::printf("  %-22s not drilled\n", t.name.c_str());
-          off = true;
-          continue;
-        }
-        off = off || e.norm() > 0.005;
-        drilled += 1;
-        errors.push_back(e.norm());
-        std::printf("  %-22s x %+6.2f mm  y %+6.2f mm  |e| %5.2f mm  depth %4.1f mm\n",
-                    t.name.c_str(), e.horizontal * 1e3, e.vertical * 1e3, e.norm() * 1e3,
-                    hole->depth() * 1e3);
-      }
-      if (logs || off || s.state() != concert::msg::DRILL_SUCCEEDED) {
-        std::cerr << sc.name << " run " << r + 1 << ": the services' logs" << run.logs << "\n";
-      }
-      t_nav += s.time_navigate();
-      t_plan += s.time_plan();
-      t_exec += s.time_execute();
-      t_drill += s.time_drill();
-      t_total += s.time_total();
-      std::fflush(stdout);
+      score(sc.name + " run " + std::to_string(r + 1), run, targets, logs, tally);
     }
-    std::printf(
-        "== %s (%d run%s): %zu of %zu marked holes drilled; error median %.2f mm, p95 %.2f mm, "
-        "max %.2f mm; time per run: navigate %.0f s, plan %.0f s, execute %.0f s, drill %.0f s, "
-        "total %.0f s\n",
-        sc.name.c_str(), runs, runs == 1 ? "" : "s", drilled, marked, percentile(errors, 0.5) * 1e3,
-        percentile(errors, 0.95) * 1e3, percentile(errors, 1.0) * 1e3, t_nav / runs, t_plan / runs,
-        t_exec / runs, t_drill / runs, t_total / runs);
+    tally.print(sc.name + " (" + std::to_string(runs) + (runs == 1 ? " run)" : " runs)"), runs);
   }
   if (!known) {
     std::cerr << "bench_drill_mission: unknown scenario '" << which
-              << "' (blobs, patterns, high, row, low, lowest, bim, demo or all)\n";
+              << "' (blobs, patterns, high, row, low, lowest, bim, demo, experiments or all)\n";
     return 2;
   }
   return 0;
@@ -180,7 +263,7 @@ int main(int argc, char** argv) {
   std::string which = "all";
   int runs = 1;
   auto& app = cli.app();
-  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "high", "row", "low", "lowest", "bim", "demo", "all"},
+  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "high", "row", "low", "lowest", "bim", "demo", "experiments", "all"},
                                 "scenario to run")
       ->capture_default_str();
   std::string assembly;

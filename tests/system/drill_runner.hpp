@@ -279,6 +279,15 @@ inline std::string building_site(const Building& b) {
   return file.string();
 }
 
+/// A service's binary: the one built beside this test, or with CONCERT_STACK_DIR set, the one of
+/// that name there (a copy of the stack taken before a long benchmark, so that building on
+/// while it runs does not change the services under it halfway).
+inline std::string stack_binary(const std::string& built) {
+  const char* dir = std::getenv("CONCERT_STACK_DIR");
+  if (dir == nullptr || *dir == '\0') return built;
+  return (std::filesystem::path(dir) / std::filesystem::path(built).filename()).string();
+}
+
 /// Runs `mission` (a mission file's text) with the robot of `assembly` in the world `site`, and
 /// waits for its end (bounded by `timeout`) and for the holes the status counts. With a
 /// `building`, the nav service runs too (started only when NAV_BINARY is defined). `map`: what
@@ -307,12 +316,14 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
                 "--initial-pose", x.str(), y.str(), yaw.str()};
 #endif
   }
-  testing::Process safety(dies_with_test({SAFETY_BINARY}));
-  testing::Process discovery(dies_with_test({DISCOVERY_BINARY}));
-  testing::Process modelgen(dies_with_test({MODELGEN_BINARY}));
+  robot_args.front() = stack_binary(ROBOT_BINARY);
+  if (!nav_args.empty()) nav_args.front() = stack_binary(nav_args.front());
+  testing::Process safety(dies_with_test({stack_binary(SAFETY_BINARY)}));
+  testing::Process discovery(dies_with_test({stack_binary(DISCOVERY_BINARY)}));
+  testing::Process modelgen(dies_with_test({stack_binary(MODELGEN_BINARY)}));
   testing::Process robot(dies_with_test(robot_args));
-  testing::Process planner(dies_with_test({PLANNER_BINARY, "--map", map}));
-  testing::Process drill(dies_with_test({DRILL_BINARY}));
+  testing::Process planner(dies_with_test({stack_binary(PLANNER_BINARY), "--map", map}));
+  testing::Process drill(dies_with_test({stack_binary(DRILL_BINARY)}));
   std::optional<testing::Process> nav;
   if (!nav_args.empty()) nav.emplace(dies_with_test(nav_args));
   const auto logs = [&] {
