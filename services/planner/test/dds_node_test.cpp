@@ -91,6 +91,7 @@ class PlannerNodeTest : public ::testing::Test {
       std::this_thread::sleep_for(10ms);
     ASSERT_EQ(node_->model_version(), version) << log_.str();
   }
+  void planned_in_the_map(bool from_nav);
 
   std::ostringstream log_;
   std::unique_ptr<Planner> planner_;
@@ -490,11 +491,13 @@ TEST_F(PlannerNodeTest, AnObstacleOnTheWorldTopicChangesThePlan) {
                        << open_x << ", " << open_y << ")";
 }
 
-TEST_F(PlannerNodeTest, ALocalisedBaseIsPlannedInTheMapAndAnsweredInOdometry) {
-  // The robot was switched on elsewhere: its odometry frame lies at (1, -2) in the map, turned
-  // by 90 degrees. The nav service localises the base at the map's origin, facing the wall the
-  // world has at x = 2 m; the client asks for the drilling area on that wall in the odometry
-  // frame. Without the map frame the base's odometry pose, (2, 1), is inside the wall.
+// The robot was switched on elsewhere: its odometry frame lies at (1, -2) in the map, turned by
+// 90 degrees. The base stands at the map's origin, facing the wall the world has at x = 2 m; the
+// client asks for the drilling area on that wall in the odometry frame. Without the map frame
+// the base's odometry pose, (2, 1), is inside the wall. Where the odometry frame lies comes from
+// nav's localisation (`from_nav`) or with the request (PlanRequest.odom_in_map, the drill's
+// landmarks).
+void PlannerNodeTest::planned_in_the_map(bool from_nav) {
   publish_model('a', 9);
   ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
   const Eigen::Vector3d map_T_odom(1.0, -2.0, M_PI / 2);
@@ -511,25 +514,29 @@ TEST_F(PlannerNodeTest, ALocalisedBaseIsPlannedInTheMapAndAnsweredInOdometry) {
   o.y(base_odom.y());
   o.yaw(base_odom.z());
   odometry.write(o);
-  msg::NavLocalisation l;
-  l.stamp_ns(stamp);
-  l.state(msg::LOCALISATION_TRACKING);
-  l.pose().x(0.0);
-  l.pose().y(0.0);
-  l.pose().yaw(0.0);
-  std::this_thread::sleep_for(200ms);  // the odometry first, as nav only stamps what it got
-  localisation.write(l);
+  if (from_nav) {
+    msg::NavLocalisation l;
+    l.stamp_ns(stamp);
+    l.state(msg::LOCALISATION_TRACKING);
+    l.pose().x(0.0);
+    l.pose().y(0.0);
+    l.pose().yaw(0.0);
+    std::this_thread::sleep_for(200ms);  // the odometry first, as nav only stamps what it got
+    localisation.write(l);
+  }
   std::this_thread::sleep_for(300ms);
 
   msg::PlanRequest req = request(61, 9, 1.2, false);
   const Eigen::Isometry3d area_map = fixtures::drilling_area(2.0, 0.0, 1.2);
   req.goals()[0] = planner::dds::to_msg(mobile_base::isometry(base_odom) * area_map);
+  if (!from_nav) req.odom_in_map({map_T_odom.x(), map_T_odom.y(), map_T_odom.z()});
   requests_->write(req);
   const auto r = wait_final(*results_, 61);
   ASSERT_TRUE(r.has_value()) << log_.str();
   ASSERT_EQ(r->state(), msg::PLAN_SUCCEEDED) << r->reason() << log_.str();
   ASSERT_GT(r->trajectory().size(), 1u);
-  EXPECT_NE(log_.str().find("planned in the map"), std::string::npos) << log_.str();
+  EXPECT_NE(log_.str().find(from_nav ? "planned in the map" : "as the client measured it"), std::string::npos)
+      << log_.str();
   // It starts where the robot's odometry is, in the odometry frame...
   const auto& first = r->trajectory().front().position();
   EXPECT_NEAR(first[0], base_odom.x(), 1e-6);
@@ -542,6 +549,32 @@ TEST_F(PlannerNodeTest, ALocalisedBaseIsPlannedInTheMapAndAnsweredInOdometry) {
   EXPECT_LT(end_map.x(), 1.6) << end_map.transpose();
   EXPECT_GT(end_map.x(), 0.0) << end_map.transpose();
   EXPECT_LT(std::abs(end_map.y()), 1.5) << end_map.transpose();
+}
+
+TEST_F(PlannerNodeTest, ALocalisedBaseIsPlannedInTheMapAndAnsweredInOdometry) { planned_in_the_map(true); }
+
+TEST_F(PlannerNodeTest, TheClientsOdometryFrameIsPlannedInTheMapAndAnsweredInOdometry) {
+  planned_in_the_map(false);
+}
+
+TEST_F(PlannerNodeTest, AnOdometryFrameWithoutThreeFiniteValuesIsRefused) {
+  publish_model('a', 9);
+  ASSERT_TRUE(requests_->wait_for_readers(1, 5s));
+  msg::PlanRequest req = request(62, 9, 1.2, false);
+  req.odom_in_map({0.1, 0.2});
+  requests_->write(req);
+  const auto r = wait_final(*results_, 62);
+  ASSERT_TRUE(r.has_value()) << log_.str();
+  EXPECT_EQ(r->state(), msg::PLAN_FAILED);
+  EXPECT_EQ(r->failure(), msg::PLAN_INVALID_REQUEST);
+  EXPECT_NE(r->reason().find("odom_in_map needs 3 finite values (x, y, yaw), got 2"), std::string::npos)
+      << r->reason();
+  req = request(63, 9, 1.2, false);
+  req.odom_in_map({0.1, std::nan(""), 0.0});
+  requests_->write(req);
+  const auto nan = wait_final(*results_, 63);
+  ASSERT_TRUE(nan.has_value()) << log_.str();
+  EXPECT_EQ(nan->failure(), msg::PLAN_INVALID_REQUEST) << nan->reason();
 }
 
 TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {

@@ -427,8 +427,32 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     return;
   }
 
-  // Into the map frame, where the world is (the identity until nav localises the base).
-  const Eigen::Vector3d map_T_odom = map_frame_.map_T_odom();
+  // Into the map frame, where the world is (the identity until nav localises the base), or where
+  // the client measured the odometry frame to be (PlanRequest.odom_in_map).
+  Eigen::Vector3d map_T_odom = map_frame_.map_T_odom();
+  std::string frame_note;
+  if (const std::vector<double>& c = request.odom_in_map(); !c.empty()) {
+    const Eigen::Vector3d given(c[0], c.size() > 1 ? c[1] : 0.0, c.size() > 2 ? c[2] : 0.0);
+    std::ostringstream note;
+    if (c.size() != 3 || !given.allFinite()) {
+      note << "odom_in_map needs 3 finite values (x, y, yaw), got " << c.size();
+      base.state(msg::PLAN_FAILED);
+      base.failure(msg::PLAN_INVALID_REQUEST);
+      base.reason(note.str());
+      publish(base);
+      log_line("planner: request " + std::to_string(request.request_id()) + " failed: " + note.str());
+      return;
+    }
+    if (use_sensors_) {
+      note << "the client's odometry frame (" << given.x() << ", " << given.y() << ", " << given.z()
+           << ") not used: the map comes from the sensors, placed with nav's";
+    } else {
+      map_T_odom = given;
+      note << "planned in the map, odometry frame at (" << given.x() << ", " << given.y() << ", "
+           << given.z() << ") as the client measured it";
+    }
+    frame_note = note.str();
+  }
   const Eigen::Isometry3d map_from_odom = mobile_base::isometry(map_T_odom);
   // The yaw back: minus the frame's turn, plus whatever whole turn wrapping the start's map yaw
   // took away; one offset for every goal of the request, so their trajectories join up.
@@ -489,7 +513,9 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
     std::ostringstream line;
     line << "planner: request " << request.request_id() << ": " << to_string(result.status)
          << (result.reason.empty() ? "" : " (" + result.reason + ")") << (result.note.empty() ? "" : "; " + result.note);
-    if (map_frame_.localised()) {
+    if (!frame_note.empty()) {
+      line << "; " << frame_note;
+    } else if (map_frame_.localised()) {
       line << "; planned in the map, odometry frame at (" << map_T_odom.x() << ", "
            << map_T_odom.y() << ", " << map_T_odom.z() << ")";
     }
