@@ -556,9 +556,34 @@ void DrillNode::tick() {
 
 // A plan request to the planner, sent again (same id) while the planner acknowledges nothing
 // (resend_unacknowledged).
-void DrillNode::send_plan(const msg::PlanRequest& r) {
+void DrillNode::send_plan(const msg::PlanRequest& request) {
+  msg::PlanRequest r = request;
+  // The odometry frame where the marks seen again put it, while nav localises nothing: the
+  // planner's map (the world) then has the wall where the camera sees it, not where odometry
+  // puts it (OdometryDrift).
+  if (!map_frame_.localised() && drift_.corrected()) {
+    const Eigen::Vector3d d = drift_.odom_in_map();
+    r.odom_in_map({d.x(), d.y(), d.z()});
+  }
   plan_requests_.write(r);
   unacknowledged_[r.request_id()] = {r, now_, 0};
+}
+
+std::string DrillNode::landmark(std::size_t area, const std::string& label) const {
+  return std::to_string(area) + ":" + label;
+}
+
+void DrillNode::hole_seen_again(const Eigen::Vector3d& in_odom) {
+  const std::optional<double> moved = drift_.seen_again(landmark(detection_.area, point_.label), in_odom);
+  if (!moved) return;
+  const Eigen::Vector3d d = drift_.odom_in_map();
+  std::ostringstream line;
+  line.setf(std::ios::fixed);
+  line.precision(1);
+  line << "drill: " << point_.label << ": the odometry frame at (" << d.x() * 1e3 << ", " << d.y() * 1e3
+       << ") mm in the map as the hole tells (moved " << *moved * 1e3 << " mm)"
+       << (map_frame_.localised() ? "; nav's localisation used instead" : "");
+  log_line(line.str());
 }
 
 // PlanRequest is volatile: one written before this writer matched the reader of a planner that
@@ -658,6 +683,8 @@ void DrillNode::start_mission(const msg::DrillMission& m) {
   mission_id_ = m.mission_id();
   resolving_.clear();
   bim_frames_.clear();
+  surfaces_.clear();
+  drift_.forget_marks();
   plans_.clear();
   hole_chain_.clear();
   returning_ = false;
@@ -801,6 +828,9 @@ Outcome DrillNode::resolution(std::size_t area, ResolvedArea& out) {
   } catch (const DrillError& e) {
     return Outcome::failed(e.what());
   }
+  // The surface as measured from here: where the odometry frame is now in the map (no drift
+  // from where the mission started, or the drift the marks told since).
+  surfaces_[area] = {drift_.to_map(out.frame.translation()), out.frame.linear().col(2)};
   return Outcome::succeeded();
 }
 
@@ -1094,10 +1124,26 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
       AreaSpec here = detection_.spec;
       here.point = located.frame.translation();
       located = locate_area(here, camera);
+      // The surface measured again after the approach: the odometry's drift along its normal.
+      if (const auto first = surfaces_.find(detection_.area); first != surfaces_.end()) {
+        if (const std::optional<double> moved =
+                drift_.surface_seen(first->second.point, first->second.normal, located.frame.translation())) {
+          const Eigen::Vector3d d = drift_.odom_in_map();
+          std::ostringstream line;
+          line.setf(std::ios::fixed);
+          line.precision(1);
+          line << "drill: area '" << detection_.spec.name << "': its surface measured again "
+               << *moved * 1e3 << " mm along its normal from where it was first; the odometry frame at ("
+               << d.x() * 1e3 << ", " << d.y() * 1e3 << ") mm in the map";
+          log_line(line.str());
+        }
+      }
     }
     points = find_holes(detection_.spec, located, camera, patterns_ ? *patterns_ : kNone,
                         area_radius(params_.camera_distance, params_.camera_fov));
     area_points_ = points;
+    for (const DrillPoint& p : points)
+      drift_.first_seen(landmark(detection_.area, p.label), p.frame.translation());
     markers_seen_.clear();
     markers_seen_at_.clear();
     for (const DrillPoint& p : points)
@@ -1563,6 +1609,7 @@ bool DrillNode::remeasure_looked_blob(const CameraView& camera) {
          << moved.norm() * 1e3 << " mm from where odometry put it ("
          << blobs_seen(camera, point_.frame) << ")";
     log_line(line.str());
+    hole_seen_again(blob->translation());
     shift_area(moved);
     point_.frame = *blob;
     const std::optional<Sample> s = latest_sample();
@@ -1605,6 +1652,7 @@ bool DrillNode::remeasure_looked_marker(const CameraView& camera) {
          << (hole->translation() - point_.frame.translation()).norm() * 1e3
          << " mm from where odometry put it";
     log_line(line.str());
+    hole_seen_again(hole->translation());
     point_.frame = *hole;
     if (const std::optional<Eigen::Isometry3d> m = marker_of(point_, *patterns_))
       markers_seen_[point_.marker] = *m;
@@ -1942,6 +1990,7 @@ void DrillNode::control_motion() {
       if (point_.marker < 0) line << " (" << blobs_seen(camera, point_.frame) << ")";
       log_line(line.str());
       const Eigen::Vector3d moved = seen->translation() - point_.frame.translation();
+      hole_seen_again(seen->translation());
       if (point_.marker < 0) shift_area(moved);  // the area's other blobs moved as much
       point_.frame = *seen;
       if (!hole_request_.fixed_base() && !hole_replanned_ && moved.norm() > kReplanShift) {

@@ -29,6 +29,7 @@
 #include "drill/drill_motion.hpp"
 #include "drill/drill_rig.hpp"
 #include "drill/mission_tree.hpp"
+#include "drill/odometry_drift.hpp"
 #include "drill/patterns.hpp"
 #include "drill/perception.hpp"
 #include "drill/ports.hpp"
@@ -259,6 +260,17 @@ class DrillNode final : public MissionPorts {
   std::map<std::size_t, std::int64_t> resolve_since_;
   std::map<std::size_t, AreaSpec> resolve_specs_;
   std::map<std::size_t, Eigen::Isometry3d> bim_frames_;  // BIM wall areas' frames in the map
+  // How far odometry drifted, from the marks seen again (the planner's requests carry it as
+  // odom_in_map while nav localises nothing): the areas' surfaces as first measured (map, outward
+  // normal), each hole a landmark ("area:label").
+  OdometryDrift drift_;
+  struct Surface {
+    Eigen::Vector3d point, normal;
+  };
+  std::map<std::size_t, Surface> surfaces_;
+  /// A hole (point_) seen again at `in_odom` after the base moved: the drift from it, logged.
+  void hole_seen_again(const Eigen::Vector3d& in_odom);
+  [[nodiscard]] std::string landmark(std::size_t area, const std::string& label) const;
   std::uint32_t nav_request_{0};
   std::map<std::size_t, Plan> plans_;
   std::optional<std::size_t> executing_area_;
