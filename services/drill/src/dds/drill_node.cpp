@@ -976,24 +976,27 @@ void DrillNode::execute(std::size_t area) {
 std::vector<msg::TrajectorySample> DrillNode::return_path(const Sample& s) const {
   std::vector<msg::TrajectorySample> back{
       sample_here(hole_chain_.front().names, s, hole_chain_.back().samples.back())};
+  // Each path's end is the hole's posture, where the arm went back after its retract.
   double t = 0.0;
-  for (auto path = hole_chain_.rbegin(); path != hole_chain_.rend(); ++path) {
-    // Each path's end is the hole's posture, where the arm went back after its retract: a
-    // settling second to reach it, then the path backwards.
-    t += kSettleBack;
-    const double end = path->samples.back().time();
-    for (auto it = path->samples.rbegin(); it != path->samples.rend(); ++it) {
-      msg::TrajectorySample sample = *it;
-      sample.time(t + end - it->time());
-      for (double& v : sample.velocity()) v = -v;
-      back.push_back(sample);
-    }
-    t += end;
-  }
+  for (auto path = hole_chain_.rbegin(); path != hole_chain_.rend(); ++path) append_reversed(back, *path, t);
   // The holes' postures all taken with the base where it stands now (arm-alone postures, or a
   // base moved by less than kBaseKept): the way back keeps it there too.
   keep_base(hole_chain_.front().names, back.front(), back, kBaseKept);
   return back;
+}
+
+// `path` backwards after `back`: a settling second to reach its end, then its samples in reverse
+// order, times from `t` on (`t` left at the path's start).
+void DrillNode::append_reversed(std::vector<msg::TrajectorySample>& back, const PlannedPath& path, double& t) {
+  t += kSettleBack;
+  const double end = path.samples.back().time();
+  for (auto it = path.samples.rbegin(); it != path.samples.rend(); ++it) {
+    msg::TrajectorySample sample = *it;
+    sample.time(t + end - it->time());
+    for (double& v : sample.velocity()) v = -v;
+    back.push_back(sample);
+  }
+  t += end;
 }
 
 // Time to go straight from `from` to `to` (zero velocity at both ends) at a third of a slow
@@ -1452,10 +1455,26 @@ void DrillNode::track_area() {
 // The camera looks at the hole: back onto the whole body's posture (the way back from the hole
 // then skips the look), where the alignment starts.
 void DrillNode::back_to_posture(const Sample& s, Motion next) {
+  const PlannedPath look = hole_chain_.back();
   hole_chain_.pop_back();
   look_pushed_ = false;
   const PlannedPath& p = hole_chain_.back();
-  trajectory_request_ = send_trajectory(p.names, settle_path(p, sample_here(p.names, s, p.samples.back())));
+  // The look's planned path backwards, not straight across in joint space: that swept the
+  // drill along the wall (J1_E pressing at 240-310 N m for 5 s, the simulator's wall cut 59
+  // times, a safety stop) when odometry had put the wall a few cm off.
+  if (look.names == p.names && look.samples.size() >= 2) {
+    std::vector<msg::TrajectorySample> back{sample_here(look.names, s, look.samples.back())};
+    double t = 0.0;
+    append_reversed(back, look, t);
+    msg::TrajectorySample posture = p.samples.back();  // where the look started from, at rest
+    posture.time(back.back().time() + settle_time(p.names, back.back(), posture));
+    for (double& v : posture.velocity()) v = 0.0;
+    back.push_back(posture);
+    keep_base(p.names, back.front(), back, kBaseKept);
+    trajectory_request_ = send_trajectory(p.names, back);
+  } else {
+    trajectory_request_ = send_trajectory(p.names, settle_path(p, sample_here(p.names, s, p.samples.back())));
+  }
   motion_ = next;
 }
 

@@ -195,6 +195,7 @@ class DrillNode final : public MissionPorts {
                                                  const msg::TrajectorySample& here);
   void request_look(std::size_t attempt);
   [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
+  static void append_reversed(std::vector<msg::TrajectorySample>& back, const PlannedPath& path, double& t);
   std::uint32_t send_trajectory(const std::vector<std::string>& names,
                                 const std::vector<msg::TrajectorySample>& samples);
   [[nodiscard]] std::optional<Sample> latest_sample() const;
