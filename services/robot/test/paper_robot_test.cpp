@@ -268,6 +268,41 @@ TEST(PaperRobot, AHeldBaseStandsAPush) {
   EXPECT_LT(after, 0.002);
 }
 
+// A base stopped by its commands (nav's stop, collab's: a zero twist, then none) stands a push as
+// a held one does. Its wheels were driven at zero velocity: 316 N rolled it at
+// F·r/(4·velocity gain): 144 mm in 5 s (0.76 mm held).
+TEST(PaperRobot, ABaseToldToStandStandsAPush) {
+  const std::string urdf = paper_robot_urdf();
+  SimHardware sim(urdf, World{}, {});
+  RobotCore core(sim);
+  core.set_model(urdf, 1);
+  test::run_cycles(core, 1500);
+  test::drive_base(core, {1, 0.2, 0.05, 0.0}, 2000);
+  test::drive_base(core, {1, 0.0, 0.0, 0.0}, 2000);  // told to stand: comes to rest
+  const auto push = [&](bool commands) {
+    const Eigen::Vector3d before = sim.base_pose().translation();
+    sim.set_external_force("base_link", Eigen::Vector3d(-300.0, 100.0, 0.0), before + Eigen::Vector3d(0.5, 0.0, 0.5));
+    if (commands) {
+      test::drive_base(core, {1, 0.0, 0.0, 0.0}, 5000);
+    } else {
+      test::run_cycles(core, 5000);
+    }
+    sim.set_external_force("base_link", Eigen::Vector3d::Zero(), before);
+    return (sim.base_pose().translation() - before).head<2>().norm();
+  };
+  const double commanded = push(true);
+  test::run_cycles(core, 2000);  // the commands time out: the base stands on
+  const double timed_out = push(false);
+  std::cout << "pushed 316 N for 5 s under a zero twist: moved " << commanded * 1e3
+            << " mm; with the commands timed out: " << timed_out * 1e3 << " mm" << std::endl;
+  EXPECT_LT(commanded, 0.003);
+  EXPECT_LT(timed_out, 0.003);
+  // Still a base: told to move again, it moves.
+  const Eigen::Vector3d before = sim.base_pose().translation();
+  test::drive_base(core, {1, 0.2, 0.0, 0.0}, 2000);
+  EXPECT_GT(sim.base_pose().translation().x() - before.x(), 0.2);
+}
+
 // The standing base turned by the arm (a drill pushed into a wall turned the demo base 3-4 mrad on
 // its wheels' contacts per hole): no wheel rolls and no leg steers, yet the gyro sees the turn.
 // The bias is learnt only while the whole robot stands still.

@@ -177,12 +177,17 @@ class BaseController final : public Controller {
  private:
   /// Leg k's steering drive reference towards `target` at up to `rate` of its velocity limit.
   void steer(CycleData& data, std::size_t k, double target, double rate, DriveCommand& d);
+  /// Leg k's wheel (joint w; its steering s), told to roll at `commanded` [rad/s] under base
+  /// commands: true when it stands, held in position where it came to rest (its drive set).
+  bool stands(CycleData& data, std::size_t k, int s, int w, double commanded);
   BaseKinematics kinematics_;
   double timeout_;
   double trajectory_steering_rate_;
   double steering_acceleration_;
   std::vector<double> steering_ref_rate_;  // per leg: the steering reference's rate [rad/s]
   std::vector<double> steered_at_;         // per leg: hardware time this controller last steered it
+  std::vector<double> stood_at_;           // per leg: hardware time its wheel was last driven here
+  std::vector<double> stand_;              // per leg: where its wheel stands [rad], NaN: rolling
   Eigen::Vector3d twist_{Eigen::Vector3d::Zero()};
   double command_time_{-1e9};
   std::vector<double> steering_, wheel_velocity_, steering_rate_;

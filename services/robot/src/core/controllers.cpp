@@ -220,6 +220,8 @@ BaseController::BaseController(std::vector<Leg> legs, double command_timeout, do
       steering_acceleration_(steering_acceleration),
       steering_ref_rate_(kinematics_.legs().size(), 0.0),
       steered_at_(kinematics_.legs().size(), -1e9),
+      stood_at_(kinematics_.legs().size(), -1e9),
+      stand_(kinematics_.legs().size(), std::numeric_limits<double>::quiet_NaN()),
       steering_(kinematics_.legs().size(), 0.0),
       wheel_velocity_(kinematics_.legs().size(), 0.0),
       steering_rate_(kinematics_.legs().size(), 0.0),
@@ -324,7 +326,6 @@ void BaseController::drive_legs(CycleData& data, const Eigen::Vector3d& twist, J
       d.effort = data.gravity(s);
     }
     if (data.owner[static_cast<std::size_t>(w)] == owner) {
-      DriveCommand& d = data.new_drive(w, DriveMode::kVelocity);
       double rolling = setpoints_[k].wheel_velocity;
       // Roll only as fast as the steering points the right way (swerve practice): steering a
       // rolling loaded wheel scrubs, which costs the steering more than its continuous torque
@@ -334,10 +335,32 @@ void BaseController::drive_legs(CycleData& data, const Eigen::Vector3d& twist, J
       // A wheel beside its steering axis rolls as its leg steers (Leg::axle_offset); held, it
       // dragged the base along (35-40 mm at each start of the demo's moves, unseen by odometry).
       rolling += kinematics_.steering_rolling(k, data.qd(s));
+      if (owner == JointOwner::kBase && stands(data, k, s, w, setpoints_[k].wheel_velocity)) continue;
+      DriveCommand& d = data.new_drive(w, DriveMode::kVelocity);
       d.velocity = clamp_abs(rolling, data.limits(w).velocity);
       data.follow(w);
     }
   }
+}
+
+// A wheel told to stand (zero twist, or the commands timed out) is held in position where it came
+// to rest, as the hold does, not driven at zero velocity: at zero velocity a sustained push rolled
+// the base at F·r/(4·velocity gain), a base stopped by nav or collab pushable by hand.
+bool BaseController::stands(CycleData& data, std::size_t k, int s, int w, double commanded) {
+  constexpr double kRolling = 0.05;  // [rad/s]: slower, a drive has come to rest (HoldController's)
+  double& at = stand_[k];
+  if (!data.continued(stood_at_[k]) || commanded != 0.0) at = std::numeric_limits<double>::quiet_NaN();
+  if (std::isnan(at)) {
+    // Told to stand (the twist under the steering deadband gives exactly 0), the wheel and its
+    // leg's steering at rest.
+    if (commanded != 0.0 || std::abs(data.qd(w)) > kRolling || std::abs(data.qd(s)) > kRolling) return false;
+    at = data.q(w);
+    data.follow(w);
+  }
+  DriveCommand& d = data.new_drive(w, DriveMode::kPosition);
+  d.position = data.ramp(w, at);
+  d.effort = data.gravity(w);
+  return true;
 }
 
 TrajectoryController::TrajectoryController(int dof, const RobotParams& params, BaseController* base)
