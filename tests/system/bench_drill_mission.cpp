@@ -79,6 +79,17 @@ struct Tally {
   std::size_t drilled{0}, marked{0};
   double nav{0}, plan{0}, exec{0}, drill{0}, total{0};  // [s]
 
+  Tally& operator+=(const Tally& o) {
+    errors.insert(errors.end(), o.errors.begin(), o.errors.end());
+    drilled += o.drilled;
+    marked += o.marked;
+    nav += o.nav;
+    plan += o.plan;
+    exec += o.exec;
+    drill += o.drill;
+    total += o.total;
+    return *this;
+  }
   void print(const std::string& what, int runs) const {
     std::printf(
         "== %s: %zu of %zu marked holes drilled; error median %.2f mm, p95 %.2f mm, max %.2f mm; "
@@ -172,16 +183,8 @@ int experiments(int runs, bool logs, const std::string& map, const concert::dril
       std::filesystem::remove(site);
       Tally one;
       score(std::string("  ") + name, run, targets, logs, one);
-      for (Tally* t : {&all, c ? &on_c : &on_a}) {
-        t->errors.insert(t->errors.end(), one.errors.begin(), one.errors.end());
-        t->drilled += one.drilled;
-        t->marked += one.marked;
-        t->nav += one.nav;
-        t->plan += one.plan;
-        t->exec += one.exec;
-        t->drill += one.drill;
-        t->total += one.total;
-      }
+      all += one;
+      (c ? on_c : on_a) += one;
       (c ? runs_c : runs_a) += 1;
     }
   }

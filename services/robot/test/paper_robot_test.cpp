@@ -34,12 +34,19 @@ std::string paper_robot_urdf() {
   return model_generation::ModelGenerator(db).generate(tree).urdf;
 }
 
+// The paper's robot in the simulator on a bare floor, its core at model version 1.
+struct PaperRobotSim {
+  std::string urdf = paper_robot_urdf();
+  SimHardware sim{urdf, World{}, {}};
+  RobotCore core{sim};
+  PaperRobotSim() { core.set_model(urdf, 1); }
+};
+
 TEST(PaperRobot, GeneratedModelRunsInTheSimulator) {
-  const std::string urdf = paper_robot_urdf();
-  SimHardware sim(urdf, World{}, {});
+  PaperRobotSim robot;
+  SimHardware& sim = robot.sim;
+  RobotCore& core = robot.core;
   EXPECT_TRUE(sim.floating_base());
-  RobotCore core(sim);
-  core.set_model(urdf, 1);
   EXPECT_EQ(core.legs().size(), 4u);
   // The public database's steering modules hang the wheel under the steering axis (0.37 m
   // down): no offset along the axle, unlike data/module_db's (0.1 m).
@@ -72,10 +79,9 @@ TEST(PaperRobot, CollisionMeshesFromTheModuleDatabase) {
 }
 
 TEST(PaperRobot, BaseDrivesOnTheGeneratedLegs) {
-  const std::string urdf = paper_robot_urdf();
-  SimHardware sim(urdf, World{}, {});
-  RobotCore core(sim);
-  core.set_model(urdf, 1);
+  PaperRobotSim robot;
+  SimHardware& sim = robot.sim;
+  RobotCore& core = robot.core;
   test::run_cycles(core, 300);
   test::drive_base(core, {1, 0.2, 0.0, 0.0}, 3000);
   const RobotState s = core.state();
@@ -90,11 +96,9 @@ TEST(PaperRobot, BaseDrivesOnTheGeneratedLegs) {
 // base then drives as told. The steering's reference used to turn at the full rate at once and
 // run ahead of the leg: 10.2-10.6 rad/s of 8.91 on each of these turns.
 TEST(PaperRobot, LegsTurningRoundStayBelowTheirVelocityLimit) {
-  const std::string urdf = paper_robot_urdf();
-  const kinematics::Model model = kinematics::Model::from_urdf_string(urdf);
-  SimHardware sim(urdf, World{}, {});
-  RobotCore core(sim);
-  core.set_model(urdf, 1);
+  PaperRobotSim robot;
+  const kinematics::Model model = kinematics::Model::from_urdf_string(robot.urdf);
+  RobotCore& core = robot.core;
   test::run_cycles(core, 1500);
   const RobotState first = core.state();
   ASSERT_EQ(core.legs().size(), 4u);
@@ -246,10 +250,9 @@ TEST(PaperRobot, AStoppedBaseStaysWhereItComesToRest) {
 // thrust, an arm leaning on a wall). Its wheels braked whenever they rolled: 300 N rolled the
 // base away on the brakes' damping, 14 cm in 5 s.
 TEST(PaperRobot, AHeldBaseStandsAPush) {
-  const std::string urdf = paper_robot_urdf();
-  SimHardware sim(urdf, World{}, {});
-  RobotCore core(sim);
-  core.set_model(urdf, 1);
+  PaperRobotSim robot;
+  SimHardware& sim = robot.sim;
+  RobotCore& core = robot.core;
   test::run_cycles(core, 1500);
   test::drive_base(core, {1, 0.2, 0.05, 0.0}, 2000);
   core.set_safety_stop(true, "test");
@@ -272,10 +275,9 @@ TEST(PaperRobot, AHeldBaseStandsAPush) {
 // a held one does. Its wheels were driven at zero velocity: 316 N rolled it at
 // F·r/(4·velocity gain): 144 mm in 5 s (0.76 mm held).
 TEST(PaperRobot, ABaseToldToStandStandsAPush) {
-  const std::string urdf = paper_robot_urdf();
-  SimHardware sim(urdf, World{}, {});
-  RobotCore core(sim);
-  core.set_model(urdf, 1);
+  PaperRobotSim robot;
+  SimHardware& sim = robot.sim;
+  RobotCore& core = robot.core;
   test::run_cycles(core, 1500);
   test::drive_base(core, {1, 0.2, 0.05, 0.0}, 2000);
   test::drive_base(core, {1, 0.0, 0.0, 0.0}, 2000);  // told to stand: comes to rest
