@@ -437,6 +437,65 @@ TEST(SafetyLimitsRule, SustainedAboveContinuousStops) {
       << m.status().causes[0];
 }
 
+JointSample stamped_elbow_sample(double tau, int64_t stamp_ns) {
+  JointSample s = elbow_sample(tau);
+  s.stamp_ns = stamp_ns;
+  return s;
+}
+
+// The robot publishes at 100 Hz; its drive holds the RMS near the continuous torque (150 N m)
+// with a transient of 400 N m (below the 460 N m peak) now and then. This process stalls for
+// 1.5 s before each transient: the samples of the stall queue up and arrive together, the
+// transient first. Weighed by arrival, the transient counted for the whole stall (RMS 241 N m,
+// a stop of a robot whose drive is within its rating); weighed by the robot's stamps it counts
+// for its 10 ms.
+TEST(SafetyLimitsRule, SamplesCountForTheRobotsClockNotForTheirArrival) {
+  const auto run = [](bool stamped) {
+    SafetyMonitor m(Params{}, kT0);
+    m.set_model(1, elbow());
+    auto arrival = kT0;
+    int64_t stamp = 1'000'000'000;
+    for (int burst = 0; burst < 10 && m.status().mode == Mode::kRunning; ++burst) {
+      for (int i = 0; i < 500; ++i, arrival += 10ms, stamp += 10'000'000) {
+        m.on_joint_state(stamped_elbow_sample(150.0, stamped ? stamp : 0), arrival);
+      }
+      arrival += 1500ms;  // the stall: 150 samples queued, delivered at once
+      for (int i = 0; i < 150; ++i, stamp += 10'000'000) {
+        m.on_joint_state(stamped_elbow_sample(i == 0 ? 400.0 : 150.0, stamped ? stamp : 0), arrival);
+      }
+    }
+    return m.status();
+  };
+  const SafetyStatus by_stamp = run(true);
+  EXPECT_EQ(by_stamp.mode, Mode::kRunning) << by_stamp.causes.front();
+  // Unstamped samples can only be weighed by arrival: the same load then stops, as it did.
+  const SafetyStatus by_arrival = run(false);
+  ASSERT_EQ(by_arrival.mode, Mode::kStopped);
+  EXPECT_EQ(by_arrival.causes[0].rfind("limits: joint J2_E RMS effort", 0), 0u) << by_arrival.causes[0];
+}
+
+// The sustained bound still holds by the stamps, and a robot whose clock starts again (a
+// restarted robot service) neither stops nor forgets the load.
+TEST(SafetyLimitsRule, StampedSustainedLoadStopsAcrossARestartedClock) {
+  SafetyMonitor m(Params{}, kT0);
+  m.set_model(1, elbow());
+  auto arrival = kT0;
+  int64_t stamp = 5'000'000'000;
+  int samples = 0;
+  for (; samples < 300; ++samples, arrival += 10ms, stamp += 10'000'000) {
+    m.on_joint_state(stamped_elbow_sample(220.0, stamp), arrival);
+  }
+  ASSERT_EQ(m.status().mode, Mode::kRunning);
+  stamp = 10'000'000;  // the robot restarted: its clock begins again
+  for (; samples < 2000 && m.status().mode == Mode::kRunning; ++samples, arrival += 10ms, stamp += 10'000'000) {
+    m.on_joint_state(stamped_elbow_sample(220.0, stamp), arrival);
+  }
+  ASSERT_EQ(m.status().mode, Mode::kStopped);
+  // 5.1 s of 220 N m from cold (SustainedAboveContinuousStops), one sample lost at the restart.
+  EXPECT_GT(samples, 450);
+  EXPECT_LT(samples, 560);
+}
+
 TEST(SafetyLimitsRule, ANewModelStartsCold) {
   SafetyMonitor m(Params{}, kT0);
   m.set_model(1, elbow());

@@ -36,6 +36,9 @@ struct JointSample {
   std::vector<double> position;  ///< [rad]
   std::vector<double> velocity;  ///< [rad/s]
   std::vector<double> effort;    ///< [N m]
+  /// When the robot measured it, on the robot's clock [ns] (simulated or real time); 0: not
+  /// stamped.
+  int64_t stamp_ns = 0;
 };
 
 struct SafetyStatus {
@@ -89,7 +92,12 @@ class SafetyMonitor {
   /// position beyond [lower - position_tolerance, upper + position_tolerance], |velocity|
   /// beyond velocity x (1 + velocity_margin), |effort| beyond the PEAK torque x
   /// (1 + effort_margin), or the RMS effort over the thermal window (model::kThermalWindow)
-  /// beyond the CONTINUOUS torque x (1 + effort_margin) stops the robot. Samples of another
+  /// beyond the CONTINUOUS torque x (1 + effort_margin) stops the robot. The thermal window
+  /// runs on the robot's clock: each sample's torque counts for the time since the previous
+  /// sample's stamp, not since its arrival (samples queued behind a stall of this process, or
+  /// of the network, arrive together; weighed by arrival, the first of them counted for the
+  /// whole stall). Unstamped samples count from their arrival `now`; a stamp that goes back
+  /// (a restarted robot) starts the clock again. Samples of another
   /// model version (a reconfiguration in flight) are not checked. A malformed sample (vector
   /// lengths differ from `name`) stops the robot too.
   SampleOutcome on_joint_state(const JointSample& sample, TimePoint now);
@@ -133,6 +141,8 @@ class SafetyMonitor {
   /// Adds a cause (once per key) and stops.
   void stop(const std::string& key, const std::string& text);
   void check_joint(std::size_t row, std::size_t i, const JointSample& sample, double dt);
+  /// The time [s] the sample stamped `stamp_ns` (0: unstamped), arriving at `now`, stands for.
+  double sample_period(int64_t stamp_ns, TimePoint now);
 
   Params params_;
   TimePoint start_;
@@ -144,7 +154,8 @@ class SafetyMonitor {
   model::LimitsTable limits_;
   std::map<std::string, std::size_t> joint_index_;
   std::vector<model::ThermalLoad> thermal_;  // per row of limits_
-  std::optional<TimePoint> last_sample_;
+  std::optional<TimePoint> last_sample_;   // arrival of the last checked sample
+  std::optional<int64_t> last_stamp_ns_;  // the robot's stamp of the last stamped sample
   std::vector<std::string> cause_keys_;
   SafetyStatus status_;
   uint64_t revision_ = 0;

@@ -161,6 +161,7 @@ void SafetyMonitor::set_model(uint32_t version, model::LimitsTable limits) {
   for (std::size_t i = 0; i < limits_.size(); ++i) joint_index_[limits_.rows()[i].name] = i;
   thermal_.assign(limits_.size(), model::ThermalLoad{});
   last_sample_.reset();
+  last_stamp_ns_.reset();
 }
 
 void SafetyMonitor::check_joint(std::size_t row, std::size_t i, const JointSample& sample, double dt) {
@@ -200,6 +201,20 @@ void SafetyMonitor::check_joint(std::size_t row, std::size_t i, const JointSampl
   }
 }
 
+double SafetyMonitor::sample_period(int64_t stamp_ns, TimePoint now) {
+  double dt = 0.0;
+  if (stamp_ns > 0) {
+    // A stamp that goes back (a restarted robot's clock) or repeats weighs nothing: the
+    // clock starts again from it.
+    if (last_stamp_ns_ && stamp_ns > *last_stamp_ns_) dt = 1e-9 * static_cast<double>(stamp_ns - *last_stamp_ns_);
+    last_stamp_ns_ = stamp_ns;
+  } else if (last_sample_) {
+    dt = std::chrono::duration<double>(now - *last_sample_).count();
+  }
+  if (!last_sample_ || now > *last_sample_) last_sample_ = now;
+  return dt;
+}
+
 SampleOutcome SafetyMonitor::on_joint_state(const JointSample& sample, TimePoint now) {
   if (model_version_ == 0) return SampleOutcome::kNoModel;
   if (sample.model_version != model_version_) return SampleOutcome::kOtherModelVersion;
@@ -212,8 +227,7 @@ SampleOutcome SafetyMonitor::on_joint_state(const JointSample& sample, TimePoint
                                  std::to_string(sample.effort.size()) + " efforts");
     return SampleOutcome::kChecked;
   }
-  const double dt = last_sample_ ? std::chrono::duration<double>(now - *last_sample_).count() : 0.0;
-  if (!last_sample_ || now > *last_sample_) last_sample_ = now;
+  const double dt = sample_period(sample.stamp_ns, now);
   for (std::size_t i = 0; i < n; ++i) {
     const auto it = joint_index_.find(sample.name[i]);
     if (it != joint_index_.end()) check_joint(it->second, i, sample, dt);

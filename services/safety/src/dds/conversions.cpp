@@ -28,7 +28,8 @@ msg::EStopSource to_msg(EStopSource source) {
 }
 
 JointSample to_core(const msg::JointState& state) {
-  return {state.model_version(), state.name(), state.position(), state.velocity(), state.effort()};
+  return {state.model_version(), state.name(),     state.position(),
+          state.velocity(),      state.effort(),   state.stamp_ns()};
 }
 
 msg::SafetyState to_msg(const SafetyStatus& status, int64_t stamp_ns) {
