@@ -37,6 +37,18 @@ double smaller_fov(const hardware::CameraIntrinsics& k);
 /// looking camera's roll free.
 double any_roll_distance(double radius, double fov);
 
+/// Room left around an ArUco marker for the odometry's drift when the camera is turned onto it
+/// after a base move [m]: up to 52 mm between odometry and the simulator's truth were measured
+/// over the pattern test's whole-body moves.
+inline constexpr double kMarkerLookDrift = 0.05;
+
+/// How far from a marker's centre a look at it must see, whichever way the camera rolls [m]:
+/// its half-diagonal (`marker_size` [m] a side) and `drift` around it.
+/// any_roll_distance(marker_look_radius(...), fov) is how near the camera may come: from the
+/// camera's distance at a drilling posture (0.22 m on morphology A) the marker filled the image
+/// past its edge and was not found.
+double marker_look_radius(double marker_size, double drift = kMarkerLookDrift);
+
 /// Where a camera looks to see a blob hole and its nearest neighbour of the area together.
 struct BlobPairView {
   Eigen::Vector3d centre;  ///< midway between the two blobs (world) [m]

@@ -44,6 +44,10 @@ double smaller_fov(const hardware::CameraIntrinsics& k) {
 
 double any_roll_distance(double radius, double fov) { return radius / std::tan(0.45 * fov); }
 
+double marker_look_radius(double marker_size, double drift) {
+  return std::sqrt(0.5) * marker_size + drift;
+}
+
 bool in_view(const CameraView& view, const Eigen::Vector3d& point) {
   const Eigen::Vector3d p = view.world_T_optical.inverse() * point;
   if (p.z() <= 0.0) return false;

@@ -1404,6 +1404,12 @@ bool DrillNode::prepare_look() {
       look_goal_.translation() = pair->centre;
       look_reach_ = pair->radius;
     }
+  } else if (patterns_) {
+    // The whole marker in view, room left for the drift (marker_look_radius). The camera's
+    // distance at the hole's posture alone put the camera 0.22 m from the marker on morphology
+    // A, which it then filled past the image's edge: "not seen" in about one look in twelve of
+    // the pattern test, and the hole drilled where odometry put it (25 mm off in one run).
+    look_reach_ = marker_look_radius(patterns_->marker_size());
   }
   // The camera's distance at the hole's posture.
   hole_reached_ = hole_request_.tip_distance() > 0.0 ? hole_request_.tip_distance() + camera_to_tip_
@@ -1589,7 +1595,12 @@ msg::PlanRequest DrillNode::look_plan(std::size_t attempt) const {
   Eigen::Isometry3d goal = look_goal_;
   double distance = hole_reached_ + kLooks[attempt].further;
   const double fov = camera_fov();
-  if (look_reach_ > 0.0) distance = std::max(distance, any_roll_distance(look_reach_, fov));
+  if (point_.marker >= 0 && look_reach_ > 0.0) {
+    // The whole marker in view first, then further out with each attempt.
+    distance = std::max(hole_reached_, any_roll_distance(look_reach_, fov)) + kLooks[attempt].further;
+  } else if (look_reach_ > 0.0) {
+    distance = std::max(distance, any_roll_distance(look_reach_, fov));
+  }
   if (kLooks[attempt].between) {
     goal.translation() = 0.5 * (look_goal_.translation() + point_.frame.translation());
     // The planner leaves the camera's roll about its axis free: the marker (its centre half
