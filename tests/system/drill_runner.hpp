@@ -323,7 +323,12 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   testing::Process modelgen(dies_with_test({stack_binary(MODELGEN_BINARY)}));
   testing::Process robot(dies_with_test(robot_args));
   testing::Process planner(dies_with_test({stack_binary(PLANNER_BINARY), "--map", map}));
-  testing::Process drill(dies_with_test({stack_binary(DRILL_BINARY)}));
+  // CONCERT_TEST_UNSEEN_FRAMES=DIR keeps the drill camera's views in which a mark was looked
+  // for and not found (concert_drill --unseen-frames).
+  std::vector<std::string> drill_args{stack_binary(DRILL_BINARY)};
+  if (const char* dir = std::getenv("CONCERT_TEST_UNSEEN_FRAMES"); dir != nullptr && *dir != '\0')
+    drill_args.insert(drill_args.end(), {"--unseen-frames", dir});
+  testing::Process drill(dies_with_test(drill_args));
   std::optional<testing::Process> nav;
   if (!nav_args.empty()) nav.emplace(dies_with_test(nav_args));
   const auto logs = [&] {

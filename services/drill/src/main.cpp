@@ -2,9 +2,11 @@
 // drill end-effector and its camera), runs one mission at a time as a behaviour tree: locate
 // the areas, navigate, plan and execute the approach, detect the marks, drill each hole with
 // Cartesian impedance and visual servoing, retract.
-//   concert_drill [--patterns FILE] [--rate HZ]
+//   concert_drill [--patterns FILE] [--rate HZ] [--unseen-frames DIR]
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM (a running mission is aborted, the arm held).
 #include <atomic>
+#include <filesystem>
+#include <stdexcept>
 #include <iostream>
 #include <string>
 
@@ -18,6 +20,7 @@ namespace {
 struct Options {
   std::string patterns = CONCERT_DRILL_PATTERNS;
   double rate = 50.0;
+  std::string unseen_frames;
 };
 
 int run(const Options& o) {
@@ -25,6 +28,15 @@ int run(const Options& o) {
   drill::dds::NodeParams params;
   params.patterns = o.patterns;
   params.rate = o.rate;
+  params.unseen_frames_dir = o.unseen_frames;
+  if (!o.unseen_frames.empty()) {
+    // Made now, so that a directory that cannot be made stops the service with the reason.
+    std::error_code error;
+    std::filesystem::create_directories(o.unseen_frames, error);
+    if (error || !std::filesystem::is_directory(o.unseen_frames))
+      throw std::runtime_error("--unseen-frames: cannot make the directory '" + o.unseen_frames +
+                               "'" + (error ? ": " + error.message() : std::string()));
+  }
   // The table is read now so that a bad file stops the service with the reason.
   (void)drill::load_patterns(o.patterns);
   const std::atomic<bool>& stop = cli::stop_on_signals();
@@ -47,6 +59,10 @@ int main(int argc, char** argv) {
   app.add_option("--patterns", o.patterns, "ArUco hole-pattern table (config/patterns.yaml)")
       ->type_name("FILE");
   app.add_option("--rate", o.rate, "control rate [Hz]")->check(concert::cli::number(5.0, 500.0));
+  app.add_option("--unseen-frames", o.unseen_frames,
+                 "write each camera view in which a looked-for mark was not found to DIR (PNG, "
+                 "the mark's expected pixel crossed)")
+      ->type_name("DIR");
   cli.on_run(app, [&o] { return run(o); });
   return cli.run(argc, argv);
 }

@@ -12,9 +12,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "concert/sim/scene_camera.hpp"
@@ -312,6 +314,32 @@ TEST(Frames, PointAtPixelIsWhereTheRenderedWallIs) {
     EXPECT_NEAR(p.x(), 2.0, 0.0006) << px.transpose();
     EXPECT_LT((project(f.intrinsics, cam.inverse() * p) - px).norm(), 1e-9);
   }
+}
+
+// A view written for a person (concert_drill --unseen-frames): read back, it is the frame's
+// colour image, pixel for pixel, with the cross where the mark was expected; a path that cannot
+// be written is an error naming it.
+TEST(Frames, AViewWrittenAsPngReadsBackAsTheFrameWithTheMarkCrossed) {
+  hardware::RgbdFrame f = flat_frame();
+  for (std::size_t i = 0; i < f.rgb.size(); ++i) f.rgb[i] = static_cast<std::uint8_t>((i * 7 + i / 1920) % 251);
+  const std::string dir = ::testing::TempDir();
+  const std::string path = dir + "/perception_test_view.png";
+  write_view_png(f, path, Eigen::Vector2d(100.0, 200.0));
+  const cv::Mat back = cv::imread(path, cv::IMREAD_COLOR);
+  std::remove(path.c_str());
+  ASSERT_FALSE(back.empty());
+  ASSERT_EQ(back.cols, 640);
+  ASSERT_EQ(back.rows, 480);
+  const auto rgb_at = [&](int u, int v) {
+    const std::size_t i = (static_cast<std::size_t>(v) * 640u + static_cast<std::size_t>(u)) * 3u;
+    return cv::Vec3b(f.rgb[i + 2], f.rgb[i + 1], f.rgb[i]);  // as OpenCV reads it: BGR
+  };
+  for (const auto& [u, v] : {std::pair{0, 0}, std::pair{639, 479}, std::pair{320, 240}, std::pair{500, 30}})
+    EXPECT_EQ(back.at<cv::Vec3b>(v, u), rgb_at(u, v)) << u << ", " << v;
+  EXPECT_EQ(back.at<cv::Vec3b>(200, 100), cv::Vec3b(0, 0, 255));  // the cross's centre: red
+  EXPECT_EQ(back.at<cv::Vec3b>(200, 116), cv::Vec3b(0, 0, 255));  // on its circle
+  expect_drill_error([&] { write_view_png(f, dir + "/no/such/dir/view.png"); },
+                     {"cannot write", "no/such/dir/view.png", "camera_E"});
 }
 
 // --- Depth averaging (hand-made frames) --------------------------------------------------------

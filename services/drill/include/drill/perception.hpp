@@ -17,6 +17,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,13 @@ Eigen::Vector2d project(const hardware::CameraIntrinsics& k, const Eigen::Vector
 /// pixel and the frame if the pixel is outside the image or no depth lies within the radius.
 Eigen::Vector3d point_at_pixel(const hardware::RgbdFrame& frame, const Eigen::Vector2d& pixel,
                                double radius = 2.0);
+
+/// Writes the frame's colour image to `path` as a PNG, with a red cross and circle on `mark`
+/// [px] when given (where a mark was looked for): how an engineer sees what the drill camera
+/// saw when a mark was not found (concert_drill --unseen-frames). Throws DrillError naming
+/// the path when it cannot be written.
+void write_view_png(const hardware::RgbdFrame& frame, const std::string& path,
+                    const std::optional<Eigen::Vector2d>& mark = std::nullopt);
 
 // --- Depth averaging (section 5.4.1) ------------------------------------------------------------
 

@@ -1,6 +1,7 @@
 #include "dds/drill_node.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <iomanip>
 #include <iterator>
@@ -1653,6 +1654,7 @@ bool DrillNode::remeasure_looked_blob(const CameraView& camera) {
   } else {
     log_line("drill: " + point_.label +
              ": the blob not seen from the look posture; measured from its drilling posture");
+    keep_unseen_view(camera, predicted.translation());
   }
   // Without a posture for the arm alone there, the arm goes back onto the whole body's.
   hole_replanned_ = true;
@@ -1673,6 +1675,8 @@ bool DrillNode::remeasure_looked_marker(const CameraView& camera) {
   }
   std::optional<Eigen::Isometry3d> hole;
   if (marker) hole = hole_of_seen_marker(point_, *marker, *patterns_);
+  if (!hole && patterns_)
+    keep_unseen_view(camera, marker_of(point_, *patterns_).value_or(point_.frame).translation());
   if (hole) {
     std::ostringstream line;
     line.setf(std::ios::fixed);
@@ -1690,6 +1694,29 @@ bool DrillNode::remeasure_looked_marker(const CameraView& camera) {
     return true;
   }
   return false;
+}
+
+void DrillNode::keep_unseen_view(const CameraView& camera, const Eigen::Vector3d& mark) {
+  if (params_.unseen_frames_dir.empty() || camera.frame == nullptr) return;
+  // One file per view: mission, hole label (spaces to '-'), a count over the service's life.
+  std::string label = point_.label;
+  std::replace_if(label.begin(), label.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '-');
+  const std::string path = params_.unseen_frames_dir + "/" + std::to_string(mission_id_) + "-" +
+                           label + "-" + std::to_string(++unseen_views_) + ".png";
+  std::optional<Eigen::Vector2d> pixel;
+  const Eigen::Vector3d in_optical = camera.world_T_optical.inverse() * mark;
+  if (in_optical.z() > 0.0) pixel = project(camera.frame->intrinsics, in_optical);
+  try {
+    write_view_png(*camera.frame, path, pixel);
+    std::ostringstream line;
+    line.setf(std::ios::fixed);
+    line.precision(3);
+    line << "drill: " << point_.label << ": the view written to " << path << " (the mark expected "
+         << in_optical.z() << " m out, crossed)";
+    log_line(line.str());
+  } catch (const DrillError& e) {
+    log_line("drill: " + point_.label + ": the view not kept: " + e.what());
+  }
 }
 
 // The latest result of plan request `id`, if any has come.

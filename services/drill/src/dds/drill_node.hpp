@@ -43,6 +43,9 @@ struct NodeParams {
   double camera_distance{0.6};  ///< [m] the planner's working distance (area radius from it)
   double camera_fov{55.0 * M_PI / 180.0};  ///< [rad] smaller field of view of the drill camera
   int averaged_frames{5};                  ///< depth frames averaged for locating and detecting
+  /// Where each camera view in which a looked-for mark was not found is written (PNG, the mark's
+  /// expected pixel crossed); empty: nowhere.
+  std::string unseen_frames_dir;
   DrillParams motion;
 };
 
@@ -186,6 +189,10 @@ class DrillNode final : public MissionPorts {
   /// A hole measured again with the camera turned onto its blob / marker (kLookReanchor).
   bool remeasure_looked_blob(const CameraView& camera);
   bool remeasure_looked_marker(const CameraView& camera);
+  /// The view in which point_'s mark, expected at `mark` (world), was not found, written to
+  /// NodeParams::unseen_frames_dir when one is set.
+  void keep_unseen_view(const CameraView& camera, const Eigen::Vector3d& mark);
+  int unseen_views_{0};
   /// From the look posture back onto the whole body's posture, then the alignment.
   void back_to_posture(const Sample& s, Motion next = Motion::kBackToPosture);
   struct PlannedPath;
@@ -334,6 +341,7 @@ class DrillNode final : public MissionPorts {
   void move_to_candidate();
   Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the mark as predicted (world)
   double look_reach_{0.0};  // how far from look_goal_ the look must see, any roll [m]; 0: the mark
+                            // (a marker: its half-diagonal and kMarkerLookDrift)
   double hole_reached_{0.0};  // camera distance of the hole's posture reached [m]
   std::map<int, Eigen::Isometry3d>
       markers_seen_;                     // marker id -> where last seen (world), this area
