@@ -9,6 +9,9 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "concert/sim/scene_camera.hpp"
 #include "concert/world/geometry.hpp"
@@ -248,32 +251,46 @@ TEST(AnyRollDistance, TheMarkerStaysInTheImagesSmallerHalfAngle) {
   EXPECT_GT(area_radius(d, smaller_fov(k)), reach);
 }
 
-// A look at an ArUco marker after a base move: the camera turned onto where odometry puts the
-// marker, which stands up to kMarkerLookDrift from there, the camera's roll left free by the
-// planner. From any_roll_distance(marker_look_radius) the marker is found wherever the drift
-// and the roll put it; from 0.22 m (the camera's distance at a drilling posture of morphology
-// A, where the looks stood before) it was cut by the image's edge and not found.
-TEST(MarkerLook, FromTheLookDistanceTheMarkerIsFoundWhereverDriftAndRollPutIt) {
+// Pattern 0 of the shipped table: a 60 cm row of 4 holes 0.2 m apart, 15 cm below the 0.1 m marker.
+PatternTable row_patterns() {
+  return parse_patterns(
+      "dictionary: DICT_4X4_50\nmarker_size: 0.1\npatterns:\n"
+      "  0: {centre: [0.0, -0.15], direction: 0.0, count: 4, spacing: 0.2}\n",
+      "test");
+}
+
+// A wall whose face is x = 2.0 (facing -x) with a 0.1 m ArUco marker of id 0 at each (name,
+// across the wall [m]), 1.2 m high.
+world::World marker_wall(const std::vector<std::pair<std::string, double>>& markers) {
   world::World w;
   world::WorldShape wall;
   wall.name = "wall";
   wall.size = {0.2, 5.0, 3.0};
   wall.position = {2.1, 0.0, 1.5};
   w.walls.push_back(wall);
-  world::Mark m;
-  m.name = "marker";
-  m.type = world::Mark::Type::kAruco;
-  m.wall = "wall";
-  m.face = world::Face::kMinusX;
-  m.at = {0.0, 1.2};
-  m.size = 0.1;
-  m.dictionary = "DICT_4X4_50";
-  m.id = 0;
-  w.marks.push_back(m);
-  const PatternTable patterns = parse_patterns(
-      "dictionary: DICT_4X4_50\nmarker_size: 0.1\npatterns:\n"
-      "  0: {centre: [0.0, -0.15], direction: 0.0, count: 4, spacing: 0.2}\n",
-      "test");
+  for (const auto& [name, u] : markers) {
+    world::Mark m;
+    m.name = name;
+    m.type = world::Mark::Type::kAruco;
+    m.wall = "wall";
+    m.face = world::Face::kMinusX;
+    m.at = {u, 1.2};
+    m.size = 0.1;
+    m.dictionary = "DICT_4X4_50";
+    m.id = 0;
+    w.marks.push_back(m);
+  }
+  return w;
+}
+
+// A look at an ArUco marker after a base move: the camera turned onto where odometry puts the
+// marker, which stands up to kMarkerLookDrift from there, the camera's roll left free by the
+// planner. From any_roll_distance(marker_look_radius) the marker is found wherever the drift
+// and the roll put it; from 0.22 m (the camera's distance at a drilling posture of morphology
+// A, where the looks stood before) it was cut by the image's edge and not found.
+TEST(MarkerLook, FromTheLookDistanceTheMarkerIsFoundWhereverDriftAndRollPutIt) {
+  const world::World w = marker_wall({{"marker", 0.0}});
+  const PatternTable patterns = row_patterns();
   sim::CameraParams params;
   params.noise = true;
   sim::SceneCamera camera(w, params, 7);
@@ -314,10 +331,7 @@ TEST(MarkerLook, FromTheLookDistanceTheMarkerIsFoundWhereverDriftAndRollPutIt) {
 // degrees off from aside) is not applied, which would move the row's end by the turn times
 // 0.34 m.
 TEST(HoleOfSeenMarker, TheMarkersShiftMovesTheHoleItsTurnDoesNot) {
-  const PatternTable patterns = parse_patterns(
-      "dictionary: DICT_4X4_50\nmarker_size: 0.1\npatterns:\n"
-      "  0: {centre: [0.0, -0.15], direction: 0.0, count: 4, spacing: 0.2}\n",
-      "test");
+  const PatternTable patterns = row_patterns();
   // The marker on a wall facing -x (z out of it, x to the robot's right, y up) at (2, 0, 1.65).
   Eigen::Isometry3d marker = Eigen::Isometry3d::Identity();
   marker.linear().col(0) = Eigen::Vector3d(0, -1, 0);
@@ -351,28 +365,8 @@ TEST(HoleOfSeenMarker, TheMarkersShiftMovesTheHoleItsTurnDoesNot) {
 // Scenario 3's wall carries several markers of one id (one pattern each): a hole's marker is
 // the one of its id nearest where it was expected, whichever the detector lists first.
 TEST(FindMarker, OfTwoMarkersWithTheHolesIdTheNearestIsTaken) {
-  world::World w;
-  world::WorldShape wall;
-  wall.name = "wall";
-  wall.size = {0.2, 5.0, 3.0};
-  wall.position = {2.1, 0.0, 1.5};
-  w.walls.push_back(wall);
-  for (const double u : {-0.13, 0.13}) {
-    world::Mark m;
-    m.name = u < 0 ? "left" : "right";
-    m.type = world::Mark::Type::kAruco;
-    m.wall = "wall";
-    m.face = world::Face::kMinusX;
-    m.at = {u, 1.2};
-    m.size = 0.1;
-    m.dictionary = "DICT_4X4_50";
-    m.id = 0;
-    w.marks.push_back(m);
-  }
-  const PatternTable patterns = parse_patterns(
-      "dictionary: DICT_4X4_50\nmarker_size: 0.1\npatterns:\n"
-      "  0: {centre: [0.0, -0.15], direction: 0.0, count: 4, spacing: 0.2}\n",
-      "test");
+  const world::World w = marker_wall({{"left", -0.13}, {"right", 0.13}});
+  const PatternTable patterns = row_patterns();
   sim::CameraParams params;
   params.noise = true;
   const Eigen::Isometry3d camera =
