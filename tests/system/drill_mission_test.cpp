@@ -11,6 +11,10 @@
 // run drilled blob_2 (100.5 mm off) for a pick 2 cm beside blob_1, towards blob_2: odometry drifts
 // over the approach, or the re-measure took blob_2 seen alone for blob_1 (since bounded, see
 // BlobShift.*); the drill log now names the blobs it saw, nearest first, with their distances.
+// Another (2026-11-30) had the approach drift odometry 45 mm along the wall: the pick lay 48.5 mm
+// from blob 1 and 51.6 mm from blob 2 as odometry put them, and blob_2 was drilled (100.8 mm off).
+// The blobs the start view showed are now seen again as a set after the approach, and the pick
+// moves with them (the log: "2 of the start view's 2 blobs seen again N mm along the wall").
 // The planner's map is built from the robot's own lidars and depth cameras (concert_planner --map
 // sensors, paper 5.4.1), not from the simulator's description of the world.
 // Judged against the simulator's truth: the holes its

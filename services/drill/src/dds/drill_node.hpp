@@ -276,6 +276,12 @@ class DrillNode final : public MissionPorts {
     Eigen::Vector3d point, normal;
   };
   std::map<std::size_t, Surface> surfaces_;
+  // A blob area's blobs as the start view located the area showed them (odometry frame then),
+  // before the approach drifted odometry: the set that names its blobs after the approach.
+  std::map<std::size_t, std::vector<DrillPoint>> start_blobs_;
+  /// The located area's centre moved by how the start view's blobs appear now (the approach's
+  /// drift along the wall); nothing without two of them matched.
+  void follow_start_blobs(const CameraView& camera, ResolvedArea& located);
   /// A hole (point_) seen again at `in_odom` after the base moved: the drift from it, logged.
   void hole_seen_again(const Eigen::Vector3d& in_odom);
   [[nodiscard]] std::string landmark(std::size_t area, const std::string& label) const;
