@@ -6,8 +6,8 @@
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM (a running mission is aborted, the arm held).
 #include <atomic>
 #include <filesystem>
-#include <stdexcept>
 #include <iostream>
+#include <stdexcept>
 #include <string>
 
 #include "concert/cli/cli.hpp"

@@ -1661,7 +1661,7 @@ msg::PlanRequest DrillNode::look_plan(std::size_t attempt) const {
     // smaller half-angle whichever way the image turns. Nearer, the marker was "not seen"
     // from every such look of two rows of scenario 3.
     const double reach = (goal.translation() - look_goal_.translation()).norm() +
-                         (patterns_ ? std::sqrt(0.5) * patterns_->marker_size() : 0.0);
+                         (patterns_ ? marker_look_radius(patterns_->marker_size(), 0.0) : 0.0);
     distance = std::max(distance, any_roll_distance(reach, fov));
   }
   r.goals().push_back(model::dds::to_pose_msg(goal));
