@@ -1,5 +1,5 @@
 # The service: the rig and area detection (core), the DDS adapter, main, `concert drill` verbs.
-concert_core_library(concert_drill_core STATIC src/core/drill_rig.cpp src/core/area_detection.cpp)
+concert_core_library(concert_drill_core STATIC src/core/drill_rig.cpp src/core/area_detection.cpp src/core/placement.cpp)
 target_include_directories(concert_drill_core PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
 target_link_libraries(concert_drill_core
   PUBLIC concert_drill_tree concert_drill_control concert_drill_perception concert_model concert_kinematics
@@ -40,3 +40,9 @@ concert_add_test(NAME area_detection_test
   LIBS concert_drill_core concert_sim concert_world
   LABELS drill
   TIMEOUT 120)
+
+# The base placement of an area of several holes: its goal and the stand-or-move choice.
+concert_add_test(NAME drill_placement_test
+  SOURCES test/placement_test.cpp
+  LIBS concert_drill_core
+  LABELS drill)

@@ -11,7 +11,8 @@
 //   run(tree, fake);                                  // ticks at 0, 1, 2, ... s until done
 //
 // Calls: "resolve I", "navigate I" (I: the area whose base pose it is), "plan I after J|none",
-// "execute I", "detect I", "align I LABEL", "drill I LABEL DEPTH", "retract I LABEL", "stop".
+// "execute I", "detect I", "place I N" (N: the holes to place for), "align I LABEL",
+// "drill I LABEL DEPTH", "retract I LABEL", "stop".
 
 #include <cstdio>
 #include <functional>
@@ -60,6 +61,7 @@ class FakePorts : public MissionPorts {
   double default_seconds{0.0};                      ///< how long the unscripted calls run [s]
   std::vector<ResolvedArea> areas;                  ///< what resolution() finds, per area
   std::vector<std::vector<DrillPoint>> points;      ///< what detection() finds, per area
+  std::vector<std::size_t> placement_order;          ///< what placement() says (empty: as given)
   std::string unhealthy;                            ///< health() fails with this when set
   std::function<void(const std::string&)> on_call;  ///< called after each recorded call
   std::vector<std::string> violations;              ///< what the robot would have refused
@@ -131,6 +133,15 @@ class FakePorts : public MissionPorts {
     return o;
   }
 
+  void place(std::size_t area, const std::vector<DrillPoint>& holes) override {
+    placing_ = start("place " + std::to_string(area) + " " + std::to_string(holes.size()));
+  }
+  Outcome placement(std::vector<std::size_t>& order) override {
+    const Outcome o = poll(placing_);
+    if (o.progress == Progress::kSucceeded) order = placement_order;
+    return o;
+  }
+
   void align(const DrillPoint& point) override {
     label_ = std::to_string(detecting_) + " " + point.label;
     alignment_ = start("align " + label_);
@@ -192,7 +203,7 @@ class FakePorts : public MissionPorts {
 
   std::map<std::size_t, Running> resolving_, planning_;
   std::map<std::size_t, std::string> plan_from_;
-  Running navigation_, execution_, detection_, alignment_, drilling_, retraction_;
+  Running navigation_, execution_, detection_, placing_, alignment_, drilling_, retraction_;
   std::size_t executing_{0}, detecting_{0};
   std::string label_;
   std::string posture_{"start"};

@@ -154,9 +154,9 @@ Mission mission_of(std::size_t n) {
   return m;
 }
 
-// The calls of drilling both blobs of area `i`.
+// The calls of drilling both blobs of area `i`, the base placed for them first.
 std::vector<std::string> holes_of(std::size_t i) {
-  std::vector<std::string> out;
+  std::vector<std::string> out{"place " + std::to_string(i) + " 2"};
   for (const char* blob : {"blob 1", "blob 2"}) {
     const std::string hole = std::to_string(i) + " " + blob;
     out.insert(out.end(), {"align " + hole, "drill " + hole + " 0.050", "retract " + hole});
@@ -274,6 +274,69 @@ TEST(MissionTree, AFailedApproachStopsTheRobotAndTheNextAreaIsPlannedFromWhereIt
   EXPECT_EQ(tree.report().areas[1].state, AreaState::kDone);
 }
 
+TEST(MissionTree, AFailedPlacementStopsTheRobotAndFailsItsAreaOnly) {
+  FakePorts fake(2);
+  fake.scripts["place 0 2"] = {5.0, "robot: the base's placement: aborted"};
+  MissionTree tree(mission_of(2), fake);
+  ASSERT_EQ(run(tree, fake), MissionState::kFailed);
+  EXPECT_EQ(fake.index_of("stop"), fake.index_of("place 0 2") + 1);
+  EXPECT_THAT(fake.calls_of("align 0"), IsEmpty()) << "no hole drilled from an unknown posture";
+  EXPECT_THAT(fake.calls_of("drill"), ElementsAre("drill 1 blob 1 0.050", "drill 1 blob 2 0.050"));
+  EXPECT_THAT(fake.violations, IsEmpty());
+  EXPECT_EQ(tree.report().areas[0].state, AreaState::kFailed);
+  EXPECT_EQ(tree.report().areas[0].reason, "place: robot: the base's placement: aborted");
+  EXPECT_EQ(tree.report().areas[0].holes[0].state, HoleState::kPending);
+  EXPECT_EQ(tree.report().areas[1].state, AreaState::kDone);
+}
+
+TEST(MissionTree, HolesAreDrilledInThePlacementsOrder) {
+  FakePorts fake(1);
+  const ResolvedArea& a = fake.areas[0];
+  fake.points[0] = {FakePorts::blob(a, 1, 0.1), FakePorts::blob(a, 2, 0.0), FakePorts::blob(a, 3, -0.1)};
+  fake.placement_order = {2, 0, 1};
+  {
+    MissionTree tree(mission_of(1), fake);
+    ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
+    EXPECT_THAT(fake.calls_of("drill"),
+                ElementsAre("drill 0 blob 3 0.050", "drill 0 blob 1 0.050", "drill 0 blob 2 0.050"));
+    ASSERT_EQ(tree.report().areas[0].holes.size(), 3u);
+    EXPECT_EQ(tree.report().areas[0].holes[0].point.label, "blob 1") << "the report keeps the marks' order";
+  }
+  // An order that does not name every hole once is not taken.
+  for (const std::vector<std::size_t>& bad :
+       {std::vector<std::size_t>{2, 0}, std::vector<std::size_t>{0, 0, 1}, std::vector<std::size_t>{0, 1, 3}}) {
+    fake.calls.clear();
+    fake.placement_order = bad;
+    MissionTree tree(mission_of(1), fake);
+    ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
+    EXPECT_THAT(fake.calls_of("drill"),
+                ElementsAre("drill 0 blob 1 0.050", "drill 0 blob 2 0.050", "drill 0 blob 3 0.050"));
+  }
+}
+
+TEST(MissionTree, APlacementsOrderCountsOnlyTheHolesStillToDrill) {
+  // Resumed: blob 1 drilled before, the placement gets blobs 2 and 3 and orders them 3, 2.
+  FakePorts fake(1);
+  const ResolvedArea& a = fake.areas[0];
+  fake.points[0] = {FakePorts::blob(a, 1, 0.1), FakePorts::blob(a, 2, 0.0), FakePorts::blob(a, 3, -0.1)};
+  MissionReport first;
+  {
+    FakePorts once(1);
+    once.points = fake.points;
+    once.scripts["drill 0 blob 2 0.050"] = {1.0, "bit stalled"};
+    once.scripts["drill 0 blob 3 0.050"] = {1.0, "bit stalled"};
+    MissionTree tree(mission_of(1), once);
+    run(tree, once);
+    first = tree.report();
+  }
+  fake.placement_order = {1, 0};
+  MissionTree tree(mission_of(1), fake);
+  tree.resume(first);
+  ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
+  EXPECT_THAT(fake.calls_of("place"), ElementsAre("place 0 2"));
+  EXPECT_THAT(fake.calls_of("drill"), ElementsAre("drill 0 blob 3 0.050", "drill 0 blob 2 0.050"));
+}
+
 TEST(MissionTree, AFailedPlanFailsItsAreaOnly) {
   FakePorts fake(2);
   fake.scripts["plan 0 after none"] = {2.0, "no approach without collision"};
@@ -294,6 +357,7 @@ TEST(MissionTree, MoreHolesThanExpectedDrillsTheNearestToTheCentre) {
   MissionTree tree(m, fake);
   ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
   EXPECT_THAT(fake.calls_of("drill"), ElementsAre("drill 0 blob 2 0.050", "drill 0 blob 3 0.050"));
+  EXPECT_THAT(fake.calls_of("place"), ElementsAre("place 0 2")) << "placed for the holes to drill";
   const auto& holes = tree.report().areas[0].holes;
   ASSERT_EQ(holes.size(), 3u);
   EXPECT_EQ(holes[0].state, HoleState::kSkipped);
@@ -428,7 +492,7 @@ TEST(MissionTree, ResumeSkipsDrilledHolesAndDoneAreas) {
     tree.resume(first);
     ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
     EXPECT_THAT(fake.calls,
-                ElementsAre("resolve 1", "plan 1 after none", "execute 1", "detect 1",
+                ElementsAre("resolve 1", "plan 1 after none", "execute 1", "detect 1", "place 1 1",
                             "align 1 blob 2", "drill 1 blob 2 0.050", "retract 1 blob 2"));
     second = tree.report();
     EXPECT_EQ(second.areas[0].state, AreaState::kSkipped);
@@ -480,9 +544,9 @@ TEST(MissionTree, ResumeRefusesAnotherMissionOrAStartedOne) {
 TEST(MissionTree, TimesAddUp) {
   FakePorts fake(3);
   fake.areas[2].base = BasePose{2.0, -1.0, 0.0};
-  fake.default_seconds = 1.0;  // resolve, detect, align, retract
+  fake.default_seconds = 1.0;  // resolve, detect, place, align, retract
   fake.scripts = {{"plan 0 after none", {3.0, ""}},
-                  {"plan 1 after 0", {20.0, ""}},  // 9 s of it while area 0 is drilled
+                  {"plan 1 after 0", {20.0, ""}},  // 10 s of it while area 0 is drilled
                   {"plan 2 after none", {2.0, ""}},
                   {"navigate 2", {6.0, ""}}};
   for (const char* call : {"execute 0", "execute 1", "execute 2"}) fake.scripts[call] = {4.0, ""};
@@ -498,9 +562,9 @@ TEST(MissionTree, TimesAddUp) {
 
   const MissionTimes& t = tree.report().times;
   EXPECT_DOUBLE_EQ(t.navigate, 6.0);
-  EXPECT_DOUBLE_EQ(t.plan, 3.0 + 11.0 + 2.0);
+  EXPECT_DOUBLE_EQ(t.plan, 3.0 + 10.0 + 2.0);
   EXPECT_DOUBLE_EQ(t.execute, 3 * 4.0);
-  EXPECT_DOUBLE_EQ(t.drill, 3 * (1.0 + 2 * (1.0 + 2.0 + 1.0)));
+  EXPECT_DOUBLE_EQ(t.drill, 3 * (1.0 + 1.0 + 2 * (1.0 + 2.0 + 1.0)));  // detect, place, holes
   const double resolve = 3 * 1.0;
   EXPECT_DOUBLE_EQ(t.total, fake.now);
   EXPECT_DOUBLE_EQ(t.navigate + t.plan + t.execute + t.drill + resolve, t.total);
@@ -536,6 +600,7 @@ TEST(MissionTree, StatusNamesTheActiveNode) {
         out.push_back("mission/area '" + area + "'/hole '" + blob + "'/" + step);
       }
     }
+    out.insert(out.begin(), "mission/area '" + area + "'/place");
     return out;
   };
   EXPECT_THAT(
@@ -568,6 +633,7 @@ TEST(MissionTree, DescribesItsShape) {
             "      execute (action)\n"
             "      plan the next area (action)\n"
             "      detect (action)\n"
+            "      place (action)\n"
             "      holes (for each)\n"
             "        hole (finally)\n"
             "          align and drill (sequence)\n"

@@ -1,7 +1,8 @@
 #pragma once
 // The drilling mission as a behaviour tree (paper Fig. 11): initialise -> per area in FIFO
 // order: navigate if the area has a base pose -> execute the approach (planned while the
-// previous area was drilled) -> detect the points -> per point: align, drill, retract.
+// previous area was drilled) -> detect the points -> place the base once for them (not in the
+// paper: drill/placement.hpp says why) -> per point: align, drill, retract.
 // Plain C++, no DDS.
 
 #include <cstddef>

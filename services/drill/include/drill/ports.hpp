@@ -89,6 +89,16 @@ class MissionPorts {
   virtual void detect(std::size_t area, const AreaSpec& spec, const ResolvedArea& located) = 0;
   virtual Outcome detection(std::vector<DrillPoint>& points) = 0;
 
+  /// Places the base for the area's holes still to drill (drill/placement.hpp): the whole body
+  /// moves once, to where the arm alone reaches them all and the camera the area's mark, or the
+  /// base stays where the approach put it (then each hole's own posture may move it). Failed
+  /// with the reason when a motion it started failed (the area fails, the robot is stopped).
+  /// Succeeded, `order` says in which order to drill the holes (indices into `holes`): those the
+  /// arm alone reaches from where the base ends first, so that a hole that moves the base does
+  /// not carry the odometry's drift into the others. Left empty: in the order given.
+  virtual void place(std::size_t area, const std::vector<DrillPoint>& holes) = 0;
+  virtual Outcome placement(std::vector<std::size_t>& order) = 0;
+
   /// Moves the bit in front of a point, along its normal (Cartesian impedance).
   virtual void align(const DrillPoint& point) = 0;
   virtual Outcome alignment() = 0;

@@ -107,6 +107,8 @@ struct MissionTree::Impl {
   std::vector<std::vector<Eigen::Vector3d>> drilled_before;  // per area: hole origins [m]
   std::vector<bool> plan_started;                            // per area
   std::vector<DrillPoint> detected;
+  std::vector<std::size_t> placing;     // the area's holes placed for (report indices)
+  std::vector<std::size_t> hole_order;  // the order to drill them, as the placement said
   std::size_t current_area{0};
   std::size_t current_hole{0};
   bool hole_active{false};
@@ -203,6 +205,16 @@ struct MissionTree::Impl {
         [this] { ports.detect(current_area, mission.areas[current_area], area().located); },
         [this] { return detection(); });
 
+    // One base placement for the area's holes (drill/placement.hpp), before the first.
+    auto place = action(
+        "place", Work::kDrill,
+        [this] {
+          placing = pending_holes();
+          hole_order.clear();
+          ports.place(current_area, pending_points());
+        },
+        [this] { return placed(); });
+
     auto align = action(
         "align", Work::kDrill, [this] { ports.align(hole().point); },
         [this] { return ports.alignment(); });
@@ -215,7 +227,7 @@ struct MissionTree::Impl {
         "hole", hidden(sequence("align and drill", std::move(align), std::move(drill))),
         std::move(retract));
     bt::ForEach::Hooks hole_hooks{
-        .items = [this] { return pending_holes(); },
+        .items = [this] { return ordered_holes(); },
         .label = [this](std::size_t i) { return quoted("hole", area().holes[i].point.label); },
         .begin =
             [this](std::size_t i) {
@@ -229,7 +241,7 @@ struct MissionTree::Impl {
 
     auto area_body =
         sequence("area", hidden(std::move(navigate)), std::move(plan), std::move(execute),
-                 std::move(plan_next), std::move(detect), std::move(holes));
+                 std::move(plan_next), std::move(detect), std::move(place), std::move(holes));
     auto areas = for_each_area(
         "areas", true,
         [this](std::size_t, bt::Status status, const std::string& why) {
@@ -321,6 +333,43 @@ struct MissionTree::Impl {
         h.reason = kDrilledBefore;
       }
     }
+  }
+
+  // A placement that failed left the whole body somewhere along its move: held there, and the
+  // area fails (as an approach does, executed()). One that succeeded says the holes' order:
+  // kept when it names each hole placed for once (else the order they came in).
+  Outcome placed() {
+    std::vector<std::size_t> order;
+    Outcome outcome = ports.placement(order);
+    if (outcome.progress == Progress::kFailed) ports.stop();
+    if (outcome.progress != Progress::kSucceeded) return outcome;
+    std::vector<std::size_t> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<std::size_t> all(placing.size());
+    std::iota(all.begin(), all.end(), 0);
+    if (sorted == all) {
+      for (const std::size_t i : order) hole_order.push_back(placing[i]);
+    }
+    return outcome;
+  }
+
+  // The pending holes in the placement's order, then any other pending hole in report order.
+  std::vector<std::size_t> ordered_holes() const {
+    const std::vector<std::size_t> pending = pending_holes();
+    std::vector<std::size_t> out;
+    for (const std::size_t i : hole_order) {
+      if (std::find(pending.begin(), pending.end(), i) != pending.end()) out.push_back(i);
+    }
+    for (const std::size_t i : pending) {
+      if (std::find(out.begin(), out.end(), i) == out.end()) out.push_back(i);
+    }
+    return out;
+  }
+
+  std::vector<DrillPoint> pending_points() const {
+    std::vector<DrillPoint> out;
+    for (const std::size_t i : pending_holes()) out.push_back(report.areas[current_area].holes[i].point);
+    return out;
   }
 
   std::vector<std::size_t> pending_holes() const {

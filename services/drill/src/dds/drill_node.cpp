@@ -150,6 +150,19 @@ constexpr double kMarkerStale = 15.0;
 // lets the camera be turned onto the marker: from a posture without, the hole was drilled where
 // odometry put it (row scenario: 7.9-33.7 mm off, the look blocked by self collision).
 constexpr std::size_t kBodyDraws = 3;
+// From a drawn posture, a hole the placement checks counts as reached by the arm alone with the
+// first posture of the hole's own (kHoleAttempts) up to this one: the bit 0, 3 or 7 cm further
+// out than its distance, reach and full thrust checked. The 0 cm one alone counted 1-2 of the 4
+// holes of scenario 3's row at 1.5 m from each drawn posture, where the hole then found its
+// posture 3 cm out. From where the base stands (the approach's posture: the camera 0.6 m from
+// the wall, the bit 0.4 m short of it) only the first is asked: further out does not bring the
+// bit nearer, and each request that finds nothing costs the planner's whole budget (2 s).
+constexpr std::size_t kPlacementAttempts = 2;
+// The placement's look at the marker: the camera framing the whole marker with room for the
+// drift (marker_look_radius), then this much further out [m], in turn, as a hole's looks are
+// asked for (kLooks). One distance alone found no look from any of 3 postures drawn in one run
+// of the pattern test.
+constexpr double kPlacementLooks[] = {0.0, 0.1, 0.2};
 // Times a hole's whole-body posture is planned again for the hole measured again more than
 // kReplanShift from where it was planned, when the arm alone has none there. Once was not
 // enough: a row hole measured 18.9 mm off, planned again, was measured 26.0 mm off after that
@@ -1238,6 +1251,348 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
   return Outcome::succeeded();
 }
 
+// --- Ports: the base's placement for an area's holes (drill/placement.hpp) --------------------
+
+// A planned-only request for a posture at `goal` from the robot's current state; the task is the
+// caller's.
+msg::PlanRequest DrillNode::placement_request(const Eigen::Isometry3d& goal) {
+  msg::PlanRequest r;
+  r.request_id(next_request_++);
+  r.model_version(static_cast<std::uint32_t>(model_version_));
+  r.stamp_ns(now_ns());
+  r.source(kSource);
+  r.end_effector(rig_->tool());
+  r.goals().push_back(model::dds::to_pose_msg(goal));
+  r.execute(false);
+  return r;
+}
+
+// An ArUco area of several holes: from where the base stands, then from whole-body postures
+// drawn (kPlacementDraws: the bit a little further out than a hole's, in front of the holes'
+// centre or of a point nearer the marker), the arm alone is asked for each hole's drilling posture (as a hole's
+// first request: the bit's reach and the full thrust checked) and, from a drawn posture, the
+// camera for a look at the marker. The base then moves once, to the first posture reaching every
+// hole with a look, or stays (PlacementChoice). Blob areas are left as they are: their holes are
+// drilled with visual servoing, which takes out the odometry's drift.
+void DrillNode::place(std::size_t area, const std::vector<DrillPoint>& holes) {
+  motion_outcome_.reset();
+  placement_ = Placement{};
+  const std::optional<Sample> s = latest_sample();
+  const bool pattern = !holes.empty() && std::all_of(holes.begin(), holes.end(), [&](const DrillPoint& h) {
+    return h.marker >= 0 && h.marker == holes.front().marker;
+  });
+  if (holes.size() < 2 || !pattern || !patterns_ || !rig_ || !s) {
+    motion_outcome_ = Outcome::succeeded();
+    return;
+  }
+  placement_.holes = holes;
+  placement_.started = now_;
+  placement_.choice.emplace(holes.size(), std::size(kPlacementDraws));
+  point_ = holes.front();
+  const Eigen::VectorXd q = rig_->q(s->joints);
+  const Eigen::Isometry3d camera = rig_->camera_in_base(q);
+  camera_to_tip_ = (rig_->tip_in_base(q).translation() - camera.translation()).dot(camera.linear().col(2));
+  hole_distance_ = params_.motion.standoff + kAlignMargin;
+  log_line("drill: area " + std::to_string(area) + ": placing the base for its " +
+           std::to_string(holes.size()) + " holes");
+  place_check(false);
+}
+
+Outcome DrillNode::placement(std::vector<std::size_t>& order) {
+  if (!motion_outcome_) return Outcome::running();
+  if (motion_outcome_->progress == Progress::kSucceeded) order = placement_.order;
+  return *motion_outcome_;
+}
+
+// "; holes 1, 4 last" when some but not all of the holes are `reached`, for the log.
+static std::string last_holes(const std::vector<bool>& reached) {
+  const auto n = static_cast<std::size_t>(std::count(reached.begin(), reached.end(), true));
+  if (n == 0 || n == reached.size()) return "";
+  std::string last;
+  for (std::size_t i = 0; i < reached.size(); ++i) {
+    if (!reached[i]) last += (last.empty() ? "" : ", ") + std::to_string(i + 1);
+  }
+  return "; holes " + last + " last";
+}
+
+// The arm alone onto every hole, from where the base stands or (`drawn`) from the end of the
+// posture drawn last, with a look at the marker from there too.
+void DrillNode::place_check(bool drawn) {
+  placement_.hole_checks.clear();
+  placement_.look_check = {};
+  const auto from = [&](msg::PlanRequest& r) {
+    if (!drawn) return;
+    r.start_names(placement_.names.back());
+    r.start_position(placement_.bodies.back().back().position());
+  };
+  for (const DrillPoint& h : placement_.holes) {
+    msg::PlanRequest r = placement_request(h.frame);
+    set_hole_task(r, kHoleAttempts[0], hole_distance_, hole_depth(), params_.motion);
+    from(r);
+    placement_.hole_checks.push_back({r.request_id(), 0, r});
+    send_plan(r);
+  }
+  if (drawn) {
+    // The whole marker in view whichever way the camera rolls (marker_look_radius), the base
+    // where the drawn posture put it. No drilling force at a look: 1 N, the planner's least.
+    const std::optional<Eigen::Isometry3d> mark = marker_of(placement_.holes.front(), *patterns_);
+    if (mark) {
+      msg::PlanRequest r = placement_request(*mark);
+      r.camera_distance(any_roll_distance(marker_look_radius(patterns_->marker_size()), camera_fov()) +
+                        kPlacementLooks[0]);
+      r.fixed_base(true);
+      r.contact_force(1.0);
+      from(r);
+      placement_.look_check = {r.request_id(), 0, r};
+      send_plan(r);
+    }
+  }
+  motion_ = Motion::kPlaceCheck;
+}
+
+// "planned in 23.4 s", for the log.
+std::string DrillNode::placement_time() const {
+  std::ostringstream t;
+  t.setf(std::ios::fixed);
+  t.precision(1);
+  t << "planned in " << now_ - placement_.started << " s";
+  return t.str();
+}
+
+// After a check or a draw: the next draw, the move to the posture chosen, or no move.
+void DrillNode::place_next() {
+  const PlacementChoice& c = *placement_.choice;
+  switch (c.next()) {
+    case PlacementChoice::Next::kCheckStanding:  // not after a check: standing was checked first
+    case PlacementChoice::Next::kDraw: {
+      const PlacementDraw& d = kPlacementDraws[c.draws()];
+      std::optional<Eigen::Vector3d> mark;
+      if (const std::optional<Eigen::Isometry3d> m = marker_of(placement_.holes.front(), *patterns_))
+        mark = m->translation();
+      msg::PlanRequest r = placement_request(placement_goal(placement_.holes, mark, d.toward));
+      set_hole_task(r, {true, false, 0.0, d.out}, hole_distance_, hole_depth(), params_.motion);
+      placement_.draw = r.request_id();
+      send_plan(r);
+      motion_ = Motion::kPlaceDraw;
+      return;
+    }
+    case PlacementChoice::Next::kStand: {
+      placement_.order = reached_first(placement_.standing_reached);
+      log_line("drill: " + c.summary() + "; the base stays where it stands (" + placement_time() + ")" +
+               last_holes(placement_.standing_reached));
+      motion_ = Motion::kNone;
+      motion_outcome_ = Outcome::succeeded();
+      return;
+    }
+    case PlacementChoice::Next::kMove: {
+      const std::size_t k = c.chosen();
+      placement_.order = reached_first(placement_.reached[k]);
+      log_line("drill: " + c.summary() + "; the whole body to posture " + std::to_string(k + 1) +
+               " drawn (" + placement_time() + ")" + last_holes(placement_.reached[k]));
+      trajectory_request_ = send_trajectory(placement_.names[k], placement_.bodies[k]);
+      motion_ = Motion::kPlaceMove;
+      return;
+    }
+  }
+}
+
+void DrillNode::control_placement() {
+  const auto answered = [&](std::uint32_t id) -> std::optional<msg::PlanResult> {
+    std::optional<msg::PlanResult> r = plan_result(id);
+    if (r && (r->state() == msg::PLAN_SUCCEEDED || r->state() == msg::PLAN_FAILED)) return r;
+    return std::nullopt;
+  };
+  if (motion_ == Motion::kPlaceCheck) {
+    const bool drawn = !placement_.bodies.empty();
+    std::size_t reached = 0;
+    bool waiting = false;
+    std::vector<bool> flags;
+    for (Placement::Check& c : placement_.hole_checks) {
+      const std::optional<msg::PlanResult> r = answered(c.id);
+      if (!r) {
+        waiting = true;
+        continue;
+      }
+      if (r->state() == msg::PLAN_FAILED && c.attempt < (drawn ? kPlacementAttempts : 0) &&
+          (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH)) {
+        // The hole's next posture further out, as the hole itself will ask (kHoleAttempts).
+        set_hole_task(c.request, kHoleAttempts[++c.attempt], hole_distance_, hole_depth(), params_.motion);
+        c.id = next_request_++;
+        c.request.request_id(c.id);
+        c.request.stamp_ns(now_ns());
+        send_plan(c.request);
+        waiting = true;
+        continue;
+      }
+      reached += r->state() == msg::PLAN_SUCCEEDED;
+      flags.push_back(r->state() == msg::PLAN_SUCCEEDED);
+    }
+    if (waiting) return;
+    std::optional<msg::PlanResult> look;
+    Placement::Check& l = placement_.look_check;
+    if (l.id != 0 && !(look = answered(l.id))) return;
+    if (look && look->state() == msg::PLAN_FAILED && l.attempt + 1 < std::size(kPlacementLooks) &&
+        (look->failure() == msg::PLAN_UNREACHABLE || look->failure() == msg::PLAN_NO_PATH)) {
+      l.request.camera_distance(l.request.camera_distance() - kPlacementLooks[l.attempt] +
+                                kPlacementLooks[l.attempt + 1]);
+      ++l.attempt;
+      l.id = next_request_++;
+      l.request.request_id(l.id);
+      l.request.stamp_ns(now_ns());
+      send_plan(l.request);
+      return;
+    }
+    if (!drawn) {
+      placement_.choice->standing(reached);
+      placement_.standing_reached = flags;
+    } else {
+      placement_.reached.back() = flags;
+      const bool seen = look && look->state() == msg::PLAN_SUCCEEDED && !look->trajectory().empty();
+      if (seen) {
+        placement_.looks.back() = look->trajectory();
+        placement_.look_distances.back() = l.request.camera_distance();
+      }
+      placement_.choice->drawn(reached, seen);
+    }
+    place_next();
+    return;
+  }
+  if (motion_ == Motion::kPlaceDraw) {
+    const std::optional<msg::PlanResult> r = answered(placement_.draw);
+    if (!r) return;
+    placement_.names.push_back(r->joint_names());
+    placement_.reached.emplace_back(placement_.holes.size(), false);
+    placement_.looks.emplace_back();
+    placement_.look_distances.push_back(0.0);
+    if (r->state() == msg::PLAN_SUCCEEDED && !r->trajectory().empty()) {
+      placement_.bodies.push_back(r->trajectory());
+      place_check(true);
+      return;
+    }
+    placement_.bodies.emplace_back();
+    log_line("drill: no whole-body posture drawn for the placement (" + r->reason() + ")");
+    placement_.choice->drawn(0, false);
+    place_next();
+    return;
+  }
+  const std::size_t k = placement_.choice ? placement_.choice->chosen() : 0;
+  if (motion_ == Motion::kPlaceMove) {
+    if (!trajectory_ran("the base's placement")) return;
+    hole_chain_.push_back({placement_.names[k], placement_.bodies[k]});
+    // The base moved: the marker's last sighting no longer places the holes.
+    markers_seen_at_.erase(point_.marker);
+    if (const std::optional<Sample> s = latest_sample()) {
+      const msg::TrajectorySample here =
+          sample_here(placement_.names[k], *s, placement_.bodies[k].back());
+      double off = 0.0, turn = 0.0;
+      for (std::size_t i = 0; i < placement_.names[k].size() && i < here.position().size(); ++i) {
+        const double d = here.position()[i] - placement_.bodies[k].back().position()[i];
+        if (placement_.names[k][i] == "base_yaw") turn = std::abs(d);
+        else if (placement_.names[k][i] == "base_x" || placement_.names[k][i] == "base_y") off += d * d;
+      }
+      std::ostringstream line;
+      line.setf(std::ios::fixed);
+      line.precision(1);
+      line << "drill: the base placed " << std::sqrt(off) * 1e3 << " mm and " << turn * 1e3
+           << " mrad from the posture planned (odometry)";
+      log_line(line.str());
+    }
+    if (placement_.looks[k].empty()) {  // no look was checked (cannot be: kMove needs one)
+      motion_ = Motion::kNone;
+      motion_outcome_ = Outcome::succeeded();
+      return;
+    }
+    place_look(0);
+    return;
+  }
+  if (motion_ == Motion::kPlaceLook) {
+    if (!trajectory_ran("the camera onto the marker from the placement")) return;
+    hole_chain_.push_back({placement_.names[k], placement_.looks[k]});
+    start_reanchor(Motion::kPlaceSee);
+    return;
+  }
+  if (motion_ == Motion::kPlaceLookAgain) {
+    const std::optional<msg::PlanResult> r = plan_result(placement_.look_again);
+    if (!r) return;
+    if (!r->trajectory().empty()) placement_.again_path = {r->joint_names(), r->trajectory()};
+    if (r->state() == msg::PLAN_SUCCEEDED) {
+      if (!placement_.again_path.samples.empty()) hole_chain_.push_back(placement_.again_path);
+      start_reanchor(Motion::kPlaceSee);
+    } else if (r->state() == msg::PLAN_FAILED && r->failure() == msg::PLAN_EXECUTION_ABORTED) {
+      motion_ = Motion::kNone;
+      motion_outcome_ = Outcome::failed("robot: the camera onto the marker from the placement: " + r->reason());
+    } else if (const std::optional<Sample> s = latest_sample();
+               r->state() == msg::PLAN_FAILED && placement_.looks_again == 0 && s) {
+      // None from where the base stands: the look checked from the posture planned, its arm
+      // path taken with the base where it stands (aimed off by the base's tracking error).
+      log_line("drill: no look at marker " + std::to_string(point_.marker) + " from where the base stands (" +
+               r->reason() + "); the look checked from the posture planned");
+      std::vector<msg::TrajectorySample> look = placement_.looks[k];
+      const msg::TrajectorySample here = sample_here(placement_.names[k], *s, look.front());
+      look.front() = here;
+      keep_base(placement_.names[k], here, look);
+      placement_.looks[k] = look;
+      trajectory_request_ = send_trajectory(placement_.names[k], look);
+      motion_ = Motion::kPlaceLook;
+    } else if (r->state() == msg::PLAN_FAILED) {
+      log_line("drill: the camera cannot be turned onto marker " + std::to_string(point_.marker) +
+               " further out from the placement (" + r->reason() + "); each hole looks for it");
+      motion_ = Motion::kNone;
+      motion_outcome_ = Outcome::succeeded();
+    }
+    return;
+  }
+  if (motion_ == Motion::kPlaceSee) {
+    const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, kReanchorFrames);
+    if (!view) return;
+    // The pattern measured again as a hole's look measures it (its drift to OdometryDrift, the
+    // marker's sighting kept for the area's holes).
+    if (!remeasure_looked_marker(CameraView{&view->frame, view->world_T_optical})) {
+      const std::optional<Eigen::Isometry3d> predicted = marker_of(point_, *patterns_);
+      if (predicted && placement_.looks_again + 1 < std::size(kPlacementLooks)) {
+        // Further out, the arm alone from where it stands: more room for the drift.
+        place_look(placement_.looks_again + 1);
+        std::ostringstream line;
+        line.setf(std::ios::fixed);
+        line.precision(2);
+        line << "drill: marker " << point_.marker << " not seen from the placement's look; the camera "
+             << placement_.look_distance << " m out";
+        log_line(line.str());
+        return;
+      }
+      log_line("drill: marker " + std::to_string(point_.marker) +
+               " not seen from the placement's looks; each hole looks for it");
+    }
+    motion_ = Motion::kNone;
+    motion_outcome_ = Outcome::succeeded();
+  }
+}
+
+// The camera onto the area's marker kPlacementLooks[attempt] [m] further out than the look checked
+// from the posture drawn, the arm alone from where the robot stands, planned and executed
+// (kPlaceLookAgain). The look checked from the posture drawn, replayed with the base where it
+// stands, is aimed off by the base's tracking error: the placement's posture reached 40 mm nearer
+// the wall than planned in one run, and its checked look showed the bare wall.
+void DrillNode::place_look(std::size_t attempt) {
+  const std::optional<Eigen::Isometry3d> mark = marker_of(point_, *patterns_);
+  if (!mark) {
+    motion_ = Motion::kNone;
+    motion_outcome_ = Outcome::succeeded();
+    return;
+  }
+  placement_.looks_again = attempt;
+  placement_.look_distance = placement_.look_distances[placement_.choice->chosen()] + kPlacementLooks[attempt];
+  msg::PlanRequest r = placement_request(*mark);
+  r.camera_distance(placement_.look_distance);
+  r.fixed_base(true);
+  r.contact_force(1.0);
+  r.execute(true);
+  placement_.look_again = r.request_id();
+  placement_.again_path = {};
+  send_plan(r);
+  motion_ = Motion::kPlaceLookAgain;
+}
+
 // Aligning a hole: the approach put the drill camera at the working distance (0.6 m), the bit
 // about 0.4 m further from the wall than it drills. Stretching the arm that far in Cartesian
 // impedance is not checked against anything (with the demo arm it held the shoulder J2_E at
@@ -1604,6 +1959,22 @@ void DrillNode::replan_body() {
   request_hole_posture();
 }
 
+// After a look at the hole's mark: its drilling posture planned again for the arm alone (the
+// base stands where the whole body put it), at the distance that reached it, for the hole where
+// the look measured it.
+void DrillNode::replan_after_look() {
+  const HoleAttempt reached = kHoleAttempts[hole_attempt_];
+  const std::size_t from = hole_attempt_;
+  hole_attempt_ = 0;
+  while (hole_attempt_ + 1 < std::size(kHoleAttempts) &&
+         !(kHoleAttempts[hole_attempt_].fixed_base && kHoleAttempts[hole_attempt_].reach == reached.reach &&
+           kHoleAttempts[hole_attempt_].lead == reached.lead &&
+           kHoleAttempts[hole_attempt_].further >= reached.further - 1e-6))
+    ++hole_attempt_;
+  if (hole_attempt_ < from && !kHoleAttempts[hole_attempt_].fixed_base) hole_attempt_ = from;
+  replan_hole(reached.reach, reached.further, reached.lead);
+}
+
 // The camera's smaller field-of-view angle: from its newest frame's intrinsics, else the
 // configured one.
 double DrillNode::camera_fov() const {
@@ -1852,6 +2223,10 @@ void DrillNode::posture_reached() {
 // each new camera frame, the motion's reference to the robot, and the phase's outcome.
 void DrillNode::control_motion() {
   if (motion_ == Motion::kNone || motion_outcome_) return;
+  if (motion_ >= Motion::kPlaceCheck) {
+    control_placement();
+    return;
+  }
   if (motion_ == Motion::kApproachHole) {
     const std::optional<msg::PlanResult> r = plan_result(hole_plan_request_);
     track_area();
@@ -2032,19 +2407,25 @@ void DrillNode::control_motion() {
       // from, not the next whole-body attempt taken unlooked (13 mm off in a row run).
       if (!hole_request_.fixed_base()) hole_replanned_ = true;
     }
-    // Back to the hole's drilling posture with the arm alone (the base stands where the whole
-    // body put it), at the distance that reached it.
-    const HoleAttempt reached = kHoleAttempts[hole_attempt_];
-    const std::size_t from = hole_attempt_;
-    hole_attempt_ = 0;
-    while (hole_attempt_ + 1 < std::size(kHoleAttempts) &&
-           !(kHoleAttempts[hole_attempt_].fixed_base &&
-             kHoleAttempts[hole_attempt_].reach == reached.reach &&
-             kHoleAttempts[hole_attempt_].lead == reached.lead &&
-             kHoleAttempts[hole_attempt_].further >= reached.further - 1e-6))
-      ++hole_attempt_;
-    if (hole_attempt_ < from && !kHoleAttempts[hole_attempt_].fixed_base) hole_attempt_ = from;
-    replan_hole(reached.reach, reached.further, reached.lead);
+    // From the look back onto the drilling posture along the look's path reversed, not along a
+    // path planned anew from the look posture: one such swung morphology A's J1_E through 3.9 rad
+    // with the bit near the wall and pressed it on the wall (300 N m, a safety stop, the
+    // simulator's wall cut 15 times). A posture of the arm alone planned within kReplanShift of
+    // the hole as measured now is aligned from (the alignment covers the rest); otherwise the
+    // posture is planned again from there.
+    const std::optional<Sample> s = latest_sample();
+    if (look_pushed_ && hole_chain_.size() > 1 && s && !hole_request_.goals().empty()) {
+      const double moved =
+          (point_.frame.translation() - model::dds::to_isometry(hole_request_.goals().front()).translation()).norm();
+      const bool keep = hole_request_.fixed_base() && moved <= kReplanShift;
+      back_to_posture(*s, keep ? Motion::kBackToPosture : Motion::kBackThenReplan);
+      return;
+    }
+    replan_after_look();
+    return;
+  }
+  if (motion_ == Motion::kBackThenReplan) {
+    if (trajectory_ran("back onto the drilling posture")) replan_after_look();
     return;
   }
   if (motion_ == Motion::kReanchor) {

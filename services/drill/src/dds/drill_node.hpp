@@ -32,6 +32,7 @@
 #include "drill/odometry_drift.hpp"
 #include "drill/patterns.hpp"
 #include "drill/perception.hpp"
+#include "drill/placement.hpp"
 #include "drill/ports.hpp"
 
 namespace concert::drill::dds {
@@ -84,6 +85,8 @@ class DrillNode final : public MissionPorts {
   Outcome execution() override;
   void detect(std::size_t area, const AreaSpec& spec, const ResolvedArea& located) override;
   Outcome detection(std::vector<DrillPoint>& points) override;
+  void place(std::size_t area, const std::vector<DrillPoint>& holes) override;
+  Outcome placement(std::vector<std::size_t>& order) override;
   void align(const DrillPoint& point) override;
   Outcome alignment() override;
   void drill(const DrillPoint& point, double depth) override;
@@ -151,9 +154,57 @@ class DrillNode final : public MissionPorts {
     kCheckLook,   // a marker hole's whole-body posture planned, not executed: is a look possible from it?
     kBodyToHole,  // that posture's path sent to the robot by the drill itself
     kCheckedLook,  // then the look's path check_look() planned, sent likewise
-    kBackForLook   // the marker not seen from a look: back onto the posture for the next look
+    kBackForLook,  // the marker not seen from a look: back onto the posture for the next look
+    kBackThenReplan,  // back from a look onto the posture, then the posture planned again there
+    // An area's base placement (place()): the arm alone asked for every hole (and the camera
+    // for the mark) from where the base stands or from a drawn posture; a whole-body posture
+    // drawn; the move there; the camera onto the mark; the mark measured again.
+    kPlaceCheck,
+    kPlaceDraw,
+    kPlaceMove,
+    kPlaceLook,
+    kPlaceSee,
+    kPlaceLookAgain  // the marker not seen: the camera further out, the arm alone (executed)
   };
 
+  // An area's base placement (place(), drill/placement.hpp): its holes, the tally, the
+  // requests out, the postures drawn and each one's look.
+  struct PlannedPath {
+    std::vector<std::string> names;
+    std::vector<msg::TrajectorySample> samples;
+  };
+  struct Placement {
+    std::vector<DrillPoint> holes;
+    double started{0.0};  // now_ [s]
+    std::optional<PlacementChoice> choice;
+    // The arm alone onto each hole (planned only): the request out and which of
+    // kHoleAttempts' first three (0, 3 and 7 cm further out) it asks.
+    struct Check {
+      std::uint32_t id{0};
+      std::size_t attempt{0};
+      msg::PlanRequest request;
+    };
+    std::vector<Check> hole_checks;
+    Check look_check;  // the camera onto the mark (id 0: none asked), attempt of kPlacementLooks
+    std::uint32_t draw{0};                   // the whole body's posture drawn
+    std::vector<std::vector<std::string>> names;                 // per draw
+    std::vector<std::vector<msg::TrajectorySample>> bodies;      // per draw (empty: none found)
+    std::vector<std::vector<msg::TrajectorySample>> looks;       // per draw (empty: no look)
+    std::vector<double> look_distances;  // per draw: the camera's distance of its look [m]
+    std::vector<bool> standing_reached;  // per hole: the arm alone reaches it from where the base stands
+    std::vector<std::vector<bool>> reached;  // per draw, per hole: from the posture drawn
+    std::vector<std::size_t> order;      // the holes' order to drill (reached first)
+    std::size_t looks_again{0};          // of kPlacementLooks: the look from where the base stands
+    double look_distance{0.0};           // its camera distance [m]
+    std::uint32_t look_again{0};         // its request
+    PlannedPath again_path;
+  } placement_;
+  [[nodiscard]] msg::PlanRequest placement_request(const Eigen::Isometry3d& goal);
+  void place_check(bool drawn);
+  void place_next();
+  void control_placement();
+  void place_look(std::size_t attempt);
+  [[nodiscard]] std::string placement_time() const;
   void tick();
   [[nodiscard]] bool mission_active() const;
   void apply_model(const msg::RobotModel& model);
@@ -185,6 +236,7 @@ class DrillNode final : public MissionPorts {
   /// Plans the hole's whole-body posture again at point_ (the hole measured again), with the
   /// request that reached the first one: when no arm-alone posture reaches it from there.
   void replan_body();
+  void replan_after_look();
   [[nodiscard]] double camera_fov() const;
   /// A hole measured again with the camera turned onto its blob / marker (kLookReanchor).
   bool remeasure_looked_blob(const CameraView& camera);
@@ -195,7 +247,6 @@ class DrillNode final : public MissionPorts {
   int unseen_views_{0};
   /// From the look posture back onto the whole body's posture, then the alignment.
   void back_to_posture(const Sample& s, Motion next = Motion::kBackToPosture);
-  struct PlannedPath;
   // Straight from `here` onto `p`'s last posture, at rest there (settle_time); the base kept
   // where it stands when within kBaseKept of the posture's (keep_base), said in the log.
   std::vector<msg::TrajectorySample> settle_path(const PlannedPath& p,
@@ -313,10 +364,6 @@ class DrillNode final : public MissionPorts {
   std::string light_why_;        // why the hole is drilled at drilling_lead_ < 1 (the log)
   std::int64_t reanchor_since_ns_{0};
   std::vector<DrillPoint> area_points_;  // the current area's holes as detected
-  struct PlannedPath {
-    std::vector<std::string> names;
-    std::vector<msg::TrajectorySample> samples;
-  };
   PlannedPath hole_path_;          // of the hole being approached
   PlannedPath look_path_;          // of the camera turned to the hole's mark
   std::uint32_t look_request_{0};  // the plan request turning the camera to the marker
