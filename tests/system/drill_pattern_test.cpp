@@ -4,9 +4,10 @@
 // 60 cm row of 4 holes 0.2 m apart, 0.15 m below the marker). Every service of the drilling stack
 // on one machine over loopback DDS, the cameras with their noise. The area is located from a
 // point picked near the marker; the drill service plans and executes the approach, finds the
-// marker and its pattern, and drills the holes by the kinematics alone (no visual servoing, as
-// in the paper): each hole's whole-body posture is drawn until the camera can be turned onto the
-// marker from it, the pattern measured again there, the hole drilled with the base standing.
+// marker and its pattern, places the base once for the row (a whole-body posture from which the
+// arm alone reaches every hole and the camera the marker: services/drill, "Placing the base"),
+// measures the pattern again from there, and drills the holes by the kinematics alone (no visual
+// servoing, as in the paper) with the base standing.
 // Judged against the simulator's truth: the holes its wall records (concert/sim/holes) against
 // the pattern laid on the marker's true pose (libs/world), not against the service's report.
 // The paper's aim for patterns: median error <= 3 mm (services/drill/README.md, figures).
