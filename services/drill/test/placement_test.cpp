@@ -149,6 +149,31 @@ TEST(PlacementChoice, AfterEveryDrawMovesToTheBestWithALookOnlyIfItReachesMoreTh
   }
 }
 
+TEST(PlacementChoice, IsShortOfEveryHoleOnlyWhenItEndsStandingWithoutThemAll) {
+  {
+    PlacementChoice c(4, 2);
+    EXPECT_FALSE(c.short_of_every_hole()) << "nothing checked yet";
+    c.standing(0);
+    EXPECT_FALSE(c.short_of_every_hole()) << "draws still to come";
+    c.drawn(0, false);
+    c.drawn(4, false);
+    EXPECT_TRUE(c.short_of_every_hole()) << "standing, no hole reached from there";
+  }
+  {
+    PlacementChoice c(4, 2);
+    c.standing(4);
+    EXPECT_FALSE(c.short_of_every_hole()) << "standing reaches them all";
+  }
+  {
+    PlacementChoice c(4, 2);
+    c.standing(0);
+    c.drawn(2, true);
+    c.drawn(1, true);
+    EXPECT_EQ(c.next(), Next::kMove);
+    EXPECT_FALSE(c.short_of_every_hole()) << "a move to a posture with a look is taken as it is";
+  }
+}
+
 TEST(PlacementChoice, SummaryNamesEveryCheck) {
   PlacementChoice c(4, 2);
   EXPECT_NE(c.summary().find("not checked"), std::string::npos) << c.summary();

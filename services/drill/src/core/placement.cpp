@@ -75,6 +75,10 @@ PlacementChoice::Next PlacementChoice::next() const {
 
 std::size_t PlacementChoice::chosen() const { return best().value_or(0); }
 
+bool PlacementChoice::short_of_every_hole() const {
+  return standing_ && next() == Next::kStand && *standing_ < holes_;
+}
+
 std::string PlacementChoice::summary() const {
   std::ostringstream s;
   s << "the arm alone reaches ";

@@ -72,7 +72,10 @@ constexpr HoleAttempt kHoleAttempts[] = {
     // No posture holds the full thrust (morphology A's row at 0.5 m: none for 200 N checked,
     // the whole body's at 100-150 N): the same at about half the thrust, still with the bit's
     // reach checked, before postures whose reach nobody checked.
-    {true, true, 0.0, 0.0, 0.5},  {true, true, 0.0, 0.07, 0.5},  {true, false, 0.3, 0.0, 0.5},
+    // (The 3 cm one as at the full thrust: a placement checked at this thrust counts a hole
+    // reached with the arm's first three postures, kPlacementAttempts.)
+    {true, true, 0.0, 0.0, 0.5},  {true, true, 0.0, 0.03, 0.5},  {true, true, 0.0, 0.07, 0.5},
+    {true, false, 0.3, 0.0, 0.5},
     {true, false, 0.3, 0.07, 0.5}, {true, false, 0.0, 0.0, 0.5},
     // Lighter still (kLightestLead: 49 N, 78 N checked): morphology A's row at 0.35 m, the
     // paper's lowest, had no posture under 104 N checked in one run of two (the base's legs in
@@ -158,6 +161,24 @@ constexpr std::size_t kBodyDraws = 3;
 // the wall, the bit 0.4 m short of it) only the first is asked: further out does not bring the
 // bit nearer, and each request that finds nothing costs the planner's whole budget (2 s).
 constexpr std::size_t kPlacementAttempts = 2;
+// A hole attempt (kHoleAttempts) with its torques checked at another lead's thrust.
+constexpr HoleAttempt at_lead(HoleAttempt a, double lead) {
+  a.lead = lead;
+  return a;
+}
+// The lead a placement is checked at again when the full thrust's leaves the base standing
+// short of the holes (PlacementChoice::short_of_every_hole): kHoleAttempts' first light one.
+// The demo robot's holes on its wall, and morphology A's below 1.2 m, are drilled at it anyway.
+constexpr double kPlacementLightLead = 0.5;
+// The first of kHoleAttempts for the arm alone at `lead`'s thrust (a hole placed at it starts
+// there: the full thrust's attempts before it, asked again, found nothing from there or would
+// move the whole body away from the placement).
+std::size_t first_fixed_at(double lead) {
+  for (std::size_t i = 0; i < std::size(kHoleAttempts); ++i) {
+    if (kHoleAttempts[i].reach && kHoleAttempts[i].fixed_base && kHoleAttempts[i].lead == lead) return i;
+  }
+  return 0;
+}
 // The placement's look at the marker: the camera framing the whole marker with room for the
 // drift (marker_look_radius), then this much further out [m], in turn, as a hole's looks are
 // asked for (kLooks). One distance alone found no look from any of 3 postures drawn in one run
@@ -1327,7 +1348,7 @@ void DrillNode::place_check(bool drawn) {
   };
   for (const DrillPoint& h : placement_.holes) {
     msg::PlanRequest r = placement_request(h.frame);
-    set_hole_task(r, kHoleAttempts[0], hole_distance_, hole_depth(), params_.motion);
+    set_hole_task(r, at_lead(kHoleAttempts[0], placement_.lead), hole_distance_, hole_depth(), params_.motion);
     from(r);
     placement_.hole_checks.push_back({r.request_id(), 0, r});
     send_plan(r);
@@ -1370,15 +1391,29 @@ void DrillNode::place_next() {
       if (const std::optional<Eigen::Isometry3d> m = marker_of(placement_.holes.front(), *patterns_))
         mark = m->translation();
       msg::PlanRequest r = placement_request(placement_goal(placement_.holes, mark, d.toward));
-      set_hole_task(r, {true, false, 0.0, d.out}, hole_distance_, hole_depth(), params_.motion);
+      set_hole_task(r, {true, false, 0.0, d.out, placement_.lead}, hole_distance_, hole_depth(), params_.motion);
       placement_.draw = r.request_id();
       send_plan(r);
       motion_ = Motion::kPlaceDraw;
       return;
     }
     case PlacementChoice::Next::kStand: {
+      if (c.short_of_every_hole() && placement_.lead > kPlacementLightLead) {
+        log_line("drill: " + c.summary() + thrust_text(placement_.lead, params_.motion) +
+                 "; the placement checked again" + thrust_text(kPlacementLightLead, params_.motion));
+        Placement again;
+        again.holes = placement_.holes;
+        again.started = placement_.started;
+        again.lead = kPlacementLightLead;
+        again.choice.emplace(again.holes.size(), std::size(kPlacementDraws));
+        placement_ = std::move(again);
+        place_check(false);
+        return;
+      }
       placement_.order = reached_first(placement_.standing_reached);
-      log_line("drill: " + c.summary() + "; the base stays where it stands (" + placement_time() + ")" +
+      placement_.placed = placement_.standing_reached;
+      log_line("drill: " + c.summary() + thrust_text(placement_.lead, params_.motion) +
+               "; the base stays where it stands (" + placement_time() + ")" +
                last_holes(placement_.standing_reached));
       motion_ = Motion::kNone;
       motion_outcome_ = Outcome::succeeded();
@@ -1387,7 +1422,9 @@ void DrillNode::place_next() {
     case PlacementChoice::Next::kMove: {
       const std::size_t k = c.chosen();
       placement_.order = reached_first(placement_.reached[k]);
-      log_line("drill: " + c.summary() + "; the whole body to posture " + std::to_string(k + 1) +
+      placement_.placed = placement_.reached[k];
+      log_line("drill: " + c.summary() + thrust_text(placement_.lead, params_.motion) +
+               "; the whole body to posture " + std::to_string(k + 1) +
                " drawn (" + placement_time() + ")" + last_holes(placement_.reached[k]));
       trajectory_request_ = send_trajectory(placement_.names[k], placement_.bodies[k]);
       motion_ = Motion::kPlaceMove;
@@ -1416,7 +1453,8 @@ void DrillNode::control_placement() {
       if (r->state() == msg::PLAN_FAILED && c.attempt < (drawn ? kPlacementAttempts : 0) &&
           (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH)) {
         // The hole's next posture further out, as the hole itself will ask (kHoleAttempts).
-        set_hole_task(c.request, kHoleAttempts[++c.attempt], hole_distance_, hole_depth(), params_.motion);
+        set_hole_task(c.request, at_lead(kHoleAttempts[++c.attempt], placement_.lead), hole_distance_,
+                      hole_depth(), params_.motion);
         c.id = next_request_++;
         c.request.request_id(c.id);
         c.request.stamp_ns(now_ns());
@@ -1647,11 +1685,17 @@ void DrillNode::align(const DrillPoint& point) {
   // The arm alone first (kHoleAttempts): the base stays where the area's approach put it, so
   // odometry does not drift between holes (3.5 deg over one whole-body move on the demo).
   hole_attempt_ = 0;
+  // A hole the area's placement reached at a lighter thrust starts there (the full thrust's
+  // attempts would find nothing from the placement, or move the whole body off it).
+  for (std::size_t i = 0; i < placement_.holes.size() && i < placement_.placed.size(); ++i) {
+    if (placement_.placed[i] && placement_.holes[i].label == point.label && placement_.lead < 1.0)
+      hole_attempt_ = first_fixed_at(placement_.lead);
+  }
   drilling_lead_ = 1.0;
   body_draws_ = 0;
   checked_look_ = 0;
   checked_path_ = {};
-  set_hole_task(r, kHoleAttempts[0], hole_distance_, hole_depth(), params_.motion);
+  set_hole_task(r, kHoleAttempts[hole_attempt_], hole_distance_, hole_depth(), params_.motion);
   hole_request_ = r;
   hole_request_write();
   hole_path_ = {};

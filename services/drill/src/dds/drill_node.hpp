@@ -194,6 +194,8 @@ class DrillNode final : public MissionPorts {
     std::vector<bool> standing_reached;  // per hole: the arm alone reaches it from where the base stands
     std::vector<std::vector<bool>> reached;  // per draw, per hole: from the posture drawn
     std::vector<std::size_t> order;      // the holes' order to drill (reached first)
+    std::vector<bool> placed;            // per hole: reached by the arm alone where the base ends
+    double lead{1.0};                    // the thrust checked: a lead of kHoleAttempts'
     std::size_t looks_again{0};          // of kPlacementLooks: the look from where the base stands
     double look_distance{0.0};           // its camera distance [m]
     std::uint32_t look_again{0};         // its request
