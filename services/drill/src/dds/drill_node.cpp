@@ -1433,6 +1433,14 @@ void DrillNode::place_next() {
   }
 }
 
+// A placement check asked again (its request changed): a new id, stamped now.
+void DrillNode::resend(Placement::Check& c) {
+  c.id = next_request_++;
+  c.request.request_id(c.id);
+  c.request.stamp_ns(now_ns());
+  send_plan(c.request);
+}
+
 void DrillNode::control_placement() {
   const auto answered = [&](std::uint32_t id) -> std::optional<msg::PlanResult> {
     std::optional<msg::PlanResult> r = plan_result(id);
@@ -1455,10 +1463,7 @@ void DrillNode::control_placement() {
         // The hole's next posture further out, as the hole itself will ask (kHoleAttempts).
         set_hole_task(c.request, at_lead(kHoleAttempts[++c.attempt], placement_.lead), hole_distance_,
                       hole_depth(), params_.motion);
-        c.id = next_request_++;
-        c.request.request_id(c.id);
-        c.request.stamp_ns(now_ns());
-        send_plan(c.request);
+        resend(c);
         waiting = true;
         continue;
       }
@@ -1474,10 +1479,7 @@ void DrillNode::control_placement() {
       l.request.camera_distance(l.request.camera_distance() - kPlacementLooks[l.attempt] +
                                 kPlacementLooks[l.attempt + 1]);
       ++l.attempt;
-      l.id = next_request_++;
-      l.request.request_id(l.id);
-      l.request.stamp_ns(now_ns());
-      send_plan(l.request);
+      resend(l);
       return;
     }
     if (!drawn) {

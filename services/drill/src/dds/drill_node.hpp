@@ -205,6 +205,7 @@ class DrillNode final : public MissionPorts {
   void place_check(bool drawn);
   void place_next();
   void control_placement();
+  void resend(Placement::Check& c);
   void place_look(std::size_t attempt);
   [[nodiscard]] std::string placement_time() const;
   void tick();
