@@ -201,8 +201,9 @@ void Map::duration_value(std::string_view key, double& seconds, Range range, dou
     if (v > 0.0 && v < tick_s / 2) {
       fail(key, "expected a duration of at least " + text_of(tick_s) + " s, got " + got(node));
     }
-    // Converting a longer one to an integer count of ticks is undefined (found by fuzz_params:
-    // 1e56 s into nanoseconds). max_s is the duration type's largest, rounded up as a double.
+    // Converting a longer one to an integer count of ticks is undefined (e.g. 1e56 s into
+    // nanoseconds: tests/fuzz/regressions/fuzz_params). max_s is the duration type's largest,
+    // rounded up as a double.
     if (std::abs(v) >= max_s) {
       fail(key, "expected a duration shorter than " + text_of(max_s) + " s, got " + got(node));
     }

@@ -44,12 +44,12 @@ void use_localhost_only(DomainParticipantQos& qos) {
   // UDP on loopback only, no shared memory: a process killed with SIGKILL (a crash, the chaos
   // test) leaves Fast DDS 2.9's shared-memory ports in a state where restarted processes, and
   // sometimes running ones, no longer hear each other (upstream, still open in 2.14: a
-  // restarted subscriber matches but receives nothing; a killed one breaks the others). We saw
-  // it as a restarted robot deaf to the safety stop naming it and a restarted drill service
-  // that never got the latched model; over UDP every restart was heard (tests/system chaos).
+  // restarted subscriber matches but receives nothing; a killed one breaks the others). It
+  // shows as a restarted robot deaf to the safety stop naming it, or a restarted drill service
+  // that never gets the latched model; over UDP every restart is heard (tests/system chaos).
   // Loopback UDP with 4 MiB socket buffers carries the 1.5 MB RGB + depth pairs at 15 Hz
   // without loss (bench_sensors_dds: 300 of 300 pairs, latency median 1.5 ms, vs 2.0 ms over
-  // shared memory); with the kernel's default 208 KiB buffers two frames in three were lost.
+  // shared memory); with the kernel's default 208 KiB buffers two frames in three are lost.
   check_socket_buffer_limit();
   auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
   udp->interfaceWhiteList.emplace_back("127.0.0.1");

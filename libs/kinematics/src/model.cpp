@@ -64,7 +64,7 @@ void check_frame(const Model::Impl& m, std::string_view frame) {
 
 // KDL's tree solvers read q(i) for every segment on the way, fixed ones included (at index 0),
 // which is out of bounds for a tree without moving joints (a robot of passive modules only):
-// Debian's KDL then fails an assertion and aborts the process (found by tests/fuzz). Such a
+// Debian's KDL then fails an assertion and aborts the process (a tests/fuzz regression). Such a
 // tree is composed here instead: the pose of each fixed segment, up to the root.
 bool has_no_joint(const Model::Impl& m) { return m.kdl.tree.getNrOfJoints() == 0; }
 
@@ -109,7 +109,7 @@ Model::Model(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
 Model Model::from_urdf_string(const std::string& urdf_xml, const ModelOptions& options) {
   // TinyXML 2.6.2, which urdfdom parses with, skips a multi-byte UTF-8 character by the length
   // its lead byte announces, past the end of the text when the character is cut short there: a
-  // heap over-read (found by tests/fuzz). Text that is not UTF-8 is refused before.
+  // heap over-read (a tests/fuzz regression). Text that is not UTF-8 is refused before.
   if (const auto at = invalid_utf8_at(urdf_xml)) {
     throw ModelError("URDF is not valid UTF-8 (byte " + std::to_string(*at) + ")");
   }

@@ -135,8 +135,8 @@ void BaseKinematics::leg_setpoints(const Eigen::Vector3d& twist, const std::vect
   };
   // A base twist whose every contact moves slower than the deadband is not driven: the direction
   // of a few mm/s (a tracking correction at the end of a path) swings with every cycle, and
-  // each swing scrubs the loaded wheels (on the demo's whole-body moves a steering drive ran
-  // over its continuous torque). Per leg it would not do: a leg rolling along a stale heading
+  // each swing scrubs the loaded wheels (on the demo's whole-body moves a steering drive would
+  // run over its continuous torque). Per leg it would not do: a leg rolling along a stale heading
   // while the others steer fights them (a wheel drive over its continuous torque).
   double fastest = 0.0;
   for (const Leg& leg : legs_) fastest = std::max(fastest, contact_velocity(leg).norm());

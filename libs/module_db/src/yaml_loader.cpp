@@ -165,7 +165,7 @@ YAML::Node load_file(const fs::path& file) {
   std::ostringstream text;
   text << in.rdbuf();
   // yaml-cpp takes bytes that are not UTF-8 as they come: they would reach the generated URDF,
-  // which the services refuse (found by fuzzing).
+  // which the services refuse (a tests/fuzz regression).
   if (const auto at = invalid_utf8_at(text.str())) {
     fail(file, "(document)", "not valid UTF-8 (byte " + std::to_string(*at) + ")");
   }

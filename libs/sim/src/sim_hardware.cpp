@@ -451,16 +451,16 @@ void carry_state(const Instance& from, Instance& to) {
 
 // MuJoCo's friction is soft: a contact below its friction limit still slides, at a speed in
 // proportion to the force. For a rolling wheel that is much what a tyre does (its lateral force
-// grows with the slip), but a base standing on its held wheels crept under any push: 0.9 mm/s
-// sideways under 150 N with 1000 N of friction to spare, 2.6 mm/s under 400 N (sim_test's
+// grows with the slip), but a base standing on its held wheels would creep under any push:
+// 0.9 mm/s sideways under 150 N with 1000 N of friction to spare, 2.6 mm/s under 400 N (sim_test's
 // HeldWheelsStandUnderAPushBelowFrictionAndSlideAboveIt), unseen by wheel odometry. A drill's
-// thrust walked the standing base back from the wall (holes 28.3-29.7 mm deep of 30 asked)
-// and a pattern drilled by the kinematics alone inherited every push of the alignment.
+// thrust would walk the standing base back from the wall (holes 28.3-29.7 mm deep of 30 asked),
+// and a pattern drilled by the kinematics alone would inherit every push of the alignment.
 // A standing tyre grips: once no steering or wheel joint has moved for kStillTime, MuJoCo's
 // no-slip pass (mjOption::noslip_iterations) removes the contacts' slip within their friction
-// cones; a push above mu N still slides the base. Made stiff all the time instead (elliptic
-// cones, impratio 100), rolling wheels whose speeds disagree a little fought each other, the
-// steering and wheel drives at their continuous torque, and a whole-body move missed its goal.
+// cones; a push above mu N still slides the base. Not stiff all the time (elliptic cones,
+// impratio 100): then rolling wheels whose speeds disagree a little fight each other, the
+// steering and wheel drives at their continuous torque, and a whole-body move misses its goal.
 void stand_grip(Instance& in) {
   constexpr double kStill = 0.01;     // leg joint speeds below this: standing [rad/s]
   constexpr double kStillTime = 0.05;  // [s]

@@ -184,11 +184,9 @@ struct DemoRobotWithImu {
 };
 
 // The base's yaw from its IMU (the demo's drill robot, its IMU on the base with the simulator's
-// MEMS noise and bias): a turn and back, then a drive. The wheels alone see the turn 4 % too
-// large and miss the base turning while the legs steer in place (measured again, 2026-11-28,
-// with the wheels beside their steering axes in the odometry, the IMU's samples withheld: 0.036
-// rad too much after a 0.99 rad turn, 0.023 rad off after the turn back, 0.037 rad after the
-// drive).
+// MEMS noise and bias): a turn and back, then a drive. The wheels alone see the turn about 4 %
+// too large and miss the base turning while the legs steer in place (with the IMU's samples
+// withheld: 0.036 rad too much after a 0.99 rad turn, 0.037 rad off after the drive).
 TEST(PaperRobot, TheGyroKeepsTheOdometrysYaw) {
   DemoRobotWithImu demo(3);
   SimHardware& sim = demo.sim;

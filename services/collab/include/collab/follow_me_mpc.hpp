@@ -65,12 +65,12 @@ struct MpcParams {
   int max_iter{50};
   /// Low-pass time constant of the end-effector force before eq. 4 [s]; 0: none. The robot's
   /// estimate is quasi-static: the arm's and the base's accelerations read as force, and the
-  /// MPC, chasing those spikes, accelerates the arm into more of them (README: on the MuJoCo robot
-  /// 0.15 s took the solves from 5 Ipopt iterations median to 2, the peak pull from 75 to 33 N).
+  /// MPC, chasing those spikes, accelerates the arm into more of them (on the MuJoCo robot, 0.15 s
+  /// against none: 2 Ipopt iterations median instead of 5, a peak pull of 33 N instead of 75).
   double force_filter{0.15};
   /// An obstacle within this distance of the one a constraint slot had at the last solve keeps
   /// that slot (and its warm start) [m]; 0: slots follow the order of MpcInput::obstacles and
-  /// keep the warm start of whatever obstacle had them before (the behaviour before slot_match).
+  /// keep the warm start of whatever obstacle had them at the last solve.
   double slot_match{0.3};
 };
 

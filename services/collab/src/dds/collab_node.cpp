@@ -304,8 +304,8 @@ void CollabNode::hold_here(double dz) {
   Eigen::VectorXd q;
   if (!rig_ || !arm_state(q)) return;
   // The robot's Cartesian targets are in its model's frame (the root: the base), not the
-  // odometry's (services/robot: RobotState::end_effector_pose; the transport scenario found a
-  // target in the odometry frame pulling the arm away once the base had moved).
+  // odometry's (services/robot: RobotState::end_effector_pose; a target in the odometry frame
+  // would pull the arm away once the base moves).
   Eigen::Isometry3d target = rig_->model->kinematics().frame_pose(rig_->data, q, rig_->tool_frame);
   target.translation().z() += dz;
   msg::CartesianImpedanceCommand c;
@@ -489,9 +489,8 @@ void CollabNode::spin(const std::atomic<bool>& stop) {
     } else if (rig_ && m != Mode::kStop) {
       // Engaged (teaching, autonomous): the base holds (the robot stops it after 0.5 s anyway).
       // In stop the service commands nothing: the robot belongs to whoever else drives it (the
-      // drill, the planner, nav); a zero base velocity at the control rate preempted every
-      // trajectory on the base (the chaos test under `concert up`: 242 of 243 requests
-      // "preempted by another command on its joints").
+      // drill, the planner, nav); a zero base velocity at the control rate would preempt every
+      // trajectory on the base ("preempted by another command on its joints").
       base_velocity(Eigen::Vector3d::Zero());
       if (m == Mode::kTeaching && Clock::now() - last_publish > std::chrono::milliseconds(200)) gravity_compensation();
     }

@@ -38,15 +38,15 @@ double smaller_fov(const hardware::CameraIntrinsics& k);
 double any_roll_distance(double radius, double fov);
 
 /// Room left around an ArUco marker for the odometry's drift when the camera is turned onto it
-/// after a base move [m]: up to 52 mm between odometry and the simulator's truth were measured
-/// over the pattern test's whole-body moves.
+/// after a base move [m]: over the pattern test's whole-body moves odometry is up to 52 mm off
+/// the simulator's truth.
 inline constexpr double kMarkerLookDrift = 0.05;
 
 /// How far from a marker's centre a look at it must see, whichever way the camera rolls [m]:
 /// its half-diagonal (`marker_size` [m] a side) and `drift` around it.
 /// any_roll_distance(marker_look_radius(...), fov) is how near the camera may come: from the
-/// camera's distance at a drilling posture (0.22 m on morphology A) the marker filled the image
-/// past its edge and was not found.
+/// camera's distance at a drilling posture (0.22 m on morphology A) the marker fills the image
+/// past its edge and is not found.
 double marker_look_radius(double marker_size, double drift = kMarkerLookDrift);
 
 /// Where a camera looks to see a blob hole and its nearest neighbour of the area together.
@@ -108,7 +108,7 @@ std::optional<Eigen::Isometry3d> hole_of(const DrillPoint& hole,
 /// frame): by the shift of the marker's centre only, the pattern's orientation kept from the
 /// hole's frame. After a base move the marker is seen from aside, near the image's edge, and its
 /// orientation comes out a few degrees off, while the row's ends lie 0.34 m from it: applied with
-/// the seen orientation, holes on morphology A came out 7-14 mm off (a system test run); the
+/// the seen orientation, holes on morphology A come out 7-14 mm off; the
 /// centre, on the depth image's plane, is good to a millimetre, and the orientation measured
 /// first (straight on, 0.6 m away, frames averaged) moves with the odometry's yaw (the gyro's).
 /// None for a blob hole or a marker without a pattern.
@@ -140,8 +140,8 @@ struct AreaShift {
 ///
 /// A shift that lays two or more blobs onto seen ones may be as long as `max_set_shift` (when
 /// longer than `max_shift`): the set's own geometry names each blob, where one blob seen alone
-/// 0.1 m from a prediction off by 0.1 m is the neighbour as well as anything (on the demo a
-/// whole-body move drifted odometry 87 mm, and blob 1's hole was cut on blob 2).
+/// 0.1 m from a prediction off by 0.1 m is the neighbour as well as anything (a whole-body move
+/// on the demo can drift odometry 87 mm).
 std::optional<AreaShift> blob_shift(const CameraView& view, const std::vector<DrillPoint>& area_points,
                                     double tolerance, double max_shift, double max_set_shift = 0.0);
 

@@ -38,7 +38,7 @@ struct DrillParams {
   /// The surface is where the bit feels it: the reference leads the tip by at least this much
   /// [m] (stiffness x 4 mm = 32 N, over the wall's 20 N threshold) while the tip advances at
   /// less than half the feed rate. The depth is counted from there, not from the surface the
-  /// camera measured (off by 2-20 mm after a base move: holes came out that much short).
+  /// camera measured (off by 2-20 mm after a base move, which would leave holes that short).
   double contact_lead{0.004};
   /// [m] beyond the depth asked (from the camera's surface) the bit feeds looking for the wall
   /// before the hole fails.
@@ -68,8 +68,8 @@ inline double thrust_bound(const DrillParams& p) {
 /// body only under 100-150 N checked, not 200 N, and its row at 0.35 m only under 50-100 N
 /// (kLightestLead). The lead stays kLeadOverContact above contact_lead, or the bit would no
 /// longer feel the wall. The feed rate stays: at half of it too the bit's contact with the wall
-/// (contact_lead reached while the tip advances at under half the feed rate) was missed once
-/// and a hole went 77.5 mm deep for 30 mm asked.
+/// (contact_lead reached while the tip advances at under half the feed rate) can be missed,
+/// and a hole then goes 77.5 mm deep for 30 mm asked.
 inline constexpr double kLeadOverContact = 0.0015;  // [m]
 inline constexpr double kLightestLead = 0.35;
 inline DrillParams light_drilling(DrillParams p, double lead = 0.5) {

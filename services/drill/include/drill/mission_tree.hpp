@@ -102,7 +102,7 @@ class MissionTree {
 
   [[nodiscard]] MissionStatus status() const;
   [[nodiscard]] const MissionReport& report() const;
-  /// The tree's shape, one node a line, indented, for `concert drill status --tree`.
+  /// The tree's shape, one node a line, indented (the tests print it).
   [[nodiscard]] std::string describe() const;
 
  private:

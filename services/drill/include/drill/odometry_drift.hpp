@@ -5,9 +5,9 @@
 // trajectories are in the odometry frame. Without nav's localisation the two are taken for one,
 // and the wheel odometry drifts: 4-6 cm over a whole-body move near the wall, up to 64 mm over a
 // pattern's four holes (system_drill_pattern_test). The drill sees it (a hole's mark found away
-// from where odometry put it) and drills where the camera sees the mark, but the planner kept the
-// wall where odometry put it: arm paths planned 3 cm from it pressed the drill on it (safety
-// stops on J1_E and J2_E's RMS torque, the simulator's wall cut 59 times).
+// from where odometry put it) and drills where the camera sees the mark, but the planner, told
+// nothing, keeps the wall where odometry puts it: arm paths planned 3 cm from it then press the
+// drill on it (safety stops on J1_E's and J2_E's RMS torque).
 //
 // So the marks are landmarks. A mark's map position is fixed when it is first seen, with the
 // drift as then estimated; seen again, the drift becomes what puts it back there. A surface

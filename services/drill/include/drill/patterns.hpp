@@ -52,8 +52,8 @@ class PatternTable {
 /// Parses a pattern table (YAML); `source` names it in errors:
 ///   dictionary: DICT_4X4_50   # OpenCV predefined dictionary of the printed markers
 ///   marker_size: 0.1          # printed side, border included [m]
-///   patterns:
-///     - {id: 0, centre: [0.0, -0.15], direction: 0.0, count: 4, spacing: 0.2}
+///   patterns:                 # a map from marker id to its row
+///     0: {centre: [0.0, -0.15], direction: 0.0, count: 4, spacing: 0.2}
 /// Throws DrillError "patterns '<source>': patterns[3].spacing: must be > 0 (got -0.1)" for
 /// unknown keys, missing or non-finite fields, an unknown dictionary, ids outside it or twice,
 /// count < 1, spacing <= 0 with count > 1, marker_size <= 0.

@@ -5,10 +5,10 @@
 // area's approach reached (section 5.4.2). That approach puts the drill camera 0.6 m from the
 // wall, the bit about 0.4 m short of it, and from there morphology A's arm alone reaches none of
 // a 60 cm ArUco row's holes (self collision and torque). Moving the whole body for each hole
-// drifted the wheel odometry 10-60 mm a move, and an ArUco pattern is drilled by the kinematics
+// drifts the wheel odometry 10-60 mm a move, and an ArUco pattern is drilled by the kinematics
 // alone: every hole then depends on the camera being turned back onto the marker after its
-// move, which from some postures it cannot be (holes 12-19 mm off in one run of the pattern
-// test in 15), and every move is another chance for the arm's path to meet the wall.
+// move, which from some postures it cannot be (the hole then 12-19 mm off), and every move is
+// another chance for the arm's path to meet the wall.
 //
 // So an area of several holes gets one base placement before its first hole: whole-body
 // postures are drawn with the bit a little further out than a hole's in front of the holes
@@ -30,9 +30,9 @@ namespace concert::drill {
 /// One whole-body posture drawn for a placement: the bit `out` [m] further from the wall than a
 /// hole's drilling distance, aimed at the holes' centre moved `toward` (a fraction) of the way to
 /// the area's mark. A bit that reaches the wall from 15-20 cm further out leaves the arm the room
-/// to swing across a 60 cm row. Measured on morphology A at scenario 3's row at 1.5 m, the
-/// marker 15 cm above it (the planner's service budgets, the arm alone then asked for each hole
-/// 0, 3 and 7 cm further out): the bit at the drilling distance on the row's centre gave
+/// to swing across a 60 cm row. On morphology A at scenario 3's row at 1.5 m, the marker
+/// 15 cm above it (the planner's service budgets, the arm alone then asked for each hole 0, 3
+/// and 7 cm further out): the bit at the drilling distance on the row's centre gives
 /// placements reaching 1-3 of the 4 holes, 10 cm out 1-3, 20 cm out 4 of 4 (3 draws of 3);
 /// aimed halfway to the marker, 15 cm out 4 of 4, 20 cm out 3 of 4, 25 cm out no posture. The
 /// planner's posture search starts from the robot's posture, so the same request drawn again
@@ -54,7 +54,7 @@ Eigen::Isometry3d placement_goal(const std::vector<DrillPoint>& holes,
 /// The order to drill an area's holes from a placement: those `reached` by the arm alone first,
 /// then the others, each in the order they came (their pattern's). A hole the arm cannot reach
 /// moves the base again, and with no look at the mark possible after that move, the holes after
-/// it carry its drift: 18 mm along the row for the three holes after the first in one run.
+/// it carry its drift (18 mm along the row on the pattern test).
 std::vector<std::size_t> reached_first(const std::vector<bool>& reached);
 
 /// The tally of an area's placement: how many of its holes the arm alone reaches from where the
@@ -90,8 +90,8 @@ class PlacementChoice {
   /// reaching every hole from there: worth a placement again with a lighter thrust checked.
   /// (Checked with the full thrust, the demo robot's arm holds it from no posture in front of
   /// its wall's pattern, nor morphology A's below 1.2 m; those holes are drilled at about half
-  /// the thrust, and without a placement at that thrust each of them moved the whole body and
-  /// was drilled where odometry put it: 15 and 29 mm off in a run of the demo pattern.)
+  /// the thrust, and without a placement at that thrust each of them moves the whole body and
+  /// is drilled where odometry puts it, centimetres off.)
   [[nodiscard]] bool short_of_every_hole() const;
   [[nodiscard]] std::size_t draws() const { return drawn_.size(); }
   /// For the log: "the arm alone reaches 0 of 4 holes from where the base stands; drawn: 4 of

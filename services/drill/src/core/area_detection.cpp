@@ -86,7 +86,7 @@ ResolvedArea locate_area(const AreaSpec& area, const CameraView& view) {
         out.frame = view.world_T_optical * area_frame_at(frame, p, up);
       } catch (const DrillError&) {
         // No surface near the point itself: it was located from afar, or the base's odometry
-        // drifted over the approach (on the demo the camera once found no wall within 7 cm of
+        // drifted over the approach (on the demo the camera can find no wall within 7 cm of
         // it). The surface along the point's line of sight is taken instead; if none, the
         // first reason.
         std::optional<Eigen::Isometry3d> along;
@@ -275,8 +275,8 @@ std::optional<AreaShift> blob_shift(const CameraView& view, const std::vector<Dr
     for (const DrillPoint& p : area_points) {
       if (p.marker >= 0) continue;
       const Eigen::Vector3d shift = s - p.frame.translation();
-      // Unbounded, the neighbour 0.1 m away seen alone scored like the target's own blob and
-      // the hole was drilled there (a CI run: 100.5 mm off).
+      // Unbounded, the neighbour 0.1 m away seen alone would score like the target's own blob,
+      // and the hole would be drilled there, 0.1 m off.
       if (shift.norm() > longest) continue;
       int score = 0;
       for (const DrillPoint& o : area_points) {
@@ -310,8 +310,8 @@ std::optional<AreaShift> blob_shift(const CameraView& view, const std::vector<Dr
   }
   if (best == nullptr) return std::nullopt;
   // Another explanation as good as the best one: one blob seen alone within the window of two
-  // predicted ones (on morphology A a re-measure 55.6 mm off took blob 2 for blob 1 this way,
-  // and blob 1's hole was cut on blob 2).
+  // predicted ones (a re-measure some 5 cm off can take a blob for its neighbour this way, and
+  // the hole would then be cut on the neighbour).
   for (const AreaShift& c : candidates) {
     if (within && c.by.norm() > max_shift) continue;
     if (c.blobs == best->blobs && (c.by - best->by).norm() > tolerance) return std::nullopt;

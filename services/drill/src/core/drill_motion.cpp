@@ -177,7 +177,7 @@ CartesianReference DrillMotion::update(const Eigen::Isometry3d& tip, double now)
       // Eq. 3: the reference advances at v_drill, never more than max_lead ahead of the tip;
       // before the bit meets the wall, at most contact_search beyond the depth asked; after,
       // contact_lead beyond it, a lead that still pushes past the wall's threshold (at 2 mm,
-      // 16 N of 20: the light drilling's bit, slower, stopped 0.2 mm short of its depth).
+      // 16 N of 20: the light drilling's bit, slower, stops 0.2 mm short of its depth).
       const double limit = target_depth_ + (contact_ ? params_.contact_lead : params_.contact_search);
       depth_ref_ = std::min({depth_ref_ + params_.feed_rate * dt, d + params_.max_lead, limit});
       if (contact_ && d >= target_depth_) {

@@ -49,14 +49,14 @@ constexpr double kAlignMargin = 0.03;
 // and 7 cm further out: the arm alone, then the whole body with the base moving at most 0.3 m and
 // 0.3 rad, then the whole body anywhere. Without such a posture, the same without the reach
 // check (0, 3, 7 and 12 cm out): the drilling then moves the bit on through postures nobody
-// checked. (Until the drill camera was pitched towards the bit the fallback put the camera on
-// the axis, the bit 11 cm beside it; pitched 30 deg, that left the bit 30 deg off the axis, and the
-// alignment's turn held J3_E past its continuous torque on the demo's pattern. Before the reach
-// check on morphology A at the BIM area the shoulder J2_E needed its peak torque.) The base stays
+// checked. (The bit, not the camera, goes on the axis: the drill camera is pitched 30 deg towards
+// the bit, so a camera on the axis leaves the bit 30 deg off it, and the alignment's turn then
+// holds J3_E past its continuous torque on the demo's pattern. Without the reach check, morphology
+// A's shoulder J2_E needs its peak torque at the BIM area.) The base stays
 // where the area's approach put it as long as the arm reaches, and moves as little as it can:
 // odometry drifts with every centimetre and degree the base moves, and an ArUco pattern is
 // drilled by the kinematics alone (on the demo wall, holes drilled after unbounded whole-body
-// moves were 5-100 mm off; one posture spun the base by 2.3 rad).
+// moves land 5-100 mm off, and such a posture can spin the base by 2.3 rad).
 struct HoleAttempt {
   bool reach;  // the bit's reach to the hole's depth checked
   bool fixed_base;
@@ -77,9 +77,9 @@ constexpr HoleAttempt kHoleAttempts[] = {
     {true, true, 0.0, 0.0, 0.5},  {true, true, 0.0, 0.03, 0.5},  {true, true, 0.0, 0.07, 0.5},
     {true, false, 0.3, 0.0, 0.5},
     {true, false, 0.3, 0.07, 0.5}, {true, false, 0.0, 0.0, 0.5},
-    // Lighter still (kLightestLead: 49 N, 78 N checked): morphology A's row at 0.35 m, the
-    // paper's lowest, had no posture under 104 N checked in one run of two (the base's legs in
-    // the wall, the arm in its own links, the torques), and all four holes failed.
+    // Lighter still (kLightestLead: 49 N, 78 N checked): for morphology A's row at 0.35 m, the
+    // paper's lowest, the planner can find no posture holding 104 N checked (the base's legs in
+    // the wall, the arm in its own links, the torques), and none of the four holes is drilled.
     {true, true, 0.0, 0.0, kLightestLead}, {true, false, 0.3, 0.0, kLightestLead},
     {true, false, 0.0, 0.0, kLightestLead},
     {false, true, 0.0, 0.0},
@@ -89,17 +89,17 @@ constexpr HoleAttempt kHoleAttempts[] = {
 constexpr double kSettleBack = 1.0;
 // A settle onto a hole's posture keeps the base where it stands when it is within this [m, rad]
 // of the posture's base (creep under the thrust, a path's tracking error): the legs swing round
-// to make a small base move and disturb the base more than the move gains. Measured on the demo
-// robot standing (paper_robot_test's harness, 2026-11-29): 10 mm asked sideways over 1 s turned
-// the base 11 mrad and left odometry 7 mm off the truth; 3 and 6 mm stayed in the robot's
-// deadband (no motion). The arm goes onto the posture; the hole is measured from there.
+// to make a small base move and disturb the base more than the move gains: on the demo robot
+// standing, 10 mm asked sideways over 1 s turns the base 11 mrad and leaves odometry 7 mm off
+// the truth; 3 and 6 mm stay in the robot's deadband (no motion). The arm goes onto the
+// posture; the hole is measured from there.
 constexpr double kBaseKept = 0.03;
 // The drilling force the planner checks the arm's torques with, as a multiple of the most the
-// bit pushes (thrust_bound: 125 N with the defaults; 200 N checked). Checked with 125 N,
-// morphology A's J2_E, planned at 0.99 of its continuous torque with the bit at the hole's depth,
-// went past 1.1 while drilling (safety stop, both runs of the BIM scenario): the simulated arm's
-// sustained load while drilling exceeds the static model's by more than 10 % (not explained
-// yet: lateral forces of the bit held in its hole are one candidate).
+// bit pushes (thrust_bound: 125 N with the defaults; 200 N checked). The simulated arm's
+// sustained load while drilling exceeds the static model's by more than 10 %: checked with
+// 125 N, morphology A's J2_E at the BIM area, planned at 0.99 of its continuous torque with the
+// bit at the hole's depth, goes past 1.1 while drilling (a safety stop). The excess is not
+// explained yet (lateral forces of the bit held in its hole are one candidate).
 constexpr double kThrustChecked = 1.6;
 double checked_thrust(const DrillParams& p) { return kThrustChecked * thrust_bound(p); }
 // The lead a posture request's thrust was checked with (kHoleAttempts' leads; 1: the full one).
@@ -117,8 +117,8 @@ std::string thrust_text(double lead, const DrillParams& p) {
 }
 // Robot shapes grown against the map in the areas' approach plans [m]: the planner's map is the
 // world, its start pose the wheel odometry, which drifts 4-6 cm over a whole-body move near the
-// wall; a base planned 3 cm from the wall was found inside it by the next plan. (The holes'
-// drilling postures keep the planner's padding: at 10 cm it found none for the demo's blobs.)
+// wall, so a base planned 3 cm from the wall can be inside it by the next plan. (The holes'
+// drilling postures keep the planner's padding: at 10 cm it finds none for the demo's blobs.)
 constexpr double kPlanPadding = 0.10;
 // An area's approach is planned again with another seed when no path or posture was found
 // within the planner's budget (on the demo about one plan in ten), this many times in all.
@@ -129,15 +129,15 @@ constexpr int kReanchorFrames = 3;
 // After the whole body moved to a hole's drilling posture, the arm alone turns the camera onto the
 // hole's mark and the hole is measured again from there: for an ArUco hole always (the pattern
 // is drilled by the kinematics alone, and the base's odometry drifts 2-4 cm over such a move:
-// the demo wall's pattern was drilled 20-37 mm off without this), for a blob hole when the view
-// from its drilling posture cannot tell its blob from a neighbour (blob_shift; before the drill
-// camera was pitched towards the bit it saw one blob or none from there). The camera is asked for at the distance the hole's posture reached
+// without the look the demo wall's pattern is drilled 20-37 mm off), for a blob hole when the
+// view from its drilling posture cannot tell its blob from a neighbour (blob_shift). The camera
+// is asked for at the distance the hole's posture reached
 // (the arm only shifts across the wall), then this much further out [m], in turn. For an ArUco
 // hole, then, the camera centred between the hole and its marker (further out, so both are in
 // view: the marker 0.15 m above the row and up to 0.3 m beside it needs 0.4 m or more), a
 // posture nearer the hole's, for when none centred on the marker exists (on morphology A the
-// arm's links in each other, or its torques, kept the camera off the marker, and the hole
-// stayed where odometry put it: 33 mm off in a run).
+// arm's links in each other, or its torques, can keep the camera off the marker, which leaves
+// the hole where odometry puts it, centimetres off).
 struct LookAttempt {
   bool between;    // centred between the hole and its marker, not on the mark
   double further;  // beyond the camera's distance at the hole's posture [m]
@@ -145,21 +145,22 @@ struct LookAttempt {
 constexpr LookAttempt kLooks[] = {{false, 0.0}, {false, 0.1}, {false, 0.2}, {true, 0.2}, {true, 0.3}};
 // An ArUco hole whose marker was last seen longer ago than this [s] gets the look too, even
 // with the base standing: the odometry's yaw comes from the base's gyro, whose bias walks while
-// the arm works (the simulated BMI055); on morphology A it drifted 0.5 deg over the 100 s of a
-// pattern's four holes with the base standing (the simulator's truth: 0.1 deg), and the holes,
-// about 1 m from the base, came out 2-3 mm further off with each.
+// the arm works (the simulated BMI055); on morphology A it drifts 0.5 deg over the 100 s of a
+// pattern's four holes with the base standing (the simulator's truth: 0.1 deg), which puts each
+// of the holes, about 1 m from the base, 2-3 mm further off than the one before.
 constexpr double kMarkerStale = 15.0;
 // Whole-body postures drawn for a marker hole (each request seeds the planner anew) until one
-// lets the camera be turned onto the marker: from a posture without, the hole was drilled where
-// odometry put it (row scenario: 7.9-33.7 mm off, the look blocked by self collision).
+// lets the camera be turned onto the marker: from a posture without, the hole is drilled where
+// odometry puts it (in the row scenario 8-34 mm off, the look blocked by self collision).
 constexpr std::size_t kBodyDraws = 3;
 // From a drawn posture, a hole the placement checks counts as reached by the arm alone with the
 // first posture of the hole's own (kHoleAttempts) up to this one: the bit 0, 3 or 7 cm further
-// out than its distance, reach and full thrust checked. The 0 cm one alone counted 1-2 of the 4
-// holes of scenario 3's row at 1.5 m from each drawn posture, where the hole then found its
-// posture 3 cm out. From where the base stands (the approach's posture: the camera 0.6 m from
-// the wall, the bit 0.4 m short of it) only the first is asked: further out does not bring the
-// bit nearer, and each request that finds nothing costs the planner's whole budget (2 s).
+// out than its distance, reach and full thrust checked. The 0 cm one alone counts only 1-2 of
+// the 4 holes of scenario 3's row at 1.5 m as reached from a drawn posture, where each hole
+// finds its posture 3 cm out. From where the base stands (the approach's posture: the camera
+// 0.6 m from the wall, the bit 0.4 m short of it) only the first is asked: further out does not
+// bring the bit nearer, and each request that finds nothing costs the planner's whole budget
+// (2 s).
 constexpr std::size_t kPlacementAttempts = 2;
 // A hole attempt (kHoleAttempts) with its torques checked at another lead's thrust.
 constexpr HoleAttempt at_lead(HoleAttempt a, double lead) {
@@ -181,13 +182,14 @@ std::size_t first_fixed_at(double lead) {
 }
 // The placement's look at the marker: the camera framing the whole marker with room for the
 // drift (marker_look_radius), then this much further out [m], in turn, as a hole's looks are
-// asked for (kLooks). One distance alone found no look from any of 3 postures drawn in one run
-// of the pattern test.
+// asked for (kLooks). At one distance alone the pattern test can find no look from any of the 3
+// postures drawn.
 constexpr double kPlacementLooks[] = {0.0, 0.1, 0.2};
 // Times a hole's whole-body posture is planned again for the hole measured again more than
-// kReplanShift from where it was planned, when the arm alone has none there. Once was not
-// enough: a row hole measured 18.9 mm off, planned again, was measured 26.0 mm off after that
-// move, and aligning across that held J2_E past its continuous torque (a safety stop).
+// kReplanShift from where it was planned, when the arm alone has none there. Twice, as the move
+// to the new posture drifts odometry again: a row hole measured 18.9 mm off and planned again can
+// be 26.0 mm off after that move, and aligning across that holds J2_E past its continuous torque
+// (a safety stop).
 constexpr std::size_t kBodyReplans = 2;
 constexpr double kReanchorDistance = 0.06;
 // Hole depth the drilling posture's reach is checked to when no mission is loaded [m].
@@ -195,23 +197,23 @@ constexpr double kDefaultDepth = 0.05;
 // A hole found this much away from where odometry put it after a whole-body move [m] gets its
 // drilling posture planned again, the arm alone, from where the base now stands: the alignment
 // would otherwise reach that much further than the posture the planner checked (odometry drifts
-// 2-8 cm over such a move; with morphology A's arm at the BIM area the shoulder J2_E then went
+// 2-8 cm over such a move; with morphology A's arm at the BIM area the shoulder J2_E then goes
 // past its continuous torque while drilling).
 constexpr double kReplanShift = 0.01;
 // Blobs of one area matched as a set: a predicted blob lies this close to a seen one [m]
 // (6 deg of odometry yaw over 0.1 m between blobs moves them 1 cm).
 constexpr double kBlobMatch = 0.02;
 // While the whole body moves to a blob hole's posture, the area's blobs are followed from camera
-// frame to frame (track_area): odometry drifts 2-6 cm over such a move (recorded on morphology
-// A at the BIM area: 27 mm over 0.45 m and 0.75 rad of base motion), more than half the 10 cm
+// frame to frame (track_area): odometry drifts 2-6 cm over such a move (on morphology A at the
+// BIM area: 27 mm over 0.45 m and 0.75 rad of base motion), more than half the 10 cm
 // between blobs, so a drilling posture's view showing one blob alone could take a neighbour
 // for it. From one frame to the next the drift grows by millimetres: a
 // seen blob is taken for a predicted one at most this far [m].
 constexpr double kTrackWindow = 0.02;
 // Two or more of an area's blobs seen together name each other however far odometry drifted, up
-// to this [m] (blob_shift's max_set_shift): a whole-body move on the demo drifted it 87 mm, and a
-// neighbour seen alone within the shorter windows above was taken for the hole's blob (blob 1's
-// hole cut on blob 2, 100.7 mm off, twice in ten runs of the system test).
+// to this [m] (blob_shift's max_set_shift): a whole-body move on the demo can drift it 87 mm, and
+// a neighbour seen alone within the shorter windows above would be taken for the hole's blob
+// (the hole then cut on the next blob, 0.1 m off).
 constexpr double kSetShift = 0.15;
 // After a whole-body move, a blob hole's look frames the hole's blob and its nearest neighbour
 // with this much room around them for the odometry's drift [m], so that both are in the image
@@ -883,7 +885,7 @@ Outcome DrillNode::resolution(std::size_t area, ResolvedArea& out) {
         blobs.push_back(p);
       }
     } catch (const DrillError&) {
-      blobs.clear();  // none taken: the area is found after the approach as before
+      blobs.clear();  // none taken: the area is then found from the view after the approach alone
     }
   }
   return Outcome::succeeded();
@@ -1056,8 +1058,8 @@ void DrillNode::append_reversed(std::vector<msg::TrajectorySample>& back, const 
 
 // Time to go straight from `from` to `to` (zero velocity at both ends) at a third of a slow
 // joint speed (0.5 rad/s, base 0.2 m/s): at least kSettleBack. The Cartesian phases can leave
-// a joint far off its posture (a wrist turned about the bit); a fixed second drove the demo's
-// J6_E past its velocity limit.
+// a joint far off its posture (a wrist turned about the bit); a fixed second would drive the
+// demo's J6_E past its velocity limit.
 double DrillNode::settle_time(const std::vector<std::string>& names,
                               const msg::TrajectorySample& from, const msg::TrajectorySample& to) {
   double t = kSettleBack;
@@ -1080,8 +1082,8 @@ msg::TrajectorySample DrillNode::sample_here(const std::vector<std::string>& nam
     if (n == "base_yaw" && i < towards.position().size()) {
       // Odometry's yaw is wrapped to (-pi, pi], the planner's is not (it is kept near the
       // start's): a robot facing -x measures -3.14 where its plan says 3.13, and the straight
-      // line between them turns the base a whole turn with the bit at the wall (the likely
-      // cause of a CI run's 38 s "settle" after a hole, then a safety stop on J1_E).
+      // line between them turns the base a whole turn with the bit at the wall (a long
+      // "settle" after a hole, then a safety stop on J1_E).
       const double planned = towards.position()[i];
       v = planned + std::remainder(s.odometry[2] - planned, 2.0 * M_PI);
     } else if (n == "base_x" || n == "base_y" || n == "base_yaw") {
@@ -1163,9 +1165,9 @@ void DrillNode::detect(std::size_t area, const AreaSpec& spec, const ResolvedAre
       frames_.empty() ? 0 : frames_.back().stamp_ns;  // frames taken after the arm stopped
 }
 
-// The approach drifts odometry along the wall too (45 mm in a CI run), where the surface tells
-// nothing: the pick, kept in odometry coordinates, then lay between two blobs 0.1 m apart, and
-// the neighbour was drilled (100.8 mm off). The start view's blobs, seen again as a set (the
+// The approach drifts odometry along the wall too (by up to several centimetres), where the
+// surface tells nothing: the pick, kept in odometry coordinates, can then lie between two blobs
+// 0.1 m apart, and the neighbour be drilled. The start view's blobs, seen again as a set (the
 // shift that lays two or more of them onto blobs seen now), measure that drift: the pick moves
 // with it, along the wall only (the surface was measured again already).
 void DrillNode::follow_start_blobs(const CameraView& camera, ResolvedArea& located) {
@@ -1611,8 +1613,8 @@ void DrillNode::control_placement() {
 // The camera onto the area's marker kPlacementLooks[attempt] [m] further out than the look checked
 // from the posture drawn, the arm alone from where the robot stands, planned and executed
 // (kPlaceLookAgain). The look checked from the posture drawn, replayed with the base where it
-// stands, is aimed off by the base's tracking error: the placement's posture reached 40 mm nearer
-// the wall than planned in one run, and its checked look showed the bare wall.
+// stands, is aimed off by the base's tracking error: a placement's posture can end 40 mm nearer
+// the wall than planned, and its checked look then shows the bare wall.
 void DrillNode::place_look(std::size_t attempt) {
   const std::optional<Eigen::Isometry3d> mark = marker_of(point_, *patterns_);
   if (!mark) {
@@ -1635,8 +1637,8 @@ void DrillNode::place_look(std::size_t attempt) {
 
 // Aligning a hole: the approach put the drill camera at the working distance (0.6 m), the bit
 // about 0.4 m further from the wall than it drills. Stretching the arm that far in Cartesian
-// impedance is not checked against anything (with the demo arm it held the shoulder J2_E at
-// its continuous torque and the safety layer stopped the robot), so the planner plans each
+// impedance is not checked against anything (with the demo arm it holds the shoulder J2_E at
+// its continuous torque, and the safety layer stops the robot), so the planner plans each
 // hole's drilling posture: the camera close to the wall on the hole's normal (NSPG with the
 // drilling force checked against the torque limits, the whole body moving) and the path
 // there; the Cartesian alignment does the last centimetres, the way back is that path reversed.
@@ -1860,9 +1862,9 @@ bool DrillNode::prepare_look() {
     }
   } else if (patterns_) {
     // The whole marker in view, room left for the drift (marker_look_radius). The camera's
-    // distance at the hole's posture alone put the camera 0.22 m from the marker on morphology
-    // A, which it then filled past the image's edge: "not seen" in about one look in twelve of
-    // the pattern test, and the hole drilled where odometry put it (25 mm off in one run).
+    // distance at the hole's posture alone puts the camera 0.22 m from the marker on morphology
+    // A, where the marker fills the image past its edge: it is then not seen, and the hole is
+    // drilled where odometry puts it.
     look_reach_ = marker_look_radius(patterns_->marker_size());
   }
   // The camera's distance at the hole's posture.
@@ -1919,9 +1921,9 @@ void DrillNode::back_to_posture(const Sample& s, Motion next) {
   hole_chain_.pop_back();
   look_pushed_ = false;
   const PlannedPath& p = hole_chain_.back();
-  // The look's planned path backwards, not straight across in joint space: that swept the
-  // drill along the wall (J1_E pressing at 240-310 N m for 5 s, the simulator's wall cut 59
-  // times, a safety stop) when odometry had put the wall a few cm off.
+  // The look's planned path backwards, not straight across in joint space: that can sweep the
+  // drill along the wall when odometry puts the wall a few cm off (J1_E pressing at
+  // 240-310 N m for 5 s, a safety stop).
   if (look.names == p.names && look.samples.size() >= 2) {
     std::vector<msg::TrajectorySample> back{sample_here(look.names, s, look.samples.back())};
     double t = 0.0;
@@ -2075,8 +2077,8 @@ msg::PlanRequest DrillNode::look_plan(std::size_t attempt) const {
     goal.translation() = 0.5 * (look_goal_.translation() + point_.frame.translation());
     // The planner leaves the camera's roll about its axis free: the marker (its centre half
     // the hole's distance from the goal, plus its half-diagonal) must fit in the image's
-    // smaller half-angle whichever way the image turns. Nearer, the marker was "not seen"
-    // from every such look of two rows of scenario 3.
+    // smaller half-angle whichever way the image turns. Nearer, such a look does not see the
+    // marker (scenario 3's rows).
     const double reach = (goal.translation() - look_goal_.translation()).norm() +
                          (patterns_ ? marker_look_radius(patterns_->marker_size(), 0.0) : 0.0);
     distance = std::max(distance, any_roll_distance(reach, fov));
@@ -2115,7 +2117,7 @@ bool DrillNode::remeasure_looked_blob(const CameraView& camera) {
     const std::optional<Sample> s = latest_sample();
     if (moved.norm() <= kReplanShift && look_pushed_ && hole_chain_.size() > 1 && s) {
       // Where the whole body's posture was planned for: back onto it, no new posture (the
-      // arm waiting in the look posture while one is sought held J3_E at its continuous
+      // arm waiting in the look posture while one is sought holds J3_E at its continuous
       // torque long enough for a safety stop).
       back_to_posture(*s);
       return true;
@@ -2246,8 +2248,8 @@ void DrillNode::posture_reached() {
   if (point_.marker >= 0 && !looked_ && !hole_request_.fixed_base() && s &&
       !checked_path_.samples.empty() && prepare_look()) {
     // The look check_look() planned from the posture: the planner's look postures are drawn at
-    // random, and a new request from here found none where the check had found one (row
-    // scenario). It starts where the robot stands, a tracking error from the planned posture.
+    // random, and a new request from here may find none where the check found one. It
+    // starts where the robot stands, a tracking error from the planned posture.
     looked_ = true;
     // The arm alone: the base keeps the pose it stands at, not the one the check started from.
     std::vector<msg::TrajectorySample> path = checked_path_.samples;
@@ -2288,8 +2290,8 @@ void DrillNode::control_motion() {
       if (body_replans_ < kBodyReplans && shift > kReplanShift) {
         // Planned again after the re-measure, the arm alone found none: the whole body's
         // posture once more, for the hole where the camera saw it. Aligning from the posture
-        // reached stretched the arm that far unchecked: on the demo, blob 1 measured again
-        // 34 mm away held J3_E past its continuous torque while drilling (safety stop).
+        // reached would stretch the arm that far unchecked: on the demo, a blob measured again
+        // 34 mm away holds J3_E past its continuous torque while drilling (a safety stop).
         std::ostringstream line;
         line.setf(std::ios::fixed);
         line.precision(1);
@@ -2305,7 +2307,7 @@ void DrillNode::control_motion() {
                "again (" + r->reason() + "); aligning from the whole body's posture");
       if (shift > kReplanShift && drilling_lead_ > kLightestLead) {
         // Past the posture the planner checked the torques of: the lightest thrust. Across
-        // 26 mm at full thrust morphology A's J2_E went past its continuous torque.
+        // 26 mm at full thrust morphology A's J2_E goes past its continuous torque.
         std::ostringstream why;
         why.setf(std::ios::fixed);
         why.precision(1);
@@ -2439,7 +2441,7 @@ void DrillNode::control_motion() {
     } else if (!remeasure_looked_marker(camera)) {
       const std::optional<Sample> s = latest_sample();
       if (look_attempt_ + 1 < std::size(kLooks) && look_pushed_ && hole_chain_.size() > 1 && s) {
-        // From another look (a run's hole 2 drilled 21.9 mm off where odometry put it).
+        // From another look (a hole drilled where odometry puts it can be 2 cm off).
         log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
                  " not seen from the look posture; back onto the drilling posture for the next look");
         back_to_posture(*s, Motion::kBackForLook);
@@ -2450,13 +2452,14 @@ void DrillNode::control_motion() {
     } else {
       // The base moved for this posture: without one for the arm alone at the hole measured
       // again, the whole body's is planned again (and the marker looked at again) or aligned
-      // from, not the next whole-body attempt taken unlooked (13 mm off in a row run).
+      // from, not the next whole-body attempt taken without a look (a row hole then lands
+      // about 13 mm off).
       if (!hole_request_.fixed_base()) hole_replanned_ = true;
     }
     // From the look back onto the drilling posture along the look's path reversed, not along a
-    // path planned anew from the look posture: one such swung morphology A's J1_E through 3.9 rad
-    // with the bit near the wall and pressed it on the wall (300 N m, a safety stop, the
-    // simulator's wall cut 15 times). A posture of the arm alone planned within kReplanShift of
+    // path planned anew from the look posture: such a path can swing morphology A's J1_E through
+    // 3.9 rad with the bit near the wall and press it on the wall (300 N m, a safety stop). A
+    // posture of the arm alone planned within kReplanShift of
     // the hole as measured now is aligned from (the alignment covers the rest); otherwise the
     // posture is planned again from there.
     const std::optional<Sample> s = latest_sample();
@@ -2560,8 +2563,8 @@ void DrillNode::control_motion() {
   if (!s) return;
   {
     // The hole stays where the world has it as the base moves: the wheels' velocity loops
-    // yield to the drilling's steady thrust, and a base creeping back took the hole's depth
-    // with it (scenario 3 on A: one hole 12.4 mm deep where the arm had advanced 30 mm).
+    // yield to the drilling's steady thrust, and a base creeping back takes the hole's depth
+    // with it (on morphology A a hole can end 12.4 mm deep where the arm advanced 30 mm).
     const Eigen::Isometry3d now_T_world = rig_->base_in_world(s->odometry).inverse();
     drill_motion_.move_base(now_T_world * base_T_world_.inverse());
     base_T_world_ = now_T_world;

@@ -56,10 +56,10 @@ msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
 
 /// A plan result taken into `kept`, the last one for its request: the trajectory of an executed
 /// plan comes once, with PLANNED, and the execution's updates and SUCCEEDED come without it, so a
-/// result without one keeps the trajectory (and its joint names) already there. Taken as they
-/// came, the control loop missed the trajectory whenever an update came first: the holes'
-/// postures went unrecorded, nothing went back along them, and the next area's approach, planned
-/// from where the last one ended, was aborted at its first sample (scenario 1: 1.0 and 1.6 rad).
+/// result without one keeps the trajectory (and its joint names) already there. Otherwise the
+/// control loop misses the trajectory whenever an update comes first: the holes' postures go
+/// unrecorded, nothing goes back along them, and the next area's approach, planned from where
+/// the last one ended, is aborted at its first sample (1.0 and 1.6 rad off in scenario 1).
 void keep_result(msg::PlanResult& kept, const msg::PlanResult& incoming);
 
 class DrillNode final : public MissionPorts {

@@ -90,7 +90,7 @@ struct Params {
   double warm_up_time = 2.0;         ///< service: per height of the background warm-up after each model [s] (0: none)
   /// Warm-up: the arm's way from the parked arm to each remembered posture [s CPU]. A search that
   /// runs out stores the posture without a way, and later plans near it cannot replay one; on
-  /// morphology B's low postures the searches took 0.23-4.4 s (0.43-0.46 s for some), so with a
+  /// morphology B's low postures the searches take 0.23-4.4 s (0.43-0.46 s for some), so with a
   /// budget near those times what is remembered depends on the machine's speed.
   double warm_up_path_time = 0.5;
   int nspg_memory = 128;             ///< goal postures remembered per model version as seeds for similar heights (0: off)
@@ -180,17 +180,17 @@ struct PlanRequest {
   /// area on its normal, z along -normal; camera_distance is then unused. The drill service's
   /// hole postures: the posture the planner checks (torques with the drilling force, clearance)
   /// is then the one the bit drills from. With the camera on the hole's normal instead, the
-  /// bit stood beside it (the drill's camera is 0.11 m off the bit) and the alignment's
-  /// Cartesian move reached out to a posture nobody had checked: on morphology A the shoulder
-  /// J2_E then needed its peak torque and the safety layer stopped the robot.
+  /// bit stands beside it (the drill's camera is 0.11 m off the bit) and the alignment's
+  /// Cartesian move reaches out to a posture nobody checked: on morphology A the shoulder
+  /// J2_E then needs its peak torque and the safety layer stops the robot.
   double tip_distance = 0.0;
   /// With tip_distance: how far [m] the bit goes on from the posture along -normal (to the wall
   /// and into it); the static torques are checked there too, the base standing. 0: not checked.
   double tip_reach = 0.0;
   /// Force the tool pushes along its axis at the goal postures [N], checked against the torques;
-  /// 0: Params::contact_force. The drill service sends its thrust bound (the impedance's
-  /// stiffness times the reference's largest lead, 125 N), less than the planner's 200 N:
-  /// checked with 200 N the demo robot found no drilling posture for its blobs whose reach held.
+  /// 0: Params::contact_force. The drill service sends its own thrust bound (the impedance's
+  /// stiffness times the reference's largest lead) with a margin (services/drill's
+  /// checked_thrust), or a lighter thrust for a placement checked again at half of it.
   double contact_force = 0.0;
   /// The base keeps its start pose: only the arm moves (the drill service's hole postures:
   /// a base that moves lets odometry drift between holes).
@@ -201,7 +201,7 @@ struct PlanRequest {
   /// The base ends at most this far from its start [m] and turned at most this much [rad]; 0:
   /// anywhere within Params::base_range of the start and the goal. The drill service bounds a
   /// hole's whole-body posture: odometry drifts with every centimetre and degree the base moves
-  /// (a hole posture that spun the demo base by 2.3 rad left it 5 cm off).
+  /// (a hole posture that spins the demo base by 2.3 rad leaves it 5 cm off).
   double base_travel = 0.0;
 };
 

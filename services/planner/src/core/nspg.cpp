@@ -89,8 +89,8 @@ namespace {
 // the task axis (reached_posture). Returns why the static torques there (with and without the
 // contact force, within Params::torque_margin of the continuous torque) fail, or "" when they
 // hold. The posture is where the planner can check collisions; the bit then goes into the wall,
-// where only the arm's load can be checked. Without this, morphology A's shoulder J2_E went past
-// its continuous torque while drilling from postures that held it at 0.7 of it.
+// where only the arm's load can be checked. Without this, morphology A's shoulder J2_E goes past
+// its continuous torque while drilling from postures that hold it at 0.7 of it.
 std::string reach_torque_failure(const PlanningModel& model, StateChecker& checker,
                                  const Eigen::VectorXd& full, const EndEffectorInfo& tool,
                                  const Task& task, const Params& params) {
@@ -204,7 +204,7 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   std::vector<Eigen::VectorXd> arms;
   arms.push_back(start.tail(n - 3));
   arms.insert(arms.end(), hints.begin(), hints.end());
-  // On one benchmark problem (seed 99, #02, A: a low area between two crates) the memory held
+  // On one benchmark problem (seed 99, #02, A: a low area between two crates) the memory holds
   // one side's posture family and only its mirror image fits: found at 0.1 s, against 3.1 s
   // of random seeds.
   std::vector<Eigen::VectorXd> mirrored;
@@ -231,8 +231,8 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
     const std::size_t turn = hint - (arms.size() - 1);
     // The preferred load first (seeds screened and solved); when the torques alone held the
     // seed off the task, the seed again with the mode's limit
-    // (PostureProblem::kPreferredTorqueTarget). (Going on from where the preferred load had
-    // pulled the base lost the demo robot's approach at 1.4 m: the base stood in the wall.)
+    // (PostureProblem::kPreferredTorqueTarget). (Not from where the preferred load pulled the
+    // base: from there the demo robot's approach at 1.4 m finds none, the base in the wall.)
     problem.set_torque_target(PostureProblem::kPreferredTorqueTarget);
     Eigen::VectorXd q = k == 0                   ? problem.place(arms[0], yaw_hint)
                         : k == 1                 ? start

@@ -279,7 +279,7 @@ std::optional<Eigen::VectorXd> base_out_of_map(StateChecker& checker, const Eige
 
 // A valid state with the planned arm joints of `q` moved by at most `tolerance` [rad or m]
 // each, or none: one joint at a time first, the smallest move (5 mrad steps; the demo's arm
-// stood 50 mrad of J3_E inside its posture's shapes, the joint's deflection under gravity),
+// can stand 50 mrad of J3_E inside its posture's shapes, the joint's deflection under gravity),
 // then seeded random moves of every joint within growing bounds, as MoveIt's
 // FixStartStateCollision does; clamped to the joint limits.
 std::optional<Eigen::VectorXd> arm_out_of_self_collision(const PlanningModel& model,
@@ -419,7 +419,7 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   auto checker_ptr = std::make_unique<StateChecker>(model, env, request_params, padding);
   Validity start_ok = checker_ptr->check(q_start_full);
   // A start a few centimetres inside the map or its padding (the base's odometry drifts: on the
-  // demo a leg was found 2-4 cm inside the wall after a hole's whole-body move), or with two
+  // demo a leg can be 2-4 cm inside the wall after a hole's whole-body move), or with two
   // links a hair inside each other (the planner's shapes are conservative, and the drill's
   // Cartesian motions leave the arm a little off the posture the planner checked): the nearest
   // state clear of both is planned from, and the move there is prepended to the path (what
@@ -430,8 +430,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   std::optional<Eigen::VectorXd> lead_in;
   Eigen::VectorXd start = q_start_full;
   // A start a hair past a joint's limit (a drive holds a few mrad beyond the limit a trajectory
-  // ended on: J1_E at -2.7504 rad of +-2.75 on the demo, and the drill could not turn its
-  // camera) is clamped onto the limit first, as MoveIt's FixStartStateBounds does; a joint more
+  // ended on, e.g. J1_E at -2.7504 rad of +-2.75 on the demo; refused, the drill could not turn
+  // its camera) is clamped onto the limit first, as MoveIt's FixStartStateBounds does; a joint more
   // than start_joint_tolerance out is refused below.
   std::string clamped_note;
   if (start_ok.constraint == Constraint::kJointLimit) {
@@ -558,7 +558,7 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     int next_seed = 0;
     // The arm shapes no path reached: the posture search's next seeds are often the same
     // posture with the first joint turned, whose arm shape no path reaches either (on the
-    // benchmark, morphology B's low areas: four such attempts in a row used up the budget).
+    // benchmark's low areas for morphology B, four such attempts in a row can use up the budget).
     std::vector<Eigen::VectorXd> unreached;
     const auto like_unreached = [&](const Eigen::VectorXd& q) {
       const Eigen::VectorXd arm = q.tail(q.size() - 3);

@@ -19,8 +19,8 @@ constexpr double kClearanceWeight = 1.0;
 constexpr double kTorqueTarget = 0.97;
 // The same for a drilling posture whose reach is checked (Params::tip_reach): the bit goes on
 // 5-20 cm from it, and a posture at 0.97 of a shoulder's continuous torque is past it there
-// (the demo robot's J2_E: 166-168 N m of 160 with the bit 0.1-0.17 m further). At 0.8 the
-// demo robot found no such posture for its blobs, at 0.9 postures that held 0.97-1.0 there.
+// (the demo robot's J2_E: 166-168 N m of 160 with the bit 0.1-0.17 m further). At 0.8 there is
+// no such posture for the demo robot's blobs; at 0.9 the postures hold 0.97-1.0 there.
 constexpr double kReachTorqueTarget = 0.9;
 // Extra clearance the smooth problem keeps, so the exact checks pass [m].
 constexpr double kClearanceSlack = 0.015;
@@ -227,8 +227,8 @@ void PostureProblem::evaluate(const Eigen::VectorXd& q, Eigen::VectorXd& r) {
     const Eigen::Isometry3d& cam = poses_[static_cast<std::size_t>(camera_)];
     r.segment<3>(0) = kTaskWeight * (cam.translation() - task_->position);
     // The axis as a difference, not a cross product: a cross product is zero for the camera
-    // looking away from the wall too, and the solver converged there (a hole posture on the
-    // demo robot passed every check with the camera turned 180 deg from the hole).
+    // looking away from the wall too, and the solver can converge there (a hole posture on the
+    // demo robot would pass every check with the camera turned 180 deg from the hole).
     r.segment<3>(3) = kTaskWeight * (cam.linear().col(2) - task_->axis);
   } else {
     r.head<6>().setZero();

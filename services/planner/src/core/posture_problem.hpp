@@ -64,10 +64,10 @@ class PostureProblem {
   void set_torque_target(double target) { torque_target_ = target; }
   [[nodiscard]] double limit_torque_target() const;
   /// What a goal posture aims under first: a posture is where the arm waits (an area's approach
-  /// held the demo robot's J2_E at 0.89 of its continuous torque for 17 s while the drill
-  /// asked for its holes' postures) and whence the arm alone must still reach the holes at a
-  /// fraction of that load (from that approach it reached none). generate_posture() solves a
-  /// seed again with the limit when the torques alone kept it off the task.
+  /// at 0.89 of the demo robot's J2_E continuous torque holds it there for the 17 s the drill
+  /// takes to ask for its holes' postures) and whence the arm alone must still reach the holes
+  /// at a fraction of that load (from such an approach it reaches none). generate_posture()
+  /// solves a seed again with the limit when the torques alone kept it off the task.
   static constexpr double kPreferredTorqueTarget = 0.8;
 
   // The planned q for arm joints `arm`: the base is placed where that arm posture reaches the

@@ -295,8 +295,8 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
 // source and id, is not taken twice. The acknowledgement is written before the request is
 // queued: queued first, the request loop could answer it (a start state refused takes
 // microseconds) before this thread wrote PLAN_PLANNING, and the result topic keeps only the
-// last sample of a request, so the late acknowledgement would replace the final answer (a CI
-// run: the answer "cannot be executed" never seen, the client waited 20 s).
+// last sample of a request, so the late acknowledgement would replace the final answer (the
+// client would never see, e.g., "cannot be executed" and would wait in vain).
 void PlannerNode::take(const msg::PlanRequest& request) {
   {
     std::lock_guard lock(mutex_);

@@ -163,7 +163,7 @@ class BaseController final : public Controller {
   /// Integrates the odometry from the measured legs (every cycle, whoever owns the legs); its
   /// yaw from the base's gyro (data.base_yaw_rate) when there is one: the wheels' yaw rate is
   /// off by their scrub in turns (3 % on the paper's base in simulation) and misses the base
-  /// turning while the legs steer, which over a 1.7 m approach put the demo's odometry 15 cm
+  /// turning while the legs steer, which over a 1.7 m approach puts the demo's odometry 15 cm
   /// off. The gyro's bias is learnt while the whole robot stands still (a zero-velocity update:
   /// no wheel rolls, no leg steers, no arm joint moves).
   void estimate(CycleData& data);

@@ -159,9 +159,9 @@ struct RobotParams {
   double trajectory_goal_time{3.0};      ///< time after the last sample to get within the goal tolerance [s]
   double trajectory_base_gain{1.5};      ///< odometry feedback of the base [1/s]
   double trajectory_base_deadband{0.01};  ///< base twists below this keep the steering [m/s, rad/s]
-  /// Fraction of the steering velocity limit while tracking a trajectory. Chosen when the
-  /// steering had no velocity feed-forward and its drive's damping at the limit cost more than
-  /// its continuous torque; kept since (base commands use the whole limit).
+  /// Fraction of the steering velocity limit while tracking a trajectory (base commands use the
+  /// whole limit): a conservative margin, sized for a steering without velocity feed-forward,
+  /// whose drive's damping at the limit costs more than its continuous torque.
   double trajectory_steering_rate{0.35};
   /// Acceleration of the steering's reference [rad/s^2]: a leg turning 90 degrees peaks at
   /// 5.6 rad/s (of the paper's 8.91) instead of being whipped past its velocity limit.

@@ -10,8 +10,8 @@ namespace concert::robot {
 /// Watches the safety service's state stream (re-published at least every 0.2 s, on every
 /// change at once). With a timeout the robot holds until a safety state is heard and again
 /// whenever none was heard for `timeout`: a robot that cannot hear the safety layer cannot
-/// hear its stops either (a restarted robot process whose DDS transport stayed deaf executed a
-/// trajectory through a stop naming it, issue #21), so silence is treated as a stop. The stop
+/// hear its stops either (a restarted robot process whose DDS transport stays deaf would execute
+/// a trajectory through a stop naming it; issue #21), so silence is treated as a stop. The stop
 /// ends with the next safety state heard, whose own mode then decides: a safety service that
 /// noticed the robot's silence latches a stop of its own until an operator reset.
 /// Without a timeout (0, the default for a robot run without the safety service) nothing is

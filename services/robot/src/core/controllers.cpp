@@ -83,10 +83,10 @@ DriveCommand& CycleData::new_drive(int i, DriveMode mode) {
 void HoldController::update(CycleData& data) {
   data.for_each_owned_by(JointOwner::kHold, [this, &data](int i) {
     // A wheel rolling when its hold begins brakes (velocity 0) and is held where it comes to
-    // rest. Held where it was when the hold began (a safety stop while the base drove), it was
-    // driven back: the stopped base rolled 6 mm and a wheel 0.07 rad during the chaos test's
-    // watch of the hold. Only then: a wheel that braked whenever it rolled let a pushed base
-    // roll away on its brakes' damping (300 N moved the paper's base 14 cm in 5 s).
+    // rest. Held where it was when the hold began (a safety stop while the base drives), it
+    // would be driven back: the stopped base rolls back 6 mm and a wheel 0.07 rad. Only then: a
+    // wheel that braked whenever it rolled would let a pushed base roll away on its brakes'
+    // damping (300 N moves the paper's base 14 cm in 5 s).
     constexpr double kRolling = 0.05;  // [rad/s]
     const auto iu = static_cast<std::size_t>(i);
     if (!data.continued(held_at_[iu])) {
@@ -246,9 +246,8 @@ void BaseController::estimate(CycleData& data) {
     constexpr double kBiasTime = 10.0;  // time constant of the bias estimate [s]
     // Still: no wheel rolls, no leg steers (a leg turning in place twists the base, with no
     // wheel speed to show it) and no arm joint moves. A moving arm, or one pushing a drill into
-    // a wall, can turn the standing base on its wheels' contacts (3-4 mrad per hole on the demo
-    // wall while the simulator let a standing base creep, libs/sim); that turn is the gyro's to
-    // see, not a bias to learn.
+    // a wall, can turn the standing base on its wheels' contacts (a few mrad per hole on the
+    // demo wall); that turn is the gyro's to see, not a bias to learn.
     bool still = twist.head<2>().norm() < kStill && std::abs(twist.z()) < kStill &&
                  data.qd.cwiseAbs().maxCoeff() < kStill;
     if (still) {
@@ -269,10 +268,10 @@ void BaseController::estimate(CycleData& data) {
 void BaseController::steer(CycleData& data, std::size_t k, double target, double rate, DriveCommand& d) {
   // The steering's reference turns along a profile with a limited acceleration, and hands its
   // rate to the drive as a velocity feed-forward (CiA 402's velocity offset). A reference that
-  // turned at full rate at once, without the feed-forward, ran ahead of the steering while the
-  // drive's damping and the tyre's scrub held it back (0.3 rad at the velocity limit), and when
-  // it stopped the drive caught up beyond the limit: 10.3 rad/s of 8.91 on the paper's base
-  // turning its wheels 90 degrees, a safety stop in the drilling benchmark.
+  // turns at full rate at once, without the feed-forward, runs ahead of the steering while the
+  // drive's damping and the tyre's scrub hold it back (0.3 rad at the velocity limit), and when
+  // it stops the drive catches up beyond the limit: 10.3 rad/s of 8.91 on the paper's base
+  // turning its wheels 90 degrees, a safety stop.
   const int s = kinematics_.legs()[k].steering_index;
   const auto su = static_cast<std::size_t>(s);
   double& ref = data.position_ref[su];
@@ -333,7 +332,7 @@ void BaseController::drive_legs(CycleData& data, const Eigen::Vector3d& twist, J
       // test's 1.2 m of moves: 33 mm off with this under base commands too, 46 mm without).
       rolling *= std::max(0.0, std::cos(setpoints_[k].steering_angle - data.q(s)));
       // A wheel beside its steering axis rolls as its leg steers (Leg::axle_offset); held, it
-      // dragged the base along (35-40 mm at each start of the demo's moves, unseen by odometry).
+      // would drag the base along (35-40 mm at each start of the demo's moves, unseen by odometry).
       rolling += kinematics_.steering_rolling(k, data.qd(s));
       if (owner == JointOwner::kBase && stands(data, k, s, w, setpoints_[k].wheel_velocity)) continue;
       DriveCommand& d = data.new_drive(w, DriveMode::kVelocity);

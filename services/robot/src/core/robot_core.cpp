@@ -286,8 +286,8 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
   }
   // The legs' drives fold their torque back as they heat; the arm's keep their peak torque. A
   // wheel or a steering that yields slips or lags (the base slows); an arm joint that yields
-  // moves the tool: with J2_E folded back at its continuous torque while the demo arm moved
-  // off a drilled hole, J5_E ran into its limit and J6_E past its velocity limit (a safety stop
+  // moves the tool: with J2_E folded back to its continuous torque while the demo arm moves
+  // off a drilled hole, J5_E runs into its limit and J6_E past its velocity limit (a safety stop
   // anyway). For the arm, safety's sustained-torque stop is the better end.
   slot->limits.resize(static_cast<std::size_t>(model->dof()));
   for (int j = 0; j < model->dof(); ++j) {

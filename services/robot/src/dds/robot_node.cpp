@@ -232,9 +232,9 @@ void RobotNode::publish(const RobotState& s) {
     status_.report(msg::SERVICE_RECONFIGURING, static_cast<uint32_t>(s.model_version), s.message);
   } else if (!last_ready_ && s.ready && status_.state() != msg::SERVICE_READY) {
     // Ready again at a model applied while this thread had not yet seen the hardware change
-    // (a hot swap on a loaded machine: the swap's model reported READY, then this thread its
-    // "hardware changed" RECONFIGURING, which then stood for good: robot_main_test waited 30 s
-    // for READY v2 in two fresh-clone CI runs with the robot ready at v2).
+    // (a hot swap on a loaded machine: the swap's model reports READY, then this thread its
+    // "hardware changed" RECONFIGURING, which would otherwise stand for good with the robot
+    // ready at the new model).
     concert::dds::ModelId applied;
     {
       std::lock_guard lock(mutex_);
