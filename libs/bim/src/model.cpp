@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -113,6 +115,18 @@ T field(const Json& j, const char* key, const std::string& where) {
   }
 }
 
+/// A count or offset: a non-negative integer (a float or a negative number converted to size_t
+/// is undefined or wraps round).
+std::size_t count_field(const Json& j, const char* key, const std::string& where) {
+  if (!j.contains(key)) throw BimError(where + ": missing field '" + key + "'");
+  const Json& v = j.at(key);
+  if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<std::int64_t>() >= 0)) {
+    throw BimError(where + ": field '" + key + "': expected a non-negative integer, got " +
+                   v.dump());
+  }
+  return v.get<std::size_t>();
+}
+
 Eigen::Vector3d vec3(const Json& j, const std::string& where) {
   if (!j.is_array() || j.size() != 3) throw BimError(where + ": expected 3 numbers");
   return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
@@ -183,8 +197,9 @@ std::string default_import_script() {
   return CONCERT_IFC_IMPORT_SCRIPT;
 }
 
-BimModel read_import(const std::string& json_path) {
-  const std::string where = "IFC import output '" + json_path + "'";
+namespace {
+
+BimModel read_import_json(const std::string& json_path, const std::string& where) {
   std::ifstream in(json_path);
   if (!in) throw BimError(where + ": cannot be opened");
   Json j;
@@ -194,7 +209,8 @@ BimModel read_import(const std::string& json_path) {
     throw BimError(where + ": not JSON: " + e.what());
   }
   if (field<std::string>(j, "format", where) != "concert-ifc-import" ||
-      field<int>(j, "version", where) != 1) {
+      !j.contains("version") || !j.at("version").is_number_integer() ||
+      j.at("version").get<std::int64_t>() != 1) {
     throw BimError(where + ": not format concert-ifc-import version 1");
   }
   BimModel m;
@@ -202,25 +218,42 @@ BimModel read_import(const std::string& json_path) {
   m.schema = field<std::string>(j, "schema", where);
   m.length_unit_m = field<double>(j, "length_unit_m", where);
 
-  const Json& binary = j.at("binary");
-  const fs::path bin =
-      fs::path(json_path).parent_path() / field<std::string>(binary, "file", where + ": binary");
-  const auto vertex_count = field<std::size_t>(binary, "vertex_count", where + ": binary");
-  const auto index_count = field<std::size_t>(binary, "index_count", where + ": binary");
+  const Json& binary = field<Json>(j, "binary", where);
+  // The step writes its binary file beside the JSON: a name with a folder in it (or an absolute
+  // path) would let the file point anywhere, e.g. at a device that never ends.
+  const std::string bin_name = field<std::string>(binary, "file", where + ": binary");
+  if (bin_name.empty() || fs::path(bin_name).filename() != fs::path(bin_name) || bin_name == "." ||
+      bin_name == "..") {
+    throw BimError(where + ": binary.file '" + bin_name + "' is not a file name beside it");
+  }
+  const fs::path bin = fs::path(json_path).parent_path() / bin_name;
+  const auto vertex_count = count_field(binary, "vertex_count", where + ": binary");
+  const auto index_count = count_field(binary, "index_count", where + ": binary");
+  std::error_code size_error;
+  const bool regular = fs::is_regular_file(bin, size_error);
+  const std::uintmax_t bin_size = regular ? fs::file_size(bin, size_error) : std::uintmax_t{0};
+  if (!regular || size_error) {
+    throw BimError(where + ": its binary file '" + bin.string() + "' cannot be opened");
+  }
+  // The counts are checked against the file's size before anything is allocated for them.
+  constexpr std::uintmax_t kVertexBytes = 3 * sizeof(float);
+  constexpr std::uintmax_t kIndexBytes = sizeof(std::uint32_t);
+  if (vertex_count > bin_size / kVertexBytes || index_count > bin_size / kIndexBytes ||
+      vertex_count * kVertexBytes + index_count * kIndexBytes != bin_size) {
+    throw BimError(where + ": binary file '" + bin.string() + "' is " + std::to_string(bin_size) +
+                   " bytes long, not the " + std::to_string(vertex_count) + " vertices and " +
+                   std::to_string(index_count) + " indices the JSON says");
+  }
   std::vector<float> vertices(vertex_count * 3);
   std::vector<std::uint32_t> indices(index_count);
   {
     std::ifstream b(bin, std::ios::binary);
     if (!b) throw BimError(where + ": its binary file '" + bin.string() + "' cannot be opened");
-    const auto expected = vertices.size() * sizeof(float) + indices.size() * sizeof(std::uint32_t);
     b.read(reinterpret_cast<char*>(vertices.data()),
            static_cast<std::streamsize>(vertices.size() * sizeof(float)));
     b.read(reinterpret_cast<char*>(indices.data()),
            static_cast<std::streamsize>(indices.size() * sizeof(std::uint32_t)));
-    if (!b || static_cast<std::uintmax_t>(fs::file_size(bin)) != expected) {
-      throw BimError(where + ": binary file '" + bin.string() + "' is not " +
-                     std::to_string(expected) + " bytes long");
-    }
+    if (!b) throw BimError(where + ": binary file '" + bin.string() + "' could not be read");
   }
 
   for (const auto& s : field<Json>(j, "storeys", where)) {
@@ -242,17 +275,21 @@ BimModel read_import(const std::string& json_path) {
       el.placement_origin = vec3(e["placement"].at("origin"), w + ": placement.origin");
       el.placement_x = vec3(e["placement"].at("x_axis"), w + ": placement.x_axis");
     }
-    const auto v0 = field<std::size_t>(e, "vertex_offset", w);
-    const auto nv = field<std::size_t>(e, "vertex_count", w);
-    const auto i0 = field<std::size_t>(e, "index_offset", w);
-    const auto ni = field<std::size_t>(e, "index_count", w);
-    if (v0 + nv > vertex_count || i0 + ni > index_count || ni % 3 != 0) {
+    const auto v0 = count_field(e, "vertex_offset", w);
+    const auto nv = count_field(e, "vertex_count", w);
+    const auto i0 = count_field(e, "index_offset", w);
+    const auto ni = count_field(e, "index_count", w);
+    if (v0 > vertex_count || nv > vertex_count - v0 || i0 > index_count ||
+        ni > index_count - i0 || ni % 3 != 0) {
       throw BimError(w + ": mesh range outside the binary file's " + std::to_string(vertex_count) +
                      " vertices / " + std::to_string(index_count) + " indices");
     }
     el.mesh.vertices.reserve(nv);
     for (std::size_t k = 0; k < nv; ++k) {
       const float* p = &vertices[(v0 + k) * 3];
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+        throw BimError(w + ": vertex " + std::to_string(k) + " is not finite");
+      }
       el.mesh.vertices.emplace_back(p[0], p[1], p[2]);
       el.bounds.extend(el.mesh.vertices.back());
     }
@@ -266,6 +303,18 @@ BimModel read_import(const std::string& json_path) {
     m.elements.push_back(std::move(el));
   }
   return m;
+}
+
+}  // namespace
+
+BimModel read_import(const std::string& json_path) {
+  const std::string where = "IFC import output '" + json_path + "'";
+  try {
+    return read_import_json(json_path, where);
+  } catch (const Json::exception& e) {
+    // A field of the wrong kind below the top level (e.g. `placement` not an object).
+    throw BimError(where + ": " + e.what());
+  }
 }
 
 BimModel load_ifc(const std::string& ifc_path, const ImportOptions& options) {

@@ -67,6 +67,11 @@ LatchedState read_state(config::Document& doc) {
     root.fail("causes", s.mode == Mode::kStopped ? "a stop needs its causes"
                                                  : "RUNNING with causes");
   }
+  // The service never writes RUNNING with an input engaged (engaging one stops the robot); a
+  // file that says so was edited or damaged, and restoring it would run with an e-stop pressed.
+  if (s.mode == Mode::kRunning && !s.engaged.empty()) {
+    root.fail("engaged", "RUNNING with an e-stop input engaged");
+  }
   for (const auto& [who, incarnation] : s.watched) {
     if (who.find('@') == std::string::npos) root.fail("watched", "'" + who + "' is not service@host");
   }
