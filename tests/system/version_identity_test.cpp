@@ -4,6 +4,7 @@
 // every service agrees and none refused anything; the next hot swap gets a new, higher version
 // everywhere. Before, the restarted modelgen published "version 1" again and a later, different
 // model reused "version 2".
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <stdlib.h>
@@ -24,6 +25,7 @@ namespace concert::system_test {
 namespace {
 
 using namespace std::chrono_literals;
+using ::testing::HasSubstr;
 using testing::Process;
 namespace fs = std::filesystem;
 
@@ -146,6 +148,14 @@ TEST_F(VersionIdentity, KilledModelgenComesBackAtTheSameVersionAndHash) {
   }
   r = concert({"status", "--check", "--wait-ms", "2000"});
   EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_THAT(r.out, HasSubstr("safety: RUNNING")) << r.out;
+
+  // A stack whose safety layer is stopped is not ready to work: --check says so and why.
+  r = concert({"safety", "estop"});
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  r = concert({"status", "--check", "--wait-ms", "2000"});
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_THAT(r.err, HasSubstr("safety is STOPPED: estop: software engaged")) << r.err;
   EXPECT_EQ(up.stop(30s), 0) << logs();
 }
 

@@ -30,16 +30,29 @@ std::string state_name(msg::ServiceState s) {
 
 }  // namespace
 
-std::vector<ServiceRow> read_statuses(int32_t domain, std::chrono::milliseconds wait) {
+std::vector<ServiceRow> read_statuses(int32_t domain, std::chrono::milliseconds wait,
+                                      std::optional<SafetyRow>* safety) {
   dds::Participant participant({.name = "concert-status", .domain_id = domain});
   std::mutex mutex;
   std::map<uint32_t, msg::ServiceStatus> latest;
+  std::optional<SafetyRow> safety_seen;
   dds::Reader<msg::ServiceStatus> reader(participant, dds::topics::status, [&](const msg::ServiceStatus& s, const auto&) {
     std::lock_guard lock(mutex);
     latest[s.id()] = s;
   });
+  std::optional<dds::Reader<msg::SafetyState>> safety_reader;
+  if (safety != nullptr) {
+    safety_reader.emplace(participant, dds::topics::safety_state,
+                          [&](const msg::SafetyState& s, const auto&) {
+                            std::lock_guard lock(mutex);
+                            safety_seen = SafetyRow{s.mode() == msg::SAFETY_STOPPED, s.causes()};
+                          });
+  }
+  // Listening is the verb's job here: statuses are heartbeats, so every running service is
+  // heard within `wait` (the --timeout the user chose).
   std::this_thread::sleep_for(wait);
   std::lock_guard lock(mutex);
+  if (safety != nullptr) *safety = safety_seen;
   std::vector<ServiceRow> rows;
   const int64_t now = now_ns();
   for (const auto& [id, s] : latest) {
@@ -105,6 +118,15 @@ std::vector<std::string> status_problems(const std::vector<ServiceRow>& rows) {
     }
   }
   return problems;
+}
+
+std::vector<std::string> safety_problems(const std::optional<SafetyRow>& safety) {
+  if (!safety) return {"no safety state heard on concert/safety/state (is concert_safety running?)"};
+  if (!safety->stopped) return {};
+  std::string text = "safety is STOPPED";
+  for (size_t i = 0; i < safety->causes.size(); ++i) text += (i == 0 ? ": " : "; ") + safety->causes[i];
+  text += " (release the e-stops, then `concert safety reset`)";
+  return {text};
 }
 
 namespace {
@@ -201,7 +223,10 @@ int status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
     return until_version(domain, o.until_version, split(o.services),
                          std::llround(timeout_s * 1000.0), out, err);
   }
-  const auto rows = read_statuses(domain, o.dds.timeout());
+  std::optional<SafetyRow> safety;
+  const auto rows = read_statuses(domain, o.dds.timeout(), &safety);
+  auto problems = status_problems(rows);
+  for (auto& p : safety_problems(safety)) problems.push_back(std::move(p));
   if (o.dds.json) {
     idl::Json arr = idl::Json::array();
     for (const auto& r : rows) {
@@ -215,7 +240,10 @@ int status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
                      {"age_s", r.age_s}});
     }
     out << arr.dump(2) << "\n";
-    return o.check && !status_problems(rows).empty() ? 1 : 0;
+    if (o.check) {
+      for (const auto& p : problems) err << "concert status: " << p << "\n";
+    }
+    return o.check && !problems.empty() ? 1 : 0;
   }
   if (rows.empty()) {
     err << "concert status: no service reported on domain " << domain << " within "
@@ -245,8 +273,14 @@ int status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
     for (const auto& d : agreement.disagreeing) out << "; " << d;
     out << "\n";
   }
+  if (!safety) {
+    out << "safety: no state heard\n";
+  } else {
+    out << "safety: " << (safety->stopped ? "STOPPED" : "RUNNING");
+    for (size_t i = 0; i < safety->causes.size(); ++i) out << (i == 0 ? ": " : "; ") << safety->causes[i];
+    out << "\n";
+  }
   if (!o.check) return 0;
-  const auto problems = status_problems(rows);
   for (const auto& p : problems) err << "concert status: " << p << "\n";
   return problems.empty() ? 0 : 1;
 }
@@ -270,8 +304,9 @@ void register_status_verb(cli::Cli& concert) {
       ->type_name("N")
       ->check(cli::number(1, 4e9, true));
   verb.add_flag("--check", o->check,
-                "exit 1 if a service is stopped or in error, the services disagree on the model, "
-                "or one refused input (each problem on stderr)");
+                "exit 1 unless the stack is ready to work: a service stopped or in error, the "
+                "services disagreeing on the model, a service that refused input, or the safety "
+                "layer STOPPED or not heard (each problem on stderr)");
   verb.add_option("--services", o->services,
                   "with --until-version: only these services (comma-separated)")
       ->type_name("a,b");

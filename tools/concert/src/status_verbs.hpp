@@ -1,6 +1,7 @@
 #pragma once
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -21,8 +22,16 @@ struct ServiceRow {
   double age_s = 0;         ///< seconds since the service last reported (heartbeat)
 };
 
-/// Statuses seen on the domain within `wait`, sorted by service then host.
-std::vector<ServiceRow> read_statuses(int32_t domain, std::chrono::milliseconds wait);
+/// The safety layer's state, as read from concert/safety/state (latched).
+struct SafetyRow {
+  bool stopped = false;
+  std::vector<std::string> causes;
+};
+
+/// Statuses seen on the domain within `wait`, sorted by service then host; with `safety`, also
+/// the safety state heard meanwhile (nullopt: none).
+std::vector<ServiceRow> read_statuses(int32_t domain, std::chrono::milliseconds wait,
+                                      std::optional<SafetyRow>* safety = nullptr);
 
 /// Which model the services run, and who disagrees: the newest (version, hash) any service
 /// reports is the reference; a service at another version, or at that version with another
@@ -37,6 +46,9 @@ ModelAgreement model_agreement(const std::vector<ServiceRow>& rows);
 /// What a scripted check (`concert status --check`) fails on: every service stopped or in
 /// error, a model disagreement, and every service that refused inputs. Empty = all good.
 std::vector<std::string> status_problems(const std::vector<ServiceRow>& rows);
+/// What `concert status --check` fails on besides: the safety layer STOPPED (naming its
+/// causes) or not heard at all. A stack that cannot move is not ready to work.
+std::vector<std::string> safety_problems(const std::optional<SafetyRow>& safety);
 
 /// Registers `concert status` ([--json] [--check] [--until-version N] [--services a,b]).
 void register_status_verb(cli::Cli& concert);

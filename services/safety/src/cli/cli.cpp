@@ -76,6 +76,8 @@ int status(const Options& o, dds::Participant& p, std::ostream& out) {
 int estop(const Options& o, dds::Participant& p, std::ostream& out) {
   const std::string name = o.source.empty() ? "software" : o.source;
   const auto source = kSources.find(name);
+  // Read before writing: the answer to an engaged input is a STOPPED state naming it.
+  dds::Reader<msg::SafetyState> states(p, dds::topics::safety_state);
   dds::Writer<msg::EStopInput> writer(p, dds::topics::estop);
   if (!writer.wait_for_readers(1, o.dds.timeout())) {
     throw Failure("no safety service on domain " + std::to_string(p.domain_id()) +
@@ -92,6 +94,26 @@ int estop(const Options& o, dds::Participant& p, std::ostream& out) {
           static_cast<int32_t>(ns / 1'000'000'000), static_cast<uint32_t>(ns % 1'000'000'000))) !=
       eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
     throw Failure("the safety service did not acknowledge the e-stop input");
+  }
+  // The acknowledgements are those of the readers matched so far, which may be other tools' or
+  // the GUI's and not yet the safety service's: an engaged input counts once the safety service
+  // says it stopped for it. The writer stays alive meanwhile (the input is latched, so a safety
+  // reader that matches late still gets it).
+  if (!o.release) {
+    // The service's cause: "estop: <its name of the input> engaged (<reason>)".
+    const std::string cause = "estop: ";
+    const std::string why = "(" + input.reason() + ")";
+    const auto stopped = wait_state(states, o.dds.timeout(), [&](const msg::SafetyState& st) {
+      if (st.mode() != msg::SAFETY_STOPPED) return false;
+      for (const auto& c : st.causes()) {
+        if (c.rfind(cause, 0) == 0 && c.find(why) != std::string::npos) return true;
+      }
+      return false;
+    });
+    if (!stopped) {
+      throw Failure("the safety service did not report a stop for the e-stop input '" + name +
+                    "' within " + std::to_string(o.dds.timeout_s) + " s");
+    }
   }
   if (o.dds.json) {
     out << nlohmann::ordered_json{{"source", name}, {"engaged", !o.release}}.dump() << "\n";
