@@ -135,7 +135,10 @@ TEST_F(SafetyNodeTest, EStopLatchesUntilReleasedAndReset) {
   EXPECT_EQ(node_->status().mode, Mode::kStopped);
 
   ASSERT_TRUE(inputs.write(estop(msg::ESTOP_WIRELESS, false)));
-  EXPECT_TRUE(eventually([&] { return node_->status().mode == Mode::kStopped; }, 1s));
+  // Once the node has taken the release, the stop must still be latched (no reset yet).
+  ASSERT_TRUE(eventually([&] { return node_->engaged_inputs().empty(); }, 10s)) << log_.str();
+  EXPECT_EQ(node_->status().mode, Mode::kStopped);
+  EXPECT_TRUE(node_->status().reset_required);
   // The release and the reset travel on different topics: on a loaded machine the reset can
   // be handled before the release. Like an operator, reset again (bounded) until accepted.
   bool running = false;

@@ -240,6 +240,11 @@ SafetyStatus SafetyNode::status() const {
   return monitor_.status();
 }
 
+std::vector<std::string> SafetyNode::engaged_inputs() const {
+  std::lock_guard lock(mutex_);
+  return monitor_.engaged_inputs();
+}
+
 uint64_t SafetyNode::checked_samples() const {
   std::lock_guard lock(mutex_);
   return checked_samples_;

@@ -11,6 +11,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "concert/common/command_once.hpp"
 #include "concert/dds/endpoint.hpp"
@@ -46,6 +47,8 @@ class SafetyNode {
   void spin(const std::atomic<bool>& stop);
 
   SafetyStatus status() const;
+  /// Names of the e-stop inputs engaged now (as the monitor has them).
+  std::vector<std::string> engaged_inputs() const;
   /// Joint samples that were checked against the model's limits.
   uint64_t checked_samples() const;
 
