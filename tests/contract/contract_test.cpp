@@ -62,12 +62,15 @@ void cross(const Vendor& writer_vendor, const Vendor& reader_vendor, uint32_t se
     // Fast DDS 2.9 reads only XCDR1; both vendors must put XCDR1 on the wire.
     EXPECT_EQ(got.at("wire"), "XCDR1 little-endian");
     expect_qos(got.at("local_qos"), t, std::string(reader_vendor.name) + " reader");
-    if (got.contains("remote_qos")) expect_qos(got.at("remote_qos"), t, "writer as announced on the wire");
+    // What each vendor read of the other side's discovery announcement (SEDP): Cyclone's
+    // matched-endpoint data, Fast DDS's discovery listener.
+    ASSERT_TRUE(got.contains("remote_qos")) << reader_vendor.name << " saw no writer announcement";
+    expect_qos(got.at("remote_qos"), t, "writer as announced on the wire");
     ASSERT_TRUE(written.count(name));
     expect_qos(written.at(name).at("local_qos"), t, std::string(writer_vendor.name) + " writer");
-    if (written.at(name).contains("remote_qos")) {
-      expect_qos(written.at(name).at("remote_qos"), t, "reader as announced on the wire");
-    }
+    ASSERT_TRUE(written.at(name).contains("remote_qos"))
+        << writer_vendor.name << " saw no reader announcement";
+    expect_qos(written.at(name).at("remote_qos"), t, "reader as announced on the wire");
   }
 }
 

@@ -271,3 +271,25 @@ int cy_matched(int endpoint, cy_qos* remote) {
   if (data) dds_builtintopic_free_endpoint(data);
   return n;
 }
+
+int cy_local(int endpoint, cy_qos* local) {
+  dds_qos_t* qos = dds_create_qos();
+  if (dds_get_qos(g_ep[endpoint].entity, qos) < 0) {
+    fprintf(stderr, "cy_local: dds_get_qos failed\n");
+    dds_delete_qos(qos);
+    return -1;
+  }
+  dds_reliability_kind_t rk = DDS_RELIABILITY_BEST_EFFORT;
+  dds_duration_t block;
+  dds_durability_kind_t dk = DDS_DURABILITY_VOLATILE;
+  dds_history_kind_t hk = DDS_HISTORY_KEEP_LAST;
+  int32_t depth = 1;
+  dds_qget_reliability(qos, &rk, &block);
+  dds_qget_durability(qos, &dk);
+  dds_qget_history(qos, &hk, &depth);
+  local->reliable = rk == DDS_RELIABILITY_RELIABLE;
+  local->transient_local = dk == DDS_DURABILITY_TRANSIENT_LOCAL;
+  local->depth = hk == DDS_HISTORY_KEEP_ALL ? 0 : depth;
+  dds_delete_qos(qos);
+  return 0;
+}

@@ -29,6 +29,8 @@ int cy_create_writer(const char* topic, const char* type_name, cy_qos qos);
 int cy_take(int reader, uint8_t** wire, size_t* wire_len, uint8_t** reser, size_t* reser_len);
 /* Decodes bytes with Cyclone's deserializer into the C type and writes the C sample. */
 int cy_write(int writer, const uint8_t* bytes, size_t len);
+/* The QoS the endpoint has, as Cyclone reports it (dds_get_qos); depth 0 = keep all. */
+int cy_local(int endpoint, cy_qos* local);
 /* Number of matched remote endpoints and the QoS announced by the first of them. */
 int cy_matched(int endpoint, cy_qos* remote);
 

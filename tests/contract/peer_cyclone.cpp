@@ -61,9 +61,10 @@ int main(int argc, char** argv) try {
       }
       const auto bytes = idl::encode(schema, ep.info.type_name, contract::expected_sample(ep.info, args.seed, args.full_images));
       if (cy_write(ep.handle, bytes.data(), bytes.size()) != 0) return 2;
-      const auto spec = dds::qos_spec(ep.info.qos);
+      cy_qos local{};
+      if (cy_local(ep.handle, &local) != 0) return 2;
       idl::Json event = {{"event", "written"}, {"topic", ep.info.name},
-                         {"local_qos", contract::qos_json(spec.reliable, spec.transient_local, spec.history_depth)}};
+                         {"local_qos", contract::qos_json(local.reliable, local.transient_local, local.depth)}};
       if (args.wait_readers) event["remote_qos"] = contract::qos_json(remote.reliable, remote.transient_local, -1);
       contract::emit(event);
     }
@@ -92,11 +93,12 @@ int main(int argc, char** argv) try {
       if (got == 0) continue;
       cy_qos remote{};
       cy_matched(ep.handle, &remote);
-      const auto spec = dds::qos_spec(ep.info.qos);
+      cy_qos local{};
+      if (cy_local(ep.handle, &local) != 0) return 2;
       contract::emit({{"event", "received"}, {"topic", ep.info.name},
                       {"sample", idl::decode(schema, ep.info.type_name, {reser, reser_len})},
                       {"wire", idl::representation({wire, wire_len})},
-                      {"local_qos", contract::qos_json(spec.reliable, spec.transient_local, spec.history_depth)},
+                      {"local_qos", contract::qos_json(local.reliable, local.transient_local, local.depth)},
                       {"remote_qos", contract::qos_json(remote.reliable, remote.transient_local, -1)}});
       std::free(wire);
       std::free(reser);

@@ -1,9 +1,18 @@
 // Contract peer on Fast DDS, using the generated types and the project's DDS layer.
 #include <cstring>
+#include <condition_variable>
+#include <map>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <thread>
 
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/rtps/builtin/data/ReaderProxyData.h>
+#include <fastdds/rtps/builtin/data/WriterProxyData.h>
+#include <fastdds/rtps/reader/ReaderDiscoveryInfo.h>
+#include <fastdds/rtps/writer/WriterDiscoveryInfo.h>
 
 #include "concert/dds/endpoint.hpp"
 #include "peer_common.hpp"
@@ -53,6 +62,47 @@ idl::Json local_qos(const eprosima::fastdds::dds::DataReaderQos& q) {
                             q.history().depth);
 }
 
+/// The QoS of remote endpoints as their discovery data (SEDP) announced them on the wire, per
+/// topic: what this peer checks of the other side, whichever vendor wrote it. History depth is
+/// not part of the announcement (-1).
+class WireQos : public eprosima::fastdds::dds::DomainParticipantListener {
+ public:
+  void on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                              eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    if (info.status != eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) return;
+    note(info.info.topicName().to_string(), info.info.m_qos.m_reliability.kind,
+         info.info.m_qos.m_durability.kind);
+  }
+  void on_subscriber_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                               eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+    if (info.status != eprosima::fastrtps::rtps::ReaderDiscoveryInfo::DISCOVERED_READER) return;
+    note(info.info.topicName().to_string(), info.info.m_qos.m_reliability.kind,
+         info.info.m_qos.m_durability.kind);
+  }
+  /// The announced QoS of `topic`'s remote endpoint, waiting for its discovery until `deadline`.
+  std::optional<idl::Json> of(const std::string& topic, std::chrono::steady_clock::time_point deadline) {
+    std::unique_lock lock(mutex_);
+    changed_.wait_until(lock, deadline, [&] { return seen_.count(topic) > 0; });
+    const auto it = seen_.find(topic);
+    if (it == seen_.end()) return std::nullopt;
+    return it->second;
+  }
+
+ private:
+  void note(const std::string& topic, eprosima::fastdds::dds::ReliabilityQosPolicyKind reliability,
+            eprosima::fastdds::dds::DurabilityQosPolicyKind durability) {
+    {
+      std::lock_guard lock(mutex_);
+      seen_[topic] = contract::qos_json(reliability == eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS,
+                                        durability == eprosima::fastdds::dds::TRANSIENT_LOCAL_DURABILITY_QOS, -1);
+    }
+    changed_.notify_all();
+  }
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::map<std::string, idl::Json> seen_;
+};
+
 struct Endpoint {
   concert::dds::TopicInfo info;
   std::shared_ptr<void> keep;
@@ -65,7 +115,10 @@ struct Endpoint {
 
 int main(int argc, char** argv) try {
   const auto args = contract::parse_peer_args(argc, argv);
-  concert::dds::Participant participant({.name = args.write ? "contract_fast_writer" : "contract_fast_reader"});
+  WireQos wire_qos;
+  concert::dds::Participant participant(
+      {.name = args.write ? "contract_fast_writer" : "contract_fast_reader", .listener = &wire_qos});
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(args.timeout_ms);
   const auto& schema = idl::Schema::builtin();
   std::vector<Endpoint> endpoints;
 
@@ -89,7 +142,11 @@ int main(int argc, char** argv) try {
         ep.write = [writer, sample] { writer->write(sample); };
         eprosima::fastdds::dds::DataWriterQos q;
         writer->get()->get_qos(q);
-        contract::emit({{"event", "written"}, {"topic", info.name}, {"local_qos", local_qos(q)}});
+        idl::Json event = {{"event", "written"}, {"topic", info.name}, {"local_qos", local_qos(q)}};
+        if (args.wait_readers) {
+          if (auto remote = wire_qos.of(std::string(info.name), deadline)) event["remote_qos"] = *remote;
+        }
+        contract::emit(event);
         ep.keep = writer;
       } else {
         // One Recording per type: topics of the same type (the camera images) share the type the
@@ -102,16 +159,20 @@ int main(int argc, char** argv) try {
         ep.keep = std::shared_ptr<void>(reader, [&participant](void* r) {
           concert::dds::detail::delete_reader(participant, static_cast<eprosima::fastdds::dds::DataReader*>(r));
         });
-        ep.poll = [reader, recording, info, &schema]() -> std::optional<idl::Json> {
+        ep.poll = [reader, recording, info, &schema, &wire_qos, deadline]() -> std::optional<idl::Json> {
           T sample;
           eprosima::fastdds::dds::SampleInfo si;
           while (reader->take_next_sample(&sample, &si) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
             if (!si.valid_data) continue;
             eprosima::fastdds::dds::DataReaderQos q;
             reader->get_qos(q);
-            return idl::Json{{"event", "received"}, {"topic", info.name},
-                             {"sample", idl::decode(schema, info.type_name, serialize(sample))},
-                             {"wire", recording->wire}, {"local_qos", local_qos(q)}};
+            idl::Json event{{"event", "received"}, {"topic", info.name},
+                            {"sample", idl::decode(schema, info.type_name, serialize(sample))},
+                            {"wire", recording->wire}, {"local_qos", local_qos(q)}};
+            // A sample came, so its writer was discovered: its announcement is there or comes
+            // with the same discovery round.
+            if (auto remote = wire_qos.of(std::string(info.name), deadline)) event["remote_qos"] = *remote;
+            return event;
           }
           return std::nullopt;
         };
