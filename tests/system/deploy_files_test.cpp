@@ -148,15 +148,15 @@ TEST(DeployCompose, EveryServiceOnItsPcWithHostNetworkingAndDds) {
     EXPECT_TRUE(seen.count(name)) << name << " (" << pc << ") is missing";
 }
 
-TEST(DeployCompose, DockerComposeAcceptsItWhenInstalled) {
+// Its own ctest entry (system_deploy_compose_cli_test), reported as skipped without the CLI.
+TEST(DeployCompose, ComposeCliAcceptsIt) {
   FILE* probe = popen("docker compose version 2>/dev/null", "r");
   ASSERT_NE(probe, nullptr);
   char buf[256] = {};
   const bool have = fgets(buf, sizeof buf, probe) != nullptr;
   const int rc = pclose(probe);
   if (!have || rc != 0) {
-    std::cout << "no `docker compose` CLI here: the YAML checks above are the syntax check\n";
-    return;
+    GTEST_SKIP() << "no `docker compose` CLI on this machine: compose.yaml was checked as YAML only";
   }
   for (const char* profile : {"rt", "nav", "manip"}) {
     const auto cmd = "docker compose -f '" + (kDeploy / "compose.yaml").string() + "' --profile " +

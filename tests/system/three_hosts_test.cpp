@@ -257,7 +257,10 @@ TEST(ThreeHostSystem, ModelReachesEveryHostLateJoinerGetsItCutLinkStopsTheRobot)
     for (const auto& l : testing::lines(nav.out())) {
       if (l.rfind("safety STOPPED", 0) == 0) stopped = l;
     }
-    EXPECT_THAT(stopped, HasSubstr("planner@manip-pc silent for"));
+    // Which of the cut host's services the safety layer names first is a race between their
+    // liveliness deadlines; any of them is right, a service of another host is not.
+    EXPECT_TRUE(std::regex_search(stopped, std::regex("(planner|drill)@manip-pc silent for")))
+        << stopped;
     EXPECT_EQ(stopped.find("nav@nav-pc"), std::string::npos) << stopped;  // still connected
     EXPECT_TRUE(wait_for_err(safety, "safety: STOPPED: liveliness: ", 5s)) << all();
     EXPECT_TRUE(safety.running()) << all();
