@@ -61,10 +61,13 @@ const Eigen::Vector3d kAreas[2] = {{2.0, 0.0, 1.2}, {2.0, 0.4, 1.0}};
 /// A request's final answer: planning and the approach (the first from the start pose takes
 /// about 15 s), or the planner's own bound on the robot's silence.
 constexpr auto kAnswerBound = 120s;
-/// The planner publishes PLANNING as soon as it takes a request: nothing within this bound and
-/// the request never reached it (lost).
-constexpr auto kAckBound = 3s;
+/// The planner publishes PLANNING as soon as it takes a request. Sent again every kResendAfter
+/// meanwhile, a request still not taken within this generous bound never reached it (lost).
+constexpr auto kAckBound = 30s;
 constexpr auto kResendAfter = 1s;  // an unacknowledged request is sent again after this
+/// A request taken later than this is reported (TaskReport::acknowledged_late): a latency
+/// figure of the stack under the kills, not a loss.
+constexpr auto kAckReported = 3s;
 /// An operator's reset not answered within this bound (neither RUNNING nor a refusal) is lost.
 constexpr auto kResetAnswer = 1s;
 
@@ -99,6 +102,7 @@ struct Request {
   bool probe = false;
   bool with_planner = false;  // unanswered: the planner was down while it waited for it
   msg::PlanRequest message;   // as sent (sent again, same id, while unacknowledged)
+  Clock::time_point acknowledged_at{};  // when the planner's first answer to it came
 };
 
 std::string state_name(msg::ServiceState s) {
@@ -265,6 +269,7 @@ struct Chaos::Impl {
           std::lock_guard lock(m);
           const auto it = requests.find(r.request_id());
           if (it == requests.end() || it->second.final) return;
+          if (!it->second.acknowledged) it->second.acknowledged_at = Clock::now();
           it->second.acknowledged = true;
           if (r.state() == msg::PLAN_SUCCEEDED || r.state() == msg::PLAN_FAILED)
             it->second.final = r;
@@ -361,10 +366,16 @@ struct Chaos::Impl {
     up = std::make_unique<testing::Process>(
         dies_with_test({CONCERT_BIN, "up", "--assembly", o.assembly, "--world", o.world}), env);
     const auto deadline = Clock::now() + o.up_timeout;
-    // Which services `concert up` started: it starts them all at once, the required four first.
-    while (Clock::now() < deadline && up->running() && pid_of("robot") <= 0)
+    // Which services `concert up` started: it starts them all at once, the required four first,
+    // having said which are not built (bounded wait until it named each one way or the other).
+    const auto all_named = [&] {
+      const std::string log = up_log();
+      return std::all_of(services().begin(), services().end(), [&](const std::string& s) {
+        return pid_of(s) > 0 || log.find("running without " + s + "\n") != std::string::npos;
+      });
+    };
+    while (Clock::now() < deadline && up->running() && !all_named())
       std::this_thread::sleep_for(50ms);
-    std::this_thread::sleep_for(500ms);
     for (const auto& s : services())
       if (pid_of(s) > 0) started.push_back(s);
     if (started.size() < 4) return {"concert up did not start the stack" + logs()};
@@ -423,7 +434,29 @@ struct Chaos::Impl {
     return req.request_id();
   }
 
-  /// Waits for the final answer to request `id` (bounded).
+  /// Waits until the planner took request `id` (or was down, or the task stopped): false when
+  /// it did not within kAckBound. Unacknowledged, the request is sent again every kResendAfter
+  /// as the drill does (a request written before this writer matched a restarted planner's
+  /// reader is lost: PlanRequest is volatile).
+  bool taken(uint32_t id) {
+    const auto sent = [&] {
+      std::lock_guard lock(m);
+      return requests.at(id).sent;
+    }();
+    const auto gone = [&] { return task_stop || down_between("planner", sent, Clock::now()); };
+    for (auto slice = sent + kResendAfter;; slice += kResendAfter) {
+      const auto until = std::min(slice, sent + kAckBound);
+      if (wait_until(until, [&] { return requests.at(id).acknowledged || gone(); })) return true;
+      if (until >= sent + kAckBound) return false;
+      msg::PlanRequest again;
+      {
+        std::lock_guard lock(m);
+        again = requests.at(id).message;
+      }
+      request_writer.write(again);
+    }
+  }
+
   /// Waits for the final answer to request `id`: it must be taken within kAckBound, and
   /// answered within `bound`. Gives up on a request the planner was killed holding (it is lost
   /// with it) and on one never taken (lost).
@@ -434,21 +467,7 @@ struct Chaos::Impl {
       return requests.at(id).sent;
     }();
     const auto gone = [&] { return task_stop || down_between("planner", sent, Clock::now()); };
-    // Unacknowledged, sent again every kResendAfter as the drill does (a request written
-    // before this writer matched a restarted planner's reader is lost: PlanRequest is volatile).
-    bool taken = false;
-    for (auto slice = sent + kResendAfter;; slice += kResendAfter) {
-      const auto until = std::min(slice, sent + kAckBound);
-      taken = wait_until(until, [&] { return requests.at(id).acknowledged || gone(); });
-      if (taken || until >= sent + kAckBound) break;
-      msg::PlanRequest again;
-      {
-        std::lock_guard lock(m);
-        again = requests.at(id).message;
-      }
-      request_writer.write(again);
-    }
-    if (taken) {
+    if (taken(id)) {
       wait_until(sent + bound, [&] {
         result = requests.at(id).final;
         return result.has_value() || gone();
@@ -496,6 +515,11 @@ struct Chaos::Impl {
     for (const auto& [id, q] : requests) {
       if (q.probe) continue;
       ++r.sent;
+      if (q.acknowledged) {
+        const double took = seconds(q.acknowledged_at - q.sent);
+        r.slowest_ack_s = std::max(r.slowest_ack_s, took);
+        if (q.acknowledged_at - q.sent > kAckReported) ++r.acknowledged_late;
+      }
       const std::string head = "request " + std::to_string(id) + " (" +
                                std::to_string(seconds(q.sent - requests.begin()->second.sent)) +
                                " s): ";
@@ -736,10 +760,9 @@ struct Chaos::Impl {
         r.held_joint = i < joint_names.size() ? joint_names[i] : "joint " + std::to_string(i);
       }
     };
-    // A command sent now is refused, naming the stop (sent again if the planner never took it).
-    uint32_t probe = send(0, true);
-    if (!wait_until(Clock::now() + kAckBound, [&] { return requests.at(probe).acknowledged; }))
-      probe = send(0, true);
+    // A command sent now is refused, naming the stop (sent again until the planner took it).
+    const uint32_t probe = send(0, true);
+    taken(probe);
     std::optional<msg::PlanResult> answer_to_probe;
     const auto probe_deadline = Clock::now() + 60s;
     while (Clock::now() < probe_deadline) {
@@ -1014,7 +1037,10 @@ std::string summary(const TaskReport& task, const std::vector<RoundReport>& roun
   out << "task: " << task.sent << " requests, " << task.succeeded << " succeeded, "
       << task.failed_safety_stop << " failed for a safety stop, " << task.failed_other
       << " failed otherwise, " << task.lost_with_planner << " lost with the killed planner, "
-      << task.lost << " lost; operator resets sent again: " << resets_lost << "\n";
+      << task.lost << " lost; operator resets sent again: " << resets_lost << "\n"
+      << std::fixed << std::setprecision(2) << "requests taken by the planner later than "
+      << std::chrono::duration<double>(kAckReported).count() << " s: " << task.acknowledged_late
+      << " (slowest " << task.slowest_ack_s << " s; a figure, not a loss)\n";
   for (const auto& d : task.details) out << "  " << d << "\n";
   return out.str();
 }

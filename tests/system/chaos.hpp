@@ -62,7 +62,9 @@ struct RoundReport {
 
 /// The task's requests: each gets a final answer (succeeded, or failed with the reason) or is
 /// lost. A request the planner was killed holding is lost with it (counted apart); any other
-/// unanswered request is a lost command.
+/// unanswered request is a lost command: never taken by the planner within a generous bound
+/// (30 s, sent again every second meanwhile), or taken and never answered. How soon the planner
+/// took them is a figure (taken later than 3 s: acknowledged_late), not a loss.
 struct TaskReport {
   int sent = 0;
   int succeeded = 0;
@@ -70,6 +72,8 @@ struct TaskReport {
   int failed_other = 0;              ///< failed for another reason (e.g. the robot was killed)
   int lost_with_planner = 0;         ///< the planner was killed while holding it
   int lost = 0;                      ///< no answer, planner alive: a lost command
+  int acknowledged_late = 0;         ///< taken by the planner more than 3 s after sent
+  double slowest_ack_s = 0.0;        ///< longest sent -> taken [s]
   std::vector<std::string> details;  ///< one line per request not succeeded
 };
 

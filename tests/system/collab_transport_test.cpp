@@ -62,14 +62,14 @@ TEST(CollabTransport, TheWholeTaskWithAPersonPullingPastObstacles) {
   EXPECT_LT(r.end_error, 0.15);
   EXPECT_GT(r.base_travel, 0.8 * r.route_length);
   EXPECT_LT(r.follow_time, 40.0);
-  EXPECT_LT(r.mean_lag, 0.6);
-  // The person never had to pull hard: a spring of 150 N/m stretched at most ~0.5 m.
-  EXPECT_LT(r.peak_force, 90.0);
+  EXPECT_LT(r.mean_lag, 0.25);  // the README's bound (measured about 0.14 m)
+  // The person never had to pull hard (the README's bound; measured 33-35 N).
+  EXPECT_LT(r.peak_force, 60.0);
   EXPECT_GT(r.peak_force_estimated, 5.0);  // the robot felt the pull (from its joint torques)
-  // Clear of the pillar and the crate: the footprint never touched them, nothing hit the base
-  // or the arm, and the MPC's own spheres kept most of its margin (0.05 m; the grid's cells add
-  // up to 0.07 m on top, the soft constraint gives some back).
-  EXPECT_GT(r.min_clearance, 0.05);
+  // Clear of the pillar and the crate: the footprint kept the README's 8 cm (measured about
+  // 0.12 m), nothing hit the base or the arm, and the MPC's own spheres kept a margin (0.05 m;
+  // the grid's cells add up to 0.07 m on top, the soft constraint gives some back).
+  EXPECT_GT(r.min_clearance, 0.08);
   EXPECT_GT(r.min_sphere_clearance, 0.0);
   EXPECT_LT(r.peak_contact, 1.0);
   EXPECT_LE(r.failures, static_cast<int>(r.solve_ms.size() / 50));

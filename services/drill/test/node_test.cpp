@@ -48,11 +48,16 @@ TEST(DrillNode, AMissionWrittenAgainIsTakenOnce) {
   // The same mission id sent anew (a new stamp) is a new request: refused again.
   m.stamp_ns(m.stamp_ns() + 1);
   missions.write(m);
-  for (int i = 0; i < 50 && count(log.str(), "mission 7 refused") < 2; ++i)
+  // Then another mission: the service takes missions in order, so once it refused that one it
+  // had handled every copy of mission 7 (bounded wait).
+  msg::DrillMission next = m;
+  next.mission_id(8);
+  missions.write(next);
+  for (int i = 0; i < 300 && count(log.str(), "mission 8 refused") < 1; ++i)
     std::this_thread::sleep_for(100ms);
-  std::this_thread::sleep_for(300ms);
   stop = true;
   spinner.join();
+  EXPECT_EQ(count(log.str(), "mission 8 refused: no robot model yet"), 1u) << log.str();
   EXPECT_EQ(count(log.str(), "mission 7 refused: no robot model yet"), 2u) << log.str();
 }
 
@@ -111,8 +116,8 @@ TEST(DrillNode, APlanRequestIsSentAgainUntilThePlannerAcknowledgesIt) {
   concert::dds::Writer<msg::PlanResult> results(participant, concert::dds::topics::plan_result);
   std::atomic<bool> stop{false};
   std::thread spinner([&] { node.spin(stop); });
-  std::optional<msg::PlanRequest> first = requests.wait(6000ms);
-  ASSERT_TRUE(first) << "no plan request sent again within 6 s\n" << log.str();
+  std::optional<msg::PlanRequest> first = requests.wait(20s);
+  ASSERT_TRUE(first) << "no plan request sent again within 20 s\n" << log.str();
   EXPECT_EQ(first->source(), "drill");
   // Acknowledged: no copy after the one in flight.
   msg::PlanResult ack;
@@ -120,6 +125,8 @@ TEST(DrillNode, APlanRequestIsSentAgainUntilThePlannerAcknowledgesIt) {
   ack.state(msg::PLAN_PLANNING);
   results.write(ack);
   int copies = 0;
+  // A bounded observation window (2.5 resend periods), not a timing assumption: a resend that
+  // does not happen leaves no event to wait for.
   const auto until = std::chrono::steady_clock::now() + 5s;
   while (std::chrono::steady_clock::now() < until) {
     const auto r = requests.wait(200ms);
@@ -143,12 +150,14 @@ TEST(DrillNode, AnAcknowledgementAfterThePlanDoesNotUndoIt) {
   DrillNode node(participant, NodeParams{}, log);
   concert::dds::Reader<msg::PlanRequest> requests(participant, concert::dds::topics::plan_request);
   concert::dds::Writer<msg::PlanResult> results(participant, concert::dds::topics::plan_result);
-  ASSERT_TRUE(results.wait_for_readers(1, 5s));
+  // The test's own reader beside the drill's: what it got, the drill got too.
+  concert::dds::Reader<msg::PlanResult> delivered(participant, concert::dds::topics::plan_result);
+  ASSERT_TRUE(results.wait_for_readers(2, 5s));
   ASSERT_TRUE(requests.wait_for_writers(1, 5s));
   node.plan(0, Eigen::Isometry3d::Identity(), std::nullopt);
   std::atomic<bool> stop{false};
   std::thread spinner([&] { node.spin(stop); });
-  const std::optional<msg::PlanRequest> request = requests.wait(6000ms);
+  const std::optional<msg::PlanRequest> request = requests.wait(20s);
   ASSERT_TRUE(request) << log.str();
   msg::PlanResult planned;
   planned.request_id(request->request_id());
@@ -162,9 +171,15 @@ TEST(DrillNode, AnAcknowledgementAfterThePlanDoesNotUndoIt) {
   ack.request_id(request->request_id());
   ack.state(msg::PLAN_PLANNING);
   results.write(ack);
-  // Both in before the area is asked (delivery within the process is synchronous; the pause is
-  // a margin), so the acknowledgement is the last sample the drill got.
-  std::this_thread::sleep_for(300ms);
+  // Both in before the area is asked (delivery within the process is synchronous; the wait
+  // confirms it), so the acknowledgement is the last sample the drill got.
+  bool acknowledged = false;
+  for (int i = 0; i < 100 && !acknowledged; ++i) {
+    const auto got = delivered.wait(100ms);
+    acknowledged = got && got->request_id() == request->request_id() &&
+                   got->state() == msg::PLAN_PLANNING;
+  }
+  EXPECT_TRUE(acknowledged) << "the acknowledgement was not delivered\n" << log.str();
   const Outcome outcome = node.planning(0);
   stop = true;
   spinner.join();
@@ -182,6 +197,8 @@ TEST(DrillNode, AfterAStopNoPlanRequestIsSentAgain) {
   concert::dds::Reader<msg::PlanRequest> requests(participant, concert::dds::topics::plan_request);
   std::atomic<bool> stop{false};
   std::thread spinner([&] { node.spin(stop); });
+  // A bounded observation window (two resend periods), not a timing assumption: a resend that
+  // does not happen leaves no event to wait for.
   const std::optional<msg::PlanRequest> r = requests.wait(4000ms);
   stop = true;
   spinner.join();

@@ -50,6 +50,7 @@ TEST(SandSystem, CentreAreaAt30NOverTheStack) {
   concert::dds::Reader<msg::FinishAreas> areas(p, concert::dds::topics::finish_areas);
   concert::dds::Reader<msg::FinishStatus> statuses(p, concert::dds::topics::finish_status);
   concert::dds::Writer<msg::FinishCommand> commands(p, concert::dds::topics::finish_command);
+  concert::dds::Reader<msg::LaserScan> scans(p, concert::dds::topics::scan);
   // Safety must stay running throughout: every state heard is recorded.
   std::mutex safety_mutex;
   std::vector<msg::SafetyMode> modes;
@@ -64,7 +65,10 @@ TEST(SandSystem, CentreAreaAt30NOverTheStack) {
   EXPECT_EQ(a->tool(), "sand");
   EXPECT_NEAR(a->wall_distance(), 1.2, 1e-9);
   ASSERT_TRUE(commands.wait_for_readers(1, 10s));
-  std::this_thread::sleep_for(2s);  // the lidars' first scans
+  // The lidars' scans flow (the service measures the wall from them): a fresh one, heard here too.
+  while (scans.take()) {
+  }
+  ASSERT_TRUE(scans.wait(30s)) << "no laser scan from the robot" << logs();
 
   // A force <= 0 is refused with the reason (the CLI checks its range itself: a raw command).
   msg::FinishCommand c;

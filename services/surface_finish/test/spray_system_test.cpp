@@ -36,13 +36,16 @@ TEST(SpraySystem, ShortAreaOverTheStackMeetsTheAims) {
   concert::dds::Reader<msg::FinishAreas> areas(p, concert::dds::topics::finish_areas);
   concert::dds::Reader<msg::FinishStatus> statuses(p, concert::dds::topics::finish_status);
   concert::dds::Writer<msg::FinishCommand> commands(p, concert::dds::topics::finish_command);
+  concert::dds::Reader<msg::LaserScan> scans(p, concert::dds::topics::scan);
   ASSERT_TRUE(wait_for_err(finish, "surface_finish: model version 1: spray", 180s)) << logs();
   const auto a = areas.wait(10s);
   ASSERT_TRUE(a) << logs();
   EXPECT_NEAR(a->wall_distance(), 1.4, 1e-9);
   ASSERT_TRUE(commands.wait_for_readers(1, 10s));
-  // Give the lidars a moment to produce a scan.
-  std::this_thread::sleep_for(2s);
+  // The lidars' scans flow (the service measures the wall from them): a fresh one, heard here too.
+  while (scans.take()) {
+  }
+  ASSERT_TRUE(scans.wait(30s)) << "no laser scan from the robot" << logs();
   msg::FinishCommand c;
   c.request_id(4242);
   c.model_version(a->model_version());

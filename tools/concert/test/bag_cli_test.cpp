@@ -135,6 +135,19 @@ std::map<std::string, std::vector<Recorded>> read_file(bag::Reader& reader) {
   return by_topic;
 }
 
+/// Messages per topic in a file still being recorded, up to its last flushed chunk (the recorder
+/// writes its open chunk every second); empty while the file cannot be read yet.
+std::map<std::string, size_t> recorded_so_far(const std::string& file) {
+  std::map<std::string, size_t> counts;
+  try {
+    bag::Reader growing(file);
+    for (const auto& [topic, messages] : read_file(growing)) counts[topic] = messages.size();
+  } catch (const std::exception&) {
+    counts.clear();
+  }
+  return counts;
+}
+
 TEST(BagCli, RecordsEveryQosClassSampleForSampleAndFoxglovesReaderAgrees) {
   testing::TempDir dir("bag-cli");
   const std::string file = dir.path() + "/run.mcap";
@@ -168,7 +181,8 @@ TEST(BagCli, RecordsEveryQosClassSampleForSampleAndFoxglovesReaderAgrees) {
     while (!p->matched() && Clock::now() < deadline) std::this_thread::sleep_for(10ms);
     ASSERT_TRUE(p->matched());
   }
-  std::this_thread::sleep_for(300ms);
+  // Both directions matched: the recorder's reader said "1 writer(s)" (wait_recording), the
+  // writers have their reader.
 
   for (uint32_t i = 0; i < 200; ++i) {
     joints.write(sample(joints.type(), 100 + i));
@@ -187,7 +201,17 @@ TEST(BagCli, RecordsEveryQosClassSampleForSampleAndFoxglovesReaderAgrees) {
     std::this_thread::sleep_for(5ms);
   }
   for (Publisher* p : {&estop, &status, &command}) p->wait_acknowledged();
-  std::this_thread::sleep_for(500ms);
+  // The streams' samples in flight reach the file too before the recorder stops: wait (bounded)
+  // until the file as it grows holds what is checked below.
+  const auto in_file = [&] {
+    auto got = recorded_so_far(file);
+    return got[topics[0]] == estop.sent().size() && got[topics[1]] == status.sent().size() &&
+           got[topics[3]] == command.sent().size() &&
+           got[topics[2]] * 100 >= joints.sent().size() * 95 &&
+           got[topics[4]] * 100 >= rgb.sent().size() * 95;
+  };
+  for (const auto until = Clock::now() + 30s; !in_file() && Clock::now() < until;)
+    std::this_thread::sleep_for(100ms);
   ASSERT_EQ(recorder.stop(20s), 0) << recorder.err();  // SIGINT: the file is closed properly
   EXPECT_THAT(recorder.out(), HasSubstr("into " + file));
 
@@ -417,9 +441,13 @@ TEST(BagCli, PlayPublishesWithTheRecordedTimingAndTopicEchoSeesIt) {
   EXPECT_GE(l.at("passes").get<int>(), 2);
   EXPECT_GE(l.at("topics").at("concert/robot/joint_command").get<int>(), 14);
   ASSERT_EQ(echo.wait(30s), 0) << echo.err();
-  // Ctrl-C stops a looping play.
+  // Ctrl-C stops a looping play (once its commands come: bounded wait).
+  const size_t commands_before = commands.size();
   Process endless({CONCERT_BIN, "bag", "play", file, "--loop", "--wait", "0", "--json"});
-  std::this_thread::sleep_for(1500ms);
+  for (const auto until = Clock::now() + 30s;
+       commands.size() <= commands_before && Clock::now() < until;)
+    std::this_thread::sleep_for(10ms);
+  EXPECT_GT(commands.size(), commands_before) << "the looping play published nothing";
   EXPECT_EQ(endless.stop(10s), 0) << endless.err();
   EXPECT_GE(Json::parse(endless.out()).at("messages").get<int>(), 1);
   const auto lines = testing::lines(echo.out());
@@ -447,11 +475,19 @@ TEST(BagCli, ARecorderKilledMidRecordingLeavesAFileReadableUpToItsLastCompleteRe
   wait_recording(recorder, {"concert/robot/joint_state"});
   const auto deadline = Clock::now() + 20s;
   while (!joints.matched() && Clock::now() < deadline) std::this_thread::sleep_for(10ms);
-  // 2.6 s at 500 Hz: the recorder writes its open chunk every second.
-  for (uint32_t i = 0; i < 1300; ++i) {
-    joints.write(sample(joints.type(), i));
-    std::this_thread::sleep_for(2ms);
-  }
+  uint32_t written = 0;
+  const auto write_for = [&](uint32_t count) {  // at 500 Hz
+    for (const uint32_t end = written + count; written < end; ++written) {
+      joints.write(sample(joints.type(), written));
+      std::this_thread::sleep_for(2ms);
+    }
+  };
+  // The recorder writes its open chunk every second: until the file holds a flushed chunk of
+  // 100 samples or more (bounded: 30000 samples, 60 s), then 0.6 s more, in its open chunk.
+  do {
+    write_for(50);
+  } while (recorded_so_far(file)["concert/robot/joint_state"] < 100 && written < 30000);
+  write_for(300);
   ::kill(recorder.pid(), SIGKILL);
   recorder.wait(10s);
 
@@ -460,8 +496,8 @@ TEST(BagCli, ARecorderKilledMidRecordingLeavesAFileReadableUpToItsLastCompleteRe
   const auto recorded = read_file(reader);
   ASSERT_TRUE(recorded.count("concert/robot/joint_state"));
   const size_t n = recorded.at("concert/robot/joint_state").size();
-  EXPECT_GE(n, 100u) << "at least the first second's chunk";
-  EXPECT_LT(n, 1300u);
+  EXPECT_GE(n, 100u) << "at least the first flushed chunk";
+  EXPECT_LT(n, joints.sent().size());
   for (size_t i = 0; i < n; ++i) {
     const auto& bytes = recorded.at("concert/robot/joint_state")[i].bytes;
     EXPECT_NE(std::find(joints.sent().begin(), joints.sent().end(), bytes), joints.sent().end());
