@@ -170,7 +170,7 @@ function(concert_check_service_links)
   endforeach()
   if(errors)
     message(FATAL_ERROR "A service links another service:${errors}\n"
-                        "Services are independent: move what they share into libs/ (DESIGN.md section 3).")
+                        "Services are independent: move what they share into libs/ (docs/architecture.md, section 4).")
   endif()
 endfunction()
 
