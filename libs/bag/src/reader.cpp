@@ -45,6 +45,18 @@ struct Reader::Scan {
 Reader::Reader(const std::string& path) : path_(path) {
   file_ = std::fopen(path.c_str(), "rb");
   if (file_ == nullptr) throw BagError(path + ": cannot open: " + std::strerror(errno));
+  try {
+    open_header();
+  } catch (...) {
+    // A constructor that throws runs no destructor: the file would stay open.
+    std::fclose(file_);
+    file_ = nullptr;
+    throw;
+  }
+}
+
+void Reader::open_header() {
+  const std::string& path = path_;
   std::fseek(file_, 0, SEEK_END);
   size_ = static_cast<uint64_t>(std::ftell(file_));
   std::fseek(file_, 0, SEEK_SET);

@@ -236,6 +236,21 @@ TEST(McapErrors, CorruptBytesAreReportedNamingTheRecord) {
               HasSubstr("missing.mcap: cannot open: No such file or directory"));
 }
 
+// A file refused by the constructor is closed again (a reader that kept it open ran out of
+// file descriptors after some thousand bad files: found by tests/fuzz/fuzz_mcap).
+TEST(McapErrors, AFileTheReaderRefusesIsClosed) {
+  testing::TempDir dir("bag-test");
+  const std::string bad = dir.path() + "/bad.mcap";
+  write_bytes(bad, {'h', 'e', 'l', 'l', 'o', ' ', 'w', 'o', 'r', 'l', 'd'}, 11);
+  const auto open_files = [] {
+    return std::distance(std::filesystem::directory_iterator("/proc/self/fd"),
+                         std::filesystem::directory_iterator{});
+  };
+  const auto before = open_files();
+  for (int i = 0; i < 100; ++i) EXPECT_THROW(Reader r(bad), BagError);
+  EXPECT_EQ(open_files(), before);
+}
+
 TEST(McapErrors, TheWriterRefusesWhatTheFileCannotHold) {
   testing::TempDir dir("bag-test");
   EXPECT_THROW(Writer(dir.path() + "/no/such/dir/a.mcap"), BagError);

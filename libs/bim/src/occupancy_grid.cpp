@@ -2,7 +2,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -30,8 +32,13 @@ OccupancyGrid OccupancyGrid::filled(int width, int height, double resolution,
 }
 
 Eigen::Vector2i OccupancyGrid::cell_of(const Eigen::Vector2d& p) const {
-  return {static_cast<int>(std::floor((p.x() - origin.x()) / resolution)),
-          static_cast<int>(std::floor((p.y() - origin.y()) / resolution))};
+  // A point far off the grid (an element of another storey kilometres away, in georeferenced
+  // coordinates) gets a cell far outside it, never an int conversion out of range (undefined).
+  const auto index = [](double count) {
+    if (std::isnan(count)) return std::numeric_limits<int>::min();
+    return static_cast<int>(std::clamp(std::floor(count), -1e9, 1e9));
+  };
+  return {index((p.x() - origin.x()) / resolution), index((p.y() - origin.y()) / resolution)};
 }
 
 Eigen::Vector2d OccupancyGrid::center_of(int col, int row) const {

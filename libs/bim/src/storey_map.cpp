@@ -2,11 +2,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace concert::bim {
 
 namespace {
+
+/// A cell index from a (floored or ceiled) count of cells: a vertex far off the grid gives an
+/// index far outside it, never an int conversion out of range (undefined behaviour).
+int cell_index(double cells) {
+  if (std::isnan(cells)) return std::numeric_limits<int>::min();
+  return static_cast<int>(std::clamp(cells, -1e9, 1e9));
+}
+
 
 /// Touching is not overlapping: material exactly on a cell border marks one side only.
 constexpr double kEps = 1e-7;
@@ -110,13 +119,13 @@ void mark_surface(const Mesh& mesh, double z_min, double z_max, Mask& mask) {
       hi = hi.cwiseMax(v.head<2>());
     }
     const int ca = std::max(
-        mask.c0(), static_cast<int>(std::floor((lo.x() - g.origin.x() + kEps) / g.resolution)));
+        mask.c0(), cell_index(std::floor((lo.x() - g.origin.x() + kEps) / g.resolution)));
     const int cb = std::min(
-        mask.c1(), static_cast<int>(std::floor((hi.x() - g.origin.x() - kEps) / g.resolution)));
+        mask.c1(), cell_index(std::floor((hi.x() - g.origin.x() - kEps) / g.resolution)));
     const int ra = std::max(
-        mask.r0(), static_cast<int>(std::floor((lo.y() - g.origin.y() + kEps) / g.resolution)));
+        mask.r0(), cell_index(std::floor((lo.y() - g.origin.y() + kEps) / g.resolution)));
     const int rb = std::min(
-        mask.r1(), static_cast<int>(std::floor((hi.y() - g.origin.y() - kEps) / g.resolution)));
+        mask.r1(), cell_index(std::floor((hi.y() - g.origin.y() - kEps) / g.resolution)));
     for (int r = ra; r <= rb; ++r) {
       for (int c = ca; c <= cb; ++c) {
         const Eigen::Vector2d cell_lo =
@@ -161,9 +170,9 @@ void mark_section(const Mesh& mesh, double z, Mask& mask) {
     std::sort(xs.begin(), xs.end());
     for (std::size_t i = 0; i + 1 < xs.size(); i += 2) {
       const int ca = std::max(
-          mask.c0(), static_cast<int>(std::ceil((xs[i] - g.origin.x()) / g.resolution - 0.5)));
+          mask.c0(), cell_index(std::ceil((xs[i] - g.origin.x()) / g.resolution - 0.5)));
       const int cb = std::min(
-          mask.c1(), static_cast<int>(std::floor((xs[i + 1] - g.origin.x()) / g.resolution - 0.5)));
+          mask.c1(), cell_index(std::floor((xs[i + 1] - g.origin.x()) / g.resolution - 0.5)));
       for (int c = ca; c <= cb; ++c) mask.set(c, r);
     }
   }

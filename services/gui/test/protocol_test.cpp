@@ -32,6 +32,7 @@ TEST(Protocol, ParsesEachOperation) {
 
 TEST(Protocol, BadMessagesAreRefusedSayingWhat) {
   EXPECT_THAT(error_of("{nope"), HasSubstr("not JSON"));
+  EXPECT_THAT(error_of(R"({"op": "ping", "id": 1e400})"), HasSubstr("not JSON"));  // beyond double
   EXPECT_THAT(error_of("[1]"), HasSubstr("JSON object"));
   EXPECT_THAT(error_of(R"({"topic":"x"})"), HasSubstr("'op'"));
   EXPECT_THAT(error_of(R"({"op":"dance"})"), HasSubstr("unknown op 'dance'"));

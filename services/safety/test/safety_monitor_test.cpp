@@ -327,6 +327,7 @@ TEST(LatchedState, RunningEmptyAndErrorsNamingFileAndKey) {
             "s.yaml: cause_keys: expected one per cause (1 causes, 0 keys) (line 3)");
   EXPECT_EQ(error_of("mode: STOPPED\n"), "s.yaml: causes: a stop needs its causes");
   EXPECT_EQ(error_of("engaged: [nowhere]"), "s.yaml: engaged: unknown e-stop input 'nowhere' (line 1)");
+  EXPECT_EQ(error_of("mode: RUNNING\nwatched: {a@b: \"\xe6\x31\"}\n"), "s.yaml: not valid UTF-8 (byte 30)");
   EXPECT_EQ(error_of("engaged: [wireless]"),
             "s.yaml: engaged: RUNNING with an e-stop input engaged (line 1)");
   EXPECT_EQ(error_of("watched: {planner: x}"), "s.yaml: watched: 'planner' is not service@host (line 1)");

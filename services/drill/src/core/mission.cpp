@@ -35,6 +35,7 @@ class Reader {
     if (!node.IsMap()) fail(path, "expected a map with " + join(keys));
     std::set<std::string> seen;
     for (const auto& entry : node) {
+      if (!entry.first.IsScalar()) fail(path, "a key that is not a name");
       const auto key = entry.first.as<std::string>();
       if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
         fail(child(path, key), "unknown key (expected " + join(keys) + ")");
@@ -153,8 +154,10 @@ AreaSpec read_area(const Reader& r, const YAML::Node& node, std::size_t index) {
 
 }  // namespace
 
-Mission parse_mission(const std::string& yaml, const std::string& source,
-                      const std::filesystem::path& base_dir) {
+namespace {
+
+Mission parse_mission_yaml(const std::string& yaml, const std::string& source,
+                           const std::filesystem::path& base_dir) {
   const Reader r(source);
   const YAML::Node root = parse_yaml<DrillError>(yaml, "mission '" + source + "'");
   if (!root || root.IsNull()) r.fail("areas", "missing: a mission needs at least one area");
@@ -192,6 +195,18 @@ Mission parse_mission(const std::string& yaml, const std::string& source,
     mission.areas.push_back(std::move(area));
   }
   return mission;
+}
+
+}  // namespace
+
+Mission parse_mission(const std::string& yaml, const std::string& source,
+                      const std::filesystem::path& base_dir) {
+  try {
+    return parse_mission_yaml(yaml, source, base_dir);
+  } catch (const YAML::Exception& e) {
+    // What the checks above do not name (a node of an unexpected kind deep inside).
+    throw DrillError("mission '" + source + "': " + e.what());
+  }
 }
 
 Mission load_mission(const std::filesystem::path& file) {

@@ -24,7 +24,9 @@ ClientMessage parse_client_message(std::string_view text) {
   Json j;
   try {
     j = Json::parse(text);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {
+    // parse_error, and out_of_range for a number beyond double (e.g. 1e400): either way a
+    // message the browser got wrong, answered with the reason, never thrown at the web server.
     throw ProtocolError(std::string("message is not JSON: ") + e.what());
   }
   if (!j.is_object()) throw ProtocolError("message must be a JSON object, got " + std::string(j.type_name()));

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "concert/common/text.hpp"
 #include "concert/config/config.hpp"
 #include "safety/safety_monitor.hpp"
 
@@ -81,6 +82,11 @@ LatchedState read_state(config::Document& doc) {
 }  // namespace
 
 LatchedState parse_latched_state(const std::string& yaml, const std::string& origin) {
+  // The service writes UTF-8 only; other bytes mean a damaged file, and yaml-cpp would pass them
+  // through into names that the next write changes (a state that does not read back as itself).
+  if (const auto at = invalid_utf8_at(yaml)) {
+    throw config::ConfigError(origin + ": not valid UTF-8 (byte " + std::to_string(*at) + ")");
+  }
   return config::Document::parse(yaml, origin).read_with(read_state);
 }
 

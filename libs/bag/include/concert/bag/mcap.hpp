@@ -211,6 +211,7 @@ class Reader {
 
  private:
   struct Scan;
+  void open_header();  // the constructor's reading of the magic and the Header
   bool read_summary_section();
   void scan(Scan& scan);
 

@@ -58,6 +58,8 @@ HolePattern pattern(config::Map& entry, int id) {
   p.id = id;
   std::vector<double> centre;
   entry.numbers("centre", centre, 2);
+  // An empty value (`centre:`) leaves the list as it was: empty.
+  if (centre.size() != 2) entry.fail("centre", "expected [x, y] [m], got nothing");
   p.centre = {centre[0], centre[1]};
   entry.number("direction", p.direction);
   entry.integer("count", p.count, 1, 1000);
