@@ -11,6 +11,11 @@ FUZZ_TARGETS ?=
 FUZZ_SEED ?= 0
 FUZZ_CMAKE_ARGS ?=
 
+# ccache (installed by deploy/install-deps.sh, used by cmake/ConcertProject.cmake): paths below
+# the source tree are hashed relative to it, so a clone in another folder (CI's) reuses the cache.
+export CCACHE_BASEDIR ?= $(CURDIR)
+export CCACHE_NOHASHDIR ?= 1
+
 .PHONY: all deps configure build test demo bench chaos fuzz fuzz-configure fuzz-smoke idl-lock clean help
 
 all: build
@@ -18,7 +23,7 @@ all: build
 help:
 	@echo "make demo   install what is missing, build, run the stack in simulation"
 	@echo "make test   install what is missing, build, run every test with ctest"
-	@echo "make bench  build and run the benchmarks (figures go in README.md)"
+	@echo "make bench  build and run the benchmarks (BENCHES=\"bench_x ...\": some); figures go to docs/benchmarks.md"
 	@echo "make chaos  the chaos test: SIGKILL every service of concert up under a task"
 	@echo "make fuzz   clang build of the fuzz targets, each run FUZZ_SECONDS (default 60)"
 	@echo "make fuzz-smoke  CI's short fuzz run (5 s a target, fixed seed, fuzz_cli left out)"
@@ -40,11 +45,13 @@ test: build
 demo: build
 	./deploy/demo.sh $(BUILD_DIR)
 
+# BENCHES: a subset of the bench_* programs (default: all); figures go to docs/benchmarks.md.
+BENCHES ?=
 bench: build
-	./deploy/bench.sh $(BUILD_DIR)
+	./deploy/bench.sh $(BUILD_DIR) $(BENCHES)
 
-# The chaos test (tests/system/README.md): SIGKILLs every service of `concert up` under a task.
-# Not part of `make test` while the bug it found is open. CHAOS_DOMAIN: its DDS domain.
+# The chaos test alone (tests/system/README.md; make test runs it too): SIGKILLs every service
+# of `concert up` under a task. CHAOS_DOMAIN: its DDS domain.
 CHAOS_DOMAIN ?= 231
 chaos: build
 	CONCERT_DOMAIN_ID=$(CHAOS_DOMAIN) $(BUILD_DIR)/tests/system/system_chaos_test
@@ -62,8 +69,8 @@ fuzz: fuzz-configure
 	cmake --build $(FUZZ_BUILD_DIR) -j$(JOBS) --target $(if $(FUZZ_TARGETS),$(FUZZ_TARGETS),fuzz_all)
 	FUZZ_SEED=$(FUZZ_SEED) ./tests/fuzz/run.sh $(FUZZ_BUILD_DIR) $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
-# CI: every target but the heavy fuzz_cli, 5 s each with a fixed seed (regressions of all of
-# them replay in `make test`).
+# CI (every run, .ci/run): every target but the heavy fuzz_cli, 5 s each with a fixed seed
+# (regressions of all of them replay in `make test`).
 fuzz-smoke: fuzz-configure
 	cmake --build $(FUZZ_BUILD_DIR) -j$(JOBS) --target fuzz_smoke
 	FUZZ_SEED=1 ./tests/fuzz/run.sh $(FUZZ_BUILD_DIR) 5 --smoke
