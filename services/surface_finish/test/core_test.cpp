@@ -238,6 +238,40 @@ TEST(Serpentine, SandingMoveEndsOffTheWallSoEveryAreaPlans) {
   }
 }
 
+// A run ends backed off the wall by the approach (5 cm); the next run starts there, a hair nearer
+// with the arm's tracking error. Its move from there is planned: it goes no nearer than where it
+// starts (the sand system test's second run was refused so, now and then).
+TEST(Serpentine, TheNextRunStartsWhereTheLastEndedJustUnderTheApproach) {
+  auto model = test::model_of(test::source_dir() / "deploy/demo/sanding_robot.yaml", test::project_db());
+  ReachParams rp;
+  rp.contact_force = 30.0;
+  Reach reach(model, model::EndEffectorKind::kSanding, rp);
+  const AreaMap& m = areas_of(reach, Task::kSand, 0.0);
+  const WallFrame wall = wall_of(reach, m);
+  const ToolSpec disc{Task::kSand, 0.0, 0.23, 0.1};
+  const PathParams sanding{0.1, 0.5, 0.02, 0.05, 0.05, 0.0, 0.0, 0.8};
+  const Area& centre = m.area("centre");
+  const auto strokes = serpentine_strokes(centre.rect, disc, 0.0);
+  const SerpentinePlan first =
+      plan_serpentine(reach, wall, centre.rect, disc, m.roll, sanding,
+                      Eigen::VectorXd::Zero(model->kinematics().dof()),
+                      &m.posture_near(strokes.front().x, strokes.front().y_start));
+  // Where the first run ends, 1.5 mm nearer the wall.
+  const Eigen::Vector3d end = first.samples.back().wall;
+  ASSERT_NEAR(end.z(), 0.05, 1e-6);
+  const ReachPose under =
+      reach.solve(Reach::target(wall, end.x(), end.y(), end.z() - 0.0015, m.roll), wall, first.samples.back().q);
+  ASSERT_TRUE(under.ok) << under.reason;
+  SerpentinePlan second;
+  try {
+    second = plan_serpentine(reach, wall, centre.rect, disc, m.roll, sanding, under.q,
+                             &m.posture_near(strokes.front().x, strokes.front().y_start));
+  } catch (const FinishError& e) {
+    FAIL() << "the next run from where the last ended was refused: " << e.what();
+  }
+  EXPECT_FALSE(second.samples.empty());
+}
+
 // The planned path fed to the deposition model (TCP poses interpolated at 2 ms).
 SprayDeposition deposit(const SerpentinePlan& plan, const WallFrame& wall, double extra_standoff = 0.0) {
   SprayDeposition dep(wall, plan.rect, plan.tool, plan.params.speed, static_cast<int>(plan.strokes.size()));

@@ -36,6 +36,11 @@ struct PathParams {
   /// approach speed leads from there to it. The move itself keeps the TCP 5 cm off the wall, so
   /// it cannot end at 5 cm: arriving obliquely, it dips under the pose it goes to.
   double move_standoff{0.1};
+  /// The joint-space move keeps the TCP this far off the wall [m], or, when it starts nearer
+  /// (a run ends backed off by `approach`, and the next starts there within the tracking's
+  /// error), no nearer than where it starts less `start_tolerance`.
+  double move_clearance{0.05};
+  double start_tolerance{0.002};  ///< [m]
 };
 
 /// One vertical stroke, in wall coordinates.

@@ -179,6 +179,8 @@ SerpentinePlan plan_serpentine(Reach& reach, const WallFrame& wall, const Rect& 
     move = std::max(move, 1.5 * std::abs(q0[j] - q_start[j]) / vel);
   }
   std::vector<PathSample> out;
+  const double start_off = wall.coordinates(reach.tcp_pose(q_start).translation()).z();
+  const double clearance = std::min(params.move_clearance, start_off - params.start_tolerance);
   if (move > 1e-6) {
     move = std::max(move, 1.0);
     const int n = std::max(2, static_cast<int>(std::ceil(move / params.sample_period)));
@@ -191,7 +193,7 @@ SerpentinePlan plan_serpentine(Reach& reach, const WallFrame& wall, const Rect& 
       m.tcp = reach.tcp_pose(m.q);
       m.wall = wall.coordinates(m.tcp.translation());
       if (auto hit = reach.self_collision(m.q)) throw FinishError("path refused: move to the approach pose: self collision " + *hit);
-      if (m.wall.z() < 0.05) {
+      if (m.wall.z() < clearance) {
         char b[160];
         std::snprintf(b, sizeof b, "path refused: the move to the approach pose brings the tool %.0f mm from the wall", m.wall.z() * 1000.0);
         throw FinishError(b);
