@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Runs the benchmark programs of the build (targets named bench_*) and writes their current
 # figures into docs/benchmarks.md: one section per benchmark with the date, the commit, the
-# machine and its load, and what the program printed. A benchmark not run this time keeps its
-# section as it was; earlier results are in git history, not kept in the file.
+# machine and its load, and what the program printed (a failed run too, with its exit code). A
+# benchmark not run this time keeps its section as it was; earlier results are in git history.
 #
 # Usage: deploy/bench.sh [BUILD_DIR] [BENCH...]
 #   BENCH: program names (default: every bench_* program of the build). Arguments for one
@@ -17,6 +17,7 @@ shift || true
 export CONCERT_DOMAIN_ID=${CONCERT_DOMAIN_ID:-199}
 doc="$root/docs/benchmarks.md"
 outdir="$build/bench"
+[ -d "$build" ] || { echo "bench.sh: no build folder '$build' (usage: deploy/bench.sh [BUILD_DIR] [BENCH...])" >&2; exit 2; }
 mkdir -p "$outdir"
 
 mapfile -t all < <(find "$build" -type f -executable -name 'bench_*' ! -path '*/CMakeFiles/*' | sort)
@@ -34,7 +35,8 @@ else
 fi
 
 commit=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
-git -C "$root" diff --quiet HEAD 2>/dev/null || commit="$commit (with uncommitted changes)"
+# (docs/benchmarks.md itself, rewritten by an earlier run, does not count as a change.)
+git -C "$root" diff --quiet HEAD -- . ':!docs/benchmarks.md' 2>/dev/null || commit="$commit (with uncommitted changes)"
 cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
 machine="$(nproc) cores ($cpu), $(free -g | awk '/^Mem:/ {print $2}') GiB, $(. /etc/os-release && echo "$PRETTY_NAME"), build type $(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$build/CMakeCache.txt" 2>/dev/null)"
 
@@ -43,8 +45,8 @@ declare -A kept
 if [ -f "$doc" ]; then
   name=""
   while IFS= read -r line; do
-    if [[ "$line" =~ ^\<!--\ bench:([a-z_0-9]+)\ --\>$ ]]; then name=${BASH_REMATCH[1]}; kept[$name]=""; continue; fi
-    if [[ "$line" =~ ^\<!--\ /bench:([a-z_0-9]+)\ --\>$ ]]; then name=""; continue; fi
+    if [[ "$line" =~ ^\<!--\ bench:([A-Za-z0-9_.-]+)\ --\>$ ]]; then name=${BASH_REMATCH[1]}; kept[$name]=""; continue; fi
+    if [[ "$line" =~ ^\<!--\ /bench:([A-Za-z0-9_.-]+)\ --\>$ ]]; then name=""; continue; fi
     [ -n "$name" ] && kept[$name]+="$line"$'\n'
   done < "$doc"
 fi
@@ -52,7 +54,7 @@ fi
 failed=()
 for b in "${benches[@]}"; do
   name=$(basename "$b")
-  var="BENCH_ARGS_$name"
+  var="BENCH_ARGS_${name//[^A-Za-z0-9_]/_}"
   read -r -a args <<< "${!var:-}"
   echo "=== $name ${args[*]:-}"
   load_before=$(cut -d' ' -f1-3 /proc/loadavg)

@@ -1,5 +1,6 @@
 // Contract peer on Fast DDS, using the generated types and the project's DDS layer.
 #include <cstring>
+#include <array>
 #include <condition_variable>
 #include <map>
 #include <memory>
@@ -65,42 +66,52 @@ idl::Json local_qos(const eprosima::fastdds::dds::DataReaderQos& q) {
 /// The QoS of remote endpoints as their discovery data (SEDP) announced them on the wire, per
 /// topic: what this peer checks of the other side, whichever vendor wrote it. History depth is
 /// not part of the announcement (-1).
+/// Fast DDS also reports the participant's own endpoints through these callbacks: only those
+/// of other participants are recorded, writers and readers apart.
 class WireQos : public eprosima::fastdds::dds::DomainParticipantListener {
  public:
-  void on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
+  enum class Side { kWriters, kReaders };
+
+  void on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant* participant,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
     if (info.status != eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) return;
-    note(info.info.topicName().to_string(), info.info.m_qos.m_reliability.kind,
+    if (info.info.guid().guidPrefix == participant->guid().guidPrefix) return;
+    note(Side::kWriters, info.info.topicName().to_string(), info.info.m_qos.m_reliability.kind,
          info.info.m_qos.m_durability.kind);
   }
-  void on_subscriber_discovery(eprosima::fastdds::dds::DomainParticipant*,
+  void on_subscriber_discovery(eprosima::fastdds::dds::DomainParticipant* participant,
                                eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
     if (info.status != eprosima::fastrtps::rtps::ReaderDiscoveryInfo::DISCOVERED_READER) return;
-    note(info.info.topicName().to_string(), info.info.m_qos.m_reliability.kind,
+    if (info.info.guid().guidPrefix == participant->guid().guidPrefix) return;
+    note(Side::kReaders, info.info.topicName().to_string(), info.info.m_qos.m_reliability.kind,
          info.info.m_qos.m_durability.kind);
   }
-  /// The announced QoS of `topic`'s remote endpoint, waiting for its discovery until `deadline`.
-  std::optional<idl::Json> of(const std::string& topic, std::chrono::steady_clock::time_point deadline) {
+  /// The announced QoS of a remote writer (or reader) of `topic`, waiting for its discovery
+  /// until `deadline`.
+  std::optional<idl::Json> of(Side side, const std::string& topic,
+                              std::chrono::steady_clock::time_point deadline) {
+    auto& seen = seen_[static_cast<int>(side)];
     std::unique_lock lock(mutex_);
-    changed_.wait_until(lock, deadline, [&] { return seen_.count(topic) > 0; });
-    const auto it = seen_.find(topic);
-    if (it == seen_.end()) return std::nullopt;
+    changed_.wait_until(lock, deadline, [&] { return seen.count(topic) > 0; });
+    const auto it = seen.find(topic);
+    if (it == seen.end()) return std::nullopt;
     return it->second;
   }
 
  private:
-  void note(const std::string& topic, eprosima::fastdds::dds::ReliabilityQosPolicyKind reliability,
+  void note(Side side, const std::string& topic, eprosima::fastdds::dds::ReliabilityQosPolicyKind reliability,
             eprosima::fastdds::dds::DurabilityQosPolicyKind durability) {
     {
       std::lock_guard lock(mutex_);
-      seen_[topic] = contract::qos_json(reliability == eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS,
-                                        durability == eprosima::fastdds::dds::TRANSIENT_LOCAL_DURABILITY_QOS, -1);
+      seen_[static_cast<int>(side)][topic] =
+          contract::qos_json(reliability == eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS,
+                             durability == eprosima::fastdds::dds::TRANSIENT_LOCAL_DURABILITY_QOS, -1);
     }
     changed_.notify_all();
   }
   std::mutex mutex_;
   std::condition_variable changed_;
-  std::map<std::string, idl::Json> seen_;
+  std::array<std::map<std::string, idl::Json>, 2> seen_;
 };
 
 struct Endpoint {
@@ -144,7 +155,9 @@ int main(int argc, char** argv) try {
         writer->get()->get_qos(q);
         idl::Json event = {{"event", "written"}, {"topic", info.name}, {"local_qos", local_qos(q)}};
         if (args.wait_readers) {
-          if (auto remote = wire_qos.of(std::string(info.name), deadline)) event["remote_qos"] = *remote;
+          if (auto remote = wire_qos.of(WireQos::Side::kReaders, std::string(info.name), deadline)) {
+            event["remote_qos"] = *remote;
+          }
         }
         contract::emit(event);
         ep.keep = writer;
@@ -171,7 +184,9 @@ int main(int argc, char** argv) try {
                             {"wire", recording->wire}, {"local_qos", local_qos(q)}};
             // A sample came, so its writer was discovered: its announcement is there or comes
             // with the same discovery round.
-            if (auto remote = wire_qos.of(std::string(info.name), deadline)) event["remote_qos"] = *remote;
+            if (auto remote = wire_qos.of(WireQos::Side::kWriters, std::string(info.name), deadline)) {
+              event["remote_qos"] = *remote;
+            }
             return event;
           }
           return std::nullopt;

@@ -22,7 +22,7 @@ using namespace concert;
 safety::LatchedState stopped_state() {
   safety::LatchedState s;
   s.mode = safety::Mode::kStopped;
-  s.causes = {"e-stop: wireless engaged", "liveliness: drill@manip-pc silent for 1.2 s"};
+  s.causes = {"estop: wireless engaged (operator)", "liveliness: drill@manip-pc silent for 1.2 s"};
   s.cause_keys = {"estop:wireless", "silent:drill@manip-pc"};
   s.engaged = {safety::EStopSource::kWireless, safety::EStopSource::kSoftware};
   s.watched = {{"drill@manip-pc", "1.f3.0.0.1"}, {"robot@rt-pc", ""}};

@@ -226,11 +226,11 @@ OccupancyGrid storey_map(const BimModel& model, const Storey& storey, const Slic
   const Eigen::Vector2d lo = ((extent.min().head<2>().array() - params.margin) / res).floor() * res;
   const Eigen::Vector2d hi = extent.max().head<2>().array() + params.margin;
   const Eigen::Vector2d cells = ((hi - lo) / res).array().ceil();
-  if (!(cells.x() * cells.y() <= 2e8)) {
+  if (!(cells.x() >= 1 && cells.y() >= 1 && cells.x() * cells.y() <= 2e8)) {
     std::ostringstream size;
     size << cells.x() << " x " << cells.y();
     throw BimError(where.str() + ": " + size.str() + " cells at " + std::to_string(res) +
-                   " m: too large a map (use a coarser resolution)");
+                   " m: a map needs 1 to 2e8 cells (use a coarser resolution, or a margin)");
   }
   OccupancyGrid grid = OccupancyGrid::filled(
       static_cast<int>(cells.x()), static_cast<int>(cells.y()), res, lo, OccupancyGrid::kFree);

@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 
 #include "concert/common/clock.hpp"
 #include "concert/common/resend.hpp"
@@ -27,6 +29,11 @@ const std::map<std::string, msg::EStopSource> kSources = {
     {"rear-right", msg::ESTOP_BUTTON_REAR_RIGHT},
     {"wireless", msg::ESTOP_WIRELESS},
     {"software", msg::ESTOP_SOFTWARE}};
+/// How the safety service names each input in its causes (services/safety's to_string).
+const std::map<std::string, std::string_view> kServiceNames = {
+    {"front-left", "button front left"},   {"front-right", "button front right"},
+    {"rear-left", "button rear left"},     {"rear-right", "button rear right"},
+    {"wireless", "wireless"},              {"software", "software"}};
 
 /// What the operator verbs take.
 struct Options {
@@ -100,13 +107,13 @@ int estop(const Options& o, dds::Participant& p, std::ostream& out) {
   // says it stopped for it. The writer stays alive meanwhile (the input is latched, so a safety
   // reader that matches late still gets it).
   if (!o.release) {
-    // The service's cause: "estop: <its name of the input> engaged (<reason>)".
-    const std::string cause = "estop: ";
-    const std::string why = "(" + input.reason() + ")";
+    // The service's cause names the input ("estop: button front left engaged (reason)"); the
+    // reason is left out of the match: a cause already latched keeps its first reason.
+    const std::string cause = "estop: " + std::string(kServiceNames.at(name)) + " engaged";
     const auto stopped = wait_state(states, o.dds.timeout(), [&](const msg::SafetyState& st) {
       if (st.mode() != msg::SAFETY_STOPPED) return false;
       for (const auto& c : st.causes()) {
-        if (c.rfind(cause, 0) == 0 && c.find(why) != std::string::npos) return true;
+        if (c.rfind(cause, 0) == 0) return true;
       }
       return false;
     });
