@@ -176,18 +176,30 @@ TEST(Serpentine, AreaOutOfReachIsRefusedWithAReason) {
   }
 }
 
+/// The demo's sanding robot at 30 N in front of its wall: what the sanding plans start from.
+struct SandingRig {
+  std::shared_ptr<const model::RobotModel> model =
+      test::model_of(test::source_dir() / "deploy/demo/sanding_robot.yaml", test::project_db());
+  Reach reach{model, model::EndEffectorKind::kSanding, [] {
+                ReachParams rp;
+                rp.contact_force = 30.0;
+                return rp;
+              }()};
+  const AreaMap& m = areas_of(reach, Task::kSand, 0.0);
+  const WallFrame wall = wall_of(reach, m);
+};
+
 // The sanding robot's joint move from its start posture ends 0.1 m off the wall
 // (PathParams::move_standoff), then a straight line leads to the approach pose 5 cm off: every
 // area plans, left and `all` included, and the move keeps the 5 cm it is checked for. With the
 // move ending at the approach pose itself (move_standoff 0, as before) the left area is refused:
 // the move swings the disc under 5 cm on its way there.
 TEST(Serpentine, SandingMoveEndsOffTheWallSoEveryAreaPlans) {
-  auto model = test::model_of(test::source_dir() / "deploy/demo/sanding_robot.yaml", test::project_db());
-  ReachParams rp;
-  rp.contact_force = 30.0;
-  Reach reach(model, model::EndEffectorKind::kSanding, rp);
-  const AreaMap& m = areas_of(reach, Task::kSand, 0.0);
-  const WallFrame wall = wall_of(reach, m);
+  SandingRig rig;
+  const auto& model = rig.model;
+  Reach& reach = rig.reach;
+  const AreaMap& m = rig.m;
+  const WallFrame& wall = rig.wall;
   print(m, "sanding");
   const ToolSpec disc{Task::kSand, 0.0, 0.23, 0.1};
   const PathParams sanding{0.1, 0.5, 0.02, 0.05, 0.05, 0.0, 0.0, 0.8};
@@ -242,12 +254,11 @@ TEST(Serpentine, SandingMoveEndsOffTheWallSoEveryAreaPlans) {
 // with the arm's tracking error. Its move from there is planned: it goes no nearer than where it
 // starts (the sand system test's second run was refused so, now and then).
 TEST(Serpentine, TheNextRunStartsWhereTheLastEndedJustUnderTheApproach) {
-  auto model = test::model_of(test::source_dir() / "deploy/demo/sanding_robot.yaml", test::project_db());
-  ReachParams rp;
-  rp.contact_force = 30.0;
-  Reach reach(model, model::EndEffectorKind::kSanding, rp);
-  const AreaMap& m = areas_of(reach, Task::kSand, 0.0);
-  const WallFrame wall = wall_of(reach, m);
+  SandingRig rig;
+  const auto& model = rig.model;
+  Reach& reach = rig.reach;
+  const AreaMap& m = rig.m;
+  const WallFrame& wall = rig.wall;
   const ToolSpec disc{Task::kSand, 0.0, 0.23, 0.1};
   const PathParams sanding{0.1, 0.5, 0.02, 0.05, 0.05, 0.0, 0.0, 0.8};
   const Area& centre = m.area("centre");
