@@ -202,6 +202,9 @@ endfunction()
 #   MANUAL: the test program is built but not registered with ctest (make chaos runs one).
 # DDS: the test gets a private CONCERT_DOMAIN_ID and the label "dds".
 set(CONCERT_TEST_SUPPORT_DIR ${CMAKE_CURRENT_LIST_DIR}/../tests/support)
+# Test data shared by libraries and services (robot URDFs: tests/fixtures/README.md); a library's
+# tests read these, never another component's test folder.
+set(CONCERT_TEST_FIXTURES_DIR ${CMAKE_CURRENT_LIST_DIR}/../tests/fixtures)
 function(concert_add_test)
   cmake_parse_arguments(T "DDS;MANUAL" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})

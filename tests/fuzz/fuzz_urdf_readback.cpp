@@ -110,7 +110,7 @@ void concert::fuzz::write_seeds(SeedWriter& seeds) {
     seeds.add("model_" + file.stem().string(), input_of(m.description()));
   }
   for (const auto& dir : {source_dir() / "libs/kinematics/test/fixtures",
-                          source_dir() / "services/robot/test/fixtures"}) {
+                          source_dir() / "tests/fixtures/urdf"}) {
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {
       if (entry.path().extension() == ".urdf") seeds.add_file(entry.path(), source_dir());
     }
