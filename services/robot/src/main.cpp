@@ -176,6 +176,26 @@ void check(Options& o) {
   }
 }
 
+/// The service's parameters (--params, else the defaults) with what the command line overrides:
+/// the module databases' mesh packages, the end-effector frame, the safety timeout, the loop's
+/// real-time settings.
+concert::robot::dds::ServiceParams service_params(const Options& options) {
+  using namespace concert;
+  robot::dds::ServiceParams service =
+      options.params.empty() ? robot::dds::ServiceParams{} : robot::dds::load_service_params(options.params);
+  // Collision meshes: package://NAME/... resolves to a module-database folder named NAME.
+  for (const auto& db : options.module_dbs) {
+    service.sim.package_paths[std::filesystem::absolute(db).lexically_normal().filename().string()] =
+        std::filesystem::absolute(db).string();
+  }
+  for (const auto& [name, dir] : options.packages) service.sim.package_paths[name] = dir;
+  if (!options.ee_frame.empty()) service.robot.end_effector_frame = options.ee_frame;
+  if (options.safety_timeout >= 0.0) service.node.safety_timeout = options.safety_timeout;
+  if (options.fast) service.loop.real_time = false;
+  if (options.fifo > 0) service.loop.fifo_priority = options.fifo;
+  return service;
+}
+
 int run(const Options& options) {
   using namespace concert;
   {
@@ -189,26 +209,10 @@ int run(const Options& options) {
       simulated.source = options.urdf;
     }
     const world::World world = options.world.empty() ? world::World{} : world::load_world_file(options.world);
-    robot::dds::ServiceParams service = options.params.empty() ? robot::dds::ServiceParams{}
-                                                                : robot::dds::load_service_params(options.params);
-    sim::SimParams& sim_params = service.sim;
-    // Collision meshes: package://NAME/... resolves to a module-database folder named NAME.
-    for (const auto& db : options.module_dbs) {
-      sim_params.package_paths[std::filesystem::absolute(db).lexically_normal().filename().string()] =
-          std::filesystem::absolute(db).string();
-    }
-    for (const auto& [name, dir] : options.packages) {
-      sim_params.package_paths[name] = dir;
-    }
-    sim::SimHardware sim(simulated.urdf, world, sim_params, simulated.sensors, simulated.drill_bits,
+    robot::dds::ServiceParams service = service_params(options);
+    sim::SimHardware sim(simulated.urdf, world, service.sim, simulated.sensors, simulated.drill_bits,
                          simulated.sanding_links);
     robot::RobotParams& params = service.robot;
-    if (!options.ee_frame.empty()) {
-      params.end_effector_frame = options.ee_frame;
-    }
-    if (options.safety_timeout >= 0.0) {
-      service.node.safety_timeout = options.safety_timeout;
-    }
     robot::RobotCore core(sim, params);
 
     concert::dds::Participant participant({.name = "robot"});
@@ -225,13 +229,7 @@ int run(const Options& options) {
       node.apply_model(simulated.urdf, 1, options.ee_frame);
     }
 
-    robot::LoopParams& loop_params = service.loop;
-    if (options.fast) {
-      loop_params.real_time = false;
-    }
-    if (options.fifo > 0) {
-      loop_params.fifo_priority = options.fifo;
-    }
+    const robot::LoopParams& loop_params = service.loop;
     // Off the loop thread: the publisher hands the loop's state to DDS.
     std::atomic<bool> stopping{false};
     std::thread publisher([&] {
