@@ -23,10 +23,27 @@ TopicInfo checked(std::string_view name, const TypeSupport& type) {
 }
 }  // namespace
 
-DataWriter* create_writer(Participant& participant, std::string_view name, TypeSupport type) {
+void MatchTracker::on_publication_matched(DataWriter* /*writer*/, const PublicationMatchedStatus& status) {
+  eprosima::fastrtps::rtps::GUID_t guid;
+  eprosima::fastrtps::rtps::iHandle2GUID(guid, status.last_subscription_handle);
+  std::lock_guard lock(mutex_);
+  if (status.current_count_change > 0) {
+    readers_.insert(guid);
+  } else if (status.current_count_change < 0) {
+    readers_.erase(guid);
+  }
+}
+
+bool MatchTracker::matched_participant(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const {
+  std::lock_guard lock(mutex_);
+  return std::any_of(readers_.begin(), readers_.end(), [&](const auto& g) { return g.guidPrefix == prefix; });
+}
+
+DataWriter* create_writer(Participant& participant, std::string_view name, TypeSupport type, MatchTracker* tracker) {
   const TopicInfo info = checked(name, type);
   Topic* topic = participant.topic(std::string(name), type);
-  DataWriter* writer = participant.publisher()->create_datawriter(topic, writer_qos(info.qos));
+  DataWriter* writer = participant.publisher()->create_datawriter(
+      topic, writer_qos(info.qos), tracker, tracker != nullptr ? StatusMask::publication_matched() : StatusMask::none());
   if (writer == nullptr) {
     throw std::runtime_error("cannot create a DDS writer on '" + std::string(name) + "'" +
                              why_refused(participant, name, true));

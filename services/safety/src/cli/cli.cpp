@@ -4,6 +4,8 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <vector>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
@@ -14,6 +16,8 @@
 #include "concert/common/resend.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
+#include "dds/conversions.hpp"
+#include "safety/safety_monitor.hpp"
 
 namespace concert::safety {
 namespace {
@@ -29,11 +33,11 @@ const std::map<std::string, msg::EStopSource> kSources = {
     {"rear-right", msg::ESTOP_BUTTON_REAR_RIGHT},
     {"wireless", msg::ESTOP_WIRELESS},
     {"software", msg::ESTOP_SOFTWARE}};
-/// How the safety service names each input in its causes (services/safety's to_string).
-const std::map<std::string, std::string_view> kServiceNames = {
-    {"front-left", "button front left"},   {"front-right", "button front right"},
-    {"rear-left", "button rear left"},     {"rear-right", "button rear right"},
-    {"wireless", "wireless"},              {"software", "software"}};
+/// How the safety service names `source` in its causes: the core's own name for it.
+std::string service_name(msg::EStopSource source) {
+  const auto core = safety::dds::to_core(source);
+  return core ? std::string(to_string(*core)) : "unknown";
+}
 
 /// What the operator verbs take.
 struct Options {
@@ -57,7 +61,7 @@ std::string describe(const msg::SafetyState& s) {
 
 /// Waits for a SafetyState sample satisfying `accept`, or nullopt at the deadline.
 template <class F>
-std::optional<msg::SafetyState> wait_state(dds::Reader<msg::SafetyState>& reader,
+std::optional<msg::SafetyState> wait_state(concert::dds::Reader<msg::SafetyState>& reader,
                                            std::chrono::milliseconds limit, F accept) {
   const auto deadline = std::chrono::steady_clock::now() + limit;
   while (std::chrono::steady_clock::now() < deadline) {
@@ -66,8 +70,8 @@ std::optional<msg::SafetyState> wait_state(dds::Reader<msg::SafetyState>& reader
   return std::nullopt;
 }
 
-int status(const Options& o, dds::Participant& p, std::ostream& out) {
-  dds::Reader<msg::SafetyState> states(p, dds::topics::safety_state);
+int status(const Options& o, concert::dds::Participant& p, std::ostream& out) {
+  concert::dds::Reader<msg::SafetyState> states(p, concert::dds::topics::safety_state);
   const auto s = wait_state(states, o.dds.timeout(), [](const auto&) { return true; });
   if (!s)
     throw Failure("no safety state on domain " + std::to_string(p.domain_id()) +
@@ -80,13 +84,35 @@ int status(const Options& o, dds::Participant& p, std::ostream& out) {
   return 0;
 }
 
-int estop(const Options& o, dds::Participant& p, std::ostream& out) {
+/// Waits until `writer` has matched a reader of the safety service's own participant (known
+/// from its ServiceStatus heartbeat): other readers of the topic (the GUI's, a recorder's) may
+/// match and acknowledge first, and a latched input written before the safety service matched
+/// would be lost with this short-lived writer.
+bool wait_for_safety_reader(concert::dds::Participant& p, const concert::dds::Writer<msg::EStopInput>& writer,
+                            std::chrono::milliseconds timeout) {
+  std::mutex mutex;
+  std::optional<eprosima::fastrtps::rtps::GuidPrefix_t> safety;
+  concert::dds::Reader<msg::ServiceStatus> statuses(
+      p, concert::dds::topics::status, [&](const msg::ServiceStatus& s, const eprosima::fastdds::dds::SampleInfo& info) {
+        if (s.service() != "safety") return;
+        std::lock_guard lock(mutex);
+        safety = info.sample_identity.writer_guid().guidPrefix;
+      });
+  return concert::dds::detail::wait_until(
+      [&] {
+        std::lock_guard lock(mutex);
+        return safety && writer.matched_participant(*safety);
+      },
+      timeout);
+}
+
+int estop(const Options& o, concert::dds::Participant& p, std::ostream& out) {
   const std::string name = o.source.empty() ? "software" : o.source;
   const auto source = kSources.find(name);
   // Read before writing: the answer to an engaged input is a STOPPED state naming it.
-  dds::Reader<msg::SafetyState> states(p, dds::topics::safety_state);
-  dds::Writer<msg::EStopInput> writer(p, dds::topics::estop);
-  if (!writer.wait_for_readers(1, o.dds.timeout())) {
+  concert::dds::Reader<msg::SafetyState> states(p, concert::dds::topics::safety_state);
+  concert::dds::Writer<msg::EStopInput> writer(p, concert::dds::topics::estop, concert::dds::TrackMatches::kYes);
+  if (!wait_for_safety_reader(p, writer, o.dds.timeout())) {
     throw Failure("no safety service on domain " + std::to_string(p.domain_id()) +
                   " read the e-stop input");
   }
@@ -102,14 +128,12 @@ int estop(const Options& o, dds::Participant& p, std::ostream& out) {
       eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
     throw Failure("the safety service did not acknowledge the e-stop input");
   }
-  // The acknowledgements are those of the readers matched so far, which may be other tools' or
-  // the GUI's and not yet the safety service's: an engaged input counts once the safety service
-  // says it stopped for it. The writer stays alive meanwhile (the input is latched, so a safety
-  // reader that matches late still gets it).
+  // The safety service's reader is among those that acknowledged (wait_for_safety_reader); an
+  // engaged input counts once the service also says it stopped for it.
   if (!o.release) {
     // The service's cause names the input ("estop: button front left engaged (reason)"); the
     // reason is left out of the match: a cause already latched keeps its first reason.
-    const std::string cause = "estop: " + std::string(kServiceNames.at(name)) + " engaged";
+    const std::string cause = "estop: " + service_name(source->second) + " engaged";
     const auto stopped = wait_state(states, o.dds.timeout(), [&](const msg::SafetyState& st) {
       if (st.mode() != msg::SAFETY_STOPPED) return false;
       for (const auto& c : st.causes()) {
@@ -130,10 +154,10 @@ int estop(const Options& o, dds::Participant& p, std::ostream& out) {
   return 0;
 }
 
-int reset(const Options& o, dds::Participant& p, std::ostream& out, std::ostream& err) {
-  dds::Reader<msg::SafetyState> states(p, dds::topics::safety_state);
-  dds::Reader<msg::ServiceStatus> statuses(p, dds::topics::status);
-  dds::Writer<msg::SafetyReset> writer(p, dds::topics::safety_reset);
+int reset(const Options& o, concert::dds::Participant& p, std::ostream& out, std::ostream& err) {
+  concert::dds::Reader<msg::SafetyState> states(p, concert::dds::topics::safety_state);
+  concert::dds::Reader<msg::ServiceStatus> statuses(p, concert::dds::topics::status);
+  concert::dds::Writer<msg::SafetyReset> writer(p, concert::dds::topics::safety_reset);
   if (!writer.wait_for_readers(1, o.dds.timeout())) {
     throw Failure("no safety service on domain " + std::to_string(p.domain_id()) + " to reset");
   }
@@ -141,7 +165,7 @@ int reset(const Options& o, dds::Participant& p, std::ostream& out, std::ostream
   msg::SafetyReset request;
   request.request_id(static_cast<uint32_t>(sent / 1000 % 4'000'000'000));
   request.stamp_ns(sent);
-  request.source(o.source.empty() ? "concert safety reset@" + dds::host_name() : o.source);
+  request.source(o.source.empty() ? "concert safety reset@" + concert::dds::host_name() : o.source);
   request.reason(o.reason);
   // Heartbeats repeat the service's last message with a fresh stamp, so a refusal is
   // recognised by naming this request's source, not by its time.
@@ -193,19 +217,19 @@ void register_verbs(cli::Cli& concert) {
   auto add = [&concert, &safety](const std::string& name, const std::string& what, auto body) {
     auto o = std::make_shared<Options>();
     CLI::App& verb = concert.verb(safety, name, what, [&concert, o, body] {
-      dds::Participant participant({.name = "concert-safety-cli", .domain_id = o->dds.domain_id()});
+      concert::dds::Participant participant({.name = "concert-safety-cli", .domain_id = o->dds.domain_id()});
       return body(*o, participant, concert.out(), concert.err());
     });
     concert.add_dds_options(verb, o->dds, 5.0, "how long to wait for the safety service");
     return std::make_pair(&verb, o);
   };
   add("status", "the live safety state: RUNNING, or STOPPED with its causes",
-      [](const Options& o, dds::Participant& p, std::ostream& out, std::ostream&) {
+      [](const Options& o, concert::dds::Participant& p, std::ostream& out, std::ostream&) {
         return status(o, p, out);
       });
   auto [estop_verb, estop_options] =
       add("estop", "engage (or release) an e-stop input",
-          [](const Options& o, dds::Participant& p, std::ostream& out, std::ostream&) {
+          [](const Options& o, concert::dds::Participant& p, std::ostream& out, std::ostream&) {
             return estop(o, p, out);
           });
   std::vector<std::string> sources;

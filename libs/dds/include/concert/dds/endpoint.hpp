@@ -5,12 +5,16 @@
 #include <chrono>
 #include <deque>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
 
+#include <set>
+
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
@@ -27,9 +31,25 @@ namespace concert::dds {
 std::string why_refused(const Participant& participant, std::string_view topic, bool writer);
 
 namespace detail {
-/// Checks `name` against the catalogue (exists, type name matches) and creates the writer.
+/// Which readers a writer has matched, by GUID, from its publication-matched events (Fast DDS
+/// 2.9's DataWriter::get_matched_subscriptions answers RETCODE_UNSUPPORTED).
+class MatchTracker : public eprosima::fastdds::dds::DataWriterListener {
+ public:
+  void on_publication_matched(eprosima::fastdds::dds::DataWriter* writer,
+                              const eprosima::fastdds::dds::PublicationMatchedStatus& status) override;
+  /// Whether a reader of the participant `prefix` names is matched now.
+  bool matched_participant(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::set<eprosima::fastrtps::rtps::GUID_t> readers_;
+};
+
+/// Checks `name` against the catalogue (exists, type name matches) and creates the writer
+/// (with `tracker` listening to its matches, when given).
 eprosima::fastdds::dds::DataWriter* create_writer(Participant& participant, std::string_view name,
-                                                  eprosima::fastdds::dds::TypeSupport type);
+                                                  eprosima::fastdds::dds::TypeSupport type,
+                                                  MatchTracker* tracker = nullptr);
 eprosima::fastdds::dds::DataReader* create_reader(Participant& participant, std::string_view name,
                                                   eprosima::fastdds::dds::TypeSupport type,
                                                   eprosima::fastdds::dds::DataReaderListener* listener);
@@ -54,12 +74,17 @@ bool take_valid(eprosima::fastdds::dds::DataReader* reader, T& sample,
 }
 }  // namespace detail
 
+/// Writer option: remember which readers matched (Writer::matched_participant).
+enum class TrackMatches { kNo, kYes };
+
 template <class T> class Writer {
  public:
-  Writer(Participant& participant, TopicHandle<T> topic)
+  Writer(Participant& participant, TopicHandle<T> topic, TrackMatches track = TrackMatches::kNo)
       : participant_(participant),
+        tracker_(track == TrackMatches::kYes ? std::make_unique<detail::MatchTracker>() : nullptr),
         writer_(detail::create_writer(participant, topic.name,
-                                      eprosima::fastdds::dds::TypeSupport(new typename PubSubOf<T>::type()))) {}
+                                      eprosima::fastdds::dds::TypeSupport(new typename PubSubOf<T>::type()),
+                                      tracker_.get())) {}
   ~Writer() { detail::delete_writer(participant_, writer_); }
   Writer(const Writer&) = delete;
   Writer& operator=(const Writer&) = delete;
@@ -94,6 +119,13 @@ template <class T> class Writer {
 
   int32_t matched_readers() const { return detail::matched_count(writer_); }
 
+  /// Whether a reader of the participant `prefix` names is matched now (TrackMatches::kYes
+  /// only; false otherwise). A tool that must reach one service, not any reader of the topic,
+  /// waits for this.
+  bool matched_participant(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const {
+    return tracker_ != nullptr && tracker_->matched_participant(prefix);
+  }
+
   /// Waits until at least `count` readers matched; false on timeout.
   bool wait_for_readers(int32_t count, std::chrono::milliseconds timeout) const {
     return detail::wait_until([&] { return matched_readers() >= count; }, timeout);
@@ -103,6 +135,7 @@ template <class T> class Writer {
 
  private:
   Participant& participant_;
+  std::unique_ptr<detail::MatchTracker> tracker_;  // before writer_: it listens from creation
   eprosima::fastdds::dds::DataWriter* writer_;
   bool keyed_ = writer_->get_type()->m_isGetKeyDefined;
   std::mutex instances_mutex_;
