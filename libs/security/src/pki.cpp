@@ -1,5 +1,11 @@
 #include "concert/security/pki.hpp"
 
+#include <arpa/inet.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+
 #include <fcntl.h>
 #include <openssl/bn.h>
 #include <openssl/err.h>
@@ -94,8 +100,10 @@ void add_extension(X509* cert, X509* issuer, int nid, const char* value) {
 }
 
 /// A certificate for `key` named `cn`, signed by `issuer`/`issuer_key` (itself when null).
+/// `alt_names` (an X.509v3 subjectAltName value, e.g. "DNS:localhost,IP:127.0.0.1") makes it a
+/// TLS server certificate.
 Cert make_certificate(const std::string& cn, EVP_PKEY* key, X509* issuer, EVP_PKEY* issuer_key,
-                      int days) {
+                      int days, const std::string& alt_names = "") {
   Cert cert(X509_new());
   const bool ca = issuer == nullptr;
   Bignum serial(BN_new());
@@ -119,6 +127,10 @@ Cert make_certificate(const std::string& cn, EVP_PKEY* key, X509* issuer, EVP_PK
   add_extension(cert.get(), signer, NID_key_usage,
                 ca ? "critical,digitalSignature,keyCertSign,cRLSign"
                    : "critical,digitalSignature,keyAgreement");
+  if (!alt_names.empty()) {
+    add_extension(cert.get(), signer, NID_subject_alt_name, alt_names.c_str());
+    add_extension(cert.get(), signer, NID_ext_key_usage, "serverAuth");
+  }
   add_extension(cert.get(), signer, NID_subject_key_identifier, "hash");
   if (!ca) add_extension(cert.get(), signer, NID_authority_key_identifier, "keyid:always");
   if (X509_sign(cert.get(), ca ? key : issuer_key, EVP_sha256()) == 0)
@@ -211,6 +223,30 @@ Cert read_certificate(const fs::path& path, const std::string& what) {
     throw std::runtime_error(what + " '" + path.string() + "' is not a PEM certificate");
   }
   return cert;
+}
+
+Key read_key(const fs::path& path, const std::string& what) {
+  Bio in = open_file(path, what);
+  Key key(PEM_read_bio_PrivateKey(in.get(), nullptr, nullptr, nullptr));
+  if (!key) {
+    ERR_clear_error();
+    throw std::runtime_error(what + " '" + path.string() + "' is not a PEM private key");
+  }
+  return key;
+}
+
+/// "IP:a.b.c.d" for an address, "DNS:name" for a host name; refuses anything else.
+std::string alt_name(const std::string& name) {
+  unsigned char buf[16];
+  if (::inet_pton(AF_INET, name.c_str(), buf) == 1 || ::inet_pton(AF_INET6, name.c_str(), buf) == 1) {
+    return "IP:" + name;
+  }
+  const bool host = !name.empty() && name.size() <= 253 && name.front() != '-' && name.front() != '.' &&
+                    std::all_of(name.begin(), name.end(), [](char c) {
+                      return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '.';
+                    });
+  if (!host) throw std::invalid_argument("--name '" + name + "': neither a host name nor an IP address");
+  return "DNS:" + name;
 }
 
 /// The RFC 2253 text of a certificate's subject ("CN=robot,O=CONCERT").
@@ -325,7 +361,36 @@ std::vector<CreatedFile> init_pki(const fs::path& dir, const InitOptions& option
     write(permissions, 0644);
     write(smime_sign(permissions, ca.get(), ca_key.get()), 0644);
   }
+  char host[256] = {};
+  HttpsOptions https{{}, options.days};
+  if (::gethostname(host, sizeof host - 1) == 0 && host[0] != '\0') https.names.emplace_back(host);
+  for (auto& f : issue_https_certificate(dir, https)) created.push_back(std::move(f));
   return created;
+}
+
+std::vector<CreatedFile> issue_https_certificate(const fs::path& dir, const HttpsOptions& options) {
+  if (options.days < 1 || options.days > kMaxDays) {
+    throw std::invalid_argument("--days: " + std::to_string(options.days) + " is not a validity from 1 to " +
+                                std::to_string(kMaxDays) + " days");
+  }
+  std::vector<std::string> names = {"localhost", "127.0.0.1", "::1"};
+  for (const auto& n : options.names) {
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+  }
+  std::string alt;
+  for (const auto& n : names) alt += (alt.empty() ? "" : ",") + alt_name(n);
+  const Cert ca = read_certificate(dir / "ca.pem", "CA certificate");
+  const Key ca_key = read_key(dir / "ca_key.pem", "CA private key");
+  make_folder(dir / "gui");
+  const Key key = new_key();
+  const Cert cert = make_certificate("CONCERT operator GUI", key.get(), ca.get(), ca_key.get(), options.days, alt);
+  const fs::path cert_file = dir / "gui" / "https_cert.pem";
+  const fs::path key_file = dir / "gui" / "https_key.pem";
+  // The key first: a certificate is never on disk without the key that goes with it.
+  write_file(key_file, pem(key.get()), 0600);
+  write_file(cert_file, pem(cert.get()) + pem(ca.get()), 0644);
+  return {{key_file, "private key of the GUI's HTTPS certificate"},
+          {cert_file, "HTTPS certificate of the GUI (" + alt + ")"}};
 }
 
 void check_identity(const IdentityFiles& f) {

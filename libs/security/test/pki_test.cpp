@@ -64,10 +64,12 @@ testing::TempDir* Pki::dir_ = nullptr;
 std::vector<CreatedFile>* Pki::created_ = nullptr;
 
 TEST_F(Pki, WritesTheCaAndFourFilesPerIdentityKeysPrivate) {
-  ASSERT_EQ(created_->size(), 4 + 4 * identities().size());
+  // The CA's four, four per identity, the GUI's HTTPS key and certificate.
+  ASSERT_EQ(created_->size(), 4 + 4 * identities().size() + 2);
   for (const auto& f : *created_) {
     ASSERT_TRUE(fs::is_regular_file(f.path)) << f.path;
-    const bool key = f.path.filename() == "key.pem" || f.path.filename() == "ca_key.pem";
+    const bool key = f.path.filename() == "key.pem" || f.path.filename() == "ca_key.pem" ||
+                     f.path.filename() == "https_key.pem";
     EXPECT_EQ(mode_of(f.path), key ? 0600u : 0644u) << f.path;
     EXPECT_EQ(key, f.what.find("private key") != std::string::npos) << f.what;
   }
@@ -96,6 +98,34 @@ TEST_F(Pki, OpensslVerifiesEveryCertificateAgainstTheCa) {
   }
   const auto ca_text = openssl({"x509", "-in", ca, "-noout", "-text"});
   EXPECT_THAT(ca_text.out, HasSubstr("CA:TRUE"));
+}
+
+TEST_F(Pki, TheGuisHttpsCertificateIsAServerCertificateForLocalhostThatOpensslVerifies) {
+  const std::string ca = (pki() / "ca.pem").string();
+  const std::string cert = (pki() / "gui" / "https_cert.pem").string();
+  // Verified for TLS servers (purpose sslserver) by name and by address.
+  for (const std::vector<std::string>& target : {std::vector<std::string>{"-verify_hostname", "localhost"},
+                                                 std::vector<std::string>{"-verify_ip", "127.0.0.1"}}) {
+    std::vector<std::string> args = {"verify", "-CAfile", ca, "-purpose", "sslserver"};
+    args.insert(args.end(), target.begin(), target.end());
+    args.push_back(cert);
+    const auto verify = openssl(args);
+    EXPECT_EQ(verify.code, 0) << verify.out << verify.err;
+  }
+  const auto wrong = openssl({"verify", "-CAfile", ca, "-verify_hostname", "example.org", cert});
+  EXPECT_NE(wrong.code, 0) << "a name it was not made for: " << wrong.out;
+  const auto key = openssl({"pkey", "-in", (pki() / "gui" / "https_key.pem").string(), "-pubout"});
+  const auto pub = openssl({"x509", "-in", cert, "-noout", "-pubkey"});
+  EXPECT_EQ(key.out, pub.out);
+  // Issued again for the site's names: the new names are in, the old key replaced.
+  const auto again = issue_https_certificate(pki(), {.names = {"robot.site", "10.1.2.3"}, .days = 30});
+  ASSERT_EQ(again.size(), 2u);
+  const auto text = openssl({"x509", "-in", cert, "-noout", "-ext", "subjectAltName,extendedKeyUsage"});
+  EXPECT_THAT(text.out, HasSubstr("DNS:robot.site"));
+  EXPECT_THAT(text.out, HasSubstr("IP Address:10.1.2.3"));
+  EXPECT_THAT(text.out, HasSubstr("TLS Web Server Authentication"));
+  EXPECT_NE(openssl({"pkey", "-in", (pki() / "gui" / "https_key.pem").string(), "-pubout"}).out, key.out);
+  EXPECT_THROW(issue_https_certificate(pki(), {.names = {"not a host;"}}), std::invalid_argument);
 }
 
 TEST_F(Pki, CertificatesAreValidForTheDaysAsked) {
@@ -229,7 +259,8 @@ TEST(SecurityCli, InitPrintsWhatItCreatedRefusesTwiceChecksAndPrintsTheTable) {
                              "nav, drill, collab, surface_finish, operator)"));
   EXPECT_THAT(out, HasSubstr("Run the stack secured with CONCERT_SECURITY=" + dir));
   EXPECT_EQ(err, "");
-  EXPECT_EQ(split(out, '\n').size(), 4 + 4 * identities().size() + 2);
+  EXPECT_EQ(split(out, '\n').size(), 4 + 4 * identities().size() + 2 + 2);  // + the GUI's HTTPS pair
+  EXPECT_THAT(out, HasSubstr("created " + dir + "/gui/https_cert.pem  (HTTPS certificate of the GUI (DNS:localhost,IP:127.0.0.1"));
 
   EXPECT_EQ(run_cli({"security", "init", dir}, out, err), 1);
   EXPECT_THAT(err, HasSubstr("already holds a PKI"));

@@ -17,6 +17,7 @@ struct Options {
   bool force = false;
   bool json = false;
   std::string identity;
+  std::vector<std::string> names;
 };
 
 int init(const Options& o, std::ostream& out, std::ostream& err) {
@@ -33,6 +34,14 @@ int init(const Options& o, std::ostream& out, std::ostream& err) {
       << "Run the stack secured with CONCERT_SECURITY=" << std::filesystem::absolute(o.dir).string()
       << "; keep " << (std::filesystem::path(o.dir) / "ca_key.pem").string()
       << " off the robot once its identities are deployed.\n";
+  return 0;
+}
+
+int https(const Options& o, std::ostream& out) {
+  const auto created = issue_https_certificate(o.dir, {.names = o.names, .days = o.days});
+  for (const auto& f : created) out << "created " << f.path.string() << "  (" << f.what << ")\n";
+  out << "Serve the GUI with it: concert gui --bind ADDR --tls " << std::filesystem::absolute(o.dir).string()
+      << " (tablets trust " << (std::filesystem::path(o.dir) / "ca.pem").string() << ").\n";
   return 0;
 }
 
@@ -95,6 +104,17 @@ void register_verbs(cli::Cli& concert) {
       .add_option("--days", o->days, "validity of the certificates and permissions (default 365)")
       ->type_name("N")
       ->check(cli::number(1, 3650, true));
+
+  auto h = std::make_shared<Options>();
+  CLI::App& https_verb =
+      concert.verb(security, "https",
+                   "a new HTTPS certificate for the operator GUI (DIR/gui/https_cert.pem), signed by DIR's CA, "
+                   "for the names tablets reach the robot at",
+                   [&concert, h] { return https(*h, concert.out()); });
+  https_verb.add_option("DIR", h->dir, "a folder made by `concert security init`")->required()->type_name("DIR");
+  https_verb.add_option("--name", h->names, "a host name or IP address of the robot (repeat; localhost is always in)")
+      ->type_name("HOST");
+  https_verb.add_option("--days", h->days, "validity (default 365)")->type_name("N")->check(cli::number(1, 3650, true));
 
   auto t = std::make_shared<Options>();
   CLI::App& table_verb = concert.verb(security, "table", "who may publish what",

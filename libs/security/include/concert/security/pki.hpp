@@ -35,11 +35,27 @@ struct CreatedFile {
 };
 
 /// Creates the PKI in `dir` (made if missing): the CA, one identity per entry of identities(),
-/// the signed governance and permissions. Refuses (std::runtime_error naming the file) when
+/// the signed governance and permissions, and the GUI's HTTPS certificate for this host
+/// (issue_https_certificate with the host's name). Refuses (std::runtime_error naming the file) when
 /// `dir` already holds a PKI and `force` is not set, and rejects days outside 1..3650
 /// (std::invalid_argument). Returns what it wrote, in order.
 std::vector<CreatedFile> init_pki(const std::filesystem::path& dir,
                                   const InitOptions& options = {});
+
+/// What issue_https_certificate() makes.
+struct HttpsOptions {
+  /// Host names and IP addresses the operator GUI is reached at (subjectAltName); localhost,
+  /// 127.0.0.1 and ::1 are always added.
+  std::vector<std::string> names;
+  int days = 365;
+};
+
+/// A TLS server certificate for the operator GUI's gateway (concert gui --tls DIR), signed by
+/// the CA of `dir`: DIR/gui/https_cert.pem (the certificate, then the CA's) and
+/// DIR/gui/https_key.pem (0600). Replaces an older one. Throws std::runtime_error naming the
+/// file when the CA cannot be read, std::invalid_argument for a name that is neither a host
+/// name nor an IP address.
+std::vector<CreatedFile> issue_https_certificate(const std::filesystem::path& dir, const HttpsOptions& options);
 
 /// The files one identity of a PKI folder uses.
 struct IdentityFiles {
