@@ -6,14 +6,37 @@
 namespace concert::gui {
 namespace {
 
-TEST(AllowList, SafetyTopicsAreCommandableMotionAndSimulatorAreNot) {
+TEST(AllowList, SafetyTopicsAreCommandableMotionAndTheSimulatorsWorldAreNot) {
   EXPECT_NE(find_operator_command("concert/safety/estop"), nullptr);
   EXPECT_NE(find_operator_command("concert/safety/reset"), nullptr);
   EXPECT_NE(find_operator_command("concert/drill/mission"), nullptr);
   EXPECT_EQ(find_operator_command("concert/robot/joint_command"), nullptr);
   EXPECT_EQ(find_operator_command("concert/robot/trajectory_command"), nullptr);
-  EXPECT_EQ(find_operator_command("concert/sim/command"), nullptr);
   EXPECT_EQ(find_operator_command("concert/safety/state"), nullptr);
+  // The simulator: a hot swap (an engineer's), never a new world.
+  const auto swap = admit_command("concert/sim/command", Json{{"content", "a"}}, "1.2.3.4:5", 7);
+  EXPECT_EQ(swap["kind"], "SIM_SWAP_ASSEMBLY");
+  EXPECT_EQ(swap["source"], "concert gui (1.2.3.4:5)");
+  EXPECT_THROW(admit_command("concert/sim/command", Json{{"kind", "SIM_SET_WORLD"}}, "o", 7), CommandRefused);
+  EXPECT_EQ(find_operator_command("concert/sim/command")->role, Role::kEngineer);
+}
+
+TEST(AllowList, RolesDecideWhoMaySendWhatAndTheEStopIsEveryones) {
+  for (Role r : {Role::kViewer, Role::kOperator, Role::kEngineer}) {
+    EXPECT_NO_THROW(check_role("concert/safety/estop", r));
+  }
+  EXPECT_THROW(check_role("concert/safety/reset", Role::kViewer), CommandRefused);
+  EXPECT_NO_THROW(check_role("concert/safety/reset", Role::kOperator));
+  EXPECT_NO_THROW(check_role("concert/collab/command", Role::kOperator));
+  EXPECT_THROW(check_role("concert/model/customisation", Role::kOperator), CommandRefused);
+  EXPECT_NO_THROW(check_role("concert/model/customisation", Role::kEngineer));
+  try {
+    check_role("concert/sim/command", Role::kOperator);
+    FAIL();
+  } catch (const CommandRefused& e) {
+    EXPECT_THAT(e.what(), testing::HasSubstr("role operator may not command 'concert/sim/command'"));
+    EXPECT_THAT(e.what(), testing::HasSubstr("needs engineer"));
+  }
 }
 
 TEST(AllowList, RefusesTopicsOffTheListNamingThem) {

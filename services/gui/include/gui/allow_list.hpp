@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "gui/auth.hpp"
+
 namespace concert::gui {
 
 using Json = nlohmann::ordered_json;
@@ -21,6 +23,10 @@ struct OperatorCommand {
   /// the client's address), whatever the browser sent.
   std::string_view fixed_json = "{}";
   bool stamp = false;  ///< set `stamp_ns` to the gateway's clock when the browser left it 0/out
+  Role role = Role::kOperator;  ///< the least role that may send it
+  /// Field -> the values the browser may give it (a JSON array); a field left out gets the
+  /// first. E.g. the simulator's command: hot swaps only, never a new world.
+  std::string_view only_json = "{}";
 };
 
 /// Raised for a command the allow-list refuses; the message names the topic and why.
@@ -37,7 +43,10 @@ const OperatorCommand* find_operator_command(std::string_view topic);
 
 /// The sample to publish for a browser's command: `data` (a JSON object, fields may be left out)
 /// with the entry's fixed fields and stamp applied. Throws CommandRefused when `topic` is not on
-/// the list or `data` is not an object.
+/// the list, `data` is not an object, or a field has a value the entry does not allow.
 Json admit_command(std::string_view topic, const Json& data, std::string_view origin, int64_t now_ns);
+
+/// Throws CommandRefused unless `role` may send `topic` (naming the role it needs).
+void check_role(std::string_view topic, Role role);
 
 }  // namespace concert::gui

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "gui/auth.hpp"
 #include "gui/hub.hpp"
 #include "gui/image.hpp"
 
@@ -21,6 +22,16 @@ struct GatewayOptions {
   int32_t domain_id = -1;                 ///< -1: CONCERT_DOMAIN_ID
   double duration_s = 0.0;                ///< stop after this long [s]; 0: only on `stop`
   bool json = false;                      ///< print the address as a JSON line on `out`
+  /// HTTPS/WSS: a PKI folder made by `concert security init` (its gui/https_{cert,key}.pem), or
+  /// the site's certificate and key. Required for any bind beyond loopback.
+  std::string tls_dir;
+  std::string tls_certificate;
+  std::string tls_key;
+  /// Sign-in: always beyond loopback; on loopback only with `auth`.
+  bool auth = false;
+  std::string users_file;  ///< empty: default_users_file()
+  bool pairing = false;    ///< print a one-time pairing code (role: auth.pairing_role)
+  AuthParams auth_params;
   HubParams hub;
   JpegParams jpeg;
 };
@@ -32,5 +43,12 @@ int run_gateway(const GatewayOptions& options, const std::atomic<bool>& stop, st
 
 /// The default folder of the built app (the build tree's), compiled in.
 std::string default_app_dir();
+
+/// The users file: $CONCERT_GUI_USERS, else $XDG_CONFIG_HOME/concert/gui_users.json, else
+/// ~/.config/concert/gui_users.json.
+std::string default_users_file();
+
+/// Whether `bind` serves this machine only (127.0.0.0/8, ::1, localhost).
+bool loopback_only(const std::string& bind);
 
 }  // namespace concert::gui

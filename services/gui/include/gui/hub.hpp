@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "gui/allow_list.hpp"
+#include "gui/auth.hpp"
 #include "gui/client_sink.hpp"
 #include "gui/protocol.hpp"
 #include "gui/rate_limiter.hpp"
@@ -46,6 +47,13 @@ struct HubParams {
   /// A client whose socket holds more than this unsent [bytes] gets no stream samples or
   /// frames until it drains (state and command samples are always sent).
   size_t max_buffered_bytes = 4u << 20;
+  /// The gateway's heartbeat to every client [ms]: the app shows every state "unknown" after
+  /// 1 s without a message from the gateway.
+  int heartbeat_ms = 250;
+  /// State topics whose instances keep the sample with the newest `stamp_ns`, not the last to
+  /// arrive: the e-stop inputs, written by several processes, where a late reader may be handed
+  /// an old writer's history after a newer release.
+  std::vector<std::string> newest_stamp_topics = {"concert/safety/estop"};
 };
 
 /// The DDS side, implemented by the adapter.
@@ -72,6 +80,9 @@ class Hub {
   Hub(std::vector<TopicEntry> topics, HubParams params, std::ostream& log);
 
   void attach(Bus* bus, ClientSink* sink);
+  /// Requires every client to sign in with `auth` (nullptr: none required, every client is the
+  /// local engineer: a gateway that serves this machine only). `pairing`: codes are offered.
+  void require_auth(Auth* auth, bool pairing);
 
   /// A new browser connection `client` from `origin` (e.g. "192.168.1.20:51544"); sends it
   /// "hello". Ids are the web server's, never reused.
@@ -93,6 +104,9 @@ class Hub {
   std::vector<TopicRate> rates(int64_t now_ns) const;
   /// Sends {"op": "rates", ...} to every client.
   void broadcast_rates(int64_t now_ns);
+  /// Sends {"op": "heartbeat"} to every client and signs out expired sessions. `wall_ns` is the
+  /// Unix time (sessions expire by it).
+  void heartbeat(int64_t wall_ns);
 
   /// Whether a client is subscribed to `topic`.
   bool wanted(std::string_view topic) const;
@@ -111,11 +125,13 @@ class Hub {
   struct Client {
     std::string origin;
     std::map<std::string, Subscription, std::less<>> subscriptions;
+    std::optional<Session> session;  ///< signed in (always, when no auth is required)
   };
   struct Topic {
     TopicEntry entry;
     RateMeter meter;
     std::map<std::string, Json, std::less<>> latest;  // state topics: per instance
+    bool newest_stamp = false;                         // keep the newest stamp_ns per instance
   };
 
   void disconnect_locked(ClientId client);
@@ -125,7 +141,12 @@ class Hub {
     std::optional<int64_t> request;
     std::string origin;
   };
-  std::optional<PendingCommand> on_message_locked(ClientId id, std::string_view text, int64_t now_ns);
+  std::optional<PendingCommand> on_message_locked(ClientId id, const ClientMessage& message, int64_t now_ns);
+  void sign_in(ClientId id, const ClientMessage& message, int64_t now_ns);
+  void unsubscribe_all_locked(Client& client);
+  /// Signs `client` out (told why, its subscriptions dropped) when its session ended by `now_ns`.
+  void expire_locked(ClientId id, Client& client, int64_t now_ns);
+  static std::string who(const Client& client);
   void flush_wanted();
   void handle(ClientId id, Client& client, const Subscribe& s, int64_t now_ns);
   void send_locked(ClientId client, std::string message, bool binary);
@@ -138,6 +159,8 @@ class Hub {
   mutable std::mutex mutex_;
   Bus* bus_ = nullptr;
   ClientSink* sink_ = nullptr;
+  Auth* auth_ = nullptr;
+  bool pairing_ = false;
   std::map<std::string, Topic, std::less<>> topics_;
   std::map<ClientId, Client> clients_;
   uint64_t published_ = 0, refused_ = 0, dropped_ = 0;

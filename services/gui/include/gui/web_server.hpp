@@ -19,6 +19,13 @@ struct WebServerOptions {
   std::string bind = "127.0.0.1";  ///< address to listen on ("0.0.0.0": every interface)
   uint16_t port = 8080;            ///< 0: any free port (see WebServer::port())
   StaticRoots roots;
+  /// HTTPS and WSS with this certificate (PEM, the chain after it) and key; both empty: plain
+  /// HTTP. TLS 1.2 or newer only.
+  std::string tls_certificate;
+  std::string tls_key;
+  /// A WebSocket message longer than this [bytes] closes the connection (1009, "message too
+  /// big"); the hub refuses shorter ones it will not read with a reason.
+  size_t max_message_bytes = 4u << 20;
 };
 
 struct WebServerHandlers {
@@ -29,7 +36,8 @@ struct WebServerHandlers {
 
 class WebServer : public ClientSink {
  public:
-  /// Listens at once. Throws std::runtime_error naming the address and port when it cannot.
+  /// Listens at once. Throws std::runtime_error naming the address and port when it cannot, or
+  /// the file when the certificate or key cannot be used.
   WebServer(WebServerOptions options, WebServerHandlers handlers, std::ostream& log);
   ~WebServer() override;
   WebServer(const WebServer&) = delete;
@@ -37,6 +45,8 @@ class WebServer : public ClientSink {
 
   /// The port listened on.
   uint16_t port() const;
+  /// Whether it serves HTTPS/WSS.
+  bool tls() const;
   /// Runs `every` on the server's thread every `period_ms` (e.g. the rates broadcast).
   void every(int period_ms, std::function<void()> every);
   /// Serves on a thread of its own until stop() or destruction.

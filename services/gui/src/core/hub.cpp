@@ -21,7 +21,9 @@ Hub::Hub(std::vector<TopicEntry> topics, HubParams params, std::ostream& log)
     : params_(params), log_(log) {
   for (auto& t : topics) {
     std::string name = t.name;
-    topics_.emplace(std::move(name), Topic{std::move(t), RateMeter{}, {}});
+    const bool newest = std::find(params_.newest_stamp_topics.begin(), params_.newest_stamp_topics.end(), name) !=
+                        params_.newest_stamp_topics.end();
+    topics_.emplace(std::move(name), Topic{std::move(t), RateMeter{}, {}, newest});
   }
 }
 
@@ -31,13 +33,26 @@ void Hub::attach(Bus* bus, ClientSink* sink) {
   sink_ = sink;
 }
 
+void Hub::require_auth(Auth* auth, bool pairing) {
+  std::lock_guard lock(mutex_);
+  auth_ = auth;
+  pairing_ = auth != nullptr && pairing;
+}
+
+std::string Hub::who(const Client& client) {
+  if (!client.session) return "not signed in";
+  return "user " + client.session->user + "/" + std::string(to_string(client.session->role));
+}
+
 void Hub::send_locked(ClientId client, std::string message, bool binary) {
   if (sink_ != nullptr) sink_->send(client, std::move(message), binary);
 }
 
 void Hub::connect(ClientId id, const std::string& origin) {
   std::lock_guard lock(mutex_);
-  clients_[id].origin = origin;
+  Client& client = clients_[id];
+  client.origin = origin;
+  if (auth_ == nullptr) client.session = Session{"", "local", Role::kEngineer, INT64_MAX};
   Json topics = Json::array();
   for (const auto& [name, t] : topics_) {
     topics.push_back({{"topic", name},
@@ -51,9 +66,10 @@ void Hub::connect(ClientId id, const std::string& origin) {
     commands.push_back({{"topic", c.topic},
                         {"what", c.what},
                         {"available", topics_.count(std::string(c.topic)) > 0},
-                        {"fixed", Json::parse(c.fixed_json)}});
+                        {"fixed", Json::parse(c.fixed_json)},
+                        {"role", to_string(c.role)}});
   }
-  const Json hello = {{"op", "hello"},
+  Json hello = {{"op", "hello"},
                       {"client", origin},
                       {"topics", topics},
                       {"commands", commands},
@@ -61,7 +77,10 @@ void Hub::connect(ClientId id, const std::string& origin) {
                        {{"stream_default_hz", params_.stream_default_hz},
                         {"stream_max_hz", params_.stream_max_hz},
                         {"image_default_hz", params_.image_default_hz},
-                        {"image_max_hz", params_.image_max_hz}}}};
+                        {"image_max_hz", params_.image_max_hz}}},
+                      {"auth", {{"required", auth_ != nullptr}, {"pairing", pairing_}}},
+                      {"heartbeat_ms", params_.heartbeat_ms}};
+  if (auth_ == nullptr) hello["session"] = {{"user", "local"}, {"role", "engineer"}};
   log_ << "concert_gui: client " << id << " connected from " << origin << std::endl;
   send_locked(id, hello.dump(), false);
 }
@@ -129,13 +148,29 @@ void Hub::handle(ClientId id, Client& client, const Subscribe& s, int64_t /*now_
 void Hub::refuse_locked(ClientId id, const Client& client, std::string_view topic, const std::string& why,
                         const std::optional<int64_t>& request) {
   ++refused_;
-  log_ << "concert_gui: command REFUSED from " << client.origin << " (client " << id << ") on " << topic
-       << ": " << why << std::endl;
+  log_ << "concert_gui: command REFUSED from " << client.origin << " (client " << id << ", " << who(client)
+       << ") on " << topic << ": " << why << std::endl;
   send_locked(id, error_message(why, request), false);
 }
 
 void Hub::on_message(ClientId id, std::string_view text, int64_t now_ns) {
-  const std::optional<PendingCommand> command = on_message_locked(id, text, now_ns);
+  ClientMessage message;
+  try {
+    message = parse_client_message(text);
+  } catch (const ProtocolError& e) {
+    std::lock_guard lock(mutex_);
+    auto c = clients_.find(id);
+    if (c == clients_.end()) return;
+    log_ << "concert_gui: message REFUSED from " << c->second.origin << " (client " << id << "): " << e.what()
+         << std::endl;
+    send_locked(id, error_message(e.what(), std::nullopt), false);
+    return;
+  }
+  if (std::holds_alternative<Login>(message) || std::holds_alternative<Pair>(message)) {
+    sign_in(id, message, now_ns);
+    return;
+  }
+  const std::optional<PendingCommand> command = on_message_locked(id, message, now_ns);
   flush_wanted();
   if (!command) return;
   // Published outside the lock: a DDS writer may deliver to this process's own readers on the
@@ -163,21 +198,127 @@ void Hub::on_message(ClientId id, std::string_view text, int64_t now_ns) {
     return;
   }
   ++published_;
-  log_ << "concert_gui: command from " << command->origin << " (client " << id << ") on " << command->topic
-       << ": " << command->sample.dump() << std::endl;
+  log_ << "concert_gui: command from " << command->origin << " (client " << id << ", "
+       << (c != clients_.end() ? who(c->second) : "gone") << ") on " << command->topic << ": "
+       << command->sample.dump() << std::endl;
   if (c != clients_.end()) send_locked(id, ack_message(command->topic, command->request), false);
 }
 
-std::optional<Hub::PendingCommand> Hub::on_message_locked(ClientId id, std::string_view text, int64_t now_ns) {
+void Hub::sign_in(ClientId id, const ClientMessage& message, int64_t now_ns) {
+  Auth* auth = nullptr;
+  std::string origin;
+  {
+    std::lock_guard lock(mutex_);
+    auto c = clients_.find(id);
+    if (c == clients_.end()) return;
+    auth = auth_;
+    origin = c->second.origin;
+  }
+  const auto* login = std::get_if<Login>(&message);
+  const auto* pair = std::get_if<Pair>(&message);
+  const std::optional<int64_t> request = login != nullptr ? login->id : pair->id;
+  const std::string address = address_of(origin);
+  std::optional<Session> session;
+  std::string why;
+  double retry = 0.0;
+  if (auth == nullptr) {
+    why = "this gateway requires no sign-in (it serves this machine only)";
+  } else {
+    // Outside the hub's lock: a password check costs argon2id's tenth of a second, and the DDS
+    // threads must not wait for it.
+    try {
+      if (pair != nullptr) {
+        session = auth->pair(address, pair->code, now_ns);
+      } else if (!login->token.empty()) {
+        session = auth->resume(address, login->token, now_ns);
+      } else {
+        session = auth->sign_in(address, login->user, login->password, now_ns);
+      }
+    } catch (const SignInRefused& e) {
+      why = e.what();
+      retry = e.retry_after_s;
+    }
+  }
+  std::lock_guard lock(mutex_);
+  auto c = clients_.find(id);
+  if (c == clients_.end()) return;
+  if (!session) {
+    log_ << "concert_gui: sign-in REFUSED from " << origin << " (client " << id << ")"
+         << (login != nullptr && !login->user.empty() ? " as '" + login->user + "'" : "") << ": " << why << std::endl;
+    send_locked(id, error_message(why, request, retry), false);
+    return;
+  }
+  if (pair != nullptr) {
+    log_ << "concert_gui: pairing code used by " << origin << "; a new code: " << auth->new_pairing_code(now_ns)
+         << std::endl;
+  }
+  c->second.session = session;
+  log_ << "concert_gui: client " << id << " (" << origin << ") signed in as " << session->user << " ("
+       << to_string(session->role) << ")" << std::endl;
+  Json m = {{"op", "session"},
+            {"user", session->user},
+            {"role", to_string(session->role)},
+            {"token", session->token},
+            {"expires_in_s", std::max<int64_t>(0, (session->expires_ns - now_ns) / 1'000'000'000)}};
+  if (request) m["id"] = *request;
+  send_locked(id, m.dump(-1, ' ', false, Json::error_handler_t::replace), false);
+}
+
+void Hub::expire_locked(ClientId id, Client& client, int64_t now_ns) {
+  if (auth_ == nullptr || !client.session || client.session->expires_ns > now_ns) return;
+  log_ << "concert_gui: client " << id << " (" << client.origin << "): session of " << client.session->user
+       << " expired" << std::endl;
+  client.session.reset();
+  unsubscribe_all_locked(client);
+  send_locked(id, Json{{"op", "signed_out"}, {"reason", "session expired: sign in again"}}.dump(), false);
+}
+
+void Hub::unsubscribe_all_locked(Client& client) {
+  for (const auto& [topic, sub] : client.subscriptions) {
+    bool still = false;
+    for (const auto& [other, c] : clients_) still = still || (&c != &client && c.subscriptions.count(topic) > 0);
+    if (!still) wanted_changes_.emplace_back(topic, false);
+  }
+  client.subscriptions.clear();
+}
+
+std::optional<Hub::PendingCommand> Hub::on_message_locked(ClientId id, const ClientMessage& message, int64_t now_ns) {
   std::lock_guard lock(mutex_);
   auto c = clients_.find(id);
   if (c == clients_.end()) return std::nullopt;
   Client& client = c->second;
-  ClientMessage message;
-  try {
-    message = parse_client_message(text);
-  } catch (const ProtocolError& e) {
-    send_locked(id, error_message(e.what(), std::nullopt), false);
+  expire_locked(id, client, now_ns);
+  if (const auto* g = std::get_if<Ping>(&message)) {
+    Json pong = {{"op", "pong"}};
+    if (g->id) pong["id"] = *g->id;
+    send_locked(id, pong.dump(), false);
+    return std::nullopt;
+  }
+  if (const auto* o = std::get_if<Logout>(&message)) {
+    if (auth_ != nullptr && client.session) {
+      auth_->sign_out(client.session->token);
+      log_ << "concert_gui: client " << id << " (" << client.origin << ") signed out (" << who(client) << ")"
+           << std::endl;
+      client.session.reset();
+      unsubscribe_all_locked(client);
+    }
+    Json m = {{"op", "signed_out"}, {"reason", auth_ != nullptr ? "signed out" : "no sign-in on this gateway"}};
+    if (o->id) m["id"] = *o->id;
+    send_locked(id, m.dump(), false);
+    return std::nullopt;
+  }
+  if (!client.session) {
+    const auto* p = std::get_if<Publish>(&message);
+    const auto* s = std::get_if<Subscribe>(&message);
+    const auto* u = std::get_if<Unsubscribe>(&message);
+    const std::optional<int64_t> request = p ? p->id : s ? s->id : u ? u->id : std::nullopt;
+    if (p != nullptr) {
+      refuse_locked(id, client, p->topic, "sign in first: this gateway takes commands from signed-in users only",
+                    request);
+    } else {
+      send_locked(id, error_message("sign in first: this gateway shows the robot to signed-in users only", request),
+                  false);
+    }
     return std::nullopt;
   }
   if (const auto* s = std::get_if<Subscribe>(&message)) {
@@ -191,6 +332,7 @@ std::optional<Hub::PendingCommand> Hub::on_message_locked(ClientId id, std::stri
   } else if (const auto* p = std::get_if<Publish>(&message)) {
     Json sample;
     try {
+      check_role(p->topic, client.session->role);
       sample = admit_command(p->topic, p->data, client.origin, now_ns);
     } catch (const CommandRefused& e) {
       refuse_locked(id, client, p->topic, e.what(), p->id);
@@ -201,10 +343,6 @@ std::optional<Hub::PendingCommand> Hub::on_message_locked(ClientId id, std::stri
       return std::nullopt;
     }
     return PendingCommand{p->topic, std::move(sample), p->id, client.origin};
-  } else if (const auto* g = std::get_if<Ping>(&message)) {
-    Json pong = {{"op", "pong"}};
-    if (g->id) pong["id"] = *g->id;
-    send_locked(id, pong.dump(), false);
   }
   return std::nullopt;
 }
@@ -251,7 +389,17 @@ void Hub::on_sample(std::string_view topic_name, std::string_view instance,
     log_ << "concert_gui: a sample of " << topic_name << " does not decode: " << e.what() << std::endl;
     return;
   }
-  if (state) topic.latest[std::string(instance)] = data;
+  if (state) {
+    auto kept = topic.latest.find(instance);
+    if (topic.newest_stamp && kept != topic.latest.end() && data.contains("stamp_ns") &&
+        kept->second.contains("stamp_ns") && data["stamp_ns"].is_number() && kept->second["stamp_ns"].is_number() &&
+        data["stamp_ns"].get<int64_t>() < kept->second["stamp_ns"].get<int64_t>()) {
+      // An older sample than the one kept (another writer's history handed to a late reader):
+      // neither kept nor shown.
+      return;
+    }
+    topic.latest[std::string(instance)] = data;
+  }
   if (due.empty()) return;
   const std::string message = sample_message(topic_name, instance, data);
   for (ClientId id : due) send_locked(id, message, false);
@@ -288,7 +436,21 @@ void Hub::broadcast_rates(int64_t now_ns) {
   }
   const std::string message = Json{{"op", "rates"}, {"topics", list}}.dump();
   std::lock_guard lock(mutex_);
-  for (const auto& [id, c] : clients_) send_locked(id, message, false);
+  for (const auto& [id, c] : clients_) {
+    if (c.session) send_locked(id, message, false);
+  }
+}
+
+void Hub::heartbeat(int64_t wall_ns) {
+  {
+    std::lock_guard lock(mutex_);
+    const std::string beat = Json{{"op", "heartbeat"}, {"now_ms", wall_ns / 1'000'000}}.dump();
+    for (auto& [id, c] : clients_) {
+      expire_locked(id, c, wall_ns);
+      send_locked(id, beat, false);
+    }
+  }
+  flush_wanted();
 }
 
 bool Hub::wanted(std::string_view topic) const {

@@ -21,6 +21,10 @@ std::string topic_of(const Json& j, std::string_view op) {
 }  // namespace
 
 ClientMessage parse_client_message(std::string_view text) {
+  if (text.size() > kMaxClientMessageBytes) {
+    throw ProtocolError("message of " + std::to_string(text.size()) + " bytes refused: at most " +
+                        std::to_string(kMaxClientMessageBytes));
+  }
   Json j;
   try {
     j = Json::parse(text);
@@ -50,7 +54,23 @@ ClientMessage parse_client_message(std::string_view text) {
     return p;
   }
   if (op == "ping") return Ping{id_of(j)};
-  throw ProtocolError("unknown op '" + op + "' (subscribe, unsubscribe, publish, ping)");
+  const auto string_field = [&](const char* name) {
+    if (!j.contains(name)) return std::string();
+    if (!j[name].is_string()) throw ProtocolError("'" + op + "': '" + name + "' must be a string");
+    return j[name].get<std::string>();
+  };
+  if (op == "login") {
+    Login l{string_field("user"), string_field("password"), string_field("token"), id_of(j)};
+    if (l.token.empty() && l.user.empty()) throw ProtocolError("'login' needs a 'user' and 'password', or a 'token'");
+    return l;
+  }
+  if (op == "pair") {
+    Pair p{string_field("code"), id_of(j)};
+    if (p.code.empty()) throw ProtocolError("'pair' needs a 'code'");
+    return p;
+  }
+  if (op == "logout") return Logout{id_of(j)};
+  throw ProtocolError("unknown op '" + op + "' (subscribe, unsubscribe, publish, ping, login, pair, logout)");
 }
 
 std::string sample_message(std::string_view topic, std::string_view instance, const Json& data) {
@@ -58,10 +78,11 @@ std::string sample_message(std::string_view topic, std::string_view instance, co
   return m.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
-std::string error_message(std::string_view error, const std::optional<int64_t>& id) {
+std::string error_message(std::string_view error, const std::optional<int64_t>& id, double retry_after_s) {
   Json m = {{"op", "error"}};
   if (id) m["id"] = *id;
   m["error"] = error;
+  if (retry_after_s > 0) m["retry_after_s"] = retry_after_s;
   return m.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
