@@ -8,11 +8,15 @@
 // sanding robot chosen, force set, start pressed) and a transport mode button; it saves a
 // screenshot of each page in <build>/services/gui/screenshots/. This test's own DDS readers
 // check what the sanding start and the mode button wrote: typed FinishCommand and CollabCommand
-// samples with the operator's choices.
+// samples with the operator's choices. Before that, app/test/safety_display_test.mjs checks the
+// safety display on the same stack: the E-STOP clear on every page at three sizes, the banner, a
+// late tablet after a release, the gateway frozen, a refused mission, homing asking first.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 #include <mutex>
 #include <regex>
 #include <string>
@@ -33,6 +37,19 @@ using concert::system_test::dies_with_test;
 namespace topics = concert::dds::topics;
 
 /// Every sample of a command topic, kept for the checks after the browser's run.
+/// The pid of `parent`'s child process named `name` (its comm), or 0.
+pid_t child_named(pid_t parent, const std::string& name) {
+  std::ifstream children("/proc/" + std::to_string(parent) + "/task/" + std::to_string(parent) + "/children");
+  pid_t child = 0;
+  while (children >> child) {
+    std::ifstream comm("/proc/" + std::to_string(child) + "/comm");
+    std::string c;
+    std::getline(comm, c);
+    if (c == name) return child;
+  }
+  return 0;
+}
+
 template <class T>
 struct Recorder {
   std::mutex mutex;
@@ -74,6 +91,25 @@ TEST(GuiBrowser, ModuleTreeHotSwapEStopResetSandingAndTransportInChromium) {
 
   auto status = concert::testing::run({CONCERT_BIN, "status", "--until-version", "1", "--timeout", "90"}, 120s, env);
   ASSERT_EQ(status.code, 0) << status.out << status.err << logs();
+
+  const pid_t gateway = child_named(up.pid(), "concert_gui");
+  ASSERT_GT(gateway, 0) << "no concert_gui child of concert up" << logs();
+  const auto gateway_log = [&] {
+    const char* domain = std::getenv("CONCERT_DOMAIN_ID");
+    return concert::testing::run({"/bin/cat", run_dir.path() + "/concert-d" + std::string(domain ? domain : "0") + "/logs/gui.log"}, 5s)
+        .out;
+  };
+  {
+    Process display({"/usr/bin/nice", "-n", "15", CONCERT_NODE, CONCERT_SOURCE_DIR "/services/gui/app/test/safety_display_test.mjs"},
+                    {"GUI_URL=" + url, "GUI_PID=" + std::to_string(gateway), "CONCERT_BIN=" CONCERT_BIN,
+                     "SHOTS_DIR=" GUI_SCREENSHOTS, "XDG_RUNTIME_DIR=" + run_dir.path()});
+    const auto code = display.wait(420s);
+    std::cout << "--- safety_display_test.mjs:\n" << display.out() << std::flush;
+    ASSERT_EQ(code, 0) << "--- safety_display_test.mjs:\n" << display.out() << display.err() << "\n--- gateway log:\n"
+                       << gateway_log() << logs();
+    // "No" to the homing question sent nothing.
+    EXPECT_EQ(gateway_log().find("on concert/model/customisation"), std::string::npos) << gateway_log();
+  }
 
   // The browser (node and its chromium, software WebGL) niced: on the robot the GUI runs on the
   // operator's tablet, not on the PCs of the stack it watches; here they share 2 cores (load

@@ -9,48 +9,19 @@
 //   CollabCommand); on the storey view a tap on the wall adds a point area to the mission YAML.
 // Saves a screenshot of every page into SHOTS_DIR. Exit 0 when every check passed.
 // Environment: GUI_URL, CONCERT_BIN, CONCERT_SOURCE_DIR, SHOTS_DIR, CHROMIUM (default /usr/bin/chromium).
-import { execFileSync } from 'node:child_process';
-import { mkdirSync } from 'node:fs';
 import { join } from 'node:path';
-import { chromium } from 'playwright-core';
+import { concertTool, environment, runChecks, step } from './harness.mjs';
 
-const url = process.env.GUI_URL;
-const concert = process.env.CONCERT_BIN;
-const source = process.env.CONCERT_SOURCE_DIR;
-const shots = process.env.SHOTS_DIR;
-if (!url || !concert || !source || !shots) {
-  console.error('browser_test: set GUI_URL, CONCERT_BIN, CONCERT_SOURCE_DIR and SHOTS_DIR');
-  process.exit(2);
-}
-mkdirSync(shots, { recursive: true });
+const env = environment('browser_test', ['GUI_URL', 'CONCERT_BIN', 'CONCERT_SOURCE_DIR', 'SHOTS_DIR']);
+const url = env.GUI_URL;
+const concert = env.CONCERT_BIN;
+const source = env.CONCERT_SOURCE_DIR;
+const shots = env.SHOTS_DIR;
 
-const step = (what) => console.log(`[${new Date().toISOString().slice(11, 23)}] ${what}`);
-function run(args, timeoutS = 60) {
-  return execFileSync(concert, args, { encoding: 'utf8', timeout: timeoutS * 1000 });
-}
-/// `concert safety status` until its line starts with `want` (at most `tries` polls).
-async function safetyOnDds(want, tries = 40) {
-  let last = '';
-  for (let i = 0; i < tries; i++) {
-    try { last = run(['safety', 'status', '--timeout', '3']).trim(); } catch (e) { last = String(e.stdout || e.message).trim(); }
-    if (last.startsWith('safety: ' + want)) return last;
-    await new Promise((r) => setTimeout(r, 250));
-  }
-  throw new Error(`safety on DDS: expected ${want}, last: ${last}`);
-}
+const { run, safetyOnDds } = concertTool(concert);
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  headless: true,
-  // WebGL on a machine without a GPU: SwiftShader, Chromium's software renderer.
-  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
-});
-const errors = [];
-let failed = false;
-try {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
-  page.on('pageerror', (e) => errors.push(String(e)));
-  page.setDefaultTimeout(60_000);
+await runChecks('browser_test', async (openPage) => {
+  const page = await openPage();
   const tab = async (name) => {
     await page.click(`#tabs button[data-page="${name}"]`);
     await page.waitForTimeout(300);
@@ -154,12 +125,4 @@ try {
   await page.waitForFunction(() => document.querySelector('#collab-result').textContent === 'follow-me sent');
   step('transport: follow-me sent');
   await shot('transport');
-  if (errors.length) throw new Error('errors in the page: ' + errors.join('; '));
-  step('all checks passed');
-} catch (e) {
-  failed = true;
-  console.error('browser_test: FAILED: ' + e.message);
-} finally {
-  await browser.close();
-}
-process.exit(failed ? 1 : 0);
+});
