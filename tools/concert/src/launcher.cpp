@@ -304,6 +304,16 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
   // other users) do not fight over one port.
   const int gui_port = o.gui_port >= 0 ? o.gui_port : 8080 + domain;
   std::vector<std::string> gui_args = {"--port", std::to_string(gui_port), "--bind", o.gui_bind};
+  const bool gui_loopback = o.gui_bind == "localhost" || o.gui_bind == "::1" || o.gui_bind.rfind("127.", 0) == 0;
+  if (!gui_loopback && o.gui_tls.empty()) {
+    throw UsageError("--gui-bind " + o.gui_bind +
+                     ": the GUI serves beyond this machine only over HTTPS: give --gui-tls DIR (a folder made by "
+                     "`concert security init`)");
+  }
+  if (!o.gui_tls.empty()) gui_args.insert(gui_args.end(), {"--tls", fs::absolute(o.gui_tls).string()});
+  if (!o.gui_users.empty()) gui_args.insert(gui_args.end(), {"--users", fs::absolute(o.gui_users).string()});
+  if (o.gui_auth) gui_args.push_back("--auth");
+  if (o.gui_pairing) gui_args.push_back("--pairing");
   gui_args.insert(gui_args.end(), db_args.begin(), db_args.end());
   // The planner's map: from the simulated world's description, the robot's own sensors, or both.
   std::vector<std::string> planner_args;
@@ -353,7 +363,11 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
   out << "concert up: domain " << domain << ", run folder " << dir.string() << "\n"
       << "  hot swap: concert sim swap FILE    status: concert status    stop: Ctrl-C" << std::endl;
   for (const auto& s : services) {
-    if (s.name == "gui") out << "  operator GUI: http://" << (o.gui_bind == "0.0.0.0" ? "<this host>" : o.gui_bind) << ":" << gui_port << "/" << std::endl;
+    if (s.name == "gui") {
+      out << "  operator GUI: " << (o.gui_tls.empty() ? "http" : "https") << "://"
+          << (o.gui_bind == "0.0.0.0" ? "<this host>" : o.gui_bind) << ":" << gui_port << "/"
+          << (o.gui_pairing ? "  (pairing code: in " + (dir / "logs" / "gui.log").string() + ")" : "") << std::endl;
+    }
   }
   Supervisor supervisor(std::move(services), dir / "logs", out);
   supervisor.start_all();
@@ -499,9 +513,16 @@ void register_launcher_verbs(cli::Cli& concert) {
       ->check(cli::number(0, 65535, true))
       ->default_str("8080 + domain");
   up_verb.add_option("--gui-bind", up->gui_bind,
-                     "the operator GUI's address (default: this machine only; 0.0.0.0: the robot's network)")
+                     "the operator GUI's address (default: this machine only; 0.0.0.0: the robot's network, "
+                     "with --gui-tls)")
       ->type_name("ADDR")
       ->default_str("127.0.0.1");
+  up_verb.add_option("--gui-tls", up->gui_tls,
+                     "the GUI serves HTTPS/WSS with the certificate of this PKI folder (concert security init)")
+      ->type_name("DIR");
+  up_verb.add_option("--gui-users", up->gui_users, "the GUI's users file (concert gui users)")->type_name("FILE");
+  up_verb.add_flag("--gui-auth", up->gui_auth, "sign-in on a GUI bound to this machine too (always beyond it)");
+  up_verb.add_flag("--gui-pairing", up->gui_pairing, "the GUI prints a one-time pairing code in its log");
   cli::Cli::add_choice(up_verb, "--map", up->map, {"world", "sensors", "both"},
                        "the planner's map: the simulated world's description, the robot's lidars and "
                        "depth cameras (paper 5.4.1), or both (default: the planner's, world)");

@@ -94,6 +94,10 @@ struct UpOptions {
   std::optional<int32_t> domain;
   int gui_port = -1;                    ///< the operator GUI's port (services/gui); -1: 8080 + domain
   std::string gui_bind = "127.0.0.1";   ///< the operator GUI's address (localhost only by default)
+  std::string gui_tls;                  ///< a PKI folder: the GUI serves HTTPS (needed beyond loopback)
+  std::string gui_users;                ///< the GUI's users file ("" = its default)
+  bool gui_auth = false;                ///< sign-in on a loopback GUI too
+  bool gui_pairing = false;             ///< the GUI prints a one-time pairing code
   std::string map;                      ///< the planner's map: world, sensors or both ("" = its default)
 };
 

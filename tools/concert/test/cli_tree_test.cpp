@@ -37,12 +37,16 @@ std::vector<std::vector<std::string>> all_commands(bool groups, bool verbs) {
   std::ostringstream out, err;
   cli::Cli concert("concert", "", out, err);
   tool::register_all(concert);
+  // A verb may have verbs of its own (`concert gui` serves, `concert gui users add` manages its
+  // users): it is a verb, not a group.
+  std::set<std::string> runnable;
+  for (const auto& [name, app] : concert.verbs()) runnable.insert(name);
   std::vector<std::vector<std::string>> found;
   std::function<void(CLI::App&, std::vector<std::string>)> walk =
       [&](CLI::App& app, std::vector<std::string> path) {
         const auto subs = app.get_subcommands([](CLI::App*) { return true; });
-        if (!path.empty() && ((subs.empty() && verbs) || (!subs.empty() && groups)))
-          found.push_back(path);
+        const bool verb = subs.empty() || runnable.count("concert " + join(path, " ")) > 0;
+        if (!path.empty() && ((verb && verbs) || (!verb && groups))) found.push_back(path);
         for (CLI::App* sub : subs) {
           auto next = path;
           next.push_back(sub->get_name());
