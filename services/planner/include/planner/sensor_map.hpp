@@ -8,8 +8,10 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "concert/hardware/sensors.hpp"
@@ -34,6 +36,33 @@ struct SensorRays {
   RayBundle rays;
   SensorMapStats stats;
 };
+
+/// One map update's sensor data, converted by the service: each lidar's newest revolution and
+/// each camera's latest depth frames (of the mapper's model version), by sensor name.
+struct SensorBatch {
+  std::vector<std::pair<std::string, hardware::LidarScan>> scans;
+  std::vector<std::pair<std::string, std::vector<hardware::RgbdFrame>>> depth;
+};
+
+/// A batch's rays from the sensors' poses, with what each sensor gave.
+struct BatchRays {
+  std::vector<RayBundle> bundles;    ///< every sensor's rays, to insert with one copy of the map
+  SensorMapStats stats;              ///< summed over the sensors used
+  std::vector<std::string> used;     ///< "front_lidar", "cam (5 depth frames averaged)"
+  std::vector<std::string> refused;  ///< "name: why" (the sensor's data is left out)
+};
+
+/// What one map update did, for the service's log line.
+struct SensorMapUpdate {
+  BatchRays rays;
+  double milliseconds = 0.0;
+  std::size_t occupied_cells = 0;     ///< of the map after the update
+  std::size_t skipped_moving = 0;     ///< revolutions and frames of periods the robot moved in
+  std::size_t skipped_version = 0;    ///< of another model version, or without a joint state
+  std::uint64_t model_version = 0;
+};
+/// "planner: sensor map: used ... in N ms, ... hits; map N occupied cells; ...".
+std::string describe(const SensorMapUpdate& update);
 
 /// Ray-casts sensor data into an Environment. Immutable; one per model version (the self
 /// filter uses that model's shapes). Parameters: Params::sensor_* and floor_height.
@@ -83,6 +112,10 @@ class SensorMapper {
   [[nodiscard]] SensorRays depth_rays(const std::vector<hardware::RgbdFrame>& frames,
                                       const Eigen::Isometry3d& map_T_optical,
                                       const Eigen::VectorXd& q_full) const;
+
+  /// Every sensor of `batch` from its pose at `q_full` (sensor_pose): a sensor whose frame or
+  /// data is bad is refused with the reason and the others are used.
+  [[nodiscard]] BatchRays batch_rays(const SensorBatch& batch, const Eigen::VectorXd& q_full) const;
 
   /// True if map point `p` lies in a robot collision shape grown by sensor_self_padding at the
   /// link poses `link_poses` (PlanningModel::link_poses).

@@ -1,6 +1,7 @@
 #include "planner/sensor_map.hpp"
 
 #include <cmath>
+#include <exception>
 #include <sstream>
 
 namespace concert::planner {
@@ -266,6 +267,52 @@ SensorRays SensorMapper::depth_rays(const std::vector<hardware::RgbdFrame>& fram
   SensorRays out = sort(map_T_optical.translation(), ends, q_full);
   out.stats.no_return = no_return;
   return out;
+}
+
+BatchRays SensorMapper::batch_rays(const SensorBatch& batch, const Eigen::VectorXd& q_full) const {
+  BatchRays out;
+  auto take = [&](SensorRays r, std::string used) {
+    out.stats.occupied += r.stats.occupied;
+    out.stats.self += r.stats.self;
+    out.stats.floor += r.stats.floor;
+    out.stats.returns += r.stats.returns;
+    out.stats.cut += r.stats.cut;
+    out.stats.no_return += r.stats.no_return;
+    out.bundles.push_back(std::move(r.rays));
+    out.used.push_back(std::move(used));
+  };
+  for (const auto& [name, scan] : batch.scans) {
+    try {
+      take(lidar_rays(scan, sensor_pose(q_full, scan.frame), q_full), name);
+    } catch (const std::exception& e) {
+      out.refused.push_back(name + ": " + e.what());
+    }
+  }
+  for (const auto& [name, frames] : batch.depth) {
+    if (frames.empty()) continue;
+    try {
+      take(depth_rays(frames, sensor_pose(q_full, frames.front().frame), q_full),
+           name + " (" + std::to_string(frames.size()) + " depth frames averaged)");
+    } catch (const std::exception& e) {
+      out.refused.push_back(name + ": " + e.what());
+    }
+  }
+  return out;
+}
+
+std::string describe(const SensorMapUpdate& u) {
+  std::ostringstream line;
+  line << "planner: sensor map: used ";
+  for (std::size_t i = 0; i < u.rays.used.size(); ++i) line << (i == 0 ? "" : ", ") << u.rays.used[i];
+  if (u.rays.used.empty()) line << "nothing";
+  line << " in " << std::lround(u.milliseconds) << " ms, " << u.rays.stats.occupied << " hits, " << u.rays.stats.self
+       << " on the robot, " << u.rays.stats.floor << " floor; map " << u.occupied_cells << " occupied cells";
+  if (u.skipped_moving > 0) line << "; " << u.skipped_moving << " revolutions or frames skipped: the robot moved";
+  if (u.skipped_version > 0) {
+    line << "; " << u.skipped_version << " skipped: not of model version " << u.model_version << " or no joint state";
+  }
+  for (const std::string& r : u.rays.refused) line << "; refused " << r;
+  return line.str();
 }
 
 }  // namespace concert::planner

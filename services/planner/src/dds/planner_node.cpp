@@ -15,6 +15,7 @@
 #include "concert/model/dds/pose.hpp"
 #include "concert/sensors_dds/conversions.hpp"
 #include "concert/world/world_dds.hpp"
+#include "planner/request.hpp"
 
 namespace concert::planner::dds {
 
@@ -34,24 +35,6 @@ World to_planner_world(const world::World& w) {
 
 Eigen::Isometry3d to_core(const msg::Pose& p) { return model::dds::to_isometry(p); }
 
-Trajectory to_odometry_frame(Trajectory trajectory, const Eigen::Vector3d& map_T_odom,
-                             double yaw_offset) {
-  const double c = std::cos(map_T_odom.z()), s = std::sin(map_T_odom.z());
-  for (TrajectoryPoint& p : trajectory.points) {
-    if (p.q.size() < 3) continue;
-    const double dx = p.q(0) - map_T_odom.x(), dy = p.q(1) - map_T_odom.y();
-    p.q(0) = c * dx + s * dy;
-    p.q(1) = -s * dx + c * dy;
-    p.q(2) += yaw_offset;
-    if (p.qd.size() >= 2) {
-      const double vx = p.qd(0), vy = p.qd(1);
-      p.qd(0) = c * vx + s * vy;
-      p.qd(1) = -s * vx + c * vy;
-    }
-  }
-  return trajectory;
-}
-
 msg::Pose to_msg(const Eigen::Isometry3d& t) { return model::dds::to_pose_msg(t); }
 
 namespace {
@@ -66,33 +49,6 @@ constexpr EnumMap kFailures{std::array{
     std::pair{Status::kUnreachable, msg::PLAN_UNREACHABLE},
     std::pair{Status::kNoPath, msg::PLAN_NO_PATH},
 }};
-
-// The full start state a request gives (base_x, base_y, base_yaw and the joints by name).
-// Throws std::runtime_error naming what is missing or unknown.
-Eigen::VectorXd given_start(const PlanningModel& model, const msg::PlanRequest& request) {
-  const auto& names = request.start_names();
-  const auto& values = request.start_position();
-  if (names.size() != values.size()) {
-    throw std::runtime_error("start state has " + std::to_string(names.size()) + " names and " +
-                             std::to_string(values.size()) + " positions");
-  }
-  Eigen::Vector3d base = Eigen::Vector3d::Zero();
-  std::vector<std::string> joints;
-  std::vector<double> positions;
-  constexpr std::array<const char*, 3> kBase{"base_x", "base_y", "base_yaw"};
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (!std::isfinite(values[i]))
-      throw std::runtime_error("start state: '" + names[i] + "' is not finite");
-    const auto b = std::find(kBase.begin(), kBase.end(), names[i]);
-    if (b != kBase.end()) {
-      base[b - kBase.begin()] = values[i];
-    } else {
-      joints.push_back(names[i]);
-      positions.push_back(values[i]);
-    }
-  }
-  return model.full_from_named(joints, positions, base);
-}
 
 }  // namespace
 
@@ -347,123 +303,11 @@ bool PlannerNode::spin_once(std::chrono::milliseconds timeout) {
   return true;
 }
 
-void PlannerNode::handle(const msg::PlanRequest& request) {
-  // After a hot swap a client may name the new model version before its sample reached us:
-  // wait (bounded) for it instead of answering "no model" or "stale".
-  if (request.model_version() > planner_.model_version()) {
-    std::unique_lock lock(mutex_);
-    wake_.wait_for(lock, options_.model_wait, [&] {
-      return stopping_ || planner_.model_version() >= request.model_version();
-    });
-  }
-  // The map from the sensors alone: nothing is planned before they were first integrated.
-  std::string map_error;
-  if (use_sensors_ && !use_world_) {
-    std::unique_lock lock(mutex_);
-    if (!wake_.wait_for(lock, options_.map_wait, [&] { return stopping_ || sensor_maps_ > 0; })) {
-      std::ostringstream why;
-      why << "no map from the sensors yet (environment_source: sensors): no lidar revolution or "
-             "depth frame integrated within "
-          << std::chrono::duration<double>(options_.map_wait).count()
-          << " s (are the sensors publishing? the map takes only data of periods the robot stood still)";
-      map_error = why.str();
-    }
-  }
-  msg::PlanResult base = planning(request);
-  publish(base);
-  const auto model = planner_.model();
+namespace {
 
-  // Start state: the robot's joint state and odometry; without a robot (planning only) the
-  // model's zero posture at the origin.
-  Eigen::VectorXd start;
-  std::string start_error;
-  if (model && request.model_version() == model->version()) {
-    std::optional<msg::JointState> js;
-    std::optional<msg::Odometry> odom;
-    {
-      std::lock_guard lock(mutex_);
-      js = joint_state_;
-      odom = odometry_;
-    }
-    const Eigen::Vector3d pose =
-        odom ? Eigen::Vector3d(odom->x(), odom->y(), odom->yaw()) : Eigen::Vector3d::Zero();
-    try {
-      if (!request.start_names().empty()) {
-        start = given_start(*model, request);
-        if (request.execute())
-          start_error = "a request with a start state cannot be executed (the robot is not there)";
-      } else if (js && js->model_version() == model->version()) {
-        start = model->full_from_named(js->name(), js->position(), pose);
-      } else if (request.execute()) {
-        start_error = js ? "the robot runs model version " + std::to_string(js->model_version()) +
-                               ", the planner " + std::to_string(model->version())
-                         : "no joint state from the robot service yet (needed to execute)";
-      } else {
-        start = Eigen::VectorXd::Zero(model->full_dof());
-        start.head<3>() = pose;
-      }
-    } catch (const std::exception& e) {
-      start_error = e.what();
-    }
-  }
-  if (!map_error.empty()) {
-    base.state(msg::PLAN_FAILED);
-    base.failure(msg::PLAN_INVALID_REQUEST);
-    base.reason(map_error);
-    publish(base);
-    log_line("planner: request " + std::to_string(request.request_id()) + " failed: " + map_error);
-    return;
-  }
-  if (!start_error.empty()) {
-    base.state(msg::PLAN_FAILED);
-    base.failure(msg::PLAN_INVALID_START);
-    base.reason(start_error);
-    publish(base);
-    {
-      std::ostringstream line;
-      line << "planner: request " << request.request_id() << " failed: " << start_error;
-      log_line(line.str());
-    }
-    return;
-  }
-
-  // Into the map frame, where the world is (the identity until nav localises the base), or where
-  // the client measured the odometry frame to be (PlanRequest.odom_in_map).
-  Eigen::Vector3d map_T_odom = map_frame_.map_T_odom();
-  std::string frame_note;
-  if (const std::vector<double>& c = request.odom_in_map(); !c.empty()) {
-    const Eigen::Vector3d given(c[0], c.size() > 1 ? c[1] : 0.0, c.size() > 2 ? c[2] : 0.0);
-    std::ostringstream note;
-    if (c.size() != 3 || !given.allFinite()) {
-      note << "odom_in_map needs 3 finite values (x, y, yaw), got " << c.size();
-      base.state(msg::PLAN_FAILED);
-      base.failure(msg::PLAN_INVALID_REQUEST);
-      base.reason(note.str());
-      publish(base);
-      log_line("planner: request " + std::to_string(request.request_id()) + " failed: " + note.str());
-      return;
-    }
-    if (use_sensors_) {
-      note << "the client's odometry frame (" << given.x() << ", " << given.y() << ", " << given.z()
-           << ") not used: the map comes from the sensors, placed with nav's";
-    } else {
-      map_T_odom = given;
-      note << "planned in the map, odometry frame at (" << given.x() << ", " << given.y() << ", "
-           << given.z() << ") as the client measured it";
-    }
-    frame_note = note.str();
-  }
-  const Eigen::Isometry3d map_from_odom = mobile_base::isometry(map_T_odom);
-  // The yaw back: minus the frame's turn, plus whatever whole turn wrapping the start's map yaw
-  // took away; one offset for every goal of the request, so their trajectories join up.
-  double yaw_offset = -map_T_odom.z();
-  if (start.size() >= 3) {
-    const double odom_yaw = start(2);
-    start.head<3>() = mobile_base::compose(map_T_odom, start.head<3>());
-    yaw_offset = odom_yaw - start(2);
-  }
-
-  PlanRequest core;
+ClientRequest to_client_request(const msg::PlanRequest& request) {
+  ClientRequest c;
+  PlanRequest& core = c.plan;
   core.request_id = request.request_id();
   core.model_version = request.model_version();
   core.end_effector = request.end_effector();
@@ -474,32 +318,94 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   core.fixed_base = request.fixed_base();
   core.environment_padding = request.environment_padding();
   core.base_travel = request.base_travel();
-  for (const msg::Pose& g : request.goals()) core.goals.push_back({map_from_odom * to_core(g)});
+  for (const msg::Pose& g : request.goals()) core.goals.push_back({to_core(g)});
+  c.start_names = request.start_names();
+  c.start_position = request.start_position();
+  c.execute = request.execute();
+  c.odom_in_map = request.odom_in_map();
+  return c;
+}
+
+MeasuredRobot to_measured(const std::optional<msg::JointState>& js, const std::optional<msg::Odometry>& odom) {
+  MeasuredRobot robot;
+  if (js) robot.joints = MeasuredRobot::Joints{js->model_version(), js->name(), js->position()};
+  if (odom) robot.odometry = Eigen::Vector3d(odom->x(), odom->y(), odom->yaw());
+  return robot;
+}
+
+// A goal's result as published: failed with its reason, or planned with its trajectory.
+msg::PlanResult goal_result(msg::PlanResult r, const GoalResult& g, const Trajectory& trajectory) {
+  r.goal_index(static_cast<uint32_t>(g.index));
+  r.planning_time(g.nspg_seconds + g.plan_seconds);
+  if (g.status != Status::kSucceeded) {
+    r.state(msg::PLAN_FAILED);
+    r.failure(to_failure(g.status));
+    r.reason(g.reason);
+    return r;
+  }
+  r.state(msg::PLAN_PLANNED);
+  r.joint_names(trajectory.joint_names);
+  for (const TrajectoryPoint& p : trajectory.points) {
+    msg::TrajectorySample s;
+    s.time(p.time);
+    s.position(std::vector<double>(p.q.data(), p.q.data() + p.q.size()));
+    s.velocity(std::vector<double>(p.qd.data(), p.qd.data() + p.qd.size()));
+    r.trajectory().push_back(std::move(s));
+  }
+  return r;
+}
+
+}  // namespace
+
+std::string PlannerNode::wait_for_inputs(const msg::PlanRequest& request) {
+  // After a hot swap a client may name the new model version before its sample reached us:
+  // wait (bounded) for it instead of answering "no model" or "stale".
+  std::unique_lock lock(mutex_);
+  if (request.model_version() > planner_.model_version()) {
+    wake_.wait_for(lock, options_.model_wait, [&] {
+      return stopping_ || planner_.model_version() >= request.model_version();
+    });
+  }
+  // The map from the sensors alone: nothing is planned before they were first integrated.
+  if (!use_sensors_ || use_world_) return {};
+  if (wake_.wait_for(lock, options_.map_wait, [&] { return stopping_ || sensor_maps_ > 0; })) return {};
+  std::ostringstream why;
+  why << "no map from the sensors yet (environment_source: sensors): no lidar revolution or "
+         "depth frame integrated within "
+      << std::chrono::duration<double>(options_.map_wait).count()
+      << " s (are the sensors publishing? the map takes only data of periods the robot stood still)";
+  return why.str();
+}
+
+void PlannerNode::handle(const msg::PlanRequest& request) {
+  const std::string map_error = wait_for_inputs(request);
+  msg::PlanResult base = planning(request);
+  publish(base);
+  const auto model = planner_.model();
+  const FrameKnowledge frame{map_frame_.map_T_odom(), map_frame_.localised(), use_sensors_};
+  PreparedRequest prepared;
+  if (map_error.empty()) {
+    std::lock_guard lock(mutex_);
+    prepared = prepare_request(to_client_request(request), model.get(), to_measured(joint_state_, odometry_), frame);
+  }
+  if (!map_error.empty() || prepared.refused()) {
+    const std::string& why = map_error.empty() ? prepared.reason : map_error;
+    base.state(msg::PLAN_FAILED);
+    base.failure(map_error.empty() ? to_failure(prepared.refusal) : msg::PLAN_INVALID_REQUEST);
+    base.reason(why);
+    publish(base);
+    log_line("planner: request " + std::to_string(request.request_id()) + " failed: " + why);
+    return;
+  }
+
   const bool execute = request.execute();
-  const std::size_t count = core.goals.size();
+  const std::size_t count = prepared.plan.goals.size();
   msg::PlanResult last_planned;
-  const PlanResult result = planner_.plan(core, start, [&](const GoalResult& g) {
-    msg::PlanResult r = base;
-    r.goal_index(static_cast<uint32_t>(g.index));
-    r.planning_time(g.nspg_seconds + g.plan_seconds);
-    if (g.status != Status::kSucceeded) {
-      r.state(msg::PLAN_FAILED);
-      r.failure(to_failure(g.status));
-      r.reason(g.reason);
-      publish(r);
-      return;
-    }
-    r.state(msg::PLAN_PLANNED);
-    const Trajectory trajectory = to_odometry_frame(g.trajectory, map_T_odom, yaw_offset);
-    r.joint_names(trajectory.joint_names);
-    for (const TrajectoryPoint& p : trajectory.points) {
-      msg::TrajectorySample s;
-      s.time(p.time);
-      s.position(std::vector<double>(p.q.data(), p.q.data() + p.q.size()));
-      s.velocity(std::vector<double>(p.qd.data(), p.qd.data() + p.qd.size()));
-      r.trajectory().push_back(std::move(s));
-    }
+  const PlanResult result = planner_.plan(prepared.plan, prepared.start, [&](const GoalResult& g) {
+    const Trajectory trajectory = to_odometry_frame(g.trajectory, prepared.map_T_odom, prepared.yaw_offset);
+    const msg::PlanResult r = goal_result(base, g, trajectory);
     publish(r);
+    if (g.status != Status::kSucceeded) return;
     last_planned = r;
     if (execute) {
       {
@@ -509,24 +415,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
       wake_.notify_all();
     }
   });
-  {
-    std::ostringstream line;
-    line << "planner: request " << request.request_id() << ": " << to_string(result.status)
-         << (result.reason.empty() ? "" : " (" + result.reason + ")") << (result.note.empty() ? "" : "; " + result.note);
-    if (!frame_note.empty()) {
-      line << "; " << frame_note;
-    } else if (map_frame_.localised()) {
-      line << "; planned in the map, odometry frame at (" << map_T_odom.x() << ", "
-           << map_T_odom.y() << ", " << map_T_odom.z() << ")";
-    }
-    for (const GoalResult& g : result.goals) {
-      if (g.status != Status::kSucceeded) continue;
-      line << "; goal " << g.index << " in "
-           << static_cast<int>(1e3 * (g.nspg_seconds + g.plan_seconds)) << " ms (" << g.path_method
-           << (g.load.empty() ? "" : "; load " + g.load) << ")";
-    }
-    log_line(line.str());
-  }
+  log_line(describe(result, prepared, frame));
   if (result.goals.empty()) {  // refused before any goal (stale model, bad request...)
     base.state(msg::PLAN_FAILED);
     base.failure(to_failure(result.status));
@@ -717,8 +606,57 @@ void PlannerNode::note_motion(const msg::JointState& joints) {
   }
 }
 
+namespace {
+
+// The pending sensor data of model `version` converted for the mapper: what is of another
+// version is counted in `stale`, what cannot be converted is refused ("name: why").
+SensorBatch to_batch(const std::map<std::string, msg::LidarScan>& scans,
+                     const std::map<std::string, std::deque<msg::Image>>& depth,
+                     const std::map<std::string, msg::CameraInfo>& infos, std::uint64_t version,
+                     std::size_t& stale, std::vector<std::string>& refused) {
+  SensorBatch batch;
+  for (const auto& [name, m] : scans) {
+    if (m.model_version() != version) {
+      stale += 1;
+      continue;
+    }
+    try {
+      batch.scans.emplace_back(name, sensors_dds::from_msg(m));
+    } catch (const std::exception& e) {
+      refused.push_back(name + ": " + e.what());
+    }
+  }
+  for (const auto& [name, images] : depth) {
+    try {
+      const auto info = infos.find(name);
+      if (info == infos.end()) throw PlannerError("no camera info");
+      std::vector<hardware::RgbdFrame> frames;
+      for (const msg::Image& image : images) {
+        if (image.model_version() != version) {
+          stale += 1;
+          continue;
+        }
+        frames.push_back(sensors_dds::to_depth_frame(image, info->second));
+      }
+      if (!frames.empty()) batch.depth.emplace_back(name, std::move(frames));
+    } catch (const std::exception& e) {
+      refused.push_back(name + ": " + e.what());
+    }
+  }
+  return batch;
+}
+
+}  // namespace
+
+std::optional<Eigen::VectorXd> PlannerNode::robot_in_map(const PlanningModel& model) const {
+  std::lock_guard lock(mutex_);
+  if (!joint_state_ || joint_state_->model_version() != model.version() || !odometry_) return std::nullopt;
+  const Eigen::Vector3d base = mobile_base::compose(
+      map_frame_.map_T_odom(), Eigen::Vector3d(odometry_->x(), odometry_->y(), odometry_->yaw()));
+  return model.full_from_named(joint_state_->name(), joint_state_->position(), base);
+}
+
 void PlannerNode::update_sensor_map() {
-  const Params& params = planner_.params();
   const auto model = planner_.model();
   std::map<std::string, msg::LidarScan> scans;
   std::map<std::string, std::deque<msg::Image>> depth;
@@ -734,108 +672,48 @@ void PlannerNode::update_sensor_map() {
   if (!model) return;  // no model: no sensor frames, no self filter
   if (!mapper_ || mapper_->model().version() != model->version()) {
     // A new model: its sensor frames and its shapes for the self filter.
-    mapper_ = std::make_shared<const SensorMapper>(model, params);
+    mapper_ = std::make_shared<const SensorMapper>(model, planner_.params());
     log_line("planner: sensor map: self filter on model version " + std::to_string(model->version()));
   }
   std::size_t inputs = scans.size();
   for (const auto& [name, frames] : depth) inputs += frames.size();
   if (inputs == 0) return;
-  std::optional<msg::JointState> js;
-  std::optional<msg::Odometry> odom;
-  {
-    std::lock_guard lock(mutex_);
-    js = joint_state_;
-    odom = odometry_;
-  }
-  if (!js || js->model_version() != model->version() || !odom) {
+  const std::optional<Eigen::VectorXd> q = robot_in_map(*model);
+  if (!q || moved) {
+    // No robot state of this model to place them with, or something moved during the period
+    // (its revolutions and frames may be smeared).
     std::lock_guard lock(map_mutex_);
-    skipped_version_ += inputs;  // no robot state of this model to place them with
+    (q ? skipped_moving_ : skipped_version_) += inputs;
     return;
   }
-  if (moved) {
-    // Something moved during the period: its revolutions and frames may be smeared.
-    std::lock_guard lock(map_mutex_);
-    skipped_moving_ += inputs;
-    return;
-  }
-  const Eigen::Vector3d base =
-      mobile_base::compose(map_frame_.map_T_odom(), Eigen::Vector3d(odom->x(), odom->y(), odom->yaw()));
-  const Eigen::VectorXd q = model->full_from_named(js->name(), js->position(), base);
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::string> used, refused;
-  SensorMapStats total;
-  auto add = [&](const SensorMapStats& s) {
-    total.occupied += s.occupied;
-    total.self += s.self;
-    total.floor += s.floor;
-  };
+  SensorMapUpdate update;
+  update.model_version = model->version();
   std::size_t stale = 0;
-  std::vector<RayBundle> bundles;  // every sensor's rays, cast with one copy of the map
-  for (const auto& [name, m] : scans) {
-    if (m.model_version() != model->version()) {
-      stale += 1;
-      continue;
-    }
-    try {
-      const hardware::LidarScan scan = sensors_dds::from_msg(m);
-      SensorRays r = mapper_->lidar_rays(scan, mapper_->sensor_pose(q, scan.frame), q);
-      add(r.stats);
-      bundles.push_back(std::move(r.rays));
-      used.push_back(name);
-    } catch (const std::exception& e) {
-      refused.push_back(name + ": " + e.what());
-    }
-  }
-  for (const auto& [name, images] : depth) {
-    try {
-      const auto info = infos.find(name);
-      if (info == infos.end()) throw PlannerError("no camera info");
-      std::vector<hardware::RgbdFrame> frames;
-      for (const msg::Image& image : images) {
-        if (image.model_version() != model->version()) {
-          stale += 1;
-          continue;
-        }
-        frames.push_back(sensors_dds::to_depth_frame(image, info->second));
-      }
-      if (frames.empty()) continue;
-      SensorRays r = mapper_->depth_rays(frames, mapper_->sensor_pose(q, frames.front().frame), q);
-      add(r.stats);
-      bundles.push_back(std::move(r.rays));
-      used.push_back(name + " (" + std::to_string(frames.size()) + " depth frames averaged)");
-    } catch (const std::exception& e) {
-      refused.push_back(name + ": " + e.what());
-    }
-  }
+  std::vector<std::string> refused;
+  update.rays = mapper_->batch_rays(to_batch(scans, depth, infos, model->version(), stale, refused), *q);
+  update.rays.refused.insert(update.rays.refused.begin(), refused.begin(), refused.end());
   Environment map = [&] {
     std::lock_guard lock(map_mutex_);
     return sensor_map_;
   }();
-  if (!bundles.empty()) map.insert_rays(bundles);
-  std::size_t moving = 0, version = 0;
+  if (!update.rays.bundles.empty()) map.insert_rays(update.rays.bundles);
   {
     std::lock_guard lock(map_mutex_);
     sensor_map_ = map;
-    if (used.empty() && refused.empty()) {
+    if (update.rays.used.empty() && update.rays.refused.empty()) {
       skipped_version_ += stale;  // nothing to report yet: counted into the next line
       return;
     }
-    moving = std::exchange(skipped_moving_, 0);
-    version = std::exchange(skipped_version_, 0) + stale;
+    update.skipped_moving = std::exchange(skipped_moving_, 0);
+    update.skipped_version = std::exchange(skipped_version_, 0) + stale;
   }
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  std::ostringstream line;
-  line << "planner: sensor map: used ";
-  for (std::size_t i = 0; i < used.size(); ++i) line << (i == 0 ? "" : ", ") << used[i];
-  if (used.empty()) line << "nothing";
-  line << " in " << std::lround(ms) << " ms, " << total.occupied << " hits, " << total.self << " on the robot, "
-       << total.floor << " floor; map " << map.occupied_cells() << " occupied cells";
-  if (moving > 0) line << "; " << moving << " revolutions or frames skipped: the robot moved";
-  if (version > 0) line << "; " << version << " skipped: not of model version " << model->version() << " or no joint state";
-  for (const std::string& r : refused) line << "; refused " << r;
-  log_line(line.str());
+  update.milliseconds =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  update.occupied_cells = map.occupied_cells();
+  log_line(describe(update));
   // After the line, so whoever sees the new map finds the line that reports it.
-  if (used.empty()) return;
+  if (update.rays.used.empty()) return;
   publish_environment();
   {
     std::lock_guard lock(mutex_);

@@ -51,13 +51,6 @@ Eigen::Isometry3d to_core(const msg::Pose& pose);
 World to_planner_world(const world::World& world);
 msg::Pose to_msg(const Eigen::Isometry3d& pose);
 msg::PlanFailure to_failure(Status status);
-/// A trajectory planned in the map frame, in the odometry frame whose pose in the map is
-/// `map_T_odom` (x, y, yaw): the base's positions and velocities turned and shifted; the yaw
-/// shifted by `yaw_offset` (the frame's turn back, and any whole turn the start's wrapped map yaw
-/// lost), not wrapped, so it stays continuous and starts where the robot's odometry yaw is.
-Trajectory to_odometry_frame(Trajectory trajectory, const Eigen::Vector3d& map_T_odom,
-                             double yaw_offset);
-
 struct NodeOptions {
   /// How long after a trajectory's duration the robot's result may take (its settling time).
   std::chrono::milliseconds result_margin{10000};
@@ -101,6 +94,9 @@ class PlannerNode {
   };
   void on_model(const msg::RobotModel& model);
   void handle(const msg::PlanRequest& request);
+  /// Waits (bounded) for the model version `request` names and, with the map from the sensors
+  /// alone, for their first map; why the request cannot be planned, or empty.
+  std::string wait_for_inputs(const msg::PlanRequest& request);
   void publish(msg::PlanResult result);
   /// A request as it arrives: queued and acknowledged, unless taken already.
   void take(const msg::PlanRequest& request);
@@ -115,6 +111,9 @@ class PlannerNode {
   /// Integrates the pending lidar scans into the sensor map and publishes the map (sensor map
   /// thread only).
   void update_sensor_map();
+  /// The robot's full state in the map frame (its joint state of `model`'s version, odometry
+  /// placed with nav's frame), or none.
+  [[nodiscard]] std::optional<Eigen::VectorXd> robot_in_map(const PlanningModel& model) const;
   /// Marks the period as moved if the base or a joint is faster than sensor_max_speed.
   void note_motion(const msg::Odometry& odometry);
   void note_motion(const msg::JointState& joints);
