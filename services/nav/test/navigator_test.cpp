@@ -210,6 +210,37 @@ TEST_F(NavigatorTest, ANewModelCancelsTheGoalAndStaleGoalsAreRefused) {
   EXPECT_EQ(nav_.submit(fresh).state, GoalState::kPlanning);
 }
 
+// An IMU sample in the IMU's own frame counts as the gyro rate about the base's z once turned by
+// the IMU's mounting; an IMU the vehicle does not know is taken as aligned with the base.
+TEST_F(NavigatorTest, AnImuSampleIsTurnedIntoTheBaseFrameByItsMounting) {
+  ASSERT_NE(nav_.vehicle(), nullptr);
+  ASSERT_FALSE(nav_.vehicle()->perception.imus.empty());
+  const SensorPose imu = nav_.vehicle()->perception.imus.front();
+  // The base's yaw rate as the vehicle's IMU, as mounted, measures it.
+  Navigator mounted{NavParams{}, 5}, unknown{NavParams{}, 5}, gyro{NavParams{}, 5};
+  for (Navigator* n : {&mounted, &unknown, &gyro}) n->set_model(*model_);
+  const Eigen::Matrix3d base_R_imu = imu.base_T_sensor.linear();
+  const double wz = 0.3;
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 1.0 + 0.01 * k;
+    for (Navigator* n : {&mounted, &unknown, &gyro}) n->on_wheel_odometry(t, Eigen::Vector3d(0.0, 0.0, 0.25));
+    gyro.on_gyro(t, wz);
+    mounted.on_imu(t, imu.name, "", base_R_imu.transpose() * Eigen::Vector3d(0.0, 0.0, wz));
+    unknown.on_imu(t, "no_such_imu", "no_such_frame", Eigen::Vector3d(0.0, 0.0, wz));
+  }
+  EXPECT_NEAR(mounted.odometry().pose.z(), gyro.odometry().pose.z(), 1e-9);
+  EXPECT_NEAR(unknown.odometry().pose.z(), gyro.odometry().pose.z(), 1e-9);
+  // A rate about the IMU's other axes adds nothing when the IMU is aligned with the base.
+  Navigator sideways{NavParams{}, 5};
+  sideways.set_model(*model_);
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 1.0 + 0.01 * k;
+    sideways.on_wheel_odometry(t, Eigen::Vector3d(0.0, 0.0, 0.25));
+    sideways.on_imu(t, "no_such_imu", "", Eigen::Vector3d(0.5, -0.5, wz));
+  }
+  EXPECT_NEAR(sideways.odometry().pose.z(), gyro.odometry().pose.z(), 1e-9);
+}
+
 TEST(NavParams, TheShippedFileHoldsEveryDefault) {
   const NavParams p = load_params(NAV_CONFIG);
   const NavParams d;

@@ -126,6 +126,11 @@ class Navigator {
   void on_wheel_odometry(double stamp, const Eigen::Vector3d& twist);
   /// IMU angular rate about the base z axis [rad/s].
   void on_gyro(double stamp, double yaw_rate);
+  /// An IMU sample's angular velocity in its own frame [rad/s]: turned into the base frame by
+  /// the vehicle's IMU of that sensor name or URDF frame (as mounted; unknown: taken as aligned
+  /// with the base), its z given to on_gyro.
+  void on_imu(double stamp, const std::string& sensor, const std::string& frame,
+              const Eigen::Vector3d& angular_velocity);
   /// A planar scan in the base frame, taken at `stamp` [s].
   void on_scan(double stamp, PlanarScan scan);
 

@@ -169,6 +169,17 @@ void Navigator::on_gyro(double stamp, double yaw_rate) {
   filter_.update(GyroRate{stamp, yaw_rate, kGyroVariance});
 }
 
+void Navigator::on_imu(double stamp, const std::string& sensor, const std::string& frame,
+                       const Eigen::Vector3d& angular_velocity) {
+  Eigen::Matrix3d base_R_imu = Eigen::Matrix3d::Identity();
+  if (vehicle_) {
+    for (const auto& imu : vehicle_->perception.imus) {
+      if (imu.frame == frame || imu.name == sensor) base_R_imu = imu.base_T_sensor.linear();
+    }
+  }
+  on_gyro(stamp, (base_R_imu * angular_velocity).z());
+}
+
 void Navigator::on_scan(double stamp, PlanarScan scan) { scan_ = Scan{stamp, std::move(scan)}; }
 
 Eigen::Vector3d Navigator::odom_at(double stamp) const {

@@ -283,12 +283,7 @@ void NavNode::publish_status() {
   }
 }
 
-void NavNode::tick() {
-  Inbox in;
-  {
-    std::lock_guard lock(mutex_);
-    std::swap(in, inbox_);
-  }
+void NavNode::take_inputs(const Inbox& in) {
   if (in.model) apply_model(*in.model);
   if (in.safety) {
     const bool stopped = in.safety->mode() != msg::SAFETY_RUNNING;
@@ -313,18 +308,8 @@ void NavNode::tick() {
   }
   for (const auto& s : in.imu) {
     try {
-      const VehicleConfig* v = navigator_.vehicle();
-      Eigen::Matrix3d base_R_imu = Eigen::Matrix3d::Identity();
-      if (v) {
-        for (const auto& imu : v->perception.imus) {
-          if (imu.frame == s.frame() || imu.name == s.sensor())
-            base_R_imu = imu.base_T_sensor.linear();
-        }
-      }
-      const Eigen::Vector3d w =
-          base_R_imu * Eigen::Vector3d(s.angular_velocity().x(), s.angular_velocity().y(),
-                                       s.angular_velocity().z());
-      navigator_.on_gyro(to_s(s.stamp_ns()), w.z());
+      const auto& w = s.angular_velocity();
+      navigator_.on_imu(to_s(s.stamp_ns()), s.sensor(), s.frame(), Eigen::Vector3d(w.x(), w.y(), w.z()));
     } catch (const LateMeasurement& e) {
       dropped_late("IMU sample", e);
     } catch (const std::exception& e) {
@@ -341,6 +326,15 @@ void NavNode::tick() {
                ", " + std::to_string(s.goal.yaw) + ")");
     }
   }
+}
+
+void NavNode::tick() {
+  Inbox in;
+  {
+    std::lock_guard lock(mutex_);
+    std::swap(in, inbox_);
+  }
+  take_inputs(in);
   if (last_stamp_ns_ == 0) {  // no robot clock yet
     publish_status();
     return;
@@ -365,6 +359,10 @@ void NavNode::tick() {
     for (const auto& q : navigator_.path()) p.poses().push_back(to_msg(Pose2{q.x(), q.y(), q.z()}));
     paths_.write(p);
   }
+  publish_odometry();
+}
+
+void NavNode::publish_odometry() {
   // Filtered odometry at the loop's rate; localisation at 10 Hz.
   const FilteredOdometry f = navigator_.odometry();
   msg::Odometry o;
@@ -380,19 +378,18 @@ void NavNode::tick() {
   o.covariance(cov);
   odometry_out_.write(o);
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_localisation_ >= std::chrono::milliseconds(100)) {
-    last_localisation_ = now;
-    const LocalisationStatus l = navigator_.localisation();
-    msg::NavLocalisation m;
-    m.stamp_ns(last_stamp_ns_);
-    m.state(to_msg(l));
-    m.pose(to_msg(l.pose));
-    std::array<double, 9> c{};
-    for (int i = 0; i < 9; ++i) c[static_cast<std::size_t>(i)] = l.covariance(i / 3, i % 3);
-    m.covariance(c);
-    m.map_to_odom(to_msg(l.map_to_odom));
-    localisation_out_.write(m);
-  }
+  if (now - last_localisation_ < std::chrono::milliseconds(100)) return;
+  last_localisation_ = now;
+  const LocalisationStatus l = navigator_.localisation();
+  msg::NavLocalisation m;
+  m.stamp_ns(last_stamp_ns_);
+  m.state(to_msg(l));
+  m.pose(to_msg(l.pose));
+  std::array<double, 9> c{};
+  for (int i = 0; i < 9; ++i) c[static_cast<std::size_t>(i)] = l.covariance(i / 3, i % 3);
+  m.covariance(c);
+  m.map_to_odom(to_msg(l.map_to_odom));
+  localisation_out_.write(m);
 }
 
 void NavNode::spin(const std::atomic<bool>& stop) {

@@ -66,6 +66,10 @@ class NavNode {
     std::optional<msg::SafetyState> safety;
   };
   void tick();
+  /// Hands what arrived since the last tick to the navigator (model, safety, pose, sensors, goals).
+  void take_inputs(const Inbox& in);
+  /// The filtered odometry every tick; the localisation at 10 Hz.
+  void publish_odometry();
   void apply_model(const msg::RobotModel& model);
   void publish_status();
   void publish_map();
