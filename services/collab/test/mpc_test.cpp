@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 #include <numeric>
 
 #include "collab/follow_me_mpc.hpp"
@@ -257,6 +259,63 @@ TEST(ObstacleGrid, SonarArcAndRanges) {
   h.add_sonar(s);
   EXPECT_EQ(h.occupied(), 0u);
   EXPECT_THROW(ObstacleGrid(GridParams{.resolution = 0.0}), std::invalid_argument);
+}
+
+
+// A planar scan from a lidar turned and placed in the world: returns land where the beam met
+// something, and what is out of range or not finite adds nothing.
+TEST(ObstacleGrid, ScanReturnsLandInTheWorldFromTheSensorsPose) {
+  ObstacleGrid g(GridParams{});
+  g.reset(Eigen::Vector2d(1.0, 0.0));
+  PlanarScanReading scan;
+  scan.world_T_sensor = Eigen::Translation3d(1.0, 0.0, 0.3) * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+  scan.angle_min = -M_PI / 2;
+  scan.angle_increment = M_PI / 2;
+  scan.range_min = 0.1;
+  scan.range_max = 5.0;
+  // Beams at -90, 0, +90 degrees of the sensor (world east, north, west) and two more.
+  scan.ranges = {1.0, 2.0, std::numeric_limits<double>::infinity(), 0.05, 7.0};
+  g.add_scan(scan);
+  ASSERT_EQ(g.occupied(), 2u);
+  std::vector<Eigen::Vector2d> seen;
+  for (const auto& c : g.cells()) seen.push_back(c.centre.head<2>());
+  auto near = [&](const Eigen::Vector2d& p) {
+    return std::any_of(seen.begin(), seen.end(), [&](const Eigen::Vector2d& c) { return (c - p).norm() < 0.08; });
+  };
+  EXPECT_TRUE(near({2.0, 0.0}));  // 1 m east of the sensor
+  EXPECT_TRUE(near({1.0, 2.0}));  // 2 m north
+}
+
+TEST(ObstacleGrid, ASonarReadsAlongItsXAxis) {
+  const Eigen::Isometry3d T = Eigen::Translation3d(0.5, -0.2, 0.4) * Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ());
+  const SonarReading r = sonar_reading(T, 1.2, 2.0, 0.5);
+  EXPECT_NEAR(r.position.x(), 0.5, 1e-12);
+  EXPECT_NEAR(r.position.y(), -0.2, 1e-12);
+  EXPECT_NEAR(r.heading, -M_PI / 2, 1e-12);
+  EXPECT_DOUBLE_EQ(r.range, 1.2);
+  EXPECT_DOUBLE_EQ(r.half_angle, 0.25);
+  EXPECT_LT(sonar_reading(T, std::numeric_limits<double>::quiet_NaN(), 2.0, 0.5).range, 0.0);
+}
+
+// The position command follows the MPC's velocities but never runs more than the wind-up bound
+// ahead of a held-back arm, nor past a joint limit.
+TEST(FollowCommand, IntegratesWithinTheWindUpBoundAndTheLimits) {
+  ArmLimits limits;
+  limits.q_min = Eigen::Vector2d(-1.0, -1.0);
+  limits.q_max = Eigen::Vector2d(1.0, 0.35);
+  const Eigen::Vector2d q(0.0, 0.3);    // the arm held where it is
+  const Eigen::Vector2d qd(0.5, 0.5);   // the MPC asks to move on
+  Eigen::VectorXd cmd;                  // no command yet: starts at q
+  integrate_position_command(cmd, q, qd, 0.02, 0.1, limits);
+  EXPECT_NEAR(cmd[0], 0.01, 1e-12);
+  EXPECT_NEAR(cmd[1], 0.31, 1e-12);
+  for (int k = 0; k < 50; ++k) integrate_position_command(cmd, q, qd, 0.02, 0.1, limits);
+  EXPECT_NEAR(cmd[0], 0.1, 1e-12);   // wind-up bound
+  EXPECT_NEAR(cmd[1], 0.35, 1e-12);  // the joint limit
+  const Eigen::Vector3d f = planar_world_force(Eigen::Vector3d(10.0, 0.0, -30.0), M_PI / 2);
+  EXPECT_NEAR(f.x(), 0.0, 1e-12);
+  EXPECT_NEAR(f.y(), 10.0, 1e-12);
+  EXPECT_EQ(f.z(), 0.0);
 }
 
 }  // namespace

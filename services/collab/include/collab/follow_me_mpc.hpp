@@ -110,6 +110,17 @@ struct MpcResult {
   bool warm{false};       ///< warm-started
 };
 
+/// The force the MPC takes (world axes, planar: the arm carries the height) from the wrench
+/// estimate's force in the base's axes, with the base turned by `base_yaw` [rad].
+Eigen::Vector3d planar_world_force(const Eigen::Vector3d& force_in_base, double base_yaw);
+
+/// The arm's command in position mode (the robot adds gravity feed-forward in position mode, not
+/// in velocity mode, where a 2 m arm sags): the MPC's joint velocities `qd` integrated over `dt`
+/// into `q_cmd` (restarted at `q` when its size differs), kept within `wind_up` [rad] of the
+/// measured joints `q`, so a held-back arm does not wind up, and within the joint limits.
+void integrate_position_command(Eigen::VectorXd& q_cmd, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                                double dt, double wind_up, const ArmLimits& limits);
+
 /// One follow-me controller for one arm. Not thread-safe; one per control loop.
 class FollowMeMpc {
  public:

@@ -5,6 +5,7 @@
 // active. Plain C++ + Eigen; no DDS.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <cstddef>
 #include <cstdint>
@@ -33,6 +34,20 @@ struct SonarReading {
   double max_range{2.0};        ///< [m]
 };
 
+/// A planar lidar scan from a sensor at `world_T_sensor`: beam i at angle_min + i *
+/// angle_increment in the sensor's x-y plane.
+struct PlanarScanReading {
+  Eigen::Isometry3d world_T_sensor{Eigen::Isometry3d::Identity()};
+  double angle_min{0.0}, angle_increment{0.0};  ///< [rad]
+  double range_min{0.0}, range_max{0.0};        ///< [m]
+  std::vector<double> ranges;                   ///< [m]
+};
+
+/// A sonar at `world_T_sonar` measuring along its x axis, as the grid takes it: a non-finite
+/// range is "nothing seen".
+SonarReading sonar_reading(const Eigen::Isometry3d& world_T_sonar, double range, double max_range,
+                           double field_of_view);
+
 /// A grid map centred on the base, rebuilt every cycle (the sensors see the present).
 class ObstacleGrid {
  public:
@@ -45,6 +60,8 @@ class ObstacleGrid {
   void add_point(const Eigen::Vector2d& p);
   /// A sonar echo: cells along the arc at the measured range.
   void add_sonar(const SonarReading& s);
+  /// Every finite return of `scan` within [range_min, range_max] as a point.
+  void add_scan(const PlanarScanReading& scan);
 
   std::size_t occupied() const;
   /// Every occupied cell as a sphere (centre at the cell centre, z = 0, radius = half diagonal).

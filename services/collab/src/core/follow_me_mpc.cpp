@@ -704,4 +704,18 @@ MpcResult FollowMeMpc::solve(const MpcInput& in) {
   return out;
 }
 
+Eigen::Vector3d planar_world_force(const Eigen::Vector3d& force_in_base, double base_yaw) {
+  const Eigen::Vector2d f = Eigen::Rotation2Dd(base_yaw) * force_in_base.head<2>();
+  return {f.x(), f.y(), 0.0};
+}
+
+void integrate_position_command(Eigen::VectorXd& q_cmd, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                                double dt, double wind_up, const ArmLimits& limits) {
+  if (q_cmd.size() != q.size()) q_cmd = q;
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    q_cmd[i] = std::clamp(q_cmd[i] + qd[i] * dt, q[i] - wind_up, q[i] + wind_up);
+    q_cmd[i] = std::clamp(q_cmd[i], limits.q_min[i], limits.q_max[i]);
+  }
+}
+
 }  // namespace concert::collab

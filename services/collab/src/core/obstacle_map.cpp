@@ -97,4 +97,25 @@ std::vector<RobotSphere> perimeter_spheres(double length, double width) {
   return {RobotSphere{Eigen::Vector2d(half, 0.0), r}, RobotSphere{Eigen::Vector2d(-half, 0.0), r}};
 }
 
+SonarReading sonar_reading(const Eigen::Isometry3d& world_T_sonar, double range, double max_range,
+                           double field_of_view) {
+  const Eigen::Vector3d axis = world_T_sonar.linear().col(0);
+  SonarReading r;
+  r.position = world_T_sonar.translation().head<2>();
+  r.heading = std::atan2(axis.y(), axis.x());
+  r.range = std::isfinite(range) ? range : -1.0;
+  r.max_range = max_range;
+  r.half_angle = field_of_view / 2.0;
+  return r;
+}
+
+void ObstacleGrid::add_scan(const PlanarScanReading& scan) {
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double r = scan.ranges[i];
+    if (!std::isfinite(r) || r < scan.range_min || r > scan.range_max) continue;
+    const double a = scan.angle_min + static_cast<double>(i) * scan.angle_increment;
+    add_point((scan.world_T_sensor * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0.0)).head<2>());
+  }
+}
+
 }  // namespace concert::collab

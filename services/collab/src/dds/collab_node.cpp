@@ -379,41 +379,35 @@ void CollabNode::follow_step() {
   in.arm_jacobian.resize(3, n);
   for (Eigen::Index i = 0; i < n; ++i) in.arm_jacobian.col(i) = J.block(0, rig_->arm_index[static_cast<std::size_t>(i)], 3, 1);
   if (wrench && wrench->model_version() == model_version_) {
-    // The estimate is in the base's axes (the robot model's root); the MPC wants the world's.
-    // The arm carries the height: the pull is planar.
     const auto& f = wrench->wrench().force();
-    const Eigen::Vector2d f_world = Eigen::Rotation2Dd(in.base.z()) * Eigen::Vector2d(f.x(), f.y());
-    in.force = Eigen::Vector3d(f_world.x(), f_world.y(), 0.0);
+    in.force = planar_world_force(Eigen::Vector3d(f.x(), f.y(), f.z()), in.base.z());
   }
   const Eigen::Isometry3d world_T_base = planar(in.base.x(), in.base.y(), in.base.z());
   grid_->reset(in.base.head<2>());
   if (scan && kin.has_frame(scan->frame())) {
-    const Eigen::Isometry3d T = world_T_base * kin.frame_pose(rig_->data, q, scan->frame());
-    for (std::size_t i = 0; i < scan->ranges().size(); ++i) {
-      const double r = scan->ranges()[i];
-      if (!std::isfinite(r) || r < scan->range_min() || r > scan->range_max()) continue;
-      const double a = scan->angle_min() + static_cast<double>(i) * scan->angle_increment();
-      grid_->add_point((T * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0.0)).head<2>());
-    }
+    PlanarScanReading reading;
+    reading.world_T_sensor = world_T_base * kin.frame_pose(rig_->data, q, scan->frame());
+    reading.angle_min = scan->angle_min();
+    reading.angle_increment = scan->angle_increment();
+    reading.range_min = scan->range_min();
+    reading.range_max = scan->range_max();
+    reading.ranges.assign(scan->ranges().begin(), scan->ranges().end());
+    grid_->add_scan(reading);
   }
   if (sonars) {
     for (const auto& s : sonars->sonars()) {
       if (!kin.has_frame(s.frame())) continue;
-      const Eigen::Isometry3d T = world_T_base * kin.frame_pose(rig_->data, q, s.frame());
-      const Eigen::Vector3d axis = T.linear().col(0);
-      SonarReading r;
-      r.position = T.translation().head<2>();
-      r.heading = std::atan2(axis.y(), axis.x());
-      r.range = std::isfinite(s.range()) ? s.range() : -1.0;
-      r.max_range = s.range_max();
-      r.half_angle = s.field_of_view() / 2.0;
-      grid_->add_sonar(r);
+      grid_->add_sonar(sonar_reading(world_T_base * kin.frame_pose(rig_->data, q, s.frame()), s.range(),
+                                     s.range_max(), s.field_of_view()));
     }
   }
   in.obstacles = grid_->active(in.base.head<2>());
   if (in.obstacles.size() > params_.mpc.max_obstacles) in.obstacles.resize(params_.mpc.max_obstacles);
   in.period = 1.0 / params_.rate;
-  const MpcResult r = mpc_->solve(in);
+  send_follow(in, mpc_->solve(in));
+}
+
+void CollabNode::send_follow(const MpcInput& in, const MpcResult& r) {
   state_msg_.ee_force(model::dds::to_vector_msg(in.force));
   state_msg_.active_obstacles(static_cast<std::uint32_t>(in.obstacles.size()));
   state_msg_.mpc_solve_ms(r.solve_ms);
@@ -423,26 +417,16 @@ void CollabNode::follow_step() {
     return;
   }
   base_velocity(r.base_velocity_local);
+  // Position mode, at most 0.1 rad ahead of the joints (integrate_position_command says why).
+  integrate_position_command(q_cmd_, in.q, r.joint_velocity, 1.0 / params_.rate, 0.1, rig_->limits);
   msg::JointCommand jc;
   jc.model_version(model_version_);
   jc.stamp_ns(now_ns());
   jc.source("collab");
-  // Position mode with the MPC's velocities integrated (the robot adds gravity feed-forward in
-  // position mode, not in velocity mode, where the 2 m arm sags), kept within 0.1 rad of where
-  // the joints are so a held-back arm does not wind up.
   jc.mode(msg::JOINT_POSITION);
   jc.name(rig_->arm_joints);
-  if (q_cmd_.size() != n) q_cmd_ = in.q;
-  const double dt = 1.0 / params_.rate;
-  std::vector<double> pos(static_cast<std::size_t>(n)), vel(static_cast<std::size_t>(n));
-  for (Eigen::Index i = 0; i < n; ++i) {
-    q_cmd_[i] = std::clamp(q_cmd_[i] + r.joint_velocity[i] * dt, in.q[i] - 0.1, in.q[i] + 0.1);
-    q_cmd_[i] = std::clamp(q_cmd_[i], rig_->limits.q_min[i], rig_->limits.q_max[i]);
-    pos[static_cast<std::size_t>(i)] = q_cmd_[i];
-    vel[static_cast<std::size_t>(i)] = r.joint_velocity[i];
-  }
-  jc.position(pos);
-  jc.velocity(vel);
+  jc.position(std::vector<double>(q_cmd_.data(), q_cmd_.data() + q_cmd_.size()));
+  jc.velocity(std::vector<double>(r.joint_velocity.data(), r.joint_velocity.data() + r.joint_velocity.size()));
   joints_out_.write(jc);
 }
 

@@ -64,6 +64,9 @@ class CollabNode {
   void on_transition(const Transition& t, const msg::CollabCommand* c);
   void enter(const State& s);
   void follow_step();
+  /// The MPC's answer at `in` sent: the base's velocity and the arm's position command, or the
+  /// base stopped for this cycle when the solve failed.
+  void send_follow(const MpcInput& in, const MpcResult& r);
   void hold_here(double dz);
   void gravity_compensation();
   void base_velocity(const Eigen::Vector3d& v);
