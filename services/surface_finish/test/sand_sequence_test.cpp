@@ -190,4 +190,90 @@ TEST(SandSequence, AStopEndsAtOnce) {
 }
 
 }  // namespace
+// The run's supervision, cycle by cycle, as the service drives it (supervise()).
+SandCycle answered(MoveReport move, double progress = 1.0) {
+  SandCycle c;
+  c.move = move;
+  c.move_progress = progress;
+  return c;
+}
+
+TEST(SandSupervise, TheRobotsAnswerToTheMoveStartsOrFailsTheRun) {
+  SandSequence s(test_plan(), SandParams{});
+  SandCycle c = answered(MoveReport::kRunning, 0.4);
+  SandStep step = supervise(s, c, SandWatch{});
+  EXPECT_EQ(step.end, SandEnd::kNone);
+  EXPECT_FALSE(step.command);
+  EXPECT_NEAR(s.progress(), 0.4 * 3.0 / 7.0, 1e-9);
+  // Succeeded, but no estimate yet: the Cartesian phases wait for the robot's time.
+  step = supervise(s, answered(MoveReport::kSucceeded), SandWatch{});
+  EXPECT_EQ(s.phase(), SandPhase::kMove);
+  EXPECT_FALSE(step.command);
+  c = answered(MoveReport::kSucceeded);
+  c.forces = {{100.0, Eigen::Vector3d::Zero()}};
+  step = supervise(s, c, SandWatch{});
+  EXPECT_EQ(s.phase(), SandPhase::kApproach);
+  ASSERT_TRUE(step.command);
+  EXPECT_NEAR(step.command->target.translation().x(), 1.0 - 0.05, 1e-9);  // at the approach pose
+
+  SandSequence refused(test_plan(), SandParams{});
+  c = answered(MoveReport::kStopped);
+  c.move_reason = "J2_E beyond its limit";
+  step = supervise(refused, c, SandWatch{});
+  EXPECT_EQ(step.end, SandEnd::kFailed);
+  EXPECT_EQ(step.reason, "the robot stopped the move to the approach pose: J2_E beyond its limit");
+
+  SandSequence silent(test_plan(), SandParams{});
+  c = SandCycle{};
+  c.since_sent = 9.0;
+  EXPECT_EQ(supervise(silent, c, SandWatch{}).end, SandEnd::kNone);
+  c.since_sent = 10.5;
+  step = supervise(silent, c, SandWatch{});
+  EXPECT_EQ(step.end, SandEnd::kFailed);
+  EXPECT_EQ(step.reason, "the robot service did not answer the move's trajectory within 10 s");
+}
+
+TEST(SandSupervise, ASafetyStopOrASilentForceEstimateAbortsTheRun) {
+  SandSequence s(test_plan(), SandParams{});
+  SandCycle c = answered(MoveReport::kRunning, 0.2);
+  c.safety_stop = "e-stop: software";
+  SandStep step = supervise(s, c, SandWatch{});
+  EXPECT_EQ(step.end, SandEnd::kAborted);
+  EXPECT_EQ(step.reason, "safety stop (e-stop: software)");
+  EXPECT_EQ(s.phase(), SandPhase::kAborted);
+
+  SandSequence quiet(test_plan(), SandParams{});
+  c = answered(MoveReport::kSucceeded);
+  c.forces = {{100.0, Eigen::Vector3d::Zero()}};
+  supervise(quiet, c, SandWatch{});
+  c = answered(MoveReport::kSucceeded);
+  c.silence = 1.5;  // within the watch's 2 s
+  EXPECT_EQ(supervise(quiet, c, SandWatch{}).end, SandEnd::kNone);
+  c.silence = 2.5;
+  step = supervise(quiet, c, SandWatch{});
+  EXPECT_EQ(step.end, SandEnd::kAborted);
+  EXPECT_EQ(step.reason, "no force estimate from the robot (concert/robot/ee_wrench) for 2.0 s");
+}
+
+TEST(SandSupervise, EstimatesAreFedAsThePushAlongTheToolsAxisUntilDone) {
+  SandSequence s(test_plan(), SandParams{});
+  SandCycle c = answered(MoveReport::kSucceeded);
+  c.forces = {{100.0, Eigen::Vector3d::Zero()}};
+  supervise(s, c, SandWatch{});
+  // 50 Hz estimates: the wall pushes back along -x (the TCP's z is +x), 30 N once in contact.
+  SandStep step;
+  double t = 100.0;
+  for (int cycle = 0; cycle < 600 && step.end == SandEnd::kNone; ++cycle) {
+    c = answered(MoveReport::kSucceeded);
+    for (int k = 0; k < 2; ++k) {
+      t += 0.01;
+      c.forces.push_back({t, Eigen::Vector3d(-30.0, 0.0, 0.0)});
+    }
+    step = supervise(s, c, SandWatch{});
+  }
+  EXPECT_EQ(step.end, SandEnd::kSucceeded) << step.reason;
+  ASSERT_FALSE(s.trace().empty());
+  EXPECT_NEAR(s.trace().back().estimated, 30.0, 1e-9);  // the push, not the wall's reaction
+}
+
 }  // namespace concert::surface_finish

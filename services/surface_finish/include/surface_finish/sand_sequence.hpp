@@ -20,6 +20,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -133,5 +134,46 @@ class SandSequence {
   std::string reason_;
   std::vector<ForceSample> trace_;
 };
+
+/// The joint move to the approach pose as the robot reports its trajectory.
+enum class MoveReport { kNoAnswer, kRunning, kSucceeded, kStopped };
+
+/// One control cycle of a sanding run as the service measured it.
+struct SandCycle {
+  /// The safety layer's causes ("e-stop: software") when it is not RUNNING; none while it runs.
+  std::optional<std::string> safety_stop;
+  MoveReport move{MoveReport::kNoAnswer};
+  double move_progress{0.0};  ///< the trajectory's progress [0, 1] (when answered)
+  std::string move_reason;    ///< kStopped: the robot's reason
+  double since_sent{0.0};     ///< [s] since the move's trajectory was sent
+  double silence{0.0};        ///< [s] without a force estimate from the robot, up to now
+  struct Force {
+    double t{0.0};                              ///< robot time [s]
+    Eigen::Vector3d force{0.0, 0.0, 0.0};       ///< the estimate at the TCP, base axes [N]
+  };
+  std::vector<Force> forces;  ///< the estimates since the last cycle, oldest first
+};
+
+/// How long the supervision waits.
+struct SandWatch {
+  double wrench_timeout{2.0};        ///< [s] without a force estimate: the run is aborted
+  double move_answer_timeout{10.0};  ///< [s] for the robot to answer the move's trajectory
+};
+
+/// How a cycle ends the run, if it does.
+enum class SandEnd { kNone, kSucceeded, kFailed, kAborted };
+
+/// What one cycle asks the service to do.
+struct SandStep {
+  std::optional<SandCommand> command;  ///< the arm's Cartesian impedance command to send
+  SandEnd end{SandEnd::kNone};
+  std::string reason;  ///< kFailed, kAborted: why
+};
+
+/// One cycle of a run: a safety stop aborts it; during the joint move, the robot's answer
+/// starts the Cartesian phases (at the robot time of the newest estimate), or its refusal, or
+/// its silence, fails the run; afterwards every estimate is fed to `seq` (the force pushed along
+/// its z_ee) and the newest one's command returned, and a silent force estimate aborts the run.
+SandStep supervise(SandSequence& seq, const SandCycle& cycle, const SandWatch& watch);
 
 }  // namespace concert::surface_finish

@@ -298,4 +298,56 @@ std::string SandSequence::report_json() const {
   return j.dump(1);
 }
 
+namespace {
+
+SandStep ended(SandSequence& seq, SandEnd end, const std::string& why) {
+  seq.stop(why);
+  return {std::nullopt, end, seq.reason()};
+}
+
+}  // namespace
+
+SandStep supervise(SandSequence& seq, const SandCycle& c, const SandWatch& watch) {
+  if (c.safety_stop) return ended(seq, SandEnd::kAborted, "safety stop (" + *c.safety_stop + ")");
+  SandStep step;
+  if (seq.phase() == SandPhase::kMove) {
+    if (c.move != MoveReport::kNoAnswer) seq.set_move_progress(c.move_progress);
+    if (c.move == MoveReport::kSucceeded) {
+      if (c.forces.empty()) return step;  // the robot's time: from its next estimate
+      seq.start(c.forces.back().t);
+    } else if (c.move == MoveReport::kStopped) {
+      return ended(seq, SandEnd::kFailed, "the robot stopped the move to the approach pose: " + c.move_reason);
+    } else if (c.move == MoveReport::kNoAnswer && c.since_sent > watch.move_answer_timeout) {
+      char b[120];
+      std::snprintf(b, sizeof b, "the robot service did not answer the move's trajectory within %.0f s",
+                    watch.move_answer_timeout);
+      return ended(seq, SandEnd::kFailed, b);
+    }
+  }
+  if (seq.phase() != SandPhase::kMove) {
+    if (c.silence > watch.wrench_timeout) {
+      char b[120];
+      std::snprintf(b, sizeof b, "no force estimate from the robot (concert/robot/ee_wrench) for %.1f s",
+                    watch.wrench_timeout);
+      return ended(seq, SandEnd::kAborted, b);
+    }
+    for (const SandCycle::Force& f : c.forces) {
+      (void)seq.update(f.t);
+      seq.add_force(f.t, -f.force.dot(seq.normal()));  // the force the disc pushes along z_ee
+      if (seq.finished()) break;
+    }
+    if (!c.forces.empty() && !seq.finished()) {
+      SandCommand command = seq.update(c.forces.back().t);
+      if (!seq.finished()) step.command = command;
+    }
+  }
+  if (seq.phase() == SandPhase::kDone) {
+    step.end = SandEnd::kSucceeded;
+  } else if (seq.phase() == SandPhase::kAborted) {
+    step.end = SandEnd::kAborted;
+    step.reason = seq.reason();
+  }
+  return step;
+}
+
 }  // namespace concert::surface_finish

@@ -434,86 +434,64 @@ void FinishNode::follow_sand() {
       ts = it->second;
   }
   const auto now = std::chrono::steady_clock::now();
-  if (safety && safety->mode() != msg::SAFETY_RUNNING) {
-    std::string causes;
-    for (const auto& cause : safety->causes()) causes += (causes.empty() ? "" : ", ") + cause;
-    seq.stop("safety stop (" + causes + ")");
-    end_run(msg::FINISH_ABORTED, seq.reason());
-    return;
-  }
   const double tick =
       run.last_tick == std::chrono::steady_clock::time_point{}
           ? 0.0
           : std::min(0.1, std::chrono::duration<double>(now - run.last_tick).count());
   run.last_tick = now;
   run.silence = wrenches.empty() ? run.silence + tick : 0.0;
-  const Eigen::Vector3d& z = seq.normal();
-  if (seq.phase() == SandPhase::kMove) {
-    if (ts) seq.set_move_progress(ts->progress());
-    if (ts && ts->state() == msg::TRAJECTORY_SUCCEEDED) {
-      if (wrenches.empty()) return;  // the robot's time: from its next estimate
-      seq.start(static_cast<double>(wrenches.back().stamp_ns) * 1e-9);
-    } else if (ts &&
-               (ts->state() == msg::TRAJECTORY_ABORTED || ts->state() == msg::TRAJECTORY_REFUSED)) {
-      seq.stop("the robot stopped the move to the approach pose: " + ts->reason());
-      end_run(msg::FINISH_FAILED, seq.reason());
-      return;
-    } else if (!ts && now - run.sent > std::chrono::seconds(10)) {
-      seq.stop("the robot service did not answer the move's trajectory within 10 s");
-      end_run(msg::FINISH_FAILED, seq.reason());
-      return;
-    }
+  SandCycle cycle;
+  if (safety && safety->mode() != msg::SAFETY_RUNNING) {
+    std::string causes;
+    for (const auto& cause : safety->causes()) causes += (causes.empty() ? "" : ", ") + cause;
+    cycle.safety_stop = causes;
   }
-  if (seq.phase() != SandPhase::kMove) {
-    if (run.silence > params_.wrench_timeout) {
-      char b[120];
-      std::snprintf(b, sizeof b,
-                    "no force estimate from the robot (concert/robot/ee_wrench) for %.1f s",
-                    params_.wrench_timeout);
-      seq.stop(b);
-      end_run(msg::FINISH_ABORTED, seq.reason());
-      return;
-    }
-    for (const Wrench& w : wrenches) {
-      const double t = static_cast<double>(w.stamp_ns) * 1e-9;
-      (void)seq.update(t);
-      seq.add_force(t, -w.force.dot(z));  // the force the disc pushes along z_ee
-      if (seq.finished()) break;
-    }
-    if (!wrenches.empty() && !seq.finished()) {
-      const SandCommand sc = seq.update(static_cast<double>(wrenches.back().stamp_ns) * 1e-9);
-      if (!seq.finished()) {
-        msg::CartesianImpedanceCommand m;
-        m.model_version(static_cast<std::uint32_t>(current_version_));
-        m.stamp_ns(now_ns());
-        m.source(kSource);
-        m.end_effector(current_.reach->tcp_frame());
-        m.target(model::dds::to_pose_msg(sc.target));
-        m.target_twist().linear().x(sc.velocity.x());
-        m.target_twist().linear().y(sc.velocity.y());
-        m.target_twist().linear().z(sc.velocity.z());
-        for (std::size_t i = 0; i < 6; ++i) {
-          m.stiffness()[i] = sc.stiffness[i];
-          m.damping()[i] = sc.damping[i];
-        }
-        m.admittance_axis(sc.admittance ? 2 : 255);  // the TCP's z
-        m.admittance_force(sc.force_setpoint);
-        m.admittance_gain(sc.admittance ? sc.admittance_gain : 0.0);
-        m.payload_mass(0.0);
-        cartesian_.write(m);
-      }
-    }
+  if (ts) {
+    const bool stopped = ts->state() == msg::TRAJECTORY_ABORTED || ts->state() == msg::TRAJECTORY_REFUSED;
+    cycle.move = ts->state() == msg::TRAJECTORY_SUCCEEDED ? MoveReport::kSucceeded
+                 : stopped                                 ? MoveReport::kStopped
+                                                           : MoveReport::kRunning;
+    cycle.move_progress = ts->progress();
+    cycle.move_reason = ts->reason();
   }
+  cycle.since_sent = std::chrono::duration<double>(now - run.sent).count();
+  cycle.silence = run.silence;
+  for (const Wrench& w : wrenches) cycle.forces.push_back({static_cast<double>(w.stamp_ns) * 1e-9, w.force});
+  const SandStep step = supervise(seq, cycle, SandWatch{params_.wrench_timeout, 10.0});
+  if (step.command) send_sand(*step.command);
   run.progress = seq.progress();
-  if (seq.phase() == SandPhase::kDone) {
+  if (step.end == SandEnd::kSucceeded) {
     end_run(msg::FINISH_SUCCEEDED, "");
-  } else if (seq.phase() == SandPhase::kAborted) {
-    end_run(msg::FINISH_ABORTED, seq.reason());
+  } else if (step.end == SandEnd::kFailed) {
+    end_run(msg::FINISH_FAILED, step.reason);
+  } else if (step.end == SandEnd::kAborted) {
+    end_run(msg::FINISH_ABORTED, step.reason);
   } else if (now - run.last_status > std::chrono::seconds(1)) {
     run.last_status = now;
     publish(run.request_id, msg::FINISH_RUNNING, std::string("sanding: ") + to_string(seq.phase()),
             &run);
   }
+}
+
+void FinishNode::send_sand(const SandCommand& sc) {
+  msg::CartesianImpedanceCommand m;
+  m.model_version(static_cast<std::uint32_t>(current_version_));
+  m.stamp_ns(now_ns());
+  m.source(kSource);
+  m.end_effector(current_.reach->tcp_frame());
+  m.target(model::dds::to_pose_msg(sc.target));
+  m.target_twist().linear().x(sc.velocity.x());
+  m.target_twist().linear().y(sc.velocity.y());
+  m.target_twist().linear().z(sc.velocity.z());
+  for (std::size_t i = 0; i < 6; ++i) {
+    m.stiffness()[i] = sc.stiffness[i];
+    m.damping()[i] = sc.damping[i];
+  }
+  m.admittance_axis(sc.admittance ? 2 : 255);  // the TCP's z
+  m.admittance_force(sc.force_setpoint);
+  m.admittance_gain(sc.admittance ? sc.admittance_gain : 0.0);
+  m.payload_mass(0.0);
+  cartesian_.write(m);
 }
 
 void FinishNode::follow_run() {

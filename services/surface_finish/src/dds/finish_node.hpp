@@ -102,6 +102,7 @@ class FinishNode {
   void start_spray(const msg::FinishCommand& c);
   void start_sand(const msg::FinishCommand& c);
   void follow_sand();
+  void send_sand(const SandCommand& command);
   void send_trajectory(Run& run, std::size_t last_sample);
   void abort_run(const std::string& why);
   void follow_run();
