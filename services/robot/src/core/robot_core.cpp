@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -226,6 +227,35 @@ RobotCore::RobotCore(Hardware& hardware, RobotParams params)
 
 RobotCore::~RobotCore() = default;
 
+namespace {
+
+// Throws ModelMismatchError (`what` first) unless the model's joints are the mounted ones.
+void check_mounted(const kinematics::Model& model, const MountedHardware& mounted, const std::string& what) {
+  const std::set<std::string> have(mounted.joint_names.begin(), mounted.joint_names.end());
+  const std::set<std::string> modelled(model.joint_names().begin(), model.joint_names().end());
+  std::vector<std::string> missing, extra;
+  std::set_difference(have.begin(), have.end(), modelled.begin(), modelled.end(), std::back_inserter(missing));
+  std::set_difference(modelled.begin(), modelled.end(), have.begin(), have.end(), std::back_inserter(extra));
+  if (!missing.empty() || !extra.empty()) {
+    throw ModelMismatchError(what + " '" + model.name() +
+                             "' does not match the mounted hardware: mounted joints missing from the model: " +
+                             join(missing) + "; model joints not mounted: " + join(extra));
+  }
+}
+
+// The joints that move the end-effector frame `ee`, legs excepted (model order); none without one.
+std::vector<int> arm_chain(const kinematics::Model& model, const std::string& ee, const std::set<int>& leg_joints) {
+  std::vector<int> arm;
+  if (ee.empty()) return arm;
+  for (int j = 0; j < model.dof(); ++j) {
+    const auto sub = model.subtree_links(j);
+    if (leg_joints.count(j) == 0 && std::find(sub.begin(), sub.end(), ee) != sub.end()) arm.push_back(j);
+  }
+  return arm;
+}
+
+}  // namespace
+
 void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame,
                           const model::LimitsTable& limits) {
   const std::string what = "model version " + std::to_string(version);
@@ -244,16 +274,7 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
   }
   // The hardware the loop runs once its pending switch (if any) is done.
   const MountedHardware mounted = hw_.mounted();
-  const std::set<std::string> have(mounted.joint_names.begin(), mounted.joint_names.end());
-  const std::set<std::string> modelled(model->joint_names().begin(), model->joint_names().end());
-  std::vector<std::string> missing, extra;
-  std::set_difference(have.begin(), have.end(), modelled.begin(), modelled.end(), std::back_inserter(missing));
-  std::set_difference(modelled.begin(), modelled.end(), have.begin(), have.end(), std::back_inserter(extra));
-  if (!missing.empty() || !extra.empty()) {
-    throw ModelMismatchError(what + " '" + model->name() +
-                             "' does not match the mounted hardware: mounted joints missing from the model: " +
-                             join(missing) + "; model joints not mounted: " + join(extra));
-  }
+  check_mounted(*model, mounted, what);
   std::string ee = end_effector_frame.empty() ? params_.end_effector_frame : end_effector_frame;
   if (ee.empty()) {
     ee = default_end_effector(*model);
@@ -267,15 +288,7 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
     leg_joints.insert(leg.steering_index);
     leg_joints.insert(leg.wheel_index);
   }
-  std::vector<int> arm;
-  if (!ee.empty()) {
-    for (int j = 0; j < model->dof(); ++j) {
-      const auto sub = model->subtree_links(j);
-      if (leg_joints.count(j) == 0 && std::find(sub.begin(), sub.end(), ee) != sub.end()) {
-        arm.push_back(j);
-      }
-    }
-  }
+  std::vector<int> arm = arm_chain(*model, ee, leg_joints);
   auto slot = std::make_unique<Slot>(model, params_, std::move(arm), std::move(legs));
   slot->version = version;
   slot->generation = mounted.generation;
@@ -452,6 +465,94 @@ void RobotCore::command_gravity_compensation(std::uint64_t model_version, const 
   publish_frame(s.commands, shared_->staged);
 }
 
+namespace {
+
+// Which of a trajectory's columns are which model joints, and which are the base's (all three
+// or none). Throws CommandError (`what` first) naming a joint given twice or unknown, a base
+// given in part, a base the model lacks, or a leg joint given with the base.
+void resolve_columns(const JointTrajectory& t, const RobotCore::Slot& s, const std::string& what,
+                     PreparedTrajectory& prepared, std::vector<int>& column_of_joint, std::array<int, 3>& base_columns) {
+  std::set<std::string> seen;
+  base_columns = {-1, -1, -1};
+  for (std::size_t k = 0; k < t.joints.size(); ++k) {
+    const std::string& name = t.joints[k];
+    if (!seen.insert(name).second) {
+      throw CommandError(what + "joint '" + name + "' given twice");
+    }
+    const int base_axis = name == kBaseX ? 0 : name == kBaseY ? 1 : name == kBaseYaw ? 2 : -1;
+    if (base_axis >= 0) {
+      base_columns[static_cast<std::size_t>(base_axis)] = static_cast<int>(k);
+      continue;
+    }
+    const auto index = s.model->joint_index(name);
+    if (!index) {
+      throw CommandError(what + "unknown joint '" + name + "' (model version " + std::to_string(s.version) +
+                         " has: " + join(s.model->joint_names()) + ")");
+    }
+    prepared.joints.push_back(*index);
+    column_of_joint.push_back(static_cast<int>(k));
+  }
+  const int base_count = (base_columns[0] >= 0) + (base_columns[1] >= 0) + (base_columns[2] >= 0);
+  if (base_count != 0 && base_count != 3) {
+    throw CommandError(what + "the base needs all of base_x, base_y, base_yaw or none of them");
+  }
+  prepared.base = base_count == 3;
+  if (prepared.base && !s.base) {
+    throw CommandError(what + "it moves the base, and model version " + std::to_string(s.version) +
+                       " has no mobile base");
+  }
+  if (!prepared.base) return;
+  for (const auto& leg : s.legs) {
+    for (int j : {leg.steering_index, leg.wheel_index}) {
+      if (std::find(prepared.joints.begin(), prepared.joints.end(), j) != prepared.joints.end()) {
+        throw CommandError(what + "leg joint '" + s.model->joint_names()[static_cast<std::size_t>(j)] +
+                           "' is driven by the base; give base_x, base_y, base_yaw or the leg joints, not both");
+      }
+    }
+  }
+}
+
+// The samples in the prepared trajectory's column order (joints, then the base). Throws
+// CommandError naming a sample of the wrong size, a time that does not increase, a non-finite value.
+void add_samples(const JointTrajectory& t, const std::string& what, const std::vector<int>& column_of_joint,
+                 const std::array<int, 3>& base_columns, PreparedTrajectory& prepared) {
+  prepared.columns = static_cast<int>(prepared.joints.size()) + (prepared.base ? 3 : 0);
+  const auto cols = static_cast<std::size_t>(prepared.columns);
+  prepared.times.reserve(t.samples.size());
+  prepared.position.reserve(t.samples.size() * cols);
+  prepared.velocity.reserve(t.samples.size() * cols);
+  for (std::size_t n = 0; n < t.samples.size(); ++n) {
+    const TrajectorySample& p = t.samples[n];
+    const std::string at = "sample " + std::to_string(n);
+    if (p.position.size() != t.joints.size() || (!p.velocity.empty() && p.velocity.size() != t.joints.size())) {
+      throw CommandError(what + at + " has " + std::to_string(p.position.size()) + " positions and " +
+                         std::to_string(p.velocity.size()) + " velocities for " + std::to_string(t.joints.size()) +
+                         " joints");
+    }
+    if (!finite(p.time) || p.time < 0.0 || (n > 0 && p.time <= prepared.times.back())) {
+      throw CommandError(what + at + " time " + std::to_string(p.time) +
+                         " s: times must be finite, >= 0 and strictly increasing");
+    }
+    for (std::size_t k = 0; k < t.joints.size(); ++k) {
+      if (!finite(p.position[k]) || (!p.velocity.empty() && !finite(p.velocity[k]))) {
+        throw CommandError(what + at + ": non-finite value for '" + t.joints[k] + "'");
+      }
+    }
+    prepared.times.push_back(p.time);
+    auto add = [&](int column) {
+      const auto c = static_cast<std::size_t>(column);
+      prepared.position.push_back(p.position[c]);
+      prepared.velocity.push_back(p.velocity.empty() ? 0.0 : p.velocity[c]);
+    };
+    for (int c : column_of_joint) add(c);
+    if (prepared.base) {
+      for (int c : base_columns) add(c);
+    }
+  }
+}
+
+}  // namespace
+
 void RobotCore::command_trajectory(const JointTrajectory& t) {
   std::lock_guard lock(shared_->mutex);
   check_command(t.model_version);
@@ -465,83 +566,10 @@ void RobotCore::command_trajectory(const JointTrajectory& t) {
   }
   auto prepared = std::make_unique<PreparedTrajectory>();
   prepared->request_id = t.request_id;
-  std::set<std::string> seen;
-  int base_columns[3] = {-1, -1, -1};
   std::vector<int> column_of_joint;
-  for (std::size_t k = 0; k < t.joints.size(); ++k) {
-    const std::string& name = t.joints[k];
-    if (!seen.insert(name).second) {
-      throw CommandError(what + "joint '" + name + "' given twice");
-    }
-    const int base_axis = name == kBaseX ? 0 : name == kBaseY ? 1 : name == kBaseYaw ? 2 : -1;
-    if (base_axis >= 0) {
-      base_columns[base_axis] = static_cast<int>(k);
-      continue;
-    }
-    const auto index = s.model->joint_index(name);
-    if (!index) {
-      throw CommandError(what + "unknown joint '" + name + "' (model version " + std::to_string(s.version) +
-                         " has: " + join(s.model->joint_names()) + ")");
-    }
-    prepared->joints.push_back(*index);
-    column_of_joint.push_back(static_cast<int>(k));
-  }
-  const int base_count = (base_columns[0] >= 0) + (base_columns[1] >= 0) + (base_columns[2] >= 0);
-  if (base_count != 0 && base_count != 3) {
-    throw CommandError(what + "the base needs all of base_x, base_y, base_yaw or none of them");
-  }
-  prepared->base = base_count == 3;
-  if (prepared->base && !s.base) {
-    throw CommandError(what + "it moves the base, and model version " + std::to_string(s.version) +
-                       " has no mobile base");
-  }
-  if (prepared->base) {
-    for (const auto& leg : s.legs) {
-      for (int j : {leg.steering_index, leg.wheel_index}) {
-        if (std::find(prepared->joints.begin(), prepared->joints.end(), j) != prepared->joints.end()) {
-          throw CommandError(what + "leg joint '" + s.model->joint_names()[static_cast<std::size_t>(j)] +
-                             "' is driven by the base; give base_x, base_y, base_yaw or the leg joints, not both");
-        }
-      }
-    }
-  }
-  prepared->columns = static_cast<int>(prepared->joints.size()) + (prepared->base ? 3 : 0);
-  const auto cols = static_cast<std::size_t>(prepared->columns);
-  prepared->times.reserve(t.samples.size());
-  prepared->position.reserve(t.samples.size() * cols);
-  prepared->velocity.reserve(t.samples.size() * cols);
-  for (std::size_t n = 0; n < t.samples.size(); ++n) {
-    const TrajectorySample& p = t.samples[n];
-    const std::string at = "sample " + std::to_string(n);
-    if (p.position.size() != t.joints.size() || (!p.velocity.empty() && p.velocity.size() != t.joints.size())) {
-      throw CommandError(what + at + " has " + std::to_string(p.position.size()) + " positions and " +
-                         std::to_string(p.velocity.size()) + " velocities for " + std::to_string(t.joints.size()) +
-                         " joints");
-    }
-    if (!finite(p.time) || p.time < 0.0 || (n > 0 && p.time <= prepared->times.back())) {
-      throw CommandError(what + at + " time " + std::to_string(p.time) +
-                         " s: times must be finite, >= 0 and strictly increasing");
-    }
-    for (std::size_t k = 0; k < t.joints.size(); ++k) {
-      if (!finite(p.position[k]) || (!p.velocity.empty() && !finite(p.velocity[k]))) {
-        throw CommandError(what + at + ": non-finite value for '" + t.joints[k] + "'");
-      }
-    }
-    prepared->times.push_back(p.time);
-    auto add = [&](int column) {
-      const auto c = static_cast<std::size_t>(column);
-      prepared->position.push_back(p.position[c]);
-      prepared->velocity.push_back(p.velocity.empty() ? 0.0 : p.velocity[c]);
-    };
-    for (int c : column_of_joint) {
-      add(c);
-    }
-    if (prepared->base) {
-      for (int c : base_columns) {
-        add(c);
-      }
-    }
-  }
+  std::array<int, 3> base_columns{};
+  resolve_columns(t, s, what, *prepared, column_of_joint, base_columns);
+  add_samples(t, what, column_of_joint, base_columns, *prepared);
   const std::uint64_t seq = ++shared_->seq;
   prepared->sequence = seq;
   s.trajectories.submit(std::move(prepared));
@@ -649,153 +677,136 @@ void apply_commands(RobotCore::Slot& s) {
 
 }  // namespace
 
-void RobotCore::cycle() {
-  Loop& L = *loop_;
-  const double dt = params_.period;
-  // Cycle boundary: switch to a prepared model, then to prepared hardware.
-  if (Slot* next = shared_->slots.take()) {
-    if (Slot* old = L.active) {
-      next->cycle.odometry = old->cycle.odometry;
-      if (old->trajectory.running()) {
-        old->trajectory.abort(TrajectoryAbort::kModelChanged, old->cycle);
-        L.last_progress = old->trajectory.progress();
-      }
-      if (!shared_->slots.retire(old)) {
-        delete old;  // unreachable in practice: set_model() collects before each hand-over
-      }
-    }
-    L.active = next;
-  }
-  hw_.switch_prepared();
-  hw_.read(L.hw_state);
+namespace {
+
+// Every drive's thermal load, from its measured torque (new hardware starts cold).
+void add_thermal_load(RobotCore::Loop& L, std::uint64_t generation, double dt) {
   const std::size_t nh = L.hw_state.position.size();
-  // Every drive's thermal load, from its measured torque (new hardware starts cold).
-  if (L.thermal.size() != nh || L.thermal_generation != hw_.generation()) {
+  if (L.thermal.size() != nh || L.thermal_generation != generation) {
     L.thermal.assign(nh, model::ThermalLoad{});
-    L.thermal_generation = hw_.generation();
+    L.thermal_generation = generation;
   }
   for (std::size_t h = 0; h < nh && h < L.hw_state.effort.size(); ++h) {
     L.thermal[h].add(L.hw_state.effort[h], dt);
   }
-  Slot* s = L.active;
-  const bool stopped = L.safety_stopped.load(std::memory_order_acquire);
-  const bool matching = s != nullptr && s->generation == hw_.generation() && s->hw_to_model.size() == nh;
-  if (!matching) {
-    // No model yet, or the mounted hardware changed (hot swap): hold every drive where it
-    // is until a matching model arrives.
-    if (s != nullptr && s->trajectory.running()) {
-      s->trajectory.abort(TrajectoryAbort::kHardwareChanged, s->cycle);
-    }
-    if (!L.holding_hw || L.holding_generation != hw_.generation() || L.drive.size() != nh) {
-      L.drive.resize(nh);
-      for (std::size_t h = 0; h < nh; ++h) {
-        L.drive[h] = DriveCommand{};
-        L.drive[h].position = L.hw_state.position[h];
-      }
-      L.holding_hw = true;
-      L.holding_generation = hw_.generation();
-    }
-    hw_.write(L.drive);
-  } else {
-    L.holding_hw = false;
-    CycleData& c = s->cycle;
-    const kinematics::Model& model = *s->model;
-    c.time = L.hw_state.time;
-    c.dt = dt;
-    c.base_yaw_rate = std::abs(c.time - L.gyro_stamp.load(std::memory_order_acquire)) <= kGyroFresh
-                          ? L.gyro_yaw_rate.load(std::memory_order_relaxed)
-                          : std::numeric_limits<double>::quiet_NaN();
-    for (std::size_t h = 0; h < nh; ++h) {
-      const int i = s->hw_to_model[h];
-      c.q(i) = L.hw_state.position[h];
-      c.qd(i) = L.hw_state.velocity[h];
-      c.tau(i) = L.hw_state.effort[h];
-    }
-    if (s->fresh) {
-      // First cycle of this model: every joint holds the position it has now.
-      s->fresh = false;
-      for (std::size_t i = 0; i < c.owner.size(); ++i) {
-        c.owner[i] = JointOwner::kHold;
-        c.follow(static_cast<int>(i));
-      }
-    }
-    if (stopped && !L.stop_seen) {
-      s->trajectory.abort(TrajectoryAbort::kSafetyStop, c);
-      for (std::size_t i = 0; i < c.owner.size(); ++i) {
-        c.owner[i] = JointOwner::kHold;
-        c.follow(static_cast<int>(i));
-      }
-    }
-    L.stop_seen = stopped;
-    apply_commands(*s);
-    // Estimation shared by the controllers: gravity, odometry, end-effector pose and wrench
-    // (quasi-static: J^T F_env = ID(q, qd, 0) - tau).
-    model.inverse_dynamics_into(s->data, c.q, c.zero, c.zero, c.gravity);
-    if (s->base) {
-      s->base->estimate(c);
-    }
-    if (!s->arm.empty()) {
-      model.frame_pose_into(s->data, c.q, s->ee_frame, c.ee_pose);
-      model.frame_jacobian_into(s->data, c.q, s->ee_frame, c.jacobian);
-      model.inverse_dynamics_into(s->data, c.q, c.qd, c.zero, c.id_tau);
-      for (std::size_t k = 0; k < s->arm.size(); ++k) {
-        const auto kk = static_cast<Eigen::Index>(k);
-        c.jac_arm.col(kk) = c.jacobian.col(s->arm[k]);
-        c.residual(kk) = c.id_tau(s->arm[k]) - c.tau(s->arm[k]);
-        c.qd_arm(kk) = c.qd(s->arm[k]);
-      }
-      Eigen::Matrix<double, 6, 6> jjt;
-      jjt.noalias() = c.jac_arm.lazyProduct(c.jac_arm.transpose());
-      jjt.diagonal().array() += 1e-6;
-      Vector6d jr;
-      jr.noalias() = c.jac_arm.lazyProduct(c.residual);
-      const Vector6d raw = jjt.ldlt().solve(jr);
-      const double alpha =
-          params_.wrench_filter_time_constant > 0.0 ? dt / (params_.wrench_filter_time_constant + dt) : 1.0;
-      c.wrench = s->wrench_initialized ? Vector6d(c.wrench + alpha * (raw - c.wrench)) : raw;
-      s->wrench_initialized = true;
-    }
-    for (Controller* controller : s->controllers) {
-      if (controller != nullptr) {
-        controller->update(c);
-      }
-    }
-    // Drive references in hardware order, with the model's limits.
+}
+
+// No model yet, or the mounted hardware changed (hot swap): every drive holds where it is until
+// a matching model arrives.
+void hold_drives(RobotCore::Loop& L, RobotCore::Slot* s, Hardware& hw) {
+  const std::size_t nh = L.hw_state.position.size();
+  if (s != nullptr && s->trajectory.running()) {
+    s->trajectory.abort(TrajectoryAbort::kHardwareChanged, s->cycle);
+  }
+  if (!L.holding_hw || L.holding_generation != hw.generation() || L.drive.size() != nh) {
     L.drive.resize(nh);
     for (std::size_t h = 0; h < nh; ++h) {
-      const int i = s->hw_to_model[h];
-      const auto& lim = c.limits(i);
-      DriveCommand d = c.drive[static_cast<std::size_t>(i)];
-      // Velocity guard for torque-level modes: damp whatever exceeds the velocity limit.
-      const double vmax = lim.velocity;
-      if ((d.mode == DriveMode::kEffort || d.mode == DriveMode::kImpedance) && vmax > 0.0 &&
-          std::abs(c.qd(i)) > vmax) {
-        d.effort -= params_.velocity_guard_gain * (c.qd(i) - std::copysign(vmax, c.qd(i)));
-      }
-      if (lim.effort > 0.0) {
-        d.effort = std::clamp(d.effort, -lim.effort, lim.effort);
-      }
-      // A leg drive's I^2 t protection: its torque limit folds back to the continuous torque as
-      // its RMS torque nears it, so a load nobody planned (wheels scrubbing while the legs
-      // steer, a base pushing an obstacle) makes it slip or lag, not the safety layer stop the
-      // robot on the sustained-torque rule. Arm joints: continuous torque 0 here (set_model).
-      const model::JointLimits& rated = s->limits[static_cast<std::size_t>(i)];
-      if (rated.continuous_torque > 0.0) {
-        d.max_effort = model::folded_back_torque(rated, L.thermal[h].rms());
-        d.effort = std::clamp(d.effort, -d.max_effort, d.max_effort);
-      } else {
-        d.max_effort = lim.effort;  // no continuous torque known: the rated peak
-      }
-      L.drive[h] = d;
+      L.drive[h] = DriveCommand{};
+      L.drive[h].position = L.hw_state.position[h];
     }
-    hw_.write(L.drive);
+    L.holding_hw = true;
+    L.holding_generation = hw.generation();
   }
-  // Hand the state out.
+  hw.write(L.drive);
+}
+
+// The hardware's reading in model order; every joint held where it is on a model's first cycle
+// and when a safety stop begins.
+void take_reading(RobotCore::Loop& L, RobotCore::Slot& s, double dt, bool stopped) {
+  CycleData& c = s.cycle;
+  c.time = L.hw_state.time;
+  c.dt = dt;
+  c.base_yaw_rate = std::abs(c.time - L.gyro_stamp.load(std::memory_order_acquire)) <= kGyroFresh
+                        ? L.gyro_yaw_rate.load(std::memory_order_relaxed)
+                        : std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t h = 0; h < s.hw_to_model.size(); ++h) {
+    const int i = s.hw_to_model[h];
+    c.q(i) = L.hw_state.position[h];
+    c.qd(i) = L.hw_state.velocity[h];
+    c.tau(i) = L.hw_state.effort[h];
+  }
+  const bool stop_begins = stopped && !L.stop_seen;
+  if (stop_begins) s.trajectory.abort(TrajectoryAbort::kSafetyStop, c);
+  if (s.fresh || stop_begins) {
+    s.fresh = false;
+    for (std::size_t i = 0; i < c.owner.size(); ++i) {
+      c.owner[i] = JointOwner::kHold;
+      c.follow(static_cast<int>(i));
+    }
+  }
+  L.stop_seen = stopped;
+}
+
+// Estimation shared by the controllers: gravity, odometry, the end-effector's pose and wrench
+// (quasi-static: J^T F_env = ID(q, qd, 0) - tau, low-pass filtered).
+void estimate(RobotCore::Slot& s, const RobotParams& params, double dt) {
+  CycleData& c = s.cycle;
+  const kinematics::Model& model = *s.model;
+  model.inverse_dynamics_into(s.data, c.q, c.zero, c.zero, c.gravity);
+  if (s.base) s.base->estimate(c);
+  if (s.arm.empty()) return;
+  model.frame_pose_into(s.data, c.q, s.ee_frame, c.ee_pose);
+  model.frame_jacobian_into(s.data, c.q, s.ee_frame, c.jacobian);
+  model.inverse_dynamics_into(s.data, c.q, c.qd, c.zero, c.id_tau);
+  for (std::size_t k = 0; k < s.arm.size(); ++k) {
+    const auto kk = static_cast<Eigen::Index>(k);
+    c.jac_arm.col(kk) = c.jacobian.col(s.arm[k]);
+    c.residual(kk) = c.id_tau(s.arm[k]) - c.tau(s.arm[k]);
+    c.qd_arm(kk) = c.qd(s.arm[k]);
+  }
+  Eigen::Matrix<double, 6, 6> jjt;
+  jjt.noalias() = c.jac_arm.lazyProduct(c.jac_arm.transpose());
+  jjt.diagonal().array() += 1e-6;
+  Vector6d jr;
+  jr.noalias() = c.jac_arm.lazyProduct(c.residual);
+  const Vector6d raw = jjt.ldlt().solve(jr);
+  const double alpha =
+      params.wrench_filter_time_constant > 0.0 ? dt / (params.wrench_filter_time_constant + dt) : 1.0;
+  c.wrench = s.wrench_initialized ? Vector6d(c.wrench + alpha * (raw - c.wrench)) : raw;
+  s.wrench_initialized = true;
+}
+
+// The controllers' drive references in hardware order, within the model's limits.
+void limit_drives(RobotCore::Loop& L, const RobotCore::Slot& s, const RobotParams& params) {
+  const CycleData& c = s.cycle;
+  const std::size_t nh = s.hw_to_model.size();
+  L.drive.resize(nh);
+  for (std::size_t h = 0; h < nh; ++h) {
+    const int i = s.hw_to_model[h];
+    const auto& lim = c.limits(i);
+    DriveCommand d = c.drive[static_cast<std::size_t>(i)];
+    // Velocity guard for torque-level modes: damp whatever exceeds the velocity limit.
+    const double vmax = lim.velocity;
+    if ((d.mode == DriveMode::kEffort || d.mode == DriveMode::kImpedance) && vmax > 0.0 &&
+        std::abs(c.qd(i)) > vmax) {
+      d.effort -= params.velocity_guard_gain * (c.qd(i) - std::copysign(vmax, c.qd(i)));
+    }
+    if (lim.effort > 0.0) {
+      d.effort = std::clamp(d.effort, -lim.effort, lim.effort);
+    }
+    // A leg drive's I^2 t protection: its torque limit folds back to the continuous torque as
+    // its RMS torque nears it, so a load nobody planned (wheels scrubbing while the legs
+    // steer, a base pushing an obstacle) makes it slip or lag, not the safety layer stop the
+    // robot on the sustained-torque rule. Arm joints: continuous torque 0 here (set_model).
+    const model::JointLimits& rated = s.limits[static_cast<std::size_t>(i)];
+    if (rated.continuous_torque > 0.0) {
+      d.max_effort = model::folded_back_torque(rated, L.thermal[h].rms());
+      d.effort = std::clamp(d.effort, -d.max_effort, d.max_effort);
+    } else {
+      d.max_effort = lim.effort;  // no continuous torque known: the rated peak
+    }
+    L.drive[h] = d;
+  }
+}
+
+// The cycle's state for the other threads (RobotCore::state()).
+void hand_out_state(RobotCore::Loop& L, const RobotCore::Slot* s, Hardware& hw, bool matching) {
+  const std::size_t nh = L.hw_state.position.size();
   RobotState& out = L.state.back();
   out.time = L.hw_state.time;
   out.cycle = ++L.cycles;
   out.ready = matching;
-  out.joint_names = hw_.joint_names();
+  out.joint_names = hw.joint_names();
   out.position = L.hw_state.position;
   out.velocity = L.hw_state.velocity;
   out.effort = L.hw_state.effort;
@@ -826,6 +837,47 @@ void RobotCore::cycle() {
   out.trajectory = own_progress ? s->trajectory.progress() : L.last_progress;
   out.replaced_trajectory = s != nullptr ? s->trajectory.replaced() : TrajectoryProgress{};
   L.state.publish();
+}
+
+}  // namespace
+
+void RobotCore::cycle() {
+  Loop& L = *loop_;
+  const double dt = params_.period;
+  // Cycle boundary: switch to a prepared model, then to prepared hardware.
+  if (Slot* next = shared_->slots.take()) {
+    if (Slot* old = L.active) {
+      next->cycle.odometry = old->cycle.odometry;
+      if (old->trajectory.running()) {
+        old->trajectory.abort(TrajectoryAbort::kModelChanged, old->cycle);
+        L.last_progress = old->trajectory.progress();
+      }
+      if (!shared_->slots.retire(old)) {
+        delete old;  // unreachable in practice: set_model() collects before each hand-over
+      }
+    }
+    L.active = next;
+  }
+  hw_.switch_prepared();
+  hw_.read(L.hw_state);
+  add_thermal_load(L, hw_.generation(), dt);
+  Slot* s = L.active;
+  const bool matching = s != nullptr && s->generation == hw_.generation() &&
+                        s->hw_to_model.size() == L.hw_state.position.size();
+  if (!matching) {
+    hold_drives(L, s, hw_);
+  } else {
+    L.holding_hw = false;
+    take_reading(L, *s, dt, L.safety_stopped.load(std::memory_order_acquire));
+    apply_commands(*s);
+    estimate(*s, params_, dt);
+    for (Controller* controller : s->controllers) {
+      if (controller != nullptr) controller->update(s->cycle);
+    }
+    limit_drives(L, *s, params_);
+    hw_.write(L.drive);
+  }
+  hand_out_state(L, s, hw_, matching);
   hw_.step(dt);
 }
 
