@@ -14,17 +14,20 @@ namespace concert::config {
 
 namespace detail {
 
-/// One mapping being read: its node (null when absent), its dotted path and the keys asked.
+/// One mapping being read: its node (null when absent), its dotted path and the keys asked;
+/// `item`: a list's item (Map::sequence), whose errors fall back to its own line.
 struct MapState {
   YAML::Node node;
   std::string path;
   std::vector<std::string> known;
+  bool item = false;
 };
 
 struct State {
   std::string source;
   std::vector<MapState> maps;  // index 0: the root
   std::vector<KeyRecord> keys;
+  bool recording = true;  // false while a typed sequence reads an item the second time
 };
 
 }  // namespace detail
@@ -100,11 +103,14 @@ bool Map::has(std::string_view key) const {
 }
 
 void Map::fail(std::string_view key, std::string_view what) const {
-  const YAML::Node& node = std::as_const(state_->maps[index_].node);
+  const detail::MapState& map = state_->maps[index_];
+  const YAML::Node& node = std::as_const(map.node);
   std::string line;
   if (node.IsMap()) {
     if (const YAML::Node value = node[std::string(key)]) line = line_of(value);
   }
+  // A list item's rule about a key it leaves out: the item's line.
+  if (line.empty() && map.item && node) line = line_of(node);
   throw ConfigError(state_->source + ": " + path(key) + ": " + std::string(what) + line);
 }
 
@@ -145,6 +151,7 @@ double scalar_number(const Map& map, std::string_view key, const YAML::Node& nod
 
 void record(detail::State& state, std::string path, const YAML::Node& node, std::string before,
             std::string after) {
+  if (!state.recording) return;
   state.keys.push_back(
       {std::move(path), node && !node.IsNull(), std::move(before), std::move(after)});
 }
@@ -349,6 +356,41 @@ Map Map::section(std::string_view key) {
   state_->maps.push_back({node, path(key), {}});
   return Map(state_, state_->maps.size() - 1);
 }
+
+std::optional<std::vector<Map>> Map::sequence_items(std::string_view key) {
+  const YAML::Node node = lookup(*state_, index_, key);
+  if (!node || node.IsNull()) return std::nullopt;
+  if (!node.IsSequence()) fail(key, "expected a list of maps, got " + got(node));
+  std::vector<Map> items;
+  for (size_t i = 0; i < node.size(); ++i) {
+    const YAML::Node item = node[i];
+    const std::string item_path = path(key) + "[" + std::to_string(i) + "]";
+    if (!item.IsMap()) {
+      throw ConfigError(state_->source + ": " + item_path + ": expected a map of parameters, got " +
+                        got(item) + line_of(item));
+    }
+    state_->maps.push_back({item, item_path, {}, true});
+    items.push_back(Map(state_, state_->maps.size() - 1));
+  }
+  return items;
+}
+
+std::vector<Map> Map::sequence(std::string_view key) {
+  std::optional<std::vector<Map>> items = sequence_items(key);
+  return items ? std::move(*items) : std::vector<Map>{};
+}
+
+void Map::record_length(std::string_view key, size_t before, size_t after) {
+  const YAML::Node node = lookup(*state_, index_, key);
+  const auto text = [](size_t n) { return std::to_string(n) + (n == 1 ? " item" : " items"); };
+  record(*state_, path(key), node, text(before), text(after));
+}
+
+Map::Quiet::Quiet(const Map& map) : state_(map.state_), was_(map.state_->recording) {
+  state_->recording = false;
+}
+
+Map::Quiet::~Quiet() { state_->recording = was_; }
 
 // ---- Document -----------------------------------------------------------------------------
 

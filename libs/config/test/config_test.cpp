@@ -140,6 +140,126 @@ TEST(Config, UnknownKeysAreRejectedWithTheKnownOnes) {
   EXPECT_EQ(error_of("name: a\nname: b\n"), "robot.yaml: name: given twice (line 2)");
 }
 
+/// A list of records, as a service's search order: each item a mapping of its own.
+struct Attempt {
+  bool reach = true;
+  double further = 0.0;
+  bool operator==(const Attempt&) const = default;
+};
+
+struct Search {
+  std::vector<Attempt> attempts{{true, 0.0}, {false, 0.03}};
+};
+
+Search read_search(Document& doc) {
+  Search s;
+  doc.root().sequence("attempts", s.attempts, [](Map& item, Attempt& a) {
+    item.boolean("reach", a.reach);
+    item.number("further", a.further, Range::non_negative());
+  });
+  doc.finish();
+  return s;
+}
+
+Search read_search(const std::string& yaml) {
+  Document doc = Document::parse(yaml, "robot.yaml");
+  return read_search(doc);
+}
+
+std::string search_error_of(const std::string& yaml) {
+  try {
+    read_search(yaml);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Config, SequenceReadsAListOfMaps) {
+  // An item's missing key takes the fresh item's value (reach true), not the default list's at
+  // its index (row 1: reach false).
+  const Search s = read_search(
+      "attempts:\n  - {reach: false, further: 0.1}\n  - {further: 0.2}\n  - reach: true\n"
+      "    further: 0.3\n");
+  EXPECT_EQ(s.attempts, (std::vector<Attempt>{{false, 0.1}, {true, 0.2}, {true, 0.3}}));
+  EXPECT_EQ(read_search("").attempts, Search{}.attempts);
+  EXPECT_EQ(read_search("attempts:\n").attempts, Search{}.attempts);
+  EXPECT_TRUE(read_search("attempts: []\n").attempts.empty());
+
+  // The untyped form: one Map per item, named key[i].
+  Document doc =
+      Document::parse("attempts:\n  - {reach: true}\n  - {further: 0.2}\n", "robot.yaml");
+  std::vector<Map> items = doc.root().sequence("attempts");
+  ASSERT_EQ(items.size(), 2u);
+  EXPECT_EQ(items[1].path("further"), "attempts[1].further");
+  EXPECT_TRUE(items[1].has("further"));
+  EXPECT_FALSE(items[1].has("reach"));
+  EXPECT_TRUE(Document::parse("", "robot.yaml").root().sequence("attempts").empty());
+}
+
+TEST(Config, SequenceItemErrorsNameTheItemKeyAndLine) {
+  EXPECT_EQ(search_error_of("attempts:\n  - {reach: true}\n  - {reach: false, further: -1}\n"),
+            "robot.yaml: attempts[1].further: expected a number >= 0, got '-1' (line 3)");
+  EXPECT_EQ(search_error_of("attempts:\n  - further: 0.1\n  - reach: false\n    further: x\n"),
+            "robot.yaml: attempts[1].further: expected a number >= 0, got 'x' (line 4)");
+  // A rule of the service's about a key the item leaves out: the item's line.
+  Document doc =
+      Document::parse("attempts:\n  - {reach: true}\n  - {reach: false}\n", "robot.yaml");
+  const std::vector<Map> items = doc.root().sequence("attempts");
+  try {
+    items[1].fail("further", "must be given when reach is false");
+    ADD_FAILURE() << "fail() returned";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "robot.yaml: attempts[1].further: must be given when reach is false (line 3)");
+  }
+}
+
+TEST(Config, SequenceItemUnknownKeysAreRejectedWithTheKnownOnes) {
+  EXPECT_EQ(search_error_of("attempts:\n  - {reach: true}\n  - {reach: true, furthr: 0.1}\n"),
+            "robot.yaml: attempts[1].furthr: unknown key (line 3); known keys of attempts[1]: "
+            "further, reach");
+  EXPECT_EQ(search_error_of("attempts:\n  - reach: true\n    reach: false\n"),
+            "robot.yaml: attempts[0].reach: given twice (line 3)");
+}
+
+TEST(Config, SequenceOfSomethingElseIsRefused) {
+  EXPECT_EQ(search_error_of("attempts: 5\n"),
+            "robot.yaml: attempts: expected a list of maps, got '5' (line 1)");
+  EXPECT_EQ(search_error_of("attempts: {reach: true}\n"),
+            "robot.yaml: attempts: expected a list of maps, got a map (line 1)");
+  EXPECT_EQ(search_error_of("attempts:\n  - {reach: true}\n  - 5\n"),
+            "robot.yaml: attempts[1]: expected a map of parameters, got '5' (line 3)");
+}
+
+TEST(Config, SequenceDifferencesFromDefaultsGoItemByItem) {
+  Document same = Document::parse(
+      "attempts:\n  - {reach: true, further: 0.0}\n  - {reach: false, further: 0.03}\n",
+      "robot.yaml");
+  read_search(same);
+  EXPECT_TRUE(same.differences_from_defaults().empty())
+      << ::testing::PrintToString(same.differences_from_defaults());
+  EXPECT_EQ(same.keys().size(), 5u);  // the list and two keys per item
+  EXPECT_EQ(same.keys()[0].path, "attempts");
+  EXPECT_EQ(same.keys()[4].path, "attempts[1].further");
+
+  Document changed = Document::parse(
+      "attempts:\n  - {reach: true, further: 0.0}\n  - {reach: false, further: 0.05}\n"
+      "  - {reach: true}\n",
+      "robot.yaml");
+  read_search(changed);
+  EXPECT_EQ(changed.differences_from_defaults(),
+            (std::vector<std::string>{
+                "robot.yaml: attempts: the file says 3 items, the default in code is 2 items",
+                "robot.yaml: attempts[1].further: the file says 0.05, the default in code is 0.03",
+                "robot.yaml: attempts[2].further: not listed (the default is 0)"}));
+
+  Document absent = Document::parse("", "robot.yaml");
+  read_search(absent);
+  EXPECT_EQ(absent.differences_from_defaults(),
+            std::vector<std::string>{"robot.yaml: attempts: not listed (the default is 2 items)"});
+}
+
 TEST(Config, LoadNamesTheFile) {
   const auto file = std::filesystem::temp_directory_path() / "concert_config_test.yaml";
   std::ofstream(file) << "sim:\n  timestep: 0.004\n";

@@ -107,6 +107,44 @@ class Map {
   void string_map(std::string_view key, std::map<std::string, std::string>& value);
   /// The nested mapping under `key` (empty when absent). Its keys are checked by finish().
   Map section(std::string_view key);
+  /// The list of mappings under `key`, one Map per item (none when absent). Item i's keys are
+  /// named "key[i].field" in errors and records; an error of the item carries the line of the
+  /// key it names, or the item's own line when the key is not in it; finish() refuses the
+  /// item's unknown and repeated keys as a section's. A value that is not a list, or an item
+  /// that is not a mapping, is an error. Records nothing for `key` itself (the form below does).
+  std::vector<Map> sequence(std::string_view key);
+  /// A list of records (a table such as a search order): when the file gives `key`, `value`
+  /// becomes one T per item, each read by `read_item(Map&, T&)` starting from `fresh` (so an
+  /// item's missing keys take fresh's values, whatever the default list holds). `key` is
+  /// recorded with the list's length ("3 items"), and each item's keys as "key[i].field" with
+  /// the default in code at the same index as the value before reading (fresh's past the
+  /// default list's end), so differences_from_defaults() compares a list item by item. For
+  /// that, `read_item` is called twice on an item that has a default at its index: it must
+  /// only read. Returns the items' Maps for rules across keys (Map::fail).
+  template <class T, class ReadItem>
+  std::vector<Map> sequence(std::string_view key, std::vector<T>& value, ReadItem&& read_item,
+                            const T& fresh = T{}) {
+    std::optional<std::vector<Map>> items = sequence_items(key);
+    record_length(key, value.size(), items ? items->size() : value.size());
+    if (!items) return {};
+    std::vector<T> out;
+    out.reserve(items->size());
+    for (size_t i = 0; i < items->size(); ++i) {
+      Map& item = (*items)[i];
+      T entry = fresh;
+      if (i < value.size()) {
+        T against = value[i];  // recorded: the default at this index, then the file's values
+        read_item(item, against);
+        const Quiet quiet(item);
+        read_item(item, entry);
+      } else {
+        read_item(item, entry);
+      }
+      out.push_back(std::move(entry));
+    }
+    value = std::move(out);
+    return std::move(*items);
+  }
 
   /// True if the file sets `key` in this mapping.
   bool has(std::string_view key) const;
@@ -121,6 +159,23 @@ class Map {
       : state_(std::move(state)), index_(index) {}
   void integer_value(std::string_view key, long long& value, long long min, long long max);
   void duration_value(std::string_view key, double& seconds, Range range, double tick_s, double max_s);
+  /// The items of the list under `key`; nullopt when it is absent or null.
+  std::optional<std::vector<Map>> sequence_items(std::string_view key);
+  /// Records `key` as a list of `before` items in code and `after` once read.
+  void record_length(std::string_view key, size_t before, size_t after);
+  /// While one lives, the getters of the whole document record nothing (a typed sequence's
+  /// second reading of an item).
+  class Quiet {
+   public:
+    explicit Quiet(const Map& map);
+    ~Quiet();
+    Quiet(const Quiet&) = delete;
+    Quiet& operator=(const Quiet&) = delete;
+
+   private:
+    std::shared_ptr<detail::State> state_;
+    bool was_;
+  };
 
   std::shared_ptr<detail::State> state_;
   size_t index_;
