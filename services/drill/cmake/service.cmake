@@ -1,9 +1,10 @@
 # The service: the rig and area detection (core), the DDS adapter, main, `concert drill` verbs.
-concert_core_library(concert_drill_core STATIC src/core/drill_rig.cpp src/core/area_detection.cpp src/core/placement.cpp)
+concert_core_library(concert_drill_core STATIC src/core/drill_rig.cpp src/core/area_detection.cpp src/core/placement.cpp
+  src/core/paths.cpp src/core/params.cpp)
 target_include_directories(concert_drill_core PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
 target_link_libraries(concert_drill_core
   PUBLIC concert_drill_tree concert_drill_control concert_drill_perception concert_model concert_kinematics
-         concert_hardware Eigen3::Eigen
+         concert_hardware concert_config Eigen3::Eigen
   PRIVATE concert_mobile_base)
 
 if(TARGET concert_dds)
@@ -17,7 +18,8 @@ if(TARGET concert_dds)
   concert_target_defaults(concert_drill)
   target_link_libraries(concert_drill PRIVATE concert_drill_dds concert_cli)
   target_compile_definitions(concert_drill PRIVATE
-    CONCERT_DRILL_PATTERNS="${CMAKE_CURRENT_SOURCE_DIR}/config/patterns.yaml")
+    CONCERT_DRILL_PATTERNS="${CMAKE_CURRENT_SOURCE_DIR}/config/patterns.yaml"
+    CONCERT_DRILL_PARAMS="${CMAKE_CURRENT_SOURCE_DIR}/config/drill.yaml")
 
   # `concert drill ...` verbs (wired into the `concert` tool by its CMakeLists).
   add_library(concert_drill_cli STATIC src/cli/cli.cpp)
@@ -44,5 +46,18 @@ concert_add_test(NAME area_detection_test
 # The base placement of an area of several holes: its goal and the stand-or-move choice.
 concert_add_test(NAME drill_placement_test
   SOURCES test/placement_test.cpp
+  LIBS concert_drill_core
+  LABELS drill)
+
+# The tuning file: the shipped one holds every default; bad values name file, key and line.
+concert_add_test(NAME drill_params_test
+  SOURCES test/params_test.cpp
+  LIBS concert_drill_core
+  LABELS drill)
+target_compile_definitions(drill_params_test PRIVATE CONCERT_DRILL_CONFIG_DIR="${CMAKE_CURRENT_SOURCE_DIR}/config")
+
+# The drill's own joint-space paths: the way back, settles, the base kept where it stands.
+concert_add_test(NAME drill_paths_test
+  SOURCES test/paths_test.cpp
   LIBS concert_drill_core
   LABELS drill)

@@ -2,7 +2,7 @@
 // drill end-effector and its camera), runs one mission at a time as a behaviour tree: locate
 // the areas, navigate, plan and execute the approach, detect the marks, drill each hole with
 // Cartesian impedance and visual servoing, retract.
-//   concert_drill [--patterns FILE] [--rate HZ] [--unseen-frames DIR]
+//   concert_drill [--params FILE] [--patterns FILE] [--rate HZ] [--unseen-frames DIR]
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM (a running mission is aborted, the arm held).
 #include <atomic>
 #include <filesystem>
@@ -18,6 +18,7 @@
 namespace {
 
 struct Options {
+  std::string params = CONCERT_DRILL_PARAMS;
   std::string patterns = CONCERT_DRILL_PATTERNS;
   double rate = 50.0;
   std::string unseen_frames;
@@ -29,6 +30,8 @@ int run(const Options& o) {
   params.patterns = o.patterns;
   params.rate = o.rate;
   params.unseen_frames_dir = o.unseen_frames;
+  // Read now, so that a bad file stops the service naming the key and line.
+  params.tuning = drill::load_params(o.params);
   if (!o.unseen_frames.empty()) {
     // Made now, so that a directory that cannot be made stops the service with the reason.
     std::error_code error;
@@ -42,8 +45,8 @@ int run(const Options& o) {
   const std::atomic<bool>& stop = cli::stop_on_signals();
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "drill"});
   drill::dds::DrillNode node(participant, params, std::cerr);
-  std::cerr << "concert_drill: domain " << participant.domain_id() << ", hole patterns "
-            << o.patterns << std::endl;
+  std::cerr << "concert_drill: domain " << participant.domain_id() << ", parameters " << o.params
+            << ", hole patterns " << o.patterns << std::endl;
   node.spin(stop);
   return 0;
 }
@@ -56,6 +59,8 @@ int main(int argc, char** argv) {
                         std::cout, std::cerr);
   Options o;
   auto& app = cli.app();
+  app.add_option("--params", o.params, "tuning (config/drill.yaml: every key with its default)")
+      ->type_name("FILE");
   app.add_option("--patterns", o.patterns, "ArUco hole-pattern table (config/patterns.yaml)")
       ->type_name("FILE");
   app.add_option("--rate", o.rate, "control rate [Hz]")->check(concert::cli::number(5.0, 500.0));

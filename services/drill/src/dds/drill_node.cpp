@@ -23,202 +23,47 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 constexpr const char* kSource = "drill";
-// A plan request the planner has not acknowledged within this [s] is sent again, up to
-// kPlanResends times (resend_unacknowledged).
-constexpr double kPlanAckBound = 2.0;
-constexpr int kPlanResends = 5;
-// A service whose status was last seen longer ago than this is lost [s] (heartbeat 1 s).
-constexpr double kServiceLost = 5.0;
-// Joint states older than this mean the robot service is gone [s].
-constexpr double kJointsLost = 1.0;
-// Samples kept: every 5 ms for 2 s.
-constexpr std::int64_t kSampleStep = 5'000'000;
-constexpr std::size_t kSamples = 400;
-constexpr std::size_t kFrames = 12;
-// Wall areas: the base's clearance in front of the wall beyond the footprint's reach [m]
-// (nav's wall_clearance) and the defaults when no nav vehicle is known.
-constexpr double kWallStandoff = 1.05;
-constexpr double kRobotRadius = 0.55;
-// A hole's drilling posture leaves the bit this much further out than the standoff (the
-// Cartesian alignment does the rest) [m]; the way back first takes this long to reach the
-// posture's path [s].
-constexpr double kAlignMargin = 0.03;
-// A hole's drilling posture, in the order it is asked for: always the bit's tip on the hole's
-// axis (PlanRequest.tip_distance, the standoff plus kAlignMargin, then further out). First with
-// its reach checked (tip_reach: the arm's torques also with the bit at the hole's depth), at 0, 3
-// and 7 cm further out: the arm alone, then the whole body with the base moving at most 0.3 m and
-// 0.3 rad, then the whole body anywhere. Without such a posture, the same without the reach
-// check (0, 3, 7 and 12 cm out): the drilling then moves the bit on through postures nobody
-// checked. (The bit, not the camera, goes on the axis: the drill camera is pitched 30 deg towards
-// the bit, so a camera on the axis leaves the bit 30 deg off it, and the alignment's turn then
-// holds J3_E past its continuous torque on the demo's pattern. Without the reach check, morphology
-// A's shoulder J2_E needs its peak torque at the BIM area.) The base stays
-// where the area's approach put it as long as the arm reaches, and moves as little as it can:
-// odometry drifts with every centimetre and degree the base moves, and an ArUco pattern is
-// drilled by the kinematics alone (on the demo wall, holes drilled after unbounded whole-body
-// moves land 5-100 mm off, and such a posture can spin the base by 2.3 rad).
-struct HoleAttempt {
-  bool reach;  // the bit's reach to the hole's depth checked
-  bool fixed_base;
-  double base_travel;  // [m, rad] for the whole body; 0: anywhere
-  double further;      // [m] beyond the hole's distance
-  double lead = 1.0;  // the largest lead's fraction the hole is drilled with (light_drilling), the
-                     // torques checked with its thrust
-};
-constexpr HoleAttempt kHoleAttempts[] = {
-    {true, true, 0.0, 0.0},    {true, true, 0.0, 0.03},   {true, true, 0.0, 0.07},
-    {true, false, 0.3, 0.0},   {true, false, 0.3, 0.03},  {true, false, 0.3, 0.07},
-    {true, false, 0.0, 0.0},   {true, false, 0.0, 0.07},
-    // No posture holds the full thrust (morphology A's row at 0.5 m: none for 200 N checked,
-    // the whole body's at 100-150 N): the same at about half the thrust, still with the bit's
-    // reach checked, before postures whose reach nobody checked.
-    // (The 3 cm one as at the full thrust: a placement checked at this thrust counts a hole
-    // reached with the arm's first three postures, kPlacementAttempts.)
-    {true, true, 0.0, 0.0, 0.5},  {true, true, 0.0, 0.03, 0.5},  {true, true, 0.0, 0.07, 0.5},
-    {true, false, 0.3, 0.0, 0.5},
-    {true, false, 0.3, 0.07, 0.5}, {true, false, 0.0, 0.0, 0.5},
-    // Lighter still (kLightestLead: 49 N, 78 N checked): for morphology A's row at 0.35 m, the
-    // paper's lowest, the planner can find no posture holding 104 N checked (the base's legs in
-    // the wall, the arm in its own links, the torques), and none of the four holes is drilled.
-    {true, true, 0.0, 0.0, kLightestLead}, {true, false, 0.3, 0.0, kLightestLead},
-    {true, false, 0.0, 0.0, kLightestLead},
-    {false, true, 0.0, 0.0},
-    {false, true, 0.0, 0.03},  {false, true, 0.0, 0.07},  {false, true, 0.0, 0.12},
-    {false, false, 0.3, 0.0},  {false, false, 0.3, 0.03}, {false, false, 0.3, 0.07},
-    {false, false, 0.3, 0.12}, {false, false, 0.0, 0.0},  {false, false, 0.0, 0.07}};
-constexpr double kSettleBack = 1.0;
-// A settle onto a hole's posture keeps the base where it stands when it is within this [m, rad]
-// of the posture's base (creep under the thrust, a path's tracking error): the legs swing round
-// to make a small base move and disturb the base more than the move gains: on the demo robot
-// standing, 10 mm asked sideways over 1 s turns the base 11 mrad and leaves odometry 7 mm off
-// the truth; 3 and 6 mm stay in the robot's deadband (no motion). The arm goes onto the
-// posture; the hole is measured from there.
-constexpr double kBaseKept = 0.03;
-// The drilling force the planner checks the arm's torques with, as a multiple of the most the
-// bit pushes (thrust_bound: 125 N with the defaults; 200 N checked). The simulated arm's
-// sustained load while drilling exceeds the static model's by more than 10 %: checked with
-// 125 N, morphology A's J2_E at the BIM area, planned at 0.99 of its continuous torque with the
-// bit at the hole's depth, goes past 1.1 while drilling (a safety stop). The excess is not
-// explained yet (lateral forces of the bit held in its hole are one candidate).
-constexpr double kThrustChecked = 1.6;
-double checked_thrust(const DrillParams& p) { return kThrustChecked * thrust_bound(p); }
-// The lead a posture request's thrust was checked with (kHoleAttempts' leads; 1: the full one).
-double lead_checked(const msg::PlanRequest& r, const DrillParams& p) {
-  for (const HoleAttempt& a : kHoleAttempts) {
-    if (std::abs(checked_thrust(light_drilling(p, a.lead)) - r.contact_force()) < 1e-6) return a.lead;
+
+// The planner's drilling force for a hole drilled with `p`: the thrust bound with a margin
+// (Params::approach.thrust_checked).
+double checked_thrust(const Params& tuning, const DrillParams& p) {
+  return tuning.approach.thrust_checked * thrust_bound(p);
+}
+
+// The lead a hole's posture request holds the thrust of (the attempt whose checked thrust it asks).
+double lead_checked(const Params& tuning, const msg::PlanRequest& r) {
+  for (const HoleAttempt& a : tuning.hole.attempts) {
+    if (std::abs(checked_thrust(tuning, light_drilling(tuning.motion, a.lead)) - r.contact_force()) < 1e-6) return a.lead;
   }
   return 1.0;
 }
-// ", at 52 % of the thrust" for a light drilling's lead, "" for the full one, for the log.
+
 std::string thrust_text(double lead, const DrillParams& p) {
   if (lead >= 1.0) return "";
   return ", at " + std::to_string(std::lround(100.0 * thrust_bound(light_drilling(p, lead)) / thrust_bound(p))) +
          " % of the thrust";
 }
-// Robot shapes grown against the map in the areas' approach plans [m]: the planner's map is the
-// world, its start pose the wheel odometry, which drifts 4-6 cm over a whole-body move near the
-// wall, so a base planned 3 cm from the wall can be inside it by the next plan. (The holes'
-// drilling postures keep the planner's padding: at 10 cm it finds none for the demo's blobs.)
-constexpr double kPlanPadding = 0.10;
-// An area's approach is planned again with another seed when no path or posture was found
-// within the planner's budget (on the demo about one plan in ten), this many times in all.
-constexpr int kPlanAttempts = 3;
-// Re-measuring a hole from its drilling posture: frames averaged, and how far from the predicted
-// position the mark may be found [m] (odometry drift over the base's move).
-constexpr int kReanchorFrames = 3;
-// After the whole body moved to a hole's drilling posture, the arm alone turns the camera onto the
-// hole's mark and the hole is measured again from there: for an ArUco hole always (the pattern
-// is drilled by the kinematics alone, and the base's odometry drifts 2-4 cm over such a move:
-// without the look the demo wall's pattern is drilled 20-37 mm off), for a blob hole when the
-// view from its drilling posture cannot tell its blob from a neighbour (blob_shift). The camera
-// is asked for at the distance the hole's posture reached
-// (the arm only shifts across the wall), then this much further out [m], in turn. For an ArUco
-// hole, then, the camera centred between the hole and its marker (further out, so both are in
-// view: the marker 0.15 m above the row and up to 0.3 m beside it needs 0.4 m or more), a
-// posture nearer the hole's, for when none centred on the marker exists (on morphology A the
-// arm's links in each other, or its torques, can keep the camera off the marker, which leaves
-// the hole where odometry puts it, centimetres off).
-struct LookAttempt {
-  bool between;    // centred between the hole and its marker, not on the mark
-  double further;  // beyond the camera's distance at the hole's posture [m]
-};
-constexpr LookAttempt kLooks[] = {{false, 0.0}, {false, 0.1}, {false, 0.2}, {true, 0.2}, {true, 0.3}};
-// An ArUco hole whose marker was last seen longer ago than this [s] gets the look too, even
-// with the base standing: the odometry's yaw comes from the base's gyro, whose bias walks while
-// the arm works (the simulated BMI055); on morphology A it drifts 0.5 deg over the 100 s of a
-// pattern's four holes with the base standing (the simulator's truth: 0.1 deg), which puts each
-// of the holes, about 1 m from the base, 2-3 mm further off than the one before.
-constexpr double kMarkerStale = 15.0;
-// Whole-body postures drawn for a marker hole (each request seeds the planner anew) until one
-// lets the camera be turned onto the marker: from a posture without, the hole is drilled where
-// odometry puts it (in the row scenario 8-34 mm off, the look blocked by self collision).
-constexpr std::size_t kBodyDraws = 3;
-// From a drawn posture, a hole the placement checks counts as reached by the arm alone with the
-// first posture of the hole's own (kHoleAttempts) up to this one: the bit 0, 3 or 7 cm further
-// out than its distance, reach and full thrust checked. The 0 cm one alone counts only 1-2 of
-// the 4 holes of scenario 3's row at 1.5 m as reached from a drawn posture, where each hole
-// finds its posture 3 cm out. From where the base stands (the approach's posture: the camera
-// 0.6 m from the wall, the bit 0.4 m short of it) only the first is asked: further out does not
-// bring the bit nearer, and each request that finds nothing costs the planner's whole budget
-// (2 s).
-constexpr std::size_t kPlacementAttempts = 2;
-// A hole attempt (kHoleAttempts) with its torques checked at another lead's thrust.
-constexpr HoleAttempt at_lead(HoleAttempt a, double lead) {
+
+// How the drill's own paths are timed (drill/paths.hpp).
+PathTiming path_timing(const Params& t) {
+  return {t.paths.settle_min, t.paths.base_kept, t.paths.joint_speed, t.paths.base_speed, t.paths.speed_share};
+}
+
+// An attempt at another lead.
+HoleAttempt at_lead(HoleAttempt a, double lead) {
   a.lead = lead;
   return a;
 }
-// The lead a placement is checked at again when the full thrust's leaves the base standing
-// short of the holes (PlacementChoice::short_of_every_hole): kHoleAttempts' first light one.
-// The demo robot's holes on its wall, and morphology A's below 1.2 m, are drilled at it anyway.
-constexpr double kPlacementLightLead = 0.5;
-// The first of kHoleAttempts for the arm alone at `lead`'s thrust (a hole placed at it starts
-// there: the full thrust's attempts before it, asked again, found nothing from there or would
-// move the whole body away from the placement).
-std::size_t first_fixed_at(double lead) {
-  for (std::size_t i = 0; i < std::size(kHoleAttempts); ++i) {
-    if (kHoleAttempts[i].reach && kHoleAttempts[i].fixed_base && kHoleAttempts[i].lead == lead) return i;
+
+// The first attempt with the bit's reach checked and the base fixed at `lead` (the loader
+// checks one exists for the placement's light lead).
+std::size_t first_fixed_at(const Params& tuning, double lead) {
+  const auto& attempts = tuning.hole.attempts;
+  for (std::size_t i = 0; i < attempts.size(); ++i) {
+    if (attempts[i].reach && attempts[i].fixed_base && attempts[i].lead == lead) return i;
   }
   return 0;
 }
-// The placement's look at the marker: the camera framing the whole marker with room for the
-// drift (marker_look_radius), then this much further out [m], in turn, as a hole's looks are
-// asked for (kLooks). At one distance alone the pattern test can find no look from any of the 3
-// postures drawn.
-constexpr double kPlacementLooks[] = {0.0, 0.1, 0.2};
-// Times a hole's whole-body posture is planned again for the hole measured again more than
-// kReplanShift from where it was planned, when the arm alone has none there. Twice, as the move
-// to the new posture drifts odometry again: a row hole measured 18.9 mm off and planned again can
-// be 26.0 mm off after that move, and aligning across that holds J2_E past its continuous torque
-// (a safety stop).
-constexpr std::size_t kBodyReplans = 2;
-constexpr double kReanchorDistance = 0.06;
-// Hole depth the drilling posture's reach is checked to when no mission is loaded [m].
-constexpr double kDefaultDepth = 0.05;
-// A hole found this much away from where odometry put it after a whole-body move [m] gets its
-// drilling posture planned again, the arm alone, from where the base now stands: the alignment
-// would otherwise reach that much further than the posture the planner checked (odometry drifts
-// 2-8 cm over such a move; with morphology A's arm at the BIM area the shoulder J2_E then goes
-// past its continuous torque while drilling).
-constexpr double kReplanShift = 0.01;
-// Blobs of one area matched as a set: a predicted blob lies this close to a seen one [m]
-// (6 deg of odometry yaw over 0.1 m between blobs moves them 1 cm).
-constexpr double kBlobMatch = 0.02;
-// While the whole body moves to a blob hole's posture, the area's blobs are followed from camera
-// frame to frame (track_area): odometry drifts 2-6 cm over such a move (on morphology A at the
-// BIM area: 27 mm over 0.45 m and 0.75 rad of base motion), more than half the 10 cm
-// between blobs, so a drilling posture's view showing one blob alone could take a neighbour
-// for it. From one frame to the next the drift grows by millimetres: a
-// seen blob is taken for a predicted one at most this far [m].
-constexpr double kTrackWindow = 0.02;
-// Two or more of an area's blobs seen together name each other however far odometry drifted, up
-// to this [m] (blob_shift's max_set_shift): a whole-body move on the demo can drift it 87 mm, and
-// a neighbour seen alone within the shorter windows above would be taken for the hole's blob
-// (the hole then cut on the next blob, 0.1 m off).
-constexpr double kSetShift = 0.15;
-// After a whole-body move, a blob hole's look frames the hole's blob and its nearest neighbour
-// with this much room around them for the odometry's drift [m], so that both are in the image
-// (any camera roll) and the set names them.
-constexpr double kSetLookDrift = 0.1;
 
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
@@ -272,14 +117,24 @@ msg::DrillHoleState to_msg(HoleState s) {
 
 Eigen::Vector3d odometry_of(const msg::Odometry& o) { return {o.x(), o.y(), o.yaw()}; }
 
+// A planned trajectory's samples as the drill's paths hold them.
+std::vector<PathSample> samples_of(const msg::PlanResult& r) {
+  std::vector<PathSample> out;
+  out.reserve(r.trajectory().size());
+  for (const msg::TrajectorySample& t : r.trajectory()) out.push_back({t.time(), t.position(), t.velocity()});
+  return out;
+}
+
+Path path_of(const msg::PlanResult& r) { return {r.joint_names(), samples_of(r)}; }
+
 // A hole's posture request for attempt `a`: the bit's tip `further` beyond the hole's distance
 // in front of it, the planner also checking the arm's torques with the bit at the hole's depth;
 // or the camera on the hole's axis as far out.
 // (`hole_distance`: the bit's tip from the wall the posture asks for before `further`.)
 void set_hole_task(msg::PlanRequest& r, const HoleAttempt& a, double hole_distance,
-                   double depth, const DrillParams& motion) {
+                   double depth, const Params& tuning) {
   const double tip = hole_distance + a.further;
-  r.contact_force(checked_thrust(light_drilling(motion, a.lead)));
+  r.contact_force(checked_thrust(tuning, light_drilling(tuning.motion, a.lead)));
   r.tip_distance(tip);
   r.tip_reach(a.reach ? tip + depth : 0.0);
   r.camera_distance(0.0);
@@ -348,7 +203,7 @@ msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
 DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ostream& log)
     : params_(std::move(params)),
       log_(log),
-      drill_motion_(params_.motion),
+      drill_motion_(tuning_.motion),
       status_(participant, "drill"),
       status_out_(participant, cdds::topics::drill_status),
       nav_goals_(participant, cdds::topics::nav_goal),
@@ -363,18 +218,7 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
                 inbox_.model = m;
               }),
       joints_in_(participant, cdds::topics::joint_state,
-                 [this](const msg::JointState& s, const auto&) {
-                   std::lock_guard lock(mutex_);
-                   joints_seen_ = Clock::now();
-                   if (!samples_.empty() && s.stamp_ns() - samples_.back().stamp_ns < kSampleStep)
-                     return;
-                   Sample sample;
-                   sample.stamp_ns = s.stamp_ns();
-                   sample.joints = {s.name(), s.position()};
-                   if (odometry_) sample.odometry = odometry_of(*odometry_);
-                   samples_.push_back(std::move(sample));
-                   while (samples_.size() > kSamples) samples_.pop_front();
-                 }),
+                 [this](const msg::JointState& s, const auto&) { on_joints(s); }),
       odometry_in_(participant, cdds::topics::odometry,
                    [this](const msg::Odometry& o, const auto&) {
                      map_frame_.on_odometry(o.stamp_ns(), odometry_of(o));
@@ -387,13 +231,7 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
                    safety_ = s;
                  }),
       services_in_(participant, cdds::topics::status,
-                   [this](const msg::ServiceStatus& s, const auto&) {
-                     std::lock_guard lock(mutex_);
-                     if (s.state() != msg::SERVICE_STOPPED)
-                       services_seen_[s.service()] = Clock::now();
-                     else
-                       services_seen_.erase(s.service());
-                   }),
+                   [this](const msg::ServiceStatus& s, const auto&) { on_service(s); }),
       plans_in_(participant, cdds::topics::plan_result,
                 [this](const msg::PlanResult& r, const auto&) {
                   std::lock_guard lock(mutex_);
@@ -443,6 +281,28 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
 }
 
 DrillNode::~DrillNode() = default;
+
+// Joint states decimated to buffers.sample_step, each with the odometry last received.
+void DrillNode::on_joints(const msg::JointState& s) {
+  std::lock_guard lock(mutex_);
+  joints_seen_ = Clock::now();
+  if (!samples_.empty() && s.stamp_ns() - samples_.back().stamp_ns < tuning_.buffers.sample_step.count()) return;
+  Sample sample;
+  sample.stamp_ns = s.stamp_ns();
+  sample.joints = {s.name(), s.position()};
+  if (odometry_) sample.odometry = odometry_of(*odometry_);
+  samples_.push_back(std::move(sample));
+  while (samples_.size() > tuning_.buffers.samples) samples_.pop_front();
+}
+
+void DrillNode::on_service(const msg::ServiceStatus& s) {
+  std::lock_guard lock(mutex_);
+  if (s.state() != msg::SERVICE_STOPPED) {
+    services_seen_[s.service()] = Clock::now();
+  } else {
+    services_seen_.erase(s.service());
+  }
+}
 
 void DrillNode::log_line(const std::string& line) {
   std::lock_guard lock(log_mutex_);
@@ -496,7 +356,7 @@ void DrillNode::assemble_frame() {
   f.base_T_optical = rig_->camera_in_base(rig_->q(s->joints));
   f.world_T_optical = rig_->base_in_world(s->odometry) * f.base_T_optical;
   frames_.push_back(std::move(f));
-  while (frames_.size() > kFrames) frames_.pop_front();
+  while (frames_.size() > tuning_.buffers.frames) frames_.pop_front();
 }
 
 std::optional<DrillNode::Sample> DrillNode::latest_sample() const {
@@ -633,18 +493,18 @@ void DrillNode::resend_unacknowledged() {
       continue;
     }
     Unacknowledged& u = it->second;
-    if (now_ - u.sent >= kPlanAckBound) {
-      if (u.resends >= kPlanResends) {
+    if (now_ - u.sent >= tuning_.plan_requests.ack_bound) {
+      if (u.resends >= tuning_.plan_requests.resends) {
         log_line("drill: plan request " + std::to_string(it->first) + " not acknowledged by the planner after " +
-                 std::to_string(kPlanResends + 1) + " sends; waiting for its answer");
+                 std::to_string(tuning_.plan_requests.resends + 1) + " sends; waiting for its answer");
         it = unacknowledged_.erase(it);
         continue;
       }
       ++u.resends;
       u.sent = now_;
       log_line("drill: plan request " + std::to_string(it->first) + " not acknowledged by the planner within " +
-               std::to_string(static_cast<int>(kPlanAckBound)) + " s; sent again (" +
-               std::to_string(u.resends) + " of " + std::to_string(kPlanResends) + ")");
+               std::to_string(static_cast<int>(tuning_.plan_requests.ack_bound)) + " s; sent again (" +
+               std::to_string(u.resends) + " of " + std::to_string(tuning_.plan_requests.resends) + ")");
       plan_requests_.write(u.request);
     }
     ++it;
@@ -754,8 +614,8 @@ Outcome DrillNode::health() {
   if (!rig_)
     return Outcome::failed(rig_error_.empty() ? "the robot model cannot drill" : rig_error_);
   // A service not heard yet when the mission began (a stack just started: its status or the
-  // joint states not matched yet) is waited for, kServiceLost at most.
-  const bool starting = seconds_since(mission_started_) < kServiceLost;
+  // joint states not matched yet) is waited for, liveness.service_lost at most.
+  const bool starting = seconds_since(mission_started_) < tuning_.liveness.service_lost;
   if (!safety_) {
     return starting ? Outcome::running()
                     : Outcome::failed("no safety state from the safety service");
@@ -769,19 +629,19 @@ Outcome DrillNode::health() {
     if (starting) return Outcome::running();
     return Outcome::failed("no joint state from the robot service (never heard)");
   }
-  if (seconds_since(joints_seen_) > kJointsLost) {
+  if (seconds_since(joints_seen_) > tuning_.liveness.joints_lost) {
     return Outcome::failed("no joint state from the robot service (lost)");
   }
   for (const char* service : {"planner"}) {
     const auto seen = services_seen_.find(service);
     if (seen == services_seen_.end() && starting) return Outcome::running();
-    if (seen == services_seen_.end() || seconds_since(seen->second) > kServiceLost) {
+    if (seen == services_seen_.end() || seconds_since(seen->second) > tuning_.liveness.service_lost) {
       return Outcome::failed(std::string("the ") + service + " service is lost");
     }
   }
   if (nav_request_ != 0) {
     const auto seen = services_seen_.find("nav");
-    if (seen == services_seen_.end() || seconds_since(seen->second) > kServiceLost) {
+    if (seen == services_seen_.end() || seconds_since(seen->second) > tuning_.liveness.service_lost) {
       return Outcome::failed("the nav service is lost");
     }
   }
@@ -798,7 +658,8 @@ void DrillNode::resolve(std::size_t area, const AreaSpec& spec) {
   // A BIM wall: the area frame and the base pose from the building's model (load_ifc runs the
   // IFC import step, a second or two, off the control thread).
   const Mission mission = *mission_;
-  resolving_[area] = std::async(std::launch::async, [mission, spec] {
+  const double standoff = tuning_.bim.wall_standoff, radius = tuning_.bim.robot_radius;
+  resolving_[area] = std::async(std::launch::async, [mission, spec, standoff, radius] {
     const bim::BimModel model = bim::load_ifc(mission.ifc.string());
     const bim::Element& wall = model.element(spec.wall);
     const bim::Storey& storey = model.storey(mission.storey.empty() ? wall.storey : mission.storey);
@@ -806,7 +667,7 @@ void DrillNode::resolve(std::size_t area, const AreaSpec& spec) {
     bim::GoalOptions options;
     options.face = bim::face_choice(spec.face);
     const bim::WallGoal goal = bim::wall_goal(model, grid, spec.wall, spec.at.x(), spec.at.y(),
-                                              kWallStandoff, kRobotRadius, options);
+                                              standoff, radius, options);
     ResolvedArea out;
     out.frame = goal.area_frame;
     out.base = BasePose{goal.base_pose.x(), goal.base_pose.y(), goal.base_pose.z()};
@@ -847,7 +708,7 @@ Outcome DrillNode::resolution(std::size_t area, ResolvedArea& out) {
     return Outcome::succeeded();
   }
   const std::optional<CameraFrame> view =
-      averaged_view(resolve_since_[area], params_.averaged_frames);
+      averaged_view(resolve_since_[area], tuning_.camera.averaged_frames);
   if (!view) return Outcome::running();
   const CameraView camera{&view->frame, view->world_T_optical};
   if (spec.point && !in_view(camera, *spec.point)) {
@@ -878,8 +739,8 @@ Outcome DrillNode::resolution(std::size_t area, ResolvedArea& out) {
         DrillPoint p;
         p.frame.translation() = view->world_T_optical * b.position;
         const Eigen::Vector3d local = out.frame.inverse() * p.frame.translation();
-        if (local.head<2>().norm() > area_radius(params_.camera_distance, params_.camera_fov) ||
-            std::abs(local.z()) > kBlobMatch)
+        if (local.head<2>().norm() > area_radius(tuning_.camera.working_distance, tuning_.camera.fov) ||
+            std::abs(local.z()) > tuning_.blobs.match)
           continue;
         p.label = "start view blob " + std::to_string(blobs.size() + 1);
         blobs.push_back(p);
@@ -940,8 +801,8 @@ void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& located,
   r.end_effector(rig_ ? rig_->tool() : "");
   r.goals().push_back(model::dds::to_pose_msg(frame));
   r.execute(false);
-  r.environment_padding(kPlanPadding);
-  r.contact_force(checked_thrust(params_.motion));
+  r.environment_padding(tuning_.approach.padding);
+  r.contact_force(checked_thrust(tuning_, tuning_.motion));
   if (after) {
     const auto prev = plans_.find(*after);
     if (prev != plans_.end() && prev->second.end.size() > 0) {
@@ -967,7 +828,7 @@ Outcome DrillNode::planning(std::size_t area) {
     if (found != plan_results_.end()) r = found->second;
   }
   if (!r) return Outcome::running();
-  if (r->state() == msg::PLAN_FAILED && p.attempts < kPlanAttempts &&
+  if (r->state() == msg::PLAN_FAILED && p.attempts < tuning_.approach.attempts &&
       (r->failure() == msg::PLAN_NO_PATH || r->failure() == msg::PLAN_UNREACHABLE)) {
     // The search is randomised (seeded by the request id): another request searches anew.
     ++p.attempts;
@@ -976,7 +837,7 @@ Outcome DrillNode::planning(std::size_t area) {
     p.request.stamp_ns(now_ns());
     log_line("drill: area " + std::to_string(area) + ": " + r->reason() +
              "; planning again (attempt " + std::to_string(p.attempts) + " of " +
-             std::to_string(kPlanAttempts) + ")");
+             std::to_string(tuning_.approach.attempts) + ")");
     send_plan(p.request);
     return Outcome::running();
   }
@@ -993,7 +854,7 @@ Outcome DrillNode::planning(std::size_t area) {
 }
 
 std::uint32_t DrillNode::send_trajectory(const std::vector<std::string>& names,
-                                         const std::vector<msg::TrajectorySample>& samples) {
+                                         const std::vector<PathSample>& samples) {
   msg::JointTrajectoryCommand c;
   const std::uint32_t id = next_request_++;
   c.request_id(id);
@@ -1001,11 +862,11 @@ std::uint32_t DrillNode::send_trajectory(const std::vector<std::string>& names,
   c.stamp_ns(now_ns());
   c.source(kSource);
   c.joint_names(names);
-  for (const msg::TrajectorySample& s : samples) {
+  for (const PathSample& s : samples) {
     msg::JointTrajectorySample out;
-    out.time(s.time());
-    out.position(s.position());
-    out.velocity(s.velocity());
+    out.time(s.time);
+    out.position(s.position);
+    out.velocity(s.velocity);
     c.samples().push_back(out);
   }
   trajectories_.write(c);
@@ -1019,111 +880,14 @@ void DrillNode::execute(std::size_t area) {
   executing_area_ = area;
   if (!hole_chain_.empty()) {
     if (const std::optional<Sample> s = latest_sample()) {
-      trajectory_request_ = send_trajectory(hole_chain_.front().names, return_path(*s));
+      trajectory_request_ = send_trajectory(hole_chain_.front().names, return_path(hole_chain_, *s, path_timing(tuning_)));
       returning_ = true;
       return;
     }
   }
   returning_ = false;
   const Plan& p = plans_.at(area);
-  trajectory_request_ = send_trajectory(p.names, p.result->trajectory());
-}
-
-// From the measured state back through every hole's planned path, reversed.
-std::vector<msg::TrajectorySample> DrillNode::return_path(const Sample& s) const {
-  std::vector<msg::TrajectorySample> back{
-      sample_here(hole_chain_.front().names, s, hole_chain_.back().samples.back())};
-  // Each path's end is the hole's posture, where the arm went back after its retract.
-  double t = 0.0;
-  for (auto path = hole_chain_.rbegin(); path != hole_chain_.rend(); ++path) append_reversed(back, *path, t);
-  // The holes' postures all taken with the base where it stands now (arm-alone postures, or a
-  // base moved by less than kBaseKept): the way back keeps it there too.
-  keep_base(hole_chain_.front().names, back.front(), back, kBaseKept);
-  return back;
-}
-
-// `path` backwards after `back`: a settling second to reach its end, then its samples in reverse
-// order, times from `t` on (`t` left at the path's start).
-void DrillNode::append_reversed(std::vector<msg::TrajectorySample>& back, const PlannedPath& path, double& t) {
-  t += kSettleBack;
-  const double end = path.samples.back().time();
-  for (auto it = path.samples.rbegin(); it != path.samples.rend(); ++it) {
-    msg::TrajectorySample sample = *it;
-    sample.time(t + end - it->time());
-    for (double& v : sample.velocity()) v = -v;
-    back.push_back(sample);
-  }
-  t += end;
-}
-
-// Time to go straight from `from` to `to` (zero velocity at both ends) at a third of a slow
-// joint speed (0.5 rad/s, base 0.2 m/s): at least kSettleBack. The Cartesian phases can leave
-// a joint far off its posture (a wrist turned about the bit); a fixed second would drive the
-// demo's J6_E past its velocity limit.
-double DrillNode::settle_time(const std::vector<std::string>& names,
-                              const msg::TrajectorySample& from, const msg::TrajectorySample& to) {
-  double t = kSettleBack;
-  for (std::size_t i = 0;
-       i < names.size() && i < from.position().size() && i < to.position().size(); ++i) {
-    const bool base = names[i] == "base_x" || names[i] == "base_y";
-    const double speed = base ? 0.2 : 0.5;
-    t = std::max(t, 3.0 * std::abs(to.position()[i] - from.position()[i]) / speed);
-  }
-  return t;
-}
-
-msg::TrajectorySample DrillNode::sample_here(const std::vector<std::string>& names,
-                                             const Sample& s, const msg::TrajectorySample& towards) {
-  msg::TrajectorySample here;
-  here.time(0.0);
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    const std::string& n = names[i];
-    double v = 0.0;
-    if (n == "base_yaw" && i < towards.position().size()) {
-      // Odometry's yaw is wrapped to (-pi, pi], the planner's is not (it is kept near the
-      // start's): a robot facing -x measures -3.14 where its plan says 3.13, and the straight
-      // line between them turns the base a whole turn with the bit at the wall (a long
-      // "settle" after a hole, then a safety stop on J1_E).
-      const double planned = towards.position()[i];
-      v = planned + std::remainder(s.odometry[2] - planned, 2.0 * M_PI);
-    } else if (n == "base_x" || n == "base_y" || n == "base_yaw") {
-      v = s.odometry[n == "base_x" ? 0 : n == "base_y" ? 1 : 2];
-    } else {
-      const auto it = std::find(s.joints.names.begin(), s.joints.names.end(), n);
-      if (it != s.joints.names.end())
-        v = s.joints.positions[static_cast<std::size_t>(it - s.joints.names.begin())];
-    }
-    here.position().push_back(v);
-    here.velocity().push_back(0.0);
-  }
-  return here;
-}
-
-bool DrillNode::keep_base(const std::vector<std::string>& names, const msg::TrajectorySample& here,
-                          std::vector<msg::TrajectorySample>& path, double bound) {
-  const auto is_base = [](const std::string& n) {
-    return n == "base_x" || n == "base_y" || n == "base_yaw";
-  };
-  if (path.empty()) return false;
-  if (bound > 0.0) {
-    for (const msg::TrajectorySample& p : path) {
-      for (std::size_t i = 0; i < names.size(); ++i) {
-        if (!is_base(names[i])) continue;
-        if (i >= p.position().size() || i >= here.position().size() ||
-            std::abs(p.position()[i] - here.position()[i]) > bound)
-          return false;
-      }
-    }
-  }
-  for (msg::TrajectorySample& p : path) {
-    for (std::size_t i = 0; i < names.size() && i < p.position().size(); ++i) {
-      if (is_base(names[i]) && i < here.position().size()) {
-        p.position()[i] = here.position()[i];
-        if (i < p.velocity().size()) p.velocity()[i] = 0.0;
-      }
-    }
-  }
-  return true;
+  trajectory_request_ = send_trajectory(p.names, samples_of(*p.result));
 }
 
 Outcome DrillNode::execution() {
@@ -1134,7 +898,7 @@ Outcome DrillNode::execution() {
     returning_ = false;
     hole_chain_.clear();
     const Plan& p = plans_.at(*executing_area_);
-    trajectory_request_ = send_trajectory(p.names, p.result->trajectory());
+    trajectory_request_ = send_trajectory(p.names, samples_of(*p.result));
     return Outcome::running();
   }
   switch (it->second.state()) {
@@ -1175,7 +939,7 @@ void DrillNode::follow_start_blobs(const CameraView& camera, ResolvedArea& locat
   if (it == start_blobs_.end() || it->second.size() < 2) return;
   std::optional<AreaShift> shift;
   try {
-    shift = blob_shift(camera, it->second, kBlobMatch, kSetShift, kSetShift);
+    shift = blob_shift(camera, it->second, tuning_.blobs.match, tuning_.blobs.set_shift, tuning_.blobs.set_shift);
   } catch (const DrillError&) {
     return;
   }
@@ -1198,7 +962,7 @@ void DrillNode::follow_start_blobs(const CameraView& camera, ResolvedArea& locat
 
 Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
   const std::optional<CameraFrame> view =
-      averaged_view(detection_.since_ns, params_.averaged_frames);
+      averaged_view(detection_.since_ns, tuning_.camera.averaged_frames);
   if (!view) return Outcome::running();
   if (!patterns_ && detection_.spec.marks == MarkKind::kAruco) {
     return Outcome::failed(
@@ -1232,7 +996,7 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
     }
     if (detection_.spec.marks == MarkKind::kBlobs) follow_start_blobs(camera, located);
     points = find_holes(detection_.spec, located, camera, patterns_ ? *patterns_ : kNone,
-                        area_radius(params_.camera_distance, params_.camera_fov));
+                        area_radius(tuning_.camera.working_distance, tuning_.camera.fov));
     area_points_ = points;
     for (const DrillPoint& p : points)
       drift_.first_seen(landmark(detection_.area, p.label), p.frame.translation());
@@ -1291,7 +1055,7 @@ msg::PlanRequest DrillNode::placement_request(const Eigen::Isometry3d& goal) {
 }
 
 // An ArUco area of several holes: from where the base stands, then from whole-body postures
-// drawn (kPlacementDraws: the bit a little further out than a hole's, in front of the holes'
+// drawn (placement.draws: the bit a little further out than a hole's, in front of the holes'
 // centre or of a point nearer the marker), the arm alone is asked for each hole's drilling posture (as a hole's
 // first request: the bit's reach and the full thrust checked) and, from a drawn posture, the
 // camera for a look at the marker. The base then moves once, to the first posture reaching every
@@ -1310,12 +1074,12 @@ void DrillNode::place(std::size_t area, const std::vector<DrillPoint>& holes) {
   }
   placement_.holes = holes;
   placement_.started = now_;
-  placement_.choice.emplace(holes.size(), std::size(kPlacementDraws));
+  placement_.choice.emplace(holes.size(), tuning_.placement.draws.size());
   point_ = holes.front();
   const Eigen::VectorXd q = rig_->q(s->joints);
   const Eigen::Isometry3d camera = rig_->camera_in_base(q);
   camera_to_tip_ = (rig_->tip_in_base(q).translation() - camera.translation()).dot(camera.linear().col(2));
-  hole_distance_ = params_.motion.standoff + kAlignMargin;
+  hole_distance_ = tuning_.motion.standoff + tuning_.hole.align_margin;
   log_line("drill: area " + std::to_string(area) + ": placing the base for its " +
            std::to_string(holes.size()) + " holes");
   place_check(false);
@@ -1346,11 +1110,11 @@ void DrillNode::place_check(bool drawn) {
   const auto from = [&](msg::PlanRequest& r) {
     if (!drawn) return;
     r.start_names(placement_.names.back());
-    r.start_position(placement_.bodies.back().back().position());
+    r.start_position(placement_.bodies.back().back().position);
   };
   for (const DrillPoint& h : placement_.holes) {
     msg::PlanRequest r = placement_request(h.frame);
-    set_hole_task(r, at_lead(kHoleAttempts[0], placement_.lead), hole_distance_, hole_depth(), params_.motion);
+    set_hole_task(r, at_lead(tuning_.hole.attempts[0], placement_.lead), hole_distance_, hole_depth(), tuning_);
     from(r);
     placement_.hole_checks.push_back({r.request_id(), 0, r});
     send_plan(r);
@@ -1361,8 +1125,8 @@ void DrillNode::place_check(bool drawn) {
     const std::optional<Eigen::Isometry3d> mark = marker_of(placement_.holes.front(), *patterns_);
     if (mark) {
       msg::PlanRequest r = placement_request(*mark);
-      r.camera_distance(any_roll_distance(marker_look_radius(patterns_->marker_size()), camera_fov()) +
-                        kPlacementLooks[0]);
+      r.camera_distance(any_roll_distance(marker_look_radius(patterns_->marker_size(), tuning_.looks.marker_drift), camera_fov()) +
+                        tuning_.placement.look_further[0]);
       r.fixed_base(true);
       r.contact_force(1.0);
       from(r);
@@ -1388,33 +1152,33 @@ void DrillNode::place_next() {
   switch (c.next()) {
     case PlacementChoice::Next::kCheckStanding:  // not after a check: standing was checked first
     case PlacementChoice::Next::kDraw: {
-      const PlacementDraw& d = kPlacementDraws[c.draws()];
+      const PlacementDraw& d = tuning_.placement.draws[c.draws()];
       std::optional<Eigen::Vector3d> mark;
       if (const std::optional<Eigen::Isometry3d> m = marker_of(placement_.holes.front(), *patterns_))
         mark = m->translation();
       msg::PlanRequest r = placement_request(placement_goal(placement_.holes, mark, d.toward));
-      set_hole_task(r, {true, false, 0.0, d.out, placement_.lead}, hole_distance_, hole_depth(), params_.motion);
+      set_hole_task(r, {true, false, 0.0, d.out, placement_.lead}, hole_distance_, hole_depth(), tuning_);
       placement_.draw = r.request_id();
       send_plan(r);
       motion_ = Motion::kPlaceDraw;
       return;
     }
     case PlacementChoice::Next::kStand: {
-      if (c.short_of_every_hole() && placement_.lead > kPlacementLightLead) {
-        log_line("drill: " + c.summary() + thrust_text(placement_.lead, params_.motion) +
-                 "; the placement checked again" + thrust_text(kPlacementLightLead, params_.motion));
+      if (c.short_of_every_hole() && placement_.lead > tuning_.placement.light_lead) {
+        log_line("drill: " + c.summary() + thrust_text(placement_.lead, tuning_.motion) +
+                 "; the placement checked again" + thrust_text(tuning_.placement.light_lead, tuning_.motion));
         Placement again;
         again.holes = placement_.holes;
         again.started = placement_.started;
-        again.lead = kPlacementLightLead;
-        again.choice.emplace(again.holes.size(), std::size(kPlacementDraws));
+        again.lead = tuning_.placement.light_lead;
+        again.choice.emplace(again.holes.size(), tuning_.placement.draws.size());
         placement_ = std::move(again);
         place_check(false);
         return;
       }
       placement_.order = reached_first(placement_.standing_reached);
       placement_.placed = placement_.standing_reached;
-      log_line("drill: " + c.summary() + thrust_text(placement_.lead, params_.motion) +
+      log_line("drill: " + c.summary() + thrust_text(placement_.lead, tuning_.motion) +
                "; the base stays where it stands (" + placement_time() + ")" +
                last_holes(placement_.standing_reached));
       motion_ = Motion::kNone;
@@ -1425,7 +1189,7 @@ void DrillNode::place_next() {
       const std::size_t k = c.chosen();
       placement_.order = reached_first(placement_.reached[k]);
       placement_.placed = placement_.reached[k];
-      log_line("drill: " + c.summary() + thrust_text(placement_.lead, params_.motion) +
+      log_line("drill: " + c.summary() + thrust_text(placement_.lead, tuning_.motion) +
                "; the whole body to posture " + std::to_string(k + 1) +
                " drawn (" + placement_time() + ")" + last_holes(placement_.reached[k]));
       trajectory_request_ = send_trajectory(placement_.names[k], placement_.bodies[k]);
@@ -1443,174 +1207,206 @@ void DrillNode::resend(Placement::Check& c) {
   send_plan(c.request);
 }
 
+// The placement's state machine (place()): one step a tick of the state it is in.
 void DrillNode::control_placement() {
-  const auto answered = [&](std::uint32_t id) -> std::optional<msg::PlanResult> {
-    std::optional<msg::PlanResult> r = plan_result(id);
-    if (r && (r->state() == msg::PLAN_SUCCEEDED || r->state() == msg::PLAN_FAILED)) return r;
-    return std::nullopt;
-  };
   if (motion_ == Motion::kPlaceCheck) {
-    const bool drawn = !placement_.bodies.empty();
-    std::size_t reached = 0;
-    bool waiting = false;
-    std::vector<bool> flags;
-    for (Placement::Check& c : placement_.hole_checks) {
-      const std::optional<msg::PlanResult> r = answered(c.id);
-      if (!r) {
-        waiting = true;
-        continue;
-      }
-      if (r->state() == msg::PLAN_FAILED && c.attempt < (drawn ? kPlacementAttempts : 0) &&
-          (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH)) {
-        // The hole's next posture further out, as the hole itself will ask (kHoleAttempts).
-        set_hole_task(c.request, at_lead(kHoleAttempts[++c.attempt], placement_.lead), hole_distance_,
-                      hole_depth(), params_.motion);
-        resend(c);
-        waiting = true;
-        continue;
-      }
-      reached += r->state() == msg::PLAN_SUCCEEDED;
-      flags.push_back(r->state() == msg::PLAN_SUCCEEDED);
-    }
-    if (waiting) return;
-    std::optional<msg::PlanResult> look;
-    Placement::Check& l = placement_.look_check;
-    if (l.id != 0 && !(look = answered(l.id))) return;
-    if (look && look->state() == msg::PLAN_FAILED && l.attempt + 1 < std::size(kPlacementLooks) &&
-        (look->failure() == msg::PLAN_UNREACHABLE || look->failure() == msg::PLAN_NO_PATH)) {
-      l.request.camera_distance(l.request.camera_distance() - kPlacementLooks[l.attempt] +
-                                kPlacementLooks[l.attempt + 1]);
-      ++l.attempt;
-      resend(l);
-      return;
-    }
-    if (!drawn) {
-      placement_.choice->standing(reached);
-      placement_.standing_reached = flags;
-    } else {
-      placement_.reached.back() = flags;
-      const bool seen = look && look->state() == msg::PLAN_SUCCEEDED && !look->trajectory().empty();
-      if (seen) {
-        placement_.looks.back() = look->trajectory();
-        placement_.look_distances.back() = l.request.camera_distance();
-      }
-      placement_.choice->drawn(reached, seen);
-    }
-    place_next();
+    place_check_step();
     return;
   }
   if (motion_ == Motion::kPlaceDraw) {
-    const std::optional<msg::PlanResult> r = answered(placement_.draw);
-    if (!r) return;
-    placement_.names.push_back(r->joint_names());
-    placement_.reached.emplace_back(placement_.holes.size(), false);
-    placement_.looks.emplace_back();
-    placement_.look_distances.push_back(0.0);
-    if (r->state() == msg::PLAN_SUCCEEDED && !r->trajectory().empty()) {
-      placement_.bodies.push_back(r->trajectory());
-      place_check(true);
-      return;
-    }
-    placement_.bodies.emplace_back();
-    log_line("drill: no whole-body posture drawn for the placement (" + r->reason() + ")");
-    placement_.choice->drawn(0, false);
-    place_next();
+    place_draw_step();
     return;
   }
-  const std::size_t k = placement_.choice ? placement_.choice->chosen() : 0;
   if (motion_ == Motion::kPlaceMove) {
-    if (!trajectory_ran("the base's placement")) return;
-    hole_chain_.push_back({placement_.names[k], placement_.bodies[k]});
-    // The base moved: the marker's last sighting no longer places the holes.
-    markers_seen_at_.erase(point_.marker);
-    if (const std::optional<Sample> s = latest_sample()) {
-      const msg::TrajectorySample here =
-          sample_here(placement_.names[k], *s, placement_.bodies[k].back());
-      double off = 0.0, turn = 0.0;
-      for (std::size_t i = 0; i < placement_.names[k].size() && i < here.position().size(); ++i) {
-        const double d = here.position()[i] - placement_.bodies[k].back().position()[i];
-        if (placement_.names[k][i] == "base_yaw") turn = std::abs(d);
-        else if (placement_.names[k][i] == "base_x" || placement_.names[k][i] == "base_y") off += d * d;
-      }
-      std::ostringstream line;
-      line.setf(std::ios::fixed);
-      line.precision(1);
-      line << "drill: the base placed " << std::sqrt(off) * 1e3 << " mm and " << turn * 1e3
-           << " mrad from the posture planned (odometry)";
-      log_line(line.str());
-    }
-    if (placement_.looks[k].empty()) {  // no look was checked (cannot be: kMove needs one)
-      motion_ = Motion::kNone;
-      motion_outcome_ = Outcome::succeeded();
-      return;
-    }
-    place_look(0);
+    place_move_step();
     return;
   }
   if (motion_ == Motion::kPlaceLook) {
-    if (!trajectory_ran("the camera onto the marker from the placement")) return;
-    hole_chain_.push_back({placement_.names[k], placement_.looks[k]});
-    start_reanchor(Motion::kPlaceSee);
+    place_look_step();
     return;
   }
   if (motion_ == Motion::kPlaceLookAgain) {
-    const std::optional<msg::PlanResult> r = plan_result(placement_.look_again);
-    if (!r) return;
-    if (!r->trajectory().empty()) placement_.again_path = {r->joint_names(), r->trajectory()};
-    if (r->state() == msg::PLAN_SUCCEEDED) {
-      if (!placement_.again_path.samples.empty()) hole_chain_.push_back(placement_.again_path);
-      start_reanchor(Motion::kPlaceSee);
-    } else if (r->state() == msg::PLAN_FAILED && r->failure() == msg::PLAN_EXECUTION_ABORTED) {
-      motion_ = Motion::kNone;
-      motion_outcome_ = Outcome::failed("robot: the camera onto the marker from the placement: " + r->reason());
-    } else if (const std::optional<Sample> s = latest_sample();
-               r->state() == msg::PLAN_FAILED && placement_.looks_again == 0 && s) {
-      // None from where the base stands: the look checked from the posture planned, its arm
-      // path taken with the base where it stands (aimed off by the base's tracking error).
-      log_line("drill: no look at marker " + std::to_string(point_.marker) + " from where the base stands (" +
-               r->reason() + "); the look checked from the posture planned");
-      std::vector<msg::TrajectorySample> look = placement_.looks[k];
-      const msg::TrajectorySample here = sample_here(placement_.names[k], *s, look.front());
-      look.front() = here;
-      keep_base(placement_.names[k], here, look);
-      placement_.looks[k] = look;
-      trajectory_request_ = send_trajectory(placement_.names[k], look);
-      motion_ = Motion::kPlaceLook;
-    } else if (r->state() == msg::PLAN_FAILED) {
-      log_line("drill: the camera cannot be turned onto marker " + std::to_string(point_.marker) +
-               " further out from the placement (" + r->reason() + "); each hole looks for it");
-      motion_ = Motion::kNone;
-      motion_outcome_ = Outcome::succeeded();
-    }
+    place_look_again_step();
     return;
   }
   if (motion_ == Motion::kPlaceSee) {
-    const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, kReanchorFrames);
-    if (!view) return;
-    // The pattern measured again as a hole's look measures it (its drift to OdometryDrift, the
-    // marker's sighting kept for the area's holes).
-    if (!remeasure_looked_marker(CameraView{&view->frame, view->world_T_optical})) {
-      const std::optional<Eigen::Isometry3d> predicted = marker_of(point_, *patterns_);
-      if (predicted && placement_.looks_again + 1 < std::size(kPlacementLooks)) {
-        // Further out, the arm alone from where it stands: more room for the drift.
-        place_look(placement_.looks_again + 1);
-        std::ostringstream line;
-        line.setf(std::ios::fixed);
-        line.precision(2);
-        line << "drill: marker " << point_.marker << " not seen from the placement's look; the camera "
-             << placement_.look_distance << " m out";
-        log_line(line.str());
-        return;
-      }
-      log_line("drill: marker " + std::to_string(point_.marker) +
-               " not seen from the placement's looks; each hole looks for it");
+    place_see_step();
+    return;
+  }
+}
+
+// A plan request's final answer (succeeded or failed), or none yet.
+std::optional<msg::PlanResult> DrillNode::answered(std::uint32_t id) const {
+  std::optional<msg::PlanResult> r = plan_result(id);
+  if (r && (r->state() == msg::PLAN_SUCCEEDED || r->state() == msg::PLAN_FAILED)) return r;
+  return std::nullopt;
+}
+
+// The posture drawn the placement moves to (the first while none is chosen).
+std::size_t DrillNode::chosen_draw() const { return placement_.choice ? placement_.choice->chosen() : 0; }
+
+void DrillNode::place_check_step() {
+  const bool drawn = !placement_.bodies.empty();
+  std::size_t reached = 0;
+  bool waiting = false;
+  std::vector<bool> flags;
+  for (Placement::Check& c : placement_.hole_checks) {
+    const std::optional<msg::PlanResult> r = answered(c.id);
+    if (!r) {
+      waiting = true;
+      continue;
     }
+    if (r->state() == msg::PLAN_FAILED && c.attempt < (drawn ? tuning_.placement.last_hole_attempt : 0) &&
+        (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH)) {
+      // The hole's next posture further out, as the hole itself will ask (Params::hole.attempts).
+      set_hole_task(c.request, at_lead(tuning_.hole.attempts[++c.attempt], placement_.lead), hole_distance_,
+                    hole_depth(), tuning_);
+      resend(c);
+      waiting = true;
+      continue;
+    }
+    reached += r->state() == msg::PLAN_SUCCEEDED;
+    flags.push_back(r->state() == msg::PLAN_SUCCEEDED);
+  }
+  if (waiting) return;
+  std::optional<msg::PlanResult> look;
+  Placement::Check& l = placement_.look_check;
+  if (l.id != 0 && !(look = answered(l.id))) return;
+  if (look && look->state() == msg::PLAN_FAILED && l.attempt + 1 < tuning_.placement.look_further.size() &&
+      (look->failure() == msg::PLAN_UNREACHABLE || look->failure() == msg::PLAN_NO_PATH)) {
+    l.request.camera_distance(l.request.camera_distance() - tuning_.placement.look_further[l.attempt] +
+                              tuning_.placement.look_further[l.attempt + 1]);
+    ++l.attempt;
+    resend(l);
+    return;
+  }
+  if (!drawn) {
+    placement_.choice->standing(reached);
+    placement_.standing_reached = flags;
+  } else {
+    placement_.reached.back() = flags;
+    const bool seen = look && look->state() == msg::PLAN_SUCCEEDED && !look->trajectory().empty();
+    if (seen) {
+      placement_.looks.back() = samples_of(*look);
+      placement_.look_distances.back() = l.request.camera_distance();
+    }
+    placement_.choice->drawn(reached, seen);
+  }
+  place_next();
+}
+
+void DrillNode::place_draw_step() {
+  const std::optional<msg::PlanResult> r = answered(placement_.draw);
+  if (!r) return;
+  placement_.names.push_back(r->joint_names());
+  placement_.reached.emplace_back(placement_.holes.size(), false);
+  placement_.looks.emplace_back();
+  placement_.look_distances.push_back(0.0);
+  if (r->state() == msg::PLAN_SUCCEEDED && !r->trajectory().empty()) {
+    placement_.bodies.push_back(samples_of(*r));
+    place_check(true);
+    return;
+  }
+  placement_.bodies.emplace_back();
+  log_line("drill: no whole-body posture drawn for the placement (" + r->reason() + ")");
+  placement_.choice->drawn(0, false);
+  place_next();
+}
+
+void DrillNode::place_move_step() {
+  const std::size_t k = chosen_draw();
+  if (!trajectory_ran("the base's placement")) return;
+  hole_chain_.push_back({placement_.names[k], placement_.bodies[k]});
+  // The base moved: the marker's last sighting no longer places the holes.
+  markers_seen_at_.erase(point_.marker);
+  if (const std::optional<Sample> s = latest_sample()) {
+    const PathSample here = sample_here(placement_.names[k], *s, placement_.bodies[k].back());
+    double off = 0.0, turn = 0.0;
+    for (std::size_t i = 0; i < placement_.names[k].size() && i < here.position.size(); ++i) {
+      const double d = here.position[i] - placement_.bodies[k].back().position[i];
+      if (placement_.names[k][i] == "base_yaw") turn = std::abs(d);
+      else if (placement_.names[k][i] == "base_x" || placement_.names[k][i] == "base_y") off += d * d;
+    }
+    std::ostringstream line;
+    line.setf(std::ios::fixed);
+    line.precision(1);
+    line << "drill: the base placed " << std::sqrt(off) * 1e3 << " mm and " << turn * 1e3
+         << " mrad from the posture planned (odometry)";
+    log_line(line.str());
+  }
+  if (placement_.looks[k].empty()) {  // no look was checked (cannot be: kMove needs one)
+    motion_ = Motion::kNone;
+    motion_outcome_ = Outcome::succeeded();
+    return;
+  }
+  place_look(0);
+}
+
+void DrillNode::place_look_step() {
+  const std::size_t k = chosen_draw();
+  if (!trajectory_ran("the camera onto the marker from the placement")) return;
+  hole_chain_.push_back({placement_.names[k], placement_.looks[k]});
+  start_reanchor(Motion::kPlaceSee);
+}
+
+void DrillNode::place_look_again_step() {
+  const std::size_t k = chosen_draw();
+  const std::optional<msg::PlanResult> r = plan_result(placement_.look_again);
+  if (!r) return;
+  if (!r->trajectory().empty()) placement_.again_path = path_of(*r);
+  if (r->state() == msg::PLAN_SUCCEEDED) {
+    if (!placement_.again_path.samples.empty()) hole_chain_.push_back(placement_.again_path);
+    start_reanchor(Motion::kPlaceSee);
+  } else if (r->state() == msg::PLAN_FAILED && r->failure() == msg::PLAN_EXECUTION_ABORTED) {
+    motion_ = Motion::kNone;
+    motion_outcome_ = Outcome::failed("robot: the camera onto the marker from the placement: " + r->reason());
+  } else if (const std::optional<Sample> s = latest_sample();
+             r->state() == msg::PLAN_FAILED && placement_.looks_again == 0 && s) {
+    // None from where the base stands: the look checked from the posture planned, its arm
+    // path taken with the base where it stands (aimed off by the base's tracking error).
+    log_line("drill: no look at marker " + std::to_string(point_.marker) + " from where the base stands (" +
+             r->reason() + "); the look checked from the posture planned");
+    std::vector<PathSample> look = placement_.looks[k];
+    const PathSample here = sample_here(placement_.names[k], *s, look.front());
+    look.front() = here;
+    keep_base(placement_.names[k], here, look);
+    placement_.looks[k] = look;
+    trajectory_request_ = send_trajectory(placement_.names[k], look);
+    motion_ = Motion::kPlaceLook;
+  } else if (r->state() == msg::PLAN_FAILED) {
+    log_line("drill: the camera cannot be turned onto marker " + std::to_string(point_.marker) +
+             " further out from the placement (" + r->reason() + "); each hole looks for it");
     motion_ = Motion::kNone;
     motion_outcome_ = Outcome::succeeded();
   }
 }
 
-// The camera onto the area's marker kPlacementLooks[attempt] [m] further out than the look checked
+void DrillNode::place_see_step() {
+  const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, tuning_.camera.reanchor_frames);
+  if (!view) return;
+  // The pattern measured again as a hole's look measures it (its drift to OdometryDrift, the
+  // marker's sighting kept for the area's holes).
+  if (!remeasure_looked_marker(CameraView{&view->frame, view->world_T_optical})) {
+    const std::optional<Eigen::Isometry3d> predicted = marker_of(point_, *patterns_);
+    if (predicted && placement_.looks_again + 1 < tuning_.placement.look_further.size()) {
+      // Further out, the arm alone from where it stands: more room for the drift.
+      place_look(placement_.looks_again + 1);
+      std::ostringstream line;
+      line.setf(std::ios::fixed);
+      line.precision(2);
+      line << "drill: marker " << point_.marker << " not seen from the placement's look; the camera "
+           << placement_.look_distance << " m out";
+      log_line(line.str());
+      return;
+    }
+    log_line("drill: marker " + std::to_string(point_.marker) +
+             " not seen from the placement's looks; each hole looks for it");
+  }
+  motion_ = Motion::kNone;
+  motion_outcome_ = Outcome::succeeded();
+}
+
+// The camera onto the area's marker placement.look_further[attempt] [m] further out than the look checked
 // from the posture drawn, the arm alone from where the robot stands, planned and executed
 // (kPlaceLookAgain). The look checked from the posture drawn, replayed with the base where it
 // stands, is aimed off by the base's tracking error: a placement's posture can end 40 mm nearer
@@ -1623,7 +1419,7 @@ void DrillNode::place_look(std::size_t attempt) {
     return;
   }
   placement_.looks_again = attempt;
-  placement_.look_distance = placement_.look_distances[placement_.choice->chosen()] + kPlacementLooks[attempt];
+  placement_.look_distance = placement_.look_distances[placement_.choice->chosen()] + tuning_.placement.look_further[attempt];
   msg::PlanRequest r = placement_request(*mark);
   r.camera_distance(placement_.look_distance);
   r.fixed_base(true);
@@ -1685,21 +1481,21 @@ void DrillNode::align(const DrillPoint& point) {
   // The bit's tip is put on the hole's axis (PlanRequest.tip_distance), so the posture the
   // planner checks is the one the bit drills from; the camera sees the hole from beside it.
   camera_to_tip_ = camera_to_tip;
-  hole_distance_ = params_.motion.standoff + kAlignMargin;
-  // The arm alone first (kHoleAttempts): the base stays where the area's approach put it, so
+  hole_distance_ = tuning_.motion.standoff + tuning_.hole.align_margin;
+  // The arm alone first (Params::hole.attempts): the base stays where the area's approach put it, so
   // odometry does not drift between holes (3.5 deg over one whole-body move on the demo).
   hole_attempt_ = 0;
   // A hole the area's placement reached at a lighter thrust starts there (the full thrust's
   // attempts would find nothing from the placement, or move the whole body off it).
   for (std::size_t i = 0; i < placement_.holes.size() && i < placement_.placed.size(); ++i) {
     if (placement_.placed[i] && placement_.holes[i].label == point.label && placement_.lead < 1.0)
-      hole_attempt_ = first_fixed_at(placement_.lead);
+      hole_attempt_ = first_fixed_at(tuning_, placement_.lead);
   }
   drilling_lead_ = 1.0;
   body_draws_ = 0;
   checked_look_ = 0;
   checked_path_ = {};
-  set_hole_task(r, kHoleAttempts[hole_attempt_], hole_distance_, hole_depth(), params_.motion);
+  set_hole_task(r, tuning_.hole.attempts[hole_attempt_], hole_distance_, hole_depth(), tuning_);
   hole_request_ = r;
   hole_request_write();
   hole_path_ = {};
@@ -1713,7 +1509,7 @@ void DrillNode::hole_request_write() {
   send_plan(hole_request_);
 }
 
-double DrillNode::hole_depth() const { return mission_ ? mission_->depth : kDefaultDepth; }
+double DrillNode::hole_depth() const { return mission_ ? mission_->depth : tuning_.hole.default_depth; }
 
 // "the bit 0.07 m", "the bit (reach unchecked) 0.07 m" or "the camera 0.23 m" (from the wall),
 // for the log.
@@ -1728,10 +1524,10 @@ std::string hole_task_text(const msg::PlanRequest& r) {
 
 void DrillNode::start_align(const Sample& s) {
   base_T_world_ = rig_->base_in_world(s.odometry).inverse();
-  drill_motion_ = DrillMotion(drilling_lead_ < 1.0 ? light_drilling(params_.motion, drilling_lead_)
-                                                  : params_.motion);
+  drill_motion_ = DrillMotion(drilling_lead_ < 1.0 ? light_drilling(tuning_.motion, drilling_lead_)
+                                                  : tuning_.motion);
   if (drilling_lead_ < 1.0)
-    log_line("drill: " + point_.label + ": drilled" + thrust_text(drilling_lead_, params_.motion) +
+    log_line("drill: " + point_.label + ": drilled" + thrust_text(drilling_lead_, tuning_.motion) +
              ": " + light_why_);
   drill_motion_.start_align(base_T_world_ * point_.frame, rig_->tip_in_base(rig_->q(s.joints)),
                             now_);
@@ -1832,7 +1628,7 @@ void DrillNode::start_reanchor(Motion next) {
 }
 
 // The whole body moved to the hole's drilling posture: the arm alone turns the camera onto the
-// hole's mark (an ArUco hole's marker, a blob hole's blob as predicted; kLooks), where the
+// hole's mark (an ArUco hole's marker, a blob hole's blob as predicted; looks.attempts), where the
 // hole is measured again.
 void DrillNode::look_at_hole(std::size_t first) {
   looked_ = true;
@@ -1856,7 +1652,7 @@ bool DrillNode::prepare_look() {
   look_reach_ = 0.0;
   if (point_.marker < 0) {
     // The hole's blob and its nearest neighbour framed together, room left for the drift.
-    if (const std::optional<BlobPairView> pair = blob_pair_view(point_, area_points_, kSetLookDrift)) {
+    if (const std::optional<BlobPairView> pair = blob_pair_view(point_, area_points_, tuning_.blobs.set_look_drift)) {
       look_goal_.translation() = pair->centre;
       look_reach_ = pair->radius;
     }
@@ -1865,7 +1661,7 @@ bool DrillNode::prepare_look() {
     // distance at the hole's posture alone puts the camera 0.22 m from the marker on morphology
     // A, where the marker fills the image past its edge: it is then not seen, and the hole is
     // drilled where odometry puts it.
-    look_reach_ = marker_look_radius(patterns_->marker_size());
+    look_reach_ = marker_look_radius(patterns_->marker_size(), tuning_.looks.marker_drift);
   }
   // The camera's distance at the hole's posture.
   hole_reached_ = hole_request_.tip_distance() > 0.0 ? hole_request_.tip_distance() + camera_to_tip_
@@ -1905,8 +1701,8 @@ void DrillNode::track_area() {
   if (!newest) return;
   track_since_ns_ = newest->stamp_ns;
   const std::optional<AreaShift> shift =
-      blob_shift(CameraView{&newest->frame, newest->world_T_optical}, area_points_, kBlobMatch,
-                 kTrackWindow, kSetShift);
+      blob_shift(CameraView{&newest->frame, newest->world_T_optical}, area_points_, tuning_.blobs.match,
+                 tuning_.blobs.track_window, tuning_.blobs.set_shift);
   if (!shift) return;
   shift_area(shift->by);
   point_.frame.translation() += shift->by;
@@ -1921,54 +1717,31 @@ void DrillNode::back_to_posture(const Sample& s, Motion next) {
   hole_chain_.pop_back();
   look_pushed_ = false;
   const PlannedPath& p = hole_chain_.back();
-  // The look's planned path backwards, not straight across in joint space: that can sweep the
-  // drill along the wall when odometry puts the wall a few cm off (J1_E pressing at
-  // 240-310 N m for 5 s, a safety stop).
+  // The look's planned path backwards (drill::back_from_look), not straight across.
   if (look.names == p.names && look.samples.size() >= 2) {
-    std::vector<msg::TrajectorySample> back{sample_here(look.names, s, look.samples.back())};
-    double t = 0.0;
-    append_reversed(back, look, t);
-    msg::TrajectorySample posture = p.samples.back();  // where the look started from, at rest
-    posture.time(back.back().time() + settle_time(p.names, back.back(), posture));
-    for (double& v : posture.velocity()) v = 0.0;
-    back.push_back(posture);
-    keep_base(p.names, back.front(), back, kBaseKept);
-    trajectory_request_ = send_trajectory(p.names, back);
+    trajectory_request_ = send_trajectory(p.names, back_from_look(look, p, s, path_timing(tuning_)));
   } else {
     trajectory_request_ = send_trajectory(p.names, settle_path(p, sample_here(p.names, s, p.samples.back())));
   }
   motion_ = next;
 }
 
-std::vector<msg::TrajectorySample> DrillNode::settle_path(const PlannedPath& p,
-                                                          const msg::TrajectorySample& here) {
-  std::vector<msg::TrajectorySample> settle{here, p.samples.back()};
-  const std::vector<double> planned = p.samples.back().position();
-  if (keep_base(p.names, here, settle, kBaseKept)) {
-    double off = 0.0, turn = 0.0;
-    for (std::size_t i = 0; i < p.names.size() && i < planned.size() && i < here.position().size(); ++i) {
-      const double d = here.position()[i] - planned[i];
-      if (p.names[i] == "base_yaw") turn = std::abs(d);
-      else if (p.names[i] == "base_x" || p.names[i] == "base_y") off += d * d;
-    }
-    off = std::sqrt(off);
-    if (off > 0.002 || turn > 0.002) {
-      std::ostringstream line;
-      line.setf(std::ios::fixed);
-      line << std::setprecision(1) << "drill: " << point_.label << ": the base stays where it stands, "
-           << off * 1e3 << " mm and " << turn * 1e3 << " mrad from the posture's; the arm alone onto it";
-      log_line(line.str());
-    }
+std::vector<PathSample> DrillNode::settle_path(const PlannedPath& p, const PathSample& here) {
+  const Settle settle = drill::settle_path(p, here, path_timing(tuning_));
+  if (settle.base_kept && (settle.base_off > 0.002 || settle.base_turn > 0.002)) {
+    std::ostringstream line;
+    line.setf(std::ios::fixed);
+    line << std::setprecision(1) << "drill: " << point_.label << ": the base stays where it stands, "
+         << settle.base_off * 1e3 << " mm and " << settle.base_turn * 1e3
+         << " mrad from the posture's; the arm alone onto it";
+    log_line(line.str());
   }
-  msg::TrajectorySample& end = settle.back();
-  end.time(settle_time(p.names, here, end));
-  for (double& v : end.velocity()) v = 0.0;
-  return settle;
+  return settle.samples;
 }
 
 void DrillNode::replan_hole(bool reach, double further, double lead) {
   set_hole_task(hole_request_, {reach, true, 0.0, further, lead}, hole_distance_, hole_depth(),
-                params_.motion);
+                tuning_);
   request_hole_posture();
 }
 
@@ -2002,8 +1775,8 @@ void DrillNode::replan_body() {
     std::lock_guard lock(mutex_);
     track_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
   }
-  set_hole_task(hole_request_, kHoleAttempts[hole_attempt_], hole_distance_, hole_depth(),
-                params_.motion);
+  set_hole_task(hole_request_, tuning_.hole.attempts[hole_attempt_], hole_distance_, hole_depth(),
+                tuning_);
   request_hole_posture();
 }
 
@@ -2011,15 +1784,15 @@ void DrillNode::replan_body() {
 // base stands where the whole body put it), at the distance that reached it, for the hole where
 // the look measured it.
 void DrillNode::replan_after_look() {
-  const HoleAttempt reached = kHoleAttempts[hole_attempt_];
+  const HoleAttempt reached = tuning_.hole.attempts[hole_attempt_];
   const std::size_t from = hole_attempt_;
   hole_attempt_ = 0;
-  while (hole_attempt_ + 1 < std::size(kHoleAttempts) &&
-         !(kHoleAttempts[hole_attempt_].fixed_base && kHoleAttempts[hole_attempt_].reach == reached.reach &&
-           kHoleAttempts[hole_attempt_].lead == reached.lead &&
-           kHoleAttempts[hole_attempt_].further >= reached.further - 1e-6))
+  while (hole_attempt_ + 1 < tuning_.hole.attempts.size() &&
+         !(tuning_.hole.attempts[hole_attempt_].fixed_base && tuning_.hole.attempts[hole_attempt_].reach == reached.reach &&
+           tuning_.hole.attempts[hole_attempt_].lead == reached.lead &&
+           tuning_.hole.attempts[hole_attempt_].further >= reached.further - 1e-6))
     ++hole_attempt_;
-  if (hole_attempt_ < from && !kHoleAttempts[hole_attempt_].fixed_base) hole_attempt_ = from;
+  if (hole_attempt_ < from && !tuning_.hole.attempts[hole_attempt_].fixed_base) hole_attempt_ = from;
   replan_hole(reached.reach, reached.further, reached.lead);
 }
 
@@ -2030,7 +1803,7 @@ double DrillNode::camera_fov() const {
   if (!frames_.empty() && frames_.back().frame.intrinsics.fx > 0.0 &&
       frames_.back().frame.intrinsics.fy > 0.0)
     return smaller_fov(frames_.back().frame.intrinsics);
-  return params_.camera_fov;
+  return tuning_.camera.fov;
 }
 
 void DrillNode::request_look(std::size_t attempt) {
@@ -2044,7 +1817,7 @@ void DrillNode::request_look(std::size_t attempt) {
   motion_ = Motion::kLookAtHole;
 }
 
-// The look of kLooks[attempt] asked from the end of the whole body's candidate posture,
+// The look of looks.attempts[attempt] asked from the end of the whole body's candidate posture,
 // planned only.
 void DrillNode::check_look(std::size_t attempt) {
   check_attempt_ = attempt;
@@ -2053,27 +1826,27 @@ void DrillNode::check_look(std::size_t attempt) {
   r.request_id(check_request_);
   r.execute(false);
   r.start_names(body_candidate_.names);
-  r.start_position(body_candidate_.samples.back().position());
+  r.start_position(body_candidate_.samples.back().position);
   send_plan(r);
   motion_ = Motion::kCheckLook;
 }
 
-// The request turning the camera onto look_goal_ (kLooks[attempt]), the arm alone; its id,
+// The request turning the camera onto look_goal_ (looks.attempts[attempt]), the arm alone; its id,
 // start and execution are the caller's.
 msg::PlanRequest DrillNode::look_plan(std::size_t attempt) const {
   msg::PlanRequest r = hole_request_;
   r.stamp_ns(now_ns());
   r.goals().clear();
   Eigen::Isometry3d goal = look_goal_;
-  double distance = hole_reached_ + kLooks[attempt].further;
+  double distance = hole_reached_ + tuning_.looks.attempts[attempt].further;
   const double fov = camera_fov();
   if (point_.marker >= 0 && look_reach_ > 0.0) {
     // The whole marker in view first, then further out with each attempt.
-    distance = std::max(hole_reached_, any_roll_distance(look_reach_, fov)) + kLooks[attempt].further;
+    distance = std::max(hole_reached_, any_roll_distance(look_reach_, fov)) + tuning_.looks.attempts[attempt].further;
   } else if (look_reach_ > 0.0) {
     distance = std::max(distance, any_roll_distance(look_reach_, fov));
   }
-  if (kLooks[attempt].between) {
+  if (tuning_.looks.attempts[attempt].between) {
     goal.translation() = 0.5 * (look_goal_.translation() + point_.frame.translation());
     // The planner leaves the camera's roll about its axis free: the marker (its centre half
     // the hole's distance from the goal, plus its half-diagonal) must fit in the image's
@@ -2098,10 +1871,10 @@ bool DrillNode::remeasure_looked_blob(const CameraView& camera) {
   // The camera on the blob's axis sees its neighbours too: the area matched as a set.
   Eigen::Isometry3d predicted = point_.frame;
   if (const std::optional<AreaShift> shift =
-          blob_shift(camera, area_points_, kBlobMatch, kReanchorDistance, kSetShift))
+          blob_shift(camera, area_points_, tuning_.blobs.match, tuning_.blobs.reanchor_distance, tuning_.blobs.set_shift))
     predicted.translation() += shift->by;
-  // Within kBlobMatch of the prediction: no neighbour is taken for it.
-  if (const std::optional<Eigen::Isometry3d> blob = track_blob(camera, predicted, kBlobMatch)) {
+  // Within blobs.match of the prediction: no neighbour is taken for it.
+  if (const std::optional<Eigen::Isometry3d> blob = track_blob(camera, predicted, tuning_.blobs.match)) {
     const Eigen::Vector3d moved = blob->translation() - point_.frame.translation();
     std::ostringstream line;
     line.setf(std::ios::fixed);
@@ -2115,7 +1888,7 @@ bool DrillNode::remeasure_looked_blob(const CameraView& camera) {
     shift_area(moved);
     point_.frame = *blob;
     const std::optional<Sample> s = latest_sample();
-    if (moved.norm() <= kReplanShift && look_pushed_ && hole_chain_.size() > 1 && s) {
+    if (moved.norm() <= tuning_.hole.replan_shift && look_pushed_ && hole_chain_.size() > 1 && s) {
       // Where the whole body's posture was planned for: back onto it, no new posture (the
       // arm waiting in the look posture while one is sought holds J3_E at its continuous
       // torque long enough for a safety stop).
@@ -2225,7 +1998,7 @@ bool DrillNode::trajectory_ran(const std::string& what) {
 void DrillNode::posture_reached() {
   // The posture holds the thrust it was checked with: drilled from it (or from the posture
   // it leads to) at that thrust.
-  drilling_lead_ = lead_checked(hole_request_, params_.motion);
+  drilling_lead_ = lead_checked(tuning_, hole_request_);
   light_why_ = "the arm's torques hold no more in any posture found";
   if (!hole_request_.fixed_base()) {
     body_attempt_ = hole_attempt_;
@@ -2243,7 +2016,7 @@ void DrillNode::posture_reached() {
     tracked_.setZero();
   }
   const auto seen_at = markers_seen_at_.find(point_.marker);
-  const bool stale = seen_at == markers_seen_at_.end() || now_ - seen_at->second > kMarkerStale;
+  const bool stale = seen_at == markers_seen_at_.end() || now_ - seen_at->second > tuning_.looks.marker_stale;
   const std::optional<Sample> s = latest_sample();
   if (point_.marker >= 0 && !looked_ && !hole_request_.fixed_base() && s &&
       !checked_path_.samples.empty() && prepare_look()) {
@@ -2252,9 +2025,8 @@ void DrillNode::posture_reached() {
     // starts where the robot stands, a tracking error from the planned posture.
     looked_ = true;
     // The arm alone: the base keeps the pose it stands at, not the one the check started from.
-    std::vector<msg::TrajectorySample> path = checked_path_.samples;
-    const msg::TrajectorySample here =
-        sample_here(checked_path_.names, *s, checked_path_.samples.front());
+    std::vector<PathSample> path = checked_path_.samples;
+    const PathSample here = sample_here(checked_path_.names, *s, checked_path_.samples.front());
     path.front() = here;
     keep_base(checked_path_.names, here, path);
     trajectory_request_ = send_trajectory(checked_path_.names, path);
@@ -2269,6 +2041,8 @@ void DrillNode::posture_reached() {
 
 // Every control period while a hole is worked on: the servo's new estimate of the blob from
 // each new camera frame, the motion's reference to the robot, and the phase's outcome.
+// The drilling motion's state machine: one step a tick of the state it is in; the Cartesian
+// phases (align, drill, retract) last.
 void DrillNode::control_motion() {
   if (motion_ == Motion::kNone || motion_outcome_) return;
   if (motion_ >= Motion::kPlaceCheck) {
@@ -2276,289 +2050,51 @@ void DrillNode::control_motion() {
     return;
   }
   if (motion_ == Motion::kApproachHole) {
-    const std::optional<msg::PlanResult> r = plan_result(hole_plan_request_);
-    track_area();
-    if (!r) return;
-    // The trajectory comes with PLANNED and the execution updates; SUCCEEDED may arrive alone.
-    if (!r->trajectory().empty()) hole_path_ = {r->joint_names(), r->trajectory()};
-    if (r->state() == msg::PLAN_SUCCEEDED && !hole_path_.samples.empty() && hole_request_.execute())
-      hole_chain_.push_back(hole_path_);
-    if (r->state() == msg::PLAN_FAILED && hole_replanned_) {
-      const std::optional<Sample> s = latest_sample();
-      if (!s) return;
-      const double shift = (point_.frame.translation() - body_goal_).norm();
-      if (body_replans_ < kBodyReplans && shift > kReplanShift) {
-        // Planned again after the re-measure, the arm alone found none: the whole body's
-        // posture once more, for the hole where the camera saw it. Aligning from the posture
-        // reached would stretch the arm that far unchecked: on the demo, a blob measured again
-        // 34 mm away holds J3_E past its continuous torque while drilling (a safety stop).
-        std::ostringstream line;
-        line.setf(std::ios::fixed);
-        line.precision(1);
-        line << "drill: " << point_.label << ": no posture for the arm alone at the hole measured "
-             << "again " << shift * 1e3 << " mm from where the whole body's posture was planned ("
-             << r->reason() << "); the whole body's posture planned again for it";
-        log_line(line.str());
-        replan_body();
-        return;
-      }
-      // The alignment's Cartesian move covers what is left of the shift.
-      log_line("drill: " + point_.label + ": no posture for the arm alone at the hole measured " +
-               "again (" + r->reason() + "); aligning from the whole body's posture");
-      if (shift > kReplanShift && drilling_lead_ > kLightestLead) {
-        // Past the posture the planner checked the torques of: the lightest thrust. Across
-        // 26 mm at full thrust morphology A's J2_E goes past its continuous torque.
-        std::ostringstream why;
-        why.setf(std::ios::fixed);
-        why.precision(1);
-        why << "the alignment reaches " << shift * 1e3 << " mm past the posture checked";
-        light_why_ = why.str();
-        drilling_lead_ = kLightestLead;
-      }
-      if (looked_ && look_pushed_ && hole_chain_.size() > 1) {
-        back_to_posture(*s);
-        return;
-      }
-      start_align(*s);
-      return;
-    }
-    if (r->state() == msg::PLAN_FAILED &&
-        (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH) &&
-        hole_attempt_ + 1 < std::size(kHoleAttempts)) {
-      const double was_lead = kHoleAttempts[hole_attempt_].lead;
-      const HoleAttempt& next = kHoleAttempts[++hole_attempt_];
-      std::ostringstream line;
-      const auto who = [](bool fixed, double travel) {
-        std::ostringstream w;
-        w << (fixed ? "the arm alone" : "the whole body");
-        if (!fixed && travel > 0.0) w << " (the base within " << travel << " m and rad)";
-        return w.str();
-      };
-      line << "drill: " << point_.label << ": no drilling posture for "
-           << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with "
-           << hole_task_text(hole_request_) << " from the wall" << thrust_text(was_lead, params_.motion)
-           << " (" << r->reason() << "); asking for " << who(next.fixed_base, next.base_travel)
-           << " with ";
-      hole_plan_request_ = next_request_++;
-      hole_request_.request_id(hole_plan_request_);
-      set_hole_task(hole_request_, next, hole_distance_, hole_depth(), params_.motion);
-      line << hole_task_text(hole_request_) << thrust_text(next.lead, params_.motion);
-      log_line(line.str());
-      body_draws_ = 0;
-      hole_request_write();
-    } else if (r->state() == msg::PLAN_FAILED) {
-      motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());
-      motion_ = Motion::kNone;
-    } else if (r->state() == msg::PLAN_SUCCEEDED && !hole_request_.execute()) {
-      // Planned only (a marker hole's whole body): is a look at the marker possible from there?
-      body_candidate_ = hole_path_;
-      checked_path_ = {};
-      ++body_draws_;
-      if (body_candidate_.samples.empty() || !prepare_look()) {
-        move_to_candidate();
-      } else {
-        check_look(0);
-      }
-    } else if (r->state() == msg::PLAN_SUCCEEDED) {
-      posture_reached();
-    }
+    hole_posture_step();
     return;
   }
   if (motion_ == Motion::kCheckLook) {
-    const std::optional<msg::PlanResult> r = plan_result(check_request_);
-    if (!r || (r->state() != msg::PLAN_SUCCEEDED && r->state() != msg::PLAN_FAILED)) return;
-    const std::string marker = "marker " + std::to_string(point_.marker);
-    if (r->state() == msg::PLAN_SUCCEEDED) {
-      checked_look_ = check_attempt_;
-      checked_path_ = {r->joint_names(), r->trajectory()};
-      if (body_draws_ > 1)
-        log_line("drill: " + point_.label + ": the camera can be turned onto " + marker +
-                 " from the whole body's posture drawn on try " + std::to_string(body_draws_) +
-                 " of " + std::to_string(kBodyDraws));
-    } else if (check_attempt_ + 1 < std::size(kLooks)) {
-      check_look(check_attempt_ + 1);
-      return;
-    } else if (body_draws_ < kBodyDraws) {
-      log_line("drill: " + point_.label + ": the camera could not be turned onto " + marker +
-               " from the whole body's posture drawn (" + r->reason() + "); another drawn");
-      hole_plan_request_ = next_request_++;
-      hole_request_.request_id(hole_plan_request_);
-      hole_request_.stamp_ns(now_ns());
-      hole_request_write();
-      hole_path_ = {};
-      motion_ = Motion::kApproachHole;
-      return;
-    } else {
-      checked_look_ = 0;
-      log_line("drill: " + point_.label + ": the camera could not be turned onto " + marker +
-               " from any of " + std::to_string(body_draws_) +
-               " whole-body postures drawn; the last one taken");
-    }
-    move_to_candidate();
+    check_look_step();
     return;
   }
   if (motion_ == Motion::kBodyToHole) {
-    if (!trajectory_ran("to the hole's drilling posture")) return;
-    hole_chain_.push_back(body_candidate_);
-    posture_reached();
+    body_to_hole_step();
     return;
   }
   if (motion_ == Motion::kCheckedLook) {
-    if (!trajectory_ran("the camera onto the marker")) return;
-    look_path_ = checked_path_;
-    look_attempt_ = checked_look_;
-    look_pushed_ = true;
-    hole_chain_.push_back(look_path_);
-    start_reanchor(Motion::kLookReanchor);
+    checked_look_step();
     return;
   }
   if (motion_ == Motion::kLookAtHole) {
-    const std::optional<msg::PlanResult> r = plan_result(look_request_);
-    if (!r) return;
-    if (!r->trajectory().empty()) look_path_ = {r->joint_names(), r->trajectory()};
-    if (r->state() == msg::PLAN_SUCCEEDED) {
-      look_pushed_ = !look_path_.samples.empty();
-      if (look_pushed_) hole_chain_.push_back(look_path_);
-      start_reanchor(Motion::kLookReanchor);
-    } else if (r->state() == msg::PLAN_FAILED &&
-               look_attempt_ + 1 < std::size(kLooks) &&
-               (point_.marker >= 0 || !kLooks[look_attempt_ + 1].between)) {
-      request_look(look_attempt_ + 1);
-    } else if (r->state() == msg::PLAN_FAILED) {
-      log_line("drill: " + point_.label + ": the camera cannot be turned onto " +
-               (point_.marker >= 0 ? "marker " + std::to_string(point_.marker) : "the blob") +
-               " from here (" + r->reason() + "); the hole is measured from its posture");
-      start_reanchor(Motion::kReanchor);
-    }
+    look_at_hole_step();
     return;
   }
   if (motion_ == Motion::kLookReanchor) {
-    const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, kReanchorFrames);
-    if (!view) return;
-    const CameraView camera{&view->frame, view->world_T_optical};
-    if (point_.marker < 0) {
-      if (remeasure_looked_blob(camera)) return;
-    } else if (!remeasure_looked_marker(camera)) {
-      const std::optional<Sample> s = latest_sample();
-      if (look_attempt_ + 1 < std::size(kLooks) && look_pushed_ && hole_chain_.size() > 1 && s) {
-        // From another look (a hole drilled where odometry puts it can be 2 cm off).
-        log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
-                 " not seen from the look posture; back onto the drilling posture for the next look");
-        back_to_posture(*s, Motion::kBackForLook);
-        return;
-      }
-      log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
-               " not seen from the look posture; the hole is drilled where odometry puts it");
-    } else {
-      // The base moved for this posture: without one for the arm alone at the hole measured
-      // again, the whole body's is planned again (and the marker looked at again) or aligned
-      // from, not the next whole-body attempt taken without a look (a row hole then lands
-      // about 13 mm off).
-      if (!hole_request_.fixed_base()) hole_replanned_ = true;
-    }
-    // From the look back onto the drilling posture along the look's path reversed, not along a
-    // path planned anew from the look posture: such a path can swing morphology A's J1_E through
-    // 3.9 rad with the bit near the wall and press it on the wall (300 N m, a safety stop). A
-    // posture of the arm alone planned within kReplanShift of
-    // the hole as measured now is aligned from (the alignment covers the rest); otherwise the
-    // posture is planned again from there.
-    const std::optional<Sample> s = latest_sample();
-    if (look_pushed_ && hole_chain_.size() > 1 && s && !hole_request_.goals().empty()) {
-      const double moved =
-          (point_.frame.translation() - model::dds::to_isometry(hole_request_.goals().front()).translation()).norm();
-      const bool keep = hole_request_.fixed_base() && moved <= kReplanShift;
-      back_to_posture(*s, keep ? Motion::kBackToPosture : Motion::kBackThenReplan);
-      return;
-    }
-    replan_after_look();
+    look_reanchor_step();
     return;
   }
   if (motion_ == Motion::kBackThenReplan) {
-    if (trajectory_ran("back onto the drilling posture")) replan_after_look();
+    back_then_replan_step();
     return;
   }
   if (motion_ == Motion::kReanchor) {
-    const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, kReanchorFrames);
-    if (!view) return;
-    static const PatternTable kNone;
-    const CameraView camera{&view->frame, view->world_T_optical};
-    DrillPoint predicted = point_;
-    double within = kReanchorDistance;
-    if (point_.marker < 0 && area_points_.size() > 1) {
-      // Several blobs: which one is this hole's is told by the pattern they make together.
-      const std::optional<AreaShift> shift =
-          blob_shift(camera, area_points_, kBlobMatch, kReanchorDistance, kSetShift);
-      if (shift && shift->blobs < 2 && !hole_request_.fixed_base() && !looked_) {
-        // The base moved: one blob seen alone near its prediction may be the neighbour, odometry
-        // having drifted as far as the blobs lie apart.
-        log_line("drill: " + point_.label +
-                 ": one blob of the area's seen from its drilling posture, not the set (" +
-                 blobs_seen(camera, point_.frame) + "); the camera is turned onto the area");
-        look_at_hole();
-        return;
-      }
-      if (shift) {
-        predicted.frame.translation() += shift->by;
-        within = kBlobMatch;
-      } else if (!hole_request_.fixed_base() && !looked_) {
-        // The base moved and the camera, beside the bit, cannot tell the blob from a neighbour.
-        log_line("drill: " + point_.label +
-                 ": its blob is not told from a neighbour from its drilling posture (" +
-                 blobs_seen(camera, point_.frame) + "); the camera is turned onto it");
-        look_at_hole();
-        return;
-      } else if (!hole_request_.fixed_base()) {
-        within = kBlobMatch;  // no neighbour is taken for it: the prediction stands
-      }
-    }
-    const std::optional<Eigen::Isometry3d> seen =
-        reanchor(camera, predicted, patterns_ ? *patterns_ : kNone, within);
-    if (seen) {
-      std::ostringstream line;
-      line.setf(std::ios::fixed);
-      line.precision(1);
-      line << "drill: " << point_.label << " measured again from its drilling posture: "
-           << (seen->translation() - point_.frame.translation()).norm() * 1e3 << " mm, "
-           << std::acos(
-                  std::clamp(seen->linear().col(2).dot(point_.frame.linear().col(2)), -1.0, 1.0)) *
-                  180.0 / M_PI
-           << " deg from the prediction";
-      const Eigen::Vector3d along = point_.frame.inverse() * seen->translation();
-      line << " (" << along.x() * 1e3 << ", " << along.y() * 1e3 << " mm on the wall, "
-           << along.z() * 1e3 << " mm out of it)";
-      if (point_.marker < 0) line << " (" << blobs_seen(camera, point_.frame) << ")";
-      log_line(line.str());
-      const Eigen::Vector3d moved = seen->translation() - point_.frame.translation();
-      hole_seen_again(seen->translation());
-      if (point_.marker < 0) shift_area(moved);  // the area's other blobs moved as much
-      point_.frame = *seen;
-      if (!hole_request_.fixed_base() && !hole_replanned_ && moved.norm() > kReplanShift) {
-        // The base moved and odometry drifted: the posture again, the arm alone, for the hole
-        // where the camera sees it now.
-        hole_replanned_ = true;
-        replan_hole(kHoleAttempts[hole_attempt_].reach, 0.0, kHoleAttempts[hole_attempt_].lead);
-        return;
-      }
-    }
-    if (const std::optional<Sample> s = latest_sample()) start_align(*s);
+    reanchor_step();
     return;
   }
   if (motion_ == Motion::kBackForLook) {
-    if (trajectory_ran("back onto the drilling posture")) request_look(look_attempt_ + 1);
+    back_for_look_step();
     return;
   }
   if (motion_ == Motion::kSettle || motion_ == Motion::kBackToPosture) {
-    // Back onto a planned posture: after a retract (then the hole is done), or from the look
-    // posture (then the alignment starts).
-    if (!trajectory_ran("back onto the drilling posture")) return;
-    if (motion_ == Motion::kSettle) {
-      motion_outcome_ = Outcome::succeeded();
-      motion_ = Motion::kNone;
-    } else if (const std::optional<Sample> here = latest_sample()) {
-      start_align(*here);
-    }
+    settle_step();
     return;
   }
+  cartesian_step();
+}
+
+// The Cartesian phases (DrillMotion): the hole followed as the base creeps, the blob servoed, the
+// reference sent; out of the hole, back onto the drilling posture.
+void DrillNode::cartesian_step() {
   const std::optional<Sample> s = latest_sample();
   if (!s) return;
   {
@@ -2574,7 +2110,7 @@ void DrillNode::control_motion() {
       servo_since_ns_ = f.stamp_ns;
       const Eigen::Isometry3d world_hole = base_T_world_.inverse() * drill_motion_.hole();
       const std::optional<Eigen::Isometry3d> seen = track_blob(
-          CameraView{&f.frame, f.world_T_optical}, world_hole, params_.motion.servo_jump);
+          CameraView{&f.frame, f.world_T_optical}, world_hole, tuning_.motion.servo_jump);
       if (seen) drill_motion_.observe(base_T_world_ * *seen);
     }
   }
@@ -2589,20 +2125,19 @@ void DrillNode::control_motion() {
     // Cartesian phases leave it a little off (up to 0.1 rad on the demo's arm, two of its links
     // then inside each other by the planner's shapes), and the next hole is planned from here.
     const PlannedPath& p = hole_chain_.back();
-    const msg::TrajectorySample here = sample_here(p.names, *s, p.samples.back());
-    const std::vector<msg::TrajectorySample> settle = settle_path(p, here);
-    const msg::TrajectorySample& end = settle.back();
-    const double t = end.time();
-    if (t > kSettleBack) {
+    const PathSample here = sample_here(p.names, *s, p.samples.back());
+    const std::vector<PathSample> settle = settle_path(p, here);
+    const PathSample& end = settle.back();
+    const double t = end.time;
+    if (t > tuning_.paths.settle_min) {
       std::ostringstream line;
       line << "drill: " << point_.label << ": back onto the drilling posture over " << t << " s";
       std::size_t far = 0;
-      for (std::size_t i = 1; i < p.names.size() && i < here.position().size(); ++i) {
-        if (std::abs(end.position()[i] - here.position()[i]) > std::abs(end.position()[far] - here.position()[far]))
-          far = i;
+      for (std::size_t i = 1; i < p.names.size() && i < here.position.size(); ++i) {
+        if (std::abs(end.position[i] - here.position[i]) > std::abs(end.position[far] - here.position[far])) far = i;
       }
-      if (far < p.names.size() && far < here.position().size())
-        line << " (" << p.names[far] << " from " << here.position()[far] << " to " << end.position()[far] << ")";
+      if (far < p.names.size() && far < here.position.size())
+        line << " (" << p.names[far] << " from " << here.position[far] << " to " << end.position[far] << ")";
       log_line(line.str());
     }
     trajectory_request_ = send_trajectory(p.names, settle);
@@ -2619,6 +2154,301 @@ void DrillNode::control_motion() {
     }
     motion_outcome_ = Outcome::succeeded();
     // Keep holding the reference until the next motion (the loop re-sends the last one).
+  }
+}
+
+void DrillNode::hole_posture_step() {
+  const std::optional<msg::PlanResult> r = plan_result(hole_plan_request_);
+  track_area();
+  if (!r) return;
+  // The trajectory comes with PLANNED and the execution updates; SUCCEEDED may arrive alone.
+  if (!r->trajectory().empty()) hole_path_ = path_of(*r);
+  if (r->state() == msg::PLAN_SUCCEEDED && !hole_path_.samples.empty() && hole_request_.execute())
+    hole_chain_.push_back(hole_path_);
+  if (r->state() == msg::PLAN_FAILED && hole_replanned_) {
+    no_posture_after_remeasure(*r);
+    return;
+  }
+  if (r->state() == msg::PLAN_FAILED &&
+      (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH) &&
+      hole_attempt_ + 1 < tuning_.hole.attempts.size()) {
+    next_hole_attempt(*r);
+  } else if (r->state() == msg::PLAN_FAILED) {
+    motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());
+    motion_ = Motion::kNone;
+  } else if (r->state() == msg::PLAN_SUCCEEDED && !hole_request_.execute()) {
+    // Planned only (a marker hole's whole body): is a look at the marker possible from there?
+    body_candidate_ = hole_path_;
+    checked_path_ = {};
+    ++body_draws_;
+    if (body_candidate_.samples.empty() || !prepare_look()) {
+      move_to_candidate();
+    } else {
+      check_look(0);
+    }
+  } else if (r->state() == msg::PLAN_SUCCEEDED) {
+    posture_reached();
+  }
+}
+
+// The hole's posture planned again after its re-measure found none for the arm alone: the whole
+// body's posture once more (up to hole.body_replans), or the alignment from the posture reached.
+void DrillNode::no_posture_after_remeasure(const msg::PlanResult& r) {
+  const std::optional<Sample> s = latest_sample();
+  if (!s) return;
+  const double shift = (point_.frame.translation() - body_goal_).norm();
+  if (body_replans_ < tuning_.hole.body_replans && shift > tuning_.hole.replan_shift) {
+    // Planned again after the re-measure, the arm alone found none: the whole body's
+    // posture once more, for the hole where the camera saw it. Aligning from the posture
+    // reached would stretch the arm that far unchecked: on the demo, a blob measured again
+    // 34 mm away holds J3_E past its continuous torque while drilling (a safety stop).
+    std::ostringstream line;
+    line.setf(std::ios::fixed);
+    line.precision(1);
+    line << "drill: " << point_.label << ": no posture for the arm alone at the hole measured "
+         << "again " << shift * 1e3 << " mm from where the whole body's posture was planned ("
+         << r.reason() << "); the whole body's posture planned again for it";
+    log_line(line.str());
+    replan_body();
+    return;
+  }
+  // The alignment's Cartesian move covers what is left of the shift.
+  log_line("drill: " + point_.label + ": no posture for the arm alone at the hole measured " +
+           "again (" + r.reason() + "); aligning from the whole body's posture");
+  if (shift > tuning_.hole.replan_shift && drilling_lead_ > tuning_.hole.lightest_lead) {
+    // Past the posture the planner checked the torques of: the lightest thrust. Across
+    // 26 mm at full thrust morphology A's J2_E goes past its continuous torque.
+    std::ostringstream why;
+    why.setf(std::ios::fixed);
+    why.precision(1);
+    why << "the alignment reaches " << shift * 1e3 << " mm past the posture checked";
+    light_why_ = why.str();
+    drilling_lead_ = tuning_.hole.lightest_lead;
+  }
+  if (looked_ && look_pushed_ && hole_chain_.size() > 1) {
+    back_to_posture(*s);
+    return;
+  }
+  start_align(*s);
+}
+
+// No posture for this attempt: the hole's next attempt (hole.attempts) asked.
+void DrillNode::next_hole_attempt(const msg::PlanResult& r) {
+  const double was_lead = tuning_.hole.attempts[hole_attempt_].lead;
+  const HoleAttempt& next = tuning_.hole.attempts[++hole_attempt_];
+  std::ostringstream line;
+  const auto who = [](bool fixed, double travel) {
+    std::ostringstream w;
+    w << (fixed ? "the arm alone" : "the whole body");
+    if (!fixed && travel > 0.0) w << " (the base within " << travel << " m and rad)";
+    return w.str();
+  };
+  line << "drill: " << point_.label << ": no drilling posture for "
+       << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with "
+       << hole_task_text(hole_request_) << " from the wall" << thrust_text(was_lead, tuning_.motion)
+       << " (" << r.reason() << "); asking for " << who(next.fixed_base, next.base_travel)
+       << " with ";
+  hole_plan_request_ = next_request_++;
+  hole_request_.request_id(hole_plan_request_);
+  set_hole_task(hole_request_, next, hole_distance_, hole_depth(), tuning_);
+  line << hole_task_text(hole_request_) << thrust_text(next.lead, tuning_.motion);
+  log_line(line.str());
+  body_draws_ = 0;
+  hole_request_write();
+}
+
+void DrillNode::check_look_step() {
+  const std::optional<msg::PlanResult> r = plan_result(check_request_);
+  if (!r || (r->state() != msg::PLAN_SUCCEEDED && r->state() != msg::PLAN_FAILED)) return;
+  const std::string marker = "marker " + std::to_string(point_.marker);
+  if (r->state() == msg::PLAN_SUCCEEDED) {
+    checked_look_ = check_attempt_;
+    checked_path_ = path_of(*r);
+    if (body_draws_ > 1)
+      log_line("drill: " + point_.label + ": the camera can be turned onto " + marker +
+               " from the whole body's posture drawn on try " + std::to_string(body_draws_) +
+               " of " + std::to_string(tuning_.hole.body_draws));
+  } else if (check_attempt_ + 1 < tuning_.looks.attempts.size()) {
+    check_look(check_attempt_ + 1);
+    return;
+  } else if (body_draws_ < tuning_.hole.body_draws) {
+    log_line("drill: " + point_.label + ": the camera could not be turned onto " + marker +
+             " from the whole body's posture drawn (" + r->reason() + "); another drawn");
+    hole_plan_request_ = next_request_++;
+    hole_request_.request_id(hole_plan_request_);
+    hole_request_.stamp_ns(now_ns());
+    hole_request_write();
+    hole_path_ = {};
+    motion_ = Motion::kApproachHole;
+    return;
+  } else {
+    checked_look_ = 0;
+    log_line("drill: " + point_.label + ": the camera could not be turned onto " + marker +
+             " from any of " + std::to_string(body_draws_) +
+             " whole-body postures drawn; the last one taken");
+  }
+  move_to_candidate();
+}
+
+void DrillNode::body_to_hole_step() {
+  if (!trajectory_ran("to the hole's drilling posture")) return;
+  hole_chain_.push_back(body_candidate_);
+  posture_reached();
+}
+
+void DrillNode::checked_look_step() {
+  if (!trajectory_ran("the camera onto the marker")) return;
+  look_path_ = checked_path_;
+  look_attempt_ = checked_look_;
+  look_pushed_ = true;
+  hole_chain_.push_back(look_path_);
+  start_reanchor(Motion::kLookReanchor);
+}
+
+void DrillNode::look_at_hole_step() {
+  const std::optional<msg::PlanResult> r = plan_result(look_request_);
+  if (!r) return;
+  if (!r->trajectory().empty()) look_path_ = path_of(*r);
+  if (r->state() == msg::PLAN_SUCCEEDED) {
+    look_pushed_ = !look_path_.samples.empty();
+    if (look_pushed_) hole_chain_.push_back(look_path_);
+    start_reanchor(Motion::kLookReanchor);
+  } else if (r->state() == msg::PLAN_FAILED &&
+             look_attempt_ + 1 < tuning_.looks.attempts.size() &&
+             (point_.marker >= 0 || !tuning_.looks.attempts[look_attempt_ + 1].between)) {
+    request_look(look_attempt_ + 1);
+  } else if (r->state() == msg::PLAN_FAILED) {
+    log_line("drill: " + point_.label + ": the camera cannot be turned onto " +
+             (point_.marker >= 0 ? "marker " + std::to_string(point_.marker) : "the blob") +
+             " from here (" + r->reason() + "); the hole is measured from its posture");
+    start_reanchor(Motion::kReanchor);
+  }
+}
+
+void DrillNode::look_reanchor_step() {
+  const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, tuning_.camera.reanchor_frames);
+  if (!view) return;
+  const CameraView camera{&view->frame, view->world_T_optical};
+  if (point_.marker < 0) {
+    if (remeasure_looked_blob(camera)) return;
+  } else if (!remeasure_looked_marker(camera)) {
+    const std::optional<Sample> s = latest_sample();
+    if (look_attempt_ + 1 < tuning_.looks.attempts.size() && look_pushed_ && hole_chain_.size() > 1 && s) {
+      // From another look (a hole drilled where odometry puts it can be 2 cm off).
+      log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
+               " not seen from the look posture; back onto the drilling posture for the next look");
+      back_to_posture(*s, Motion::kBackForLook);
+      return;
+    }
+    log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
+             " not seen from the look posture; the hole is drilled where odometry puts it");
+  } else {
+    // The base moved for this posture: without one for the arm alone at the hole measured
+    // again, the whole body's is planned again (and the marker looked at again) or aligned
+    // from, not the next whole-body attempt taken without a look (a row hole then lands
+    // about 13 mm off).
+    if (!hole_request_.fixed_base()) hole_replanned_ = true;
+  }
+  // From the look back onto the drilling posture along the look's path reversed, not along a
+  // path planned anew from the look posture: such a path can swing morphology A's J1_E through
+  // 3.9 rad with the bit near the wall and press it on the wall (300 N m, a safety stop). A
+  // posture of the arm alone planned within hole.replan_shift of
+  // the hole as measured now is aligned from (the alignment covers the rest); otherwise the
+  // posture is planned again from there.
+  const std::optional<Sample> s = latest_sample();
+  if (look_pushed_ && hole_chain_.size() > 1 && s && !hole_request_.goals().empty()) {
+    const double moved =
+        (point_.frame.translation() - model::dds::to_isometry(hole_request_.goals().front()).translation()).norm();
+    const bool keep = hole_request_.fixed_base() && moved <= tuning_.hole.replan_shift;
+    back_to_posture(*s, keep ? Motion::kBackToPosture : Motion::kBackThenReplan);
+    return;
+  }
+  replan_after_look();
+}
+
+void DrillNode::back_then_replan_step() {
+  if (trajectory_ran("back onto the drilling posture")) replan_after_look();
+}
+
+void DrillNode::reanchor_step() {
+  const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, tuning_.camera.reanchor_frames);
+  if (!view) return;
+  static const PatternTable kNone;
+  const CameraView camera{&view->frame, view->world_T_optical};
+  DrillPoint predicted = point_;
+  double within = tuning_.blobs.reanchor_distance;
+  if (point_.marker < 0 && area_points_.size() > 1) {
+    // Several blobs: which one is this hole's is told by the pattern they make together.
+    const std::optional<AreaShift> shift =
+        blob_shift(camera, area_points_, tuning_.blobs.match, tuning_.blobs.reanchor_distance, tuning_.blobs.set_shift);
+    if (shift && shift->blobs < 2 && !hole_request_.fixed_base() && !looked_) {
+      // The base moved: one blob seen alone near its prediction may be the neighbour, odometry
+      // having drifted as far as the blobs lie apart.
+      log_line("drill: " + point_.label +
+               ": one blob of the area's seen from its drilling posture, not the set (" +
+               blobs_seen(camera, point_.frame) + "); the camera is turned onto the area");
+      look_at_hole();
+      return;
+    }
+    if (shift) {
+      predicted.frame.translation() += shift->by;
+      within = tuning_.blobs.match;
+    } else if (!hole_request_.fixed_base() && !looked_) {
+      // The base moved and the camera, beside the bit, cannot tell the blob from a neighbour.
+      log_line("drill: " + point_.label +
+               ": its blob is not told from a neighbour from its drilling posture (" +
+               blobs_seen(camera, point_.frame) + "); the camera is turned onto it");
+      look_at_hole();
+      return;
+    } else if (!hole_request_.fixed_base()) {
+      within = tuning_.blobs.match;  // no neighbour is taken for it: the prediction stands
+    }
+  }
+  const std::optional<Eigen::Isometry3d> seen =
+      reanchor(camera, predicted, patterns_ ? *patterns_ : kNone, within);
+  if (seen) {
+    std::ostringstream line;
+    line.setf(std::ios::fixed);
+    line.precision(1);
+    line << "drill: " << point_.label << " measured again from its drilling posture: "
+         << (seen->translation() - point_.frame.translation()).norm() * 1e3 << " mm, "
+         << std::acos(
+                std::clamp(seen->linear().col(2).dot(point_.frame.linear().col(2)), -1.0, 1.0)) *
+                180.0 / M_PI
+         << " deg from the prediction";
+    const Eigen::Vector3d along = point_.frame.inverse() * seen->translation();
+    line << " (" << along.x() * 1e3 << ", " << along.y() * 1e3 << " mm on the wall, "
+         << along.z() * 1e3 << " mm out of it)";
+    if (point_.marker < 0) line << " (" << blobs_seen(camera, point_.frame) << ")";
+    log_line(line.str());
+    const Eigen::Vector3d moved = seen->translation() - point_.frame.translation();
+    hole_seen_again(seen->translation());
+    if (point_.marker < 0) shift_area(moved);  // the area's other blobs moved as much
+    point_.frame = *seen;
+    if (!hole_request_.fixed_base() && !hole_replanned_ && moved.norm() > tuning_.hole.replan_shift) {
+      // The base moved and odometry drifted: the posture again, the arm alone, for the hole
+      // where the camera sees it now.
+      hole_replanned_ = true;
+      replan_hole(tuning_.hole.attempts[hole_attempt_].reach, 0.0, tuning_.hole.attempts[hole_attempt_].lead);
+      return;
+    }
+  }
+  if (const std::optional<Sample> s = latest_sample()) start_align(*s);
+}
+
+void DrillNode::back_for_look_step() {
+  if (trajectory_ran("back onto the drilling posture")) request_look(look_attempt_ + 1);
+}
+
+void DrillNode::settle_step() {
+  // Back onto a planned posture: after a retract (then the hole is done), or from the look
+  // posture (then the alignment starts).
+  if (!trajectory_ran("back onto the drilling posture")) return;
+  if (motion_ == Motion::kSettle) {
+    motion_outcome_ = Outcome::succeeded();
+    motion_ = Motion::kNone;
+  } else if (const std::optional<Sample> here = latest_sample()) {
+    start_align(*here);
   }
 }
 

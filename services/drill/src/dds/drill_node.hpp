@@ -33,6 +33,8 @@
 #include "drill/patterns.hpp"
 #include "drill/perception.hpp"
 #include "drill/placement.hpp"
+#include "drill/params.hpp"
+#include "drill/paths.hpp"
 #include "drill/ports.hpp"
 
 namespace concert::drill::dds {
@@ -41,13 +43,10 @@ namespace concert::drill::dds {
 struct NodeParams {
   std::string patterns;         ///< default hole-pattern table (a mission may name its own)
   double rate{50.0};            ///< control rate [Hz]
-  double camera_distance{0.6};  ///< [m] the planner's working distance (area radius from it)
-  double camera_fov{55.0 * M_PI / 180.0};  ///< [rad] smaller field of view of the drill camera
-  int averaged_frames{5};                  ///< depth frames averaged for locating and detecting
   /// Where each camera view in which a looked-for mark was not found is written (PNG, the mark's
   /// expected pixel crossed); empty: nowhere.
   std::string unseen_frames_dir;
-  DrillParams motion;
+  Params tuning;  ///< config/drill.yaml (drill/params.hpp)
 };
 
 /// The mission's status message from a tree.
@@ -96,29 +95,7 @@ class DrillNode final : public MissionPorts {
   void stop() override;
 
   /// A joint state with its odometry, as received (robot clock).
-  struct Sample {
-    std::int64_t stamp_ns{0};
-    JointPositions joints;
-    Eigen::Vector3d odometry{0, 0, 0};
-  };
-  // The measured state of `names` (base joints from odometry) as a trajectory sample at t = 0,
-  // to go on to the planned sample `towards` (same names): its base_yaw within half a turn of
-  // that one's.
-  [[nodiscard]] static msg::TrajectorySample sample_here(const std::vector<std::string>& names,
-                                                         const Sample& s,
-                                                         const msg::TrajectorySample& towards);
-
-  // The base joints of every sample of `path` set to `here`'s: the base stays where it stands
-  // while the arm goes on. With `bound` > 0 only when `here`'s base is within `bound` [m, rad]
-  // of every sample's (a few mm of creep or tracking error, not a move); true when the base
-  // was kept.
-  static bool keep_base(const std::vector<std::string>& names, const msg::TrajectorySample& here,
-                        std::vector<msg::TrajectorySample>& path, double bound = 0.0);
-
-  // Time to go straight from `from` to `to` at a third of a slow joint speed (at least 1 s).
-  [[nodiscard]] static double settle_time(const std::vector<std::string>& names,
-                                          const msg::TrajectorySample& from,
-                                          const msg::TrajectorySample& to);
+  using Sample = JointSample;
 
  private:
   struct Inbox {
@@ -169,34 +146,31 @@ class DrillNode final : public MissionPorts {
 
   // An area's base placement (place(), drill/placement.hpp): its holes, the tally, the
   // requests out, the postures drawn and each one's look.
-  struct PlannedPath {
-    std::vector<std::string> names;
-    std::vector<msg::TrajectorySample> samples;
-  };
+  using PlannedPath = Path;
   struct Placement {
     std::vector<DrillPoint> holes;
     double started{0.0};  // now_ [s]
     std::optional<PlacementChoice> choice;
     // The arm alone onto each hole (planned only): the request out and which of
-    // kHoleAttempts' first three (0, 3 and 7 cm further out) it asks.
+    // Params::hole.attempts' first three (0, 3 and 7 cm further out) it asks.
     struct Check {
       std::uint32_t id{0};
       std::size_t attempt{0};
       msg::PlanRequest request;
     };
     std::vector<Check> hole_checks;
-    Check look_check;  // the camera onto the mark (id 0: none asked), attempt of kPlacementLooks
+    Check look_check;  // the camera onto the mark (id 0: none asked), attempt of Params::placement.look_further
     std::uint32_t draw{0};                   // the whole body's posture drawn
     std::vector<std::vector<std::string>> names;                 // per draw
-    std::vector<std::vector<msg::TrajectorySample>> bodies;      // per draw (empty: none found)
-    std::vector<std::vector<msg::TrajectorySample>> looks;       // per draw (empty: no look)
+    std::vector<std::vector<PathSample>> bodies;      // per draw (empty: none found)
+    std::vector<std::vector<PathSample>> looks;       // per draw (empty: no look)
     std::vector<double> look_distances;  // per draw: the camera's distance of its look [m]
     std::vector<bool> standing_reached;  // per hole: the arm alone reaches it from where the base stands
     std::vector<std::vector<bool>> reached;  // per draw, per hole: from the posture drawn
     std::vector<std::size_t> order;      // the holes' order to drill (reached first)
     std::vector<bool> placed;            // per hole: reached by the arm alone where the base ends
-    double lead{1.0};                    // the thrust checked: a lead of kHoleAttempts'
-    std::size_t looks_again{0};          // of kPlacementLooks: the look from where the base stands
+    double lead{1.0};                    // the thrust checked: a lead of Params::hole.attempts'
+    std::size_t looks_again{0};          // of Params::placement.look_further: the look from where the base stands
     double look_distance{0.0};           // its camera distance [m]
     std::uint32_t look_again{0};         // its request
     PlannedPath again_path;
@@ -205,6 +179,15 @@ class DrillNode final : public MissionPorts {
   void place_check(bool drawn);
   void place_next();
   void control_placement();
+  // control_placement's steps, one per placement state.
+  void place_check_step();
+  void place_draw_step();
+  void place_move_step();
+  void place_look_step();
+  void place_look_again_step();
+  void place_see_step();
+  [[nodiscard]] std::optional<msg::PlanResult> answered(std::uint32_t id) const;
+  [[nodiscard]] std::size_t chosen_draw() const;
   void resend(Placement::Check& c);
   void place_look(std::size_t attempt);
   [[nodiscard]] std::string placement_time() const;
@@ -214,10 +197,24 @@ class DrillNode final : public MissionPorts {
   void start_mission(const msg::DrillMission& m);
   void publish_status(bool force);
   void control_motion();
+  // control_motion's steps, one per Motion state, and the Cartesian phases.
+  void hole_posture_step();
+  void no_posture_after_remeasure(const msg::PlanResult& r);
+  void next_hole_attempt(const msg::PlanResult& r);
+  void check_look_step();
+  void body_to_hole_step();
+  void checked_look_step();
+  void look_at_hole_step();
+  void look_reanchor_step();
+  void back_then_replan_step();
+  void reanchor_step();
+  void back_for_look_step();
+  void settle_step();
+  void cartesian_step();
   void send_cartesian(const CartesianReference& r);
   void send_hold();
   void start_align(const Sample& s);
-  /// The mission's hole depth [m] (kDefaultDepth before a mission).
+  /// The mission's hole depth [m] (Params::hole.default_depth before a mission).
   [[nodiscard]] double hole_depth() const;
   void start_reanchor(Motion next);
   void look_at_hole(std::size_t first = 0);
@@ -250,27 +247,25 @@ class DrillNode final : public MissionPorts {
   int unseen_views_{0};
   /// From the look posture back onto the whole body's posture, then the alignment.
   void back_to_posture(const Sample& s, Motion next = Motion::kBackToPosture);
-  // Straight from `here` onto `p`'s last posture, at rest there (settle_time); the base kept
-  // where it stands when within kBaseKept of the posture's (keep_base), said in the log.
-  std::vector<msg::TrajectorySample> settle_path(const PlannedPath& p,
-                                                 const msg::TrajectorySample& here);
+  // Straight from `here` onto `p`'s last posture, at rest there (drill::settle_path); the base
+  // kept where it stands when within Params::paths.base_kept of the posture's, said in the log.
+  std::vector<PathSample> settle_path(const PlannedPath& p, const PathSample& here);
   void request_look(std::size_t attempt);
-  [[nodiscard]] std::vector<msg::TrajectorySample> return_path(const Sample& s) const;
-  static void append_reversed(std::vector<msg::TrajectorySample>& back, const PlannedPath& path, double& t);
-  std::uint32_t send_trajectory(const std::vector<std::string>& names,
-                                const std::vector<msg::TrajectorySample>& samples);
+  std::uint32_t send_trajectory(const std::vector<std::string>& names, const std::vector<PathSample>& samples);
   [[nodiscard]] std::optional<Sample> latest_sample() const;
-  [[nodiscard]] std::optional<Sample> sample_at(std::int64_t stamp_ns) const;
   /// Frames of the drill camera since `since` (robot clock), newest last.
   [[nodiscard]] std::vector<CameraFrame> frames_since(std::int64_t since_ns) const;
   /// The latest `count` frames averaged (depth), with the newest's pose; none if fewer.
   [[nodiscard]] std::optional<CameraFrame> averaged_view(std::int64_t since_ns, int count) const;
+  void on_joints(const msg::JointState& state);
+  void on_service(const msg::ServiceStatus& status);
   void on_image(const msg::Image& image, bool depth);
   void on_info(const msg::CameraInfo& info);
   void assemble_frame();  // with mutex_ held
   void log_line(const std::string& line);
 
   NodeParams params_;
+  const Params& tuning_ = params_.tuning;
   std::ostream& log_;
   std::mutex log_mutex_;
   mutable std::mutex mutex_;  // inbox and the sensor buffers below
@@ -362,7 +357,7 @@ class DrillNode final : public MissionPorts {
   msg::PlanRequest hole_request_;
   double hole_distance_{0.0};  // the bit tip's distance from the wall a hole's posture asks for [m]
   double camera_to_tip_{0.0};  // the tool's camera to its tip along the camera's axis [m]
-  std::size_t hole_attempt_{0};  // which of kHoleAttempts the hole's posture request is
+  std::size_t hole_attempt_{0};  // which of Params::hole.attempts the hole's posture request is
   double drilling_lead_{1.0};    // the lead the hole's posture holds the thrust of (light_drilling)
   std::string light_why_;        // why the hole is drilled at drilling_lead_ < 1 (the log)
   std::int64_t reanchor_since_ns_{0};
@@ -376,28 +371,28 @@ class DrillNode final : public MissionPorts {
   int tracked_frames_{0};            // frames track_area() moved the area by, this hole
   Eigen::Vector3d tracked_{Eigen::Vector3d::Zero()};  // how far it moved the area, this hole [m]
   bool hole_replanned_{false};     // the hole's posture was planned again after its re-measure
-  // The whole body's posture the hole was reached with: which of kHoleAttempts, the hole it was
+  // The whole body's posture the hole was reached with: which of Params::hole.attempts, the hole it was
   // planned for (world), and whether it was planned once more at the hole measured again.
   std::size_t body_attempt_{0};
   Eigen::Vector3d body_goal_{Eigen::Vector3d::Zero()};
   std::size_t body_replans_{0};
-  std::size_t look_attempt_{0};    // which of kLooks the look request is
+  std::size_t look_attempt_{0};    // which of Params::looks.attempts the look request is
   // A marker hole's whole-body posture is planned without executing it, and a look at the marker
   // planned from its end (check_look) before the base moves: without a look there the hole is
   // drilled where odometry puts it. The candidate path, the draws of it so far, the check's
-  // request and which of kLooks it is.
+  // request and which of Params::looks.attempts it is.
   PlannedPath body_candidate_;
   std::size_t body_draws_{0};
   std::uint32_t check_request_{0};
   std::size_t check_attempt_{0};
-  std::size_t checked_look_{0};  // the kLooks attempt the check found (the look starts there)
+  std::size_t checked_look_{0};  // the Params::looks.attempts attempt the check found (the look starts there)
   PlannedPath checked_path_;     // its path from the candidate's end; empty: none found
   bool trajectory_ran(const std::string& what);
   std::optional<msg::PlanResult> plan_result(std::uint32_t id) const;
   void move_to_candidate();
   Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the mark as predicted (world)
   double look_reach_{0.0};  // how far from look_goal_ the look must see, any roll [m]; 0: the mark
-                            // (a marker: its half-diagonal and kMarkerLookDrift)
+                            // (a marker: its half-diagonal and Params::looks.marker_drift)
   double hole_reached_{0.0};  // camera distance of the hole's posture reached [m]
   std::map<int, Eigen::Isometry3d>
       markers_seen_;                     // marker id -> where last seen (world), this area
