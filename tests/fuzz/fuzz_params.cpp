@@ -1,7 +1,7 @@
 // Parameter files (libs/config: every service's --params YAML), through the safety service's
 // reader and through a reader that asks for a key with every kind of getter the library has
 // (numbers and ranges, `auto`, integers, booleans, strings, choices, durations, lists, maps,
-// nested sections), then finish() and the defaults report. Documented failure: ConfigError.
+// nested sections, lists of records), then finish() and the defaults report. Documented failure: ConfigError.
 //
 // Seeds: every parameter file the services ship (services/*/config/*.yaml) and one file that
 // sets every key of the all-getters reader.
@@ -19,6 +19,12 @@
 namespace {
 
 using namespace concert;
+
+/// A record of a list (Map::sequence), as a table of search attempts is.
+struct Row {
+  double a = 0.0;
+  bool b = false;
+};
 
 /// One key per getter of config::Map.
 struct AllKinds {
@@ -40,6 +46,8 @@ struct AllKinds {
   std::map<std::string, std::string> labels;
   double inner = 0.0;
   int64_t deep = 0;
+  std::vector<Row> rows{{1.0, true}, {2.0, false}};
+  double item_total = 0.0;
 };
 
 AllKinds read_all_kinds(config::Document& doc) {
@@ -64,6 +72,15 @@ AllKinds read_all_kinds(config::Document& doc) {
   config::Map section = root.section("section");
   section.number("inner", p.inner);
   section.section("deeper").integer("deep", p.deep, -5, 5);
+  root.sequence("rows", p.rows, [](config::Map& m, Row& r) {
+    m.number("a", r.a, config::Range::non_negative());
+    m.boolean("b", r.b);
+  });
+  for (config::Map& item : root.sequence("items")) {
+    double v = 0.0;
+    item.number("v", v);
+    p.item_total += v;
+  }
   (void)root.has("flag");
   doc.finish();
   return p;
@@ -90,6 +107,11 @@ labels: {a: x, b: y}
 section:
   inner: 7
   deeper: {deep: -5}
+rows:
+  - {a: 3, b: no}
+  - {a: 0.5}
+  - {b: yes}
+items: [{v: 1}, {v: 2.5}]
 )";
 
 template <class Read>
