@@ -117,7 +117,8 @@ TEST_F(SafetyNodeTest, EStopLatchesUntilReleasedAndReset) {
       states_,
       [](const auto& s) {
         return s.mode() == msg::SAFETY_STOPPED && s.reset_required() && s.causes().size() == 1 &&
-               s.causes()[0] == "estop: wireless engaged (test)";
+               s.causes()[0] == "estop: wireless engaged (test)" && s.engaged_inputs().size() == 1 &&
+               s.engaged_inputs()[0] == msg::ESTOP_WIRELESS;
       },
       10s));
 
@@ -138,6 +139,10 @@ TEST_F(SafetyNodeTest, EStopLatchesUntilReleasedAndReset) {
   // Once the node has taken the release, the stop must still be latched (no reset yet).
   ASSERT_TRUE(eventually([&] { return node_->engaged_inputs().empty(); }, 10s)) << log_.str();
   EXPECT_EQ(node_->status().mode, Mode::kStopped);
+  // The release alone goes out as a new state: still stopped, nothing engaged.
+  EXPECT_TRUE(wait_state(
+      states_,
+      [](const auto& s) { return s.mode() == msg::SAFETY_STOPPED && s.engaged_inputs().empty(); }, 10s));
   EXPECT_TRUE(node_->status().reset_required);
   // The release and the reset travel on different topics: on a loaded machine the reset can
   // be handled before the release. Like an operator, reset again (bounded) until accepted.

@@ -63,6 +63,28 @@ TEST(SafetyMonitor, StopIsLatchedAfterRelease) {
   EXPECT_TRUE(m.engaged_inputs().empty());
 }
 
+// The state says which inputs are engaged (a display shows those, not the inputs' own samples),
+// and a release alone is a new state to publish.
+TEST(SafetyMonitor, StatusNamesTheEngagedInputsAndAReleaseIsANewRevision) {
+  SafetyMonitor m(Params{}, kT0);
+  EXPECT_TRUE(m.status().engaged.empty());
+  m.set_estop(EStopSource::kSoftware, true, "gui");
+  m.set_estop(EStopSource::kWireless, true, "");
+  EXPECT_EQ(m.status().engaged, (std::vector<EStopSource>{EStopSource::kWireless, EStopSource::kSoftware}));
+  const auto before = m.revision();
+  m.set_estop(EStopSource::kSoftware, false, "tool");
+  EXPECT_GT(m.revision(), before);
+  EXPECT_EQ(m.status().engaged, std::vector<EStopSource>{EStopSource::kWireless});
+  EXPECT_EQ(m.status().mode, Mode::kStopped);
+  const auto released = m.revision();
+  m.set_estop(EStopSource::kSoftware, false, "tool");  // re-sent: nothing new
+  EXPECT_EQ(m.revision(), released);
+
+  SafetyMonitor restarted(Params{}, kT0);
+  restarted.restore(m.latched(), kT0);
+  EXPECT_EQ(restarted.status().engaged, std::vector<EStopSource>{EStopSource::kWireless});
+}
+
 TEST(SafetyMonitor, ResetRefusedWhileAnyInputEngaged) {
   SafetyMonitor m(Params{}, kT0);
   m.set_estop(EStopSource::kButtonFrontLeft, true, "");

@@ -33,6 +33,12 @@ export function safetyStale() {
 }
 
 const sourceName = (s) => s.replace('ESTOP_', '').toLowerCase();
+/// The e-stop sources the safety state holds engaged (a gateway older than that field: the
+/// inputs' newest samples).
+function heldEngaged() {
+  if (safety && Array.isArray(safety.engaged_inputs)) return safety.engaged_inputs;
+  return [...estops.values()].filter((i) => i.engaged).map((i) => i.source);
+}
 function setHtml(el, html) { if (el.innerHTML !== html) el.innerHTML = html; }
 function setText(el, text) { if (el.textContent !== text) el.textContent = text; }
 function setClass(el, cls) { if (el.className !== cls) el.className = cls; }
@@ -67,12 +73,18 @@ function renderSafety() {
   setText($('safety-why'), fresh ? '' : `(${why})`);
   setHtml($('safety-causes'), !fresh ? '' : safety.causes.map((c) => `<li class="fault">${esc(c)}</li>`).join('') +
     (safety.reset_required ? '<li>latched: release every input, then reset</li>' : ''));
-  // Every input with its newest sample; "unknown" when the safety state is.
-  setHtml($('estop-inputs'), [...estops.values()].map((i) => {
-    const state = !fresh ? 'unknown' : i.engaged ? 'ENGAGED' : 'released';
-    const c = !fresh ? 'unknown' : i.engaged ? 'fault' : '';
-    return `<li data-source="${sourceName(i.source)}" class="${c}">${esc(sourceName(i.source).replace(/_/g, ' '))}: ` +
-      `<b class="input-state">${state}</b> <span class="small">${esc(i.reason)}</span></li>`;
+  // Every input heard or held engaged, engaged as the safety service says (its state is the
+  // authority: an input's own release may never reach this gateway), with the newest sample's
+  // reason; "unknown" when the safety state is.
+  const held = fresh ? heldEngaged() : [];
+  const sources = [...new Set([...estops.keys(), ...held])].sort();
+  setHtml($('estop-inputs'), sources.map((source) => {
+    const on = held.includes(source);
+    const state = !fresh ? 'unknown' : on ? 'ENGAGED' : 'released';
+    const c = !fresh ? 'unknown' : on ? 'fault' : '';
+    const i = estops.get(source);
+    return `<li data-source="${sourceName(source)}" class="${c}">${esc(sourceName(source).replace(/_/g, ' '))}: ` +
+      `<b class="input-state">${state}</b> <span class="small">${esc(i && i.engaged === on ? i.reason : '')}</span></li>`;
   }).join('') || '<li class="small">no e-stop input heard yet</li>');
   renderEstop(fresh);
   renderBanner(fresh, stopped);
@@ -80,8 +92,7 @@ function renderSafety() {
 
 function renderEstop(fresh) {
   const b = $('estop');
-  const sw = estops.get('ESTOP_SOFTWARE');
-  const engaged = fresh && !!sw && sw.engaged;
+  const engaged = fresh && heldEngaged().includes('ESTOP_SOFTWARE');
   const state = !fresh ? 'unknown' : engaged ? 'true' : 'false';
   if (b.dataset.engaged !== state) b.dataset.engaged = state;
   b.classList.toggle('engaged', engaged);
@@ -113,7 +124,7 @@ function renderBanner(fresh, stopped) {
   b.classList.toggle('min', bannerMin);
   setHtml($('stopped-causes'), safety.causes.map((c) => `<li>${esc(c)}</li>`).join(''));
   setText($('stopped-summary'), safety.causes.join('; '));
-  const engaged = [...estops.values()].filter((i) => i.engaged).map((i) => sourceName(i.source).replace(/_/g, ' '));
+  const engaged = heldEngaged().map((source) => sourceName(source).replace(/_/g, ' '));
   setText($('stopped-engaged'), engaged.length ? `Still engaged: ${engaged.join(', ')}.` : 'Every e-stop input is released.');
   const block = commandBlock('concert/safety/reset');
   $('reset-wrap').hidden = !!block;

@@ -52,12 +52,30 @@ function estopLayout() {
   };
 }
 
+/// What the safety display shows now, for a failure message.
+function safetyShown() {
+  const text = (sel) => { const e = document.querySelector(sel); return e ? e.textContent.replace(/\s+/g, ' ').trim() : '(none)'; };
+  return `badge "${text('#safety-badge')}" (${document.querySelector('#safety-badge').title || 'fresh'}), ` +
+    `link "${text('#link')}", E-STOP engaged=${document.querySelector('[data-testid=estop]').dataset.engaged}, ` +
+    `inputs "${text('#estop-inputs')}"`;
+}
+
+/// Waits until `fn(arg)` holds in `page`; when it does not, the error says what the safety
+/// display showed instead.
+async function until(page, what, fn, arg) {
+  try {
+    await page.waitForFunction(fn, arg);
+  } catch (e) {
+    throw new Error(`${what}: not seen (${e.message.split('\n')[0]}); the page shows ${await page.evaluate(safetyShown)}`);
+  }
+}
+
 await runChecks('safety_display_test', async (openPage) => {
   const open = async (w, h) => {
     const page = await openPage(w, h);
     await page.goto(url, { waitUntil: 'domcontentloaded' });
     await page.waitForFunction(() => document.querySelector('[data-testid=model-version]').textContent === 'version 1');
-    await page.waitForFunction(() => document.querySelector('#safety-badge').textContent === 'safety: RUNNING');
+    await until(page, 'safety RUNNING on a new page', () => document.querySelector('#safety-badge').textContent === 'safety: RUNNING');
     return page;
   };
   const tab = async (page, name) => {
@@ -90,9 +108,9 @@ await runChecks('safety_display_test', async (openPage) => {
   step('e-stop from the page');
   await page.click('[data-testid=estop]');
   step(await safetyOnDds('STOPPED'));
-  await page.waitForFunction(() => document.querySelector('#safety-badge').textContent === 'safety: STOPPED');
+  await until(page, 'safety STOPPED', () => document.querySelector('#safety-badge').textContent === 'safety: STOPPED');
   await page.waitForSelector('[data-testid=stopped-banner]', { state: 'visible' });
-  await page.waitForFunction(() => document.querySelector('[data-testid=estop]').dataset.engaged === 'true');
+  await until(page, 'the E-STOP engaged', () => document.querySelector('[data-testid=estop]').dataset.engaged === 'true');
   step(`banner: ${(await page.textContent('[data-testid=stopped-banner]')).replace(/\s+/g, ' ').trim().slice(0, 160)}`);
   await page.screenshot({ path: join(shots, 'stopped_banner_1280x800.png') });
 
@@ -101,8 +119,8 @@ await runChecks('safety_display_test', async (openPage) => {
   run(['safety', 'estop', '--release', '--reason', 'released by the test']);
   run(['safety', 'reset', '--timeout', '10']);
   step(await safetyOnDds('RUNNING'));
-  await page.waitForFunction(() => document.querySelector('#safety-badge').textContent === 'safety: RUNNING');
-  await page.waitForFunction(() => document.querySelector('[data-testid=estop]').dataset.engaged !== 'true');
+  await until(page, 'safety RUNNING after the reset', () => document.querySelector('#safety-badge').textContent === 'safety: RUNNING');
+  await until(page, 'the E-STOP released after the reset', () => document.querySelector('[data-testid=estop]').dataset.engaged === 'false');
   const late = await open(1280, 800);
   await tab(late, 'safety');
   await late.waitForSelector('#estop-inputs li[data-source=software]');
@@ -124,7 +142,7 @@ await runChecks('safety_display_test', async (openPage) => {
   } finally {
     process.kill(gatewayPid, 'SIGCONT');
   }
-  await page.waitForFunction(() => document.querySelector('#safety-badge').textContent === 'safety: RUNNING');
+  await until(page, 'safety RUNNING once the gateway runs again', () => document.querySelector('#safety-badge').textContent === 'safety: RUNNING');
   step('gateway running again: safety RUNNING');
 
   // ---- a refused mission shows the refusal

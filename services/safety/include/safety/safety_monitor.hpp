@@ -47,6 +47,8 @@ struct SafetyStatus {
   bool reset_required = false;
   /// Why the robot is stopped, oldest first; e.g. "estop: wireless engaged (operator)".
   std::vector<std::string> causes;
+  /// The e-stop inputs engaged now, in EStopSource order.
+  std::vector<EStopSource> engaged;
 };
 
 struct ResetOutcome {
@@ -138,6 +140,7 @@ class SafetyMonitor {
   };
 
   bool is_watched(const std::string& service) const;
+  std::vector<EStopSource> engaged_sources() const;
   /// Adds a cause (once per key) and stops.
   void stop(const std::string& key, const std::string& text);
   void check_joint(std::size_t row, std::size_t i, const JointSample& sample, double dt);

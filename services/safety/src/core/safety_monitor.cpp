@@ -64,8 +64,12 @@ void SafetyMonitor::set_estop(EStopSource source, bool engaged, const std::strin
   const auto i = static_cast<std::size_t>(source);
   if (i >= kEStopSourceCount)
     throw std::invalid_argument("unknown e-stop source " + std::to_string(i));
-  if (engaged_[i] != engaged) ++latched_revision_;
-  engaged_[i] = engaged;
+  if (engaged_[i] != engaged) {
+    engaged_[i] = engaged;
+    status_.engaged = engaged_sources();
+    ++revision_;
+    ++latched_revision_;
+  }
   if (engaged) {
     std::string text = "estop: " + std::string(to_string(source)) + " engaged";
     if (!reason.empty()) text += " (" + reason + ")";
@@ -295,6 +299,7 @@ void SafetyMonitor::restore(const LatchedState& state, TimePoint now) {
   cause_keys_ = state.cause_keys;
   engaged_.fill(false);
   for (const auto e : state.engaged) engaged_.at(static_cast<std::size_t>(e)) = true;
+  status_.engaged = engaged_sources();
   instances_.clear();
   for (const auto& [who, incarnation] : state.watched) {
     const std::string service = who.substr(0, who.find('@'));
@@ -307,6 +312,14 @@ void SafetyMonitor::restore(const LatchedState& state, TimePoint now) {
   restored_at_ = now;
   ++revision_;
   ++latched_revision_;
+}
+
+std::vector<EStopSource> SafetyMonitor::engaged_sources() const {
+  std::vector<EStopSource> out;
+  for (std::size_t i = 0; i < kEStopSourceCount; ++i) {
+    if (engaged_[i]) out.push_back(static_cast<EStopSource>(i));
+  }
+  return out;
 }
 
 std::vector<std::string> SafetyMonitor::engaged_inputs() const {

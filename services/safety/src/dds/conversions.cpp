@@ -38,6 +38,7 @@ msg::SafetyState to_msg(const SafetyStatus& status, int64_t stamp_ns) {
   out.reset_required(status.reset_required);
   out.stamp_ns(stamp_ns);
   out.causes(status.causes);
+  for (const EStopSource e : status.engaged) out.engaged_inputs().push_back(to_msg(e));
   return out;
 }
 

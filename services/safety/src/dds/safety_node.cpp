@@ -19,6 +19,9 @@ std::string summary(const SafetyStatus& status) {
   std::string text = "STOPPED";
   for (std::size_t i = 0; i < status.causes.size(); ++i)
     text += (i == 0 ? ": " : "; ") + status.causes[i];
+  std::string engaged;
+  for (const EStopSource e : status.engaged) engaged += (engaged.empty() ? "" : ", ") + std::string(to_string(e));
+  text += engaged.empty() ? " (every e-stop input released)" : " (engaged: " + engaged + ")";
   return text;
 }
 
