@@ -59,13 +59,15 @@ inline void expect_safety_and_report(const MissionRun& run, std::ostringstream& 
   summary << "safety: " << (run.safety_running ? "RUNNING" : "not RUNNING") << "\n";
   EXPECT_TRUE(run.safety_running);
   std::cout << odometry_drift(run.track);
-  // A safety stop on a joint's torque: what that joint carried before it.
+  // A safety stop on a joint's torque or position: what that joint carried, and where it was,
+  // before it.
   std::string trace;
   if (const auto at = run.logs.find("STOPPED: limits: joint "); at != std::string::npos) {
     const std::size_t from = at + std::string("STOPPED: limits: joint ").size();
     const std::string joint = run.logs.substr(from, run.logs.find(' ', from) - from);
     if (run.logs.compare(from + joint.size(), 11, " RMS effort") == 0 ||
-        run.logs.compare(from + joint.size(), 7, " effort") == 0)
+        run.logs.compare(from + joint.size(), 7, " effort") == 0 ||
+        run.logs.compare(from + joint.size(), 9, " position") == 0)
       trace = torque_trace(run, joint);
   }
   std::cout << trace;

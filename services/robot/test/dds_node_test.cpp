@@ -405,7 +405,7 @@ TEST(RobotParamsYaml, ShippedConfigListsEveryParameterWithItsDefault) {
   auto doc =
       config::Document::load(std::string(CONCERT_SOURCE_DIR) + "/services/robot/config/robot.yaml");
   (void)dds::read_service_params(doc);
-  EXPECT_EQ(doc.keys().size(), 81u);
+  EXPECT_EQ(doc.keys().size(), 84u);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
 }

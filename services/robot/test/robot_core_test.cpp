@@ -124,6 +124,38 @@ TEST_F(RobotCoreTest, EffortCommandsSaturateAtTheTorqueLimit) {
   EXPECT_NEAR(s.effort[hw_index(s, "J4_B")], 40.0, 1e-6);
 }
 
+// A torque-level command pushing a joint outward (a Cartesian target it cannot reach does the
+// same): the position guard stops it short of its limit, where without the guard it passes the
+// limit by more than the safety service's 0.02 rad tolerance.
+TEST(RobotCore, ThePositionGuardStopsATorquePushShortOfTheLimit) {
+  const auto farthest = [](double margin) {
+    SimHardware sim(read_fixture("arm_drill.urdf"), World{}, [] {
+      SimParams p;
+      p.initial_positions = {{"J1_A", 2.85}};
+      return p;
+    }());
+    RobotParams params;
+    params.position_guard_margin = margin;
+    RobotCore core(sim, params);
+    core.set_model(read_fixture("arm_drill.urdf"), 1);
+    run_cycles(core, 100);
+    // J1_A: vertical axis (no gravity on it), limits +-2.9 rad, peak torque 150 N m.
+    core.command_joints({1, {{"J1_A", DriveMode::kEffort, 0, 0, 30.0, 0, 0}}});
+    double most = -1e9;
+    for (int k = 0; k < 3000; ++k) {
+      core.cycle();
+      const RobotState s = core.state();
+      most = std::max(most, s.position[hw_index(s, "J1_A")]);
+    }
+    return most;
+  };
+  const double guarded = farthest(0.03);
+  EXPECT_LT(guarded, 2.9) << "guarded";
+  EXPECT_GT(guarded, 2.9 - 0.03) << "the push reaches into the margin";
+  const double unguarded = farthest(0.0);
+  EXPECT_GT(unguarded, 2.9 + 0.02) << "without the guard the push passes the limit";
+}
+
 TEST_F(RobotCoreTest, GravityCompensationFloatsTheArm) {
   test::SimulatedArm arm({{"J2_A", 0.5}, {"J3_A", 0.6}}, 200);
   RobotCore& core = arm.core;

@@ -32,6 +32,11 @@ struct Params {
   double camera_distance = 0.6;      ///< d: camera frame to wall along the normal [m]
   double contact_force = 200.0;      ///< expected drilling force along the tool axis [N]
   double torque_margin = 1.0;        ///< allowed fraction of the continuous torque [-]
+  /// A goal posture (NSPG) keeps each arm joint this far inside its position limits [rad or m],
+  /// at most a tenth of the joint's range: the Cartesian phases that start there (a drill's
+  /// align and thrust, visual servoing) move the arm on, and a joint past its limit stops the
+  /// robot (the safety service's position rule). Paths and explicit joint goals use the limits.
+  double posture_limit_margin = 0.05;
 
   // World.
   double floor_height = 0.0;         ///< [m] world z of the floor

@@ -23,6 +23,7 @@ Params read_params(config::Document& doc) {
       {"camera_distance", &p.camera_distance},
       {"contact_force", &p.contact_force},
       {"torque_margin", &p.torque_margin},
+      {"posture_limit_margin", &p.posture_limit_margin},
       {"environment_padding", &p.environment_padding},
       {"start_tolerance", &p.start_tolerance},
       {"start_joint_tolerance", &p.start_joint_tolerance},

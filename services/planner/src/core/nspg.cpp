@@ -150,6 +150,13 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
   const Eigen::VectorXd start = model.to_planned(q_start_full);
   Eigen::VectorXd lo = model.lower();
   Eigen::VectorXd hi = model.upper();
+  // The arm joints' room for the Cartesian phases that start at the posture (posture_limit_margin).
+  for (int i = 3; i < n; ++i) {
+    if (!std::isfinite(lo[i]) || !std::isfinite(hi[i]) || hi[i] <= lo[i]) continue;
+    const double margin = std::min(params.posture_limit_margin, 0.1 * (hi[i] - lo[i]));
+    lo[i] += margin;
+    hi[i] -= margin;
+  }
   // The base may go anywhere within base_range of the start or of the camera target.
   lo.head<2>() = start.head<2>().cwiseMin(task.position.head<2>()).array() - params.base_range;
   hi.head<2>() = start.head<2>().cwiseMax(task.position.head<2>()).array() + params.base_range;

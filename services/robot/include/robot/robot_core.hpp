@@ -152,6 +152,15 @@ struct RobotParams {
   double wrench_filter_time_constant{0.02};  ///< low-pass of the wrench estimate [s]
   double base_command_timeout{0.5};      ///< base stops if no base command for this long [s]
   double velocity_guard_gain{20.0};      ///< damping added above the velocity limit [Nm s/rad]
+  /// Position guard of the torque-level modes (effort, impedance: Cartesian impedance, gravity
+  /// compensation): within this of a position limit [rad or m] (at most a tenth of the joint's
+  /// range) a spring pushes the joint back inside, reaching position_guard_torque x its peak
+  /// torque at the limit itself, and motion outward is damped; 0: off. A Cartesian target a
+  /// joint cannot reach stops the arm short of its limit instead of tripping the safety
+  /// service's position rule (its tolerance is 0.02 rad past the limit).
+  double position_guard_margin{0.03};
+  double position_guard_torque{0.5};     ///< the guard's torque at the limit [-] of the peak torque
+  double position_guard_damping{10.0};   ///< against motion outward within the margin [Nm s/rad]
   double trajectory_path_tolerance{0.3};  ///< joint tracking error that aborts a trajectory [rad] or [m]
   double trajectory_base_path_tolerance{0.5};  ///< base position error that aborts it [m]
   double trajectory_goal_tolerance{0.03};  ///< final joint error to succeed [rad] or [m]

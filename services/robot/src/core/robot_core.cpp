@@ -766,6 +766,25 @@ void estimate(RobotCore::Slot& s, const RobotParams& params, double dt) {
   s.wrench_initialized = true;
 }
 
+// The position guard's torque on joint i (RobotParams::position_guard_margin): a spring back
+// inside the margin, reaching position_guard_torque x the peak torque at the limit, and damping
+// of motion outward; 0 outside the margin, for joints without position limits or peak torque.
+double position_guard(const CycleData& c, int i, const RobotParams& params) {
+  const auto& lim = c.limits(i);
+  if (!lim.has_position_limits || lim.effort <= 0.0 || params.position_guard_margin <= 0.0 ||
+      lim.upper <= lim.lower)
+    return 0.0;
+  const double margin = std::min(params.position_guard_margin, 0.1 * (lim.upper - lim.lower));
+  const double stiffness = params.position_guard_torque * lim.effort / margin;
+  const double q = c.q(i);
+  const double qd = c.qd(i);
+  if (q < lim.lower + margin)
+    return stiffness * (lim.lower + margin - q) - (qd < 0.0 ? params.position_guard_damping * qd : 0.0);
+  if (q > lim.upper - margin)
+    return stiffness * (lim.upper - margin - q) - (qd > 0.0 ? params.position_guard_damping * qd : 0.0);
+  return 0.0;
+}
+
 // The controllers' drive references in hardware order, within the model's limits.
 void limit_drives(RobotCore::Loop& L, const RobotCore::Slot& s, const RobotParams& params) {
   const CycleData& c = s.cycle;
@@ -781,6 +800,7 @@ void limit_drives(RobotCore::Loop& L, const RobotCore::Slot& s, const RobotParam
         std::abs(c.qd(i)) > vmax) {
       d.effort -= params.velocity_guard_gain * (c.qd(i) - std::copysign(vmax, c.qd(i)));
     }
+    if (d.mode == DriveMode::kEffort || d.mode == DriveMode::kImpedance) d.effort += position_guard(c, i, params);
     if (lim.effort > 0.0) {
       d.effort = std::clamp(d.effort, -lim.effort, lim.effort);
     }

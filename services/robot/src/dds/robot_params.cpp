@@ -17,6 +17,9 @@ void read_robot(config::Map& root, RobotParams& robot_params) {
   robot.number("wrench_filter_time_constant", robot_params.wrench_filter_time_constant, kNonNegative);
   robot.number("base_command_timeout", robot_params.base_command_timeout, kPositive);
   robot.number("velocity_guard_gain", robot_params.velocity_guard_gain, kNonNegative);
+  robot.number("position_guard_margin", robot_params.position_guard_margin, kNonNegative);
+  robot.number("position_guard_torque", robot_params.position_guard_torque, kNonNegative);
+  robot.number("position_guard_damping", robot_params.position_guard_damping, kNonNegative);
   robot.number("trajectory_path_tolerance", robot_params.trajectory_path_tolerance, kPositive);
   robot.number("trajectory_base_path_tolerance", robot_params.trajectory_base_path_tolerance, kPositive);
   robot.number("trajectory_goal_tolerance", robot_params.trajectory_goal_tolerance, kPositive);
