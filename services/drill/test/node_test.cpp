@@ -67,42 +67,6 @@ TEST(DrillNode, AMissionWrittenAgainIsTakenOnce) {
 namespace concert::drill::dds {
 namespace {
 
-// An executed plan's trajectory comes once, with PLANNED; the execution's updates and SUCCEEDED
-// come without it. The service keeps it (it records the holes' postures from it).
-TEST(DrillNode, AnExecutedPlansTrajectoryOutlivesItsUpdates) {
-  msg::PlanResult planned;
-  planned.request_id(17);
-  planned.state(msg::PLAN_PLANNED);
-  planned.joint_names({"base_x", "J1_E"});
-  msg::TrajectorySample s;
-  s.position({0.1, 0.2});
-  planned.trajectory().push_back(s);
-  planned.trajectory().push_back(s);
-  msg::PlanResult kept;
-  keep_result(kept, planned);
-  msg::PlanResult update;
-  update.request_id(17);
-  update.state(msg::PLAN_EXECUTING);
-  keep_result(kept, update);
-  update.state(msg::PLAN_SUCCEEDED);
-  keep_result(kept, update);
-  EXPECT_EQ(kept.state(), msg::PLAN_SUCCEEDED);
-  ASSERT_EQ(kept.trajectory().size(), 2u);
-  EXPECT_EQ(kept.joint_names().size(), 2u);
-  // A result with a trajectory of its own replaces the kept one.
-  msg::PlanResult again = planned;
-  again.trajectory().pop_back();
-  keep_result(kept, again);
-  EXPECT_EQ(kept.trajectory().size(), 1u);
-  EXPECT_EQ(kept.state(), msg::PLAN_PLANNED);
-}
-
-}  // namespace
-}  // namespace concert::drill::dds
-
-namespace concert::drill::dds {
-namespace {
-
 // PlanRequest is volatile: a request written before the drill's writer matched the planner's
 // reader (a planner just restarted) is lost. The drill sends a plan request again, same id,
 // every 2 s until the planner acknowledges it (PLAN_PLANNING), and no more once it has.

@@ -1,6 +1,7 @@
 #include "dds/drill_node.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <iomanip>
@@ -11,6 +12,7 @@
 #include "concert/bim/storey_map.hpp"
 #include "concert/bim/wall_goal.hpp"
 #include "concert/common/clock.hpp"
+#include "concert/common/enum_map.hpp"
 #include "concert/model/dds/conversions.hpp"
 #include "concert/model/dds/pose.hpp"
 #include "concert/sensors_dds/conversions.hpp"
@@ -31,9 +33,9 @@ double checked_thrust(const Params& tuning, const DrillParams& p) {
 }
 
 // The lead a hole's posture request holds the thrust of (the attempt whose checked thrust it asks).
-double lead_checked(const Params& tuning, const msg::PlanRequest& r) {
+double lead_checked(const Params& tuning, const PlanAsk& r) {
   for (const HoleAttempt& a : tuning.hole.attempts) {
-    if (std::abs(checked_thrust(tuning, light_drilling(tuning.motion, a.lead)) - r.contact_force()) < 1e-6) return a.lead;
+    if (std::abs(checked_thrust(tuning, light_drilling(tuning.motion, a.lead)) - r.contact_force) < 1e-6) return a.lead;
   }
   return 1.0;
 }
@@ -69,136 +71,22 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-msg::DrillMissionState to_msg(MissionState s) {
-  switch (s) {
-    case MissionState::kIdle:
-      return msg::DRILL_IDLE;
-    case MissionState::kRunning:
-      return msg::DRILL_RUNNING;
-    case MissionState::kSucceeded:
-      return msg::DRILL_SUCCEEDED;
-    case MissionState::kFailed:
-      return msg::DRILL_FAILED;
-    case MissionState::kAborted:
-      return msg::DRILL_ABORTED;
-  }
-  return msg::DRILL_FAILED;
-}
-
-msg::DrillAreaState to_msg(AreaState s) {
-  switch (s) {
-    case AreaState::kPending:
-      return msg::AREA_PENDING;
-    case AreaState::kActive:
-      return msg::AREA_ACTIVE;
-    case AreaState::kDone:
-      return msg::AREA_DONE;
-    case AreaState::kFailed:
-      return msg::AREA_FAILED;
-    case AreaState::kSkipped:
-      return msg::AREA_SKIPPED;
-  }
-  return msg::AREA_FAILED;
-}
-
-msg::DrillHoleState to_msg(HoleState s) {
-  switch (s) {
-    case HoleState::kPending:
-      return msg::HOLE_PENDING;
-    case HoleState::kDrilled:
-      return msg::HOLE_DRILLED;
-    case HoleState::kFailed:
-      return msg::HOLE_FAILED;
-    case HoleState::kSkipped:
-      return msg::HOLE_SKIPPED;
-  }
-  return msg::HOLE_FAILED;
-}
-
-Eigen::Vector3d odometry_of(const msg::Odometry& o) { return {o.x(), o.y(), o.yaw()}; }
-
-// A planned trajectory's samples as the drill's paths hold them.
-std::vector<PathSample> samples_of(const msg::PlanResult& r) {
-  std::vector<PathSample> out;
-  out.reserve(r.trajectory().size());
-  for (const msg::TrajectorySample& t : r.trajectory()) out.push_back({t.time(), t.position(), t.velocity()});
-  return out;
-}
-
-Path path_of(const msg::PlanResult& r) { return {r.joint_names(), samples_of(r)}; }
-
 // A hole's posture request for attempt `a`: the bit's tip `further` beyond the hole's distance
 // in front of it, the planner also checking the arm's torques with the bit at the hole's depth;
 // or the camera on the hole's axis as far out.
 // (`hole_distance`: the bit's tip from the wall the posture asks for before `further`.)
-void set_hole_task(msg::PlanRequest& r, const HoleAttempt& a, double hole_distance,
+void set_hole_task(PlanAsk& r, const HoleAttempt& a, double hole_distance,
                    double depth, const Params& tuning) {
   const double tip = hole_distance + a.further;
-  r.contact_force(checked_thrust(tuning, light_drilling(tuning.motion, a.lead)));
-  r.tip_distance(tip);
-  r.tip_reach(a.reach ? tip + depth : 0.0);
-  r.camera_distance(0.0);
-  r.fixed_base(a.fixed_base);
-  r.base_travel(a.base_travel);
+  r.contact_force = checked_thrust(tuning, light_drilling(tuning.motion, a.lead));
+  r.tip_distance = tip;
+  r.tip_reach = a.reach ? tip + depth : 0.0;
+  r.camera_distance = 0.0;
+  r.fixed_base = a.fixed_base;
+  r.base_travel = a.base_travel;
 }
 
 }  // namespace
-
-void keep_result(msg::PlanResult& kept, const msg::PlanResult& incoming) {
-  // PLAN_PLANNING only ever opens a request's answers: one coming after a later state is a
-  // stale acknowledgement (a planner that wrote it after its answer), never news. Kept, it
-  // would leave the area waiting on a plan already made.
-  if (incoming.state() == msg::PLAN_PLANNING && kept.request_id() == incoming.request_id() &&
-      kept.state() != msg::PLAN_PLANNING)
-    return;
-  if (incoming.trajectory().empty() && !kept.trajectory().empty() &&
-      kept.request_id() == incoming.request_id()) {
-    auto trajectory = std::move(kept.trajectory());
-    auto names = std::move(kept.joint_names());
-    kept = incoming;
-    kept.trajectory(std::move(trajectory));
-    kept.joint_names(std::move(names));
-    return;
-  }
-  kept = incoming;
-}
-
-msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
-                        const MissionReport& report) {
-  msg::DrillStatus out;
-  out.mission_id(mission_id);
-  out.stamp_ns(now_ns());
-  out.mission(report.mission);
-  out.state(to_msg(status.state));
-  out.active(status.active);
-  out.area(static_cast<std::uint32_t>(status.area));
-  out.hole(static_cast<std::uint32_t>(status.hole));
-  out.reason(!report.reason.empty() ? report.reason : status.reason);
-  for (const AreaReport& a : report.areas) {
-    msg::DrillArea area;
-    area.name(a.name);
-    area.state(to_msg(a.state));
-    area.reason(a.reason);
-    area.frame(model::dds::to_pose_msg(a.located.frame));
-    for (const HoleReport& h : a.holes) {
-      msg::DrillHole hole;
-      hole.label(h.point.label);
-      hole.frame(model::dds::to_pose_msg(h.point.frame));
-      hole.state(to_msg(h.state));
-      hole.reason(h.reason);
-      area.holes().push_back(hole);
-    }
-    out.areas().push_back(area);
-  }
-  out.time_navigate(report.times.navigate);
-  out.time_plan(report.times.plan);
-  out.time_execute(report.times.execute);
-  out.time_drill(report.times.drill);
-  out.time_total(report.times.total);
-  out.holes_drilled(static_cast<std::uint32_t>(report.holes_drilled()));
-  out.holes_marked(static_cast<std::uint32_t>(report.holes_marked()));
-  return out;
-}
 
 DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ostream& log)
     : params_(std::move(params)),
@@ -235,7 +123,7 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
       plans_in_(participant, cdds::topics::plan_result,
                 [this](const msg::PlanResult& r, const auto&) {
                   std::lock_guard lock(mutex_);
-                  keep_result(plan_results_[r.request_id()], r);
+                  merge_reply(plan_results_[r.request_id()], to_core(r));
                 }),
       trajectories_in_(participant, cdds::topics::trajectory_status,
                        [this](const msg::TrajectoryStatus& s, const auto&) {
@@ -453,17 +341,17 @@ void DrillNode::tick() {
 
 // A plan request to the planner, sent again (same id) while the planner acknowledges nothing
 // (resend_unacknowledged).
-void DrillNode::send_plan(const msg::PlanRequest& request) {
-  msg::PlanRequest r = request;
+void DrillNode::send_plan(const PlanAsk& request) {
+  PlanAsk r = request;
   // The odometry frame where the marks seen again put it, while nav localises nothing: the
   // planner's map (the world) then has the wall where the camera sees it, not where odometry
   // puts it (OdometryDrift).
   if (!map_frame_.localised() && drift_.corrected()) {
     const Eigen::Vector3d d = drift_.odom_in_map();
-    r.odom_in_map({d.x(), d.y(), d.z()});
+    r.odom_in_map = d;
   }
-  plan_requests_.write(r);
-  unacknowledged_[r.request_id()] = {r, now_, 0};
+  plan_requests_.write(to_msg(r));
+  unacknowledged_[r.request_id] = {r, now_, 0};
 }
 
 std::string DrillNode::landmark(std::size_t area, const std::string& label) const {
@@ -505,7 +393,7 @@ void DrillNode::resend_unacknowledged() {
       log_line("drill: plan request " + std::to_string(it->first) + " not acknowledged by the planner within " +
                std::to_string(static_cast<int>(tuning_.plan_requests.ack_bound)) + " s; sent again (" +
                std::to_string(u.resends) + " of " + std::to_string(tuning_.plan_requests.resends) + ")");
-      plan_requests_.write(u.request);
+      plan_requests_.write(to_msg(u.request));
     }
     ++it;
   }
@@ -793,22 +681,20 @@ void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& located,
       bim == bim_frames_.end() ? located : map_frame_.to_odom(bim->second);
   Plan p;
   p.request_id = next_request_++;
-  msg::PlanRequest r;
-  r.request_id(p.request_id);
-  r.model_version(static_cast<std::uint32_t>(model_version_));
-  r.stamp_ns(now_ns());
-  r.source(kSource);
-  r.end_effector(rig_ ? rig_->tool() : "");
-  r.goals().push_back(model::dds::to_pose_msg(frame));
-  r.execute(false);
-  r.environment_padding(tuning_.approach.padding);
-  r.contact_force(checked_thrust(tuning_, tuning_.motion));
+  PlanAsk r;
+  r.request_id = p.request_id;
+  r.model_version = static_cast<std::uint32_t>(model_version_);
+  r.source = kSource;
+  r.end_effector = rig_ ? rig_->tool() : "";
+  r.goals.push_back(frame);
+  r.execute = false;
+  r.environment_padding = tuning_.approach.padding;
+  r.contact_force = checked_thrust(tuning_, tuning_.motion);
   if (after) {
     const auto prev = plans_.find(*after);
     if (prev != plans_.end() && prev->second.end.size() > 0) {
-      r.start_names(prev->second.names);
-      r.start_position(std::vector<double>(prev->second.end.data(),
-                                           prev->second.end.data() + prev->second.end.size()));
+      r.start_names = prev->second.names;
+      r.start_position.assign(prev->second.end.data(), prev->second.end.data() + prev->second.end.size());
     }
   }
   p.request = r;
@@ -821,32 +707,31 @@ Outcome DrillNode::planning(std::size_t area) {
   if (it == plans_.end()) return Outcome::failed("no plan was asked for this area");
   Plan& p = it->second;
   if (p.result) return Outcome::succeeded();
-  std::optional<msg::PlanResult> r;
+  std::optional<PlanReply> r;
   {
     std::lock_guard lock(mutex_);
     const auto found = plan_results_.find(p.request_id);
     if (found != plan_results_.end()) r = found->second;
   }
   if (!r) return Outcome::running();
-  if (r->state() == msg::PLAN_FAILED && p.attempts < tuning_.approach.attempts &&
-      (r->failure() == msg::PLAN_NO_PATH || r->failure() == msg::PLAN_UNREACHABLE)) {
+  if (r->state == PlanState::kFailed && p.attempts < tuning_.approach.attempts &&
+      (r->failure == PlanFailure::kNoPath || r->failure == PlanFailure::kUnreachable)) {
     // The search is randomised (seeded by the request id): another request searches anew.
     ++p.attempts;
     p.request_id = next_request_++;
-    p.request.request_id(p.request_id);
-    p.request.stamp_ns(now_ns());
-    log_line("drill: area " + std::to_string(area) + ": " + r->reason() +
+    p.request.request_id = p.request_id;
+    log_line("drill: area " + std::to_string(area) + ": " + r->reason +
              "; planning again (attempt " + std::to_string(p.attempts) + " of " +
              std::to_string(tuning_.approach.attempts) + ")");
     send_plan(p.request);
     return Outcome::running();
   }
-  if (r->state() == msg::PLAN_FAILED) return Outcome::failed("planner: " + r->reason());
-  if ((r->state() == msg::PLAN_PLANNED || r->state() == msg::PLAN_SUCCEEDED) &&
-      !r->trajectory().empty()) {
+  if (r->state == PlanState::kFailed) return Outcome::failed("planner: " + r->reason);
+  if ((r->state == PlanState::kPlanned || r->state == PlanState::kSucceeded) &&
+      !r->path.samples.empty()) {
     p.result = r;
-    p.names = r->joint_names();
-    const auto& last = r->trajectory().back().position();
+    p.names = r->path.names;
+    const auto& last = r->path.samples.back().position;
     p.end = Eigen::Map<const Eigen::VectorXd>(last.data(), static_cast<Eigen::Index>(last.size()));
     return Outcome::succeeded();
   }
@@ -887,7 +772,7 @@ void DrillNode::execute(std::size_t area) {
   }
   returning_ = false;
   const Plan& p = plans_.at(area);
-  trajectory_request_ = send_trajectory(p.names, samples_of(*p.result));
+  trajectory_request_ = send_trajectory(p.names, p.result->path.samples);
 }
 
 Outcome DrillNode::execution() {
@@ -898,7 +783,7 @@ Outcome DrillNode::execution() {
     returning_ = false;
     hole_chain_.clear();
     const Plan& p = plans_.at(*executing_area_);
-    trajectory_request_ = send_trajectory(p.names, samples_of(*p.result));
+    trajectory_request_ = send_trajectory(p.names, p.result->path.samples);
     return Outcome::running();
   }
   switch (it->second.state()) {
@@ -1042,15 +927,14 @@ Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
 
 // A planned-only request for a posture at `goal` from the robot's current state; the task is the
 // caller's.
-msg::PlanRequest DrillNode::placement_request(const Eigen::Isometry3d& goal) {
-  msg::PlanRequest r;
-  r.request_id(next_request_++);
-  r.model_version(static_cast<std::uint32_t>(model_version_));
-  r.stamp_ns(now_ns());
-  r.source(kSource);
-  r.end_effector(rig_->tool());
-  r.goals().push_back(model::dds::to_pose_msg(goal));
-  r.execute(false);
+PlanAsk DrillNode::placement_request(const Eigen::Isometry3d& goal) {
+  PlanAsk r;
+  r.request_id = next_request_++;
+  r.model_version = static_cast<std::uint32_t>(model_version_);
+  r.source = kSource;
+  r.end_effector = rig_->tool();
+  r.goals.push_back(goal);
+  r.execute = false;
   return r;
 }
 
@@ -1107,16 +991,16 @@ static std::string last_holes(const std::vector<bool>& reached) {
 void DrillNode::place_check(bool drawn) {
   placement_.hole_checks.clear();
   placement_.look_check = {};
-  const auto from = [&](msg::PlanRequest& r) {
+  const auto from = [&](PlanAsk& r) {
     if (!drawn) return;
-    r.start_names(placement_.names.back());
-    r.start_position(placement_.bodies.back().back().position);
+    r.start_names = placement_.names.back();
+    r.start_position = placement_.bodies.back().back().position;
   };
   for (const DrillPoint& h : placement_.holes) {
-    msg::PlanRequest r = placement_request(h.frame);
+    PlanAsk r = placement_request(h.frame);
     set_hole_task(r, at_lead(tuning_.hole.attempts[0], placement_.lead), hole_distance_, hole_depth(), tuning_);
     from(r);
-    placement_.hole_checks.push_back({r.request_id(), 0, r});
+    placement_.hole_checks.push_back({r.request_id, 0, r});
     send_plan(r);
   }
   if (drawn) {
@@ -1124,13 +1008,14 @@ void DrillNode::place_check(bool drawn) {
     // where the drawn posture put it. No drilling force at a look: 1 N, the planner's least.
     const std::optional<Eigen::Isometry3d> mark = marker_of(placement_.holes.front(), *patterns_);
     if (mark) {
-      msg::PlanRequest r = placement_request(*mark);
-      r.camera_distance(any_roll_distance(marker_look_radius(patterns_->marker_size(), tuning_.looks.marker_drift), camera_fov()) +
-                        tuning_.placement.look_further[0]);
-      r.fixed_base(true);
-      r.contact_force(1.0);
+      PlanAsk r = placement_request(*mark);
+      r.camera_distance =
+          any_roll_distance(marker_look_radius(patterns_->marker_size(), tuning_.looks.marker_drift), camera_fov()) +
+          tuning_.placement.look_further[0];
+      r.fixed_base = true;
+      r.contact_force = 1.0;
       from(r);
-      placement_.look_check = {r.request_id(), 0, r};
+      placement_.look_check = {r.request_id, 0, r};
       send_plan(r);
     }
   }
@@ -1156,9 +1041,9 @@ void DrillNode::place_next() {
       std::optional<Eigen::Vector3d> mark;
       if (const std::optional<Eigen::Isometry3d> m = marker_of(placement_.holes.front(), *patterns_))
         mark = m->translation();
-      msg::PlanRequest r = placement_request(placement_goal(placement_.holes, mark, d.toward));
+      PlanAsk r = placement_request(placement_goal(placement_.holes, mark, d.toward));
       set_hole_task(r, {true, false, 0.0, d.out, placement_.lead}, hole_distance_, hole_depth(), tuning_);
-      placement_.draw = r.request_id();
+      placement_.draw = r.request_id;
       send_plan(r);
       motion_ = Motion::kPlaceDraw;
       return;
@@ -1202,8 +1087,7 @@ void DrillNode::place_next() {
 // A placement check asked again (its request changed): a new id, stamped now.
 void DrillNode::resend(Placement::Check& c) {
   c.id = next_request_++;
-  c.request.request_id(c.id);
-  c.request.stamp_ns(now_ns());
+  c.request.request_id = c.id;
   send_plan(c.request);
 }
 
@@ -1236,9 +1120,9 @@ void DrillNode::control_placement() {
 }
 
 // A plan request's final answer (succeeded or failed), or none yet.
-std::optional<msg::PlanResult> DrillNode::answered(std::uint32_t id) const {
-  std::optional<msg::PlanResult> r = plan_result(id);
-  if (r && (r->state() == msg::PLAN_SUCCEEDED || r->state() == msg::PLAN_FAILED)) return r;
+std::optional<PlanReply> DrillNode::answered(std::uint32_t id) const {
+  std::optional<PlanReply> r = plan_result(id);
+  if (r && (r->state == PlanState::kSucceeded || r->state == PlanState::kFailed)) return r;
   return std::nullopt;
 }
 
@@ -1251,13 +1135,13 @@ void DrillNode::place_check_step() {
   bool waiting = false;
   std::vector<bool> flags;
   for (Placement::Check& c : placement_.hole_checks) {
-    const std::optional<msg::PlanResult> r = answered(c.id);
+    const std::optional<PlanReply> r = answered(c.id);
     if (!r) {
       waiting = true;
       continue;
     }
-    if (r->state() == msg::PLAN_FAILED && c.attempt < (drawn ? tuning_.placement.last_hole_attempt : 0) &&
-        (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH)) {
+    if (r->state == PlanState::kFailed && c.attempt < (drawn ? tuning_.placement.last_hole_attempt : 0) &&
+        (r->failure == PlanFailure::kUnreachable || r->failure == PlanFailure::kNoPath)) {
       // The hole's next posture further out, as the hole itself will ask (Params::hole.attempts).
       set_hole_task(c.request, at_lead(tuning_.hole.attempts[++c.attempt], placement_.lead), hole_distance_,
                     hole_depth(), tuning_);
@@ -1265,17 +1149,17 @@ void DrillNode::place_check_step() {
       waiting = true;
       continue;
     }
-    reached += r->state() == msg::PLAN_SUCCEEDED;
-    flags.push_back(r->state() == msg::PLAN_SUCCEEDED);
+    reached += r->state == PlanState::kSucceeded;
+    flags.push_back(r->state == PlanState::kSucceeded);
   }
   if (waiting) return;
-  std::optional<msg::PlanResult> look;
+  std::optional<PlanReply> look;
   Placement::Check& l = placement_.look_check;
   if (l.id != 0 && !(look = answered(l.id))) return;
-  if (look && look->state() == msg::PLAN_FAILED && l.attempt + 1 < tuning_.placement.look_further.size() &&
-      (look->failure() == msg::PLAN_UNREACHABLE || look->failure() == msg::PLAN_NO_PATH)) {
-    l.request.camera_distance(l.request.camera_distance() - tuning_.placement.look_further[l.attempt] +
-                              tuning_.placement.look_further[l.attempt + 1]);
+  if (look && look->state == PlanState::kFailed && l.attempt + 1 < tuning_.placement.look_further.size() &&
+      (look->failure == PlanFailure::kUnreachable || look->failure == PlanFailure::kNoPath)) {
+    l.request.camera_distance +=
+        tuning_.placement.look_further[l.attempt + 1] - tuning_.placement.look_further[l.attempt];
     ++l.attempt;
     resend(l);
     return;
@@ -1285,10 +1169,10 @@ void DrillNode::place_check_step() {
     placement_.standing_reached = flags;
   } else {
     placement_.reached.back() = flags;
-    const bool seen = look && look->state() == msg::PLAN_SUCCEEDED && !look->trajectory().empty();
+    const bool seen = look && look->state == PlanState::kSucceeded && !look->path.samples.empty();
     if (seen) {
-      placement_.looks.back() = samples_of(*look);
-      placement_.look_distances.back() = l.request.camera_distance();
+      placement_.looks.back() = look->path.samples;
+      placement_.look_distances.back() = l.request.camera_distance;
     }
     placement_.choice->drawn(reached, seen);
   }
@@ -1296,19 +1180,19 @@ void DrillNode::place_check_step() {
 }
 
 void DrillNode::place_draw_step() {
-  const std::optional<msg::PlanResult> r = answered(placement_.draw);
+  const std::optional<PlanReply> r = answered(placement_.draw);
   if (!r) return;
-  placement_.names.push_back(r->joint_names());
+  placement_.names.push_back(r->path.names);
   placement_.reached.emplace_back(placement_.holes.size(), false);
   placement_.looks.emplace_back();
   placement_.look_distances.push_back(0.0);
-  if (r->state() == msg::PLAN_SUCCEEDED && !r->trajectory().empty()) {
-    placement_.bodies.push_back(samples_of(*r));
+  if (r->state == PlanState::kSucceeded && !r->path.samples.empty()) {
+    placement_.bodies.push_back(r->path.samples);
     place_check(true);
     return;
   }
   placement_.bodies.emplace_back();
-  log_line("drill: no whole-body posture drawn for the placement (" + r->reason() + ")");
+  log_line("drill: no whole-body posture drawn for the placement (" + r->reason + ")");
   placement_.choice->drawn(0, false);
   place_next();
 }
@@ -1351,21 +1235,21 @@ void DrillNode::place_look_step() {
 
 void DrillNode::place_look_again_step() {
   const std::size_t k = chosen_draw();
-  const std::optional<msg::PlanResult> r = plan_result(placement_.look_again);
+  const std::optional<PlanReply> r = plan_result(placement_.look_again);
   if (!r) return;
-  if (!r->trajectory().empty()) placement_.again_path = path_of(*r);
-  if (r->state() == msg::PLAN_SUCCEEDED) {
+  if (!r->path.samples.empty()) placement_.again_path = r->path;
+  if (r->state == PlanState::kSucceeded) {
     if (!placement_.again_path.samples.empty()) hole_chain_.push_back(placement_.again_path);
     start_reanchor(Motion::kPlaceSee);
-  } else if (r->state() == msg::PLAN_FAILED && r->failure() == msg::PLAN_EXECUTION_ABORTED) {
+  } else if (r->state == PlanState::kFailed && r->failure == PlanFailure::kExecutionAborted) {
     motion_ = Motion::kNone;
-    motion_outcome_ = Outcome::failed("robot: the camera onto the marker from the placement: " + r->reason());
+    motion_outcome_ = Outcome::failed("robot: the camera onto the marker from the placement: " + r->reason);
   } else if (const std::optional<Sample> s = latest_sample();
-             r->state() == msg::PLAN_FAILED && placement_.looks_again == 0 && s) {
+             r->state == PlanState::kFailed && placement_.looks_again == 0 && s) {
     // None from where the base stands: the look checked from the posture planned, its arm
     // path taken with the base where it stands (aimed off by the base's tracking error).
     log_line("drill: no look at marker " + std::to_string(point_.marker) + " from where the base stands (" +
-             r->reason() + "); the look checked from the posture planned");
+             r->reason + "); the look checked from the posture planned");
     std::vector<PathSample> look = placement_.looks[k];
     const PathSample here = sample_here(placement_.names[k], *s, look.front());
     look.front() = here;
@@ -1373,9 +1257,9 @@ void DrillNode::place_look_again_step() {
     placement_.looks[k] = look;
     trajectory_request_ = send_trajectory(placement_.names[k], look);
     motion_ = Motion::kPlaceLook;
-  } else if (r->state() == msg::PLAN_FAILED) {
+  } else if (r->state == PlanState::kFailed) {
     log_line("drill: the camera cannot be turned onto marker " + std::to_string(point_.marker) +
-             " further out from the placement (" + r->reason() + "); each hole looks for it");
+             " further out from the placement (" + r->reason + "); each hole looks for it");
     motion_ = Motion::kNone;
     motion_outcome_ = Outcome::succeeded();
   }
@@ -1420,12 +1304,12 @@ void DrillNode::place_look(std::size_t attempt) {
   }
   placement_.looks_again = attempt;
   placement_.look_distance = placement_.look_distances[placement_.choice->chosen()] + tuning_.placement.look_further[attempt];
-  msg::PlanRequest r = placement_request(*mark);
-  r.camera_distance(placement_.look_distance);
-  r.fixed_base(true);
-  r.contact_force(1.0);
-  r.execute(true);
-  placement_.look_again = r.request_id();
+  PlanAsk r = placement_request(*mark);
+  r.camera_distance = placement_.look_distance;
+  r.fixed_base = true;
+  r.contact_force = 1.0;
+  r.execute = true;
+  placement_.look_again = r.request_id;
   placement_.again_path = {};
   send_plan(r);
   motion_ = Motion::kPlaceLookAgain;
@@ -1469,15 +1353,14 @@ void DrillNode::align(const DrillPoint& point) {
   const Eigen::Isometry3d camera = rig_->camera_in_base(q);
   const double camera_to_tip =
       (rig_->tip_in_base(q).translation() - camera.translation()).dot(camera.linear().col(2));
-  msg::PlanRequest r;
+  PlanAsk r;
   hole_plan_request_ = next_request_++;
-  r.request_id(hole_plan_request_);
-  r.model_version(static_cast<std::uint32_t>(model_version_));
-  r.stamp_ns(now_ns());
-  r.source(kSource);
-  r.end_effector(rig_->tool());
-  r.goals().push_back(model::dds::to_pose_msg(point_.frame));
-  r.execute(true);
+  r.request_id = hole_plan_request_;
+  r.model_version = static_cast<std::uint32_t>(model_version_);
+  r.source = kSource;
+  r.end_effector = rig_->tool();
+  r.goals.push_back(point_.frame);
+  r.execute = true;
   // The bit's tip is put on the hole's axis (PlanRequest.tip_distance), so the posture the
   // planner checks is the one the bit drills from; the camera sees the hole from beside it.
   camera_to_tip_ = camera_to_tip;
@@ -1505,7 +1388,7 @@ void DrillNode::align(const DrillPoint& point) {
 // hole_request_ to the planner. A marker hole's whole-body posture is only planned: before the
 // base moves, check_look() asks whether the camera can be turned onto the marker from it.
 void DrillNode::hole_request_write() {
-  hole_request_.execute(!(point_.marker >= 0 && patterns_ && !hole_request_.fixed_base()));
+  hole_request_.execute = !(point_.marker >= 0 && patterns_ && !hole_request_.fixed_base);
   send_plan(hole_request_);
 }
 
@@ -1513,12 +1396,12 @@ double DrillNode::hole_depth() const { return mission_ ? mission_->depth : tunin
 
 // "the bit 0.07 m", "the bit (reach unchecked) 0.07 m" or "the camera 0.23 m" (from the wall),
 // for the log.
-std::string hole_task_text(const msg::PlanRequest& r) {
+std::string hole_task_text(const PlanAsk& r) {
   std::ostringstream t;
-  if (r.tip_distance() > 0.0)
-    t << "the bit " << (r.tip_reach() > 0.0 ? "" : "(reach unchecked) ") << r.tip_distance() << " m";
+  if (r.tip_distance > 0.0)
+    t << "the bit " << (r.tip_reach > 0.0 ? "" : "(reach unchecked) ") << r.tip_distance << " m";
   else
-    t << "the camera " << r.camera_distance() << " m";
+    t << "the camera " << r.camera_distance << " m";
   return t.str();
 }
 
@@ -1664,8 +1547,8 @@ bool DrillNode::prepare_look() {
     look_reach_ = marker_look_radius(patterns_->marker_size(), tuning_.looks.marker_drift);
   }
   // The camera's distance at the hole's posture.
-  hole_reached_ = hole_request_.tip_distance() > 0.0 ? hole_request_.tip_distance() + camera_to_tip_
-                                                     : hole_request_.camera_distance();
+  hole_reached_ = hole_request_.tip_distance > 0.0 ? hole_request_.tip_distance + camera_to_tip_
+                                                     : hole_request_.camera_distance;
   return true;
 }
 
@@ -1692,7 +1575,7 @@ std::string blobs_seen(const CameraView& view, const Eigen::Isometry3d& predicte
 }
 
 void DrillNode::track_area() {
-  if (point_.marker >= 0 || hole_request_.fixed_base() || area_points_.empty()) return;
+  if (point_.marker >= 0 || hole_request_.fixed_base || area_points_.empty()) return;
   std::optional<CameraFrame> newest;  // the newest only: detection costs, and the drift is slow
   {
     std::lock_guard lock(mutex_);
@@ -1748,10 +1631,9 @@ void DrillNode::replan_hole(bool reach, double further, double lead) {
 // The hole's posture (hole_request_'s task) asked for again at point_, where it was measured last.
 void DrillNode::request_hole_posture() {
   hole_plan_request_ = next_request_++;
-  hole_request_.request_id(hole_plan_request_);
-  hole_request_.goals().clear();
-  hole_request_.goals().push_back(model::dds::to_pose_msg(point_.frame));
-  hole_request_.stamp_ns(now_ns());
+  hole_request_.request_id = hole_plan_request_;
+  hole_request_.goals.clear();
+  hole_request_.goals.push_back(point_.frame);
   hole_request_write();
   hole_path_ = {};
   motion_ = Motion::kApproachHole;
@@ -1808,10 +1690,10 @@ double DrillNode::camera_fov() const {
 
 void DrillNode::request_look(std::size_t attempt) {
   look_attempt_ = attempt;
-  msg::PlanRequest r = look_plan(attempt);
+  PlanAsk r = look_plan(attempt);
   look_request_ = next_request_++;
-  r.request_id(look_request_);
-  r.execute(true);
+  r.request_id = look_request_;
+  r.execute = true;
   send_plan(r);
   look_path_ = {};
   motion_ = Motion::kLookAtHole;
@@ -1821,22 +1703,21 @@ void DrillNode::request_look(std::size_t attempt) {
 // planned only.
 void DrillNode::check_look(std::size_t attempt) {
   check_attempt_ = attempt;
-  msg::PlanRequest r = look_plan(attempt);
+  PlanAsk r = look_plan(attempt);
   check_request_ = next_request_++;
-  r.request_id(check_request_);
-  r.execute(false);
-  r.start_names(body_candidate_.names);
-  r.start_position(body_candidate_.samples.back().position);
+  r.request_id = check_request_;
+  r.execute = false;
+  r.start_names = body_candidate_.names;
+  r.start_position = body_candidate_.samples.back().position;
   send_plan(r);
   motion_ = Motion::kCheckLook;
 }
 
 // The request turning the camera onto look_goal_ (looks.attempts[attempt]), the arm alone; its id,
 // start and execution are the caller's.
-msg::PlanRequest DrillNode::look_plan(std::size_t attempt) const {
-  msg::PlanRequest r = hole_request_;
-  r.stamp_ns(now_ns());
-  r.goals().clear();
+PlanAsk DrillNode::look_plan(std::size_t attempt) const {
+  PlanAsk r = hole_request_;
+  r.goals.clear();
   Eigen::Isometry3d goal = look_goal_;
   double distance = hole_reached_ + tuning_.looks.attempts[attempt].further;
   const double fov = camera_fov();
@@ -1856,12 +1737,12 @@ msg::PlanRequest DrillNode::look_plan(std::size_t attempt) const {
                          (patterns_ ? marker_look_radius(patterns_->marker_size(), 0.0) : 0.0);
     distance = std::max(distance, any_roll_distance(reach, fov));
   }
-  r.goals().push_back(model::dds::to_pose_msg(goal));
-  r.tip_distance(0.0);  // the camera looks at the mark
-  r.tip_reach(0.0);
-  r.camera_distance(distance);
-  r.fixed_base(true);
-  r.base_travel(0.0);
+  r.goals.push_back(goal);
+  r.tip_distance = 0.0;
+  r.tip_reach = 0.0;
+  r.camera_distance = distance;
+  r.fixed_base = true;
+  r.base_travel = 0.0;
   return r;
 }
 
@@ -1964,7 +1845,7 @@ void DrillNode::keep_unseen_view(const CameraView& camera, const Eigen::Vector3d
 }
 
 // The latest result of plan request `id`, if any has come.
-std::optional<msg::PlanResult> DrillNode::plan_result(std::uint32_t id) const {
+std::optional<PlanReply> DrillNode::plan_result(std::uint32_t id) const {
   std::lock_guard lock(mutex_);
   const auto it = plan_results_.find(id);
   if (it == plan_results_.end()) return std::nullopt;
@@ -2000,9 +1881,9 @@ void DrillNode::posture_reached() {
   // it leads to) at that thrust.
   drilling_lead_ = lead_checked(tuning_, hole_request_);
   light_why_ = "the arm's torques hold no more in any posture found";
-  if (!hole_request_.fixed_base()) {
+  if (!hole_request_.fixed_base) {
     body_attempt_ = hole_attempt_;
-    body_goal_ = model::dds::to_isometry(hole_request_.goals().front()).translation();
+    body_goal_ = hole_request_.goals.front().translation();
   }
   if (tracked_frames_ > 0) {
     std::ostringstream line;
@@ -2018,7 +1899,7 @@ void DrillNode::posture_reached() {
   const auto seen_at = markers_seen_at_.find(point_.marker);
   const bool stale = seen_at == markers_seen_at_.end() || now_ - seen_at->second > tuning_.looks.marker_stale;
   const std::optional<Sample> s = latest_sample();
-  if (point_.marker >= 0 && !looked_ && !hole_request_.fixed_base() && s &&
+  if (point_.marker >= 0 && !looked_ && !hole_request_.fixed_base && s &&
       !checked_path_.samples.empty() && prepare_look()) {
     // The look check_look() planned from the posture: the planner's look postures are drawn at
     // random, and a new request from here may find none where the check found one. It
@@ -2031,8 +1912,8 @@ void DrillNode::posture_reached() {
     keep_base(checked_path_.names, here, path);
     trajectory_request_ = send_trajectory(checked_path_.names, path);
     motion_ = Motion::kCheckedLook;
-  } else if (point_.marker >= 0 && !looked_ && (!hole_request_.fixed_base() || stale)) {
-    look_at_hole(hole_request_.fixed_base() ? 0 : checked_look_);
+  } else if (point_.marker >= 0 && !looked_ && (!hole_request_.fixed_base || stale)) {
+    look_at_hole(hole_request_.fixed_base ? 0 : checked_look_);
   } else {
     // The base moved: measure the hole again in frames taken from here.
     start_reanchor(Motion::kReanchor);
@@ -2158,25 +2039,25 @@ void DrillNode::cartesian_step() {
 }
 
 void DrillNode::hole_posture_step() {
-  const std::optional<msg::PlanResult> r = plan_result(hole_plan_request_);
+  const std::optional<PlanReply> r = plan_result(hole_plan_request_);
   track_area();
   if (!r) return;
   // The trajectory comes with PLANNED and the execution updates; SUCCEEDED may arrive alone.
-  if (!r->trajectory().empty()) hole_path_ = path_of(*r);
-  if (r->state() == msg::PLAN_SUCCEEDED && !hole_path_.samples.empty() && hole_request_.execute())
+  if (!r->path.samples.empty()) hole_path_ = r->path;
+  if (r->state == PlanState::kSucceeded && !hole_path_.samples.empty() && hole_request_.execute)
     hole_chain_.push_back(hole_path_);
-  if (r->state() == msg::PLAN_FAILED && hole_replanned_) {
+  if (r->state == PlanState::kFailed && hole_replanned_) {
     no_posture_after_remeasure(*r);
     return;
   }
-  if (r->state() == msg::PLAN_FAILED &&
-      (r->failure() == msg::PLAN_UNREACHABLE || r->failure() == msg::PLAN_NO_PATH) &&
+  if (r->state == PlanState::kFailed &&
+      (r->failure == PlanFailure::kUnreachable || r->failure == PlanFailure::kNoPath) &&
       hole_attempt_ + 1 < tuning_.hole.attempts.size()) {
     next_hole_attempt(*r);
-  } else if (r->state() == msg::PLAN_FAILED) {
-    motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason());
+  } else if (r->state == PlanState::kFailed) {
+    motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason);
     motion_ = Motion::kNone;
-  } else if (r->state() == msg::PLAN_SUCCEEDED && !hole_request_.execute()) {
+  } else if (r->state == PlanState::kSucceeded && !hole_request_.execute) {
     // Planned only (a marker hole's whole body): is a look at the marker possible from there?
     body_candidate_ = hole_path_;
     checked_path_ = {};
@@ -2186,14 +2067,14 @@ void DrillNode::hole_posture_step() {
     } else {
       check_look(0);
     }
-  } else if (r->state() == msg::PLAN_SUCCEEDED) {
+  } else if (r->state == PlanState::kSucceeded) {
     posture_reached();
   }
 }
 
 // The hole's posture planned again after its re-measure found none for the arm alone: the whole
 // body's posture once more (up to hole.body_replans), or the alignment from the posture reached.
-void DrillNode::no_posture_after_remeasure(const msg::PlanResult& r) {
+void DrillNode::no_posture_after_remeasure(const PlanReply& r) {
   const std::optional<Sample> s = latest_sample();
   if (!s) return;
   const double shift = (point_.frame.translation() - body_goal_).norm();
@@ -2207,14 +2088,14 @@ void DrillNode::no_posture_after_remeasure(const msg::PlanResult& r) {
     line.precision(1);
     line << "drill: " << point_.label << ": no posture for the arm alone at the hole measured "
          << "again " << shift * 1e3 << " mm from where the whole body's posture was planned ("
-         << r.reason() << "); the whole body's posture planned again for it";
+         << r.reason << "); the whole body's posture planned again for it";
     log_line(line.str());
     replan_body();
     return;
   }
   // The alignment's Cartesian move covers what is left of the shift.
   log_line("drill: " + point_.label + ": no posture for the arm alone at the hole measured " +
-           "again (" + r.reason() + "); aligning from the whole body's posture");
+           "again (" + r.reason + "); aligning from the whole body's posture");
   if (shift > tuning_.hole.replan_shift && drilling_lead_ > tuning_.hole.lightest_lead) {
     // Past the posture the planner checked the torques of: the lightest thrust. Across
     // 26 mm at full thrust morphology A's J2_E goes past its continuous torque.
@@ -2233,7 +2114,7 @@ void DrillNode::no_posture_after_remeasure(const msg::PlanResult& r) {
 }
 
 // No posture for this attempt: the hole's next attempt (hole.attempts) asked.
-void DrillNode::next_hole_attempt(const msg::PlanResult& r) {
+void DrillNode::next_hole_attempt(const PlanReply& r) {
   const double was_lead = tuning_.hole.attempts[hole_attempt_].lead;
   const HoleAttempt& next = tuning_.hole.attempts[++hole_attempt_];
   std::ostringstream line;
@@ -2244,12 +2125,12 @@ void DrillNode::next_hole_attempt(const msg::PlanResult& r) {
     return w.str();
   };
   line << "drill: " << point_.label << ": no drilling posture for "
-       << who(hole_request_.fixed_base(), hole_request_.base_travel()) << " with "
+       << who(hole_request_.fixed_base, hole_request_.base_travel) << " with "
        << hole_task_text(hole_request_) << " from the wall" << thrust_text(was_lead, tuning_.motion)
-       << " (" << r.reason() << "); asking for " << who(next.fixed_base, next.base_travel)
+       << " (" << r.reason << "); asking for " << who(next.fixed_base, next.base_travel)
        << " with ";
   hole_plan_request_ = next_request_++;
-  hole_request_.request_id(hole_plan_request_);
+  hole_request_.request_id = hole_plan_request_;
   set_hole_task(hole_request_, next, hole_distance_, hole_depth(), tuning_);
   line << hole_task_text(hole_request_) << thrust_text(next.lead, tuning_.motion);
   log_line(line.str());
@@ -2258,12 +2139,12 @@ void DrillNode::next_hole_attempt(const msg::PlanResult& r) {
 }
 
 void DrillNode::check_look_step() {
-  const std::optional<msg::PlanResult> r = plan_result(check_request_);
-  if (!r || (r->state() != msg::PLAN_SUCCEEDED && r->state() != msg::PLAN_FAILED)) return;
+  const std::optional<PlanReply> r = plan_result(check_request_);
+  if (!r || (r->state != PlanState::kSucceeded && r->state != PlanState::kFailed)) return;
   const std::string marker = "marker " + std::to_string(point_.marker);
-  if (r->state() == msg::PLAN_SUCCEEDED) {
+  if (r->state == PlanState::kSucceeded) {
     checked_look_ = check_attempt_;
-    checked_path_ = path_of(*r);
+    checked_path_ = r->path;
     if (body_draws_ > 1)
       log_line("drill: " + point_.label + ": the camera can be turned onto " + marker +
                " from the whole body's posture drawn on try " + std::to_string(body_draws_) +
@@ -2273,10 +2154,9 @@ void DrillNode::check_look_step() {
     return;
   } else if (body_draws_ < tuning_.hole.body_draws) {
     log_line("drill: " + point_.label + ": the camera could not be turned onto " + marker +
-             " from the whole body's posture drawn (" + r->reason() + "); another drawn");
+             " from the whole body's posture drawn (" + r->reason + "); another drawn");
     hole_plan_request_ = next_request_++;
-    hole_request_.request_id(hole_plan_request_);
-    hole_request_.stamp_ns(now_ns());
+    hole_request_.request_id = hole_plan_request_;
     hole_request_write();
     hole_path_ = {};
     motion_ = Motion::kApproachHole;
@@ -2306,21 +2186,21 @@ void DrillNode::checked_look_step() {
 }
 
 void DrillNode::look_at_hole_step() {
-  const std::optional<msg::PlanResult> r = plan_result(look_request_);
+  const std::optional<PlanReply> r = plan_result(look_request_);
   if (!r) return;
-  if (!r->trajectory().empty()) look_path_ = path_of(*r);
-  if (r->state() == msg::PLAN_SUCCEEDED) {
+  if (!r->path.samples.empty()) look_path_ = r->path;
+  if (r->state == PlanState::kSucceeded) {
     look_pushed_ = !look_path_.samples.empty();
     if (look_pushed_) hole_chain_.push_back(look_path_);
     start_reanchor(Motion::kLookReanchor);
-  } else if (r->state() == msg::PLAN_FAILED &&
+  } else if (r->state == PlanState::kFailed &&
              look_attempt_ + 1 < tuning_.looks.attempts.size() &&
              (point_.marker >= 0 || !tuning_.looks.attempts[look_attempt_ + 1].between)) {
     request_look(look_attempt_ + 1);
-  } else if (r->state() == msg::PLAN_FAILED) {
+  } else if (r->state == PlanState::kFailed) {
     log_line("drill: " + point_.label + ": the camera cannot be turned onto " +
              (point_.marker >= 0 ? "marker " + std::to_string(point_.marker) : "the blob") +
-             " from here (" + r->reason() + "); the hole is measured from its posture");
+             " from here (" + r->reason + "); the hole is measured from its posture");
     start_reanchor(Motion::kReanchor);
   }
 }
@@ -2347,7 +2227,7 @@ void DrillNode::look_reanchor_step() {
     // again, the whole body's is planned again (and the marker looked at again) or aligned
     // from, not the next whole-body attempt taken without a look (a row hole then lands
     // about 13 mm off).
-    if (!hole_request_.fixed_base()) hole_replanned_ = true;
+    if (!hole_request_.fixed_base) hole_replanned_ = true;
   }
   // From the look back onto the drilling posture along the look's path reversed, not along a
   // path planned anew from the look posture: such a path can swing morphology A's J1_E through
@@ -2356,10 +2236,10 @@ void DrillNode::look_reanchor_step() {
   // the hole as measured now is aligned from (the alignment covers the rest); otherwise the
   // posture is planned again from there.
   const std::optional<Sample> s = latest_sample();
-  if (look_pushed_ && hole_chain_.size() > 1 && s && !hole_request_.goals().empty()) {
+  if (look_pushed_ && hole_chain_.size() > 1 && s && !hole_request_.goals.empty()) {
     const double moved =
-        (point_.frame.translation() - model::dds::to_isometry(hole_request_.goals().front()).translation()).norm();
-    const bool keep = hole_request_.fixed_base() && moved <= tuning_.hole.replan_shift;
+        (point_.frame.translation() - hole_request_.goals.front().translation()).norm();
+    const bool keep = hole_request_.fixed_base && moved <= tuning_.hole.replan_shift;
     back_to_posture(*s, keep ? Motion::kBackToPosture : Motion::kBackThenReplan);
     return;
   }
@@ -2381,7 +2261,7 @@ void DrillNode::reanchor_step() {
     // Several blobs: which one is this hole's is told by the pattern they make together.
     const std::optional<AreaShift> shift =
         blob_shift(camera, area_points_, tuning_.blobs.match, tuning_.blobs.reanchor_distance, tuning_.blobs.set_shift);
-    if (shift && shift->blobs < 2 && !hole_request_.fixed_base() && !looked_) {
+    if (shift && shift->blobs < 2 && !hole_request_.fixed_base && !looked_) {
       // The base moved: one blob seen alone near its prediction may be the neighbour, odometry
       // having drifted as far as the blobs lie apart.
       log_line("drill: " + point_.label +
@@ -2393,14 +2273,14 @@ void DrillNode::reanchor_step() {
     if (shift) {
       predicted.frame.translation() += shift->by;
       within = tuning_.blobs.match;
-    } else if (!hole_request_.fixed_base() && !looked_) {
+    } else if (!hole_request_.fixed_base && !looked_) {
       // The base moved and the camera, beside the bit, cannot tell the blob from a neighbour.
       log_line("drill: " + point_.label +
                ": its blob is not told from a neighbour from its drilling posture (" +
                blobs_seen(camera, point_.frame) + "); the camera is turned onto it");
       look_at_hole();
       return;
-    } else if (!hole_request_.fixed_base()) {
+    } else if (!hole_request_.fixed_base) {
       within = tuning_.blobs.match;  // no neighbour is taken for it: the prediction stands
     }
   }
@@ -2425,7 +2305,7 @@ void DrillNode::reanchor_step() {
     hole_seen_again(seen->translation());
     if (point_.marker < 0) shift_area(moved);  // the area's other blobs moved as much
     point_.frame = *seen;
-    if (!hole_request_.fixed_base() && !hole_replanned_ && moved.norm() > tuning_.hole.replan_shift) {
+    if (!hole_request_.fixed_base && !hole_replanned_ && moved.norm() > tuning_.hole.replan_shift) {
       // The base moved and odometry drifted: the posture again, the arm alone, for the hole
       // where the camera sees it now.
       hole_replanned_ = true;

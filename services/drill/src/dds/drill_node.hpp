@@ -25,6 +25,7 @@
 #include "concert/dds/status_reporter.hpp"
 #include "concert/hardware/sensors.hpp"
 #include "concert/mobile_base/map_frame.hpp"
+#include "dds/conversions.hpp"
 #include "drill/area_detection.hpp"
 #include "drill/drill_motion.hpp"
 #include "drill/drill_rig.hpp"
@@ -35,6 +36,7 @@
 #include "drill/placement.hpp"
 #include "drill/params.hpp"
 #include "drill/paths.hpp"
+#include "drill/plan_exchange.hpp"
 #include "drill/ports.hpp"
 
 namespace concert::drill::dds {
@@ -49,17 +51,6 @@ struct NodeParams {
   Params tuning;  ///< config/drill.yaml (drill/params.hpp)
 };
 
-/// The mission's status message from a tree.
-msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
-                        const MissionReport& report);
-
-/// A plan result taken into `kept`, the last one for its request: the trajectory of an executed
-/// plan comes once, with PLANNED, and the execution's updates and SUCCEEDED come without it, so a
-/// result without one keeps the trajectory (and its joint names) already there. Otherwise the
-/// control loop misses the trajectory whenever an update comes first: the holes' postures go
-/// unrecorded, nothing goes back along them, and the next area's approach, planned from where
-/// the last one ended, is aborted at its first sample (1.0 and 1.6 rad off in scenario 1).
-void keep_result(msg::PlanResult& kept, const msg::PlanResult& incoming);
 
 class DrillNode final : public MissionPorts {
  public:
@@ -105,9 +96,9 @@ class DrillNode final : public MissionPorts {
   };
   struct Plan {
     std::uint32_t request_id{0};
-    msg::PlanRequest request;  ///< as sent (a retry sends it again under a new id)
+    PlanAsk request;  ///< as sent (a retry sends it again under a new id)
     int attempts{1};
-    std::optional<msg::PlanResult> result;
+    std::optional<PlanReply> result;
     std::vector<std::string> names;  ///< of the trajectory
     Eigen::VectorXd end;             ///< last sample's positions
   };
@@ -156,7 +147,7 @@ class DrillNode final : public MissionPorts {
     struct Check {
       std::uint32_t id{0};
       std::size_t attempt{0};
-      msg::PlanRequest request;
+      PlanAsk request;
     };
     std::vector<Check> hole_checks;
     Check look_check;  // the camera onto the mark (id 0: none asked), attempt of Params::placement.look_further
@@ -175,7 +166,7 @@ class DrillNode final : public MissionPorts {
     std::uint32_t look_again{0};         // its request
     PlannedPath again_path;
   } placement_;
-  [[nodiscard]] msg::PlanRequest placement_request(const Eigen::Isometry3d& goal);
+  [[nodiscard]] PlanAsk placement_request(const Eigen::Isometry3d& goal);
   void place_check(bool drawn);
   void place_next();
   void control_placement();
@@ -186,7 +177,7 @@ class DrillNode final : public MissionPorts {
   void place_look_step();
   void place_look_again_step();
   void place_see_step();
-  [[nodiscard]] std::optional<msg::PlanResult> answered(std::uint32_t id) const;
+  [[nodiscard]] std::optional<PlanReply> answered(std::uint32_t id) const;
   [[nodiscard]] std::size_t chosen_draw() const;
   void resend(Placement::Check& c);
   void place_look(std::size_t attempt);
@@ -199,8 +190,8 @@ class DrillNode final : public MissionPorts {
   void control_motion();
   // control_motion's steps, one per Motion state, and the Cartesian phases.
   void hole_posture_step();
-  void no_posture_after_remeasure(const msg::PlanResult& r);
-  void next_hole_attempt(const msg::PlanResult& r);
+  void no_posture_after_remeasure(const PlanReply& r);
+  void next_hole_attempt(const PlanReply& r);
   void check_look_step();
   void body_to_hole_step();
   void checked_look_step();
@@ -219,7 +210,7 @@ class DrillNode final : public MissionPorts {
   void start_reanchor(Motion next);
   void look_at_hole(std::size_t first = 0);
   bool prepare_look();
-  msg::PlanRequest look_plan(std::size_t attempt) const;
+  PlanAsk look_plan(std::size_t attempt) const;
   void check_look(std::size_t attempt);
   void posture_reached();
   void hole_request_write();
@@ -279,7 +270,7 @@ class DrillNode final : public MissionPorts {
   std::chrono::steady_clock::time_point mission_started_{};  // health waits a while from here
   std::optional<msg::SafetyState> safety_;
   std::map<std::string, std::chrono::steady_clock::time_point> services_seen_;
-  std::map<std::uint32_t, msg::PlanResult> plan_results_;
+  std::map<std::uint32_t, PlanReply> plan_results_;
   std::map<std::uint32_t, msg::TrajectoryStatus> trajectory_statuses_;
   std::map<std::uint32_t, msg::NavStatus> nav_statuses_;
   std::optional<msg::Image> rgb_, depth_;
@@ -306,12 +297,12 @@ class DrillNode final : public MissionPorts {
   // again would take the planner's latched results of its predecessor's requests for its own.
   std::uint32_t next_request_{(std::random_device{}() & 0x3fffffffu) + 1u};
   struct Unacknowledged {
-    msg::PlanRequest request;
+    PlanAsk request;
     double sent{0.0};  // last sent (now_) [s]
     int resends{0};
   };
   std::map<std::uint32_t, Unacknowledged> unacknowledged_;  // plan requests by id
-  void send_plan(const msg::PlanRequest& r);
+  void send_plan(const PlanAsk& r);
   void resend_unacknowledged();
   std::map<std::size_t, std::future<ResolvedArea>> resolving_;
   std::map<std::size_t, std::int64_t> resolve_since_;
@@ -354,7 +345,7 @@ class DrillNode final : public MissionPorts {
   Eigen::Isometry3d base_T_world_{Eigen::Isometry3d::Identity()};  // fixed while drilling
   std::int64_t servo_since_ns_{0};
   std::uint32_t hole_plan_request_{0};
-  msg::PlanRequest hole_request_;
+  PlanAsk hole_request_;
   double hole_distance_{0.0};  // the bit tip's distance from the wall a hole's posture asks for [m]
   double camera_to_tip_{0.0};  // the tool's camera to its tip along the camera's axis [m]
   std::size_t hole_attempt_{0};  // which of Params::hole.attempts the hole's posture request is
@@ -388,7 +379,7 @@ class DrillNode final : public MissionPorts {
   std::size_t checked_look_{0};  // the Params::looks.attempts attempt the check found (the look starts there)
   PlannedPath checked_path_;     // its path from the candidate's end; empty: none found
   bool trajectory_ran(const std::string& what);
-  std::optional<msg::PlanResult> plan_result(std::uint32_t id) const;
+  std::optional<PlanReply> plan_result(std::uint32_t id) const;
   void move_to_candidate();
   Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the mark as predicted (world)
   double look_reach_{0.0};  // how far from look_goal_ the look must see, any roll [m]; 0: the mark

@@ -1,0 +1,155 @@
+#include "dds/conversions.hpp"
+
+#include <array>
+#include <utility>
+
+#include "concert/common/clock.hpp"
+#include "concert/common/enum_map.hpp"
+#include "concert/model/dds/pose.hpp"
+
+namespace concert::drill::dds {
+
+namespace {
+
+msg::DrillMissionState to_msg(MissionState s) {
+  switch (s) {
+    case MissionState::kIdle:
+      return msg::DRILL_IDLE;
+    case MissionState::kRunning:
+      return msg::DRILL_RUNNING;
+    case MissionState::kSucceeded:
+      return msg::DRILL_SUCCEEDED;
+    case MissionState::kFailed:
+      return msg::DRILL_FAILED;
+    case MissionState::kAborted:
+      return msg::DRILL_ABORTED;
+  }
+  return msg::DRILL_FAILED;
+}
+
+msg::DrillAreaState to_msg(AreaState s) {
+  switch (s) {
+    case AreaState::kPending:
+      return msg::AREA_PENDING;
+    case AreaState::kActive:
+      return msg::AREA_ACTIVE;
+    case AreaState::kDone:
+      return msg::AREA_DONE;
+    case AreaState::kFailed:
+      return msg::AREA_FAILED;
+    case AreaState::kSkipped:
+      return msg::AREA_SKIPPED;
+  }
+  return msg::AREA_FAILED;
+}
+
+msg::DrillHoleState to_msg(HoleState s) {
+  switch (s) {
+    case HoleState::kPending:
+      return msg::HOLE_PENDING;
+    case HoleState::kDrilled:
+      return msg::HOLE_DRILLED;
+    case HoleState::kFailed:
+      return msg::HOLE_FAILED;
+    case HoleState::kSkipped:
+      return msg::HOLE_SKIPPED;
+  }
+  return msg::HOLE_FAILED;
+}
+
+// The planner's states and failures and their wire twins, one row each.
+constexpr EnumMap kPlanStates{std::array{
+    std::pair{PlanState::kPlanning, msg::PLAN_PLANNING},
+    std::pair{PlanState::kPlanned, msg::PLAN_PLANNED},
+    std::pair{PlanState::kExecuting, msg::PLAN_EXECUTING},
+    std::pair{PlanState::kSucceeded, msg::PLAN_SUCCEEDED},
+    std::pair{PlanState::kFailed, msg::PLAN_FAILED},
+}};
+constexpr EnumMap kPlanFailures{std::array{
+    std::pair{PlanFailure::kOk, msg::PLAN_OK},
+    std::pair{PlanFailure::kNoModel, msg::PLAN_NO_MODEL},
+    std::pair{PlanFailure::kStaleModel, msg::PLAN_STALE_MODEL},
+    std::pair{PlanFailure::kInvalidRequest, msg::PLAN_INVALID_REQUEST},
+    std::pair{PlanFailure::kInvalidStart, msg::PLAN_INVALID_START},
+    std::pair{PlanFailure::kUnreachable, msg::PLAN_UNREACHABLE},
+    std::pair{PlanFailure::kNoPath, msg::PLAN_NO_PATH},
+    std::pair{PlanFailure::kExecutionAborted, msg::PLAN_EXECUTION_ABORTED},
+}};
+
+}  // namespace
+
+Eigen::Vector3d odometry_of(const msg::Odometry& o) { return {o.x(), o.y(), o.yaw()}; }
+
+PlanReply to_core(const msg::PlanResult& r) {
+  PlanReply out;
+  out.request_id = r.request_id();
+  // A state this build does not know is a failure, never taken for progress.
+  out.state = kPlanStates.from(r.state()).value_or(PlanState::kFailed);
+  out.failure = kPlanFailures.from(r.failure()).value_or(PlanFailure::kInvalidRequest);
+  out.reason = r.reason();
+  out.path.names = r.joint_names();
+  out.path.samples.reserve(r.trajectory().size());
+  for (const msg::TrajectorySample& t : r.trajectory()) out.path.samples.push_back({t.time(), t.position(), t.velocity()});
+  return out;
+}
+
+msg::PlanRequest to_msg(const PlanAsk& a) {
+  msg::PlanRequest r;
+  r.request_id(a.request_id);
+  r.model_version(a.model_version);
+  r.stamp_ns(now_ns());  // when this copy is sent (a resend is stamped anew)
+  r.source(a.source);
+  r.end_effector(a.end_effector);
+  for (const Eigen::Isometry3d& g : a.goals) r.goals().push_back(model::dds::to_pose_msg(g));
+  r.execute(a.execute);
+  r.start_names(a.start_names);
+  r.start_position(a.start_position);
+  r.camera_distance(a.camera_distance);
+  r.fixed_base(a.fixed_base);
+  r.environment_padding(a.environment_padding);
+  r.base_travel(a.base_travel);
+  r.tip_distance(a.tip_distance);
+  r.tip_reach(a.tip_reach);
+  r.contact_force(a.contact_force);
+  if (a.odom_in_map) r.odom_in_map({a.odom_in_map->x(), a.odom_in_map->y(), a.odom_in_map->z()});
+  return r;
+}
+
+msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
+                        const MissionReport& report) {
+  msg::DrillStatus out;
+  out.mission_id(mission_id);
+  out.stamp_ns(now_ns());
+  out.mission(report.mission);
+  out.state(to_msg(status.state));
+  out.active(status.active);
+  out.area(static_cast<std::uint32_t>(status.area));
+  out.hole(static_cast<std::uint32_t>(status.hole));
+  out.reason(!report.reason.empty() ? report.reason : status.reason);
+  for (const AreaReport& a : report.areas) {
+    msg::DrillArea area;
+    area.name(a.name);
+    area.state(to_msg(a.state));
+    area.reason(a.reason);
+    area.frame(model::dds::to_pose_msg(a.located.frame));
+    for (const HoleReport& h : a.holes) {
+      msg::DrillHole hole;
+      hole.label(h.point.label);
+      hole.frame(model::dds::to_pose_msg(h.point.frame));
+      hole.state(to_msg(h.state));
+      hole.reason(h.reason);
+      area.holes().push_back(hole);
+    }
+    out.areas().push_back(area);
+  }
+  out.time_navigate(report.times.navigate);
+  out.time_plan(report.times.plan);
+  out.time_execute(report.times.execute);
+  out.time_drill(report.times.drill);
+  out.time_total(report.times.total);
+  out.holes_drilled(static_cast<std::uint32_t>(report.holes_drilled()));
+  out.holes_marked(static_cast<std::uint32_t>(report.holes_marked()));
+  return out;
+}
+
+}  // namespace concert::drill::dds
