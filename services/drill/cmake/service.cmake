@@ -1,6 +1,6 @@
 # The service: the rig and area detection (core), the DDS adapter, main, `concert drill` verbs.
 concert_core_library(concert_drill_core STATIC src/core/drill_rig.cpp src/core/area_detection.cpp src/core/placement.cpp
-  src/core/paths.cpp src/core/params.cpp src/core/plan_exchange.cpp)
+  src/core/paths.cpp src/core/params.cpp src/core/plan_exchange.cpp src/core/inputs.cpp)
 target_include_directories(concert_drill_core PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
 target_link_libraries(concert_drill_core
   PUBLIC concert_drill_tree concert_drill_control concert_drill_perception concert_model concert_kinematics
@@ -58,6 +58,6 @@ target_compile_definitions(drill_params_test PRIVATE CONCERT_DRILL_CONFIG_DIR="$
 
 # The drill's own joint-space paths: the way back, settles, the base kept where it stands.
 concert_add_test(NAME drill_paths_test
-  SOURCES test/paths_test.cpp test/plan_exchange_test.cpp
+  SOURCES test/paths_test.cpp test/plan_exchange_test.cpp test/inputs_test.cpp
   LIBS concert_drill_core
   LABELS drill)

@@ -173,3 +173,65 @@ TEST(DrillNode, AfterAStopNoPlanRequestIsSentAgain) {
 }  // namespace
 }  // namespace concert::drill::dds
 
+
+namespace concert::drill::dds {
+namespace {
+
+// The robot's and nav's words as the core reads them: running, done, or failed saying how.
+TEST(DrillConversions, TrajectoryAndNavStatusesBecomeProgressWithHowTheyFailed) {
+  msg::TrajectoryStatus t;
+  t.state(msg::TRAJECTORY_EXECUTING);
+  EXPECT_EQ(to_core(t).progress, Progress::kRunning);
+  t.state(msg::TRAJECTORY_SUCCEEDED);
+  EXPECT_EQ(to_core(t).progress, Progress::kSucceeded);
+  t.state(msg::TRAJECTORY_REFUSED);
+  t.reason("stale model version 3");
+  EXPECT_EQ(to_core(t).progress, Progress::kFailed);
+  EXPECT_EQ(to_core(t).failure, "refused");
+  EXPECT_EQ(to_core(t).reason, "stale model version 3");
+  t.state(msg::TRAJECTORY_ABORTED);
+  EXPECT_EQ(to_core(t).failure, "aborted");
+
+  msg::NavStatus n;
+  for (const auto s : {msg::NAV_IDLE, msg::NAV_PLANNING, msg::NAV_FOLLOWING}) {
+    n.state(s);
+    EXPECT_EQ(to_core(n).progress, Progress::kRunning);
+  }
+  n.state(msg::NAV_REACHED);
+  EXPECT_EQ(to_core(n).progress, Progress::kSucceeded);
+  n.state(msg::NAV_CANCELLED);
+  EXPECT_EQ(to_core(n).progress, Progress::kFailed);
+  EXPECT_EQ(to_core(n).failure, "cancelled");
+
+  msg::SafetyState st;
+  st.mode(msg::SAFETY_STOPPED);
+  st.causes({"estop: software engaged"});
+  EXPECT_FALSE(to_core(st).running);
+  EXPECT_EQ(to_core(st).causes.size(), 1u);
+}
+
+// A planner state this build does not know is a failure, never progress.
+TEST(DrillConversions, APlanResultBecomesAReplyWithItsTrajectory) {
+  msg::PlanResult r;
+  r.request_id(9);
+  r.state(msg::PLAN_FAILED);
+  r.failure(msg::PLAN_NO_PATH);
+  r.reason("no path");
+  r.joint_names({"base_x"});
+  msg::TrajectorySample s;
+  s.time(0.5);
+  s.position({1.0});
+  r.trajectory().push_back(s);
+  const PlanReply p = to_core(r);
+  EXPECT_EQ(p.request_id, 9u);
+  EXPECT_EQ(p.state, PlanState::kFailed);
+  EXPECT_EQ(p.failure, PlanFailure::kNoPath);
+  EXPECT_EQ(p.reason, "no path");
+  ASSERT_EQ(p.path.samples.size(), 1u);
+  EXPECT_DOUBLE_EQ(p.path.samples[0].time, 0.5);
+  r.state(static_cast<msg::PlanState>(42));
+  EXPECT_EQ(to_core(r).state, PlanState::kFailed);
+}
+
+}  // namespace
+}  // namespace concert::drill::dds

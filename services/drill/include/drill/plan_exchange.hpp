@@ -1,8 +1,9 @@
 #pragma once
 // What the drill asks the whole-body planner and what the planner answers, as the drill's
 // decisions use them: concert/planner/request and concert/planner/result (idl/planning.idl)
-// without the DDS. The adapter converts these to and from the messages; the core decides with
-// them. Poses are in the odometry frame, like the messages'.
+// without the DDS; and the robot's and nav's word on the trajectories and goals the drill sent,
+// and the safety state. The adapter converts these to and from the messages; the core decides
+// with them. Poses are in the odometry frame, like the messages'.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "drill/paths.hpp"
+#include "drill/ports.hpp"
 
 namespace concert::drill {
 
@@ -57,6 +59,20 @@ struct PlanReply {
   PlanFailure failure{PlanFailure::kOk};
   std::string reason;
   Path path;
+};
+
+/// The robot's latest word on a trajectory the drill sent (concert/robot/trajectory_status), or
+/// nav's on a goal (concert/nav/status): still running, done, or failed with how and why.
+struct MotionReply {
+  Progress progress{Progress::kRunning};
+  std::string failure;  ///< when failed: "refused", "aborted", "failed" or "cancelled"
+  std::string reason;   ///< the sender's reason
+};
+
+/// The safety service's state as the drill's health check reads it (concert/safety/state).
+struct SafetyWord {
+  bool running{false};
+  std::vector<std::string> causes;  ///< why stopped
 };
 
 /// `incoming` taken into `kept`, the last answer for its request. The trajectory of an executed

@@ -78,6 +78,40 @@ constexpr EnumMap kPlanFailures{std::array{
 
 }  // namespace
 
+MotionReply to_core(const msg::TrajectoryStatus& s) {
+  switch (s.state()) {
+    case msg::TRAJECTORY_EXECUTING:
+      return {Progress::kRunning, {}, s.reason()};
+    case msg::TRAJECTORY_SUCCEEDED:
+      return {Progress::kSucceeded, {}, s.reason()};
+    case msg::TRAJECTORY_REFUSED:
+      return {Progress::kFailed, "refused", s.reason()};
+    case msg::TRAJECTORY_ABORTED:
+      break;
+  }
+  return {Progress::kFailed, "aborted", s.reason()};
+}
+
+MotionReply to_core(const msg::NavStatus& s) {
+  switch (s.state()) {
+    case msg::NAV_REACHED:
+      return {Progress::kSucceeded, {}, s.reason()};
+    case msg::NAV_FAILED:
+      return {Progress::kFailed, "failed", s.reason()};
+    case msg::NAV_CANCELLED:
+      return {Progress::kFailed, "cancelled", s.reason()};
+    case msg::NAV_REFUSED:
+      return {Progress::kFailed, "refused", s.reason()};
+    case msg::NAV_IDLE:
+    case msg::NAV_PLANNING:
+    case msg::NAV_FOLLOWING:
+      break;
+  }
+  return {Progress::kRunning, {}, s.reason()};
+}
+
+SafetyWord to_core(const msg::SafetyState& s) { return {s.mode() == msg::SAFETY_RUNNING, s.causes()}; }
+
 Eigen::Vector3d odometry_of(const msg::Odometry& o) { return {o.x(), o.y(), o.yaw()}; }
 
 PlanReply to_core(const msg::PlanResult& r) {

@@ -7,7 +7,9 @@
 #include <cstdint>
 
 #include "drill.h"
+#include "nav.h"
 #include "planning.h"
+#include "system.h"
 #include "robot.h"
 #include "drill/mission_tree.hpp"
 #include "drill/plan_exchange.hpp"
@@ -22,6 +24,11 @@ msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status, c
 PlanReply to_core(const msg::PlanResult& r);
 /// A request as the planner takes it, stamped now.
 msg::PlanRequest to_msg(const PlanAsk& a);
+
+/// The robot's word on a trajectory, nav's on a goal, the safety state, as the core reads them.
+MotionReply to_core(const msg::TrajectoryStatus& s);
+MotionReply to_core(const msg::NavStatus& s);
+SafetyWord to_core(const msg::SafetyState& s);
 
 /// x, y, yaw of an odometry message.
 Eigen::Vector3d odometry_of(const msg::Odometry& o);

@@ -110,31 +110,20 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
       odometry_in_(participant, cdds::topics::odometry,
                    [this](const msg::Odometry& o, const auto&) {
                      map_frame_.on_odometry(o.stamp_ns(), odometry_of(o));
-                     std::lock_guard lock(mutex_);
-                     odometry_ = o;
+                     inputs_.on_odometry(odometry_of(o));
                    }),
       safety_in_(participant, cdds::topics::safety_state,
-                 [this](const msg::SafetyState& s, const auto&) {
-                   std::lock_guard lock(mutex_);
-                   safety_ = s;
-                 }),
+                 [this](const msg::SafetyState& s, const auto&) { inputs_.on_safety(to_core(s)); }),
       services_in_(participant, cdds::topics::status,
                    [this](const msg::ServiceStatus& s, const auto&) { on_service(s); }),
       plans_in_(participant, cdds::topics::plan_result,
-                [this](const msg::PlanResult& r, const auto&) {
-                  std::lock_guard lock(mutex_);
-                  merge_reply(plan_results_[r.request_id()], to_core(r));
-                }),
+                [this](const msg::PlanResult& r, const auto&) { inputs_.on_plan(to_core(r)); }),
       trajectories_in_(participant, cdds::topics::trajectory_status,
                        [this](const msg::TrajectoryStatus& s, const auto&) {
-                         std::lock_guard lock(mutex_);
-                         trajectory_statuses_[s.request_id()] = s;
+                         inputs_.on_trajectory(s.request_id(), to_core(s));
                        }),
       nav_in_(participant, cdds::topics::nav_status,
-              [this](const msg::NavStatus& s, const auto&) {
-                std::lock_guard lock(mutex_);
-                nav_statuses_[s.request_id()] = s;
-              }),
+              [this](const msg::NavStatus& s, const auto&) { inputs_.on_nav(s.request_id(), to_core(s)); }),
       localisation_in_(
           participant, cdds::topics::nav_localisation,
           [this](const msg::NavLocalisation& l, const auto&) {
@@ -170,26 +159,12 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
 
 DrillNode::~DrillNode() = default;
 
-// Joint states decimated to buffers.sample_step, each with the odometry last received.
 void DrillNode::on_joints(const msg::JointState& s) {
-  std::lock_guard lock(mutex_);
-  joints_seen_ = Clock::now();
-  if (!samples_.empty() && s.stamp_ns() - samples_.back().stamp_ns < tuning_.buffers.sample_step.count()) return;
-  Sample sample;
-  sample.stamp_ns = s.stamp_ns();
-  sample.joints = {s.name(), s.position()};
-  if (odometry_) sample.odometry = odometry_of(*odometry_);
-  samples_.push_back(std::move(sample));
-  while (samples_.size() > tuning_.buffers.samples) samples_.pop_front();
+  inputs_.on_joints(s.stamp_ns(), {s.name(), s.position()}, Clock::now());
 }
 
 void DrillNode::on_service(const msg::ServiceStatus& s) {
-  std::lock_guard lock(mutex_);
-  if (s.state() != msg::SERVICE_STOPPED) {
-    services_seen_[s.service()] = Clock::now();
-  } else {
-    services_seen_.erase(s.service());
-  }
+  inputs_.on_service(s.service(), s.state() == msg::SERVICE_STOPPED, Clock::now());
 }
 
 void DrillNode::log_line(const std::string& line) {
@@ -221,9 +196,9 @@ void DrillNode::assemble_frame() {
       info_->stamp_ns() != rgb_->stamp_ns())
     return;
   const std::int64_t stamp = rgb_->stamp_ns();
-  CameraFrame f;
+  hardware::RgbdFrame f;
   try {
-    f.frame = sensors_dds::to_rgbd_frame(*rgb_, *depth_, *info_);
+    f = sensors_dds::to_rgbd_frame(*rgb_, *depth_, *info_);
   } catch (const std::exception& e) {
     log_line(std::string("drill: camera frame dropped: ") + e.what());
     rgb_.reset();
@@ -231,55 +206,7 @@ void DrillNode::assemble_frame() {
   }
   rgb_.reset();
   depth_.reset();
-  if (!rig_) return;
-  const Sample* s = nullptr;
-  for (auto it = samples_.rbegin(); it != samples_.rend(); ++it) {
-    if (it->stamp_ns <= stamp) {
-      s = &*it;
-      break;
-    }
-  }
-  if (s == nullptr) return;
-  f.stamp_ns = stamp;
-  f.base_T_optical = rig_->camera_in_base(rig_->q(s->joints));
-  f.world_T_optical = rig_->base_in_world(s->odometry) * f.base_T_optical;
-  frames_.push_back(std::move(f));
-  while (frames_.size() > tuning_.buffers.frames) frames_.pop_front();
-}
-
-std::optional<DrillNode::Sample> DrillNode::latest_sample() const {
-  std::lock_guard lock(mutex_);
-  if (samples_.empty()) return std::nullopt;
-  Sample s = samples_.back();
-  if (odometry_) s.odometry = odometry_of(*odometry_);
-  return s;
-}
-
-std::vector<DrillNode::CameraFrame> DrillNode::frames_since(std::int64_t since_ns) const {
-  std::lock_guard lock(mutex_);
-  std::vector<CameraFrame> out;
-  for (const CameraFrame& f : frames_) {
-    if (f.stamp_ns > since_ns) out.push_back(f);
-  }
-  return out;
-}
-
-std::optional<DrillNode::CameraFrame> DrillNode::averaged_view(std::int64_t since_ns,
-                                                               int count) const {
-  std::vector<CameraFrame> frames;
-  {
-    // Copies only the frames averaged (each is 1.5 MB at 640 x 480), once enough have come.
-    std::lock_guard lock(mutex_);
-    const auto newer = std::count_if(frames_.begin(), frames_.end(),
-                                     [&](const CameraFrame& f) { return f.stamp_ns > since_ns; });
-    if (newer < count) return std::nullopt;
-    frames.assign(frames_.end() - count, frames_.end());
-  }
-  DepthAverager averager(static_cast<std::size_t>(count));
-  for (const CameraFrame& f : frames) averager.add(f.frame);
-  CameraFrame out = frames.back();
-  out.frame = averager.average();
-  return out;
+  inputs_.on_frame(stamp, std::move(f));
 }
 
 // --- The control loop ------------------------------------------------------------------------
@@ -416,8 +343,8 @@ void DrillNode::apply_model(const msg::RobotModel& m) {
     std::lock_guard lock(mutex_);
     rig_ = rig;
     camera_ = rig ? rig->camera() : "";
-    frames_.clear();
   }
+  inputs_.set_rig(rig);
   rig_error_ = error;
   if (mission_active()) {
     tree_->abort("the robot model changed (version " + std::to_string(old) + " -> " +
@@ -498,50 +425,13 @@ void DrillNode::publish_status(bool force) {
 // --- Ports: health, areas, navigation, planning, execution -----------------------------------
 
 Outcome DrillNode::health() {
-  std::lock_guard lock(mutex_);
-  if (!rig_)
-    return Outcome::failed(rig_error_.empty() ? "the robot model cannot drill" : rig_error_);
-  // A service not heard yet when the mission began (a stack just started: its status or the
-  // joint states not matched yet) is waited for, liveness.service_lost at most.
-  const bool starting = seconds_since(mission_started_) < tuning_.liveness.service_lost;
-  if (!safety_) {
-    return starting ? Outcome::running()
-                    : Outcome::failed("no safety state from the safety service");
-  }
-  if (safety_->mode() != msg::SAFETY_RUNNING) {
-    std::string causes;
-    for (const auto& c : safety_->causes()) causes += (causes.empty() ? "" : ", ") + c;
-    return Outcome::failed("safety stop" + (causes.empty() ? "" : " (" + causes + ")"));
-  }
-  if (joints_seen_ == Clock::time_point{}) {
-    if (starting) return Outcome::running();
-    return Outcome::failed("no joint state from the robot service (never heard)");
-  }
-  if (seconds_since(joints_seen_) > tuning_.liveness.joints_lost) {
-    return Outcome::failed("no joint state from the robot service (lost)");
-  }
-  for (const char* service : {"planner"}) {
-    const auto seen = services_seen_.find(service);
-    if (seen == services_seen_.end() && starting) return Outcome::running();
-    if (seen == services_seen_.end() || seconds_since(seen->second) > tuning_.liveness.service_lost) {
-      return Outcome::failed(std::string("the ") + service + " service is lost");
-    }
-  }
-  if (nav_request_ != 0) {
-    const auto seen = services_seen_.find("nav");
-    if (seen == services_seen_.end() || seconds_since(seen->second) > tuning_.liveness.service_lost) {
-      return Outcome::failed("the nav service is lost");
-    }
-  }
-  return Outcome::succeeded();
+  if (!rig_) return Outcome::failed(rig_error_.empty() ? "the robot model cannot drill" : rig_error_);
+  return inputs_.health(mission_started_, nav_request_ != 0, Clock::now());
 }
 
 void DrillNode::resolve(std::size_t area, const AreaSpec& spec) {
   resolve_specs_[area] = spec;
-  {
-    std::lock_guard lock(mutex_);
-    resolve_since_[area] = frames_.empty() ? 0 : frames_.back().stamp_ns;
-  }
+  resolve_since_[area] = inputs_.newest_stamp();
   if (spec.wall.empty()) return;  // located from the camera in resolution()
   // A BIM wall: the area frame and the base pose from the building's model (load_ifc runs the
   // IFC import step, a second or two, off the control thread).
@@ -596,13 +486,13 @@ Outcome DrillNode::resolution(std::size_t area, ResolvedArea& out) {
     return Outcome::succeeded();
   }
   const std::optional<CameraFrame> view =
-      averaged_view(resolve_since_[area], tuning_.camera.averaged_frames);
+      inputs_.averaged_view(resolve_since_[area], tuning_.camera.averaged_frames);
   if (!view) return Outcome::running();
   const CameraView camera{&view->frame, view->world_T_optical};
   if (spec.point && !in_view(camera, *spec.point)) {
     // Where the arm is parked the drill camera may not see the point: plan the approach to a
     // frame facing the robot, and measure the surface with the drill camera once there.
-    const std::optional<Sample> s = latest_sample();
+    const std::optional<Sample> s = inputs_.latest_sample();
     out = provisional_area(
         *spec.point, rig_->base_in_world(s ? s->odometry : Eigen::Vector3d::Zero()).translation());
     log_line("drill: area '" + spec.name +
@@ -657,21 +547,11 @@ void DrillNode::navigate(const BasePose& goal) {
 }
 
 Outcome DrillNode::navigation() {
-  std::lock_guard lock(mutex_);
-  const auto it = nav_statuses_.find(nav_request_);
-  if (it == nav_statuses_.end()) return Outcome::running();
-  switch (it->second.state()) {
-    case msg::NAV_REACHED:
-      nav_request_ = 0;
-      return Outcome::succeeded();
-    case msg::NAV_FAILED:
-    case msg::NAV_CANCELLED:
-    case msg::NAV_REFUSED:
-      nav_request_ = 0;
-      return Outcome::failed("navigation: " + it->second.reason());
-    default:
-      return Outcome::running();
-  }
+  const std::optional<MotionReply> reply = inputs_.nav(nav_request_);
+  if (!reply || reply->progress == Progress::kRunning) return Outcome::running();
+  nav_request_ = 0;
+  if (reply->progress == Progress::kSucceeded) return Outcome::succeeded();
+  return Outcome::failed("navigation: " + reply->reason);
 }
 
 void DrillNode::plan(std::size_t area, const Eigen::Isometry3d& located,
@@ -707,12 +587,7 @@ Outcome DrillNode::planning(std::size_t area) {
   if (it == plans_.end()) return Outcome::failed("no plan was asked for this area");
   Plan& p = it->second;
   if (p.result) return Outcome::succeeded();
-  std::optional<PlanReply> r;
-  {
-    std::lock_guard lock(mutex_);
-    const auto found = plan_results_.find(p.request_id);
-    if (found != plan_results_.end()) r = found->second;
-  }
+  const std::optional<PlanReply> r = inputs_.plan(p.request_id);
   if (!r) return Outcome::running();
   if (r->state == PlanState::kFailed && p.attempts < tuning_.approach.attempts &&
       (r->failure == PlanFailure::kNoPath || r->failure == PlanFailure::kUnreachable)) {
@@ -764,7 +639,7 @@ std::uint32_t DrillNode::send_trajectory(const std::vector<std::string>& names,
 void DrillNode::execute(std::size_t area) {
   executing_area_ = area;
   if (!hole_chain_.empty()) {
-    if (const std::optional<Sample> s = latest_sample()) {
+    if (const std::optional<Sample> s = inputs_.latest_sample()) {
       trajectory_request_ = send_trajectory(hole_chain_.front().names, return_path(hole_chain_, *s, path_timing(tuning_)));
       returning_ = true;
       return;
@@ -776,30 +651,23 @@ void DrillNode::execute(std::size_t area) {
 }
 
 Outcome DrillNode::execution() {
-  std::lock_guard lock(mutex_);
-  const auto it = trajectory_statuses_.find(trajectory_request_);
-  if (it == trajectory_statuses_.end()) return Outcome::running();
-  if (returning_ && it->second.state() == msg::TRAJECTORY_SUCCEEDED) {
+  const std::optional<MotionReply> status = inputs_.trajectory(trajectory_request_);
+  if (!status) return Outcome::running();
+  const MotionReply& reply = *status;
+  if (returning_ && reply.progress == Progress::kSucceeded) {
     returning_ = false;
     hole_chain_.clear();
     const Plan& p = plans_.at(*executing_area_);
     trajectory_request_ = send_trajectory(p.names, p.result->path.samples);
     return Outcome::running();
   }
-  switch (it->second.state()) {
-    case msg::TRAJECTORY_SUCCEEDED:
-      hole_chain_.clear();
-      return Outcome::succeeded();
-    case msg::TRAJECTORY_ABORTED:
-    case msg::TRAJECTORY_REFUSED:
-      return Outcome::failed(
-          std::string(returning_ ? "robot: the way back from the holes "
-                                 : "robot: approach trajectory ") +
-          std::string(it->second.state() == msg::TRAJECTORY_REFUSED ? "refused" : "aborted") +
-          ": " + it->second.reason());
-    default:
-      return Outcome::running();
+  if (reply.progress == Progress::kRunning) return Outcome::running();
+  if (reply.progress == Progress::kSucceeded) {
+    hole_chain_.clear();
+    return Outcome::succeeded();
   }
+  return Outcome::failed(std::string(returning_ ? "robot: the way back from the holes " : "robot: approach trajectory ") +
+                         reply.failure + ": " + reply.reason);
 }
 
 // --- Ports: detection and the drilling motion ------------------------------------------------
@@ -809,9 +677,7 @@ void DrillNode::detect(std::size_t area, const AreaSpec& spec, const ResolvedAre
   detection_.area = area;
   detection_.spec = spec;
   detection_.located = located;
-  std::lock_guard lock(mutex_);
-  detection_.since_ns =
-      frames_.empty() ? 0 : frames_.back().stamp_ns;  // frames taken after the arm stopped
+  detection_.since_ns = inputs_.newest_stamp();  // frames taken after the arm stopped
 }
 
 // The approach drifts odometry along the wall too (by up to several centimetres), where the
@@ -847,7 +713,7 @@ void DrillNode::follow_start_blobs(const CameraView& camera, ResolvedArea& locat
 
 Outcome DrillNode::detection(std::vector<DrillPoint>& points) {
   const std::optional<CameraFrame> view =
-      averaged_view(detection_.since_ns, tuning_.camera.averaged_frames);
+      inputs_.averaged_view(detection_.since_ns, tuning_.camera.averaged_frames);
   if (!view) return Outcome::running();
   if (!patterns_ && detection_.spec.marks == MarkKind::kAruco) {
     return Outcome::failed(
@@ -948,7 +814,7 @@ PlanAsk DrillNode::placement_request(const Eigen::Isometry3d& goal) {
 void DrillNode::place(std::size_t area, const std::vector<DrillPoint>& holes) {
   motion_outcome_.reset();
   placement_ = Placement{};
-  const std::optional<Sample> s = latest_sample();
+  const std::optional<Sample> s = inputs_.latest_sample();
   const bool pattern = !holes.empty() && std::all_of(holes.begin(), holes.end(), [&](const DrillPoint& h) {
     return h.marker >= 0 && h.marker == holes.front().marker;
   });
@@ -1203,7 +1069,7 @@ void DrillNode::place_move_step() {
   hole_chain_.push_back({placement_.names[k], placement_.bodies[k]});
   // The base moved: the marker's last sighting no longer places the holes.
   markers_seen_at_.erase(point_.marker);
-  if (const std::optional<Sample> s = latest_sample()) {
+  if (const std::optional<Sample> s = inputs_.latest_sample()) {
     const PathSample here = sample_here(placement_.names[k], *s, placement_.bodies[k].back());
     double off = 0.0, turn = 0.0;
     for (std::size_t i = 0; i < placement_.names[k].size() && i < here.position.size(); ++i) {
@@ -1244,7 +1110,7 @@ void DrillNode::place_look_again_step() {
   } else if (r->state == PlanState::kFailed && r->failure == PlanFailure::kExecutionAborted) {
     motion_ = Motion::kNone;
     motion_outcome_ = Outcome::failed("robot: the camera onto the marker from the placement: " + r->reason);
-  } else if (const std::optional<Sample> s = latest_sample();
+  } else if (const std::optional<Sample> s = inputs_.latest_sample();
              r->state == PlanState::kFailed && placement_.looks_again == 0 && s) {
     // None from where the base stands: the look checked from the posture planned, its arm
     // path taken with the base where it stands (aimed off by the base's tracking error).
@@ -1266,7 +1132,7 @@ void DrillNode::place_look_again_step() {
 }
 
 void DrillNode::place_see_step() {
-  const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, tuning_.camera.reanchor_frames);
+  const std::optional<CameraFrame> view = inputs_.averaged_view(reanchor_since_ns_, tuning_.camera.reanchor_frames);
   if (!view) return;
   // The pattern measured again as a hole's look measures it (its drift to OdometryDrift, the
   // marker's sighting kept for the area's holes).
@@ -1323,7 +1189,7 @@ void DrillNode::place_look(std::size_t attempt) {
 // drilling force checked against the torque limits, the whole body moving) and the path
 // there; the Cartesian alignment does the last centimetres, the way back is that path reversed.
 void DrillNode::align(const DrillPoint& point) {
-  const std::optional<Sample> s = latest_sample();
+  const std::optional<Sample> s = inputs_.latest_sample();
   motion_outcome_.reset();
   if (!s || !rig_) {
     motion_outcome_ = Outcome::failed("no joint state to align from");
@@ -1336,10 +1202,7 @@ void DrillNode::align(const DrillPoint& point) {
   body_replans_ = 0;
   tracked_frames_ = 0;
   tracked_.setZero();
-  {
-    std::lock_guard lock(mutex_);
-    track_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
-  }
+  track_since_ns_ = inputs_.newest_stamp();
   // A blob where the area's last re-measure puts it (shift_area: odometry drifted since).
   for (const DrillPoint& p : area_points_) {
     if (p.marker < 0 && p.label == point.label) point_.frame = p.frame;
@@ -1415,14 +1278,13 @@ void DrillNode::start_align(const Sample& s) {
   drill_motion_.start_align(base_T_world_ * point_.frame, rig_->tip_in_base(rig_->q(s.joints)),
                             now_);
   motion_ = Motion::kAlign;
-  std::lock_guard lock(mutex_);
-  servo_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
+  servo_since_ns_ = inputs_.newest_stamp();
 }
 
 Outcome DrillNode::alignment() { return motion_outcome_ ? *motion_outcome_ : Outcome::running(); }
 
 void DrillNode::drill(const DrillPoint& point, double depth) {
-  const std::optional<Sample> s = latest_sample();
+  const std::optional<Sample> s = inputs_.latest_sample();
   motion_outcome_.reset();
   if (!s || !rig_) {
     motion_outcome_ = Outcome::failed("no joint state to drill from");
@@ -1436,7 +1298,7 @@ void DrillNode::drill(const DrillPoint& point, double depth) {
 Outcome DrillNode::drilling() { return motion_outcome_ ? *motion_outcome_ : Outcome::running(); }
 
 void DrillNode::retract() {
-  const std::optional<Sample> s = latest_sample();
+  const std::optional<Sample> s = inputs_.latest_sample();
   motion_outcome_.reset();
   if (!s || !rig_) {
     motion_outcome_ = Outcome::failed("no joint state to retract from");
@@ -1462,7 +1324,7 @@ void DrillNode::stop() {
 
 // The arm holds where it is (position mode at the measured positions); the base stops.
 void DrillNode::send_hold() {
-  const std::optional<Sample> s = latest_sample();
+  const std::optional<Sample> s = inputs_.latest_sample();
   if (!s || !rig_) return;
   msg::JointCommand c;
   c.model_version(static_cast<std::uint32_t>(model_version_));
@@ -1505,8 +1367,7 @@ void DrillNode::send_cartesian(const CartesianReference& r) {
 }
 
 void DrillNode::start_reanchor(Motion next) {
-  std::lock_guard lock(mutex_);
-  reanchor_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
+  reanchor_since_ns_ = inputs_.newest_stamp();
   motion_ = next;
 }
 
@@ -1576,11 +1437,8 @@ std::string blobs_seen(const CameraView& view, const Eigen::Isometry3d& predicte
 
 void DrillNode::track_area() {
   if (point_.marker >= 0 || hole_request_.fixed_base || area_points_.empty()) return;
-  std::optional<CameraFrame> newest;  // the newest only: detection costs, and the drift is slow
-  {
-    std::lock_guard lock(mutex_);
-    if (!frames_.empty() && frames_.back().stamp_ns > track_since_ns_) newest = frames_.back();
-  }
+  // The newest only: detection costs, and the drift is slow.
+  const std::optional<CameraFrame> newest = inputs_.newest_frame(track_since_ns_);
   if (!newest) return;
   track_since_ns_ = newest->stamp_ns;
   const std::optional<AreaShift> shift =
@@ -1653,10 +1511,7 @@ void DrillNode::replan_body() {
   checked_path_ = {};
   tracked_frames_ = 0;
   tracked_.setZero();
-  {
-    std::lock_guard lock(mutex_);
-    track_since_ns_ = frames_.empty() ? 0 : frames_.back().stamp_ns;
-  }
+  track_since_ns_ = inputs_.newest_stamp();
   set_hole_task(hole_request_, tuning_.hole.attempts[hole_attempt_], hole_distance_, hole_depth(),
                 tuning_);
   request_hole_posture();
@@ -1681,11 +1536,8 @@ void DrillNode::replan_after_look() {
 // The camera's smaller field-of-view angle: from its newest frame's intrinsics, else the
 // configured one.
 double DrillNode::camera_fov() const {
-  std::lock_guard lock(mutex_);
-  if (!frames_.empty() && frames_.back().frame.intrinsics.fx > 0.0 &&
-      frames_.back().frame.intrinsics.fy > 0.0)
-    return smaller_fov(frames_.back().frame.intrinsics);
-  return tuning_.camera.fov;
+  const std::optional<hardware::CameraIntrinsics> k = inputs_.intrinsics();
+  return k ? smaller_fov(*k) : tuning_.camera.fov;
 }
 
 void DrillNode::request_look(std::size_t attempt) {
@@ -1768,7 +1620,7 @@ bool DrillNode::remeasure_looked_blob(const CameraView& camera) {
     hole_seen_again(blob->translation());
     shift_area(moved);
     point_.frame = *blob;
-    const std::optional<Sample> s = latest_sample();
+    const std::optional<Sample> s = inputs_.latest_sample();
     if (moved.norm() <= tuning_.hole.replan_shift && look_pushed_ && hole_chain_.size() > 1 && s) {
       // Where the whole body's posture was planned for: back onto it, no new posture (the
       // arm waiting in the look posture while one is sought holds J3_E at its continuous
@@ -1845,12 +1697,7 @@ void DrillNode::keep_unseen_view(const CameraView& camera, const Eigen::Vector3d
 }
 
 // The latest result of plan request `id`, if any has come.
-std::optional<PlanReply> DrillNode::plan_result(std::uint32_t id) const {
-  std::lock_guard lock(mutex_);
-  const auto it = plan_results_.find(id);
-  if (it == plan_results_.end()) return std::nullopt;
-  return it->second;
-}
+std::optional<PlanReply> DrillNode::plan_result(std::uint32_t id) const { return inputs_.plan(id); }
 
 // The whole body's candidate posture (body_candidate_) sent to the robot by the drill.
 void DrillNode::move_to_candidate() {
@@ -1861,15 +1708,10 @@ void DrillNode::move_to_candidate() {
 // The drill's own trajectory (trajectory_request_): true once the robot ran it; refused or
 // aborted, the hole fails ("robot: <what>: <reason>").
 bool DrillNode::trajectory_ran(const std::string& what) {
-  std::optional<msg::TrajectoryStatus> status;
-  {
-    std::lock_guard lock(mutex_);
-    const auto it = trajectory_statuses_.find(trajectory_request_);
-    if (it != trajectory_statuses_.end()) status = it->second;
-  }
-  if (!status || status->state() == msg::TRAJECTORY_EXECUTING) return false;
-  if (status->state() == msg::TRAJECTORY_SUCCEEDED) return true;
-  motion_outcome_ = Outcome::failed("robot: " + what + ": " + status->reason());
+  const std::optional<MotionReply> status = inputs_.trajectory(trajectory_request_);
+  if (!status || status->progress == Progress::kRunning) return false;
+  if (status->progress == Progress::kSucceeded) return true;
+  motion_outcome_ = Outcome::failed("robot: " + what + ": " + status->reason);
   motion_ = Motion::kNone;
   return false;
 }
@@ -1898,7 +1740,7 @@ void DrillNode::posture_reached() {
   }
   const auto seen_at = markers_seen_at_.find(point_.marker);
   const bool stale = seen_at == markers_seen_at_.end() || now_ - seen_at->second > tuning_.looks.marker_stale;
-  const std::optional<Sample> s = latest_sample();
+  const std::optional<Sample> s = inputs_.latest_sample();
   if (point_.marker >= 0 && !looked_ && !hole_request_.fixed_base && s &&
       !checked_path_.samples.empty() && prepare_look()) {
     // The look check_look() planned from the posture: the planner's look postures are drawn at
@@ -1976,7 +1818,7 @@ void DrillNode::control_motion() {
 // The Cartesian phases (DrillMotion): the hole followed as the base creeps, the blob servoed, the
 // reference sent; out of the hole, back onto the drilling posture.
 void DrillNode::cartesian_step() {
-  const std::optional<Sample> s = latest_sample();
+  const std::optional<Sample> s = inputs_.latest_sample();
   if (!s) return;
   {
     // The hole stays where the world has it as the base moves: the wheels' velocity loops
@@ -1987,7 +1829,7 @@ void DrillNode::cartesian_step() {
     base_T_world_ = now_T_world;
   }
   if (point_.servo && (motion_ == Motion::kAlign || motion_ == Motion::kDrill)) {
-    for (const CameraFrame& f : frames_since(servo_since_ns_)) {
+    for (const CameraFrame& f : inputs_.frames_since(servo_since_ns_)) {
       servo_since_ns_ = f.stamp_ns;
       const Eigen::Isometry3d world_hole = base_T_world_.inverse() * drill_motion_.hole();
       const std::optional<Eigen::Isometry3d> seen = track_blob(
@@ -2075,7 +1917,7 @@ void DrillNode::hole_posture_step() {
 // The hole's posture planned again after its re-measure found none for the arm alone: the whole
 // body's posture once more (up to hole.body_replans), or the alignment from the posture reached.
 void DrillNode::no_posture_after_remeasure(const PlanReply& r) {
-  const std::optional<Sample> s = latest_sample();
+  const std::optional<Sample> s = inputs_.latest_sample();
   if (!s) return;
   const double shift = (point_.frame.translation() - body_goal_).norm();
   if (body_replans_ < tuning_.hole.body_replans && shift > tuning_.hole.replan_shift) {
@@ -2206,13 +2048,13 @@ void DrillNode::look_at_hole_step() {
 }
 
 void DrillNode::look_reanchor_step() {
-  const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, tuning_.camera.reanchor_frames);
+  const std::optional<CameraFrame> view = inputs_.averaged_view(reanchor_since_ns_, tuning_.camera.reanchor_frames);
   if (!view) return;
   const CameraView camera{&view->frame, view->world_T_optical};
   if (point_.marker < 0) {
     if (remeasure_looked_blob(camera)) return;
   } else if (!remeasure_looked_marker(camera)) {
-    const std::optional<Sample> s = latest_sample();
+    const std::optional<Sample> s = inputs_.latest_sample();
     if (look_attempt_ + 1 < tuning_.looks.attempts.size() && look_pushed_ && hole_chain_.size() > 1 && s) {
       // From another look (a hole drilled where odometry puts it can be 2 cm off).
       log_line("drill: " + point_.label + ": marker " + std::to_string(point_.marker) +
@@ -2235,7 +2077,7 @@ void DrillNode::look_reanchor_step() {
   // posture of the arm alone planned within hole.replan_shift of
   // the hole as measured now is aligned from (the alignment covers the rest); otherwise the
   // posture is planned again from there.
-  const std::optional<Sample> s = latest_sample();
+  const std::optional<Sample> s = inputs_.latest_sample();
   if (look_pushed_ && hole_chain_.size() > 1 && s && !hole_request_.goals.empty()) {
     const double moved =
         (point_.frame.translation() - hole_request_.goals.front().translation()).norm();
@@ -2251,7 +2093,7 @@ void DrillNode::back_then_replan_step() {
 }
 
 void DrillNode::reanchor_step() {
-  const std::optional<CameraFrame> view = averaged_view(reanchor_since_ns_, tuning_.camera.reanchor_frames);
+  const std::optional<CameraFrame> view = inputs_.averaged_view(reanchor_since_ns_, tuning_.camera.reanchor_frames);
   if (!view) return;
   static const PatternTable kNone;
   const CameraView camera{&view->frame, view->world_T_optical};
@@ -2313,7 +2155,7 @@ void DrillNode::reanchor_step() {
       return;
     }
   }
-  if (const std::optional<Sample> s = latest_sample()) start_align(*s);
+  if (const std::optional<Sample> s = inputs_.latest_sample()) start_align(*s);
 }
 
 void DrillNode::back_for_look_step() {
@@ -2327,7 +2169,7 @@ void DrillNode::settle_step() {
   if (motion_ == Motion::kSettle) {
     motion_outcome_ = Outcome::succeeded();
     motion_ = Motion::kNone;
-  } else if (const std::optional<Sample> here = latest_sample()) {
+  } else if (const std::optional<Sample> here = inputs_.latest_sample()) {
     start_align(*here);
   }
 }

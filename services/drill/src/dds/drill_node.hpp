@@ -29,6 +29,7 @@
 #include "drill/area_detection.hpp"
 #include "drill/drill_motion.hpp"
 #include "drill/drill_rig.hpp"
+#include "drill/inputs.hpp"
 #include "drill/mission_tree.hpp"
 #include "drill/odometry_drift.hpp"
 #include "drill/patterns.hpp"
@@ -101,12 +102,6 @@ class DrillNode final : public MissionPorts {
     std::optional<PlanReply> result;
     std::vector<std::string> names;  ///< of the trajectory
     Eigen::VectorXd end;             ///< last sample's positions
-  };
-  struct CameraFrame {
-    std::int64_t stamp_ns{0};
-    hardware::RgbdFrame frame;
-    Eigen::Isometry3d world_T_optical{Eigen::Isometry3d::Identity()};
-    Eigen::Isometry3d base_T_optical{Eigen::Isometry3d::Identity()};
   };
   enum class Motion {
     kNone,
@@ -243,11 +238,6 @@ class DrillNode final : public MissionPorts {
   std::vector<PathSample> settle_path(const PlannedPath& p, const PathSample& here);
   void request_look(std::size_t attempt);
   std::uint32_t send_trajectory(const std::vector<std::string>& names, const std::vector<PathSample>& samples);
-  [[nodiscard]] std::optional<Sample> latest_sample() const;
-  /// Frames of the drill camera since `since` (robot clock), newest last.
-  [[nodiscard]] std::vector<CameraFrame> frames_since(std::int64_t since_ns) const;
-  /// The latest `count` frames averaged (depth), with the newest's pose; none if fewer.
-  [[nodiscard]] std::optional<CameraFrame> averaged_view(std::int64_t since_ns, int count) const;
   void on_joints(const msg::JointState& state);
   void on_service(const msg::ServiceStatus& status);
   void on_image(const msg::Image& image, bool depth);
@@ -259,25 +249,17 @@ class DrillNode final : public MissionPorts {
   const Params& tuning_ = params_.tuning;
   std::ostream& log_;
   std::mutex log_mutex_;
-  mutable std::mutex mutex_;  // inbox and the sensor buffers below
+  mutable std::mutex mutex_;  // inbox, the camera's messages and its name below
   Inbox inbox_;
-  std::deque<Sample> samples_;  // joint states decimated to 200 Hz, 2 s
-  std::optional<msg::Odometry> odometry_;
+  Inputs inputs_{tuning_.buffers, tuning_.liveness};  // what was measured and heard (thread-safe)
   // Where the odometry frame lies in the map (nav's localisation): a BIM wall area is in the map,
   // the camera and the planner's requests in the odometry frame. Thread-safe on its own.
   mobile_base::MapFrame map_frame_;
-  std::chrono::steady_clock::time_point joints_seen_{};
   std::chrono::steady_clock::time_point mission_started_{};  // health waits a while from here
-  std::optional<msg::SafetyState> safety_;
-  std::map<std::string, std::chrono::steady_clock::time_point> services_seen_;
-  std::map<std::uint32_t, PlanReply> plan_results_;
-  std::map<std::uint32_t, msg::TrajectoryStatus> trajectory_statuses_;
-  std::map<std::uint32_t, msg::NavStatus> nav_statuses_;
   std::optional<msg::Image> rgb_, depth_;
   std::optional<msg::CameraInfo> info_;
-  std::deque<CameraFrame> frames_;          // the drill camera's latest frames
   std::string camera_;                      // sensor name of the drill camera (for the callbacks)
-  std::shared_ptr<const DrillRig> rig_;     // set by the control thread under mutex_
+  std::shared_ptr<const DrillRig> rig_;     // the control thread's (Inputs has its own)
   std::atomic<bool> camera_wanted_{false};  // a mission runs: the camera callbacks keep frames
 
   // Control thread.

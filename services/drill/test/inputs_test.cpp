@@ -1,0 +1,111 @@
+// What the drill keeps of what it measured and heard, and whether the robot may move
+// (drill/inputs.hpp), without DDS.
+#include "drill/inputs.hpp"
+
+#include <gtest/gtest.h>
+
+namespace concert::drill {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = Inputs::Clock;
+
+const Clock::time_point kT0{std::chrono::seconds(1000)};
+
+Inputs make_inputs() { return Inputs(Params::Buffers{}, Params::Liveness{}); }
+
+JointPositions arm(double q) { return {{"J1"}, {q}}; }
+
+// Every service a mission uses heard at `t`, safety running.
+void all_heard(Inputs& in, Clock::time_point t) {
+  in.on_safety({true, {}});
+  in.on_joints(1, arm(0.0), t);
+  in.on_service("planner", false, t);
+  in.on_service("nav", false, t);
+}
+
+TEST(DrillInputs, JointStatesAreDecimatedBoundedAndCarryTheNewestOdometry) {
+  Params::Buffers buffers;
+  buffers.sample_step = 5ms;
+  buffers.samples = 3;
+  Inputs in(buffers, Params::Liveness{});
+  EXPECT_FALSE(in.latest_sample());
+  in.on_odometry({1.0, 2.0, 0.5});
+  in.on_joints(0, arm(0.1), kT0);
+  in.on_joints(4'000'000, arm(0.2), kT0);  // within the step: dropped
+  ASSERT_TRUE(in.latest_sample());
+  EXPECT_DOUBLE_EQ(in.latest_sample()->joints.positions[0], 0.1);
+  in.on_joints(5'000'000, arm(0.3), kT0);
+  EXPECT_DOUBLE_EQ(in.latest_sample()->joints.positions[0], 0.3);
+  in.on_odometry({1.5, 2.0, 0.5});
+  EXPECT_DOUBLE_EQ(in.latest_sample()->odometry.x(), 1.5);  // the newest, not the sample's own
+  // Without a rig no frame can be posed: none kept.
+  EXPECT_FALSE(in.on_frame(5'000'000, hardware::RgbdFrame{}));
+  EXPECT_EQ(in.newest_stamp(), 0);
+  EXPECT_FALSE(in.newest_frame(0));
+  EXPECT_FALSE(in.intrinsics());
+  EXPECT_FALSE(in.averaged_view(0, 1));
+}
+
+TEST(DrillInputs, AStartingStackIsWaitedForThenEachMissingServiceIsNamed) {
+  Inputs in = make_inputs();
+  EXPECT_EQ(in.health(kT0, false, kT0 + 1s).progress, Progress::kRunning);
+  const Outcome late = in.health(kT0, false, kT0 + 6s);
+  EXPECT_EQ(late.progress, Progress::kFailed);
+  EXPECT_EQ(late.reason, "no safety state from the safety service");
+  in.on_safety({true, {}});
+  EXPECT_EQ(in.health(kT0, false, kT0 + 6s).reason, "no joint state from the robot service (never heard)");
+  in.on_joints(1, arm(0.0), kT0 + 6s);
+  EXPECT_EQ(in.health(kT0, false, kT0 + 6s).reason, "the planner service is lost");
+  in.on_service("planner", false, kT0 + 6s);
+  EXPECT_EQ(in.health(kT0, false, kT0 + 6s).progress, Progress::kSucceeded);
+}
+
+TEST(DrillInputs, ASafetyStopALostServiceOrSilentJointsStopTheMission) {
+  Inputs in = make_inputs();
+  all_heard(in, kT0);
+  EXPECT_EQ(in.health(kT0, true, kT0 + 500ms).progress, Progress::kSucceeded);
+  // Joint states older than liveness.joints_lost (1 s).
+  EXPECT_EQ(in.health(kT0, true, kT0 + 2s).reason, "no joint state from the robot service (lost)");
+  in.on_joints(2, arm(0.0), kT0 + 2s);
+  in.on_service("planner", false, kT0 + 2s);
+  // Nav heard at kT0 only: lost after liveness.service_lost (5 s), but only a mission using it fails.
+  in.on_joints(3, arm(0.0), kT0 + 6s);
+  in.on_service("planner", false, kT0 + 6s);
+  EXPECT_EQ(in.health(kT0, true, kT0 + 6s).reason, "the nav service is lost");
+  EXPECT_EQ(in.health(kT0, false, kT0 + 6s).progress, Progress::kSucceeded);
+  // A service that says it stops is gone at once.
+  in.on_service("planner", true, kT0 + 6s);
+  EXPECT_EQ(in.health(kT0, false, kT0 + 6s).reason, "the planner service is lost");
+  in.on_service("planner", false, kT0 + 6s);
+  in.on_safety({false, {"estop: software engaged (gui)", "limits: joint J1_E position"}});
+  EXPECT_EQ(in.health(kT0, false, kT0 + 6s).reason,
+            "safety stop (estop: software engaged (gui), limits: joint J1_E position)");
+}
+
+TEST(DrillInputs, RepliesAreKeptPerRequestAndPlansMerged) {
+  Inputs in = make_inputs();
+  EXPECT_FALSE(in.plan(3));
+  PlanReply planned;
+  planned.request_id = 3;
+  planned.state = PlanState::kPlanned;
+  planned.path = {{"base_x"}, {{0.0, {0.0}, {}}, {1.0, {0.5}, {}}}};
+  in.on_plan(planned);
+  PlanReply done;
+  done.request_id = 3;
+  done.state = PlanState::kSucceeded;
+  in.on_plan(done);
+  ASSERT_TRUE(in.plan(3));
+  EXPECT_EQ(in.plan(3)->state, PlanState::kSucceeded);
+  EXPECT_EQ(in.plan(3)->path.samples.size(), 2u);
+
+  in.on_trajectory(7, {Progress::kFailed, "aborted", "safety stop"});
+  EXPECT_FALSE(in.trajectory(8));
+  EXPECT_EQ(in.trajectory(7)->failure, "aborted");
+  in.on_nav(7, {Progress::kSucceeded, {}, {}});
+  EXPECT_EQ(in.nav(7)->progress, Progress::kSucceeded);
+  EXPECT_EQ(in.trajectory(7)->progress, Progress::kFailed);  // separate tables
+}
+
+}  // namespace
+}  // namespace concert::drill
