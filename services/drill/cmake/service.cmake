@@ -1,11 +1,11 @@
 # The service: the rig and area detection (core), the DDS adapter, main, `concert drill` verbs.
 concert_core_library(concert_drill_core STATIC src/core/drill_rig.cpp src/core/area_detection.cpp src/core/placement.cpp
-  src/core/paths.cpp src/core/params.cpp src/core/plan_exchange.cpp src/core/inputs.cpp)
+  src/core/paths.cpp src/core/params.cpp src/core/plan_exchange.cpp src/core/inputs.cpp src/core/engine.cpp)
 target_include_directories(concert_drill_core PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
 target_link_libraries(concert_drill_core
   PUBLIC concert_drill_tree concert_drill_control concert_drill_perception concert_model concert_kinematics
-         concert_hardware concert_config Eigen3::Eigen
-  PRIVATE concert_mobile_base)
+         concert_hardware concert_config concert_mobile_base concert_common Eigen3::Eigen
+  PRIVATE concert_bim)
 
 if(TARGET concert_dds)
   add_library(concert_drill_dds STATIC src/dds/drill_node.cpp src/dds/conversions.cpp)
@@ -35,6 +35,12 @@ if(TARGET concert_dds)
     TIMEOUT 60
     DDS)
 endif()
+
+# The mission engine without DDS: resends, acknowledgements, retries, stops, refusals.
+concert_add_test(NAME drill_engine_test
+  SOURCES test/engine_test.cpp
+  LIBS concert_drill_core
+  LABELS drill)
 
 # Area location on frames the simulator's camera renders (libs/sim SceneCamera).
 concert_add_test(NAME area_detection_test

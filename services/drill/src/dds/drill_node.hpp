@@ -1,44 +1,27 @@
 #pragma once
 // DDS adapter of the drill service: the robot model in (the drill and its camera, status READY
 // at the version or "cannot drill: ..."); joint states, odometry, the drill camera's frames,
-// the safety state and the other services' statuses in; missions and aborts in. It implements
-// the mission tree's ports with the other services' topics (nav goals, planner requests, joint
-// trajectories, Cartesian impedance commands) and publishes the mission's status and report.
+// the safety state, the planner's, robot's and nav's answers and the other services' statuses
+// into drill::Inputs; missions and aborts to the engine (drill/engine.hpp), which decides. As
+// the engine's DrillSink it writes nav goals, planner requests, joint trajectories, holds and
+// Cartesian impedance commands, and the mission's status and report.
 //
-// DDS callbacks only queue; one control thread ticks the tree and the drilling motion.
+// DDS callbacks only queue or fill Inputs; one control thread ticks the engine.
 
 #include <atomic>
-#include <chrono>
 #include <deque>
-#include <future>
-#include <map>
-#include <memory>
 #include <mutex>
 #include <optional>
 #include <ostream>
-#include <random>
 #include <string>
-#include <utility>
 
-#include "concert/common/command_once.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
-#include "concert/hardware/sensors.hpp"
 #include "concert/mobile_base/map_frame.hpp"
 #include "dds/conversions.hpp"
-#include "drill/area_detection.hpp"
-#include "drill/drill_motion.hpp"
-#include "drill/drill_rig.hpp"
+#include "drill/engine.hpp"
 #include "drill/inputs.hpp"
-#include "drill/mission_tree.hpp"
-#include "drill/odometry_drift.hpp"
-#include "drill/patterns.hpp"
-#include "drill/perception.hpp"
-#include "drill/placement.hpp"
 #include "drill/params.hpp"
-#include "drill/paths.hpp"
-#include "drill/plan_exchange.hpp"
-#include "drill/ports.hpp"
 
 namespace concert::drill::dds {
 
@@ -52,8 +35,7 @@ struct NodeParams {
   Params tuning;  ///< config/drill.yaml (drill/params.hpp)
 };
 
-
-class DrillNode final : public MissionPorts {
+class DrillNode final : private DrillSink {
  public:
   DrillNode(concert::dds::Participant& participant, NodeParams params, std::ostream& log);
   ~DrillNode() override;
@@ -63,317 +45,43 @@ class DrillNode final : public MissionPorts {
   /// Runs the control loop until `stop` is set (then stops any motion).
   void spin(const std::atomic<bool>& stop);
 
-  // MissionPorts (control thread).
-  Outcome health() override;
-  void resolve(std::size_t area, const AreaSpec& spec) override;
-  Outcome resolution(std::size_t area, ResolvedArea& out) override;
-  void navigate(const BasePose& goal) override;
-  Outcome navigation() override;
-  void plan(std::size_t area, const Eigen::Isometry3d& frame,
-            std::optional<std::size_t> after) override;
-  Outcome planning(std::size_t area) override;
-  void execute(std::size_t area) override;
-  Outcome execution() override;
-  void detect(std::size_t area, const AreaSpec& spec, const ResolvedArea& located) override;
-  Outcome detection(std::vector<DrillPoint>& points) override;
-  void place(std::size_t area, const std::vector<DrillPoint>& holes) override;
-  Outcome placement(std::vector<std::size_t>& order) override;
-  void align(const DrillPoint& point) override;
-  Outcome alignment() override;
-  void drill(const DrillPoint& point, double depth) override;
-  Outcome drilling() override;
-  void retract() override;
-  Outcome retraction() override;
-  void stop() override;
-
-  /// A joint state with its odometry, as received (robot clock).
-  using Sample = JointSample;
-
  private:
   struct Inbox {
     std::optional<msg::RobotModel> model;
     std::deque<msg::DrillMission> missions;
     std::deque<msg::DrillAbort> aborts;
   };
-  struct Plan {
-    std::uint32_t request_id{0};
-    PlanAsk request;  ///< as sent (a retry sends it again under a new id)
-    int attempts{1};
-    std::optional<PlanReply> result;
-    std::vector<std::string> names;  ///< of the trajectory
-    Eigen::VectorXd end;             ///< last sample's positions
-  };
-  enum class Motion {
-    kNone,
-    kApproachHole,
-    kLookAtHole,
-    kLookReanchor,
-    kReanchor,
-    kAlign,
-    kDrill,
-    kRetractOut,
-    kSettle,
-    kBackToPosture,
-    kCheckLook,   // a marker hole's whole-body posture planned, not executed: is a look possible from it?
-    kBodyToHole,  // that posture's path sent to the robot by the drill itself
-    kCheckedLook,  // then the look's path check_look() planned, sent likewise
-    kBackForLook,  // the marker not seen from a look: back onto the posture for the next look
-    kBackThenReplan,  // back from a look onto the posture, then the posture planned again there
-    // An area's base placement (place()): the arm alone asked for every hole (and the camera
-    // for the mark) from where the base stands or from a drawn posture; a whole-body posture
-    // drawn; the move there; the camera onto the mark; the mark measured again.
-    kPlaceCheck,
-    kPlaceDraw,
-    kPlaceMove,
-    kPlaceLook,
-    kPlaceSee,
-    kPlaceLookAgain  // the marker not seen: the camera further out, the arm alone (executed)
-  };
 
-  // An area's base placement (place(), drill/placement.hpp): its holes, the tally, the
-  // requests out, the postures drawn and each one's look.
-  using PlannedPath = Path;
-  struct Placement {
-    std::vector<DrillPoint> holes;
-    double started{0.0};  // now_ [s]
-    std::optional<PlacementChoice> choice;
-    // The arm alone onto each hole (planned only): the request out and which of
-    // Params::hole.attempts' first three (0, 3 and 7 cm further out) it asks.
-    struct Check {
-      std::uint32_t id{0};
-      std::size_t attempt{0};
-      PlanAsk request;
-    };
-    std::vector<Check> hole_checks;
-    Check look_check;  // the camera onto the mark (id 0: none asked), attempt of Params::placement.look_further
-    std::uint32_t draw{0};                   // the whole body's posture drawn
-    std::vector<std::vector<std::string>> names;                 // per draw
-    std::vector<std::vector<PathSample>> bodies;      // per draw (empty: none found)
-    std::vector<std::vector<PathSample>> looks;       // per draw (empty: no look)
-    std::vector<double> look_distances;  // per draw: the camera's distance of its look [m]
-    std::vector<bool> standing_reached;  // per hole: the arm alone reaches it from where the base stands
-    std::vector<std::vector<bool>> reached;  // per draw, per hole: from the posture drawn
-    std::vector<std::size_t> order;      // the holes' order to drill (reached first)
-    std::vector<bool> placed;            // per hole: reached by the arm alone where the base ends
-    double lead{1.0};                    // the thrust checked: a lead of Params::hole.attempts'
-    std::size_t looks_again{0};          // of Params::placement.look_further: the look from where the base stands
-    double look_distance{0.0};           // its camera distance [m]
-    std::uint32_t look_again{0};         // its request
-    PlannedPath again_path;
-  } placement_;
-  [[nodiscard]] PlanAsk placement_request(const Eigen::Isometry3d& goal);
-  void place_check(bool drawn);
-  void place_next();
-  void control_placement();
-  // control_placement's steps, one per placement state.
-  void place_check_step();
-  void place_draw_step();
-  void place_move_step();
-  void place_look_step();
-  void place_look_again_step();
-  void place_see_step();
-  [[nodiscard]] std::optional<PlanReply> answered(std::uint32_t id) const;
-  [[nodiscard]] std::size_t chosen_draw() const;
-  void resend(Placement::Check& c);
-  void place_look(std::size_t attempt);
-  [[nodiscard]] std::string placement_time() const;
-  void tick();
-  [[nodiscard]] bool mission_active() const;
-  void apply_model(const msg::RobotModel& model);
-  void start_mission(const msg::DrillMission& m);
-  void publish_status(bool force);
-  void control_motion();
-  // control_motion's steps, one per Motion state, and the Cartesian phases.
-  void hole_posture_step();
-  void no_posture_after_remeasure(const PlanReply& r);
-  void next_hole_attempt(const PlanReply& r);
-  void check_look_step();
-  void body_to_hole_step();
-  void checked_look_step();
-  void look_at_hole_step();
-  void look_reanchor_step();
-  void back_then_replan_step();
-  void reanchor_step();
-  void back_for_look_step();
-  void settle_step();
-  void cartesian_step();
-  void send_cartesian(const CartesianReference& r);
-  void send_hold();
-  void start_align(const Sample& s);
-  /// The mission's hole depth [m] (Params::hole.default_depth before a mission).
-  [[nodiscard]] double hole_depth() const;
-  void start_reanchor(Motion next);
-  void look_at_hole(std::size_t first = 0);
-  bool prepare_look();
-  PlanAsk look_plan(std::size_t attempt) const;
-  void check_look(std::size_t attempt);
-  void posture_reached();
-  void hole_request_write();
-  /// Moves the area's blob holes by `shift` (world frame): odometry drifted by that much.
-  void shift_area(const Eigen::Vector3d& shift);
-  /// While the whole body moves to a blob hole's posture: the area's blobs followed in the
-  /// newest camera frame (shift_area), odometry's drift taken out as it grows.
-  void track_area();
-  /// Plans the hole's drilling posture again at point_, the arm alone: the bit's tip on the
-  /// hole's axis, `further` [m] beyond the hole's distance, its reach checked if `reach`, the
-  /// thrust of `lead` (light_drilling) checked.
-  void replan_hole(bool reach, double further, double lead);
-  void request_hole_posture();
-  /// Plans the hole's whole-body posture again at point_ (the hole measured again), with the
-  /// request that reached the first one: when no arm-alone posture reaches it from there.
-  void replan_body();
-  void replan_after_look();
-  [[nodiscard]] double camera_fov() const;
-  /// A hole measured again with the camera turned onto its blob / marker (kLookReanchor).
-  bool remeasure_looked_blob(const CameraView& camera);
-  bool remeasure_looked_marker(const CameraView& camera);
-  /// The view in which point_'s mark, expected at `mark` (world), was not found, written to
-  /// NodeParams::unseen_frames_dir when one is set.
-  void keep_unseen_view(const CameraView& camera, const Eigen::Vector3d& mark);
-  int unseen_views_{0};
-  /// From the look posture back onto the whole body's posture, then the alignment.
-  void back_to_posture(const Sample& s, Motion next = Motion::kBackToPosture);
-  // Straight from `here` onto `p`'s last posture, at rest there (drill::settle_path); the base
-  // kept where it stands when within Params::paths.base_kept of the posture's, said in the log.
-  std::vector<PathSample> settle_path(const PlannedPath& p, const PathSample& here);
-  void request_look(std::size_t attempt);
-  std::uint32_t send_trajectory(const std::vector<std::string>& names, const std::vector<PathSample>& samples);
-  void on_joints(const msg::JointState& state);
-  void on_service(const msg::ServiceStatus& status);
+  // DrillSink: the engine's commands and reports onto the topics.
+  void plan(const PlanAsk& ask) override;
+  void trajectory(std::uint32_t id, std::uint32_t model_version, const std::vector<std::string>& names,
+                  const std::vector<PathSample>& samples) override;
+  void navigate(std::uint32_t id, std::uint32_t model_version, const BasePose& goal) override;
+  void cancel_navigation() override;
+  void hold(std::uint32_t model_version, const JointPositions& arm) override;
+  void cartesian(std::uint32_t model_version, const std::string& frame, const CartesianReference& r) override;
+  void mission_status(std::uint32_t mission_id, const MissionStatus& status, const MissionReport& report) override;
+  void refused(const std::string& why) override;
+  void log(const std::string& line) override;
+
+  void tick(double now);
+  void apply_model(const msg::RobotModel& m);
   void on_image(const msg::Image& image, bool depth);
   void on_info(const msg::CameraInfo& info);
   void assemble_frame();  // with mutex_ held
-  void log_line(const std::string& line);
 
   NodeParams params_;
-  const Params& tuning_ = params_.tuning;
   std::ostream& log_;
   std::mutex log_mutex_;
   mutable std::mutex mutex_;  // inbox, the camera's messages and its name below
   Inbox inbox_;
-  Inputs inputs_{tuning_.buffers, tuning_.liveness};  // what was measured and heard (thread-safe)
-  // Where the odometry frame lies in the map (nav's localisation): a BIM wall area is in the map,
-  // the camera and the planner's requests in the odometry frame. Thread-safe on its own.
+  Inputs inputs_;  // what was measured and heard (thread-safe)
+  // Where the odometry frame lies in the map (nav's localisation). Thread-safe on its own.
   mobile_base::MapFrame map_frame_;
-  std::chrono::steady_clock::time_point mission_started_{};  // health waits a while from here
   std::optional<msg::Image> rgb_, depth_;
   std::optional<msg::CameraInfo> info_;
   std::string camera_;                      // sensor name of the drill camera (for the callbacks)
-  std::shared_ptr<const DrillRig> rig_;     // the control thread's (Inputs has its own)
   std::atomic<bool> camera_wanted_{false};  // a mission runs: the camera callbacks keep frames
-
-  // Control thread.
-  std::string rig_error_;
-  std::uint64_t model_version_{0};
-  std::unique_ptr<MissionTree> tree_;
-  std::unique_ptr<Mission> mission_;
-  std::uint32_t mission_id_{0};
-  // `concert drill run` writes a mission again
-  // every second until a status names it, and each is taken once.
-  concert::CommandOnce missions_seen_;                 // (mission id, stamp) of the missions taken
-  std::map<std::string, MissionReport> last_reports_;  // by mission name, for resume
-  std::optional<PatternTable> patterns_;
-  std::chrono::steady_clock::time_point last_status_{};
-  std::string last_active_;
-  // Request ids (plan, trajectory, navigation) start anywhere: a restarted drill numbering from 1
-  // again would take the planner's latched results of its predecessor's requests for its own.
-  std::uint32_t next_request_{(std::random_device{}() & 0x3fffffffu) + 1u};
-  struct Unacknowledged {
-    PlanAsk request;
-    double sent{0.0};  // last sent (now_) [s]
-    int resends{0};
-  };
-  std::map<std::uint32_t, Unacknowledged> unacknowledged_;  // plan requests by id
-  void send_plan(const PlanAsk& r);
-  void resend_unacknowledged();
-  std::map<std::size_t, std::future<ResolvedArea>> resolving_;
-  std::map<std::size_t, std::int64_t> resolve_since_;
-  std::map<std::size_t, AreaSpec> resolve_specs_;
-  std::map<std::size_t, Eigen::Isometry3d> bim_frames_;  // BIM wall areas' frames in the map
-  // How far odometry drifted, from the marks seen again (the planner's requests carry it as
-  // odom_in_map while nav localises nothing): the areas' surfaces as first measured (map, outward
-  // normal), each hole a landmark ("area:label").
-  OdometryDrift drift_;
-  struct Surface {
-    Eigen::Vector3d point, normal;
-  };
-  std::map<std::size_t, Surface> surfaces_;
-  // A blob area's blobs as the start view located the area showed them (odometry frame then),
-  // before the approach drifted odometry: the set that names its blobs after the approach.
-  std::map<std::size_t, std::vector<DrillPoint>> start_blobs_;
-  /// The located area's centre moved by how the start view's blobs appear now (the approach's
-  /// drift along the wall); nothing without two of them matched.
-  void follow_start_blobs(const CameraView& camera, ResolvedArea& located);
-  /// A hole (point_) seen again at `in_odom` after the base moved: the drift from it, logged.
-  void hole_seen_again(const Eigen::Vector3d& in_odom);
-  [[nodiscard]] std::string landmark(std::size_t area, const std::string& label) const;
-  std::uint32_t nav_request_{0};
-  std::map<std::size_t, Plan> plans_;
-  std::optional<std::size_t> executing_area_;
-  std::uint32_t trajectory_request_{0};
-  // Detection.
-  struct Detection {
-    std::size_t area{0};
-    AreaSpec spec;
-    ResolvedArea located;
-    std::int64_t since_ns{0};
-    std::optional<Outcome> outcome;
-    std::vector<DrillPoint> points;
-  } detection_;
-  // The drilling motion.
-  Motion motion_{Motion::kNone};
-  DrillMotion drill_motion_;
-  DrillPoint point_;
-  Eigen::Isometry3d base_T_world_{Eigen::Isometry3d::Identity()};  // fixed while drilling
-  std::int64_t servo_since_ns_{0};
-  std::uint32_t hole_plan_request_{0};
-  PlanAsk hole_request_;
-  double hole_distance_{0.0};  // the bit tip's distance from the wall a hole's posture asks for [m]
-  double camera_to_tip_{0.0};  // the tool's camera to its tip along the camera's axis [m]
-  std::size_t hole_attempt_{0};  // which of Params::hole.attempts the hole's posture request is
-  double drilling_lead_{1.0};    // the lead the hole's posture holds the thrust of (light_drilling)
-  std::string light_why_;        // why the hole is drilled at drilling_lead_ < 1 (the log)
-  std::int64_t reanchor_since_ns_{0};
-  std::vector<DrillPoint> area_points_;  // the current area's holes as detected
-  PlannedPath hole_path_;          // of the hole being approached
-  PlannedPath look_path_;          // of the camera turned to the hole's mark
-  std::uint32_t look_request_{0};  // the plan request turning the camera to the marker
-  bool looked_{false};             // the hole's mark was looked at from its posture's base
-  bool look_pushed_{false};        // the look's path is the last of hole_chain_
-  std::int64_t track_since_ns_{0};  // track_area(): the last frame looked at
-  int tracked_frames_{0};            // frames track_area() moved the area by, this hole
-  Eigen::Vector3d tracked_{Eigen::Vector3d::Zero()};  // how far it moved the area, this hole [m]
-  bool hole_replanned_{false};     // the hole's posture was planned again after its re-measure
-  // The whole body's posture the hole was reached with: which of Params::hole.attempts, the hole it was
-  // planned for (world), and whether it was planned once more at the hole measured again.
-  std::size_t body_attempt_{0};
-  Eigen::Vector3d body_goal_{Eigen::Vector3d::Zero()};
-  std::size_t body_replans_{0};
-  std::size_t look_attempt_{0};    // which of Params::looks.attempts the look request is
-  // A marker hole's whole-body posture is planned without executing it, and a look at the marker
-  // planned from its end (check_look) before the base moves: without a look there the hole is
-  // drilled where odometry puts it. The candidate path, the draws of it so far, the check's
-  // request and which of Params::looks.attempts it is.
-  PlannedPath body_candidate_;
-  std::size_t body_draws_{0};
-  std::uint32_t check_request_{0};
-  std::size_t check_attempt_{0};
-  std::size_t checked_look_{0};  // the Params::looks.attempts attempt the check found (the look starts there)
-  PlannedPath checked_path_;     // its path from the candidate's end; empty: none found
-  bool trajectory_ran(const std::string& what);
-  std::optional<PlanReply> plan_result(std::uint32_t id) const;
-  void move_to_candidate();
-  Eigen::Isometry3d look_goal_{Eigen::Isometry3d::Identity()};  // the mark as predicted (world)
-  double look_reach_{0.0};  // how far from look_goal_ the look must see, any roll [m]; 0: the mark
-                            // (a marker: its half-diagonal and Params::looks.marker_drift)
-  double hole_reached_{0.0};  // camera distance of the hole's posture reached [m]
-  std::map<int, Eigen::Isometry3d>
-      markers_seen_;                     // marker id -> where last seen (world), this area
-  std::map<int, double> markers_seen_at_;  // marker id -> when last seen (now_) [s], this area
-  std::vector<PlannedPath> hole_chain_;  // the area's hole postures as reached, first to last
-  bool returning_{false};                // execute(): the way back runs before the approach
-  std::optional<Outcome> motion_outcome_;
-  double now_{0.0};
 
   concert::dds::StatusReporter status_;
   concert::dds::Writer<msg::DrillStatus> status_out_;
@@ -383,6 +91,7 @@ class DrillNode final : public MissionPorts {
   concert::dds::Writer<msg::JointTrajectoryCommand> trajectories_;
   concert::dds::Writer<msg::CartesianImpedanceCommand> cartesian_;
   concert::dds::Writer<msg::JointCommand> joint_commands_;
+  DrillEngine engine_;  // control thread only; before the readers, whose callbacks outlive none of it
   concert::dds::Reader<msg::RobotModel> models_;
   concert::dds::Reader<msg::JointState> joints_in_;
   concert::dds::Reader<msg::Odometry> odometry_in_;
