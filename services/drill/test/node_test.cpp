@@ -100,6 +100,32 @@ TEST(DrillConversions, TrajectoryAndNavStatusesBecomeProgressWithHowTheyFailed) 
   EXPECT_EQ(to_core(st).causes.size(), 1u);
 }
 
+// The mission's status message: each state onto its wire twin, the holes counted.
+TEST(DrillConversions, TheStatusCarriesTheMissionsAreasAndHolesStates) {
+  MissionReport report;
+  report.mission = "m";
+  AreaReport area;
+  area.name = "a";
+  area.state = AreaState::kSkipped;
+  HoleReport drilled;
+  drilled.state = HoleState::kDrilled;
+  HoleReport skipped;
+  skipped.state = HoleState::kSkipped;
+  area.holes = {drilled, skipped};
+  report.areas = {area};
+  MissionStatus status;
+  status.state = MissionState::kAborted;
+  const msg::DrillStatus out = to_msg(3, status, report);
+  EXPECT_EQ(out.mission_id(), 3u);
+  EXPECT_EQ(out.state(), msg::DRILL_ABORTED);
+  ASSERT_EQ(out.areas().size(), 1u);
+  EXPECT_EQ(out.areas()[0].state(), msg::AREA_SKIPPED);
+  ASSERT_EQ(out.areas()[0].holes().size(), 2u);
+  EXPECT_EQ(out.areas()[0].holes()[0].state(), msg::HOLE_DRILLED);
+  EXPECT_EQ(out.areas()[0].holes()[1].state(), msg::HOLE_SKIPPED);
+  EXPECT_EQ(out.holes_drilled(), 1u);
+}
+
 // A planner state this build does not know is a failure, never progress.
 TEST(DrillConversions, APlanResultBecomesAReplyWithItsTrajectory) {
   msg::PlanResult r;

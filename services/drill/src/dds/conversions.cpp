@@ -11,51 +11,27 @@ namespace concert::drill::dds {
 
 namespace {
 
-msg::DrillMissionState to_msg(MissionState s) {
-  switch (s) {
-    case MissionState::kIdle:
-      return msg::DRILL_IDLE;
-    case MissionState::kRunning:
-      return msg::DRILL_RUNNING;
-    case MissionState::kSucceeded:
-      return msg::DRILL_SUCCEEDED;
-    case MissionState::kFailed:
-      return msg::DRILL_FAILED;
-    case MissionState::kAborted:
-      return msg::DRILL_ABORTED;
-  }
-  return msg::DRILL_FAILED;
-}
-
-msg::DrillAreaState to_msg(AreaState s) {
-  switch (s) {
-    case AreaState::kPending:
-      return msg::AREA_PENDING;
-    case AreaState::kActive:
-      return msg::AREA_ACTIVE;
-    case AreaState::kDone:
-      return msg::AREA_DONE;
-    case AreaState::kFailed:
-      return msg::AREA_FAILED;
-    case AreaState::kSkipped:
-      return msg::AREA_SKIPPED;
-  }
-  return msg::AREA_FAILED;
-}
-
-msg::DrillHoleState to_msg(HoleState s) {
-  switch (s) {
-    case HoleState::kPending:
-      return msg::HOLE_PENDING;
-    case HoleState::kDrilled:
-      return msg::HOLE_DRILLED;
-    case HoleState::kFailed:
-      return msg::HOLE_FAILED;
-    case HoleState::kSkipped:
-      return msg::HOLE_SKIPPED;
-  }
-  return msg::HOLE_FAILED;
-}
+// The mission's, areas' and holes' states and their wire twins, one row each.
+constexpr EnumMap kMissionStates{std::array{
+    std::pair{MissionState::kIdle, msg::DRILL_IDLE},
+    std::pair{MissionState::kRunning, msg::DRILL_RUNNING},
+    std::pair{MissionState::kSucceeded, msg::DRILL_SUCCEEDED},
+    std::pair{MissionState::kFailed, msg::DRILL_FAILED},
+    std::pair{MissionState::kAborted, msg::DRILL_ABORTED},
+}};
+constexpr EnumMap kAreaStates{std::array{
+    std::pair{AreaState::kPending, msg::AREA_PENDING},
+    std::pair{AreaState::kActive, msg::AREA_ACTIVE},
+    std::pair{AreaState::kDone, msg::AREA_DONE},
+    std::pair{AreaState::kFailed, msg::AREA_FAILED},
+    std::pair{AreaState::kSkipped, msg::AREA_SKIPPED},
+}};
+constexpr EnumMap kHoleStates{std::array{
+    std::pair{HoleState::kPending, msg::HOLE_PENDING},
+    std::pair{HoleState::kDrilled, msg::HOLE_DRILLED},
+    std::pair{HoleState::kFailed, msg::HOLE_FAILED},
+    std::pair{HoleState::kSkipped, msg::HOLE_SKIPPED},
+}};
 
 // The planner's states and failures and their wire twins, one row each.
 constexpr EnumMap kPlanStates{std::array{
@@ -155,7 +131,7 @@ msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
   out.mission_id(mission_id);
   out.stamp_ns(now_ns());
   out.mission(report.mission);
-  out.state(to_msg(status.state));
+  out.state(kMissionStates.to(status.state).value_or(msg::DRILL_FAILED));
   out.active(status.active);
   out.area(static_cast<std::uint32_t>(status.area));
   out.hole(static_cast<std::uint32_t>(status.hole));
@@ -163,14 +139,14 @@ msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
   for (const AreaReport& a : report.areas) {
     msg::DrillArea area;
     area.name(a.name);
-    area.state(to_msg(a.state));
+    area.state(kAreaStates.to(a.state).value_or(msg::AREA_FAILED));
     area.reason(a.reason);
     area.frame(model::dds::to_pose_msg(a.located.frame));
     for (const HoleReport& h : a.holes) {
       msg::DrillHole hole;
       hole.label(h.point.label);
       hole.frame(model::dds::to_pose_msg(h.point.frame));
-      hole.state(to_msg(h.state));
+      hole.state(kHoleStates.to(h.state).value_or(msg::HOLE_FAILED));
       hole.reason(h.reason);
       area.holes().push_back(hole);
     }
