@@ -265,7 +265,7 @@ class DrillEngine final : public MissionPorts {
   bool remeasure_looked_blob(const CameraView& camera);
   bool remeasure_looked_marker(const CameraView& camera);
   /// The view in which point_'s mark, expected at `mark` (world), was not found, written to
-  /// NodeParams::unseen_frames_dir when one is set.
+  /// EngineParams::unseen_frames_dir when one is set.
   void keep_unseen_view(const CameraView& camera, const Eigen::Vector3d& mark);
   int unseen_views_{0};
   /// From the look posture back onto the whole body's posture, then the alignment.

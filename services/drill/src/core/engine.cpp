@@ -166,9 +166,9 @@ void DrillEngine::hole_seen_again(const Eigen::Vector3d& in_odom) {
   log_line(line.str());
 }
 
-// PlanRequest is volatile: one written before this writer matched the reader of a planner that
-// just (re)started is lost, and the drill would wait for its answer for good. The planner
-// acknowledges each request as it arrives (PLAN_PLANNING) and takes a resend only once.
+// Plan requests travel volatile: one written before the drill's writer matched the reader of a
+// planner that just (re)started is lost, and the drill would wait for its answer for good. The
+// planner acknowledges each request as it arrives (PlanState::kPlanning) and takes a resend once.
 void DrillEngine::resend_unacknowledged() {
   for (auto it = unacknowledged_.begin(); it != unacknowledged_.end();) {
     if (plan_result(it->first)) {
