@@ -182,14 +182,24 @@ endfunction()
 
 # Tests that talk DDS each get their own domain id (CONCERT_DOMAIN_ID), so `ctest -j` never
 # mixes two tests' traffic. Ids from CONCERT_TEST_DOMAIN_BASE on are handed out in
-# configuration order (up to 229); two build trees on one machine whose tests may run at the
-# same time take bases far enough apart (e.g. 100 and 160).
-set(CONCERT_TEST_DOMAIN_BASE 100 CACHE STRING "First DDS domain id handed to the tests (<= 229)")
+# configuration order, up to 100: RTPS puts domain d on UDP ports 7400 + 250 d onwards, and from
+# domain 101 on those lie in Linux's ephemeral port range (32768-60999), where the transmit
+# socket of a Cyclone DDS participant of one test may land in another test's band and join its
+# domain (libs/dds/README.md). Two build trees on one machine whose tests may run at the same
+# time take bases far enough apart (e.g. 1 and 50).
+set(CONCERT_TEST_DOMAIN_BASE 50 CACHE STRING "First DDS domain id handed to the tests (1 to 100)")
+set(CONCERT_TEST_DOMAIN_LAST 100)
+if(CONCERT_TEST_DOMAIN_BASE LESS 1 OR CONCERT_TEST_DOMAIN_BASE GREATER CONCERT_TEST_DOMAIN_LAST)
+  message(FATAL_ERROR "CONCERT_TEST_DOMAIN_BASE=${CONCERT_TEST_DOMAIN_BASE}: must be 1 to "
+                      "${CONCERT_TEST_DOMAIN_LAST} (0 is the robot's own domain; above "
+                      "${CONCERT_TEST_DOMAIN_LAST} the ports lie in the ephemeral range)")
+endif()
 set_property(GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN ${CONCERT_TEST_DOMAIN_BASE})
 function(concert_next_test_domain out_var)
   get_property(id GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN)
-  if(id GREATER 229)
-    message(FATAL_ERROR "More DDS tests than test domain ids (${CONCERT_TEST_DOMAIN_BASE}..229)")
+  if(id GREATER CONCERT_TEST_DOMAIN_LAST)
+    message(FATAL_ERROR "More DDS tests than test domain ids "
+                        "(${CONCERT_TEST_DOMAIN_BASE}..${CONCERT_TEST_DOMAIN_LAST}): lower CONCERT_TEST_DOMAIN_BASE")
   endif()
   math(EXPR next "${id} + 1")
   set_property(GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN ${next})

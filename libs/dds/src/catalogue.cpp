@@ -149,6 +149,22 @@ int32_t parse_domain_id(std::string_view text, std::string_view what) {
   return id;
 }
 
+std::string domain_port_warning(int32_t domain_id, long low, long high) {
+  const long first = 7400L + 250L * domain_id;
+  const long last = first + 249;
+  if (last < low || first > high) return "";
+  std::string text = "concert dds: domain " + std::to_string(domain_id) + " uses UDP ports " +
+                     std::to_string(first) + "-" + std::to_string(last) +
+                     ", inside this machine's ephemeral port range " + std::to_string(low) + "-" +
+                     std::to_string(high) +
+                     ": another program's socket may take one of them, and a Cyclone DDS "
+                     "participant of another domain may then join this one; use a domain whose "
+                     "ports lie below that range";
+  if (low >= 7650) text += " (0 to " + std::to_string((low - 7650) / 250) + " here)";
+  return text + " or reserve them (sysctl -w net.ipv4.ip_local_reserved_ports=" +
+         std::to_string(first) + "-" + std::to_string(last) + ")";
+}
+
 int32_t domain_id_from_env() {
   const char* env = std::getenv("CONCERT_DOMAIN_ID");
   if (env == nullptr || *env == '\0') return 0;

@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <mutex>
+#include <set>
 #include <stdexcept>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -38,6 +40,21 @@ void check_socket_buffer_limit() {
     return true;
   }();
   (void)checked;
+}
+
+// Once per process and domain: a warning when the domain's ports lie in the kernel's ephemeral
+// port range, where domains may leak into each other (domain_port_warning).
+void check_domain_ports(int32_t domain_id) {
+  static std::mutex mutex;
+  static std::set<int32_t> checked;
+  std::lock_guard lock(mutex);
+  if (!checked.insert(domain_id).second) return;
+  std::ifstream in("/proc/sys/net/ipv4/ip_local_port_range");
+  long low = 0;
+  long high = 0;
+  if (!(in >> low >> high)) return;
+  const std::string warning = domain_port_warning(domain_id, low, high);
+  if (!warning.empty()) std::cerr << warning << "\n";
 }
 
 void use_localhost_only(DomainParticipantQos& qos) {
@@ -132,6 +149,7 @@ Participant::Participant(ParticipantOptions options) : name_(options.name) {
     }
   }
   qos.name(options.name);
+  check_domain_ports(domain_id_);
   if (const auto pki = security::pki_from_environment()) {
     use_security(qos, *pki, options);
   }

@@ -103,6 +103,21 @@ TEST(Catalogue, DomainIds) {
   }
 }
 
+TEST(Catalogue, ADomainWhosePortsLieInTheEphemeralRangeIsNamed) {
+  // Linux's default range: domain 100 ends at port 32649, below it; 101 and 126 lie inside.
+  EXPECT_EQ(domain_port_warning(0, 32768, 60999), "");
+  EXPECT_EQ(domain_port_warning(100, 32768, 60999), "");
+  EXPECT_EQ(domain_port_warning(232, 32768, 60999), "");  // from 65400: above it
+  EXPECT_EQ(domain_port_warning(126, 32768, 60999),
+            "concert dds: domain 126 uses UDP ports 38900-39149, inside this machine's ephemeral "
+            "port range 32768-60999: another program's socket may take one of them, and a "
+            "Cyclone DDS participant of another domain may then join this one; use a domain "
+            "whose ports lie below that range (0 to 100 here) or reserve them (sysctl -w "
+            "net.ipv4.ip_local_reserved_ports=38900-39149)");
+  EXPECT_NE(domain_port_warning(101, 32768, 60999), "");  // 32650-32899 straddles 32768
+  EXPECT_NE(domain_port_warning(0, 1024, 65535), "");     // a range that covers everything
+}
+
 TEST(Catalogue, StatusInstanceIdsAreStableAndDistinct) {
   EXPECT_EQ(status_instance_id("planner", "manip"), status_instance_id("planner", "manip"));
   std::set<uint32_t> ids;

@@ -203,12 +203,17 @@ TEST_F(UpTest, WorldFromTheSimulatorChangesThePlanAndExecutionRunsInTheRobot) {
     r = concert({"plan", "drill", "--at", "2.0", "1.6", "1.2", "--request-id", std::to_string(id), "--timeout", "60"});
     const auto blocked = plan_until(id);
     ASSERT_TRUE(blocked.has_value()) << r.out << r.err;
-    if (blocked->state() != msg::PLAN_SUCCEEDED || blocked->trajectory().empty()) continue;
+    if (blocked->state() != msg::PLAN_SUCCEEDED || blocked->trajectory().empty()) {
+      last += "\n  request " + std::to_string(id) + ": failed: " + blocked->reason();
+      continue;
+    }
     const auto& end = blocked->trajectory().back().position();
     moved = std::abs(end[0] - x) > 0.4 || std::abs(end[1] - y) > 0.4;
-    last = std::to_string(end[0]) + ", " + std::to_string(end[1]);
+    last += "\n  request " + std::to_string(id) + ": the base ends at (" + std::to_string(end[0]) + ", " +
+            std::to_string(end[1]) + ")";
   }
-  EXPECT_TRUE(moved) << "the base still ends at (" << last << "), inside the crate at (" << x << ", " << y << ")";
+  EXPECT_TRUE(moved) << "no plan moves the base out of the crate at (" << x << ", " << y << "):" << last
+                     << "\n" << up.out();
 
   // Executed: the planner hands the trajectory to the robot, whose loop tracks it, and the
   // plan's result is the robot's. On this stack the safety service may stop the robot on the

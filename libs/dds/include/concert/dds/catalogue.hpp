@@ -57,6 +57,12 @@ int32_t domain_id_from_env();
 /// Parses a domain id given on a command line or in the environment; `what` names the source.
 int32_t parse_domain_id(std::string_view text, std::string_view what);
 
+/// RTPS puts domain d on the 250 UDP ports from 7400 + 250 d. Where those overlap the kernel's
+/// ephemeral port range [low, high], any program's outgoing socket may take one of them, and a
+/// Cyclone DDS participant of another domain whose transmit socket lands there joins this
+/// domain (libs/dds/README.md). Returns the warning to print then, else "".
+std::string domain_port_warning(int32_t domain_id, long low, long high);
+
 /// Key of a ServiceStatus instance: FNV-1a 32-bit of "service@host" (keys stay < 16 bytes).
 uint32_t status_instance_id(std::string_view service, std::string_view host);
 
