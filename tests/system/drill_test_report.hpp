@@ -1,7 +1,7 @@
 #pragma once
 // The end of a drilling system test (drill_mission_test, drill_pattern_test): safety RUNNING
-// expected, the services' logs printed once on failure (or with CONCERT_TEST_PRINT_LOGS), and a
-// short account of why printed last of all.
+// expected, the services' logs printed on failure (each cut to its head and tail; whole with
+// CONCERT_TEST_PRINT_LOGS), and a short account of why printed before them and last of all.
 
 #include <gtest/gtest.h>
 
@@ -52,6 +52,30 @@ inline std::string alarming_lines(const std::string& logs, std::size_t max) {
   return out;
 }
 
+// The services' logs cut to fit a CI log: each section ("--- service:" and the lines after it)
+// keeps its first `head` and last `tail` lines, with a line saying how many were left out.
+// ctest keeps only the first 300 kB of a failed test's output; the whole logs of a mission run
+// exceed that and pushed the robot's log, gtest's summary and the account of why out of it.
+inline std::string trimmed_logs(const std::string& logs, std::size_t head, std::size_t tail) {
+  std::vector<std::vector<std::string>> sections(1);
+  std::istringstream in(logs);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("--- ", 0) == 0 && !line.empty() && line.back() == ':') sections.emplace_back();
+    sections.back().push_back(std::move(line));
+  }
+  std::string out;
+  for (const auto& lines : sections) {
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      if (i == head && lines.size() > head + tail) {
+        out += "  [" + std::to_string(lines.size() - head - tail) + " lines left out]\n";
+        i = lines.size() - tail;
+      }
+      out += lines[i] + "\n";
+    }
+  }
+  return out;
+}
+
 /// Expects safety RUNNING at the end of `run` and prints how odometry parted from the truth; on
 /// a failure of the test so far prints the logs and keeps `summary` (the test's own account: state, holes, errors) with the alarming log lines
 /// for the end of the output.
@@ -72,11 +96,20 @@ inline void expect_safety_and_report(const MissionRun& run, std::ostringstream& 
   }
   std::cout << trace;
   const bool failed = ::testing::Test::HasFailure();
-  if (failed || std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr) std::cout << run.logs << std::endl;
-  if (failed)
+  if (failed) {
     failure_summary().text = summary.str() + odometry_drift(run.track) + trace +
                              "what the services' logs said went wrong (last 25):\n" +
                              alarming_lines(run.logs, 25);
+    // First as well as last: a cut output keeps one of the two.
+    std::cout << "\n==== why the drilling test failed ====\n" << failure_summary().text << std::flush;
+  }
+  if (std::getenv("CONCERT_TEST_PRINT_LOGS") != nullptr) {
+    std::cout << run.logs << std::endl;
+  } else if (failed) {
+    std::cout << "\n==== the services' logs, each cut to its first 40 and last 200 lines "
+                 "(CONCERT_TEST_PRINT_LOGS=1: whole) ====\n"
+              << trimmed_logs(run.logs, 40, 200) << std::flush;
+  }
 }
 
 }  // namespace concert::system_test
