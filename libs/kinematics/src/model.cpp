@@ -27,18 +27,26 @@ struct Model::Impl {
   Eigen::Vector3d gravity;
 };
 
+// Each Data owns a copy of the model's KDL tree, and its solvers work on that copy alone. KDL's
+// Joint::pose caches the last position and pose in mutable members, so a tree is written by every
+// solve. TreeIdSolver_RNE keeps a reference to the tree it is given: on the model's own tree,
+// two threads with their own Data both wrote its joints' caches, and a Data made meanwhile
+// copied a cache torn between two positions; its forward kinematics then returned the pose of
+// another position (kinematics_test's DataPerThreadGivesSameResults, once in a CI run).
 struct Data::Impl {
   explicit Impl(std::shared_ptr<const Model::Impl> m)
       : model(std::move(m)),
-        fk(model->kdl.tree),
-        jac_solver(model->kdl.tree),
-        id(model->kdl.tree, KDL::Vector(model->gravity.x(), model->gravity.y(), model->gravity.z())),
+        tree(model->kdl.tree),
+        fk(tree),
+        jac_solver(tree),
+        id(tree, KDL::Vector(model->gravity.x(), model->gravity.y(), model->gravity.z())),
         q(model->kdl.tree.getNrOfJoints()),
         qd(model->kdl.tree.getNrOfJoints()),
         qdd(model->kdl.tree.getNrOfJoints()),
         tau(model->kdl.tree.getNrOfJoints()),
         jac(model->kdl.tree.getNrOfJoints()) {}
   std::shared_ptr<const Model::Impl> model;
+  KDL::Tree tree;  // this Data's own: the solvers below write its joints' caches
   KDL::TreeFkSolverPos_recursive fk;
   KDL::TreeJntToJacSolver jac_solver;
   KDL::TreeIdSolver_RNE id;
@@ -80,7 +88,7 @@ KDL::Frame fixed_tree_pose(const KDL::Tree& tree, const std::string& frame) {
 /// Forward kinematics of `frame` at d.q (a frame of the model); false if KDL fails.
 bool pose_at(const Model::Impl& m, Data::Impl& d, const std::string& frame, KDL::Frame& out) {
   if (has_no_joint(m)) {
-    out = fixed_tree_pose(m.kdl.tree, frame);
+    out = fixed_tree_pose(d.tree, frame);
     return true;
   }
   return d.fk.JntToCart(d.q, out, frame) >= 0;
