@@ -5,23 +5,16 @@
 #include <stdexcept>
 
 #include "concert/common/error_text.hpp"
+#include "model_fixture.hpp"
 #include "modelgen/model_generator.hpp"
 
 namespace concert::modelgen::test {
 
 using module_db::ModuleDescription;
 
-const module_db::ModuleDatabase& public_db() {
-  static const module_db::ModuleDatabase db =
-      module_db::load_module_database(std::filesystem::path(CONCERT_SHARED_DATA) / "concert_resources");
-  return db;
-}
+const module_db::ModuleDatabase& public_db() { return testing::module_database(testing::public_module_db()); }
 
-const module_db::ModuleDatabase& own_db() {
-  static const module_db::ModuleDatabase db =
-      module_db::load_module_database(std::filesystem::path(CONCERT_SOURCE_DIR) / "data" / "module_db");
-  return db;
-}
+const module_db::ModuleDatabase& own_db() { return testing::module_database(testing::project_module_db()); }
 
 std::string error_of(const std::function<void()>& f) { return error_text<ModelError>(f); }
 

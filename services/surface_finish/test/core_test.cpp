@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "model_fixture.hpp"
+#include "finish_fixture.hpp"
 #include "surface_finish/admittance.hpp"
 #include "surface_finish/areas.hpp"
 #include "surface_finish/deposition.hpp"

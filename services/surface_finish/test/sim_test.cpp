@@ -7,7 +7,7 @@
 
 #include <cstdio>
 
-#include "model_fixture.hpp"
+#include "finish_fixture.hpp"
 #include "surface_finish/sim_run.hpp"
 
 namespace concert::surface_finish {
