@@ -39,7 +39,7 @@ endif()
 # The mission engine without DDS: resends, acknowledgements, retries, stops, refusals.
 concert_add_test(NAME drill_engine_test
   SOURCES test/engine_test.cpp
-  LIBS concert_drill_core
+  LIBS concert_drill_core concert_test_model
   LABELS drill)
 
 # Area location on frames the simulator's camera renders (libs/sim SceneCamera).

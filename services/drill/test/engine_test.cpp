@@ -4,8 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
+
+#include "model_fixture.hpp"
 
 namespace concert::drill {
 namespace {
@@ -18,6 +21,7 @@ struct FakeSink final : DrillSink {
   std::vector<JointPositions> holds;
   std::vector<MissionStatus> statuses;
   std::vector<std::string> refusals;
+  std::vector<std::string> cartesian_frames;
   std::string log_text;
 
   void plan(const PlanAsk& ask) override { plans.push_back(ask); }
@@ -28,7 +32,9 @@ struct FakeSink final : DrillSink {
   void navigate(std::uint32_t, std::uint32_t, const BasePose&) override {}
   void cancel_navigation() override { ++cancels; }
   void hold(std::uint32_t, const JointPositions& arm) override { holds.push_back(arm); }
-  void cartesian(std::uint32_t, const std::string&, const CartesianReference&) override {}
+  void cartesian(std::uint32_t, const std::string& frame, const CartesianReference&) override {
+    cartesian_frames.push_back(frame);
+  }
   void mission_status(std::uint32_t, const MissionStatus& status, const MissionReport&) override {
     statuses.push_back(status);
   }
@@ -149,6 +155,219 @@ TEST_F(EngineTest, AMissionWithoutADrillingModelIsRefusedOnce) {
   ASSERT_EQ(sink.refusals.size(), 2u);
   EXPECT_EQ(sink.refusals[1], "mission 8: model version 2 cannot drill: no drill");
   EXPECT_EQ(engine.health().reason, "model version 2 cannot drill: no drill");
+}
+
+
+// --- A hole's motion on the demo's drill robot (deploy/demo/drill_robot.yaml) -----------------
+// The ports the mission tree calls (align), driven by hand; step_motion() runs the motion as a
+// control period does. The robot stands at its zero posture; the camera sees a synthetic flat
+// view (grey, constant depth) with one blue blob drawn where the test puts it.
+
+struct RigEngineTest : EngineTest {
+  std::shared_ptr<const DrillRig> rig;
+  JointPositions joints;
+  std::int64_t stamp_ns = 1'000'000'000;
+  double now = 0.0;
+
+  void SetUp() override {
+    rig = std::make_shared<const DrillRig>(
+        testing::robot_model(std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml", 2));
+    engine.apply_model(2, rig, "");
+    for (const std::string& name : rig->model().kinematics().joint_names()) {
+      joints.names.push_back(name);
+      joints.positions.push_back(0.0);
+    }
+    inputs.on_odometry(Eigen::Vector3d::Zero());
+    sample();
+  }
+
+  // A joint sample at the next stamp (5 ms on).
+  void sample() {
+    stamp_ns += 5'000'000;
+    inputs.on_joints(stamp_ns, joints, Inputs::Clock::now());
+  }
+
+  [[nodiscard]] Eigen::Isometry3d world_T_optical() const {
+    return rig->base_in_world(Eigen::Vector3d::Zero()) * rig->camera_in_base(rig->q(joints));
+  }
+
+  // A blob hole 0.5 m in front of the camera, on a wall facing it.
+  [[nodiscard]] DrillPoint hole_ahead() const {
+    DrillPoint p;
+    p.label = "blob 1";
+    p.frame = world_T_optical() * Eigen::Translation3d(0.0, 0.0, 0.5) *
+              Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY());  // z out of the wall, to the camera
+    return p;
+  }
+
+  // `count` frames of the wall 0.5 m ahead with a 2 cm blue blob at `blob` (world), each after a
+  // new joint sample.
+  void camera_sees_blob_at(const Eigen::Vector3d& blob, int count) {
+    const Eigen::Vector3d in_optical = world_T_optical().inverse() * blob;
+    for (int i = 0; i < count; ++i) {
+      sample();
+      hardware::RgbdFrame f;
+      f.sensor = rig->camera();
+      f.intrinsics = {640, 480, 615.0, 615.0, 319.5, 239.5};
+      f.rgb.assign(640u * 480u * 3u, 128);
+      f.depth.assign(640u * 480u, static_cast<std::uint16_t>(std::lround(in_optical.z() * 1e3)));
+      const double u = 615.0 * in_optical.x() / in_optical.z() + 319.5;
+      const double v = 615.0 * in_optical.y() / in_optical.z() + 239.5;
+      const double r = 615.0 * 0.01 / in_optical.z();
+      for (int y = 0; y < 480; ++y) {
+        for (int x = 0; x < 640; ++x) {
+          if (std::hypot(x - u, y - v) > r) continue;
+          std::uint8_t* px = &f.rgb[(static_cast<std::size_t>(y) * 640 + static_cast<std::size_t>(x)) * 3];
+          px[0] = 20;
+          px[1] = 30;
+          px[2] = 220;
+        }
+      }
+      ASSERT_TRUE(inputs.on_frame(stamp_ns + 1, std::move(f)));
+    }
+  }
+
+  // Answers the newest plan request with `state` (and `failure`, `reason`); a success carries a
+  // one-sample path of the base and the arm at the zero posture.
+  std::uint32_t answer(PlanState state, PlanFailure failure = PlanFailure::kOk, const std::string& reason = "") {
+    PlanReply r = reply(sink.plans.back().request_id, state);
+    r.failure = failure;
+    r.reason = reason;
+    if (state == PlanState::kSucceeded) {
+      r.path.names = {"base_x", "base_y", "base_yaw"};
+      r.path.samples = {{0.0, {0.0, 0.0, 0.0}, {}}};
+      const model::ChainInfo& arm = rig->model().arm();
+      for (const std::string& j : arm.joints) {
+        r.path.names.push_back(j);
+        r.path.samples[0].position.push_back(0.0);
+      }
+    }
+    inputs.on_plan(r);
+    return r.request_id;
+  }
+
+  void step(int periods = 1) {
+    for (int i = 0; i < periods; ++i) engine.step_motion(now += 0.005);
+  }
+
+  // Fails the arm-alone postures until the first whole-body one (Params::hole.attempts) is
+  // asked, and returns its request.
+  PlanAsk fail_until_whole_body() {
+    while (sink.plans.back().fixed_base) {
+      answer(PlanState::kFailed, PlanFailure::kUnreachable, "no posture reaches the hole");
+      step();
+    }
+    return sink.plans.back();
+  }
+};
+
+// The hole's posture is asked of the planner for the drill's tool, the bit on the hole's axis,
+// the arm alone first; each posture the planner cannot find moves on to the next attempt.
+TEST_F(RigEngineTest, TheHolesPostureIsAskedArmAloneFirstThenTheNextAttempts) {
+  const DrillPoint hole = hole_ahead();
+  engine.align(hole);
+  ASSERT_EQ(sink.plans.size(), 1u);
+  const PlanAsk first = sink.plans.back();
+  EXPECT_EQ(first.end_effector, rig->tool());
+  EXPECT_EQ(first.model_version, 2u);
+  ASSERT_EQ(first.goals.size(), 1u);
+  EXPECT_TRUE(first.goals[0].isApprox(hole.frame, 1e-9));
+  EXPECT_TRUE(first.fixed_base);
+  EXPECT_TRUE(first.execute);  // a blob hole: planned and executed at once
+  EXPECT_NEAR(first.tip_distance, tuning.motion.standoff + tuning.hole.align_margin, 1e-9);
+
+  const PlanAsk body = fail_until_whole_body();
+  EXPECT_FALSE(body.fixed_base);
+  EXPECT_NE(body.request_id, first.request_id);
+  EXPECT_EQ(sink.logged("blob 1: no drilling posture for the arm alone"), 3u) << sink.log_text;
+  EXPECT_EQ(engine.alignment().progress, Progress::kRunning);
+}
+
+// A safety stop while the robot moves onto the hole's posture: the planner reports the
+// execution aborted, and the hole fails with its reason; nothing else is asked or aligned.
+TEST_F(RigEngineTest, ASafetyStopOnTheWayToTheHolesPostureFailsTheHole) {
+  engine.align(hole_ahead());
+  answer(PlanState::kFailed, PlanFailure::kExecutionAborted,
+         "execution aborted: safety stop (limits: joint J2_E effort)");
+  step(10);
+  const Outcome o = engine.alignment();
+  EXPECT_EQ(o.progress, Progress::kFailed);
+  EXPECT_EQ(o.reason, "planner: the hole's drilling posture: execution aborted: safety stop "
+                      "(limits: joint J2_E effort)");
+  EXPECT_EQ(sink.plans.size(), 1u) << sink.log_text;
+  EXPECT_TRUE(sink.cartesian_frames.empty());
+  // The tree stops the engine then: the arm is held where it stands, every arm joint.
+  engine.stop();
+  ASSERT_EQ(sink.holds.size(), 1u);
+  EXPECT_EQ(sink.holds[0].names, rig->model().arm().joints);
+}
+
+// The posture reached, the hole is measured again in the camera's frames (the blob where it was
+// predicted) and the bit aligned onto it by the Cartesian reference of the drill's TCP.
+TEST_F(RigEngineTest, APostureReachedIsMeasuredAgainThenTheBitAligned) {
+  const DrillPoint hole = hole_ahead();
+  engine.align(hole);
+  answer(PlanState::kSucceeded);
+  step();
+  EXPECT_TRUE(sink.cartesian_frames.empty()) << "aligned before the hole was measured again";
+  camera_sees_blob_at(hole.frame.translation(), tuning.camera.reanchor_frames);
+  step();
+  EXPECT_EQ(sink.logged("blob 1 measured again from its drilling posture: 0.0 mm"), 1u) << sink.log_text;
+  step();  // the alignment's first reference
+  ASSERT_FALSE(sink.cartesian_frames.empty()) << sink.log_text;
+  EXPECT_EQ(sink.cartesian_frames.back(), rig->tcp_frame());
+  EXPECT_EQ(sink.plans.size(), 1u) << "planned again though the hole was where predicted";
+  EXPECT_EQ(engine.alignment().progress, Progress::kRunning);
+}
+
+// Odometry drifted while the whole body moved: the blob is seen 3 cm off its prediction, and
+// the posture is planned again, the arm alone, for the hole where the camera sees it.
+TEST_F(RigEngineTest, ADriftedOdometryPlansThePostureAgainWhereTheCameraSeesTheHole) {
+  const DrillPoint hole = hole_ahead();
+  engine.align(hole);
+  fail_until_whole_body();
+  answer(PlanState::kSucceeded);
+  step();
+  const Eigen::Vector3d seen = hole.frame * Eigen::Vector3d(0.03, 0.0, 0.0);  // 3 cm along the wall
+  camera_sees_blob_at(seen, tuning.camera.reanchor_frames);
+  const std::size_t asked = sink.plans.size();
+  step();
+  ASSERT_EQ(sink.plans.size(), asked + 1) << sink.log_text;
+  const PlanAsk again = sink.plans.back();
+  EXPECT_TRUE(again.fixed_base);
+  ASSERT_EQ(again.goals.size(), 1u);
+  EXPECT_LT((again.goals[0].translation() - seen).norm(), 0.003) << sink.log_text;
+  EXPECT_TRUE(sink.cartesian_frames.empty());
+
+  // Stopped on the way there (a safety stop): the hole fails. Before, a posture aborted after
+  // the re-measure was taken for "no posture for the arm alone", and the whole body's posture
+  // was planned once more.
+  answer(PlanState::kFailed, PlanFailure::kExecutionAborted, "execution aborted: safety stop");
+  step(10);
+  EXPECT_EQ(engine.alignment().progress, Progress::kFailed);
+  EXPECT_EQ(engine.alignment().reason, "planner: the hole's drilling posture: execution aborted: safety stop");
+  EXPECT_EQ(sink.plans.size(), asked + 1) << sink.log_text;
+  EXPECT_TRUE(sink.cartesian_frames.empty());
+}
+
+// Measured again and no posture for the arm alone there: the whole body's posture is planned
+// once more for the hole where the camera saw it (hole.body_replans).
+TEST_F(RigEngineTest, NoArmAlonePostureAtTheHoleMeasuredAgainPlansTheWholeBodyAgain) {
+  const DrillPoint hole = hole_ahead();
+  engine.align(hole);
+  fail_until_whole_body();
+  answer(PlanState::kSucceeded);
+  step();
+  const Eigen::Vector3d seen = hole.frame * Eigen::Vector3d(0.03, 0.0, 0.0);
+  camera_sees_blob_at(seen, tuning.camera.reanchor_frames);
+  step();
+  const std::size_t asked = sink.plans.size();
+  answer(PlanState::kFailed, PlanFailure::kUnreachable, "no posture reaches the hole");
+  step();
+  ASSERT_EQ(sink.plans.size(), asked + 1) << sink.log_text;
+  EXPECT_FALSE(sink.plans.back().fixed_base);
+  EXPECT_LT((sink.plans.back().goals.at(0).translation() - seen).norm(), 0.003);
+  EXPECT_EQ(sink.logged("the whole body's posture planned again for it"), 1u) << sink.log_text;
 }
 
 }  // namespace

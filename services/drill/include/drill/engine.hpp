@@ -102,6 +102,10 @@ class DrillEngine final : public MissionPorts {
   void abort(const AbortOrder& a);
   /// One control period at `now` [s, monotonic]: resends, the motion, the tree, the status.
   void tick(double now);
+  /// The motion's part of a control period at `now` [s, monotonic], alone: the resends, then
+  /// the motion's state machine (what tick() runs before the tree while a mission is active).
+  /// For tests that call the ports (align, drill, retract, place) as the mission tree would.
+  void step_motion(double now);
   /// A mission was accepted and has not ended.
   [[nodiscard]] bool mission_active() const;
   /// The newest model version taken (0: none).

@@ -128,6 +128,12 @@ void DrillEngine::tick(double now) {
   publish_status(false);
 }
 
+void DrillEngine::step_motion(double now) {
+  now_ = now;
+  resend_unacknowledged();
+  control_motion();
+}
+
 void DrillEngine::shutdown() {
   if (!mission_active()) return;
   tree_->abort("the drill service is stopping");
@@ -1689,6 +1695,13 @@ void DrillEngine::hole_posture_step() {
   if (!r->path.samples.empty()) hole_path_ = r->path;
   if (r->state == PlanState::kSucceeded && !hole_path_.samples.empty() && hole_request_.execute)
     hole_chain_.push_back(hole_path_);
+  if (r->state == PlanState::kFailed && r->failure == PlanFailure::kExecutionAborted) {
+    // The robot stopped on the way (a safety stop, its trajectory refused): the hole fails. No
+    // other posture is asked for, and nothing is aligned from wherever the arm stopped.
+    motion_outcome_ = Outcome::failed("planner: the hole's drilling posture: " + r->reason);
+    motion_ = Motion::kNone;
+    return;
+  }
   if (r->state == PlanState::kFailed && hole_replanned_) {
     no_posture_after_remeasure(*r);
     return;
