@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace concert::mobile_base {
@@ -47,60 +48,125 @@ double standing_height(const std::vector<Leg>& legs) {
   return height;
 }
 
+namespace {
+
+// The model at q = 0 as the legs are measured: its data, the root's pose, and which joints have
+// a movable ancestor.
+struct Zero {
+  explicit Zero(const kinematics::Model& m)
+      : model(m), data(m.make_data()), q(Eigen::VectorXd::Zero(m.dof())),
+        base(m.frame_pose(data, q, m.root_link())),
+        has_movable_ancestor(static_cast<std::size_t>(m.dof()), false) {
+    for (int j = 0; j < m.dof(); ++j) {
+      for (int d : m.descendant_joints(j)) has_movable_ancestor[static_cast<std::size_t>(d)] = true;
+    }
+  }
+  [[nodiscard]] Eigen::Isometry3d in_base(const std::string& link) {
+    return base.inverse() * model.frame_pose(data, q, link);
+  }
+  [[nodiscard]] Eigen::Vector3d axis_in_base(int j) {
+    return in_base(model.joint_child_link(j)).linear() * model.joint_axis(j);
+  }
+  const kinematics::Model& model;
+  kinematics::Data data;
+  Eigen::VectorXd q;
+  Eigen::Isometry3d base;
+  std::vector<bool> has_movable_ancestor;
+};
+
+// The leg of steering joint s over wheel joint w, or none when they do not make one: s a
+// vertical axis without a movable ancestor whose only movable descendant is w, a horizontal
+// revolute axis.
+std::optional<Leg> leg_of(Zero& zero, int s, int w, double wheel_radius) {
+  const kinematics::Model& model = zero.model;
+  if (model.is_virtual_joint(s) || zero.has_movable_ancestor[static_cast<std::size_t>(s)]) return std::nullopt;
+  const Eigen::Vector3d steer_axis = zero.axis_in_base(s);
+  const auto below = model.descendant_joints(s);
+  if (std::abs(steer_axis.z()) < 0.9 || below.size() != 1 || below.front() != w) return std::nullopt;
+  const Eigen::Vector3d wheel_axis = zero.axis_in_base(w);
+  if (std::abs(wheel_axis.z()) > 0.1 ||
+      model.joint_types()[static_cast<std::size_t>(w)] == kinematics::JointType::kPrismatic) {
+    return std::nullopt;
+  }
+  Leg leg;
+  leg.steering_joint = model.joint_names()[static_cast<std::size_t>(s)];
+  leg.wheel_joint = model.joint_names()[static_cast<std::size_t>(w)];
+  leg.steering_index = s;
+  leg.wheel_index = w;
+  leg.position = zero.in_base(model.joint_child_link(s)).translation().head<2>();
+  const Eigen::Isometry3d wheel_frame = zero.in_base(model.joint_child_link(w));
+  leg.wheel_center_height = wheel_frame.translation().z();
+  leg.wheel_radius = wheel_radius;
+  leg.steering_sign = steer_axis.z() > 0.0 ? 1.0 : -1.0;
+  const Eigen::Vector3d rolling = wheel_axis.cross(Eigen::Vector3d::UnitZ());
+  leg.heading_offset = std::atan2(rolling.y(), rolling.x());
+  leg.axle_offset = (wheel_frame.translation().head<2>() - leg.position).dot(wheel_axis.head<2>().normalized());
+  const auto& limits = model.joint_limits()[static_cast<std::size_t>(s)];
+  if (limits.has_position_limits) {
+    leg.steering_lower = limits.lower;
+    leg.steering_upper = limits.upper;
+  }
+  return leg;
+}
+
+}  // namespace
+
 std::vector<Leg> detect_legs(const kinematics::Model& model, const std::map<std::string, double>& wheel_radii,
                              double default_wheel_radius) {
   std::vector<Leg> legs;
-  kinematics::Data data = model.make_data();
-  const Eigen::VectorXd q0 = Eigen::VectorXd::Zero(model.dof());
-  const Eigen::Isometry3d base = model.frame_pose(data, q0, model.root_link());
-  std::vector<bool> has_movable_ancestor(static_cast<std::size_t>(model.dof()), false);
-  for (int j = 0; j < model.dof(); ++j) {
-    for (int d : model.descendant_joints(j)) {
-      has_movable_ancestor[static_cast<std::size_t>(d)] = true;
-    }
-  }
-  auto axis_in_base = [&](int j) -> Eigen::Vector3d {
-    const Eigen::Isometry3d child = base.inverse() * model.frame_pose(data, q0, model.joint_child_link(j));
-    return child.linear() * model.joint_axis(j);
-  };
+  Zero zero(model);
   for (int s = 0; s < model.dof(); ++s) {
-    if (model.is_virtual_joint(s) || has_movable_ancestor[static_cast<std::size_t>(s)]) {
-      continue;
-    }
-    const Eigen::Vector3d steer_axis = axis_in_base(s);
     const auto below = model.descendant_joints(s);
-    if (std::abs(steer_axis.z()) < 0.9 || below.size() != 1) {
-      continue;
-    }
+    if (below.size() != 1) continue;
     const int w = below.front();
-    const Eigen::Vector3d wheel_axis = axis_in_base(w);
-    if (std::abs(wheel_axis.z()) > 0.1 || model.joint_types()[static_cast<std::size_t>(w)] ==
-                                              kinematics::JointType::kPrismatic) {
-      continue;
-    }
-    Leg leg;
-    leg.steering_joint = model.joint_names()[static_cast<std::size_t>(s)];
-    leg.wheel_joint = model.joint_names()[static_cast<std::size_t>(w)];
-    leg.steering_index = s;
-    leg.wheel_index = w;
-    const Eigen::Isometry3d steer_frame = base.inverse() * model.frame_pose(data, q0, model.joint_child_link(s));
-    leg.position = steer_frame.translation().head<2>();
-    const Eigen::Isometry3d wheel_frame = base.inverse() * model.frame_pose(data, q0, model.joint_child_link(w));
-    leg.wheel_center_height = wheel_frame.translation().z();
     const auto radius = wheel_radii.find(model.joint_child_link(w));
-    leg.wheel_radius = radius != wheel_radii.end() ? radius->second : default_wheel_radius;
-    leg.steering_sign = steer_axis.z() > 0.0 ? 1.0 : -1.0;
-    const Eigen::Vector3d rolling = wheel_axis.cross(Eigen::Vector3d::UnitZ());
-    leg.heading_offset = std::atan2(rolling.y(), rolling.x());
-    leg.axle_offset = (wheel_frame.translation().head<2>() - leg.position).dot(wheel_axis.head<2>().normalized());
-    const auto& limits = model.joint_limits()[static_cast<std::size_t>(s)];
-    if (limits.has_position_limits) {
-      leg.steering_lower = limits.lower;
-      leg.steering_upper = limits.upper;
+    if (std::optional<Leg> leg =
+            leg_of(zero, s, w, radius != wheel_radii.end() ? radius->second : default_wheel_radius)) {
+      legs.push_back(std::move(*leg));
     }
-    legs.push_back(leg);
   }
   return legs;
+}
+
+Leg measure_leg(const kinematics::Model& model, const std::string& steering_joint,
+                const std::string& wheel_joint, double wheel_radius) {
+  Zero zero(model);
+  std::optional<Leg> leg = leg_of(zero, model.joint_index_or_throw(steering_joint),
+                                  model.joint_index_or_throw(wheel_joint), wheel_radius);
+  if (!leg) {
+    throw std::invalid_argument("joint '" + steering_joint +
+                                "' is not a vertical steering axis directly above the horizontal "
+                                "axis of wheel joint '" + wheel_joint + "'");
+  }
+  return *leg;
+}
+
+std::vector<Leg> steering_legs(const model::RobotModel& model) {
+  std::vector<Leg> out;
+  for (const model::Leg& leg : model.legs()) {
+    if (leg.steering_joint.empty()) {
+      throw std::invalid_argument(model.where() + ": leg chain " + leg.chain->name +
+                                  " has no steering joint (wheel joint '" + leg.wheel_joint + "')");
+    }
+    try {
+      out.push_back(measure_leg(model.kinematics(), leg.steering_joint, leg.wheel_joint, leg.wheel_radius));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(model.where() + ": leg chain " + leg.chain->name + ": " + e.what());
+    }
+  }
+  return out;
+}
+
+double standing_height(const model::RobotModel& model) {
+  const kinematics::Model& k = model.kinematics();
+  kinematics::Data data = k.make_data();
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(k.dof());
+  double height = 0.0;
+  for (const model::Leg& leg : model.legs()) {
+    const double centre = k.relative_pose(data, q, k.root_link(), leg.wheel_frame).translation().z();
+    height = std::max(height, leg.wheel_radius - centre);
+  }
+  return height;
 }
 
 BaseKinematics::BaseKinematics(std::vector<Leg> legs) : legs_(std::move(legs)) {

@@ -6,6 +6,7 @@
 #include <random>
 #include <tuple>
 
+#include "model_fixture.hpp"
 
 namespace concert::mobile_base {
 namespace {
@@ -29,6 +30,45 @@ TEST(BaseKinematics, DetectsFourLegsOfTheMobileBase) {
   EXPECT_NEAR(legs[0].wheel_center_height, -0.3, 1e-12);
   EXPECT_EQ(legs_of("mobile_three_legs.urdf").size(), 3u);
   EXPECT_TRUE(legs_of("arm_drill.urdf").empty());  // arm joints are not legs
+}
+
+// Legs selected by role (the model's leg chains) measure as the geometric search finds them, on
+// the project's demo robot and the paper's morphology B built from the public CONCERT database;
+// joints that do not make a steering leg are named.
+TEST(BaseKinematics, LegsByRoleMeasureAsTheGeometricSearchFindsThem) {
+  for (const auto& [assembly, db] :
+       {std::make_pair(std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml",
+                       testing::project_module_db()),
+        std::make_pair(std::string(CONCERT_SOURCE_DIR) +
+                           "/services/surface_finish/test/fixtures/morphology_b_spraying_public.yaml",
+                       testing::public_module_db())}) {
+    const auto model = testing::robot_model(assembly, 1, db);
+    const std::vector<Leg> by_role = steering_legs(*model);
+    const std::vector<Leg> found =
+        detect_legs(model->kinematics(), collision_cylinder_radii(model->description().urdf));
+    ASSERT_EQ(by_role.size(), 4u) << assembly;
+    ASSERT_EQ(found.size(), by_role.size()) << assembly;
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      EXPECT_EQ(by_role[i].steering_joint, found[i].steering_joint);
+      EXPECT_EQ(by_role[i].wheel_joint, found[i].wheel_joint);
+      EXPECT_TRUE(by_role[i].position.isApprox(found[i].position, 1e-12));
+      EXPECT_DOUBLE_EQ(by_role[i].wheel_radius, found[i].wheel_radius);
+      EXPECT_DOUBLE_EQ(by_role[i].heading_offset, found[i].heading_offset);
+      EXPECT_DOUBLE_EQ(by_role[i].axle_offset, found[i].axle_offset);
+      EXPECT_DOUBLE_EQ(by_role[i].wheel_center_height, found[i].wheel_center_height);
+    }
+    EXPECT_NEAR(standing_height(*model), standing_height(found), 1e-9) << assembly;
+    EXPECT_GT(standing_height(*model), 0.1);
+    try {
+      (void)measure_leg(model->kinematics(), found[0].wheel_joint, found[0].steering_joint, 0.1);
+      ADD_FAILURE() << "a wheel taken for a steering axis";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()), "joint '" + found[0].wheel_joint +
+                                           "' is not a vertical steering axis directly above the "
+                                           "horizontal axis of wheel joint '" +
+                                           found[0].steering_joint + "'");
+    }
+  }
 }
 
 TEST(BaseKinematics, StandsOnItsLargestWheelBelowTheBase) {

@@ -21,9 +21,7 @@ DrillRig::DrillRig(std::shared_ptr<const model::RobotModel> model)
     if (const std::string at = model_->where() + ": "; why.rfind(at, 0) == 0) why.erase(0, at.size());
     throw DrillError(model_->where() + " cannot drill: " + why);
   }
-  const auto legs = mobile_base::detect_legs(
-      model_->kinematics(), mobile_base::collision_cylinder_radii(model_->description().urdf));
-  standing_height_ = mobile_base::standing_height(legs);
+  standing_height_ = mobile_base::standing_height(*model_);
 }
 
 Eigen::VectorXd DrillRig::q(const JointPositions& state) const {

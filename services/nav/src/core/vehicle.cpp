@@ -259,19 +259,6 @@ VehicleConfig recognise_vehicle(const RobotModel& model, const VehicleParams& pa
   std::string posture;
   const Eigen::VectorXd q = transport_posture(model, &posture);
 
-  // Legs of the mobile_base library's geometric test (vertical steering above horizontal wheel).
-  std::map<std::string, double> radii;
-  for (const model::Leg& leg : legs) {
-    radii[kin.joint_child_link(kin.joint_index_or_throw(leg.wheel_joint))] = leg.wheel_radius;
-  }
-  const std::vector<mobile_base::Leg> detected = mobile_base::detect_legs(kin, radii);
-  auto detected_leg = [&](const std::string& steering) -> const mobile_base::Leg* {
-    for (const mobile_base::Leg& d : detected) {
-      if (d.steering_joint == steering) return &d;
-    }
-    return nullptr;
-  };
-
   std::vector<std::string> steered, unsteered;
   for (const model::Leg& leg : legs) {
     (leg.steering_joint.empty() ? unsteered : steered).push_back(leg.chain->name);
@@ -297,19 +284,18 @@ VehicleConfig recognise_vehicle(const RobotModel& model, const VehicleParams& pa
     config.limits.steering_rate = std::numeric_limits<double>::infinity();
     double reach = 0.0;
     for (const model::Leg& leg : legs) {
-      const mobile_base::Leg* d = detected_leg(leg.steering_joint);
-      if (d == nullptr || d->wheel_joint != leg.wheel_joint) {
-        throw VehicleError(where + ": leg chain " + leg.chain->name + ": joint '" +
-                           leg.steering_joint +
-                           "' is not a vertical steering axis directly above "
-                           "the horizontal axis of wheel joint '" +
-                           leg.wheel_joint + "'");
+      // The leg's geometry: a vertical steering axis directly above the wheel's horizontal one.
+      mobile_base::Leg measured;
+      try {
+        measured = mobile_base::measure_leg(kin, leg.steering_joint, leg.wheel_joint, leg.wheel_radius);
+      } catch (const std::invalid_argument& e) {
+        throw VehicleError(where + ": leg chain " + leg.chain->name + ": " + e.what());
       }
-      config.steering_legs.push_back(*d);
+      config.steering_legs.push_back(measured);
       WheelConfig w{leg.chain->name,
                     leg.steering_joint,
                     leg.wheel_joint,
-                    d->position,
+                    measured.position,
                     leg.wheel_radius,
                     velocity_limit(model, leg.wheel_joint),
                     velocity_limit(model, leg.steering_joint),

@@ -57,9 +57,7 @@ Reach::Reach(std::shared_ptr<const model::RobotModel> model, model::EndEffectorK
   const kinematics::Model& k = model_->kinematics();
   const model::ChainInfo& arm = model_->arm();
   for (const std::string& j : arm.joints) arm_.push_back(k.joint_index_or_throw(j));
-  const auto legs =
-      mobile_base::detect_legs(k, mobile_base::collision_cylinder_radii(model_->description().urdf));
-  standing_height_ = mobile_base::standing_height(legs);
+  standing_height_ = mobile_base::standing_height(*model_);
 
   impl_ = std::make_unique<Impl>(Impl{k.make_data(), {}, {}, {}, std::mt19937(params_.seed)});
   const std::set<std::string> arm_joint_names(arm.joints.begin(), arm.joints.end());

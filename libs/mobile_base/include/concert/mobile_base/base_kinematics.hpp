@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "concert/kinematics/model.hpp"
+#include "concert/model/robot_model.hpp"
 
 namespace concert::mobile_base {
 
@@ -56,9 +57,26 @@ std::map<std::string, double> collision_cylinder_radii(const std::string& urdf);
 std::vector<Leg> detect_legs(const kinematics::Model& model, const std::map<std::string, double>& wheel_radii,
                              double default_wheel_radius = 0.16);
 
+/// The leg of `steering_joint` over `wheel_joint` of `model` (fixed base), measured at q = 0:
+/// where its steering axis stands, its signs, offsets and limits, with `wheel_radius` [m].
+/// Throws std::invalid_argument naming both joints when the steering axis is not vertical,
+/// has a movable ancestor or other movable descendants, or the wheel's axis is not horizontal;
+/// kinematics::ModelError for a joint the model lacks.
+Leg measure_leg(const kinematics::Model& model, const std::string& steering_joint,
+                const std::string& wheel_joint, double wheel_radius);
+
+/// The steering legs of `model`, selected by role (its chains of role leg, model::RobotModel::legs())
+/// and measured (measure_leg). Throws std::invalid_argument naming a leg chain without a
+/// steering joint or whose joints do not make a steering leg; model::ModelError from legs().
+std::vector<Leg> steering_legs(const model::RobotModel& model);
+
 /// Height of the base frame above the floor when the base stands on its wheels [m]: the
 /// largest wheel radius above its wheel centre's height (0 without legs).
 double standing_height(const std::vector<Leg>& legs);
+
+/// The same for `model`'s wheels (chains of role leg, steered or not) at q = 0: 0 for a model
+/// without legs (a fixed arm).
+double standing_height(const model::RobotModel& model);
 
 /// Omni-steering kinematics of a base with N >= 2 steering+wheel legs.
 class BaseKinematics {
