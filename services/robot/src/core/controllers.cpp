@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "concert/common/enum_map.hpp"
+#include "concert/kinematics/impedance.hpp"
 
 namespace concert::robot {
 namespace {
@@ -16,11 +17,6 @@ namespace {
 double clamp_abs(double v, double limit) { return limit > 0.0 ? std::clamp(v, -limit, limit) : v; }
 
 double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
-
-Eigen::Vector3d rotation_error(const Eigen::Matrix3d& target, const Eigen::Matrix3d& current) {
-  const Eigen::AngleAxisd aa(target * current.transpose());
-  return aa.angle() * aa.axis();
-}
 
 using namespace std::string_view_literals;
 
@@ -182,17 +178,14 @@ void CartesianController::update(CycleData& data) {
   }
   Vector6d twist;
   twist.noalias() = data.jac_arm.lazyProduct(data.qd_arm);
-  Vector6d error;
-  error.head<3>() = target.translation() - data.ee_pose.translation();
-  error.tail<3>() = rotation_error(target.linear(), data.ee_pose.linear());
-  Vector6d force =
-      cc.stiffness.cwiseProduct(error) + cc.damping.cwiseProduct(cc.target_twist - twist) + cc.feedforward_wrench;
+  Vector6d force = kinematics::impedance_wrench(data.ee_pose, target, twist, cc.target_twist, cc.stiffness,
+                                                cc.damping) +
+                   cc.feedforward_wrench;
   // The payload's weight, held at the frame's origin (J^T m (-g), beside the arm's own g(q)).
   if (cc.payload_mass > 0.0) {
     force.head<3>() -= cc.payload_mass * data.model->gravity();
   }
-  tau_arm_.noalias() = data.jac_arm.transpose().lazyProduct(force);
-  tau_arm_ -= cc.nullspace_damping * data.qd_arm;
+  kinematics::wrench_torques(data.jac_arm, force, data.qd_arm, cc.nullspace_damping, tau_arm_);
   for (std::size_t k = 0; k < arm_.size(); ++k) {
     const int i = arm_[k];
     const auto iu = static_cast<std::size_t>(i);

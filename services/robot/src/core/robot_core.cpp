@@ -11,6 +11,7 @@
 #include <set>
 
 #include "concert/hardware/realtime_buffer.hpp"
+#include "concert/kinematics/impedance.hpp"
 #include "robot/controllers.hpp"
 
 namespace concert::robot {
@@ -754,15 +755,8 @@ void estimate(RobotCore::Slot& s, const RobotParams& params, double dt) {
     c.residual(kk) = c.id_tau(s.arm[k]) - c.tau(s.arm[k]);
     c.qd_arm(kk) = c.qd(s.arm[k]);
   }
-  Eigen::Matrix<double, 6, 6> jjt;
-  jjt.noalias() = c.jac_arm.lazyProduct(c.jac_arm.transpose());
-  jjt.diagonal().array() += 1e-6;
-  Vector6d jr;
-  jr.noalias() = c.jac_arm.lazyProduct(c.residual);
-  const Vector6d raw = jjt.ldlt().solve(jr);
-  const double alpha =
-      params.wrench_filter_time_constant > 0.0 ? dt / (params.wrench_filter_time_constant + dt) : 1.0;
-  c.wrench = s.wrench_initialized ? Vector6d(c.wrench + alpha * (raw - c.wrench)) : raw;
+  const Vector6d raw = kinematics::wrench_from_residual(c.jac_arm, c.residual);
+  c.wrench = s.wrench_initialized ? kinematics::low_pass(c.wrench, raw, dt, params.wrench_filter_time_constant) : raw;
   s.wrench_initialized = true;
 }
 

@@ -1,9 +1,7 @@
 // Sanding runs in the MuJoCo simulator (sim_run.hpp). The arm is driven as the robot service
 // drives it for a Cartesian impedance command, and the force the law closes on is the robot
-// service's estimate from the joint torques: a service may not link another service (the layout
-// check), so the two formulas of services/robot (CartesianController::update and the wrench
-// estimate of RobotCore's cycle) are repeated here, a few lines each, with the same constants.
-#include <Eigen/Cholesky>
+// service's estimate from the joint torques: both formulas are libs/kinematics' (impedance.hpp),
+// with the robot service's constants.
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -13,6 +11,7 @@
 #include <deque>
 #include <fstream>
 
+#include "concert/kinematics/impedance.hpp"
 #include "concert/sim/sim_hardware.hpp"
 #include "concert/world/geometry.hpp"
 #include "concert/world/world.hpp"
@@ -24,12 +23,6 @@ namespace concert::surface_finish {
 namespace {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
-
-// Rotation error as a rotation vector (target * current^T), as the robot service's.
-Eigen::Vector3d rotation_error(const Eigen::Matrix3d& target, const Eigen::Matrix3d& current) {
-  const Eigen::AngleAxisd aa(target * current.transpose());
-  return aa.angle() * aa.axis();
-}
 
 // The plan's TCP position at plan time t (linear between samples) and its velocity.
 struct PlanCursor {
@@ -135,10 +128,8 @@ SandRunResult run_sand_in_sim(const SandRunParams& params) {
       residual(a) = id(j) - tau(j);
       qd_arm(a) = qd(j);
     }
-    Eigen::Matrix<double, 6, 6> jjt = jac_arm * jac_arm.transpose();
-    jjt.diagonal().array() += 1e-6;
-    const Vector6d raw = jjt.ldlt().solve(jac_arm * residual);
-    wrench = wrench_init ? Vector6d(wrench + dt / (wrench_tau + dt) * (raw - wrench)) : raw;
+    const Vector6d raw = kinematics::wrench_from_residual(jac_arm, residual);
+    wrench = wrench_init ? kinematics::low_pass(wrench, raw, dt, wrench_tau) : raw;
     wrench_init = true;
   };
   // Position mode with velocity feed-forward and gravity (the trajectory controller).
@@ -160,16 +151,15 @@ SandRunResult run_sand_in_sim(const SandRunParams& params) {
   Eigen::Vector3d z_ee = Eigen::Vector3d::UnitZ();  // into the wall (set once the plan is known)
   Eigen::VectorXd q_hold;
   auto drive_cartesian = [&](const Eigen::Isometry3d& target, const Eigen::Vector3d& target_velocity) {
-    Vector6d twist = jac_arm * qd_arm;
-    Vector6d error, target_twist = Vector6d::Zero();
+    const Vector6d twist = jac_arm * qd_arm;
+    Vector6d target_twist = Vector6d::Zero();
     target_twist.head<3>() = target_velocity;
-    error.head<3>() = target.translation() - ee.translation();
-    error.tail<3>() = rotation_error(target.linear(), ee.linear());
-    Vector6d f = kgain.cwiseProduct(error) + dgain.cwiseProduct(target_twist - twist);
+    Vector6d f = kinematics::impedance_wrench(ee, target, twist, target_twist, kgain, dgain);
     // Softer along z_ee (normal_stiffness): bumps press less on the wall before the law reacts.
-    f.head<3>() += (normal_k - params.stiffness) * z_ee * z_ee.dot(error.head<3>()) +
+    const Eigen::Vector3d position_error = target.translation() - ee.translation();
+    f.head<3>() += (normal_k - params.stiffness) * z_ee * z_ee.dot(position_error) +
                    (normal_d - dgain(0)) * z_ee * z_ee.dot(target_twist.head<3>() - twist.head<3>());
-    tau_arm = jac_arm.transpose() * f - nullspace_damping * qd_arm;
+    kinematics::wrench_torques(jac_arm, f, qd_arm, nullspace_damping, tau_arm);
     for (std::size_t i = 0; i < names.size(); ++i) {
       cmd[i] = hardware::DriveCommand{};
       cmd[i].mode = hardware::DriveMode::kPosition;
