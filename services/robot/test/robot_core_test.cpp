@@ -8,6 +8,7 @@
 #include <iostream>
 #include <thread>
 
+#include "model_fixture.hpp"
 #include "test_helpers.hpp"
 
 namespace concert::robot {
@@ -53,6 +54,33 @@ TEST_F(RobotCoreTest, AcceptsAMatchingModelAndFindsArmAndLegs) {
   EXPECT_EQ(s.end_effector_frame, "tcp");
   EXPECT_TRUE(s.has_base);
   EXPECT_EQ(s.message, "ready at model version 1");
+}
+
+// The model as the services hold it (libs/model): the end-effector is its tool and the legs
+// its leg chains, by role; the hardware is the simulation of the same model.
+TEST(RobotCoreModel, ReadsTheToolAndTheLegsOfTheModelByRole) {
+  const auto model = concert::testing::robot_model(std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml", 3);
+  SimHardware sim(model->description().urdf, World{}, {});
+  RobotCore core(sim);
+  core.set_model(model);
+  ASSERT_TRUE(core.ready());
+  EXPECT_EQ(core.model_version(), 3u);
+  EXPECT_EQ(core.arm_joints(), model->arm().joints);
+  ASSERT_EQ(core.legs().size(), model->legs().size());
+  for (std::size_t i = 0; i < core.legs().size(); ++i) {
+    EXPECT_EQ(core.legs()[i].steering_joint, model->legs()[i].steering_joint);
+    EXPECT_EQ(core.legs()[i].wheel_joint, model->legs()[i].wheel_joint);
+    EXPECT_DOUBLE_EQ(core.legs()[i].wheel_radius, model->legs()[i].wheel_radius);
+  }
+  run_cycles(core, 10);
+  EXPECT_EQ(core.state().end_effector_frame, model->tool().frame);
+  EXPECT_TRUE(core.state().has_base);
+  // An older version is refused; the running one stays.
+  EXPECT_NE(message_of([&] { core.set_model(concert::testing::robot_model(
+                               std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml", 2)); })
+                .find("older than the current version 3"),
+            std::string::npos);
+  EXPECT_EQ(core.model_version(), 3u);
 }
 
 TEST_F(RobotCoreTest, RefusesModelsThatDoNotMatchTheMountedHardware) {

@@ -13,6 +13,7 @@
 #include "concert/hardware/sensors.hpp"
 #include "concert/kinematics/model.hpp"
 #include "concert/model/limits.hpp"
+#include "concert/model/robot_model.hpp"
 #include "robot/base_kinematics.hpp"
 #include "robot/hardware.hpp"
 
@@ -231,6 +232,14 @@ class RobotCore {
   /// (model::folded_back_torque); arm joints and joints not listed keep their rated peak.
   void set_model(const std::string& urdf, std::uint64_t version, const std::string& end_effector_frame = "",
                  const model::LimitsTable& limits = {});
+  /// The model as every service holds it (libs/model), read by role, never guessed: the
+  /// end-effector is the model's tool (the one end-effector at the tip of an arm), else
+  /// RobotParams::end_effector_frame when set, else the arm chain's tip link, else none (a base
+  /// alone); the legs are its leg chains (mobile_base::steering_legs); the limits its table. A
+  /// description without chains (a bare URDF, as hand-made model messages carry) is run as
+  /// set_model(urdf, version) runs one. Throws ModelMismatchError as that does, and naming a
+  /// leg chain that is not a steering leg over a wheel.
+  void set_model(const std::shared_ptr<const model::RobotModel>& model);
 
   void command_joints(const JointCommandSet& command);
   void command_cartesian(const CartesianCommand& command);
@@ -278,6 +287,9 @@ class RobotCore {
 
  private:
   struct Shared;
+  // The model installed with its end-effector frame (checked a link of it), legs and limits.
+  void install(std::shared_ptr<const kinematics::Model> model, std::uint64_t version, const std::string& ee,
+               std::vector<Leg> legs, const model::LimitsTable& limits);
   void check_command(std::uint64_t model_version) const;
   Hardware& hw_;
   RobotParams params_;

@@ -266,6 +266,47 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
   } catch (const kinematics::ModelError& e) {
     throw ModelMismatchError(what + " refused: " + e.what());
   }
+  std::string ee = end_effector_frame.empty() ? params_.end_effector_frame : end_effector_frame;
+  if (ee.empty()) ee = default_end_effector(*model);
+  // A bare URDF: the legs by their geometry.
+  std::vector<Leg> legs = detect_legs(*model, collision_cylinder_radii(urdf), params_.default_wheel_radius);
+  install(model, version, ee, std::move(legs), limits);
+}
+
+void RobotCore::set_model(const std::shared_ptr<const model::RobotModel>& m) {
+  if (m->chains().empty()) {
+    set_model(m->description().urdf, m->version(), "", m->limits());
+    return;
+  }
+  const std::string what = "model version " + std::to_string(m->version());
+  // The tool, else the configured frame, else the arm's tip; none without one arm.
+  std::string ee;
+  try {
+    ee = m->tool().frame;
+  } catch (const model::ModelError&) {
+    ee = params_.end_effector_frame;
+    if (ee.empty()) {
+      try {
+        ee = m->arm().tip_link;
+      } catch (const model::ModelError&) {
+        ee.clear();
+      }
+    }
+  }
+  std::vector<Leg> legs;
+  try {
+    legs = mobile_base::steering_legs(*m);
+  } catch (const std::exception& e) {
+    throw ModelMismatchError(what + " refused: " + e.what());
+  }
+  // The fixed-base kinematics of the model, kept alive with it.
+  install(std::shared_ptr<const kinematics::Model>(m, &m->kinematics()), m->version(), ee, std::move(legs),
+          m->limits());
+}
+
+void RobotCore::install(std::shared_ptr<const kinematics::Model> model, std::uint64_t version, const std::string& ee,
+                        std::vector<Leg> legs, const model::LimitsTable& limits) {
+  const std::string what = "model version " + std::to_string(version);
   {
     std::lock_guard lock(shared_->mutex);
     if (shared_->accepted != nullptr && version < shared_->accepted->version) {
@@ -276,14 +317,10 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
   // The hardware the loop runs once its pending switch (if any) is done.
   const MountedHardware mounted = hw_.mounted();
   check_mounted(*model, mounted, what);
-  std::string ee = end_effector_frame.empty() ? params_.end_effector_frame : end_effector_frame;
-  if (ee.empty()) {
-    ee = default_end_effector(*model);
-  } else if (!model->has_frame(ee)) {
+  if (!ee.empty() && !model->has_frame(ee)) {
     throw ModelMismatchError(what + ": end-effector frame '" + ee + "' is not a link of the model");
   }
-  // Legs of the mobile base (never part of the arm chain), then the arm chain.
-  std::vector<Leg> legs = detect_legs(*model, collision_cylinder_radii(urdf), params_.default_wheel_radius);
+  // The legs of the mobile base are never part of the arm chain.
   std::set<int> leg_joints;
   for (const auto& leg : legs) {
     leg_joints.insert(leg.steering_index);

@@ -60,19 +60,6 @@ namespace {
 /// The tool end-effector and the limits table of a model message, from one parse: "" and an
 /// empty table where the description does not parse (the core's own end-effector, the drives'
 /// rated peaks), "" alone where it has no arm tool.
-std::pair<std::string, model::LimitsTable> tool_and_limits(const msg::RobotModel& m) {
-  std::shared_ptr<const model::RobotModel> built;
-  try {
-    built = model::RobotModel::build(model::dds::to_description(m));
-  } catch (const std::exception&) {
-    return {};
-  }
-  try {
-    return {built->tool().frame, built->limits()};
-  } catch (const std::exception&) {
-    return {"", built->limits()};
-  }
-}
 }  // namespace
 
 void RobotNode::on_safety(const msg::SafetyState& s) {
@@ -160,18 +147,40 @@ void RobotNode::on_model(const msg::RobotModel& m) {
   if (core_.ready() && core_.model_version() == m.version() &&
       status_.model().hash == m.content_hash())
     return;
-  // The limits table gives the legs' drives their continuous torques (their torque foldback).
-  const auto [tool, limits] = tool_and_limits(m);
-  apply_model(m.urdf(), m.version(), tool, m.content_hash(), limits);
+  // A message without chains carries a bare URDF (hand-made models, tests): run as a URDF.
+  if (m.chains().empty()) {
+    apply_model(m.urdf(), m.version(), "", m.content_hash());
+    return;
+  }
+  // The model as every service builds it; the core reads its tool, legs and limits table
+  // (the legs' continuous torques: their drives' torque foldback).
+  apply(m.version(), m.content_hash(), [&] {
+    std::shared_ptr<const model::RobotModel> built;
+    try {
+      built = model::RobotModel::build(model::dds::to_description(m));
+    } catch (const std::exception& e) {
+      throw ModelMismatchError(e.what());
+    }
+    core_.set_model(built);
+    return built->limits();
+  });
 }
 
 void RobotNode::apply_model(const std::string& urdf, std::uint64_t version,
                             const std::string& end_effector_frame,
                             const std::string& content_hash, const model::LimitsTable& limits) {
+  apply(version, content_hash, [&] {
+    core_.set_model(urdf, version, end_effector_frame, limits);
+    return limits;
+  });
+}
+
+template <class Install>
+void RobotNode::apply(std::uint64_t version, const std::string& content_hash, Install&& install) {
   try {
     status_.report(msg::SERVICE_RECONFIGURING, status_.model_version(),
                    "reconfiguring to model version " + std::to_string(version));
-    core_.set_model(urdf, version, end_effector_frame, limits);
+    const model::LimitsTable limits = install();
     {
       std::lock_guard lock(mutex_);
       limits_ = limits;

@@ -67,6 +67,8 @@ class RobotNode {
   void on_safety(const msg::SafetyState& state);
   void check_safety_silence();
   template <class F> void guarded(const std::string& what, F&& f);
+  // Reconfigures through `install` (returns the model's limits table), reporting the outcome.
+  template <class Install> void apply(std::uint64_t version, const std::string& content_hash, Install&& install);
 
   concert::dds::Participant& participant_;
   RobotCore& core_;
