@@ -33,11 +33,14 @@ TEST(BaseKinematics, DetectsFourLegsOfTheMobileBase) {
 }
 
 // Legs selected by role (the model's leg chains) measure as the geometric search finds them, on
-// the project's demo robot and the paper's morphology B built from the public CONCERT database;
+// the project's demo robot, morphology A (the pattern test's) and the paper's morphology B built
+// from the public CONCERT database;
 // joints that do not make a steering leg are named.
 TEST(BaseKinematics, LegsByRoleMeasureAsTheGeometricSearchFindsThem) {
   for (const auto& [assembly, db] :
        {std::make_pair(std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml",
+                       testing::project_module_db()),
+        std::make_pair(std::string(CONCERT_SOURCE_DIR) + "/services/planner/data/morphology_a.yaml",
                        testing::project_module_db()),
         std::make_pair(std::string(CONCERT_SOURCE_DIR) +
                            "/services/surface_finish/test/fixtures/morphology_b_spraying_public.yaml",
