@@ -370,5 +370,41 @@ TEST_F(RigEngineTest, NoArmAlonePostureAtTheHoleMeasuredAgainPlansTheWholeBodyAg
   EXPECT_EQ(sink.logged("the whole body's posture planned again for it"), 1u) << sink.log_text;
 }
 
+
+// An ArUco hole (the default pattern table): from its arm-alone posture the camera is turned
+// onto the marker first. A safety stop while it turns fails the hole; no further look is asked
+// for. Before, the next look attempt was planned and executed.
+TEST_F(RigEngineTest, ASafetyStopWhileTheCameraTurnsOntoTheMarkerFailsTheHole) {
+  FakeSink marker_sink;
+  DrillEngine marker_engine(
+      EngineParams{std::string(CONCERT_SOURCE_DIR) + "/services/drill/config/patterns.yaml", {}, tuning},
+      inputs, map_frame, marker_sink);
+  marker_engine.apply_model(2, rig, "");
+  DrillPoint hole = hole_ahead();
+  hole.label = "aruco 0 hole 1";
+  hole.marker = 0;
+  hole.pattern_index = 0;
+  marker_engine.align(hole);
+  ASSERT_EQ(marker_sink.plans.size(), 1u);
+  ASSERT_TRUE(marker_sink.plans[0].fixed_base);
+  PlanReply posture = reply(marker_sink.plans[0].request_id, PlanState::kSucceeded);
+  posture.path = {{"base_x", "base_y", "base_yaw"}, {{0.0, {0.0, 0.0, 0.0}, {}}}};
+  inputs.on_plan(posture);
+  marker_engine.step_motion(0.005);
+  ASSERT_EQ(marker_sink.plans.size(), 2u) << marker_sink.log_text;
+  const PlanAsk look = marker_sink.plans[1];
+  EXPECT_GT(look.camera_distance, 0.0);  // the camera, not the bit, onto the marker
+  EXPECT_EQ(look.tip_distance, 0.0);
+  PlanReply aborted = reply(look.request_id, PlanState::kFailed);
+  aborted.failure = PlanFailure::kExecutionAborted;
+  aborted.reason = "execution aborted: safety stop";
+  inputs.on_plan(aborted);
+  for (int i = 2; i < 12; ++i) marker_engine.step_motion(0.005 * i);
+  EXPECT_EQ(marker_engine.alignment().progress, Progress::kFailed);
+  EXPECT_EQ(marker_engine.alignment().reason, "planner: the look at the hole's mark: execution aborted: safety stop");
+  EXPECT_EQ(marker_sink.plans.size(), 2u) << marker_sink.log_text;
+  EXPECT_TRUE(marker_sink.cartesian_frames.empty());
+}
+
 }  // namespace
 }  // namespace concert::drill

@@ -1845,6 +1845,13 @@ void DrillEngine::look_at_hole_step() {
   const std::optional<PlanReply> r = plan_result(look_request_);
   if (!r) return;
   if (!r->path.samples.empty()) look_path_ = r->path;
+  if (r->state == PlanState::kFailed && r->failure == PlanFailure::kExecutionAborted) {
+    // The robot stopped while turning the camera (a safety stop): the hole fails; no other
+    // look is asked for.
+    motion_outcome_ = Outcome::failed("planner: the look at the hole's mark: " + r->reason);
+    motion_ = Motion::kNone;
+    return;
+  }
   if (r->state == PlanState::kSucceeded) {
     look_pushed_ = !look_path_.samples.empty();
     if (look_pushed_) hole_chain_.push_back(look_path_);
