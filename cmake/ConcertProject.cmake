@@ -189,6 +189,12 @@ endfunction()
 # time take bases far enough apart (e.g. 1 and 50).
 set(CONCERT_TEST_DOMAIN_BASE 50 CACHE STRING "First DDS domain id handed to the tests (1 to 100)")
 set(CONCERT_TEST_DOMAIN_LAST 100)
+# A build tree configured when the default was 100 keeps that in its cache, and 100 leaves room
+# for one test: such a tree takes the default instead of failing to configure.
+if(CONCERT_TEST_DOMAIN_BASE EQUAL 100)
+  set(CONCERT_TEST_DOMAIN_BASE 50 CACHE STRING "First DDS domain id handed to the tests (1 to 100)" FORCE)
+  message(STATUS "CONCERT_TEST_DOMAIN_BASE: 100 leaves room for one DDS test; using 50")
+endif()
 if(CONCERT_TEST_DOMAIN_BASE LESS 1 OR CONCERT_TEST_DOMAIN_BASE GREATER CONCERT_TEST_DOMAIN_LAST)
   message(FATAL_ERROR "CONCERT_TEST_DOMAIN_BASE=${CONCERT_TEST_DOMAIN_BASE}: must be 1 to "
                       "${CONCERT_TEST_DOMAIN_LAST} (0 is the robot's own domain; above "
@@ -199,7 +205,8 @@ function(concert_next_test_domain out_var)
   get_property(id GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN)
   if(id GREATER CONCERT_TEST_DOMAIN_LAST)
     message(FATAL_ERROR "More DDS tests than test domain ids "
-                        "(${CONCERT_TEST_DOMAIN_BASE}..${CONCERT_TEST_DOMAIN_LAST}): lower CONCERT_TEST_DOMAIN_BASE")
+                        "(${CONCERT_TEST_DOMAIN_BASE}..${CONCERT_TEST_DOMAIN_LAST}): lower "
+                        "CONCERT_TEST_DOMAIN_BASE (cmake -DCONCERT_TEST_DOMAIN_BASE=50 <build dir>)")
   endif()
   math(EXPR next "${id} + 1")
   set_property(GLOBAL PROPERTY CONCERT_NEXT_TEST_DOMAIN ${next})
