@@ -235,10 +235,11 @@ class RobotCore {
   /// The model as every service holds it (libs/model), read by role, never guessed: the
   /// end-effector is the model's tool (the one end-effector at the tip of an arm), else
   /// RobotParams::end_effector_frame when set, else the arm chain's tip link, else none (a base
-  /// alone); the legs are its leg chains (mobile_base::steering_legs); the limits its table. A
-  /// description without chains (a bare URDF, as hand-made model messages carry) is run as
-  /// set_model(urdf, version) runs one. Throws ModelMismatchError as that does, and naming a
-  /// leg chain that is not a steering leg over a wheel.
+  /// alone); the legs are its steered leg chains, measured (mobile_base::measure_leg;
+  /// unsteered wheels are not driven); the limits its table. A description without chains (a
+  /// bare URDF with its limits) is run as set_model(urdf, version) runs one. Throws
+  /// ModelMismatchError as that does, and naming a leg whose joints are not a steering axis
+  /// over a wheel.
   void set_model(const std::shared_ptr<const model::RobotModel>& model);
 
   void command_joints(const JointCommandSet& command);
@@ -287,6 +288,8 @@ class RobotCore {
 
  private:
   struct Shared;
+  // Throws ModelMismatchError (`what` first) when `version` is older than the accepted one.
+  void check_newer(std::uint64_t version, const std::string& what) const;
   // The model installed with its end-effector frame (checked a link of it), legs and limits.
   void install(std::shared_ptr<const kinematics::Model> model, std::uint64_t version, const std::string& ee,
                std::vector<Leg> legs, const model::LimitsTable& limits);

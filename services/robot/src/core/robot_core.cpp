@@ -293,10 +293,20 @@ void RobotCore::set_model(const std::shared_ptr<const model::RobotModel>& m) {
       }
     }
   }
+  check_newer(m->version(), what);
+  // The steered leg chains, measured. Unsteered wheels (a differential drive) are not this base
+  // controller's: the robot runs without driving them, as it did for a URDF. A leg whose wheel
+  // radius the model cannot give (no collision cylinder about the wheel axis) leaves the legs to
+  // the geometric search with the default radius, as for a bare URDF.
   std::vector<Leg> legs;
   try {
-    legs = mobile_base::steering_legs(*m);
-  } catch (const std::exception& e) {
+    for (const model::Leg& leg : m->legs()) {
+      if (leg.steering_joint.empty()) continue;
+      legs.push_back(mobile_base::measure_leg(m->kinematics(), leg.steering_joint, leg.wheel_joint, leg.wheel_radius));
+    }
+  } catch (const model::ModelError&) {
+    legs = detect_legs(m->kinematics(), collision_cylinder_radii(m->description().urdf), params_.default_wheel_radius);
+  } catch (const std::invalid_argument& e) {
     throw ModelMismatchError(what + " refused: " + e.what());
   }
   // The fixed-base kinematics of the model, kept alive with it.
@@ -304,16 +314,18 @@ void RobotCore::set_model(const std::shared_ptr<const model::RobotModel>& m) {
           m->limits());
 }
 
+void RobotCore::check_newer(std::uint64_t version, const std::string& what) const {
+  std::lock_guard lock(shared_->mutex);
+  if (shared_->accepted != nullptr && version < shared_->accepted->version) {
+    throw ModelMismatchError(what + " refused: older than the current version " +
+                             std::to_string(shared_->accepted->version));
+  }
+}
+
 void RobotCore::install(std::shared_ptr<const kinematics::Model> model, std::uint64_t version, const std::string& ee,
                         std::vector<Leg> legs, const model::LimitsTable& limits) {
   const std::string what = "model version " + std::to_string(version);
-  {
-    std::lock_guard lock(shared_->mutex);
-    if (shared_->accepted != nullptr && version < shared_->accepted->version) {
-      throw ModelMismatchError(what + " refused: older than the current version " +
-                               std::to_string(shared_->accepted->version));
-    }
-  }
+  check_newer(version, what);
   // The hardware the loop runs once its pending switch (if any) is done.
   const MountedHardware mounted = hw_.mounted();
   check_mounted(*model, mounted, what);

@@ -147,18 +147,19 @@ void RobotNode::on_model(const msg::RobotModel& m) {
   if (core_.ready() && core_.model_version() == m.version() &&
       status_.model().hash == m.content_hash())
     return;
-  // A message without chains carries a bare URDF (hand-made models, tests): run as a URDF.
-  if (m.chains().empty()) {
-    apply_model(m.urdf(), m.version(), "", m.content_hash());
-    return;
-  }
   // The model as every service builds it; the core reads its tool, legs and limits table
-  // (the legs' continuous torques: their drives' torque foldback).
+  // (the legs' continuous torques: their drives' torque foldback). A message without chains
+  // that does not build (a bare URDF without a limits table: hand-made models, tests) is run as
+  // a URDF.
   apply(m.version(), m.content_hash(), [&] {
     std::shared_ptr<const model::RobotModel> built;
     try {
       built = model::RobotModel::build(model::dds::to_description(m));
     } catch (const std::exception& e) {
+      if (m.chains().empty()) {
+        core_.set_model(m.urdf(), m.version());
+        return model::LimitsTable{};
+      }
       throw ModelMismatchError(e.what());
     }
     core_.set_model(built);
