@@ -189,11 +189,12 @@ endfunction()
 # time take bases far enough apart (e.g. 1 and 50).
 set(CONCERT_TEST_DOMAIN_BASE 50 CACHE STRING "First DDS domain id handed to the tests (1 to 100)")
 set(CONCERT_TEST_DOMAIN_LAST 100)
-# A build tree configured when the default was 100 keeps that in its cache, and 100 leaves room
-# for one test: such a tree takes the default instead of failing to configure.
-if(CONCERT_TEST_DOMAIN_BASE EQUAL 100)
+# A build tree configured when the tests' domains went up to 229 may keep a base of 100 or more
+# in its cache: such a tree takes the default instead of failing to configure.
+if(CONCERT_TEST_DOMAIN_BASE GREATER_EQUAL 100)
+  message(STATUS "CONCERT_TEST_DOMAIN_BASE: ${CONCERT_TEST_DOMAIN_BASE} leaves no room for the DDS tests "
+                 "below domain 101; using 50")
   set(CONCERT_TEST_DOMAIN_BASE 50 CACHE STRING "First DDS domain id handed to the tests (1 to 100)" FORCE)
-  message(STATUS "CONCERT_TEST_DOMAIN_BASE: 100 leaves room for one DDS test; using 50")
 endif()
 if(CONCERT_TEST_DOMAIN_BASE LESS 1 OR CONCERT_TEST_DOMAIN_BASE GREATER CONCERT_TEST_DOMAIN_LAST)
   message(FATAL_ERROR "CONCERT_TEST_DOMAIN_BASE=${CONCERT_TEST_DOMAIN_BASE}: must be 1 to "

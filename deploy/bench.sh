@@ -14,7 +14,7 @@ here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 root=$(cd "$here/.." && pwd)
 build=${1:-build}
 shift || true
-export CONCERT_DOMAIN_ID=${CONCERT_DOMAIN_ID:-199}
+export CONCERT_DOMAIN_ID=${CONCERT_DOMAIN_ID:-49}
 doc="$root/docs/benchmarks.md"
 outdir="$build/bench"
 [ -d "$build" ] || { echo "bench.sh: no build folder '$build' (usage: deploy/bench.sh [BUILD_DIR] [BENCH...])" >&2; exit 2; }

@@ -18,7 +18,7 @@ namespace {
 
 int bench(unsigned seed, double duration_s) {
   using namespace concert::system_test::chaos;
-  if (std::getenv("CONCERT_DOMAIN_ID") == nullptr) setenv("CONCERT_DOMAIN_ID", "197", 1);
+  if (std::getenv("CONCERT_DOMAIN_ID") == nullptr) setenv("CONCERT_DOMAIN_ID", "47", 1);
   concert::testing::TempDir run("concert-bench-chaos");
   Chaos chaos(demo_options(run.path()));
   for (const auto& f : chaos.start()) {

@@ -50,7 +50,7 @@ double pct(std::vector<double> v, double q) {
 }
 
 int bench(int swaps) {
-  if (std::getenv("CONCERT_DOMAIN_ID") == nullptr) setenv("CONCERT_DOMAIN_ID", "198", 1);
+  if (std::getenv("CONCERT_DOMAIN_ID") == nullptr) setenv("CONCERT_DOMAIN_ID", "48", 1);
   char tmpl[] = "/tmp/concert-bench-XXXXXX";
   const std::string run = mkdtemp(tmpl);
   const std::string demo = CONCERT_SOURCE_DIR "/deploy/demo/";
