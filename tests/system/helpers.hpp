@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -38,6 +39,30 @@ inline std::string tool(const std::string& name, const std::string& package) {
 inline std::vector<std::string> dies_with_test(std::vector<std::string> argv) {
   argv.insert(argv.begin(), {tool("setpriv", "util-linux"), "--pdeathsig", "KILL", "--"});
   return argv;
+}
+
+// The services' logs cut to fit a CI log: each section ("--- service:" and the lines after it)
+// keeps its first `head` and last `tail` lines, with a line saying how many were left out.
+// ctest keeps only the first 300 kB of a failed test's output; the whole logs of a mission run
+// (or of a GUI test's stack) exceed that and pushed the robot's log, gtest's summary and the account of why out of it.
+inline std::string trimmed_logs(const std::string& logs, std::size_t head, std::size_t tail) {
+  std::vector<std::vector<std::string>> sections(1);
+  std::istringstream in(logs);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("--- ", 0) == 0 && !line.empty() && line.back() == ':') sections.emplace_back();
+    sections.back().push_back(std::move(line));
+  }
+  std::string out;
+  for (const auto& lines : sections) {
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      if (i == head && lines.size() > head + tail) {
+        out += "  [" + std::to_string(lines.size() - head - tail) + " lines left out]\n";
+        i = lines.size() - tail;
+      }
+      out += lines[i] + "\n";
+    }
+  }
+  return out;
 }
 
 }  // namespace concert::system_test

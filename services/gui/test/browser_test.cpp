@@ -77,11 +77,17 @@ TEST(GuiBrowser, ModuleTreeHotSwapEStopResetSandingAndTransportInChromium) {
   Process up(dies_with_test({CONCERT_BIN, "up", "--assembly", CONCERT_SOURCE_DIR "/deploy/demo/drill_robot.yaml", "--world",
                                 CONCERT_SOURCE_DIR "/deploy/demo/drill_site.yaml"}),
              env);
+  // On a failure: `concert up`'s output and the logs of the services that decide a stop (safety
+  // names why it stopped; the robot its limits and overruns), each cut to its ends so that ctest's
+  // 300 kB of kept output still reach gtest's summary.
   const auto logs = [&] {
     const char* d = std::getenv("CONCERT_DOMAIN_ID");
-    const std::string finish_log = run_dir.path() + "/concert-d" + std::string(d ? d : "0") + "/logs/surface_finish.log";
-    return "\n--- concert up:\n" + up.out() + up.err() + "\n--- surface_finish:\n" +
-           concert::testing::run({"/bin/cat", finish_log}, 5s).out;
+    const std::string dir = run_dir.path() + "/concert-d" + std::string(d ? d : "0") + "/logs/";
+    std::string all = "\n--- concert up:\n" + up.out() + up.err();
+    for (const char* service : {"safety", "robot", "surface_finish"})
+      all += "\n--- " + std::string(service) + ":\n" +
+             concert::testing::run({"/bin/cat", dir + service + ".log"}, 5s).out;
+    return concert::system_test::trimmed_logs(all, 40, 120);
   };
   ASSERT_TRUE(up.wait_for_output("operator GUI: http://", 30s)) << logs();
   std::smatch m;

@@ -57,7 +57,7 @@ function safetyShown() {
   const text = (sel) => { const e = document.querySelector(sel); return e ? e.textContent.replace(/\s+/g, ' ').trim() : '(none)'; };
   return `badge "${text('#safety-badge')}" (${document.querySelector('#safety-badge').title || 'fresh'}), ` +
     `link "${text('#link')}", E-STOP engaged=${document.querySelector('[data-testid=estop]').dataset.engaged}, ` +
-    `inputs "${text('#estop-inputs')}"`;
+    `inputs "${text('#estop-inputs')}", causes "${text('#safety-causes')}"`;
 }
 
 /// Waits until `fn(arg)` holds in `page`; when it does not, the error says what the safety
