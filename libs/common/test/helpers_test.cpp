@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -10,6 +11,7 @@
 
 #include "concert/common/command_once.hpp"
 #include "concert/common/error_text.hpp"
+#include "concert/common/priority.hpp"
 #include "concert/common/resend.hpp"
 #include "concert/common/source_text.hpp"
 
@@ -20,6 +22,29 @@ class ReadError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+TEST(ThreadNice, SetsTheCallingThreadOnlyAndSaysWhenItMayNot) {
+  const auto nice_of_this_thread = [] { return getpriority(PRIO_PROCESS, static_cast<id_t>(::gettid())); };
+  const int main_before = nice_of_this_thread();
+  NiceResult up, down;
+  int up_seen = 0;
+  std::thread([&] {
+    up = set_thread_nice(main_before + 3);  // a higher nice value is always allowed
+    up_seen = nice_of_this_thread();
+    down = set_thread_nice(main_before - 2);  // lower: only with CAP_SYS_NICE or RLIMIT_NICE
+  }).join();
+  EXPECT_TRUE(up.applied) << up.error;
+  EXPECT_EQ(up.now, main_before + 3);
+  EXPECT_EQ(up_seen, main_before + 3);
+  if (down.applied) {
+    EXPECT_EQ(down.now, main_before - 2);
+    EXPECT_TRUE(down.error.empty());
+  } else {
+    EXPECT_EQ(down.now, main_before + 3) << "a refused change leaves the thread as it was";
+    EXPECT_FALSE(down.error.empty());
+  }
+  EXPECT_EQ(nice_of_this_thread(), main_before) << "another thread's nice value is its own";
+}
 
 TEST(ErrorText, GivesTheMessageOfTheNamedErrorOnly) {
   EXPECT_EQ(error_text<ReadError>([] { throw ReadError("a.yaml: x: missing"); }),

@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "concert/common/clock.hpp"
+#include "concert/common/priority.hpp"
 
 namespace concert::dds {
 
@@ -44,6 +45,11 @@ StatusReporter::~StatusReporter() {
 }
 
 void StatusReporter::beat() {
+  // The heartbeat proves the process alive and on the network, not that its work keeps up. On
+  // a loaded PC a heartbeat starved behind the service's own work (or a browser's) would read as
+  // a dead service and stop the robot; this thread wakes five times a second for one write, so
+  // it runs above the work when the process may raise it (else at the service's priority).
+  (void)set_thread_nice(kHeartbeatNice);
   std::unique_lock lock(mutex_);
   auto next = std::chrono::steady_clock::now() + heartbeat_;
   while (!wake_.wait_until(lock, next, [this] { return stopping_; })) {

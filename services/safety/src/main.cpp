@@ -9,6 +9,7 @@
 
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
+#include "concert/common/priority.hpp"
 #include "concert/dds/participant.hpp"
 #include "dds/safety_node.hpp"
 #include "safety/params.hpp"
@@ -19,6 +20,12 @@ int run(const std::string& params_file, const std::string& state_file) {
   using namespace concert;
   safety::Params params;
   if (!params_file.empty()) params = safety::load_params(params_file);
+  // Before any thread exists: the DDS threads created below inherit the value.
+  if (const auto nice = concert::set_thread_nice(params.nice); !nice.applied) {
+    std::cerr << "concert_safety: running at nice " << nice.now << ", not " << params.nice << " ("
+              << nice.error << "; CAP_SYS_NICE lets it): on a loaded PC its checks may wait"
+              << std::endl;
+  }
   const std::atomic<bool>& stop = concert::cli::stop_on_signals();
   safety::dds::use_interprocess_delivery_only();
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "safety"});

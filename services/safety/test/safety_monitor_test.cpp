@@ -588,7 +588,7 @@ TEST(SafetyParams, DefaultsAndOverrides) {
   const auto p = parse_params(
       "liveliness_timeout: 0.5\nrobot_service: rob\ntask_services: [a, b]\nrequire_robot: true\n"
       "position_tolerance: 0.1\nvelocity_margin: 0.2\neffort_margin: 0.3\npublish_period: "
-      "0.1\ncheck_period: 0.02\nstall_checks: 0\n",
+      "0.1\ncheck_period: 0.02\nstall_checks: 0\nnice: 5\n",
       "x");
   EXPECT_EQ(p.liveliness_timeout, 500ms);
   EXPECT_EQ(p.robot_service, "rob");
@@ -600,13 +600,16 @@ TEST(SafetyParams, DefaultsAndOverrides) {
   EXPECT_EQ(p.publish_period, 100ms);
   EXPECT_EQ(p.check_period, 20ms);
   EXPECT_EQ(p.stall_checks, 0);
+  EXPECT_EQ(p.nice, 5);
+  EXPECT_EQ(d.nice, -10);
+  EXPECT_THROW(parse_params("nice: -21\n", "x"), std::runtime_error);
 }
 
 TEST(SafetyParams, ShippedConfigListsEveryParameterWithItsDefault) {
   auto doc = config::Document::load(std::string(CONCERT_SOURCE_DIR) +
                                     "/services/safety/config/safety.yaml");
   (void)read_params(doc);
-  EXPECT_EQ(doc.keys().size(), 10u);
+  EXPECT_EQ(doc.keys().size(), 11u);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
 }

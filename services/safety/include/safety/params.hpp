@@ -33,6 +33,11 @@ struct Params {
   /// A liveliness check more than this many check periods after the previous one finds the
   /// safety process itself stalled: that time is not counted as anyone's silence (0: off).
   int stall_checks = 5;
+  /// Nice value the safety process runs at (-20..19), set at its start before its DDS threads
+  /// exist so that they inherit it: on a loaded PC the watchdog and the threads that take in the
+  /// heartbeats run before the services they watch. Where the process may not lower it
+  /// (no CAP_SYS_NICE), it runs at its own and says so.
+  int nice = -10;
 };
 
 /// Reads a params YAML file: every key optional, unknown keys are errors. Throws

@@ -16,6 +16,7 @@ Params read_params(config::Document& doc) {
   root.duration("publish_period", p.publish_period, period);
   root.duration("check_period", p.check_period, period);
   root.integer("stall_checks", p.stall_checks, 0, 1000);
+  root.integer("nice", p.nice, -20, 19);
   doc.finish();
   if (p.check_period > p.liveliness_timeout) {
     root.fail("check_period", "must not exceed liveliness_timeout");

@@ -4,7 +4,8 @@
 //
 // Heartbeat: the last status is re-published every `heartbeat` period (new stamp_ns) from a
 // background thread, so a service that dies or is cut off from the network goes silent and
-// the safety service can tell (liveliness, services/safety).
+// the safety service can tell (liveliness, services/safety). The heartbeat thread runs at
+// kHeartbeatNice where permitted.
 
 #include <chrono>
 #include <condition_variable>
@@ -22,6 +23,10 @@ std::string host_name();
 
 /// Default heartbeat period of a StatusReporter [ms].
 inline constexpr std::chrono::milliseconds kDefaultHeartbeat{200};
+
+/// Nice value of the heartbeat thread, where the process may lower it (CAP_SYS_NICE or
+/// RLIMIT_NICE): a loaded PC then starves the service's work before its proof of life.
+inline constexpr int kHeartbeatNice = -10;
 
 /// The robot model a service runs: version and content hash (RobotModel.content_hash). Two
 /// services at the same version with different hashes disagree (`concert status` flags it).
