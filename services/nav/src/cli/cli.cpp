@@ -126,6 +126,13 @@ int run_goto(const GotoOptions& o, std::ostream& out, std::ostream& err) {
         << " (is concert_nav running?)\n";
     return 1;
   }
+  // The answer's path matched before the goal is sent (a status written before our reader
+  // matched would reach us only through the late joiner's history).
+  if (!statuses.wait_for_writers(1, std::min(left_until(deadline), std::chrono::milliseconds(5000)))) {
+    err << "concert nav goto: the nav service's statuses do not reach this client on domain "
+        << participant.domain_id() << "\n";
+    return 1;
+  }
   msg::NavGoal g;
   g.request_id(o.request_id);
   g.model_version(model->version());

@@ -66,6 +66,12 @@ int drill(const DrillOptions& o, std::ostream& out, std::ostream& err) {
       err << "concert plan drill: no planner listening on domain " << participant.domain_id() << " (is concert_planner running?)\n";
       return 1;
     }
+    // The answer's path matched before the question is asked: a result written before our reader
+    // matched the planner's writer would reach us only through the late joiner's history.
+    if (!results.wait_for_writers(1, std::min(left(), std::chrono::milliseconds(5000)))) {
+      err << "concert plan drill: the planner's results do not reach this client on domain " << participant.domain_id() << "\n";
+      return 1;
+    }
     msg::PlanRequest req;
     req.request_id(request_id);
     req.model_version(model->version());
