@@ -33,7 +33,7 @@ struct LinkNode {
   bool prismatic = false;
   std::vector<LinkShape> shapes;    ///< collision primitives
   bool leg = false;                 ///< belongs to a leg chain (touches the floor)
-  int rigid_group = -1;             ///< nearest planned arm joint above it (-1: base group)
+  int rigid_group = -1;             ///< link of the nearest planned arm joint at or above it (-1: base group; collision::rigid_groups)
   double mass = 0.0;                ///< URDF inertial mass [kg]
   Eigen::Vector3d com = Eigen::Vector3d::Zero();  ///< centre of mass in the link frame [m]
 };

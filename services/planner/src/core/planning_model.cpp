@@ -6,6 +6,8 @@
 #include <map>
 #include <set>
 
+#include "concert/collision/link_shapes.hpp"
+
 namespace concert::planner {
 
 const char* to_string(Constraint constraint) {
@@ -85,6 +87,8 @@ std::shared_ptr<const PlanningModel> PlanningModel::build(std::shared_ptr<const 
   // Links with their collision primitives (meshes are reported, not used).
   std::set<std::string> leg_chains;
   for (const model::ChainInfo* c : robot->chains(model::ChainRole::kLeg)) leg_chains.insert(c->name);
+  // Rigid group: the nearest planned arm joint at or above the link (-1: the base group).
+  const std::vector<int> groups = collision::rigid_groups(*robot, arm_joints);
   for (const model::Link& link : robot->links()) {
     LinkNode node;
     node.name = link.name;
@@ -95,12 +99,8 @@ std::shared_ptr<const PlanningModel> PlanningModel::build(std::shared_ptr<const 
     node.leg = leg_chains.count(link.chain) > 0;
     node.mass = link.mass;
     node.com = link.com;
-    // Rigid group: the nearest planned arm joint at or above the link (-1: the base group).
-    node.rigid_group = link.parent >= 0 ? m->links_[static_cast<std::size_t>(link.parent)].rigid_group : -1;
-    if (link.moving) {
-      node.full_index = k.joint_index_or_throw(link.joint);
-      if (std::find(arm_joints.begin(), arm_joints.end(), link.joint) != arm_joints.end()) node.rigid_group = node.full_index;
-    }
+    node.rigid_group = groups[m->links_.size()];
+    if (link.moving) node.full_index = k.joint_index_or_throw(link.joint);
     for (const model::CollisionShape& c : link.shapes) {
       LinkShape s;
       s.origin = c.origin;

@@ -6,35 +6,13 @@
 #include <cmath>
 #include <sstream>
 
+#include "concert/collision/link_shapes.hpp"
+
 namespace concert::planner {
-namespace {
-
-std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const LinkShape& s, double pad) {
-  switch (s.type) {
-    case LinkShape::Type::kBox:
-      return std::make_shared<fcl::Boxd>(s.size.x() + 2 * pad, s.size.y() + 2 * pad, s.size.z() + 2 * pad);
-    case LinkShape::Type::kCylinder:
-      return std::make_shared<fcl::Cylinderd>(s.size.x() + pad, s.size.z() + 2 * pad);
-    case LinkShape::Type::kSphere:
-      return std::make_shared<fcl::Sphered>(s.size.x() + pad);
-  }
-  return nullptr;
-}
-
-struct ShapeObject {
-  int link = -1;
-  double bounding_radius = 0.0;  // about the shape origin [m]
-  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
-  std::unique_ptr<fcl::CollisionObjectd> exact;
-  std::unique_ptr<fcl::CollisionObjectd> padded;
-};
-
-}  // namespace
 
 struct StateChecker::Impl {
   kinematics::Data data;
-  std::vector<ShapeObject> shapes;
-  std::vector<std::pair<int, int>> pairs;  // indices into shapes
+  collision::LinkShapes shapes;  // padded copies against the environment, exact against each other
   std::unique_ptr<fcl::CollisionObjectd> octree;
   fcl::AABBd octree_box;
   bool octree_empty = true;
@@ -45,28 +23,11 @@ struct StateChecker::Impl {
 
 StateChecker::StateChecker(std::shared_ptr<const PlanningModel> model, const Environment& environment, const Params& params,
                            double padding)
-    : model_(std::move(model)), environment_(environment), params_(params), impl_(new Impl{model_->kinematics().make_data(), {}, {}, nullptr, {}, true, {}, {}, nullptr}), padding_(padding) {
-  const auto& links = model_->links();
-  for (std::size_t l = 0; l < links.size(); ++l) {
-    for (const LinkShape& s : links[l].shapes) {
-      ShapeObject o;
-      o.link = static_cast<int>(l);
-      o.origin = s.origin;
-      o.bounding_radius = s.type == LinkShape::Type::kBox        ? 0.5 * s.size.norm()
-                          : s.type == LinkShape::Type::kCylinder ? std::hypot(s.size.x(), 0.5 * s.size.z())
-                                                                 : s.size.x();
-      o.exact = std::make_unique<fcl::CollisionObjectd>(make_geometry(s, 0.0));
-      o.padded = std::make_unique<fcl::CollisionObjectd>(make_geometry(s, padding));
-      impl_->shapes.push_back(std::move(o));
-    }
-  }
-  for (std::size_t a = 0; a < impl_->shapes.size(); ++a) {
-    for (std::size_t b = a + 1; b < impl_->shapes.size(); ++b) {
-      if (!model_->pair_disabled(impl_->shapes[a].link, impl_->shapes[b].link)) {
-        impl_->pairs.emplace_back(static_cast<int>(a), static_cast<int>(b));
-      }
-    }
-  }
+    : model_(std::move(model)), environment_(environment), params_(params), padding_(padding) {
+  std::vector<int> groups;
+  for (const LinkNode& link : model_->links()) groups.push_back(link.rigid_group);
+  impl_.reset(new Impl{model_->kinematics().make_data(), collision::LinkShapes(model_->robot(), groups, padding), nullptr, {}, true, {}, {},
+                       nullptr});
   const std::shared_ptr<const octomap::OcTree> tree = environment.octree();
   if (tree->size() > 0) {
     auto geometry = std::make_shared<fcl::OcTreed>(tree);
@@ -156,20 +117,16 @@ Validity StateChecker::check(const Eigen::VectorXd& q, const std::string& contac
   if (Validity v = torque_validity(contact_frame); !v.valid()) return v;
 
   const auto& links = m.links();
-  for (ShapeObject& o : impl_->shapes) {
-    const fcl::Transform3d t(impl_->poses[static_cast<std::size_t>(o.link)] * o.origin);
-    o.exact->setTransform(t);
-    o.exact->computeAABB();
-    o.padded->setTransform(t);
-    o.padded->computeAABB();
-  }
-  for (const ShapeObject& o : impl_->shapes) {
+  collision::LinkShapes& shapes = impl_->shapes;
+  shapes.place(impl_->poses);
+  for (std::size_t i = 0; i < shapes.shapes().size(); ++i) {
     // Legs touch the floor and the base body stands on them: only the arm can hit the floor.
-    if (links[static_cast<std::size_t>(o.link)].leg || links[static_cast<std::size_t>(o.link)].rigid_group < 0) continue;
-    const double bottom = o.exact->getAABB().min_.z();
+    const LinkNode& link = links[static_cast<std::size_t>(shapes.shapes()[i].link)];
+    if (link.leg || link.rigid_group < 0) continue;
+    const double bottom = shapes.exact(i).getAABB().min_.z();
     if (bottom < params_.floor_height + params_.floor_clearance) {
       std::ostringstream s;
-      s << links[static_cast<std::size_t>(o.link)].name << " reaches z = " << bottom << " m";
+      s << link.name << " reaches z = " << bottom << " m";
       return {Constraint::kFloor, s.str()};
     }
   }
@@ -180,31 +137,24 @@ Validity StateChecker::check(const Eigen::VectorXd& q, const std::string& contac
     // interpolation error (one cell diagonal): shapes clear of it by more skip FCL's octree
     // traversal, which is most of the cost of a check.
     const double field_error = std::sqrt(3.0) * field.resolution();
-    for (const ShapeObject& o : impl_->shapes) {
-      if (!o.padded->getAABB().overlap(impl_->octree_box)) continue;
-      if (field.distance(o.padded->getTranslation()) - field_error > o.bounding_radius + padding_) continue;
+    for (std::size_t i = 0; i < shapes.shapes().size(); ++i) {
+      const fcl::CollisionObjectd& padded = shapes.padded(i);
+      if (!padded.getAABB().overlap(impl_->octree_box)) continue;
+      if (field.distance(padded.getTranslation()) - field_error > shapes.shapes()[i].bounding_radius + padding_) continue;
       fcl::CollisionResultd result;
-      fcl::collide(o.padded.get(), impl_->octree.get(), request, result);
+      fcl::collide(&padded, impl_->octree.get(), request, result);
       if (result.isCollision()) {
-        const Eigen::Vector3d at = o.padded->getTranslation();
+        const Eigen::Vector3d at = padded.getTranslation();
         std::ostringstream s;
-        s << links[static_cast<std::size_t>(o.link)].name << " hits the map near (" << at.x() << ", " << at.y() << ", " << at.z()
-          << ")";
+        s << links[static_cast<std::size_t>(shapes.shapes()[i].link)].name << " hits the map near (" << at.x() << ", " << at.y()
+          << ", " << at.z() << ")";
         return {Constraint::kEnvironmentCollision, s.str()};
       }
     }
   }
-  fcl::CollisionRequestd request;
-  for (const auto& [a, b] : impl_->pairs) {
-    const ShapeObject& oa = impl_->shapes[static_cast<std::size_t>(a)];
-    const ShapeObject& ob = impl_->shapes[static_cast<std::size_t>(b)];
-    if (!oa.exact->getAABB().overlap(ob.exact->getAABB())) continue;
-    fcl::CollisionResultd result;
-    fcl::collide(oa.exact.get(), ob.exact.get(), request, result);
-    if (result.isCollision()) {
-      return {Constraint::kSelfCollision,
-              links[static_cast<std::size_t>(oa.link)].name + " and " + links[static_cast<std::size_t>(ob.link)].name};
-    }
+  if (const auto hit = shapes.self_collision()) {
+    return {Constraint::kSelfCollision,
+            links[static_cast<std::size_t>(hit->first)].name + " and " + links[static_cast<std::size_t>(hit->second)].name};
   }
   return {};
 }

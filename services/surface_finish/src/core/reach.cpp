@@ -1,30 +1,18 @@
 #include "surface_finish/reach.hpp"
 
-#include <fcl/fcl.h>
-
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <map>
-#include <set>
 
+#include "concert/collision/link_shapes.hpp"
 #include "concert/mobile_base/base_kinematics.hpp"
 
 namespace concert::surface_finish {
 
 namespace {
-
-// One collision primitive of a link. The planner's state checker does the same with its own
-// planning model (services/planner); a service may not link another, and the finishing checks
-// need neither its OctoMap nor its torque model, so this is the small self-collision part only.
-struct Shape {
-  int link{-1};
-  int group{-1};  // nearest arm joint at or above the link (-1: base and legs, fixed here)
-  Eigen::Isometry3d origin{Eigen::Isometry3d::Identity()};
-  std::unique_ptr<fcl::CollisionObjectd> object;
-};
 
 std::string mm(double metres) {
   char b[32];
@@ -36,9 +24,8 @@ std::string mm(double metres) {
 
 struct Reach::Impl {
   kinematics::Data data;
-  std::vector<Shape> shapes;
-  std::vector<std::pair<int, int>> pairs;  // indices into shapes
-  std::vector<int> shape_links;            // distinct links with shapes
+  collision::LinkShapes shapes;  // the arm's joints move, the base and the legs stand
+  std::vector<Eigen::Isometry3d> poses;
   std::mt19937 rng;
 };
 
@@ -59,44 +46,10 @@ Reach::Reach(std::shared_ptr<const model::RobotModel> model, model::EndEffectorK
   for (const std::string& j : arm.joints) arm_.push_back(k.joint_index_or_throw(j));
   standing_height_ = mobile_base::standing_height(*model_);
 
-  impl_ = std::make_unique<Impl>(Impl{k.make_data(), {}, {}, {}, std::mt19937(params_.seed)});
-  const std::set<std::string> arm_joint_names(arm.joints.begin(), arm.joints.end());
-  const auto& links = model_->links();
-  std::vector<int> group(links.size(), -1);
-  for (std::size_t l = 0; l < links.size(); ++l) {
-    const model::Link& link = links[l];
-    group[l] = link.parent >= 0 ? group[static_cast<std::size_t>(link.parent)] : -1;
-    if (link.moving && arm_joint_names.count(link.joint) > 0) group[l] = static_cast<int>(l);
-    bool any = false;
-    for (const model::CollisionShape& c : link.shapes) {
-      std::shared_ptr<fcl::CollisionGeometryd> g;
-      switch (c.type) {
-        case model::CollisionShape::Type::kBox: g = std::make_shared<fcl::Boxd>(c.size.x(), c.size.y(), c.size.z()); break;
-        case model::CollisionShape::Type::kCylinder: g = std::make_shared<fcl::Cylinderd>(c.size.x(), c.size.z()); break;
-        case model::CollisionShape::Type::kSphere: g = std::make_shared<fcl::Sphered>(c.size.x()); break;
-        case model::CollisionShape::Type::kMesh: ignored_.push_back(link.name + ": mesh"); continue;
-      }
-      Shape s;
-      s.link = static_cast<int>(l);
-      s.group = group[l];
-      s.origin = c.origin;
-      s.object = std::make_unique<fcl::CollisionObjectd>(g);
-      impl_->shapes.push_back(std::move(s));
-      any = true;
-    }
-    if (any) impl_->shape_links.push_back(static_cast<int>(l));
-  }
-  std::set<std::pair<int, int>> disabled(model_->disabled_pairs().begin(), model_->disabled_pairs().end());
-  for (std::size_t a = 0; a < impl_->shapes.size(); ++a) {
-    for (std::size_t b = a + 1; b < impl_->shapes.size(); ++b) {
-      const Shape& sa = impl_->shapes[a];
-      const Shape& sb = impl_->shapes[b];
-      if (sa.group == sb.group) continue;  // rigidly attached: never moves against each other
-      const int la = std::min(sa.link, sb.link), lb = std::max(sa.link, sb.link);
-      if (disabled.count({la, lb}) > 0) continue;
-      impl_->pairs.emplace_back(static_cast<int>(a), static_cast<int>(b));
-    }
-  }
+  impl_ = std::make_unique<Impl>(Impl{k.make_data(), collision::LinkShapes(*model_, collision::rigid_groups(*model_, arm.joints)),
+                                      std::vector<Eigen::Isometry3d>(model_->links().size(), Eigen::Isometry3d::Identity()),
+                                      std::mt19937(params_.seed)});
+  ignored_ = impl_->shapes.ignored();
 }
 
 Reach::~Reach() = default;
@@ -139,24 +92,12 @@ double Reach::singular_value(const Eigen::VectorXd& q) {
 std::optional<std::string> Reach::self_collision(const Eigen::VectorXd& q) {
   const kinematics::Model& k = model_->kinematics();
   const auto& links = model_->links();
-  std::vector<Eigen::Isometry3d> pose(links.size(), Eigen::Isometry3d::Identity());
-  for (int l : impl_->shape_links) pose[static_cast<std::size_t>(l)] = k.frame_pose(impl_->data, q, links[static_cast<std::size_t>(l)].name);
-  for (Shape& s : impl_->shapes) {
-    s.object->setTransform(fcl::Transform3d(pose[static_cast<std::size_t>(s.link)] * s.origin));
-    s.object->computeAABB();
-  }
-  const fcl::CollisionRequestd request;
-  for (const auto& [a, b] : impl_->pairs) {
-    const Shape& sa = impl_->shapes[static_cast<std::size_t>(a)];
-    const Shape& sb = impl_->shapes[static_cast<std::size_t>(b)];
-    if (!sa.object->getAABB().overlap(sb.object->getAABB())) continue;
-    fcl::CollisionResultd result;
-    fcl::collide(sa.object.get(), sb.object.get(), request, result);
-    if (result.isCollision()) {
-      return links[static_cast<std::size_t>(sa.link)].name + " / " + links[static_cast<std::size_t>(sb.link)].name;
-    }
-  }
-  return std::nullopt;
+  for (int l : impl_->shapes.links_with_shapes())
+    impl_->poses[static_cast<std::size_t>(l)] = k.frame_pose(impl_->data, q, links[static_cast<std::size_t>(l)].name);
+  impl_->shapes.place(impl_->poses);
+  const auto hit = impl_->shapes.self_collision();
+  if (!hit) return std::nullopt;
+  return links[static_cast<std::size_t>(hit->first)].name + " / " + links[static_cast<std::size_t>(hit->second)].name;
 }
 
 ReachPose Reach::solve(const Eigen::Isometry3d& tcp, const WallFrame& wall, const Eigen::VectorXd& seed,

@@ -1,0 +1,136 @@
+#include "concert/collision/link_shapes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+namespace concert::collision {
+namespace {
+
+using Type = model::CollisionShape::Type;
+
+std::shared_ptr<fcl::CollisionGeometryd> geometry(const model::CollisionShape& s, double pad) {
+  switch (s.type) {
+    case Type::kBox:
+      return std::make_shared<fcl::Boxd>(s.size.x() + 2 * pad, s.size.y() + 2 * pad, s.size.z() + 2 * pad);
+    case Type::kCylinder:
+      return std::make_shared<fcl::Cylinderd>(s.size.x() + pad, s.size.z() + 2 * pad);
+    case Type::kSphere:
+      return std::make_shared<fcl::Sphered>(s.size.x() + pad);
+    case Type::kMesh:
+      break;
+  }
+  return nullptr;
+}
+
+double bounding_radius(const model::CollisionShape& s) {
+  switch (s.type) {
+    case Type::kBox: return 0.5 * s.size.norm();
+    case Type::kCylinder: return std::hypot(s.size.x(), 0.5 * s.size.z());
+    case Type::kSphere: return s.size.x();
+    case Type::kMesh: break;
+  }
+  return 0.0;
+}
+
+}  // namespace
+
+std::vector<int> rigid_groups(const model::RobotModel& model, const std::vector<std::string>& joints) {
+  const std::set<std::string> moving(joints.begin(), joints.end());
+  const auto& links = model.links();
+  std::vector<int> group(links.size(), -1);
+  for (std::size_t l = 0; l < links.size(); ++l) {
+    const model::Link& link = links[l];
+    group[l] = link.parent >= 0 ? group[static_cast<std::size_t>(link.parent)] : -1;
+    if (link.moving && moving.count(link.joint) > 0) group[l] = static_cast<int>(l);
+  }
+  return group;
+}
+
+struct LinkShapes::Impl {
+  std::vector<Shape> shapes;
+  std::vector<std::unique_ptr<fcl::CollisionObjectd>> exact;
+  std::vector<std::unique_ptr<fcl::CollisionObjectd>> padded;
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<int> links;
+  std::vector<std::string> ignored;
+  double padding = 0.0;
+};
+
+LinkShapes::LinkShapes(const model::RobotModel& model, const std::vector<int>& groups, double padding)
+    : impl_(std::make_unique<Impl>()) {
+  const auto& links = model.links();
+  if (groups.size() != links.size()) {
+    throw std::invalid_argument("collision: " + std::to_string(groups.size()) + " rigid groups for " +
+                                std::to_string(links.size()) + " links");
+  }
+  if (!(padding >= 0.0)) throw std::invalid_argument("collision: padding must be >= 0");
+  impl_->padding = padding;
+  for (std::size_t l = 0; l < links.size(); ++l) {
+    bool any = false;
+    for (const model::CollisionShape& c : links[l].shapes) {
+      if (c.type == Type::kMesh) {
+        impl_->ignored.push_back(links[l].name + ": mesh");
+        continue;
+      }
+      impl_->shapes.push_back(Shape{static_cast<int>(l), c, bounding_radius(c)});
+      impl_->exact.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(c, 0.0)));
+      impl_->padded.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(c, padding)));
+      any = true;
+    }
+    if (any) impl_->links.push_back(static_cast<int>(l));
+  }
+  const std::set<std::pair<int, int>> disabled(model.disabled_pairs().begin(), model.disabled_pairs().end());
+  for (std::size_t a = 0; a < impl_->shapes.size(); ++a) {
+    for (std::size_t b = a + 1; b < impl_->shapes.size(); ++b) {
+      const int la = std::min(impl_->shapes[a].link, impl_->shapes[b].link);
+      const int lb = std::max(impl_->shapes[a].link, impl_->shapes[b].link);
+      if (groups[static_cast<std::size_t>(la)] == groups[static_cast<std::size_t>(lb)]) continue;
+      if (disabled.count({la, lb}) > 0 || disabled.count({lb, la}) > 0) continue;
+      impl_->pairs.emplace_back(static_cast<int>(a), static_cast<int>(b));
+    }
+  }
+}
+
+LinkShapes::~LinkShapes() = default;
+LinkShapes::LinkShapes(LinkShapes&&) noexcept = default;
+LinkShapes& LinkShapes::operator=(LinkShapes&&) noexcept = default;
+
+void LinkShapes::place(const std::vector<Eigen::Isometry3d>& link_poses) {
+  for (std::size_t i = 0; i < impl_->shapes.size(); ++i) {
+    const Shape& s = impl_->shapes[i];
+    const fcl::Transform3d t(link_poses.at(static_cast<std::size_t>(s.link)) * s.primitive.origin);
+    impl_->exact[i]->setTransform(t);
+    impl_->exact[i]->computeAABB();
+    impl_->padded[i]->setTransform(t);
+    impl_->padded[i]->computeAABB();
+  }
+}
+
+std::optional<std::pair<int, int>> LinkShapes::self_collision() const {
+  const fcl::CollisionRequestd request;
+  for (const auto& [a, b] : impl_->pairs) {
+    const fcl::CollisionObjectd& oa = *impl_->exact[static_cast<std::size_t>(a)];
+    const fcl::CollisionObjectd& ob = *impl_->exact[static_cast<std::size_t>(b)];
+    if (!oa.getAABB().overlap(ob.getAABB())) continue;
+    fcl::CollisionResultd result;
+    fcl::collide(&oa, &ob, request, result);
+    if (result.isCollision()) {
+      const int la = impl_->shapes[static_cast<std::size_t>(a)].link;
+      const int lb = impl_->shapes[static_cast<std::size_t>(b)].link;
+      return std::make_pair(std::min(la, lb), std::max(la, lb));
+    }
+  }
+  return std::nullopt;
+}
+
+const std::vector<Shape>& LinkShapes::shapes() const { return impl_->shapes; }
+const fcl::CollisionObjectd& LinkShapes::exact(std::size_t i) const { return *impl_->exact.at(i); }
+const fcl::CollisionObjectd& LinkShapes::padded(std::size_t i) const { return *impl_->padded.at(i); }
+const std::vector<int>& LinkShapes::links_with_shapes() const { return impl_->links; }
+const std::vector<std::pair<int, int>>& LinkShapes::pairs() const { return impl_->pairs; }
+const std::vector<std::string>& LinkShapes::ignored() const { return impl_->ignored; }
+double LinkShapes::padding() const { return impl_->padding; }
+
+}  // namespace concert::collision
