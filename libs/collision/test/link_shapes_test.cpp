@@ -45,11 +45,41 @@ TEST(RigidGroups, StartAtEachListedJointAndFollowFixedChildren) {
   }
 }
 
+// The paper's morphology B from the public CONCERT module database (its modules carry mesh
+// collision geometry besides primitives).
+std::shared_ptr<const model::RobotModel> public_morphology_b() {
+  return testing::robot_model(
+      std::string(CONCERT_SOURCE_DIR) + "/services/surface_finish/test/fixtures/morphology_b_spraying_public.yaml", 1,
+      testing::public_module_db());
+}
+
+TEST(LinkShapes, LeavesOutEveryMeshOfThePublicDatabaseAndNamesItsLink) {
+  const auto m = public_morphology_b();
+  const LinkShapes shapes(*m, rigid_groups(*m, m->arm().joints));
+  std::size_t meshes = 0, primitives = 0;
+  for (const model::Link& link : m->links()) {
+    for (const model::CollisionShape& c : link.shapes) {
+      if (c.type == model::CollisionShape::Type::kMesh) {
+        ++meshes;
+        EXPECT_NE(std::find(shapes.ignored().begin(), shapes.ignored().end(), link.name + ": mesh"), shapes.ignored().end())
+            << link.name;
+      } else {
+        ++primitives;
+      }
+    }
+  }
+  EXPECT_GT(meshes, 0u) << "the public modules carry meshes";
+  EXPECT_EQ(shapes.ignored().size(), meshes);
+  EXPECT_EQ(shapes.shapes().size(), primitives);
+  for (const Shape& s : shapes.shapes()) EXPECT_NE(s.primitive.type, model::CollisionShape::Type::kMesh);
+}
+
 TEST(LinkShapes, ChecksEveryPairThatMovesAgainstEachOtherAndNoOther) {
-  const auto m = drill_robot();
+ // The drill robot's modules are primitives; the public database's mostly meshes.
+ for (const auto& [m, at_least] : {std::pair{drill_robot(), 10u}, std::pair{public_morphology_b(), 5u}}) {
   const std::vector<int> g = rigid_groups(*m, m->arm().joints);
   const LinkShapes shapes(*m, g, 0.02);
-  ASSERT_GT(shapes.shapes().size(), 10u);
+  ASSERT_GE(shapes.shapes().size(), at_least);
   const std::set<std::pair<int, int>> disabled(m->disabled_pairs().begin(), m->disabled_pairs().end());
   const std::set<std::pair<int, int>> checked(shapes.pairs().begin(), shapes.pairs().end());
   std::size_t expected = 0;
@@ -66,6 +96,7 @@ TEST(LinkShapes, ChecksEveryPairThatMovesAgainstEachOtherAndNoOther) {
   }
   EXPECT_EQ(shapes.pairs().size(), expected);
   EXPECT_GT(expected, 0u);
+ }
 }
 
 TEST(LinkShapes, FindsTwoLinksPlacedOntoEachOtherAndNothingWhenApart) {
