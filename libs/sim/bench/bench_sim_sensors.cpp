@@ -87,7 +87,7 @@ int bench(double seconds) {
   const world::World world = world::load_world_file(source + "/libs/world/test/fixtures/marks_world.yaml");
   sim::SimParams params;
   params.base_position = {-0.5, 0.0, 0.0};
-  sim::SimHardware sim(robot.urdf, world, params, robot.sensors);
+  sim::SimHardware sim(robot, world, params);
   Counter counter;
   sim.set_sensor_sink(&counter);
   std::printf("bench_sim_sensors: %zu sensors at default rates (camera %.0f Hz %ux%u, lidar %.0f Hz, sonar %.0f Hz, "

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "concert/kinematics/model.hpp"
+#include "concert/model/robot_model.hpp"
 #include "concert/model_generation/generator.hpp"
 #include "concert/module_db/module_db.hpp"
 #include "concert/simbus/assembly.hpp"
@@ -59,6 +60,17 @@ std::vector<std::string> sanding_links(
     }
   }
   return links;
+}
+
+/// The steering legs of the generated model, by role (its chains of role leg). A leg without a
+/// steering joint (an unsteered wheel) is not one the simulated base drives.
+std::vector<SimLeg> steering_legs(const model_generation::GeneratedModel& generated) {
+  std::vector<SimLeg> legs;
+  for (const model::Leg& leg : model::RobotModel::build(generated.description())->legs()) {
+    if (leg.steering_joint.empty()) continue;
+    legs.push_back({leg.steering_joint, leg.wheel_joint, leg.wheel_radius});
+  }
+  return legs;
 }
 
 }  // namespace
@@ -133,6 +145,7 @@ SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const s
     out.sensors = sensor_mounts(model.sensor_frames);
     out.drill_bits = drill_bits(model.end_effectors);
     out.sanding_links = sanding_links(model.urdf, model.end_effectors);
+    out.legs = steering_legs(model);
   } catch (const std::exception& e) {
     throw std::runtime_error("assembly '" + source + "': model generation failed: " + e.what());
   }

@@ -243,8 +243,24 @@ struct Built {
   std::vector<std::string> leg_joints;  ///< every steering and wheel joint of the mobile base
 };
 
+/// The steering legs of the robot: by role when the robot names them, else (a bare URDF, which
+/// carries no roles) by their axes.
+std::vector<Leg> robot_legs(const kinematics::Model& model, const std::string& urdf,
+                            const std::optional<std::vector<SimLeg>>& by_role) {
+  if (!by_role) return detect_legs(model, collision_cylinder_radii(urdf));
+  std::vector<Leg> legs;
+  for (const SimLeg& leg : *by_role) {
+    try {
+      legs.push_back(mobile_base::measure_leg(model, leg.steering_joint, leg.wheel_joint, leg.wheel_radius));
+    } catch (const std::exception& e) {
+      throw HardwareError("sim: leg " + leg.steering_joint + "/" + leg.wheel_joint + ": " + e.what());
+    }
+  }
+  return legs;
+}
+
 Built build_mjcf(const std::string& urdf, const World& world, const SimParams& params,
-                 const std::vector<SensorMount>& sensors) {
+                 const std::vector<SensorMount>& sensors, const std::optional<std::vector<SimLeg>>& by_role) {
   const auto parsed = parse(urdf);
   for (const auto& [link, mu] : params.link_friction) {
     if (!parsed->getLink(link)) {
@@ -254,9 +270,8 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
       throw HardwareError("sim: link_friction of '" + link + "' must be a finite friction >= 0");
     }
   }
-  const auto radii = collision_cylinder_radii(urdf);
   const kinematics::Model model = kinematics::Model::from_urdf_string(urdf);
-  std::vector<Leg> legs = detect_legs(model, radii);
+  std::vector<Leg> legs = robot_legs(model, urdf, by_role);
   std::map<std::string, double> wheel_links;
   Built out;
   for (const auto& leg : legs) {
@@ -316,7 +331,7 @@ Built build_mjcf(const std::string& urdf, const World& world, const SimParams& p
 }  // namespace
 
 std::string urdf_to_mjcf(const std::string& urdf, const World& world, const SimParams& params) {
-  return build_mjcf(urdf, world, params, {}).mjcf;
+  return build_mjcf(urdf, world, params, {}, std::nullopt).mjcf;
 }
 
 /// One MuJoCo robot in one world: what a hot swap or a world change prepares off the control
@@ -357,11 +372,12 @@ struct Instance {
 
 namespace {
 
-std::unique_ptr<Instance> make_instance(const std::string& urdf,
-                                        const std::vector<SensorMount>& sensors,
-                                        const std::vector<DrillBit>& drill_bits, const World& world,
-                                        const SimParams& robot_params,
-                                        const std::vector<std::string>& sanding_links = {}) {
+std::unique_ptr<Instance> make_instance(const SimulatedRobot& robot, const World& world,
+                                        const SimParams& robot_params) {
+  const std::string& urdf = robot.urdf;
+  const std::vector<SensorMount>& sensors = robot.sensors;
+  const std::vector<DrillBit>& drill_bits = robot.drill_bits;
+  const std::vector<std::string>& sanding_links = robot.sanding_links;
   world::validate_world(world, "sim world");
   // The running sanding disc's friction on the sanding tools' links (link_friction wins).
   SimParams params = robot_params;
@@ -370,7 +386,7 @@ std::unique_ptr<Instance> make_instance(const std::string& urdf,
       params.link_friction.emplace(link, params.sanding_disc_friction);
   }
   auto in = std::make_unique<Instance>();
-  in->built = build_mjcf(urdf, world, params, sensors);
+  in->built = build_mjcf(urdf, world, params, sensors, robot.legs);
   in->sensors = sensors;
   in->urdf = urdf;
   in->world = world;
@@ -482,10 +498,7 @@ struct SimHardware::Impl {
   // world changes; `mutex` guards what they announce.
   std::mutex preparing;
   mutable std::mutex mutex;
-  std::string latest_urdf;
-  std::vector<SensorMount> latest_sensors;
-  std::vector<DrillBit> latest_drill_bits;
-  std::vector<std::string> latest_sanding_links;
+  SimulatedRobot latest_robot;  // its urdf, sensors, drill bits, sanding links and legs
   World latest_world;
   // The sensors: the scene of the running instance (published by the control thread at each
   // switch) and the threads that read it (made on the first sink).
@@ -569,21 +582,35 @@ struct SimHardware::Impl {
   }
 };
 
+namespace {
+
+SimulatedRobot bare(const std::string& urdf, std::vector<SensorMount> sensors, std::vector<DrillBit> drill_bits,
+                    std::vector<std::string> sanding_links) {
+  SimulatedRobot robot;
+  robot.urdf = urdf;
+  robot.sensors = std::move(sensors);
+  robot.drill_bits = std::move(drill_bits);
+  robot.sanding_links = std::move(sanding_links);
+  return robot;
+}
+
+}  // namespace
+
 SimHardware::SimHardware(const std::string& urdf, World world, SimParams params,
                          std::vector<SensorMount> sensors, std::vector<DrillBit> drill_bits,
                          std::vector<std::string> sanding_links)
-    : impl_(std::make_unique<Impl>()) {
+    : SimHardware(bare(urdf, std::move(sensors), std::move(drill_bits), std::move(sanding_links)),
+                  std::move(world), std::move(params)) {}
+
+SimHardware::SimHardware(SimulatedRobot robot, World world, SimParams params) : impl_(std::make_unique<Impl>()) {
   impl_->params = std::move(params);
   impl_->rng.seed(impl_->params.seed);
   if (impl_->params.timestep <= 0.0) {
     throw HardwareError("sim: timestep must be positive");
   }
-  impl_->active = make_instance(urdf, sensors, drill_bits, world, impl_->params, sanding_links);
+  impl_->active = make_instance(robot, world, impl_->params);
   impl_->active->generation = 1;
-  impl_->latest_urdf = urdf;
-  impl_->latest_sensors = std::move(sensors);
-  impl_->latest_drill_bits = std::move(drill_bits);
-  impl_->latest_sanding_links = std::move(sanding_links);
+  impl_->latest_robot = std::move(robot);
   impl_->latest_world = std::move(world);
   impl_->mounted = {1, impl_->active->built.joints};
   impl_->active_scene.store(impl_->active->scene);
@@ -608,7 +635,7 @@ std::vector<hardware::SensorInfo> SimHardware::sensors() const {
     return out;
   }
   std::lock_guard lock(impl_->mutex);
-  for (const SensorMount& m : impl_->latest_sensors) {
+  for (const SensorMount& m : impl_->latest_robot.sensors) {
     out.push_back({m.name, m.type, m.frame, sensor_rate(impl_->params.sensors, m.type)});
   }
   return out;
@@ -710,24 +737,25 @@ void SimHardware::step(double dt) {
 bool SimHardware::swap_model(const std::string& urdf, std::vector<SensorMount> sensors,
                              std::vector<DrillBit> drill_bits,
                              std::vector<std::string> sanding_links) {
+  return swap_model(bare(urdf, std::move(sensors), std::move(drill_bits), std::move(sanding_links)));
+}
+
+bool SimHardware::swap_model(SimulatedRobot robot) {
   // Preparations are serialised (each builds on the latest robot and world); mounted() and
   // world() stay answerable meanwhile, as they only take `mutex`.
   std::lock_guard preparing(impl_->preparing);
   World world;
   {
     std::lock_guard lock(impl_->mutex);
-    if (urdf == impl_->latest_urdf) {
+    if (robot.urdf == impl_->latest_robot.urdf) {
       return false;  // the same robot was mounted again: no hardware change
     }
     world = impl_->latest_world;
   }
-  auto next = make_instance(urdf, sensors, drill_bits, world, impl_->params, sanding_links);
+  auto next = make_instance(robot, world, impl_->params);
   std::lock_guard lock(impl_->mutex);
   next->generation = impl_->mounted.generation + 1;
-  impl_->latest_urdf = urdf;
-  impl_->latest_sensors = std::move(sensors);
-  impl_->latest_drill_bits = std::move(drill_bits);
-  impl_->latest_sanding_links = std::move(sanding_links);
+  impl_->latest_robot = std::move(robot);
   impl_->mounted = {next->generation, next->built.joints};
   impl_->submit(std::move(next));
   return true;
@@ -735,18 +763,12 @@ bool SimHardware::swap_model(const std::string& urdf, std::vector<SensorMount> s
 
 void SimHardware::set_world(const World& world) {
   std::lock_guard preparing(impl_->preparing);
-  std::string urdf;
-  std::vector<SensorMount> sensors;
-  std::vector<DrillBit> drill_bits;
-  std::vector<std::string> sanding_links;
+  SimulatedRobot robot;
   {
     std::lock_guard lock(impl_->mutex);
-    urdf = impl_->latest_urdf;
-    sensors = impl_->latest_sensors;
-    drill_bits = impl_->latest_drill_bits;
-    sanding_links = impl_->latest_sanding_links;
+    robot = impl_->latest_robot;
   }
-  auto next = make_instance(urdf, sensors, drill_bits, world, impl_->params, sanding_links);
+  auto next = make_instance(robot, world, impl_->params);
   next->same_robot = true;
   std::lock_guard lock(impl_->mutex);
   next->generation = impl_->mounted.generation;  // same robot: no new hardware generation

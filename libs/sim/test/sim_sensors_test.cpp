@@ -327,6 +327,50 @@ TEST(SimSensors, DrillCameraSeesTheMarksWhereTheWorldPutsThem) {
 namespace concert::sim {
 namespace {
 
+// The simulated base stands on the wheels its model names by role (its chains of role leg), not
+// on wheels guessed from the URDF's axes: the demo robot and the paper's robot from the public
+// CONCERT database each have four steering legs; the same URDF with no legs named is a fixed robot,
+// and bare (no roles at all) is put on the wheels its axes show.
+TEST(SimAssembly, TheBaseStandsOnTheLegsTheModelNamesByRole) {
+  SimParams params;
+  params.sensors.enabled = false;
+  const SimulatedRobot paper = AssemblyBuilder({test_data::kPublicDb})
+                                   .build(test_data::kExamples + "/concert_paper_robot.yaml");
+  for (const SimulatedRobot& robot : {demo_robot("drill_robot.yaml"), paper}) {
+    SCOPED_TRACE(robot.source);
+    ASSERT_TRUE(robot.legs.has_value());
+    ASSERT_EQ(robot.legs->size(), 4u);
+    for (const SimLeg& leg : *robot.legs) {
+      EXPECT_GT(leg.wheel_radius, 0.05) << leg.wheel_joint;
+      EXPECT_NE(leg.steering_joint, leg.wheel_joint);
+    }
+    const SimHardware sim(robot, World{}, params);
+    EXPECT_NE(sim.mjcf().find("__floating_base"), std::string::npos);
+    // Standing on its wheels: the base frame as high as a wheel radius above the wheel centres.
+    EXPECT_GT(sim.base_pose().translation().z(), 0.05);
+
+    SimulatedRobot none = robot;
+    none.legs = std::vector<SimLeg>{};
+    const SimHardware fixed(none, World{}, params);
+    EXPECT_EQ(fixed.mjcf().find("__floating_base"), std::string::npos);
+    EXPECT_EQ(fixed.base_pose().translation().z(), 0.0);
+
+    const SimHardware bare(robot.urdf, World{}, params);
+    EXPECT_NE(bare.mjcf().find("__floating_base"), std::string::npos);
+
+    // A leg whose joints are no steering axis over a wheel is refused, named.
+    SimulatedRobot wrong = robot;
+    (*wrong.legs)[0].steering_joint = (*wrong.legs)[0].wheel_joint;
+    try {
+      const SimHardware hw(wrong, World{}, params);
+      FAIL() << "a leg without a steering axis was taken";
+    } catch (const hardware::HardwareError& e) {
+      EXPECT_NE(std::string(e.what()).find("sim: leg " + (*wrong.legs)[0].wheel_joint), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 // The sanding tool's links get the running disc's friction (SimParams::sanding_disc_friction):
 // the links moved with it are found from its end-effector, and they are links of the robot
 // (a name that is none is refused by the simulator, as below).

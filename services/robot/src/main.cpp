@@ -210,8 +210,7 @@ int run(const Options& options) {
     }
     const world::World world = options.world.empty() ? world::World{} : world::load_world_file(options.world);
     robot::dds::ServiceParams service = service_params(options);
-    sim::SimHardware sim(simulated.urdf, world, service.sim, simulated.sensors, simulated.drill_bits,
-                         simulated.sanding_links);
+    sim::SimHardware sim(simulated, world, service.sim);
     robot::RobotParams& params = service.robot;
     robot::RobotCore core(sim, params);
 

@@ -64,7 +64,7 @@ TEST(HotSwap, NewScanNewModelAccepted) {
   const AssemblyBuilder builder({kPublicDb});
   const std::string paper = read_text(kPaperRobot);
   const SimulatedRobot a = builder.build_from_text(paper, "paper.yaml");
-  SimHardware sim(a.urdf, World{}, {});
+  SimHardware sim(a, World{}, {});
   RobotCore core(sim);
   core.set_model(model_from_scan(a.scan), 1);
   test::run_cycles(core, 300);
@@ -74,7 +74,7 @@ TEST(HotSwap, NewScanNewModelAccepted) {
   const SimulatedRobot b = builder.build_from_text(
       replace(paper, "key: module_drill_concert", "key: module_spraying_tool_concert"), "spray.yaml");
   EXPECT_NE(b.scan, a.scan);
-  sim.swap_model(b.urdf);
+  sim.swap_model(b);
   test::run_cycles(core, 100);
   EXPECT_FALSE(core.ready());
   core.set_model(model_from_scan(b.scan), 2);
@@ -87,7 +87,7 @@ TEST(HotSwap, NewScanNewModelAccepted) {
               "  - {name: drill, key: module_drill_concert, parent: link_3, connector: 1, robot_id: 60}"),
       "link.yaml");
   EXPECT_EQ(c.tree.modules.size(), a.tree.modules.size() + 1);
-  sim.swap_model(c.urdf);
+  sim.swap_model(c);
   test::run_cycles(core, 100);
   core.set_model(model_from_scan(c.scan), 3);
   EXPECT_TRUE(core.ready());
@@ -98,7 +98,7 @@ TEST(HotSwap, NewScanNewModelAccepted) {
               "  - {name: wheel_rr, key: module_wheel_concert, parent: steer_rr, connector: 1, robot_id: 42}\n", ""),
       "three_legs.yaml");
   EXPECT_EQ(d.scan.slaves.size(), a.scan.slaves.size() - 2);
-  sim.swap_model(d.urdf);
+  sim.swap_model(d);
   test::run_cycles(core, 100);
   EXPECT_THROW(core.set_model(model_from_scan(c.scan), 4), ModelMismatchError);
   core.set_model(model_from_scan(d.scan), 4);

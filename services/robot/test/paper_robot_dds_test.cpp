@@ -62,7 +62,7 @@ TEST(PaperRobotDds, CartesianImpedanceMovesTheDrillToolFrameNotAWheel) {
   // As on the paper's robot: the first end-effector of the message is a wheel.
   ASSERT_EQ(model.end_effectors().front().frame(), wheel_frame);
 
-  SimHardware sim(robot.urdf, World{}, {});
+  SimHardware sim(robot, World{}, {});
   RobotCore core(sim);
   cdds::Participant robot_side({.name = "robot"});
   dds::RobotNode node(robot_side, core);

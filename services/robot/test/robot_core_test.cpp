@@ -83,6 +83,30 @@ TEST(RobotCoreModel, ReadsTheToolAndTheLegsOfTheModelByRole) {
   EXPECT_EQ(core.model_version(), 3u);
 }
 
+// A leg chain the model cannot give (here: its wheel end-effector dropped) refuses the model
+// with the chain's name, as nav refuses it; the robot does not guess the legs by their axes.
+TEST(RobotCoreModel, RefusesAModelWhoseLegChainHasNoWheel) {
+  const std::string assembly = std::string(CONCERT_SOURCE_DIR) + "/deploy/demo/drill_robot.yaml";
+  const auto good = concert::testing::robot_model(assembly, 1);
+  SimHardware sim(good->description().urdf, World{}, {});
+  RobotCore core(sim);
+  core.set_model(good);
+  ASSERT_TRUE(core.ready());
+  concert::model::ModelDescription d = good->description();
+  d.version = 2;
+  const auto wheel = std::find_if(d.end_effectors.begin(), d.end_effectors.end(), [](const auto& e) {
+    return e.kind == concert::model::EndEffectorKind::kWheel;
+  });
+  ASSERT_NE(wheel, d.end_effectors.end());
+  const std::string chain = wheel->chain;
+  d.end_effectors.erase(wheel);
+  const std::string msg = message_of([&] { core.set_model(concert::model::RobotModel::build(d)); });
+  EXPECT_NE(msg.find("model version 2 refused"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("leg chain " + chain), std::string::npos) << msg;
+  EXPECT_EQ(core.model_version(), 1u);  // the last good model stays
+  EXPECT_TRUE(core.ready());
+}
+
 TEST_F(RobotCoreTest, RefusesModelsThatDoNotMatchTheMountedHardware) {
   core_.set_model(read_fixture("mobile_drill.urdf"), 1);
   const std::string msg = message_of([&] { core_.set_model(read_fixture("mobile_three_legs.urdf"), 2); });

@@ -149,7 +149,7 @@ struct RobotParams {
   /// Empty: the deepest frame named "tcp" or "tcp_<chain>" (modelgen's naming), else the
   /// deepest leaf link (most movable joints above it).
   std::string end_effector_frame;
-  double default_wheel_radius{0.16};     ///< for wheel links without a collision cylinder [m]
+  double default_wheel_radius{0.16};     ///< a bare URDF's wheel links without a collision cylinder [m]
   double wrench_filter_time_constant{0.02};  ///< low-pass of the wrench estimate [s]
   double base_command_timeout{0.5};      ///< base stops if no base command for this long [s]
   double velocity_guard_gain{20.0};      ///< damping added above the velocity limit [Nm s/rad]

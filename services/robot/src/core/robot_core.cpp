@@ -268,7 +268,7 @@ void RobotCore::set_model(const std::string& urdf, std::uint64_t version, const 
   }
   std::string ee = end_effector_frame.empty() ? params_.end_effector_frame : end_effector_frame;
   if (ee.empty()) ee = default_end_effector(*model);
-  // A bare URDF: the legs by their geometry.
+  // A bare URDF carries no roles: the legs by their axes, the only place the robot guesses them.
   std::vector<Leg> legs = detect_legs(*model, collision_cylinder_radii(urdf), params_.default_wheel_radius);
   install(model, version, ee, std::move(legs), limits);
 }
@@ -294,18 +294,17 @@ void RobotCore::set_model(const std::shared_ptr<const model::RobotModel>& m) {
     }
   }
   check_newer(m->version(), what);
-  // The steered leg chains, measured. Unsteered wheels (a differential drive) are not this base
-  // controller's: the robot runs without driving them, as it did for a URDF. A leg whose wheel
-  // radius the model cannot give (no collision cylinder about the wheel axis) leaves the legs to
-  // the geometric search with the default radius, as for a bare URDF.
+  // The steered leg chains, by role, measured. Unsteered wheels (a differential drive) are not
+  // this base controller's: the robot runs without driving them. A leg the model cannot give
+  // (no wheel, no wheel radius) refuses the model, as nav refuses it.
   std::vector<Leg> legs;
   try {
     for (const model::Leg& leg : m->legs()) {
       if (leg.steering_joint.empty()) continue;
       legs.push_back(mobile_base::measure_leg(m->kinematics(), leg.steering_joint, leg.wheel_joint, leg.wheel_radius));
     }
-  } catch (const model::ModelError&) {
-    legs = detect_legs(m->kinematics(), collision_cylinder_radii(m->description().urdf), params_.default_wheel_radius);
+  } catch (const model::ModelError& e) {
+    throw ModelMismatchError(what + " refused: " + e.what());
   } catch (const std::invalid_argument& e) {
     throw ModelMismatchError(what + " refused: " + e.what());
   }

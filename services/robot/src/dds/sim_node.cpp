@@ -182,7 +182,7 @@ std::string SimNode::swap_assembly(const std::string& yaml, const std::string& n
         "the simulated robot is a fixed URDF (--urdf): there is no assembly to swap");
   }
   const sim::SimulatedRobot robot = builder_->build_from_text(yaml, name);
-  if (!sim_.swap_model(robot.urdf, robot.sensors, robot.drill_bits, robot.sanding_links)) {
+  if (!sim_.swap_model(robot)) {
     return "the same robot is mounted again: nothing changed";
   }
   // The loop switches at its next cycle boundary; mounted() already names the new joints, so

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,14 @@
 #include "concert/topology/types.hpp"
 
 namespace concert::sim {
+
+/// A steering leg of the simulated robot, named by the model's roles (a chain of role leg,
+/// model::RobotModel::legs()): the steering joint over its wheel joint and the wheel's radius.
+struct SimLeg {
+  std::string steering_joint;
+  std::string wheel_joint;
+  double wheel_radius{0.0};  ///< [m]
+};
 
 /// What the simulator needs to stand in for an assembled robot.
 struct SimulatedRobot {
@@ -23,6 +32,9 @@ struct SimulatedRobot {
   /// The links moved with its sanding tools (the subtree of the last joint moving each sanding
   /// end-effector's TCP: the tool and its flange), for SimParams::sanding_disc_friction.
   std::vector<std::string> sanding_links;
+  /// The steering legs by role (the wheels that roll on the floor). nullopt for a bare URDF,
+  /// which carries no roles: the simulator then finds them by their axes (mobile_base::detect_legs).
+  std::optional<std::vector<SimLeg>> legs;
 };
 
 /// The simulated sensors of a model's sensor frames: cameras (RGB-D), lidars, sonars, IMUs;

@@ -12,6 +12,7 @@
 #include "concert/hardware/hardware.hpp"
 #include "concert/sim/drilling.hpp"
 #include "concert/sim/sensor_params.hpp"
+#include "concert/sim/sim_assembly.hpp"
 #include "concert/world/world.hpp"
 
 namespace concert::sim {
@@ -71,9 +72,14 @@ class SimHardware final : public hardware::Hardware {
   /// in the world's walls (drilling.hpp).
   /// `sanding_links`: the links of its sanding tools (SimulatedRobot::sanding_links), whose
   /// contacts get SimParams::sanding_disc_friction.
+  /// A bare URDF carries no roles: its steering legs are found by their axes (detect_legs).
   SimHardware(const std::string& urdf, World world, SimParams params = {},
               std::vector<SensorMount> sensors = {}, std::vector<DrillBit> drill_bits = {},
               std::vector<std::string> sanding_links = {});
+  /// An assembled robot (AssemblyBuilder): its URDF, sensors, drill bits, sanding links, and the
+  /// steering legs its model names by role (SimulatedRobot::legs; by their axes when nullopt).
+  /// Throws HardwareError naming a leg whose joints are not a steering axis over a wheel.
+  SimHardware(SimulatedRobot robot, World world, SimParams params = {});
   ~SimHardware() override;
   SimHardware(const SimHardware&) = delete;
   SimHardware& operator=(const SimHardware&) = delete;
@@ -104,6 +110,8 @@ class SimHardware final : public hardware::Hardware {
   bool swap_model(const std::string& urdf, std::vector<SensorMount> sensors = {},
                   std::vector<DrillBit> drill_bits = {},
                   std::vector<std::string> sanding_links = {});
+  /// The same for an assembled robot, its legs by role as in the constructor.
+  bool swap_model(SimulatedRobot robot);
   /// Replaces the world the same way (keeps the robot state and the hardware generation).
   void set_world(const World& world);
   /// The latest world given (any thread).
