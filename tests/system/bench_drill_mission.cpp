@@ -120,7 +120,12 @@ void score(const std::string& what, const MissionRun& run, const std::vector<Tar
     const auto [hole, e] = nearest_hole(run.holes, t);
     // A hole within 5 cm is this mark's; farther, the mark was not drilled.
     if (hole == nullptr || e.norm() > 0.05) {
-      std::printf("  %-22s not drilled\n", t.name.c_str());
+      if (hole == nullptr) {
+        std::printf("  %-22s not drilled (no hole in any wall)\n", t.name.c_str());
+      } else {
+        std::printf("  %-22s not drilled (the nearest hole %.1f mm away: x %+.1f mm y %+.1f mm)\n", t.name.c_str(),
+                    e.norm() * 1e3, e.horizontal * 1e3, e.vertical * 1e3);
+      }
       off = true;
       continue;
     }
@@ -129,6 +134,16 @@ void score(const std::string& what, const MissionRun& run, const std::vector<Tar
     tally.errors.push_back(e.norm());
     std::printf("  %-22s x %+6.2f mm  y %+6.2f mm  |e| %5.2f mm  depth %4.1f mm\n", t.name.c_str(),
                 e.horizontal * 1e3, e.vertical * 1e3, e.norm() * 1e3, hole->depth() * 1e3);
+  }
+  // Holes no mark claims (more than 5 cm from every mark): where the drill went instead.
+  for (const concert::msg::SimHole& h : run.holes) {
+    bool claimed = false;
+    for (const Target& t : targets) claimed = claimed || error_of(h, t.position, t.normal).norm() <= 0.05;
+    if (!claimed) {
+      std::printf("  a hole at no mark: entry (%.3f, %.3f, %.3f) m in %s, depth %.1f mm\n", h.entry().x(),
+                  h.entry().y(), h.entry().z(), h.wall().c_str(), h.depth() * 1e3);
+      off = true;
+    }
   }
   if (logs || off || s.state() != concert::msg::DRILL_SUCCEEDED) {
     std::cerr << what << ": the services' logs" << run.logs << "\n";
