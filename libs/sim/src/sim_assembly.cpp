@@ -73,6 +73,18 @@ std::vector<SimLeg> steering_legs(const model_generation::GeneratedModel& genera
   return legs;
 }
 
+/// Who a module is across hot swaps: its key and robot_id (the one its upstream ESC reports),
+/// else (no robot_id) its key and the connectors from the root down to it.
+std::string module_identity(const topology::ModuleTree& tree, int index) {
+  const topology::ModuleNode& node = tree.modules.at(static_cast<std::size_t>(index));
+  if (node.robot_id >= 0) return node.key + " robot_id " + std::to_string(node.robot_id);
+  std::string place;
+  for (int m = index; m >= 0; m = tree.modules.at(static_cast<std::size_t>(m)).parent_module) {
+    place = "/" + std::to_string(tree.modules.at(static_cast<std::size_t>(m)).parent_connector) + place;
+  }
+  return node.key + " at " + place;
+}
+
 }  // namespace
 
 std::vector<SensorMount> sensor_mounts(const std::vector<model::SensorFrame>& frames) {
@@ -146,6 +158,15 @@ SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const s
     out.drill_bits = drill_bits(model.end_effectors);
     out.sanding_links = sanding_links(model.urdf, model.end_effectors);
     out.legs = steering_legs(model);
+    std::map<int, int> joints_of_module;  // a module's moving joints so far (model order)
+    for (const model_generation::JointInfo& j : model.joints) {
+      if (j.module >= 0) {
+        const int n = joints_of_module[j.module]++;
+        out.joint_modules[j.name] =
+            module_identity(out.tree, j.module) + (n > 0 ? " joint " + std::to_string(n + 1) : std::string());
+      }
+      out.joint_homes[j.name] = j.home;
+    }
   } catch (const std::exception& e) {
     throw std::runtime_error("assembly '" + source + "': model generation failed: " + e.what());
   }

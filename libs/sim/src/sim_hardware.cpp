@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <iomanip>
 #include <random>
 #include <mutex>
@@ -355,6 +356,10 @@ struct Instance {
   mjData* d{nullptr};
   ObstacleMotion obstacles;  ///< moves the world's moving obstacles (mocap bodies)
   std::vector<int> qpos_adr, dof_adr;
+  /// Per actuated joint: its module's identity (SimulatedRobot::joint_modules; empty for a bare
+  /// URDF), its homing position and its range (-inf, inf without limits).
+  std::vector<std::string> module_of;
+  std::vector<double> home, lower, upper;
   std::vector<DriveCommand> commands;
   std::vector<double> rated_effort;  ///< each actuator's forcerange from the URDF (0: none)
   std::uint64_t generation{0};
@@ -417,8 +422,16 @@ std::unique_ptr<Instance> make_instance(const SimulatedRobot& robot, const World
     const int jid = mj_name2id(in->m, mjOBJ_JOINT, in->built.joints[i].c_str());
     in->qpos_adr.push_back(in->m->jnt_qposadr[jid]);
     in->dof_adr.push_back(in->m->jnt_dofadr[jid]);
-    double q = 0.0;
-    if (auto p = params.initial_positions.find(in->built.joints[i]); p != params.initial_positions.end()) {
+    const std::string& name = in->built.joints[i];
+    const bool limited = in->m->jnt_limited[jid] != 0;
+    in->lower.push_back(limited ? in->m->jnt_range[2 * jid] : -std::numeric_limits<double>::infinity());
+    in->upper.push_back(limited ? in->m->jnt_range[2 * jid + 1] : std::numeric_limits<double>::infinity());
+    const auto module = robot.joint_modules.find(name);
+    in->module_of.push_back(module != robot.joint_modules.end() ? module->second : std::string());
+    const auto home = robot.joint_homes.find(name);
+    in->home.push_back(std::clamp(home != robot.joint_homes.end() ? home->second : 0.0, in->lower[i], in->upper[i]));
+    double q = in->home[i];  // each module is new to the robot: its homing position
+    if (auto p = params.initial_positions.find(name); p != params.initial_positions.end()) {
       q = p->second;
     }
     in->d->qpos[in->qpos_adr[i]] = q;
@@ -437,8 +450,22 @@ std::unique_ptr<Instance> make_instance(const SimulatedRobot& robot, const World
   return in;
 }
 
-/// Carries the state of `from` into `to` (control thread, no allocation): the base pose and
-/// same-named joints for a new robot, everything for a new world around the same robot.
+/// The joint of `from` that `to`'s joint i is, or -1: the same module (a hot swap can give a
+/// kept module's joint another name, and a kept name to another module's joint); by name only
+/// where either robot is a bare URDF, which names no modules.
+int same_joint(const Instance& from, const Instance& to, std::size_t i) {
+  for (std::size_t k = 0; k < from.built.joints.size(); ++k) {
+    const bool by_name = to.module_of[i].empty() || from.module_of[k].empty();
+    if (by_name ? from.built.joints[k] == to.built.joints[i] : from.module_of[k] == to.module_of[i]) {
+      return static_cast<int>(k);
+    }
+  }
+  return -1;
+}
+
+/// Carries the state of `from` into `to` (control thread, no allocation): for a new robot the
+/// base pose and each joint of a kept module, within the joint's range; a joint whose module is
+/// new starts at its homing position. Everything for a new world around the same robot.
 void carry_state(const Instance& from, Instance& to) {
   to.d->time = from.d->time;
   to.obstacles.apply(to.d, to.d->time);
@@ -449,14 +476,14 @@ void carry_state(const Instance& from, Instance& to) {
     std::copy(from.commands.begin(), from.commands.end(), to.commands.begin());
   } else {
     for (std::size_t i = 0; i < to.built.joints.size(); ++i) {
-      for (std::size_t k = 0; k < from.built.joints.size(); ++k) {
-        if (from.built.joints[k] == to.built.joints[i]) {
-          to.d->qpos[to.qpos_adr[i]] = from.d->qpos[from.qpos_adr[k]];
-          to.d->qvel[to.dof_adr[i]] = from.d->qvel[from.dof_adr[k]];
-          to.commands[i].position = from.d->qpos[from.qpos_adr[k]];
-          break;
-        }
+      const int k = same_joint(from, to, i);
+      double q = to.home[i];
+      if (k >= 0) {
+        q = std::clamp(from.d->qpos[from.qpos_adr[static_cast<std::size_t>(k)]], to.lower[i], to.upper[i]);
+        to.d->qvel[to.dof_adr[i]] = from.d->qvel[from.dof_adr[static_cast<std::size_t>(k)]];
       }
+      to.d->qpos[to.qpos_adr[i]] = q;
+      to.commands[i].position = q;
     }
     if (from.built.floating && to.built.floating) {
       std::copy_n(from.d->qpos, 7, to.d->qpos);

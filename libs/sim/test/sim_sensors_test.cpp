@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -369,6 +370,78 @@ TEST(SimAssembly, TheBaseStandsOnTheLegsTheModelNamesByRole) {
           << e.what();
     }
   }
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  if (at == std::string::npos) throw std::runtime_error("no '" + from + "' in the assembly");
+  return text.replace(at, from.size(), to);
+}
+
+// A hot swap carries a joint's state by its module, as a drive's encoder does, never by the
+// joint's name (the paper's naming numbers joints along a chain, so another morphology gives a
+// kept name to another module's joint and a kept module's joint another name).
+TEST(SimAssembly, AHotSwapCarriesAJointsStateByItsModuleNeverByItsName) {
+  const AssemblyBuilder builder({test_data::kPublicDb});
+  std::ifstream in(test_data::kExamples + "/concert_paper_robot.yaml");
+  const std::string paper{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const auto joint_of = [](const SimulatedRobot& r, const std::string& module) {
+    for (const auto& [joint, m] : r.joint_modules)
+      if (m == module) return joint;
+    return std::string();
+  };
+  const auto position = [](SimHardware& sim, const std::string& joint) {
+    hardware::HardwareState s;
+    sim.read(s);
+    const auto& names = sim.joint_names();
+    const auto at = std::find(names.begin(), names.end(), joint);
+    if (at == names.end()) throw std::runtime_error("no joint " + joint);
+    return s.position[static_cast<std::size_t>(at - names.begin())];
+  };
+  const std::string kElbow3 = "module_joint_elbow_B_concert robot_id 55";
+  const std::string kYaw2 = "module_joint_yaw_B_concert robot_id 54";
+  const SimulatedRobot a = builder.build_from_text(paper, "paper.yaml");
+  const std::string elbow3 = joint_of(a, kElbow3);
+  const std::string yaw2 = joint_of(a, kYaw2);
+  ASSERT_FALSE(elbow3.empty());
+  ASSERT_FALSE(yaw2.empty());
+  SimParams params;
+  params.sensors.enabled = false;
+  params.initial_positions = {{elbow3, 0.7}, {yaw2, -0.4}};
+  SimHardware sim(a, World{}, params);
+  for (int i = 0; i < 10; ++i) sim.step(0.001);
+  EXPECT_NEAR(position(sim, elbow3), 0.7, 0.02);
+
+  // Another elbow (another type, another robot_id) where elbow_3 was: the joint keeps its
+  // name, not the old module's state; it starts at its homing position.
+  const std::string kElbowA = "module_joint_elbow_A_concert robot_id 57";
+  const std::string b_text =
+      replaced(paper, "{name: elbow_3, key: module_joint_elbow_B_concert, parent: link_2, connector: 1, robot_id: 55}",
+               "{name: elbow_3, key: module_joint_elbow_A_concert, parent: link_2, connector: 1, robot_id: 57}");
+  const SimulatedRobot b = builder.build_from_text(b_text, "other_elbow.yaml");
+  ASSERT_EQ(joint_of(b, kElbowA), elbow3);
+  ASSERT_TRUE(sim.swap_model(b));
+  ASSERT_TRUE(sim.switch_prepared());
+  EXPECT_NEAR(position(sim, elbow3), b.joint_homes.at(elbow3), 1e-9);
+  EXPECT_NEAR(position(sim, yaw2), -0.4, 0.02);
+
+  // elbow_2 taken out: the joints after it are numbered one less, and yaw_2's joint, under its
+  // new name, keeps yaw_2's state.
+  const SimulatedRobot c = builder.build_from_text(
+      replaced(replaced(b_text, "  - {name: elbow_2, key: module_joint_elbow_A_concert, parent: link_1, connector: 1, robot_id: 53}\n", ""),
+               "{name: yaw_2, key: module_joint_yaw_B_concert, parent: elbow_2,",
+               "{name: yaw_2, key: module_joint_yaw_B_concert, parent: link_1,"),
+      "no_elbow_2.yaml");
+  const std::string yaw2_c = joint_of(c, kYaw2);
+  ASSERT_FALSE(yaw2_c.empty());
+  EXPECT_NE(yaw2_c, yaw2);
+  ASSERT_TRUE(sim.swap_model(c));
+  ASSERT_TRUE(sim.switch_prepared());
+  EXPECT_NEAR(position(sim, yaw2_c), -0.4, 0.02);
+  // The name yaw_2's joint had now is the spare elbow's joint: it keeps the elbow's state, not
+  // the -0.4 rad a carry by name would give it.
+  EXPECT_EQ(c.joint_modules.at(yaw2), kElbowA);
+  EXPECT_NEAR(position(sim, yaw2), b.joint_homes.at(elbow3), 0.02);
 }
 
 // The sanding tool's links get the running disc's friction (SimParams::sanding_disc_friction):

@@ -46,7 +46,9 @@ struct SimParams {
   std::optional<bool> floating_base;
   Eigen::Vector3d base_position{0.0, 0.0, 0.0};  ///< [m]; z is computed for a floating base on the floor
   double base_yaw{0.0};                           ///< [rad]
-  std::map<std::string, double> initial_positions;  ///< joint -> [rad]/[m]; others start at 0
+  /// Joint -> [rad]/[m]; the others start at their homing position (SimulatedRobot::joint_homes;
+  /// else 0, within the joint's limits).
+  std::map<std::string, double> initial_positions;
   double position_noise{0.0};        ///< std-dev of the encoder noise [rad]
   double effort_noise{0.0};          ///< std-dev of the torque-sensor noise [Nm]
   unsigned seed{1};                  ///< noise seed
@@ -101,8 +103,9 @@ class SimHardware final : public hardware::Hardware {
 
   /// Hot swap, prepared on the calling thread (any thread but the control thread: URDF ->
   /// MJCF -> MuJoCo model and data) and switched in by the control thread's next
-  /// switch_prepared(): the robot becomes `urdf` (the base pose and joints with the same name
-  /// keep their state, every drive holds position) and generation() increases; mounted()
+  /// switch_prepared(): the robot becomes `urdf` (the base pose and the joints of a bare URDF
+  /// with the same name keep their state, within the new joint's limits; every drive holds
+  /// position) and generation() increases; mounted()
   /// reports it at once. The same URDF again is no change (returns false). Throws
   /// HardwareError (nothing changes) if the URDF cannot be simulated.
   /// `sensors` and `drill_bits` are the new robot's (the old robot's sensors stop, the new
@@ -110,7 +113,10 @@ class SimHardware final : public hardware::Hardware {
   bool swap_model(const std::string& urdf, std::vector<SensorMount> sensors = {},
                   std::vector<DrillBit> drill_bits = {},
                   std::vector<std::string> sanding_links = {});
-  /// The same for an assembled robot, its legs by role as in the constructor.
+  /// The same for an assembled robot, its legs by role as in the constructor. A joint's state
+  /// belongs to its module (SimulatedRobot::joint_modules), as a drive's encoder does: a kept
+  /// module's joint keeps it under whatever name the new model gives it; a joint whose module
+  /// is new starts at its homing position, whatever the old robot's joint of that name did.
   bool swap_model(SimulatedRobot robot);
   /// Replaces the world the same way (keeps the robot state and the hardware generation).
   void set_world(const World& world);
