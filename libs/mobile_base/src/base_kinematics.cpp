@@ -144,10 +144,7 @@ Leg measure_leg(const kinematics::Model& model, const std::string& steering_join
 std::vector<Leg> steering_legs(const model::RobotModel& model) {
   std::vector<Leg> out;
   for (const model::Leg& leg : model.legs()) {
-    if (leg.steering_joint.empty()) {
-      throw std::invalid_argument(model.where() + ": leg chain " + leg.chain->name +
-                                  " has no steering joint (wheel joint '" + leg.wheel_joint + "')");
-    }
+    if (leg.steering_joint.empty()) continue;
     try {
       out.push_back(measure_leg(model.kinematics(), leg.steering_joint, leg.wheel_joint, leg.wheel_radius));
     } catch (const std::invalid_argument& e) {

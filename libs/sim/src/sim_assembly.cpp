@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "concert/kinematics/model.hpp"
+#include "concert/mobile_base/base_kinematics.hpp"
 #include "concert/model/robot_model.hpp"
 #include "concert/model_generation/generator.hpp"
 #include "concert/module_db/module_db.hpp"
@@ -62,12 +63,10 @@ std::vector<std::string> sanding_links(
   return links;
 }
 
-/// The steering legs of the generated model, by role (its chains of role leg). A leg without a
-/// steering joint (an unsteered wheel) is not one the simulated base drives.
+/// The steering legs of the generated model, by role (mobile_base::steering_legs).
 std::vector<SimLeg> steering_legs(const model_generation::GeneratedModel& generated) {
   std::vector<SimLeg> legs;
-  for (const model::Leg& leg : model::RobotModel::build(generated.description())->legs()) {
-    if (leg.steering_joint.empty()) continue;
+  for (const mobile_base::Leg& leg : mobile_base::steering_legs(*model::RobotModel::build(generated.description()))) {
     legs.push_back({leg.steering_joint, leg.wheel_joint, leg.wheel_radius});
   }
   return legs;

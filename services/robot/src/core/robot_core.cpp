@@ -299,13 +299,8 @@ void RobotCore::set_model(const std::shared_ptr<const model::RobotModel>& m) {
   // (no wheel, no wheel radius) refuses the model, as nav refuses it.
   std::vector<Leg> legs;
   try {
-    for (const model::Leg& leg : m->legs()) {
-      if (leg.steering_joint.empty()) continue;
-      legs.push_back(mobile_base::measure_leg(m->kinematics(), leg.steering_joint, leg.wheel_joint, leg.wheel_radius));
-    }
-  } catch (const model::ModelError& e) {
-    throw ModelMismatchError(what + " refused: " + e.what());
-  } catch (const std::invalid_argument& e) {
+    legs = mobile_base::steering_legs(*m);
+  } catch (const std::exception& e) {  // model::ModelError, std::invalid_argument
     throw ModelMismatchError(what + " refused: " + e.what());
   }
   // The fixed-base kinematics of the model, kept alive with it.

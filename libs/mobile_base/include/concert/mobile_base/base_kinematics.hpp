@@ -66,8 +66,9 @@ Leg measure_leg(const kinematics::Model& model, const std::string& steering_join
                 const std::string& wheel_joint, double wheel_radius);
 
 /// The steering legs of `model`, selected by role (its chains of role leg, model::RobotModel::legs())
-/// and measured (measure_leg). Throws std::invalid_argument naming a leg chain without a
-/// steering joint or whose joints do not make a steering leg; model::ModelError from legs().
+/// and measured (measure_leg). A leg chain without a steering joint (an unsteered wheel, a
+/// differential drive's) is no steering leg and is left out. Throws std::invalid_argument naming
+/// a leg chain whose joints do not make a steering leg; model::ModelError from legs().
 std::vector<Leg> steering_legs(const model::RobotModel& model);
 
 /// Height of the base frame above the floor when the base stands on its wheels [m]: the

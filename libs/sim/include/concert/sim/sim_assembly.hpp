@@ -37,8 +37,9 @@ struct SimulatedRobot {
   /// which carries no roles: the simulator then finds them by their axes (mobile_base::detect_legs).
   std::optional<std::vector<SimLeg>> legs;
   /// Moving joint -> the module it belongs to: its key and robot_id (the ESC's), else its key
-  /// and place in the tree (and which of the module's joints, for a module with several). A hot swap carries a joint's state by this, never by the joint's
-  /// name, which another morphology may give to another module's joint. Empty for a bare URDF.
+  /// and place in the tree (and which of the module's joints, for a module with several). A hot
+  /// swap carries a joint's state by this, never by the joint's name, which another morphology
+  /// may give to another module's joint. Empty for a bare URDF.
   std::map<std::string, std::string> joint_modules;
   /// Moving joint -> its homing position, within its limits: where a joint whose module is new
   /// in a hot swap starts.
