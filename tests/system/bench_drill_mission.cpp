@@ -162,7 +162,8 @@ void score(const std::string& what, const MissionRun& run, const std::vector<Tar
 // up to 2.4 m (a marker of id 0, the row 15 cm below it), C above (id 1, the row 15 cm above it:
 // the marker stays within the wall). The marker stands 2.2 m in front of the robot's start,
 // 0.3 m left, ahead or right in turn. Each experiment's world is a file in the temp directory.
-int experiments(int runs, bool logs, const std::string& map, const concert::drill::PatternTable& patterns) {
+int experiments(int runs, bool logs, const std::string& map, const concert::drill::PatternTable& patterns,
+                std::pair<double, double> rows) {
   constexpr int kExperiments = 22;
   constexpr double kLowest = 0.35, kHighest = 2.90, kMorphologyC = 2.4;
   Tally all, on_a, on_c;
@@ -170,6 +171,7 @@ int experiments(int runs, bool logs, const std::string& map, const concert::dril
   for (int r = 0; r < runs; ++r) {
     for (int k = 0; k < kExperiments; ++k) {
       const double row = kLowest + (kHighest - kLowest) * k / (kExperiments - 1);
+      if (row < rows.first - 1e-9 || row > rows.second + 1e-9) continue;
       const bool c = row > kMorphologyC;
       const double marker = c ? row - 0.15 : row + 0.15;
       const double u = 0.3 * static_cast<double>(k % 3 - 1);  // along the wall, -y
@@ -210,7 +212,7 @@ int experiments(int runs, bool logs, const std::string& map, const concert::dril
 }
 
 int bench(const std::string& which, int runs, const std::string& assembly, bool logs,
-          const std::string& map) {
+          const std::string& map, std::pair<double, double> rows) {
   const std::vector<Scenario> all{
       {"blobs", source("services/planner/data/morphology_b.yaml"),
        source("deploy/bench/drill_blobs_site.yaml"), source("deploy/bench/drill_blobs_mission.yaml")},
@@ -239,7 +241,7 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
   };
   const concert::drill::PatternTable patterns =
       concert::drill::load_patterns(source("services/drill/config/patterns.yaml"));
-  if (which == "experiments") return experiments(runs, logs, map, patterns);
+  if (which == "experiments") return experiments(runs, logs, map, patterns, rows);
   bool known = false;
   for (const Scenario& sc : all) {
     // all: row and low are in patterns
@@ -297,8 +299,20 @@ int main(int argc, char** argv) {
                                 "the planner's map: the simulated world's description, the robot's lidars and "
                                 "depth cameras, or both (concert_planner --map)")
       ->capture_default_str();
+  std::vector<double> rows{0.0, 10.0};
+  app.add_option("--rows", rows,
+                 "experiments only: the rows' heights to run, MIN MAX in metres (default: all 22, "
+                 "0.35-2.90 m)")
+      ->expected(2)
+      ->check(concert::cli::number(0.0, 10.0, false));
   bool logs = false;
   app.add_flag("--logs", logs, "print the services' logs after every run (default: after a failed one, or one with a hole past 5 mm)");
-  cli.on_run(app, [&] { return bench(which, runs, assembly, logs, map); });
+  cli.on_run(app, [&] {
+    if (rows[0] > rows[1]) {
+      throw concert::cli::UsageError("--rows: MIN " + std::to_string(rows[0]) + " is above MAX " +
+                                     std::to_string(rows[1]));
+    }
+    return bench(which, runs, assembly, logs, map, {rows[0], rows[1]});
+  });
   return cli.run(argc, argv);
 }
