@@ -54,8 +54,9 @@ TEST(NavHouse, DrivesFromTheGardenThroughTheTerraceDoorIntoTheLivingRoom) {
       << "sim:\n  base_position: [" << kStart[0] << ", " << kStart[1]
       << ", 0.0]\n  base_yaw: " << kStart[2] << "\nsensors:\n  camera:\n    rate: 1.0\n";
 
-  // The safety layer watches the whole run: driving must not trip it (e.g. the arm's first joint
-  // holding the arm's yaw inertia while the base turns).
+  // The safety layer watches the whole run: driving must not trip it. The base turns at the
+  // platform's 1 rad/s^2, scaled by the drives' budget at the arm's posture (nav reads the
+  // joint state); the legs' steering drives fold back to their continuous torque.
   testing::Process safety(dies_with_test({SAFETY_BINARY}));
   testing::Process discovery(dies_with_test({DISCOVERY_BINARY}));
   testing::Process modelgen(dies_with_test({MODELGEN_BINARY}));

@@ -8,9 +8,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iostream>
 #include <random>
 
 #include "concert/model_generation/generator.hpp"
@@ -82,8 +85,10 @@ struct Drive {
 // Runs the navigator closed-loop for up to `seconds` of simulated time at 100 Hz odometry, 10 Hz
 // scans and the control rate; the base follows the command with a first-order lag and its wheels
 // slip 2 % in speed. Returns the final status.
+// `on_command` sees every command with its stamp.
 GoalStatus run(Navigator& nav, Drive& d, const bim::OccupancyGrid& truth, double seconds,
-               std::mt19937& rng) {
+               std::mt19937& rng,
+               const std::function<void(double, const BaseTwist&)>& on_command = {}) {
   const double dt = 0.01;
   BaseTwist cmd;
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
@@ -99,6 +104,7 @@ GoalStatus run(Navigator& nav, Drive& d, const bim::OccupancyGrid& truth, double
     if (k % 5 == 0) {
       const StepOutput out = nav.step(t);
       cmd = out.drive ? out.command : BaseTwist{};
+      if (on_command) on_command(t, cmd);
       const auto s = nav.status().state;
       if (s == GoalState::kReached || s == GoalState::kFailed || s == GoalState::kCancelled) break;
     }
@@ -153,6 +159,85 @@ TEST_F(NavigatorTest, DrivesThroughTheDoorAndStopsWithinTolerance) {
   for (const auto& p : nav_.path())
     through_door |= p.x() > 6.9 && p.x() < 7.3 && p.y() > 1.5 && p.y() < 3.5;
   EXPECT_TRUE(through_door);
+}
+
+// The demo arm riding on the base, stretched out, cannot hold the platform's 1 rad/s^2 turn within
+// its continuous torques (a safety stop, measured before the drive budget existed): the navigator
+// turns no faster than the budget at the posture it is sent, says which joint sets it, and still
+// arrives.
+TEST_F(NavigatorTest, TurnsTheBaseNoFasterThanTheArmItCarriesCanHold) {
+  const model::DriveBudget drives(*model_);
+  const std::vector<std::string>& names = drives.joint_names();
+  const model::ChainInfo& arm = model_->arm();
+  // The shoulder (the arm's second joint) swept from upright to either side, the other joints
+  // at 0: the posture whose budget is nearest half the platform's accelerations. The arm then
+  // holds most of its continuous torque against gravity, and a brake or a turn adds the rest.
+  const NavParams params;
+  const model::BaseMotion asked{params.max_acceleration, params.max_acceleration,
+                                params.max_angular_acceleration, nav_.vehicle()->limits.angular};
+  const auto shoulder = std::find(names.begin(), names.end(), arm.joints.at(1)) - names.begin();
+  const model::JointLimits& limits = model_->limits().at(arm.joints.at(1));
+  Eigen::VectorXd worst = drives.neutral_posture();
+  double worst_scale = 1.0;
+  for (int k = -300; k <= 300; ++k) {
+    Eigen::VectorXd q = drives.neutral_posture();
+    q(shoulder) = std::clamp(0.01 * k, limits.lower, limits.upper);
+    const model::BaseBudget b = drives.base_motion(q, asked, 1.0);
+    if (b.holds_static && std::abs(b.scale - 0.5) < std::abs(worst_scale - 0.5)) {
+      worst_scale = b.scale;
+      worst = q;
+    }
+  }
+  const model::BaseBudget budget = drives.base_motion(worst, asked, 1.0);
+  ASSERT_LT(budget.scale, 0.9) << "no posture of the demo arm's shoulder limits the base";
+  ASSERT_GT(budget.scale, 0.01) << budget.joint << " is overloaded standing still";
+  std::cout << "demo arm leaning: " << 100.0 * budget.scale << " % of the base's accelerations, set by "
+            << budget.joint << " (" << 100.0 * budget.static_load << " % still, " << 100.0 * budget.dynamic_load
+            << " % more at full)\n";
+
+  start({2.0, 2.5, 0.0});
+  nav_.on_joint_positions(names, std::vector<double>(worst.data(), worst.data() + worst.size()));
+  ASSERT_EQ(nav_.submit(goal(2.0, 2.5, M_PI)).state, GoalState::kPlanning);
+  std::vector<std::pair<double, double>> yaw_rates;  // (stamp, commanded wz)
+  const GoalStatus s = run(nav_, drive_, map_, 60.0, rng_,
+                           [&](double t, const BaseTwist& c) { yaw_rates.emplace_back(t, c.wz); });
+  ASSERT_EQ(s.state, GoalState::kReached) << s.reason;
+  EXPECT_NEAR(nav_.drive_budget().scale, budget.scale, 1e-9);
+  EXPECT_EQ(nav_.drive_budget().joint, budget.joint);
+  // The commands' yaw acceleration stays within the budget. The last command, the stop at the
+  // goal, is a step to zero (within the heading tolerance; the wheels' drives take it).
+  ASSERT_GE(yaw_rates.size(), 3u);
+  double steepest = 0.0;
+  for (std::size_t i = 1; i + 1 < yaw_rates.size(); ++i) {
+    const double dt = yaw_rates[i].first - yaw_rates[i - 1].first;
+    steepest = std::max(steepest, std::abs(yaw_rates[i].second - yaw_rates[i - 1].second) / dt);
+  }
+  EXPECT_EQ(yaw_rates.back().second, 0.0);
+  EXPECT_LE(steepest, params.max_angular_acceleration * budget.scale + 1e-6);
+  EXPECT_GT(steepest, 0.5 * params.max_angular_acceleration * budget.scale) << "it hardly turned";
+  const std::string note = nav_.take_budget_note();
+  EXPECT_THAT(note, HasSubstr(budget.joint));
+  EXPECT_THAT(note, HasSubstr("% of the configured"));
+
+  // A posture no drive can hold still leaves no acceleration: the goal fails naming the joint.
+  Eigen::VectorXd overload = worst;
+  NavParams strict;
+  strict.drive_torque_fraction = 1e-3;
+  Navigator weak(strict, 5);
+  weak.set_model(*model_);
+  weak.set_map(map_, "two rooms");
+  weak.on_joint_positions(names, std::vector<double>(overload.data(), overload.data() + overload.size()));
+  weak.on_wheel_odometry(9.99, Eigen::Vector3d::Zero());
+  weak.set_initial_pose({2.0, 2.5, 0.0}, 0.0, 0.0);
+  for (int i = 0; i < 5; ++i) {
+    weak.on_scan(9.99, scan_at(map_, {2.0, 2.5, 0.0}, rng_));
+    weak.step(9.99);
+  }
+  ASSERT_EQ(weak.submit(goal(2.0, 2.5, M_PI)).state, GoalState::kPlanning);
+  weak.step(10.0);
+  weak.step(10.05);
+  EXPECT_EQ(weak.status().state, GoalState::kFailed);
+  EXPECT_THAT(weak.status().reason, HasSubstr("leaves the base no acceleration"));
 }
 
 TEST_F(NavigatorTest, RefusesWhatItCannotDoWithAReason) {

@@ -119,6 +119,11 @@ class LocalController {
   /// (its obstacle layer updated from the latest scans).
   ControlOutput compute(const Costmap& costmap, const Eigen::Vector3d& pose, double stamp);
 
+  /// Sets the acceleration limits (each > 0; throws std::invalid_argument naming a bad one),
+  /// e.g. scaled to what the drives sustain with the posture the base carries. The velocity
+  /// limits and the path stay.
+  void set_acceleration_limits(double max_ax, double max_ay, double max_aw);
+
   [[nodiscard]] const ControllerParams& params() const { return params_; }
   [[nodiscard]] const BaseTwist& last_command() const { return last_cmd_; }
 

@@ -19,6 +19,7 @@
 
 #include "concert/bim/model.hpp"
 #include "concert/bim/occupancy_grid.hpp"
+#include "concert/model/drive_budget.hpp"
 #include "concert/model/robot_model.hpp"
 #include "nav/costmap.hpp"
 #include "nav/global_planner.hpp"
@@ -39,10 +40,13 @@ struct NavParams {
   ControllerParams controller;
   double control_rate{20.0};     ///< control loop [Hz]
   double cruise_speed{0.5};      ///< along the path, capped by the vehicle's limits [m/s]
-  double max_acceleration{0.5};  ///< [m/s^2]
-  /// [rad/s^2]; low: the arm rides on the base, and its first joint holds the arm's yaw inertia
-  /// (the demo arm at 1 rad/s^2 exceeds its continuous torque: a safety stop)
-  double max_angular_acceleration{0.3};
+  /// The base's accelerations [m/s^2, rad/s^2]: what the platform may do. Scaled down, at the
+  /// posture the base carries, to what every drive sustains (model::DriveBudget).
+  double max_acceleration{0.5};
+  double max_angular_acceleration{1.0};
+  /// Base accelerations keep every joint's and wheel's torque within this fraction of its
+  /// continuous torque, the posture's static load included (0, 1] [-].
+  double drive_torque_fraction{1.0};
   int max_replans{10};          ///< blocked this often -> the goal fails
   double initial_std_xy{0.2};   ///< default spread of an initial pose [m]
   double initial_std_yaw{0.1};  ///< [rad]
@@ -133,6 +137,10 @@ class Navigator {
               const Eigen::Vector3d& angular_velocity);
   /// A planar scan in the base frame, taken at `stamp` [s].
   void on_scan(double stamp, PlanarScan scan);
+  /// The robot's joint positions (names and positions alike indexed; joints of another model
+  /// are ignored): the posture whose drives bound the base's accelerations. Until the first
+  /// sample, each joint is taken at 0 within its limits.
+  void on_joint_positions(const std::vector<std::string>& names, const std::vector<double>& positions);
 
   // --- goals --------------------------------------------------------------------------------
   /// Accepts (state kPlanning) or refuses (kRefused with the reason: no vehicle, stale model
@@ -150,6 +158,9 @@ class Navigator {
   /// Goal statuses to publish since the last call, oldest first: every state change (a goal
   /// replaced by a new one included) and periodic feedback while a goal runs.
   std::vector<GoalStatus> take_updates();
+  /// A line for the log when the drives' budget for base motion changed (the share of the
+  /// configured accelerations allowed and the joint that sets it); empty otherwise.
+  std::string take_budget_note();
 
   // --- state --------------------------------------------------------------------------------
   [[nodiscard]] std::uint64_t model_version() const { return model_version_; }
@@ -168,11 +179,17 @@ class Navigator {
   [[nodiscard]] double wall_standoff() const;
   /// Why the current model cannot navigate ("" when it can or there is no model).
   [[nodiscard]] const std::string& vehicle_error() const { return vehicle_error_; }
+  /// The drives' budget for base motion at the latest posture (scale 1 without a model).
+  [[nodiscard]] const model::BaseBudget& drive_budget() const { return budget_; }
   /// The costmap (null without a vehicle or a map).
   [[nodiscard]] const Costmap* costmap() const { return costmap_.get(); }
 
  private:
   void rebuild();
+  // Scales the controller's accelerations to the drives' budget at the current posture; fails
+  // a running goal when the posture leaves the base no acceleration.
+  void apply_drive_budget();
+  void update_drive_budget();
   void set_state(GoalState state, std::string reason);
   void localise();
   void plan_path(double stamp);
@@ -192,6 +209,13 @@ class Navigator {
   std::unique_ptr<Localiser> localiser_;
   GlobalPlanner planner_;
   std::unique_ptr<LocalController> controller_;
+  std::unique_ptr<model::DriveBudget> drives_;
+  Eigen::VectorXd posture_;  // in drives_->joint_names() order
+  bool budget_stale_{true};
+  model::BaseBudget budget_;
+  std::string budget_note_;
+  double noted_scale_{1.0};
+  std::string noted_joint_;
   OdometryFilter filter_;
   bool have_odometry_{false};
   // Filtered odometry poses (stamp, x, y, yaw) of the last second, to place each scan in time.

@@ -114,6 +114,16 @@ void LocalController::reset() {
   last_cmd_ = {};
 }
 
+void LocalController::set_acceleration_limits(double max_ax, double max_ay, double max_aw) {
+  require(max_ax > 0.0, "limits.max_ax", max_ax, "must be > 0 [m/s^2]");
+  require(params_.drive == ControllerParams::Drive::kDifferential || max_ay > 0.0, "limits.max_ay",
+          max_ay, "must be > 0 [m/s^2] for an omni-steering base");
+  require(max_aw > 0.0, "limits.max_aw", max_aw, "must be > 0 [rad/s^2]");
+  params_.limits.max_ax = max_ax;
+  params_.limits.max_ay = max_ay;
+  params_.limits.max_aw = max_aw;
+}
+
 BaseTwist LocalController::limit_acceleration(const BaseTwist& want, double dt) const {
   const ControllerParams::Limits& l = params_.limits;
   auto step = [dt](double from, double to, double accel) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "concert/bim/wall_goal.hpp"
 #include "concert/mobile_base/map_frame.hpp"
@@ -68,6 +69,8 @@ Navigator::Navigator(NavParams params, std::uint64_t seed)
   if (!(params_.control_rate > 0.0)) throw std::invalid_argument("nav: control_rate must be > 0");
   if (!(params_.cruise_speed > 0.0)) throw std::invalid_argument("nav: cruise_speed must be > 0");
   if (params_.max_replans < 0) throw std::invalid_argument("nav: max_replans must be >= 0");
+  if (!(params_.drive_torque_fraction > 0.0 && params_.drive_torque_fraction <= 1.0))
+    throw std::invalid_argument("nav: drive_torque_fraction must be in (0, 1]");
   params_.localiser.seed = seed_;
 }
 
@@ -79,9 +82,12 @@ const VehicleConfig& Navigator::set_model(const model::RobotModel& model) {
   model_version_ = model.version();
   try {
     vehicle_ = recognise_vehicle(model, params_.vehicle);
+    drives_ = std::make_unique<model::DriveBudget>(model);
+    posture_ = drives_->neutral_posture();
     vehicle_error_.clear();
   } catch (const std::exception& e) {
     vehicle_.reset();
+    drives_.reset();
     vehicle_error_ = e.what();
     rebuild();
     throw;
@@ -134,6 +140,7 @@ void Navigator::rebuild() {
   cp.desired_speed = linear;
   cp.control_period = 1.0 / params_.control_rate;
   controller_ = std::make_unique<LocalController>(cp);
+  budget_stale_ = true;
   if (!map_) return;
   costmap_ = std::make_unique<Costmap>(
       *map_, RobotShape::from_footprint(vehicle_->footprint.polygon), params_.costmap);
@@ -150,6 +157,73 @@ void Navigator::set_initial_pose(const Pose2& pose, double std_xy, double std_ya
   localiser_->set_pose(vec(pose), sigma, filter_.estimate().pose);
   map_to_odom_ = localiser_->estimate().map_T_odom;
 }
+
+void Navigator::on_joint_positions(const std::vector<std::string>& names,
+                                   const std::vector<double>& positions) {
+  if (!drives_) return;
+  const std::vector<std::string>& joints = drives_->joint_names();
+  const std::size_t n = std::min(names.size(), positions.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto it = std::find(joints.begin(), joints.end(), names[k]);
+    if (it == joints.end() || !std::isfinite(positions[k])) continue;
+    double& q = posture_(it - joints.begin());
+    // A posture change below a milliradian changes the budget by nothing worth a recompute.
+    if (std::abs(q - positions[k]) > 1e-3) {
+      q = positions[k];
+      budget_stale_ = true;
+    }
+  }
+}
+
+namespace {
+// Below 1 % of the platform's accelerations the base would crawl for minutes to reach speed.
+constexpr double kLeastAcceleration = 0.01;
+}  // namespace
+
+void Navigator::apply_drive_budget() {
+  if (budget_stale_ && drives_ && controller_ && vehicle_) update_drive_budget();
+  if (drives_ && budget_.scale < kLeastAcceleration && running(status_.state)) {
+    set_state(GoalState::kFailed,
+              "the posture leaves the base no acceleration: " + budget_.joint + " holds " +
+                  fixed(100.0 * budget_.static_load, 0) +
+                  " % of its continuous torque standing still (move the arm to a posture it "
+                  "holds with the base accelerating)");
+  }
+}
+
+void Navigator::update_drive_budget() {
+  budget_stale_ = false;
+  const bool differential = vehicle_->drive == DriveType::kDifferential;
+  model::BaseMotion asked;
+  asked.ax = params_.max_acceleration;
+  asked.ay = differential ? 0.0 : params_.max_acceleration;
+  asked.aw = params_.max_angular_acceleration;
+  asked.wz = vehicle_->limits.angular;
+  budget_ = drives_->base_motion(posture_, asked, params_.drive_torque_fraction);
+  const double scale = std::max(budget_.scale, kLeastAcceleration);
+  controller_->set_acceleration_limits(asked.ax * scale, differential ? 0.0 : asked.ay * scale,
+                                       asked.aw * scale);
+  const bool changed = budget_.joint != noted_joint_ ||
+                       std::abs(budget_.scale - noted_scale_) > 0.1 * std::max(noted_scale_, 0.01);
+  if (changed) {
+    noted_joint_ = budget_.joint;
+    noted_scale_ = budget_.scale;
+    std::ostringstream note;
+    if (budget_.joint.empty()) {
+      note << "base accelerations as configured (" << fixed(asked.ax) << " m/s^2, "
+           << fixed(asked.aw) << " rad/s^2): every drive holds them at this posture";
+    } else {
+      note << "base accelerations at " << fixed(100.0 * budget_.scale, 0) << " % of the configured ("
+           << fixed(asked.ax * budget_.scale) << " m/s^2, " << fixed(asked.aw * budget_.scale)
+           << " rad/s^2): " << budget_.joint << " holds " << fixed(100.0 * budget_.static_load, 0)
+           << " % of its continuous torque still and " << fixed(100.0 * budget_.dynamic_load, 0)
+           << " % more at the full accelerations";
+    }
+    budget_note_ = note.str();
+  }
+}
+
+std::string Navigator::take_budget_note() { return std::exchange(budget_note_, std::string()); }
 
 void Navigator::on_wheel_odometry(double stamp, const Eigen::Vector3d& twist) {
   if (!have_odometry_) {
@@ -395,6 +469,7 @@ StepOutput Navigator::step(double stamp) {
   localise();
   if (goal_ && (!costmap_ || !controller_))
     set_state(GoalState::kFailed, "the map or the vehicle went away");
+  apply_drive_budget();
   if (goal_ && status_.state == GoalState::kPlanning) plan_path(stamp);
   if (goal_ && status_.state == GoalState::kFollowing) {
     out.drive = true;

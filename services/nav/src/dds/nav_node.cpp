@@ -178,6 +178,11 @@ NavNode::NavNode(cdds::Participant& participant, Navigator& navigator, std::stri
                    std::lock_guard lock(mutex_);
                    inbox_.safety = s;
                  }),
+      joints_in_(participant, cdds::topics::joint_state,
+                 [this](const msg::JointState& j, const auto&) {
+                   std::lock_guard lock(mutex_);
+                   inbox_.joints = j;
+                 }),
       goals_in_(participant, cdds::topics::nav_goal,
                 [this](const msg::NavGoal& g, const auto&) {
                   std::lock_guard lock(mutex_);
@@ -316,6 +321,10 @@ void NavNode::take_inputs(const Inbox& in) {
       status_.refused(std::string("IMU sample refused: ") + e.what());
     }
   }
+  // A sample of another model version names other joints (or the same names on other modules).
+  if (in.joints && in.joints->model_version() == navigator_.model_version()) {
+    navigator_.on_joint_positions(in.joints->name(), in.joints->position());
+  }
   if (in.scan) navigator_.on_scan(to_s(in.scan->stamp_ns()), to_core(*in.scan));
   for (const auto& c : in.cancels) navigator_.cancel(c.request_id(), "cancelled by " + c.source());
   for (const auto& g : in.goals) {
@@ -340,6 +349,7 @@ void NavNode::tick() {
     return;
   }
   const StepOutput out = navigator_.step(to_s(last_stamp_ns_));
+  if (const std::string note = navigator_.take_budget_note(); !note.empty()) log_line("nav: " + note);
   if (out.drive && navigator_.vehicle()) {
     msg::BaseVelocityCommand c;
     c.model_version(static_cast<uint32_t>(navigator_.model_version()));

@@ -1,7 +1,8 @@
 #pragma once
 // DDS adapter of the nav service: RobotModel in (reconfigure the vehicle, status READY at the
 // version, or ERROR naming why the model cannot navigate); wheel odometry, IMU and the planar
-// scan in; goals, cancels and initial poses in; safety state in (a stop cancels the goal).
+// scan in; goals, cancels and initial poses in; safety state in (a stop cancels the goal); the
+// joint state in (the posture whose drives bound the base's accelerations, the latest only).
 // Out: base velocity commands while a goal runs, goal status (feedback and result, one
 // instance per goal), the path and the storey map (latched), the filtered odometry, the
 // localisation (map -> odom) and the vehicle set-up (latched).
@@ -64,6 +65,7 @@ class NavNode {
     std::deque<msg::NavCancel> cancels;
     std::optional<msg::NavInitialPose> initial_pose;
     std::optional<msg::SafetyState> safety;
+    std::optional<msg::JointState> joints;
   };
   void tick();
   /// Hands what arrived since the last tick to the navigator (model, safety, pose, sensors, goals).
@@ -101,6 +103,7 @@ class NavNode {
   concert::dds::Reader<msg::Imu> imu_in_;
   concert::dds::Reader<msg::LaserScan> scan_in_;
   concert::dds::Reader<msg::SafetyState> safety_in_;
+  concert::dds::Reader<msg::JointState> joints_in_;
   concert::dds::Reader<msg::NavGoal> goals_in_;
   concert::dds::Reader<msg::NavCancel> cancels_in_;
   concert::dds::Reader<msg::NavInitialPose> initial_pose_in_;
