@@ -320,6 +320,34 @@ TEST_F(RigEngineTest, APostureReachedIsMeasuredAgainThenTheBitAligned) {
   EXPECT_EQ(engine.alignment().progress, Progress::kRunning);
 }
 
+// A loaded machine slows the simulated robot: the alignment's time limit counts the robot's time
+// (the joint samples' stamps), so a wall clock running ten times faster fails nothing; the arm
+// not aligned after align_timeout of its own time fails the hole, saying so.
+TEST_F(RigEngineTest, TheAlignmentsTimeLimitCountsTheRobotsTimeNotTheWalls) {
+  const DrillPoint hole = hole_ahead();
+  engine.align(hole);
+  answer(PlanState::kSucceeded);
+  step();
+  camera_sees_blob_at(hole.frame.translation(), tuning.camera.reanchor_frames);
+  step(2);
+  ASSERT_EQ(engine.alignment().progress, Progress::kRunning) << sink.log_text;
+  const double limit = tuning.motion.align_timeout;
+  // Wall time 2 x the limit, robot time a tenth of it: a new joint sample every tenth period.
+  const int periods = static_cast<int>(2.0 * limit / 0.005);
+  for (int i = 0; i < periods; ++i) {
+    if (i % 10 == 0) sample();
+    step();
+  }
+  EXPECT_EQ(engine.alignment().progress, Progress::kRunning) << engine.alignment().reason;
+  // Robot time past the limit, the tip never moved onto the hole: the hole fails.
+  for (int i = 0; i < static_cast<int>(limit / 0.005); ++i) {
+    sample();
+    step();
+  }
+  ASSERT_EQ(engine.alignment().progress, Progress::kFailed);
+  EXPECT_EQ(engine.alignment().reason.rfind("not aligned after 15 s", 0), 0u) << engine.alignment().reason;
+}
+
 // Odometry drifted while the whole body moved: the blob is seen 3 cm off its prediction, and
 // the posture is planned again, the arm alone, for the hole where the camera sees it.
 TEST_F(RigEngineTest, ADriftedOdometryPlansThePostureAgainWhereTheCameraSeesTheHole) {

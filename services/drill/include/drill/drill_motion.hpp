@@ -86,7 +86,8 @@ struct CartesianReference {
 };
 
 /// One hole's motion. Call start_*() then update() every control period with the tip's
-/// measured pose and a monotonic time [s]; send the returned reference to the robot.
+/// measured pose and the robot's time of that measurement [s] (its timeouts, settle time and
+/// ramps count the robot's time, not the wall's); send the returned reference to the robot.
 class DrillMotion {
  public:
   enum class Phase { kIdle, kAligning, kDrilling, kRetracting, kDone, kFailed };

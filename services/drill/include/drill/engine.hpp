@@ -241,6 +241,10 @@ class DrillEngine final : public MissionPorts {
   void send_cartesian(const CartesianReference& r);
   void send_hold();
   void start_align(const Sample& s);
+  // The hole's motion runs on the robot's clock, the stamp of the joint sample whose tip it
+  // follows: a loaded machine slows the simulated robot, and a reference ramped or a timeout
+  // counted on the wall clock would then run ahead of the arm and fail holes the arm drills.
+  static double robot_time(const Sample& s) { return 1e-9 * static_cast<double>(s.stamp_ns); }
   /// The mission's hole depth [m] (Params::hole.default_depth before a mission).
   [[nodiscard]] double hole_depth() const;
   void start_reanchor(Motion next);

@@ -1107,7 +1107,7 @@ void DrillEngine::start_align(const Sample& s) {
     log_line("drill: " + point_.label + ": drilled" + thrust_text(drilling_lead_, tuning_.motion) +
              ": " + light_why_);
   drill_motion_.start_align(base_T_world_ * point_.frame, rig_->tip_in_base(rig_->q(s.joints)),
-                            now_);
+                            robot_time(s));
   motion_ = Motion::kAlign;
   servo_since_ns_ = inputs_.newest_stamp();
 }
@@ -1122,7 +1122,7 @@ void DrillEngine::drill(const DrillPoint& point, double depth) {
     return;
   }
   point_ = point;
-  drill_motion_.start_drill(depth, point.servo, rig_->tip_in_base(rig_->q(s->joints)), now_);
+  drill_motion_.start_drill(depth, point.servo, rig_->tip_in_base(rig_->q(s->joints)), robot_time(*s));
   motion_ = Motion::kDrill;
 }
 
@@ -1135,7 +1135,7 @@ void DrillEngine::retract() {
     motion_outcome_ = Outcome::failed("no joint state to retract from");
     return;
   }
-  drill_motion_.start_retract(rig_->tip_in_base(rig_->q(s->joints)), now_);
+  drill_motion_.start_retract(rig_->tip_in_base(rig_->q(s->joints)), robot_time(*s));
   motion_ = Motion::kRetractOut;
 }
 
@@ -1644,7 +1644,7 @@ void DrillEngine::cartesian_step() {
       if (seen) drill_motion_.observe(base_T_world_ * *seen);
     }
   }
-  const CartesianReference r = drill_motion_.update(rig_->tip_in_base(rig_->q(s->joints)), now_);
+  const CartesianReference r = drill_motion_.update(rig_->tip_in_base(rig_->q(s->joints)), robot_time(*s));
   send_cartesian(r);
   if (drill_motion_.phase() == DrillMotion::Phase::kFailed) {
     motion_outcome_ = Outcome::failed(drill_motion_.reason());
