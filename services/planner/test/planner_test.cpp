@@ -6,9 +6,14 @@
 
 #include <octomap/OcTree.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <memory>
 #include <random>
+#include <vector>
 
 #include "planner/fixtures.hpp"
 #include "planner/planner.hpp"
@@ -92,6 +97,35 @@ std::unique_ptr<Planner> planner_at_site(const Params& params, char which, uint6
   return planner;
 }
 
+// `n` processes spinning on the CPU beside the test, killed and reaped when it ends; each also
+// ends by itself after 10 minutes (alarm), should the test die first.
+class BusyProcesses {
+ public:
+  explicit BusyProcesses(int n) {
+    for (int i = 0; i < n; ++i) {
+      const pid_t pid = ::fork();
+      if (pid == 0) {
+        ::alarm(600);
+        volatile unsigned long spin = 0;
+        for (;;) spin = spin + 1;
+      }
+      if (pid > 0) pids_.push_back(pid);
+    }
+  }
+  ~BusyProcesses() {
+    for (const pid_t p : pids_) {
+      ::kill(p, SIGKILL);
+      ::waitpid(p, nullptr, 0);
+    }
+  }
+  BusyProcesses(const BusyProcesses&) = delete;
+  BusyProcesses& operator=(const BusyProcesses&) = delete;
+  [[nodiscard]] std::size_t size() const { return pids_.size(); }
+
+ private:
+  std::vector<pid_t> pids_;
+};
+
 struct Case {
   char morphology;
   std::vector<Eigen::Vector2d> areas;  // (y, z) on the wall
@@ -135,6 +169,44 @@ INSTANTIATE_TEST_SUITE_P(
     Paper, MorphologyPlans,
     ::testing::Values(Case{'a', {{0.0, 1.9}, {0.4, 2.3}, {-0.4, 2.1}}}, Case{'b', {{0.0, 2.2}, {-0.3, 2.6}, {0.4, 2.0}}}),
     [](const ::testing::TestParamInfo<Case>& i) { return std::string("morphology_") + i.param.morphology; });
+
+// The planner's budgets are CPU time of its thread: two busy processes beside it (on this
+// 2-core machine: each core shared) make a plan slower, never different. The shipped budgets,
+// not the generous ones the other tests use.
+TEST(Planner, APlanIsTheSameWithTwoBusyProcessesBesideIt) {
+  Params params;
+  params.seed = 31;
+  const auto plan_once = [&] {
+    Planner planner(params);
+    planner.set_model(morphology('a', 4));
+    planner.set_environment(environment_of(site(2.2), params));
+    PlanRequest req;
+    req.request_id = 1;
+    req.model_version = 4;
+    req.goals.push_back({fixtures::drilling_area(2.2, 0.0, 1.9)});
+    req.goals.push_back({fixtures::drilling_area(2.2, 0.4, 2.3)});
+    return planner.plan(req, start_state(*planner.model()), [](const GoalResult&) {});
+  };
+  const PlanResult quiet = plan_once();
+  ASSERT_EQ(quiet.status, Status::kSucceeded) << quiet.reason;
+  PlanResult loaded;
+  {
+    const BusyProcesses busy(2);
+    ASSERT_EQ(busy.size(), 2u) << "could not start the busy processes";
+    loaded = plan_once();
+  }
+  ASSERT_EQ(loaded.status, quiet.status) << loaded.reason;
+  ASSERT_EQ(loaded.goals.size(), quiet.goals.size());
+  for (std::size_t g = 0; g < quiet.goals.size(); ++g) {
+    const Trajectory& a = quiet.goals[g].trajectory;
+    const Trajectory& b = loaded.goals[g].trajectory;
+    ASSERT_EQ(b.points.size(), a.points.size()) << "goal " << g;
+    for (std::size_t i = 0; i < a.points.size(); ++i) {
+      EXPECT_EQ(b.points[i].time, a.points[i].time) << "goal " << g << " sample " << i;
+      EXPECT_EQ((b.points[i].q - a.points[i].q).cwiseAbs().maxCoeff(), 0.0) << "goal " << g << " sample " << i;
+    }
+  }
+}
 
 TEST(Planner, HotSwapRebuildsTheConfigurationSpace) {
   Params params = generous(23);
