@@ -1,10 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "concert/common/error_text.hpp"
 #include "concert/simbus/assembly.hpp"
+#include "concert/simbus/random_robot.hpp"
 #include "concert/simbus/testing.hpp"
 
 namespace concert::simbus {
@@ -262,6 +266,44 @@ TEST(SimBus, RandomAssembliesAreValidAndDeterministic) {
     EXPECT_NO_THROW(validate(a, catalog)) << seed;
     EXPECT_EQ(simulate_scan(a, catalog).slaves.size(), tree_from_assembly(a, catalog).slaves.size());
   }
+}
+
+}  // namespace
+}  // namespace concert::simbus
+
+namespace concert::simbus {
+namespace {
+
+// Random robots of the project's database: valid assemblies of its catalogue with 3-7 arm
+// joints; among 30 seeds every tool, the riser and several arm lengths; the same robot for the
+// same seed; each written and read back unchanged.
+TEST(RandomRobot, ThirtySeedsGiveValidArmsOf3To7JointsWithEveryTool) {
+  const topology::EscCatalog catalog =
+      topology::EscCatalog::load(std::string(CONCERT_SOURCE_DIR) + "/data/module_db");
+  std::set<std::string> tools;
+  std::set<int> lengths;
+  int risers = 0;
+  for (unsigned seed = 1; seed <= 30; ++seed) {
+    std::mt19937 rng(seed);
+    const Assembly a = random_robot(rng);
+    EXPECT_NO_THROW(validate(a, catalog)) << "seed " << seed << ":\n" << assembly_to_yaml(a);
+    int joints = 0;
+    for (const MountedModule& m : a.modules) {
+      const auto& keys = random_robot_joints();
+      joints += static_cast<int>(std::count(keys.begin(), keys.end(), m.key));
+      if (m.name == "tool") tools.insert(m.key);
+      risers += m.key == "concert_base_link_600" ? 1 : 0;
+    }
+    EXPECT_GE(joints, 3) << "seed " << seed;
+    EXPECT_LE(joints, 7) << "seed " << seed;
+    lengths.insert(joints);
+    std::mt19937 again(seed);
+    EXPECT_EQ(random_robot(again).modules, a.modules) << "seed " << seed;
+    EXPECT_EQ(parse_assembly(assembly_to_yaml(a), "random").modules, a.modules) << "seed " << seed;
+  }
+  EXPECT_EQ(tools.size(), random_robot_tools().size());
+  EXPECT_GT(risers, 0);
+  EXPECT_GE(lengths.size(), 4u);
 }
 
 }  // namespace

@@ -22,6 +22,7 @@ struct FakeSink final : DrillSink {
   std::vector<MissionStatus> statuses;
   std::vector<std::string> refusals;
   std::vector<std::string> cartesian_frames;
+  std::vector<CartesianReference> cartesian_refs;
   std::string log_text;
 
   void plan(const PlanAsk& ask) override { plans.push_back(ask); }
@@ -32,8 +33,9 @@ struct FakeSink final : DrillSink {
   void navigate(std::uint32_t, std::uint32_t, const BasePose&) override {}
   void cancel_navigation() override { ++cancels; }
   void hold(std::uint32_t, const JointPositions& arm) override { holds.push_back(arm); }
-  void cartesian(std::uint32_t, const std::string& frame, const CartesianReference&) override {
+  void cartesian(std::uint32_t, const std::string& frame, const CartesianReference& reference) override {
     cartesian_frames.push_back(frame);
+    cartesian_refs.push_back(reference);
   }
   void mission_status(std::uint32_t, const MissionStatus& status, const MissionReport&) override {
     statuses.push_back(status);
@@ -346,6 +348,110 @@ TEST_F(RigEngineTest, TheAlignmentsTimeLimitCountsTheRobotsTimeNotTheWalls) {
   }
   ASSERT_EQ(engine.alignment().progress, Progress::kFailed);
   EXPECT_EQ(engine.alignment().reason.rfind("not aligned after 15 s", 0), 0u) << engine.alignment().reason;
+}
+
+// Leaving contact is part of every stop at a hole: the bit (put by the arm's joints 10 mm into
+// the hole the alignment aimed at) is pulled back along the hole's axis before the arm holds; a
+// safety stop holds the robot, and the bit leaves once the stop is reset.
+struct LeaveTest : RigEngineTest {
+  DrillPoint hole;
+
+  void SetUp() override {
+    RigEngineTest::SetUp();
+    inputs.on_safety({true, {}});
+    hole = hole_ahead();
+    engine.align(hole);
+    answer(PlanState::kSucceeded);
+    step();
+    camera_sees_blob_at(hole.frame.translation(), tuning.camera.reanchor_frames);
+    step(2);
+    ASSERT_FALSE(sink.cartesian_frames.empty()) << "the alignment did not start" << sink.log_text;
+  }
+
+  // The arm's joints that put the tip `depth` [m] behind the hole's surface on its axis, the bit
+  // along it (inverse kinematics of the rig's model), as the next joint sample.
+  void tip_at_depth(double depth) {
+    const Eigen::Isometry3d world_T_tip = hole.frame * Eigen::Translation3d(0.0, 0.0, -depth) *
+                                          Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY());
+    const Eigen::Isometry3d target = rig->base_in_world(Eigen::Vector3d::Zero()).inverse() * world_T_tip;
+    const auto& k = rig->model().kinematics();
+    kinematics::Data data = k.make_data();
+    kinematics::IkOptions options;
+    options.joints.clear();
+    for (const std::string& j : rig->model().arm().joints) options.joints.push_back(k.joint_index_or_throw(j));
+    const kinematics::IkResult ik = k.inverse_kinematics(data, rig->tcp_frame(), target, rig->q(joints), options);
+    ASSERT_TRUE(ik.converged) << "no arm posture puts the tip " << depth << " m into the hole ("
+                              << ik.position_error << " m off)";
+    for (std::size_t i = 0; i < joints.positions.size(); ++i) joints.positions[i] = ik.q(static_cast<Eigen::Index>(i));
+    sample();
+  }
+
+  // Depth of the last reference sent [m] (behind the surface positive).
+  [[nodiscard]] double reference_depth() const {
+    const Eigen::Isometry3d hole_in_base = rig->base_in_world(Eigen::Vector3d::Zero()).inverse() * hole.frame;
+    return -(hole_in_base.inverse() * sink.cartesian_refs.back().pose.translation()).z();
+  }
+};
+
+TEST_F(LeaveTest, AStopWithTheBitInTheWallPullsItOutAlongTheHolesAxisThenHolds) {
+  tip_at_depth(0.01);
+  step();
+  const std::size_t before = sink.cartesian_refs.size();
+  engine.stop();
+  EXPECT_TRUE(engine.leaving_wall());
+  EXPECT_TRUE(sink.holds.empty()) << "held with the bit in the wall";
+  EXPECT_EQ(sink.logged("leaving the wall: the bit 10.0 mm behind the surface"), 1u) << sink.log_text;
+  // A new mission waits for the bit to be out.
+  engine.start_mission({9, 101, "m", "name: m\ndepth: 0.03\nareas: []\n", "", false});
+  ASSERT_FALSE(sink.refusals.empty());
+  EXPECT_NE(sink.refusals.back().find("leaving the wall"), std::string::npos) << sink.refusals.back();
+  // 1.1 s of the robot's time: the reference backs out along the axis at the approach speed
+  // (50 mm at 0.05 m/s) and stops at the standoff.
+  for (int i = 0; i < 220; ++i) {
+    sample();
+    step();
+  }
+  ASSERT_GT(sink.cartesian_refs.size(), before);
+  EXPECT_NEAR(reference_depth(), -tuning.motion.standoff, 1e-3);
+  EXPECT_TRUE(sink.holds.empty());
+  // The arm follows: the tip at the standoff, out of the wall; then the arm holds.
+  tip_at_depth(-tuning.motion.standoff);
+  step();
+  EXPECT_FALSE(engine.leaving_wall());
+  ASSERT_EQ(sink.holds.size(), 1u);
+  EXPECT_EQ(sink.logged("the bit is out of the wall; the arm holds there"), 1u) << sink.log_text;
+}
+
+TEST_F(LeaveTest, UnderASafetyStopTheBitLeavesOnceTheStopIsReset) {
+  tip_at_depth(0.01);
+  step();
+  inputs.on_safety({false, {"e-stop"}});
+  engine.stop();
+  EXPECT_TRUE(engine.leaving_wall());
+  EXPECT_EQ(sink.logged("once the safety stop is reset"), 1u) << sink.log_text;
+  const std::size_t sent = sink.cartesian_refs.size();
+  for (int i = 0; i < 4000; ++i) {  // 20 s of the robot's time, longer than retract_timeout
+    sample();
+    step();
+  }
+  EXPECT_EQ(sink.cartesian_refs.size(), sent) << "commanded the robot during a safety stop";
+  EXPECT_TRUE(engine.leaving_wall());
+  inputs.on_safety({true, {}});
+  sample();
+  step();
+  EXPECT_EQ(sink.logged("the safety stop is reset: leaving the wall now"), 1u) << sink.log_text;
+  EXPECT_GT(sink.cartesian_refs.size(), sent);
+  tip_at_depth(-tuning.motion.standoff);
+  step();
+  EXPECT_FALSE(engine.leaving_wall());
+  EXPECT_EQ(sink.holds.size(), 1u);
+}
+
+TEST_F(LeaveTest, ABitClearOfTheWallIsHeldAtOnce) {
+  // The alignment's tip where the arm stands (0.5 m from the hole): nothing to leave.
+  engine.stop();
+  EXPECT_FALSE(engine.leaving_wall());
+  EXPECT_EQ(sink.holds.size(), 1u);
 }
 
 // Odometry drifted while the whole body moved: the blob is seen 3 cm off its prediction, and

@@ -196,6 +196,26 @@ concert::robot::dds::ServiceParams service_params(const Options& options) {
   return service;
 }
 
+// Every 10 s of wall time until `stopping`, the log says how fast simulated time runs: the
+// loop's lag behind the wall clock on a loaded machine (no cycle is late in simulated time).
+std::thread timing_reporter(const robot::Loop& loop, double period, const std::atomic<bool>& stopping) {
+  return std::thread([&loop, period, &stopping] {
+    using Clock = std::chrono::steady_clock;
+    auto since = Clock::now();
+    robot::LoopProgress before = loop.progress();
+    while (!stopping.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      const auto now = Clock::now();
+      const double wall = std::chrono::duration<double>(now - since).count();
+      if (wall < 10.0) continue;
+      const robot::LoopProgress p = loop.progress();
+      std::cerr << "concert_robot: " << robot::simulated_time_line(before, p, wall, period) << std::endl;
+      before = p;
+      since = now;
+    }
+  });
+}
+
 int run(const Options& options) {
   using namespace concert;
   {
@@ -261,12 +281,14 @@ int run(const Options& options) {
     concert::cli::on_stop_signals(on_signal);
     const auto cycles = options.duration > 0.0 ? static_cast<std::uint64_t>(options.duration / params.period)
                                                 : std::numeric_limits<std::uint64_t>::max();
+    std::thread timing = timing_reporter(loop, params.period, stopping);
     const robot::LoopStats stats = loop.run(cycles);
     g_loop = nullptr;
     stopping = true;
     publisher.join();
-    std::cerr << "concert_robot: stopped after " << stats.cycles << " cycles (" << stats.overruns
-              << " overruns)\n";
+    timing.join();
+    std::cerr << "concert_robot: stopped: "
+              << robot::simulated_time_line({}, {stats.cycles, stats.overruns}, stats.wall_time, params.period) << "\n";
   }
   return 0;
 }

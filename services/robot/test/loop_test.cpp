@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <iostream>
 #include <thread>
 
@@ -50,6 +51,24 @@ TEST(Loop, StopsFromAnotherThread) {
   EXPECT_GE(stats.cycles, 20u);
   // stop() ends the loop after the tick under way: at most one tick after it was asked.
   EXPECT_LE(stats.cycles, static_cast<std::uint64_t>(at_stop) + 1);
+}
+
+// The counts a reporter thread reads while the loop runs, and what the log says of them:
+// simulated time against the wall clock (each cycle steps the simulation once).
+TEST(Loop, ItsProgressIsReadableWhileItRunsAndSaysHowFastSimulatedTimeRuns) {
+  std::atomic<std::uint64_t> seen{0};
+  Loop loop({0.001, false, false}, [&] {});
+  Loop* running = &loop;
+  Loop watched({0.001, false, false}, [&] { seen.store(running->progress().cycles); });
+  (void)loop.run(250);
+  EXPECT_EQ(loop.progress().cycles, 250u);
+  EXPECT_EQ(loop.progress().overruns, 0u);  // no deadlines without real time
+  running = &watched;
+  (void)watched.run(10);
+  EXPECT_EQ(seen.load(), 9u);  // during its 10th tick, 9 were done
+  EXPECT_EQ(simulated_time_line({100, 3}, {9400, 15}, 10.0, 0.001),
+            "simulated time at 0.93 x real time over the last 10.0 s (9300 cycles, 12 over their 1.0 ms "
+            "wall-clock period; each steps the simulation once: none is late in simulated time)");
 }
 
 TEST(Loop, RejectsBadPeriod) { EXPECT_THROW(Loop({0.0, false, false}, [] {}), std::invalid_argument); }

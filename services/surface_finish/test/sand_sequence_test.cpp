@@ -179,6 +179,33 @@ TEST(SandSequence, LostContactWhileStrokingStops) {
   EXPECT_NE(s.reason().find("contact lost"), std::string::npos) << s.reason();
 }
 
+// A user's abort in contact leaves the wall along the normal first, from where the TCP is
+// measured (here 4 mm in front of the target the admittance pushed into the plaster), then
+// ends aborted; during the joint move it stops at once.
+TEST(SandSequence, AnAbortInContactLeavesTheWallAlongTheNormalFirst) {
+  SandSequence s(test_plan(), SandParams{});
+  s.start(0.0);
+  feed(s, 0.0, 4.5, [](double) { return 30.0; });
+  ASSERT_EQ(s.phase(), SandPhase::kStrokes);
+  Eigen::Isometry3d tcp = s.update(4.5).target;
+  tcp.translation().x() -= 0.004;
+  s.set_tcp(tcp);
+  EXPECT_TRUE(s.abort("aborted by the test"));
+  ASSERT_EQ(s.phase(), SandPhase::kLeaving);
+  const SandCommand first = s.update(4.5);
+  EXPECT_FALSE(first.admittance);
+  EXPECT_NEAR(first.target.translation().x(), tcp.translation().x(), 1e-9);  // not pushed back in
+  EXPECT_NEAR(s.update(5.0).target.translation().x(), tcp.translation().x() - 0.025, 1e-9);
+  EXPECT_FALSE(s.finished());
+  (void)s.update(5.6);
+  EXPECT_EQ(s.phase(), SandPhase::kAborted);
+  EXPECT_EQ(s.reason(), "aborted by the test");
+
+  SandSequence moving(test_plan(), SandParams{});
+  EXPECT_FALSE(moving.abort("aborted during the move"));
+  EXPECT_EQ(moving.phase(), SandPhase::kAborted);
+}
+
 TEST(SandSequence, AStopEndsAtOnce) {
   SandSequence s(test_plan(), SandParams{});
   s.start(0.0);
@@ -253,6 +280,45 @@ TEST(SandSupervise, ASafetyStopOrASilentForceEstimateAbortsTheRun) {
   step = supervise(quiet, c, SandWatch{});
   EXPECT_EQ(step.end, SandEnd::kAborted);
   EXPECT_EQ(step.reason, "no force estimate from the robot (concert/robot/ee_wrench) for 2.0 s");
+}
+
+// A safety stop in contact: nothing is commanded while it lasts (the robot holds the disc where
+// it is), and once it is reset the run leaves the wall along the normal, then ends aborted,
+// saying both.
+TEST(SandSupervise, ASafetyStopInContactHoldsThenLeavesTheWallAfterTheReset) {
+  SandSequence s(test_plan(), SandParams{});
+  SandCycle c = answered(MoveReport::kSucceeded);
+  c.forces = {{100.0, Eigen::Vector3d::Zero()}};
+  supervise(s, c, SandWatch{});
+  double t = 100.0;
+  const auto cycle = [&](bool stopped) {
+    SandCycle k = answered(MoveReport::kSucceeded);
+    for (int i = 0; i < 2; ++i) {
+      t += 0.01;
+      k.forces.push_back({t, Eigen::Vector3d(-30.0, 0.0, 0.0)});
+    }
+    if (stopped) k.safety_stop = "e-stop: software";
+    return supervise(s, k, SandWatch{});
+  };
+  while (s.phase() != SandPhase::kStrokes && t < 110.0) (void)cycle(false);
+  ASSERT_EQ(s.phase(), SandPhase::kStrokes);
+  for (int i = 0; i < 100; ++i) {  // 2 s of the robot's time stopped
+    const SandStep held = cycle(true);
+    EXPECT_FALSE(held.command);
+    EXPECT_EQ(held.end, SandEnd::kNone);
+  }
+  EXPECT_EQ(s.phase(), SandPhase::kHeld);
+  SandStep step = cycle(false);
+  EXPECT_EQ(s.phase(), SandPhase::kLeaving);
+  ASSERT_TRUE(step.command);
+  EXPECT_FALSE(step.command->admittance);
+  const double x0 = step.command->target.translation().x();
+  for (int i = 0; i < 100 && step.end == SandEnd::kNone; ++i) {
+    step = cycle(false);
+    if (step.command) EXPECT_LE(step.command->target.translation().x(), x0 + 1e-9);  // off the wall only
+  }
+  EXPECT_EQ(step.end, SandEnd::kAborted);
+  EXPECT_EQ(step.reason, "safety stop (e-stop: software); the tool left the wall after the reset");
 }
 
 TEST(SandSupervise, EstimatesAreFedAsThePushAlongTheToolsAxisUntilDone) {

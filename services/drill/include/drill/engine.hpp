@@ -108,6 +108,8 @@ class DrillEngine final : public MissionPorts {
   void step_motion(double now);
   /// A mission was accepted and has not ended.
   [[nodiscard]] bool mission_active() const;
+  /// A stopped mission's bit is being pulled back out of the wall (no new mission until it is).
+  [[nodiscard]] bool leaving_wall() const { return motion_ == Motion::kLeave; }
   /// The newest model version taken (0: none).
   [[nodiscard]] std::uint64_t model_version() const { return model_version_; }
   /// The service stops: a running mission is aborted and its status sent.
@@ -164,6 +166,7 @@ class DrillEngine final : public MissionPorts {
     kCheckedLook,  // then the look's path check_look() planned, sent likewise
     kBackForLook,  // the marker not seen from a look: back onto the posture for the next look
     kBackThenReplan,  // back from a look onto the posture, then the posture planned again there
+    kLeave,  // a stopped mission's bit pulled back out of the wall along the hole's axis, then held
     // An area's base placement (place()): the arm alone asked for every hole (and the camera
     // for the mark) from where the base stands or from a drawn posture; a whole-body posture
     // drawn; the move there; the camera onto the mark; the mark measured again.
@@ -240,6 +243,13 @@ class DrillEngine final : public MissionPorts {
   void cartesian_step();
   void send_cartesian(const CartesianReference& r);
   void send_hold();
+  // Leaving contact, the first thing a stop does at a hole (abort, a health failure, a new
+  // model with the same arm): the bit aligned onto, in or leaving the wall is pulled back along
+  // the hole's axis to the standoff, then the arm holds. False when the bit is clear already.
+  bool start_leave();
+  void leave_step();
+  // The tool tip's pose in the base frame at the latest joint sample with the current rig.
+  [[nodiscard]] std::optional<Eigen::Isometry3d> tip_now() const;
   void start_align(const Sample& s);
   // The hole's motion runs on the robot's clock, the stamp of the joint sample whose tip it
   // follows: a loaded machine slows the simulated robot, and a reference ramped or a timeout
@@ -355,6 +365,9 @@ class DrillEngine final : public MissionPorts {
   } detection_;
   // The drilling motion.
   Motion motion_{Motion::kNone};
+  bool leave_paused_{false};  // a safety stop holds the robot: the leave starts again after it
+  bool shutting_down_{false};  // the service stops: hold, there is no next period to leave in
+  bool leave_allowed_{true};   // false while a new model with another arm stops the mission
   DrillMotion drill_motion_;
   DrillPoint point_;
   Eigen::Isometry3d base_T_world_{Eigen::Isometry3d::Identity()};  // fixed while drilling

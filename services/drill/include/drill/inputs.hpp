@@ -85,6 +85,8 @@ class Inputs {
   /// Liveness::service_lost. A service not heard yet is waited for (kRunning) until
   /// service_lost after the mission's start, then it fails the mission, naming it.
   [[nodiscard]] Outcome health(Clock::time_point mission_started, bool uses_nav, Clock::time_point now) const;
+  /// The safety service's last word was RUNNING (false before any word).
+  [[nodiscard]] bool safety_running() const;
 
  private:
   Params::Buffers buffers_;

@@ -114,7 +114,9 @@ void DrillEngine::abort(const AbortOrder& a) {
 void DrillEngine::tick(double now) {
   now_ = now;
   resend_unacknowledged();
-  if (mission_active()) {
+  if (leaving_wall()) {
+    control_motion();
+  } else if (mission_active()) {
     control_motion();
     const MissionState state = tree_->tick(now_);
     if (state != MissionState::kRunning) {
@@ -135,6 +137,7 @@ void DrillEngine::step_motion(double now) {
 }
 
 void DrillEngine::shutdown() {
+  shutting_down_ = true;
   if (!mission_active()) return;
   tree_->abort("the drill service is stopping");
   publish_status(true);
@@ -203,13 +206,25 @@ void DrillEngine::resend_unacknowledged() {
 std::string DrillEngine::apply_model(std::uint32_t version, std::shared_ptr<const DrillRig> rig,
                                      const std::string& why) {
   const std::uint64_t old = model_version_;
+  // A bit in the wall leaves it under the new model only when the new model puts the tool where
+  // the old one did (the same arm); with another arm the joints no longer say where the bit is.
+  const std::optional<Eigen::Isometry3d> old_tip = tip_now();
   model_version_ = version;
   rig_ = rig;
   inputs_.set_rig(rig);
   rig_error_ = rig ? "" : why;
+  const std::optional<Eigen::Isometry3d> new_tip = tip_now();
+  leave_allowed_ = old_tip && new_tip && (old_tip->translation() - new_tip->translation()).norm() < 0.005;
+  if (leaving_wall() && !leave_allowed_) {
+    log_line("drill: the robot model changed while the bit left the wall, and the new model's arm is another: "
+             "the arm holds where it is");
+    motion_ = Motion::kNone;
+    send_hold();
+  }
   if (mission_active()) {
     tree_->abort("the robot model changed (version " + std::to_string(old) + " -> " + std::to_string(version) + ")");
   }
+  leave_allowed_ = true;
   if (!rig) {
     log_line("drill: " + why);
     return why;
@@ -237,6 +252,9 @@ void DrillEngine::start_mission(const MissionOrder& m) {
   if (mission_active()) {
     return refuse("mission " + std::to_string(mission_id_) + " ('" + tree_->report().mission +
                   "') is running; abort it first");
+  }
+  if (leaving_wall()) {
+    return refuse("the bit is leaving the wall after the last mission; send the mission again when it is out");
   }
   if (!rig_)
     return refuse(rig_error_.empty() ? "no robot model yet" : rig_error_);
@@ -1144,8 +1162,74 @@ Outcome DrillEngine::retraction() { return motion_outcome_ ? *motion_outcome_ : 
 void DrillEngine::stop() {
   if (nav_request_ != 0) sink_.cancel_navigation();
   nav_request_ = 0;
+  const bool at_hole = motion_ == Motion::kAlign || motion_ == Motion::kDrill || motion_ == Motion::kRetractOut;
   motion_ = Motion::kNone;
   unacknowledged_.clear();  // not sent again: a planner taking it now would move the robot
+  if (at_hole && !shutting_down_ && leave_allowed_ && start_leave()) return;
+  send_hold();
+}
+
+std::optional<Eigen::Isometry3d> DrillEngine::tip_now() const {
+  const std::optional<Sample> s = inputs_.latest_sample();
+  if (!s || !rig_) return std::nullopt;
+  try {
+    return rig_->tip_in_base(rig_->q(s->joints));
+  } catch (const std::exception&) {
+    return std::nullopt;  // the sample names joints of another model
+  }
+}
+
+bool DrillEngine::start_leave() {
+  const std::optional<Sample> s = inputs_.latest_sample();
+  if (!s || !rig_) return false;
+  const Eigen::Isometry3d tip = rig_->tip_in_base(rig_->q(s->joints));
+  const double depth = drill_motion_.depth_of(tip);
+  drill_motion_.start_retract(tip, robot_time(*s));
+  if (drill_motion_.phase() != DrillMotion::Phase::kRetracting) return false;  // clear of the wall
+  motion_ = Motion::kLeave;
+  motion_outcome_.reset();
+  leave_paused_ = !inputs_.safety_running();
+  std::ostringstream line;
+  line.setf(std::ios::fixed);
+  line.precision(1);
+  line << "drill: leaving the wall: the bit " << std::abs(depth) * 1e3 << " mm "
+       << (depth > 0.0 ? "behind" : "in front of") << " the surface, pulled back along the hole's axis to "
+       << tuning_.motion.standoff * 1e3 << " mm in front of it"
+       << (leave_paused_ ? " once the safety stop is reset" : "");
+  log_line(line.str());
+  return true;
+}
+
+// The leave's control period: the retract's reference on the robot's clock while the safety
+// layer lets the robot move; a safety stop holds the robot, and the retract starts again from
+// where the tip is when it is reset. Out (or out of time): the arm holds.
+void DrillEngine::leave_step() {
+  const std::optional<Sample> s = inputs_.latest_sample();
+  if (!s || !rig_) {
+    motion_ = Motion::kNone;
+    return;
+  }
+  if (!inputs_.safety_running()) {
+    leave_paused_ = true;
+    return;
+  }
+  const Eigen::Isometry3d tip = rig_->tip_in_base(rig_->q(s->joints));
+  if (leave_paused_) {
+    leave_paused_ = false;
+    drill_motion_.start_retract(tip, robot_time(*s));
+    log_line("drill: the safety stop is reset: leaving the wall now");
+  }
+  const CartesianReference r = drill_motion_.update(tip, robot_time(*s));
+  if (drill_motion_.phase() == DrillMotion::Phase::kRetracting) {
+    send_cartesian(r);
+    return;
+  }
+  if (drill_motion_.phase() == DrillMotion::Phase::kFailed) {
+    log_line("drill: leaving the wall failed: " + drill_motion_.reason() + "; the arm holds where it is");
+  } else {
+    log_line("drill: the bit is out of the wall; the arm holds there");
+  }
+  motion_ = Motion::kNone;
   send_hold();
 }
 
@@ -1575,6 +1659,10 @@ void DrillEngine::posture_reached() {
 // phases (align, drill, retract) last.
 void DrillEngine::control_motion() {
   if (motion_ == Motion::kNone || motion_outcome_) return;
+  if (motion_ == Motion::kLeave) {
+    leave_step();
+    return;
+  }
   if (motion_ >= Motion::kPlaceCheck) {
     control_placement();
     return;

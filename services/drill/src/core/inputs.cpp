@@ -165,6 +165,11 @@ std::optional<MotionReply> Inputs::nav(std::uint32_t request) const {
   return it->second;
 }
 
+bool Inputs::safety_running() const {
+  std::lock_guard lock(mutex_);
+  return safety_ && safety_->running;
+}
+
 Outcome Inputs::health(Clock::time_point mission_started, bool uses_nav, Clock::time_point now) const {
   std::lock_guard lock(mutex_);
   // A service not heard yet when the mission began (a stack just started: its status or the

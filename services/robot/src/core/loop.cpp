@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <thread>
@@ -17,11 +18,27 @@ Loop::Loop(LoopParams params, std::function<void()> tick) : params_(params), tic
   }
 }
 
+std::string simulated_time_line(const LoopProgress& from, const LoopProgress& to, double wall_seconds,
+                                double period) {
+  const std::uint64_t cycles = to.cycles - from.cycles;
+  const std::uint64_t over = to.overruns - from.overruns;
+  const double factor = wall_seconds > 0.0 ? static_cast<double>(cycles) * period / wall_seconds : 0.0;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "simulated time at %.2f x real time over the last %.1f s (%llu cycles, %llu over their "
+                "%.1f ms wall-clock period; each steps the simulation once: none is late in simulated time)",
+                factor, wall_seconds, static_cast<unsigned long long>(cycles),
+                static_cast<unsigned long long>(over), period * 1e3);
+  return line;
+}
+
 LoopStats Loop::run_forever() { return run(std::numeric_limits<std::uint64_t>::max()); }
 
 LoopStats Loop::run(std::uint64_t cycles) {
   using Clock = std::chrono::steady_clock;
   stop_.store(false);
+  cycles_.store(0, std::memory_order_relaxed);
+  overruns_.store(0, std::memory_order_relaxed);
   fifo_applied_ = false;
   int old_policy = SCHED_OTHER;
   sched_param old_param{};
@@ -59,10 +76,10 @@ LoopStats Loop::run(std::uint64_t cycles) {
     }
     last = now;
     tick_();
-    ++stats.cycles;
+    cycles_.store(++stats.cycles, std::memory_order_relaxed);
     deadline += period;
     if (params_.real_time && Clock::now() > deadline) {
-      ++stats.overruns;
+      overruns_.store(++stats.overruns, std::memory_order_relaxed);
       deadline = Clock::now();  // do not try to catch up with a burst of ticks
     }
   }

@@ -17,6 +17,12 @@
 // stroke time and stop the run when far outside the band: above abort_force for abort_time, or
 // (while stroking) below lost_contact_fraction x setpoint for lost_contact_time; the run then
 // leaves the wall straight along the normal (leaving) and ends aborted.
+//
+// Leaving contact is part of every end in contact: a user's abort leaves the wall the same way
+// (abort()); a safety stop holds the robot where it is (held), and the run leaves the wall once
+// the stop is reset. The leave starts where the TCP is measured (set_tcp), not at the commanded
+// target: with the admittance off, a target that the admittance had held inside the plaster
+// would first push the disc into it.
 #include <Eigen/Geometry>
 #include <array>
 #include <limits>
@@ -57,6 +63,7 @@ enum class SandPhase {
   kUnload,
   kRetreat,
   kLeaving,
+  kHeld,  ///< a safety stop in contact: the robot holds; the run leaves the wall after the reset
   kDone,
   kAborted
 };
@@ -95,8 +102,19 @@ class SandSequence {
   /// One estimate sample: the force pushed along z_ee at robot time t [N]. Recorded (stroke
   /// samples give the statistics), checked against the stop limits.
   void add_force(double t, double pushed);
-  /// Stops now without moving (e-stop, safety stop, the robot's refusal): kAborted.
+  /// Stops now without moving (the robot's refusal, a new model, the service stopping): kAborted.
   void stop(const std::string& reason);
+  /// A user's abort: in the Cartesian phases the tool leaves the wall along the normal first
+  /// (kLeaving, then kAborted with `reason`); during the joint move it stops at once. True when
+  /// it leaves (the run ends when update() reaches kAborted).
+  bool abort(const std::string& reason);
+  /// A safety stop (`reason`): in the Cartesian phases or leaving, the run is held (kHeld: the
+  /// robot holds the tool where it is) until resume_leaving(); before them it stops at once.
+  void hold_for_safety(const std::string& reason);
+  /// The safety stop is reset at robot time t [s]: a held run leaves the wall from there.
+  void resume_leaving(double t);
+  /// The TCP as measured now (base frame): where a leave starts.
+  void set_tcp(const Eigen::Isometry3d& tcp) { measured_tcp_ = tcp; }
 
   [[nodiscard]] SandPhase phase() const { return phase_; }
   [[nodiscard]] bool finished() const {
@@ -130,6 +148,7 @@ class SandSequence {
   double move_progress_{0.0};
   double over_since_{-1.0}, under_since_{-1.0};
   Eigen::Isometry3d leave_from_{Eigen::Isometry3d::Identity()};
+  std::optional<Eigen::Isometry3d> measured_tcp_;
   SandCommand last_;
   std::string reason_;
   std::vector<ForceSample> trace_;
@@ -152,6 +171,7 @@ struct SandCycle {
     Eigen::Vector3d force{0.0, 0.0, 0.0};       ///< the estimate at the TCP, base axes [N]
   };
   std::vector<Force> forces;  ///< the estimates since the last cycle, oldest first
+  std::optional<Eigen::Isometry3d> tcp;  ///< the TCP measured now (base frame), when known
 };
 
 /// How long the supervision waits.
@@ -170,7 +190,8 @@ struct SandStep {
   std::string reason;  ///< kFailed, kAborted: why
 };
 
-/// One cycle of a run: a safety stop aborts it; during the joint move, the robot's answer
+/// One cycle of a run: a safety stop aborts it during the joint move and holds it (kHeld) in
+/// contact, the run leaving the wall once the stop is reset; during the joint move, the robot's answer
 /// starts the Cartesian phases (at the robot time of the newest estimate), or its refusal, or
 /// its silence, fails the run; afterwards every estimate is fed to `seq` (the force pushed along
 /// its z_ee) and the newest one's command returned, and a silent force estimate aborts the run.

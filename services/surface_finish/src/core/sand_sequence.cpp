@@ -23,6 +23,8 @@ const char* to_string(SandPhase phase) {
       return "retreat";
     case SandPhase::kLeaving:
       return "leaving";
+    case SandPhase::kHeld:
+      return "held";
     case SandPhase::kDone:
       return "done";
     case SandPhase::kAborted:
@@ -104,7 +106,7 @@ const PathSample& SandSequence::at(double plan_t, Eigen::Vector3d& p, Eigen::Vec
 }
 
 SandCommand SandSequence::update(double t) {
-  if (phase_ == SandPhase::kMove || finished()) return last_;
+  if (phase_ == SandPhase::kMove || phase_ == SandPhase::kHeld || finished()) return last_;
   now_ = std::max(now_, t);
   const auto& s = plan_.samples;
   const SandParams& p = params_;
@@ -240,6 +242,7 @@ void SandSequence::add_force(double t, double pushed) {
 void SandSequence::leave(const std::string& reason) {
   reason_ = reason;
   leave_from_ = last_.target;
+  if (measured_tcp_) leave_from_.translation() = measured_tcp_->translation();
   if (phase_ == SandPhase::kMove) {
     phase_ = SandPhase::kAborted;
     return;
@@ -252,6 +255,34 @@ void SandSequence::stop(const std::string& reason) {
   if (finished()) return;
   reason_ = reason;
   phase_ = SandPhase::kAborted;
+}
+
+bool SandSequence::abort(const std::string& reason) {
+  if (finished()) return false;
+  if (phase_ == SandPhase::kLeaving) return true;  // on its way off the wall already
+  if (phase_ == SandPhase::kMove || phase_ == SandPhase::kHeld) {
+    // The joint move stops where it is; a held run stays held until the stop is reset.
+    if (phase_ == SandPhase::kMove) stop(reason);
+    return phase_ == SandPhase::kHeld;
+  }
+  leave(reason);
+  return true;
+}
+
+void SandSequence::hold_for_safety(const std::string& reason) {
+  if (finished() || phase_ == SandPhase::kHeld) return;
+  if (phase_ == SandPhase::kMove) {
+    stop(reason);
+    return;
+  }
+  reason_ = reason;
+  phase_ = SandPhase::kHeld;
+}
+
+void SandSequence::resume_leaving(double t) {
+  if (phase_ != SandPhase::kHeld) return;
+  now_ = std::max(now_, t);
+  leave(reason_ + "; the tool left the wall after the reset");
 }
 
 double SandSequence::progress() const {
@@ -308,8 +339,18 @@ SandStep ended(SandSequence& seq, SandEnd end, const std::string& why) {
 }  // namespace
 
 SandStep supervise(SandSequence& seq, const SandCycle& c, const SandWatch& watch) {
-  if (c.safety_stop) return ended(seq, SandEnd::kAborted, "safety stop (" + *c.safety_stop + ")");
+  if (c.tcp) seq.set_tcp(*c.tcp);
+  if (c.safety_stop) {
+    const std::string why = "safety stop (" + *c.safety_stop + ")";
+    if (seq.phase() == SandPhase::kMove) return ended(seq, SandEnd::kAborted, why);
+    seq.hold_for_safety(why);  // the robot holds; nothing to command until the reset
+    return {};
+  }
   SandStep step;
+  if (seq.phase() == SandPhase::kHeld) {
+    if (c.forces.empty()) return step;  // the robot's time: from its next estimate
+    seq.resume_leaving(c.forces.back().t);
+  }
   if (seq.phase() == SandPhase::kMove) {
     if (c.move != MoveReport::kNoAnswer) seq.set_move_progress(c.move_progress);
     if (c.move == MoveReport::kSucceeded) {

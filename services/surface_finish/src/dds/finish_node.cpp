@@ -206,7 +206,7 @@ void FinishNode::handle(const msg::FinishCommand& c) {
   // (request id, stamp) is taken once.
   if (!taken_.first_time(c.request_id(), c.stamp_ns())) return;
   if (c.verb() == msg::FINISH_ABORT) {
-    if (run_) abort_run("aborted by " + (c.source().empty() ? std::string("a client") : c.source()));
+    if (run_) abort_run("aborted by " + (c.source().empty() ? std::string("a client") : c.source()), true);
     return;
   }
   if (c.model_version() != current_version_ || current_version_ == 0) {
@@ -455,6 +455,14 @@ void FinishNode::follow_sand() {
     cycle.move_reason = ts->reason();
   }
   cycle.since_sent = std::chrono::duration<double>(now - run.sent).count();
+  {
+    std::optional<Measured> latest;
+    {
+      std::lock_guard lock(mutex_);
+      latest = latest_;
+    }
+    if (latest && current_.reach) cycle.tcp = current_.reach->tcp_pose(q_of(*latest));
+  }
   cycle.silence = run.silence;
   for (const Wrench& w : wrenches) cycle.forces.push_back({static_cast<double>(w.stamp_ns) * 1e-9, w.force});
   const SandStep step = supervise(seq, cycle, SandWatch{params_.wrench_timeout, 10.0});
@@ -637,8 +645,13 @@ void FinishNode::hold_here() {
   trajectories_.write(t);
 }
 
-void FinishNode::abort_run(const std::string& why) {
+void FinishNode::abort_run(const std::string& why, bool leave_wall) {
   if (run_ && run_->sand) {
+    if (leave_wall && run_->sand->abort(why)) {
+      log_line("surface_finish: request " + std::to_string(run_->request_id) + ": " + why +
+               ": the tool leaves the wall first");
+      return;  // follow_sand ends the run when it has
+    }
     run_->sand->stop(why);  // end_run holds the arm
   } else {
     hold_here();

@@ -104,7 +104,9 @@ class FinishNode {
   void follow_sand();
   void send_sand(const SandCommand& command);
   void send_trajectory(Run& run, std::size_t last_sample);
-  void abort_run(const std::string& why);
+  /// Ends the run: `leave_wall` (a user's abort), a sanding tool in contact leaves the wall
+  /// first (SandSequence::abort) and the run ends when it has; else it stops where it is.
+  void abort_run(const std::string& why, bool leave_wall = false);
   void follow_run();
   void end_run(msg::FinishState state, const std::string& reason);
   void publish(std::uint32_t request_id, msg::FinishState state, const std::string& reason, const Run* run,
