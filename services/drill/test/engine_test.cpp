@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -359,7 +360,20 @@ struct LeaveTest : RigEngineTest {
   void SetUp() override {
     RigEngineTest::SetUp();
     inputs.on_safety({true, {}});
-    hole = hole_ahead();
+    // The arm bent (shoulder, elbow and wrist pitch: the demo arm's 2nd, 3rd and 5th joints), off
+    // its stretched zero posture where the tip cannot move on along the bit.
+    const std::vector<std::string>& arm = rig->model().arm().joints;
+    const std::pair<std::size_t, double> bends[] = {{1, 0.3}, {2, 0.8}, {4, 0.5}};
+    for (const auto& [index, angle] : bends) {
+      const auto at = std::find(joints.names.begin(), joints.names.end(), arm.at(index));
+      joints.positions[static_cast<std::size_t>(at - joints.names.begin())] = angle;
+    }
+    sample();
+    // The hole 15 cm ahead of the bit on its axis: the arm reaches into it moving straight on.
+    const Eigen::Isometry3d world_T_tip =
+        rig->base_in_world(Eigen::Vector3d::Zero()) * rig->tip_in_base(rig->q(joints));
+    hole.label = "blob 1";
+    hole.frame = world_T_tip * Eigen::Translation3d(0.0, 0.0, 0.15) * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY());
     engine.align(hole);
     answer(PlanState::kSucceeded);
     step();
@@ -377,45 +391,52 @@ struct LeaveTest : RigEngineTest {
     const auto& k = rig->model().kinematics();
     kinematics::Data data = k.make_data();
     kinematics::IkOptions options;
+    options.max_iterations = 5000;
+    options.position_tolerance = 1e-5;
+    options.orientation_tolerance = 1e-4;
     options.joints.clear();
     for (const std::string& j : rig->model().arm().joints) options.joints.push_back(k.joint_index_or_throw(j));
     const kinematics::IkResult ik = k.inverse_kinematics(data, rig->tcp_frame(), target, rig->q(joints), options);
     ASSERT_TRUE(ik.converged) << "no arm posture puts the tip " << depth << " m into the hole ("
-                              << ik.position_error << " m off)";
+                              << ik.position_error << " m, " << ik.orientation_error << " rad off after "
+                              << ik.iterations << " iterations)";
     for (std::size_t i = 0; i < joints.positions.size(); ++i) joints.positions[i] = ik.q(static_cast<Eigen::Index>(i));
     sample();
-  }
-
-  // Depth of the last reference sent [m] (behind the surface positive).
-  [[nodiscard]] double reference_depth() const {
-    const Eigen::Isometry3d hole_in_base = rig->base_in_world(Eigen::Vector3d::Zero()).inverse() * hole.frame;
-    return -(hole_in_base.inverse() * sink.cartesian_refs.back().pose.translation()).z();
   }
 };
 
 TEST_F(LeaveTest, AStopWithTheBitInTheWallPullsItOutAlongTheHolesAxisThenHolds) {
   tip_at_depth(0.01);
   step();
+  const Eigen::Isometry3d tip = rig->tip_in_base(rig->q(joints));
   const std::size_t before = sink.cartesian_refs.size();
   engine.stop();
   EXPECT_TRUE(engine.leaving_wall());
   EXPECT_TRUE(sink.holds.empty()) << "held with the bit in the wall";
-  EXPECT_EQ(sink.logged("leaving the wall: the bit 10.0 mm behind the surface"), 1u) << sink.log_text;
+  // About 10 mm: the engine's hole is where the camera measured it again.
+  EXPECT_EQ(sink.logged("leaving the wall: the bit "), 1u) << sink.log_text;
+  EXPECT_EQ(sink.logged(" mm behind the surface, pulled back along the hole's axis to 40.0 mm in front of it"), 1u)
+      << sink.log_text;
   // A new mission waits for the bit to be out.
   engine.start_mission({9, 101, "m", "name: m\ndepth: 0.03\nareas: []\n", "", false});
   ASSERT_FALSE(sink.refusals.empty());
   EXPECT_NE(sink.refusals.back().find("leaving the wall"), std::string::npos) << sink.refusals.back();
-  // 1.1 s of the robot's time: the reference backs out along the axis at the approach speed
-  // (50 mm at 0.05 m/s) and stops at the standoff.
-  for (int i = 0; i < 220; ++i) {
+  // 1.2 s of the robot's time: the reference backs out along the hole's axis at the approach
+  // speed, from about 9 mm in to the 40 mm standoff, and stays there. The hole's axis is the wall's
+  // normal as the camera measured it (the synthetic view's wall faces the camera, 20 deg off the
+  // bit): backwards along the bit within that.
+  for (int i = 0; i < 240; ++i) {
     sample();
     step();
   }
   ASSERT_GT(sink.cartesian_refs.size(), before);
-  EXPECT_NEAR(reference_depth(), -tuning.motion.standoff, 1e-3);
+  const Eigen::Vector3d bit = tip.linear().col(2);
+  const Eigen::Vector3d moved = sink.cartesian_refs.back().pose.translation() - tip.translation();
+  EXPECT_NEAR(moved.norm(), 0.049, 0.004) << moved.transpose();
+  EXPECT_GT(-moved.normalized().dot(bit), std::cos(0.4)) << moved.transpose();
   EXPECT_TRUE(sink.holds.empty());
-  // The arm follows: the tip at the standoff, out of the wall; then the arm holds.
-  tip_at_depth(-tuning.motion.standoff);
+  // The arm follows, the tip well out of the wall: the arm holds there.
+  tip_at_depth(-0.06);
   step();
   EXPECT_FALSE(engine.leaving_wall());
   ASSERT_EQ(sink.holds.size(), 1u);
@@ -441,7 +462,7 @@ TEST_F(LeaveTest, UnderASafetyStopTheBitLeavesOnceTheStopIsReset) {
   step();
   EXPECT_EQ(sink.logged("the safety stop is reset: leaving the wall now"), 1u) << sink.log_text;
   EXPECT_GT(sink.cartesian_refs.size(), sent);
-  tip_at_depth(-tuning.motion.standoff);
+  tip_at_depth(-0.06);
   step();
   EXPECT_FALSE(engine.leaving_wall());
   EXPECT_EQ(sink.holds.size(), 1u);

@@ -198,18 +198,19 @@ concert::robot::dds::ServiceParams service_params(const Options& options) {
 
 // Every 10 s of wall time until `stopping`, the log says how fast simulated time runs: the
 // loop's lag behind the wall clock on a loaded machine (no cycle is late in simulated time).
-std::thread timing_reporter(const robot::Loop& loop, double period, const std::atomic<bool>& stopping) {
+std::thread timing_reporter(const concert::robot::Loop& loop, double period, const std::atomic<bool>& stopping) {
   return std::thread([&loop, period, &stopping] {
     using Clock = std::chrono::steady_clock;
+    using concert::robot::LoopProgress;
     auto since = Clock::now();
-    robot::LoopProgress before = loop.progress();
+    LoopProgress before = loop.progress();
     while (!stopping.load()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
       const auto now = Clock::now();
       const double wall = std::chrono::duration<double>(now - since).count();
       if (wall < 10.0) continue;
-      const robot::LoopProgress p = loop.progress();
-      std::cerr << "concert_robot: " << robot::simulated_time_line(before, p, wall, period) << std::endl;
+      const LoopProgress p = loop.progress();
+      std::cerr << "concert_robot: " << concert::robot::simulated_time_line(before, p, wall, period) << std::endl;
       before = p;
       since = now;
     }

@@ -315,7 +315,9 @@ TEST(SandSupervise, ASafetyStopInContactHoldsThenLeavesTheWallAfterTheReset) {
   const double x0 = step.command->target.translation().x();
   for (int i = 0; i < 100 && step.end == SandEnd::kNone; ++i) {
     step = cycle(false);
-    if (step.command) EXPECT_LE(step.command->target.translation().x(), x0 + 1e-9);  // off the wall only
+    if (step.command) {
+      EXPECT_LE(step.command->target.translation().x(), x0 + 1e-9);  // off the wall only
+    }
   }
   EXPECT_EQ(step.end, SandEnd::kAborted);
   EXPECT_EQ(step.reason, "safety stop (e-stop: software); the tool left the wall after the reset");

@@ -149,7 +149,9 @@ TEST(SandSystem, CentreAreaAt30NOverTheStack) {
     for (const msg::SafetyMode m : modes) EXPECT_EQ(m, msg::SAFETY_RUNNING);
   }
 
-  // An e-stop while stroking ends the run at once, aborted, naming the stop.
+  // An e-stop while stroking holds the run (the robot holds the disc where it is); once the stop
+  // is released and reset, the disc leaves the wall along its normal and the run ends aborted,
+  // naming both.
   c.request_id(5153);
   c.stamp_ns(now_ns());
   c.verb(msg::FINISH_SAND);
@@ -169,6 +171,21 @@ TEST(SandSystem, CentreAreaAt30NOverTheStack) {
                                    "--reason", "sand test"}),
                    30s);
   ASSERT_EQ(estop.code, 0) << estop.out << estop.err;
+  bool held = false;
+  for (const auto until = std::chrono::steady_clock::now() + 30s;
+       !held && std::chrono::steady_clock::now() < until;) {
+    const auto s = statuses.wait(500ms);
+    if (!s || s->request_id() != 5153) continue;
+    ASSERT_EQ(s->state(), msg::FINISH_RUNNING) << s->reason() << logs();
+    held = s->reason() == "sanding: held";
+  }
+  ASSERT_TRUE(held) << logs();
+  for (const std::vector<std::string>& verb :
+       {std::vector<std::string>{CONCERT_BINARY, "safety", "estop", "--source", "front-left", "--release"},
+        std::vector<std::string>{CONCERT_BINARY, "safety", "reset", "--reason", "sand test"}}) {
+    const testing::Outcome done = testing::run(dies_with_test(verb), 30s);
+    ASSERT_EQ(done.code, 0) << done.out << done.err;
+  }
   std::optional<msg::FinishStatus> stopped;
   for (const auto until = std::chrono::steady_clock::now() + 30s;
        std::chrono::steady_clock::now() < until;) {
@@ -181,7 +198,9 @@ TEST(SandSystem, CentreAreaAt30NOverTheStack) {
   ASSERT_TRUE(stopped) << logs();
   EXPECT_EQ(stopped->state(), msg::FINISH_ABORTED);
   EXPECT_NE(stopped->reason().find("safety stop (estop"), std::string::npos) << stopped->reason();
-  std::printf("e-stop while stroking: %s\n", stopped->reason().c_str());
+  EXPECT_NE(stopped->reason().find("the tool left the wall after the reset"), std::string::npos)
+      << stopped->reason();
+  std::printf("e-stop while stroking, then reset: %s\n", stopped->reason().c_str());
 }
 
 }  // namespace
