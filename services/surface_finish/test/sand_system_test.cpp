@@ -157,29 +157,24 @@ TEST(SandSystem, CentreAreaAt30NOverTheStack) {
   c.verb(msg::FINISH_SAND);
   c.force(30.0);
   commands.write(c);
-  bool stroking = false;
-  for (const auto until = std::chrono::steady_clock::now() + 120s;
-       !stroking && std::chrono::steady_clock::now() < until;) {
-    const auto s = statuses.wait(500ms);
-    if (!s || s->request_id() != 5153) continue;
-    ASSERT_EQ(s->state(), msg::FINISH_RUNNING) << s->reason() << logs();
-    stroking = s->reason() == "sanding: strokes";
-  }
-  ASSERT_TRUE(stroking) << logs();
+  // Run 5153's statuses until one says `phase` (each must say it runs), for at most `bound`.
+  const auto reaches = [&](const std::string& phase, std::chrono::seconds bound) {
+    for (const auto until = std::chrono::steady_clock::now() + bound; std::chrono::steady_clock::now() < until;) {
+      const auto s = statuses.wait(500ms);
+      if (!s || s->request_id() != 5153) continue;
+      EXPECT_EQ(s->state(), msg::FINISH_RUNNING) << s->reason();
+      if (s->state() != msg::FINISH_RUNNING) return false;
+      if (s->reason() == "sanding: " + phase) return true;
+    }
+    return false;
+  };
+  ASSERT_TRUE(reaches("strokes", 120s)) << logs();
   const testing::Outcome estop =
       testing::run(dies_with_test({CONCERT_BINARY, "safety", "estop", "--source", "front-left",
                                    "--reason", "sand test"}),
                    30s);
   ASSERT_EQ(estop.code, 0) << estop.out << estop.err;
-  bool held = false;
-  for (const auto until = std::chrono::steady_clock::now() + 30s;
-       !held && std::chrono::steady_clock::now() < until;) {
-    const auto s = statuses.wait(500ms);
-    if (!s || s->request_id() != 5153) continue;
-    ASSERT_EQ(s->state(), msg::FINISH_RUNNING) << s->reason() << logs();
-    held = s->reason() == "sanding: held";
-  }
-  ASSERT_TRUE(held) << logs();
+  ASSERT_TRUE(reaches("held", 30s)) << logs();
   for (const std::vector<std::string>& verb :
        {std::vector<std::string>{CONCERT_BINARY, "safety", "estop", "--source", "front-left", "--release"},
         std::vector<std::string>{CONCERT_BINARY, "safety", "reset", "--reason", "sand test"}}) {
