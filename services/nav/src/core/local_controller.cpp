@@ -69,10 +69,7 @@ LocalController::LocalController(const ControllerParams& params) : params_(param
   require(params_.drive == ControllerParams::Drive::kDifferential || l.max_vy > 0.0,
           "limits.max_vy", l.max_vy, "must be > 0 [m/s] for an omni-steering base");
   require(l.max_wz > 0.0, "limits.max_wz", l.max_wz, "must be > 0 [rad/s]");
-  require(l.max_ax > 0.0, "limits.max_ax", l.max_ax, "must be > 0 [m/s^2]");
-  require(params_.drive == ControllerParams::Drive::kDifferential || l.max_ay > 0.0,
-          "limits.max_ay", l.max_ay, "must be > 0 [m/s^2] for an omni-steering base");
-  require(l.max_aw > 0.0, "limits.max_aw", l.max_aw, "must be > 0 [rad/s^2]");
+  set_acceleration_limits(l.max_ax, l.max_ay, l.max_aw);  // checks them
   require(params_.desired_speed > 0.0, "desired_speed", params_.desired_speed, "must be > 0 [m/s]");
   require(params_.min_lookahead > 0.0 && params_.max_lookahead >= params_.min_lookahead,
           "min_lookahead", params_.min_lookahead, "need 0 < min_lookahead <= max_lookahead [m]");
