@@ -148,10 +148,12 @@ TEST(RandomSwaps, ADrillingApproachOnEachRandomRobotWithADrillExecutesOrIsRefuse
     const planner::PlanResult plan = planner.plan(request, start);
     if (plan.status != planner::Status::kSucceeded) {
       EXPECT_FALSE(plan.reason.empty()) << "refused without a reason";
+      std::cout << "random robot " << r.seed << ": refused: " << plan.reason << "\n";
       ++refused;
       continue;
     }
     ++planned;
+    std::cout << "random robot " << r.seed << ": planned (" << plan.goals.at(0).drives << ")\n";
     const planner::Trajectory& t = plan.goals.at(0).trajectory;
     robot::JointTrajectory command;
     command.request_id = 7;

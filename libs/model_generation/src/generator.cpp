@@ -1,6 +1,7 @@
 // chi -> phi (paper section 4.3.3, eq. 1-2) and the model's lists.
 
 #include "concert/model_generation/generator.hpp"
+#include "resting_posture.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -681,6 +682,14 @@ GeneratedModel ModelGenerator::generate(const topology::ModuleTree& input_tree, 
     if (!homed.count(name)) throw ModelError("customisation home: no moving joint '" + name + "' in this robot");
   }
   model.urdf = write_urdf(model.tree, params_.robot_name);
+  // A first SRDF: the posture search reads its disabled collision pairs; the final one carries
+  // the posture chosen.
+  model.srdf = write_srdf(model, params_.robot_name);
+  try {
+    model.resting = choose_resting_posture(model, homed, params_.home_torque_fraction);
+  } catch (const std::exception& e) {
+    throw ModelError(std::string("homing posture: ") + e.what());
+  }
   model.srdf = write_srdf(model, params_.robot_name);
   model.config_yaml = write_config_yaml(model, params_.robot_name);
   std::string canonical = model.urdf;

@@ -58,6 +58,7 @@ class ModelgenService {
   /// The highest model version known (current, learned from the wire or the bundle).
   uint64_t known_version() const { return versioner_.known_version(); }
   const Customisation& customisation() const { return custom_; }
+  const ServiceParams& params() const { return params_; }
 
  private:
   Outcome offer(GeneratedModel model);

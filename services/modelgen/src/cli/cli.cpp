@@ -64,6 +64,7 @@ int generate(const GenerateOptions& o, std::ostream& out) {
     for (const std::string& j : c.joints) out << " " << j;
     out << "\n";
   }
+  if (const std::string rest = describe(model.resting, Params{}.home_torque_fraction); !rest.empty()) out << "  " << rest << "\n";
   for (const EndEffectorInfo& e : model.end_effectors) out << "  end-effector " << e.name << " (" << concert::model::to_string(e.kind) << ") at " << e.frame << " (" << e.module_key << ")\n";
   return 0;
 }

@@ -85,6 +85,9 @@ void ModelgenNode::report(const Outcome& outcome, const std::string& what) {
     models_.write(concert::model::dds::to_msg(m.description(), now_ns()));
     log_ << "modelgen: published model version " << m.version << " (" << m.content_hash << ", " << m.modules.size()
          << " modules, " << m.joints.size() << " joints) from " << what << "\n";
+    if (const std::string rest = describe(m.resting, service_.params().generator.home_torque_fraction); !rest.empty()) {
+      log_ << "modelgen: " << rest << "\n";
+    }
     status_.report(msg::ServiceState::SERVICE_READY, current_id(),
                    "model version " + std::to_string(version));
   } else {

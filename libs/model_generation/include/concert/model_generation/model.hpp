@@ -114,6 +114,22 @@ struct Customisation {
   bool operator==(const Customisation&) const = default;
 };
 
+/// How the default homing posture was chosen (ModelGenerator::generate).
+struct RestingPosture {
+  /// False: every arm joint rests at the database's zero (clamped into its limits) or at the
+  /// customisation's home. True: the zero posture overloaded a drive, so the free arm joints
+  /// were moved to a posture the drives hold.
+  bool moved = false;
+  /// Largest gravity torque of an arm joint at the homing posture, as a fraction of that
+  /// joint's continuous torque [-], and that joint ("" without an arm).
+  double static_load = 0.0;
+  std::string joint;
+};
+
+/// One line for a log on how the arm's homing posture was chosen, or "" when it rests at the
+/// database's zero within `fraction` (Params::home_torque_fraction) of every continuous torque.
+std::string describe(const RestingPosture& resting, double fraction);
+
 /// A generated model. Texts contain no version or time, so equal content gives an equal hash.
 struct GeneratedModel {
   uint64_t version = 0;            ///< assigned by ModelVersioner; 0 = not published
@@ -128,6 +144,7 @@ struct GeneratedModel {
   std::vector<EndEffectorInfo> end_effectors;
   std::vector<model::SensorFrame> sensor_frames;  ///< camera frames of modules, add-on frames
   Customisation customisation;     ///< the customisation applied
+  RestingPosture resting;          ///< how the homing posture was chosen
   PhysicalTree tree;               ///< phi
 
   /// What the RobotModel message carries: version, hash, texts and the lists, with the
@@ -144,6 +161,10 @@ struct Params {
   double default_kp = 500.0;
   double default_kd = 10.0;
   double default_velocity_kp = 5.0;
+  /// The arms' default homing posture keeps each arm joint's gravity torque within this share
+  /// of its continuous torque, leaving the rest for motion (the safety layer stops the robot
+  /// when a joint's torque RMS exceeds its continuous torque).
+  double home_torque_fraction = 0.5;
 };
 
 }  // namespace concert::model_generation
