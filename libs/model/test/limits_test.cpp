@@ -74,6 +74,17 @@ TEST(ThermalLoad, ConvergesToTheRmsOfASteadyLoadWithTheWindowAsTimeConstant) {
   EXPECT_THROW(ThermalLoad(0.0), ModelError);
 }
 
+// A drive that has held a load: its RMS starts there and cools towards a lighter one with the
+// window as time constant (mean square 100^2 -> 20^2 by e^-1 of the way in one window).
+TEST(ThermalLoad, StartsWarmFromAHeldLoad) {
+  ThermalLoad load(5.0);
+  load.hold(-100.0);
+  EXPECT_DOUBLE_EQ(load.rms(), 100.0);
+  double rms = 0.0;
+  for (int i = 0; i < 500; ++i) rms = load.add(20.0, 0.01);
+  EXPECT_NEAR(rms * rms, 400.0 + (10000.0 - 400.0) * std::exp(-1.0), 1.0);
+}
+
 TEST(FoldedBackTorque, PeakWhileCoolThenDownToTheContinuousTorque) {
   // The wheel drive of the demo robot (Table 1, Small B): peak 24, continuous 17.5 N m.
   const JointLimits wheel = joint(17.5, 24.0);

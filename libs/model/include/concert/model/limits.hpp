@@ -78,6 +78,11 @@ class ThermalLoad {
   double add(double tau, double dt);
   /// RMS torque [N m] now.
   [[nodiscard]] double rms() const;
+  /// The drive has held |tau| [N m] for long: its RMS is |tau|, the next add() weighs by dt.
+  void hold(double tau) {
+    mean_square_ = tau * tau;
+    started_ = true;
+  }
   void reset() {
     mean_square_ = 0.0;
     started_ = false;
