@@ -3,15 +3,18 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <optional>
 #include <random>
 
+#include "concert/model/limits.hpp"
 #include "planner/state_checker.hpp"
 #include "planner/fixtures.hpp"
 #include "planner/trajectory.hpp"
 
 using namespace concert::planner;
 namespace model = concert::model;
+namespace kinematics = concert::kinematics;
 
 namespace {
 
@@ -271,4 +274,96 @@ TEST(Trajectory, TimingRespectsLimitsAndPassesThroughWaypoints) {
     EXPECT_TRUE((acc.cwiseAbs().array() <= lim.acceleration.array() * 1.0001).all()) << "sample " << i;
   }
   EXPECT_THROW((void)time_parameterize({}, m->joint_names(), lim, 0.01), PlannerError);
+}
+
+// The arm drives' thermal RMS and peak along a timed trajectory, judged from its samples alone
+// (accelerations by finite differences of the sampled velocities, inverse dynamics on the planar
+// model, model::ThermalLoad warm from the start posture): largest RMS / continuous, largest
+// static load / continuous over the samples.
+struct SampledLoads {
+  double rms_share = 0.0, static_share = 0.0;
+};
+SampledLoads sampled_loads(const PlanningModel& m, const Trajectory& t, const Eigen::VectorXd& q_full) {
+  const kinematics::Model& k = m.kinematics();
+  kinematics::Data data = k.make_data();
+  const auto& planned = m.planned_indices();
+  const auto full = [&](const Eigen::VectorXd& part) {
+    Eigen::VectorXd out = Eigen::VectorXd::Zero(k.dof());
+    out.head(q_full.size()) = q_full;
+    for (std::size_t p = 0; p < planned.size(); ++p) out[planned[p]] = part[static_cast<Eigen::Index>(p)];
+    return out;
+  };
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(k.dof());
+  std::vector<model::ThermalLoad> heat(planned.size());
+  const Eigen::VectorXd g0 = k.gravity_torques(data, full(t.points.front().q));
+  for (std::size_t p = 3; p < planned.size(); ++p) heat[p].hold(std::abs(g0[planned[p]]));
+  SampledLoads out;
+  for (std::size_t i = 1; i < t.points.size(); ++i) {
+    const double dt = t.points[i].time - t.points[i - 1].time;
+    Eigen::VectorXd qd = zero, qdd = zero;
+    for (std::size_t p = 0; p < planned.size(); ++p) {
+      qd[planned[p]] = t.points[i].qd[static_cast<Eigen::Index>(p)];
+      qdd[planned[p]] = (t.points[i].qd - t.points[i - 1].qd)[static_cast<Eigen::Index>(p)] / dt;
+    }
+    const Eigen::VectorXd q = full(t.points[i].q);
+    const Eigen::VectorXd tau = k.inverse_dynamics(data, q, qd, qdd);
+    const Eigen::VectorXd g = k.gravity_torques(data, q);
+    for (std::size_t p = 3; p < planned.size(); ++p) {
+      const double c = m.robot().limits().at(m.joint_names()[p]).continuous_torque;
+      out.rms_share = std::max(out.rms_share, heat[p].add(std::abs(tau[planned[p]]), dt) / c);
+      out.static_share = std::max(out.static_share, std::abs(g[planned[p]]) / c);
+    }
+  }
+  return out;
+}
+
+// A fast path (joint accelerations of 10 rad/s^2 at full joint speed) asks the arm drives for
+// more than holding the path's postures does. Timed for the drives, its segments are stretched
+// until the RMS over the thermal window, judged from the samples, stays within the fraction; a
+// fraction below what holding the postures alone needs is refused (not sustainable).
+TEST(Trajectory, SlowsDownWhereTheArmsDrivesCannotSustainTheKinematicLimits) {
+  const auto m = morphology('a');
+  Params params;
+  params.velocity_scale = 1.0;
+  params.joint_acceleration = 10.0;
+  const MotionLimits lim = motion_limits(*m, params);
+  std::vector<Eigen::VectorXd> wp;
+  std::mt19937 rng(3u);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (int i = 0; i < 4; ++i) {
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(m->dof());
+    for (Eigen::Index j = 3; j < q.size(); ++j) q[j] = u(rng);
+    wp.push_back(q);
+  }
+  const Eigen::VectorXd start = Eigen::VectorXd::Zero(m->full_dof());
+  const Trajectory fast = time_parameterize(wp, m->joint_names(), lim, 0.005);
+  const SampledLoads kinematic = sampled_loads(*m, fast, start);
+  std::printf("kinematic timing: %.2f s, RMS %.0f %%, static %.0f %% of continuous\n", fast.points.back().time,
+              100.0 * kinematic.rms_share, 100.0 * kinematic.static_share);
+  ASSERT_GT(kinematic.rms_share, kinematic.static_share + 0.02) << "the path asks nothing of the drives' dynamics";
+
+  DriveLimits drives;
+  drives.model = m.get();
+  drives.q_start_full = start;
+  drives.fraction = std::min(1.0, kinematic.static_share + 0.5 * (kinematic.rms_share - kinematic.static_share));
+  drives.max_stretch = 50.0;
+  drives.max_stretches = 400;
+  DriveReport report;
+  const Trajectory fitted = time_parameterize(wp, m->joint_names(), lim, 0.005, drives, &report);
+  std::printf("for %.0f %%: %s\n", 100.0 * drives.fraction, report.summary().c_str());
+  EXPECT_TRUE(report.within) << report.summary();
+  EXPECT_GT(report.stretches, 0);
+  EXPECT_GT(fitted.points.back().time, fast.points.back().time);
+  EXPECT_NEAR(report.slowed * fast.points.back().time, fitted.points.back().time, 1e-6);
+  EXPECT_LT((fitted.points.back().q - wp.back()).norm(), 1e-12);
+  const SampledLoads judged = sampled_loads(*m, fitted, start);
+  EXPECT_LE(judged.rms_share, drives.fraction + 0.01);  // finite differences smear the switches
+
+  drives.fraction = 0.9 * kinematic.static_share;  // less than holding the postures needs
+  DriveReport refused;
+  (void)time_parameterize(wp, m->joint_names(), lim, 0.005, drives, &refused);
+  EXPECT_FALSE(refused.within);
+  EXPECT_NE(refused.summary().find("not sustainable"), std::string::npos) << refused.summary();
+  drives.fraction = 1.5;
+  EXPECT_THROW((void)time_parameterize(wp, m->joint_names(), lim, 0.005, drives), PlannerError);
 }

@@ -111,6 +111,12 @@ struct Params {
   double base_angular_velocity = 0.5;     ///< [rad/s]
   double base_angular_acceleration = 1.0; ///< [rad/s^2]
   double sample_period = 0.02;       ///< output trajectory sample period [s]
+  /// The arm drives' RMS torque over the thermal window stays within this fraction of their
+  /// continuous torque along every trajectory, |tau| within the peak (inverse dynamics with the
+  /// base's accelerations); segments are stretched until it does, at most max_drive_stretch x
+  /// longer, and a path that still does not is refused (0: not checked) [-].
+  double drive_torque_fraction = 1.0;
+  double max_drive_stretch = 4.0;   ///< [-], >= 1
 };
 
 /// Which constraint rejected a state.
@@ -220,6 +226,7 @@ struct GoalResult {
   double nspg_seconds = 0.0;      ///< goal posture generation time [s]
   double plan_seconds = 0.0;      ///< path search + simplification + timing [s]
   std::string load;               ///< the goal posture's heaviest joint load (fraction of its continuous torque), e.g. "J2_E 0.91 with the drilling force"
+  std::string drives;             ///< the arm drives along the trajectory (DriveReport::summary)
   std::string path_method;        ///< how the path was found: "direct", "projected line", "arm, then drive", "drive, then arm" (or
                                   ///< with a "remembered arm path"), "RRT-Connect"
 };

@@ -67,6 +67,8 @@ Params read_params(config::Document& doc) {
     root.number(key, *value, config::Range::non_negative());
   for (const auto& [key, value] : positive) root.number(key, *value, config::Range::positive());
   for (const auto& [key, value] : counts) root.integer(key, *value, 0);
+  root.number("drive_torque_fraction", p.drive_torque_fraction, config::Range::between(0.0, 1.0));
+  root.number("max_drive_stretch", p.max_drive_stretch, config::Range::at_least(1.0));
   root.integer("sensor_depth_stride", p.sensor_depth_stride, 1);
   root.integer("sensor_depth_frames", p.sensor_depth_frames, 1);
   root.number("sensor_depth_min_valid", p.sensor_depth_min_valid, config::Range{0.0, 1.0, true});

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <memory>
 #include <mutex>
@@ -351,8 +352,26 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
     return r;
   }
   if (lead_in) waypoints.insert(waypoints.begin(), model.to_planned(*lead_in));
+  DriveLimits drives;
+  if (params_.drive_torque_fraction > 0.0) {
+    drives.model = &model;
+    drives.q_start_full = q_start_full;
+    drives.fraction = params_.drive_torque_fraction;
+    drives.max_stretch = params_.max_drive_stretch;
+  }
+  DriveReport load;
   r.trajectory = time_parameterize(waypoints, model.joint_names(), motion_limits(model, params_),
-                                   params_.sample_period);
+                                   params_.sample_period, drives, &load);
+  r.drives = load.summary();
+  r.plan_seconds = seconds_since(t0);
+  if (!load.within) {
+    r.status = Status::kNoPath;
+    char b[120];
+    std::snprintf(b, sizeof b, "the arm's drives cannot sustain the path even %.1f times slower: ",
+                  params_.max_drive_stretch);
+    r.reason = b + r.drives;
+    return r;
+  }
   r.status = Status::kSucceeded;
   r.plan_seconds = seconds_since(t0);
   return r;

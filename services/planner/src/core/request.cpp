@@ -141,7 +141,8 @@ std::string describe(const PlanResult& result, const PreparedRequest& prepared, 
   for (const GoalResult& g : result.goals) {
     if (g.status != Status::kSucceeded) continue;
     line << "; goal " << g.index << " in " << static_cast<int>(1e3 * (g.nspg_seconds + g.plan_seconds)) << " ms ("
-         << g.path_method << (g.load.empty() ? "" : "; load " + g.load) << ")";
+         << g.path_method << (g.load.empty() ? "" : "; load " + g.load)
+         << (g.drives.empty() ? "" : "; drives " + g.drives) << ")";
   }
   return line.str();
 }
