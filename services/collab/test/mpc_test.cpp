@@ -82,6 +82,32 @@ TEST(FollowMeMpc, NoForceNoMotion) {
   EXPECT_LT(r.joint_velocity.norm(), 1e-3);
 }
 
+// A hard pull from rest: the base's first velocity is bounded by its acceleration bound
+// (base_lin_acc_max 2 m/s^2 over a 0.1 s step: 0.2 m/s) times the share the drives sustain
+// (model::DriveBudget in the adapter), never below min_base_acceleration_scale (0.1) so the base
+// can still brake. A share outside [0, 1] is refused.
+TEST(FollowMeMpc, TheBaseAcceleratesNoHarderThanTheDrivesSustain) {
+  std::vector<double> vx;
+  for (const double scale : {1.0, 0.25, 0.0}) {
+    FollowMeMpc mpc(MpcParams{}, ExampleArm::limits(), spheres());
+    MpcInput in = at_posture();
+    in.force = Eigen::Vector3d(200.0, 0.0, 0.0);
+    in.base_acceleration_scale = scale;
+    const auto r = mpc.solve(in);
+    ASSERT_TRUE(r.ok) << r.status;
+    EXPECT_LE(std::abs(r.base_velocity.x()), std::max(0.1, scale) * 2.0 * 0.1 + 1e-6) << "scale " << scale;
+    vx.push_back(std::abs(r.base_velocity.x()));
+  }
+  EXPECT_GT(vx[0], 0.25 * 0.2 + 0.01) << "the pull does not reach the bound: the test shows nothing";
+  EXPECT_GT(vx[1], vx[2]);
+  FollowMeMpc mpc(MpcParams{}, ExampleArm::limits(), spheres());
+  MpcInput in = at_posture();
+  in.base_acceleration_scale = 1.5;
+  const auto r = mpc.solve(in);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.status.find("acceleration scale"), std::string::npos) << r.status;
+}
+
 TEST(FollowMeMpc, BadInputIsRefusedWithTheReason) {
   FollowMeMpc mpc(MpcParams{}, ExampleArm::limits(), spheres());
   MpcInput in;

@@ -60,6 +60,9 @@ struct MpcParams {
   double base_lin_acc_max{2.0};  ///< [m/s^2]
   double base_ang_acc_max{3.0};  ///< [rad/s^2]
   double joint_acc_max{4.0};     ///< [rad/s^2]
+  /// The base's acceleration bounds are never scaled below this share
+  /// (MpcInput::base_acceleration_scale), so that the base can always brake [-], in (0, 1].
+  double min_base_acceleration_scale{0.1};
   double margin{0.05};           ///< extra clearance added to r_robot + r_obs [m]
   std::size_t max_obstacles{8};  ///< constraint slots (one per sector); unused slots are inert
   int max_iter{50};
@@ -93,6 +96,9 @@ struct MpcInput {
   /// virtual mass-damper advances by it, and the warm start moves one step along the horizon
   /// once a step's time has passed (a 50 Hz loop over 0.1 s steps: every fifth solve).
   double period{0.0};
+  /// Share of base_lin_acc_max and base_ang_acc_max usable now, in [0, 1]: what the arm's drives
+  /// sustain at this posture (model::DriveBudget). Raised to min_base_acceleration_scale.
+  double base_acceleration_scale{1.0};
 };
 
 struct MpcResult {

@@ -84,9 +84,10 @@ struct Problem : public Ipopt::TNLP {
   std::size_t is(std::size_t k) const { return (k - 1) * m; }      // s_k, k = 1..N
   std::size_t iu(std::size_t k) const { return N * m + k * m; }    // u_k, k = 0..N-1
   std::size_t isg(std::size_t k, std::size_t j) const { return 2 * N * m + k * K + j; }
+  double base_acc_scale{1.0};         // set before each solve
   double acc_max(std::size_t i) const {
-    if (i < 2) return p.base_lin_acc_max;
-    if (i == 2) return p.base_ang_acc_max;
+    if (i < 2) return base_acc_scale * p.base_lin_acc_max;
+    if (i == 2) return base_acc_scale * p.base_ang_acc_max;
     return p.joint_acc_max;
   }
 
@@ -416,6 +417,8 @@ FollowMeMpc::FollowMeMpc(MpcParams params, ArmLimits arm, std::vector<RobotSpher
   if (params_.max_obstacles > 64) bad("max_obstacles must be <= 64");
   if (!(params_.force_filter >= 0.0)) bad("force_filter must be >= 0 s");
   if (!(params_.slot_match >= 0.0)) bad("slot_match must be >= 0 m");
+  if (!(params_.min_base_acceleration_scale > 0.0 && params_.min_base_acceleration_scale <= 1.0))
+    bad("min_base_acceleration_scale must be in (0, 1]");
 
   auto& pb = impl_->problem;
   pb = new Problem();
@@ -526,6 +529,11 @@ MpcResult FollowMeMpc::solve(const MpcInput& in) {
     out.status = "period must be >= 0 (0: one step), got " + std::to_string(in.period);
     return out;
   }
+  if (!(in.base_acceleration_scale >= 0.0 && in.base_acceleration_scale <= 1.0)) {
+    out.status = "base acceleration scale must be in [0, 1], got " + std::to_string(in.base_acceleration_scale);
+    return out;
+  }
+  pb.base_acc_scale = std::max(params_.min_base_acceleration_scale, in.base_acceleration_scale);
   const double period = in.period > 0.0 ? in.period : params_.dt;
   if (in.obstacles.size() > pb.K) {
     out.status = std::to_string(in.obstacles.size()) + " obstacles, at most " + std::to_string(pb.K);

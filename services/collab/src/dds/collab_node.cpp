@@ -47,6 +47,8 @@ struct CollabNode::Rig {
   ArmLimits limits;
   std::string jaw;          ///< the gripper's moving joint (a branch off the arm's tip), or ""
   double jaw_open{0.0}, jaw_closed{0.0};
+  /// What the drives sustain of the base's accelerations (none: the model has no wheeled legs).
+  std::optional<model::DriveBudget> budget;
 
   explicit Rig(std::shared_ptr<const model::RobotModel> m) : model(std::move(m)), data(model->kinematics().make_data()) {
     const auto grippers = model->end_effectors(model::EndEffectorKind::kGripper);
@@ -86,6 +88,11 @@ struct CollabNode::Rig {
       jaw_open = l.has_position_limits ? l.upper : 0.0;
       jaw_closed = l.has_position_limits ? l.lower : 0.0;
       break;
+    }
+    try {
+      budget.emplace(*model);
+    } catch (const model::ModelError&) {
+      // A leg chain without a wheel: the base cannot drive; the MPC keeps its bounds.
     }
   }
 };
@@ -404,6 +411,15 @@ void CollabNode::follow_step() {
   in.obstacles = grid_->active(in.base.head<2>());
   if (in.obstacles.size() > params_.mpc.max_obstacles) in.obstacles.resize(params_.mpc.max_obstacles);
   in.period = 1.0 / params_.rate;
+  if (rig_->budget) {
+    // The base accelerates no harder than the arm's drives (and the wheels) sustain at this
+    // posture, the turn's centrifugal load counted first.
+    model::BaseMotion asked;
+    asked.ax = asked.ay = params_.mpc.base_lin_acc_max;
+    asked.aw = params_.mpc.base_ang_acc_max;
+    asked.wz = odo ? odo->wz() : 0.0;
+    in.base_acceleration_scale = rig_->budget->base_motion(q, asked, params_.drive_torque_fraction).scale;
+  }
   send_follow(in, mpc_->solve(in));
 }
 

@@ -28,6 +28,7 @@
 #include "concert/common/command_once.hpp"
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
+#include "concert/model/drive_budget.hpp"
 #include "concert/model/robot_model.hpp"
 
 namespace concert::collab::dds {
@@ -40,6 +41,9 @@ struct NodeParams {
   /// compensation) tells the robot it carries this payload at the TCP; 0: unknown, none sent.
   double object_mass{0.0};
   MpcParams mpc;
+  /// The base's accelerations keep every arm joint and wheel within this share of its
+  /// continuous torque (model::DriveBudget) [-], (0, 1].
+  double drive_torque_fraction{1.0};
   GridParams grid;
   /// Footprint for the perimeter spheres [m]: the transport base's (lidars at +-0.62 m, sonars
   /// and wheels to +-0.42 m).
