@@ -250,6 +250,48 @@ TEST(Serpentine, SandingMoveEndsOffTheWallSoEveryAreaPlans) {
   }
 }
 
+// The wall clearance counts the arm's shapes, not its TCP: the disc (0.23 m, its face at the
+// TCP) parallel to the wall keeps the TCP's distance; tilted by 15 degrees its rim comes
+// 0.115 sin(15 deg) = 30 mm nearer, which the TCP alone does not show.
+TEST(Reach, TheWallClearanceCountsATiltedDiscsRim) {
+  SandingRig rig;
+  Reach& reach = rig.reach;
+  const Rect& centre = rig.m.area("centre").rect;
+  const double x = 0.5 * (centre.x0 + centre.x1), y = 0.5 * (centre.y0 + centre.y1);
+  const Eigen::Isometry3d flat = Reach::target(rig.wall, x, y, 0.1, rig.m.roll);
+  const ReachPose a = reach.solve(flat, rig.wall, rig.m.posture_near(x, y), nullptr, true);
+  ASSERT_TRUE(a.ok) << a.reason;
+  std::string link;
+  const double parallel = reach.wall_clearance(a.q, rig.wall, &link);
+  EXPECT_NEAR(parallel, 0.1, 1e-3) << link;
+  EXPECT_FALSE(link.empty());
+  Eigen::Isometry3d tilted = flat;
+  tilted.rotate(Eigen::AngleAxisd(15.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()));
+  const ReachPose b = reach.solve(tilted, rig.wall, a.q, nullptr, true);
+  ASSERT_TRUE(b.ok) << b.reason;
+  EXPECT_NEAR(rig.wall.coordinates(reach.tcp_pose(b.q).translation()).z(), 0.1, 1e-3);  // the TCP as far
+  EXPECT_NEAR(reach.wall_clearance(b.q, rig.wall), 0.1 - 0.115 * std::sin(15.0 * M_PI / 180.0), 1.5e-3);
+}
+
+// A new model version with the same arm and tool puts the disc where the old one did at the
+// joints measured now: a run in contact leaves the wall under it. Another arm and tool (the
+// spraying robot) does not: its joints no longer say where the disc is.
+TEST(Reach, ANewModelWithTheSameArmKeepsTheToolWhereItWas) {
+  SandingRig rig;
+  const auto again = test::model_of(test::source_dir() / "deploy/demo/sanding_robot.yaml", test::project_db());
+  const kinematics::Model& k = rig.model->kinematics();
+  const Rect& centre = rig.m.area("centre").rect;
+  const Eigen::VectorXd& q = rig.m.posture_near(0.5 * (centre.x0 + centre.x1), 0.5 * (centre.y0 + centre.y1));
+  const std::vector<double> positions(q.data(), q.data() + q.size());
+  EXPECT_TRUE(same_frame_pose(*rig.model, *again, rig.reach.tcp_frame(), k.joint_names(), positions));
+  EXPECT_FALSE(same_frame_pose(*rig.model, *spraying_project(), rig.reach.tcp_frame(), k.joint_names(), positions));
+  // The same arm agrees at any joints measured; a frame neither model has is not the tool.
+  std::vector<double> moved = positions;
+  moved[static_cast<std::size_t>(rig.reach.arm_joints().front())] += 0.1;
+  EXPECT_TRUE(same_frame_pose(*rig.model, *again, rig.reach.tcp_frame(), k.joint_names(), moved));
+  EXPECT_FALSE(same_frame_pose(*rig.model, *again, "no_such_frame", k.joint_names(), positions));
+}
+
 // A run ends backed off the wall by the approach (5 cm); the next run starts there, a hair nearer
 // with the arm's tracking error. Its move from there is planned: it goes no nearer than where it
 // starts (the sand system test's second run was refused so, now and then).

@@ -62,6 +62,16 @@ TEST(SandSequence, RefusesANonPositiveForceNamingIt) {
   SerpentinePlan no_stroke = test_plan();
   for (auto& s : no_stroke.samples) s.stroke = -1;
   EXPECT_THROW(SandSequence(no_stroke, SandParams{}), FinishError);
+  SandParams wide;
+  wide.contact_gap = 0.05;  // the plan's whole approach: the tool would never come nearer
+  try {
+    SandSequence(test_plan(), wide);
+    ADD_FAILURE() << "a contact gap as long as the approach was accepted";
+  } catch (const FinishError& e) {
+    EXPECT_NE(std::string(e.what()).find("contact gap 0.050 m must be less than the plan's approach 0.050 m"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(SandSequence, CommandsThePhasesInTurn) {
@@ -77,15 +87,17 @@ TEST(SandSequence, CommandsThePhasesInTurn) {
   SandCommand c = s.update(100.5);
   EXPECT_EQ(s.phase(), SandPhase::kApproach);
   EXPECT_FALSE(c.admittance);
-  EXPECT_NEAR(c.target.translation().x(), 1.0 - 0.025, 1e-9);  // half-way to the wall
-  EXPECT_NEAR(c.velocity.x(), 0.05, 1e-9);
+  // Half-way to the contact gap (2 cm) in front of the wall: 1.5 cm of its 3 cm in 0.5 s.
+  EXPECT_NEAR(c.target.translation().x(), 1.0 - 0.05 + 0.015, 1e-9);
+  EXPECT_NEAR(c.velocity.x(), 0.03, 1e-9);
   EXPECT_DOUBLE_EQ(c.stiffness[0], 1500.0);
   EXPECT_NEAR(c.damping[0], 2.0 * std::sqrt(15000.0), 1e-9);
   c = s.update(102.0);  // 1 s in contact: half the ramp
   EXPECT_EQ(s.phase(), SandPhase::kContact);
   EXPECT_TRUE(c.admittance);
   EXPECT_NEAR(c.force_setpoint, 15.0, 1e-9);
-  EXPECT_NEAR(c.target.translation().x(), 1.0, 1e-9);
+  // The target stays the gap in front of the nominal surface: the admittance meets the wall.
+  EXPECT_NEAR(c.target.translation().x(), 1.0 - 0.02, 1e-9);
   EXPECT_DOUBLE_EQ(c.admittance_gain, 0.01);
   c = s.update(103.5);  // ramped, held
   EXPECT_EQ(s.phase(), SandPhase::kContact);
@@ -94,7 +106,9 @@ TEST(SandSequence, CommandsThePhasesInTurn) {
   EXPECT_EQ(s.phase(), SandPhase::kStrokes);
   EXPECT_NEAR(c.force_setpoint, 30.0, 1e-9);
   EXPECT_NEAR(c.target.translation().z(), 1.1, 1e-9);
+  EXPECT_NEAR(c.target.translation().x(), 1.0 - 0.02, 1e-9);
   EXPECT_NEAR(c.velocity.z(), 0.1, 1e-9);
+  EXPECT_NEAR(c.velocity.x(), 0.0, 1e-9);
   c = s.update(106.5);  // 0.5 s into the unload
   EXPECT_EQ(s.phase(), SandPhase::kUnload);
   EXPECT_NEAR(c.force_setpoint, 15.0, 1e-9);
@@ -102,7 +116,8 @@ TEST(SandSequence, CommandsThePhasesInTurn) {
   c = s.update(107.5);  // 0.5 s into the retreat
   EXPECT_EQ(s.phase(), SandPhase::kRetreat);
   EXPECT_FALSE(c.admittance);
-  EXPECT_NEAR(c.target.translation().x(), 1.0 - 0.025, 1e-9);
+  // The admittance off, the target is still the gap in front of the wall: nothing pushes.
+  EXPECT_NEAR(c.target.translation().x(), 1.0 - 0.025 - 0.02, 1e-9);
   const double before = s.progress();
   (void)s.update(109.0);
   EXPECT_EQ(s.phase(), SandPhase::kDone);

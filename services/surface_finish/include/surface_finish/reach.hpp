@@ -88,6 +88,11 @@ class Reach {
 
   /// First self-collision of q as "link_a / link_b", or nullopt.
   [[nodiscard]] std::optional<std::string> self_collision(const Eigen::VectorXd& q);
+  /// How far the arm's collision primitives (the tool's among them) keep from the plane of
+  /// `wall` at q [m], negative when one reaches through it; the link of the nearest one in
+  /// `nearest` (when given). A tilted tool's rim is nearer the wall than its TCP. +inf when the
+  /// arm has no primitive (mesh shapes are not counted: ignored_shapes()).
+  [[nodiscard]] double wall_clearance(const Eigen::VectorXd& q, const WallFrame& wall, std::string* nearest = nullptr);
   /// Smallest singular value of the arm's TCP Jacobian at q.
   [[nodiscard]] double singular_value(const Eigen::VectorXd& q);
   /// TCP pose in the base frame.
@@ -107,5 +112,14 @@ class Reach {
   std::vector<std::string> ignored_;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Whether `after` (a new model) puts `frame` where `before` does, at the joint positions
+/// measured now (`names`, `positions`; the joints not named at 0): within `tolerance` [m] and
+/// 0.01 rad. True for the same arm and tool under a new version (a module swapped elsewhere):
+/// a run in contact may then leave the wall under the new version. False when either model has
+/// no such frame: with another arm the joints no longer say where the tool is.
+bool same_frame_pose(const model::RobotModel& before, const model::RobotModel& after, const std::string& frame,
+                     const std::vector<std::string>& names, const std::vector<double>& positions,
+                     double tolerance = 0.005);
 
 }  // namespace concert::surface_finish

@@ -4,13 +4,20 @@
 // is one joint trajectory; from the approach pose on, Cartesian impedance targets of the
 // plan's TCP with the robot service's admittance along the TCP's z (into the wall):
 //
-//   approach   to the nominal surface along the plan (impedance only)
+//   approach   along the plan to contact_gap in front of the nominal surface (impedance only)
 //   contact    held at the first stroke's start, the force setpoint ramped from 0 (ramp_time),
-//              then held (start_delay)
+//              then held (start_delay): the admittance closes the gap and meets the surface
+//              under force control
 //   strokes    the serpentine in contact, the force held by the admittance along z_ee, the
 //              other directions under impedance
 //   unload     held at the last stroke's end, the setpoint ramped back to 0 (unload_time)
 //   retreat    admittance off, the plan's retreat off the wall
+//
+// The nominal surface is the wall the lidars fit, in their plane; a plaster layer or a panel
+// above that plane stands proud of it by an unknown few millimetres. Every target in contact
+// is therefore held contact_gap in front of the nominal surface and the admittance finds the
+// real one: the impedance alone never pushes the disc into the plaster (on entering contact,
+// nor when the admittance is switched off for the retreat).
 //
 // The time is the robot's (the stamps of its estimates). The force samples (the robot's
 // estimate from the joint torques, the force pushed along z_ee) give the statistics of the
@@ -53,6 +60,10 @@ struct SandParams {
   double lost_contact_fraction{0.25};  ///< of the setpoint, while stroking
   double lost_contact_time{1.0};       ///< [s]
   double leave_time{1.0};  ///< after a stop: back off the wall by the plan's approach over this [s]
+  /// The Cartesian targets in contact stay this far in front of the nominal surface; the
+  /// admittance closes the gap [m]. A surface up to this much proud of the fitted wall is met
+  /// under force control. Less than the plan's approach.
+  double contact_gap{0.02};
 };
 
 enum class SandPhase {

@@ -40,6 +40,10 @@ struct PathParams {
   /// (a run ends backed off by `approach`, and the next starts there within the tracking's
   /// error), no nearer than where it starts less `start_tolerance`.
   double move_clearance{0.05};
+  /// The same for every collision primitive of the arm and its tool (a tilted disc's rim comes
+  /// nearer the wall than its TCP; the TCP's 5 cm leave a 0.23 m disc's rim at 46-49 mm on the
+  /// sanding robot's moves) [m].
+  double move_shape_clearance{0.03};
   double start_tolerance{0.002};  ///< [m]
 };
 

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <optional>
 #include <random>
 #include <map>
 
@@ -98,6 +100,43 @@ std::optional<std::string> Reach::self_collision(const Eigen::VectorXd& q) {
   const auto hit = impl_->shapes.self_collision();
   if (!hit) return std::nullopt;
   return links[static_cast<std::size_t>(hit->first)].name + " / " + links[static_cast<std::size_t>(hit->second)].name;
+}
+
+double Reach::wall_clearance(const Eigen::VectorXd& q, const WallFrame& wall, std::string* nearest) {
+  const kinematics::Model& k = model_->kinematics();
+  const auto& links = model_->links();
+  const Eigen::Vector3d n = wall.pose.linear().col(2);  // the wall's normal, towards the robot
+  double best = std::numeric_limits<double>::infinity();
+  for (const collision::Shape& shape : impl_->shapes.shapes()) {
+    const model::Link& link = links[static_cast<std::size_t>(shape.link)];
+    if (link.chain.empty() || model_->chain(link.chain).role != model::ChainRole::kArm) continue;
+    const Eigen::Isometry3d pose = k.frame_pose(impl_->data, q, link.name) * shape.primitive.origin;
+    const Eigen::Matrix3d& r = pose.linear();
+    const Eigen::Vector3d& size = shape.primitive.size;
+    // Half the shape's extent along the normal: its support distance towards the wall.
+    double reach = 0.0;
+    switch (shape.primitive.type) {
+      case model::CollisionShape::Type::kBox:
+        for (int i = 0; i < 3; ++i) reach += 0.5 * size[i] * std::abs(r.col(i).dot(n));
+        break;
+      case model::CollisionShape::Type::kCylinder: {
+        const double along = std::abs(r.col(2).dot(n));
+        reach = size.x() * std::sqrt(std::max(0.0, 1.0 - along * along)) + 0.5 * size.z() * along;
+        break;
+      }
+      case model::CollisionShape::Type::kSphere:
+        reach = size.x();
+        break;
+      case model::CollisionShape::Type::kMesh:
+        continue;
+    }
+    const double clearance = wall.coordinates(pose.translation()).z() - reach;
+    if (clearance < best) {
+      best = clearance;
+      if (nearest != nullptr) *nearest = link.name;
+    }
+  }
+  return best;
 }
 
 ReachPose Reach::solve(const Eigen::Isometry3d& tcp, const WallFrame& wall, const Eigen::VectorXd& seed,
@@ -198,6 +237,24 @@ ReachPose Reach::solve(const Eigen::Isometry3d& tcp, const WallFrame& wall, cons
   }
   out.ok = true;
   return out;
+}
+
+bool same_frame_pose(const model::RobotModel& before, const model::RobotModel& after, const std::string& frame,
+                     const std::vector<std::string>& names, const std::vector<double>& positions, double tolerance) {
+  const auto pose = [&](const model::RobotModel& m) -> std::optional<Eigen::Isometry3d> {
+    const kinematics::Model& k = m.kinematics();
+    if (!k.has_frame(frame)) return std::nullopt;
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(k.dof());
+    for (std::size_t i = 0; i < names.size() && i < positions.size(); ++i) {
+      if (const auto j = k.joint_index(names[i])) q[*j] = positions[i];
+    }
+    kinematics::Data data = k.make_data();
+    return k.frame_pose(data, q, frame);
+  };
+  const std::optional<Eigen::Isometry3d> a = pose(before), b = pose(after);
+  if (!a || !b) return false;
+  const double turned = Eigen::AngleAxisd(a->linear().transpose() * b->linear()).angle();
+  return (a->translation() - b->translation()).norm() <= tolerance && turned <= 0.01;
 }
 
 }  // namespace concert::surface_finish

@@ -44,11 +44,10 @@ SandSequence::SandSequence(SerpentinePlan plan, SandParams params)
   if (!(p.tolerance > 0.0) || !(p.ramp_time >= 0.0) || !(p.start_delay >= 0.0) ||
       !(p.unload_time >= 0.0) || !(p.admittance_gain > 0.0) || !(p.stiffness > 0.0) ||
       !(p.rot_stiffness > 0.0) || !(p.damping_ratio >= 0.0) || !(p.abort_time >= 0.0) ||
-      !(p.lost_contact_fraction >= 0.0) || !(p.lost_contact_time > 0.0) || !(p.leave_time > 0.0)) {
+      !(p.lost_contact_fraction >= 0.0) || !(p.lost_contact_time > 0.0) || !(p.leave_time > 0.0) || !(p.contact_gap >= 0.0)) {
     throw FinishError(
         "sand parameters: tolerance, admittance gain, stiffnesses, lost-contact and leave times > "
-        "0; ramp, delay, "
-        "unload, abort time, damping ratio and lost-contact fraction >= 0");
+        "0; ramp, delay, unload, abort time, damping ratio, lost-contact fraction and contact gap >= 0");
   }
   if (std::isfinite(p.abort_force) && !(p.abort_force > p.force)) {
     throw FinishError("sand parameters: the abort force must exceed the setpoint");
@@ -71,6 +70,12 @@ SandSequence::SandSequence(SerpentinePlan plan, SandParams params)
     throw FinishError("sand run: the plan has no joint move, approach or stroke");
   }
   z_ee_ = s[i_wall_].tcp.linear().col(2);
+  if (!(p.contact_gap < plan_.params.approach)) {
+    char b[160];
+    std::snprintf(b, sizeof b, "sand parameters: the contact gap %.3f m must be less than the plan's approach %.3f m",
+                  p.contact_gap, plan_.params.approach);
+    throw FinishError(b);
+  }
 }
 
 void SandSequence::start(double t) {
@@ -173,7 +178,13 @@ SandCommand SandSequence::update(double t) {
   } else {
     Eigen::Vector3d pos, vel;
     (void)at(plan_t_, pos, vel);
-    c.target.translation() = pos;
+    // Held contact_gap in front of the plan's path, reached over the approach.
+    const double t_app = s[i_app_].t, t_wall = s[i_wall_].t;
+    const double share = phase_ == SandPhase::kApproach && t_wall > t_app
+                             ? std::clamp((plan_t_ - t_app) / (t_wall - t_app), 0.0, 1.0)
+                             : 1.0;
+    c.target.translation() = pos - share * p.contact_gap * z_ee_;
+    if (phase_ == SandPhase::kApproach && plan_t_ < t_wall) vel -= p.contact_gap / (t_wall - t_app) * z_ee_;
     if (phase_ == SandPhase::kApproach || phase_ == SandPhase::kStrokes ||
         phase_ == SandPhase::kRetreat) {
       c.velocity = vel;

@@ -181,6 +181,9 @@ SerpentinePlan plan_serpentine(Reach& reach, const WallFrame& wall, const Rect& 
   std::vector<PathSample> out;
   const double start_off = wall.coordinates(reach.tcp_pose(q_start).translation()).z();
   const double clearance = std::min(params.move_clearance, start_off - params.start_tolerance);
+  // The same rule for the arm's shapes: a tilted tool's rim comes nearer the wall than its TCP.
+  const double shape_clearance =
+      std::min(params.move_shape_clearance, reach.wall_clearance(q_start, wall) - params.start_tolerance);
   if (move > 1e-6) {
     move = std::max(move, 1.0);
     const int n = std::max(2, static_cast<int>(std::ceil(move / params.sample_period)));
@@ -196,6 +199,13 @@ SerpentinePlan plan_serpentine(Reach& reach, const WallFrame& wall, const Rect& 
       if (m.wall.z() < clearance) {
         char b[160];
         std::snprintf(b, sizeof b, "path refused: the move to the approach pose brings the tool %.0f mm from the wall", m.wall.z() * 1000.0);
+        throw FinishError(b);
+      }
+      std::string link;
+      if (const double c = reach.wall_clearance(m.q, wall, &link); c < shape_clearance) {
+        char b[200];
+        std::snprintf(b, sizeof b, "path refused: the move to the approach pose brings %s %.0f mm from the wall",
+                      link.c_str(), c * 1000.0);
         throw FinishError(b);
       }
       out.push_back(m);

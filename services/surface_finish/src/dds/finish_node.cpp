@@ -110,7 +110,32 @@ void FinishNode::tick() {
 
 void FinishNode::on_model(const msg::RobotModel& m) {
   version_seen_ = m.version();
-  if (run_) abort_run("the robot model changed to version " + std::to_string(m.version()));
+  if (run_) {
+    // A sanding disc in contact leaves the wall under the new version when the new model puts
+    // the tool where the old one does at the joints now (the same arm); otherwise it holds.
+    std::string why = "the robot model changed to version " + std::to_string(m.version());
+    bool leave = false;
+    if (run_->sand && run_->reach) {
+      std::optional<Measured> latest;
+      {
+        std::lock_guard lock(mutex_);
+        latest = latest_;
+      }
+      try {
+        const auto after = model::RobotModel::build(model::dds::to_description(m));
+        leave = latest && same_frame_pose(run_->reach->model(), *after, run_->reach->tcp_frame(), latest->names,
+                                          latest->positions);
+      } catch (const std::exception& e) {
+        why += " (" + std::string(e.what()) + ")";
+      }
+      if (leave) {
+        command_version_ = m.version();
+      } else {
+        why += "; the new model's arm is another: the arm holds where it is";
+      }
+    }
+    abort_run(why, leave);
+  }
   status_.report(msg::SERVICE_RECONFIGURING, cdds::ModelId{m.version(), m.content_hash()},
                  "computing the areas of model version " + std::to_string(m.version()));
   preparing_version_ = m.version();
@@ -144,6 +169,7 @@ void FinishNode::finish_preparation() {
   if (preparing_version_ < version_seen_) return;  // a newer model is being prepared
   current_ = std::move(p);
   current_version_ = preparing_version_;
+  command_version_ = current_version_;
   msg::FinishAreas a;
   a.model_version(static_cast<std::uint32_t>(current_version_));
   a.stamp_ns(now_ns());
@@ -238,8 +264,10 @@ void FinishNode::handle(const msg::FinishCommand& c) {
   }
 }
 
-Eigen::VectorXd FinishNode::q_of(const Measured& m) const {
-  const kinematics::Model& k = current_.model->kinematics();
+Eigen::VectorXd FinishNode::q_of(const Measured& m) const { return q_in(*current_.model, m); }
+
+Eigen::VectorXd FinishNode::q_in(const model::RobotModel& model, const Measured& m) {
+  const kinematics::Model& k = model.kinematics();
   Eigen::VectorXd q = Eigen::VectorXd::Zero(k.dof());
   for (std::size_t i = 0; i < m.names.size() && i < m.positions.size(); ++i) {
     if (auto j = k.joint_index(m.names[i])) q[*j] = m.positions[i];
@@ -313,6 +341,7 @@ FinishNode::Run FinishNode::plan_run(const msg::FinishCommand& c, const ToolSpec
   run.request_id = c.request_id();
   run.wall = fit.wall;
   run.wall_distance = fit.wall.distance();
+  run.reach = current_.reach;
   run.plan = plan_serpentine(*current_.reach, fit.wall, rect, tool, areas.roll, path, q_now,
                              &areas.posture_near(strokes.front().x, strokes.front().y_start));
   target = rect.str() + " of area '" + area.id + "'";
@@ -461,7 +490,7 @@ void FinishNode::follow_sand() {
       std::lock_guard lock(mutex_);
       latest = latest_;
     }
-    if (latest && current_.reach) cycle.tcp = current_.reach->tcp_pose(q_of(*latest));
+    if (latest && run.reach) cycle.tcp = run.reach->tcp_pose(q_in(run.reach->model(), *latest));
   }
   cycle.silence = run.silence;
   for (const Wrench& w : wrenches) cycle.forces.push_back({static_cast<double>(w.stamp_ns) * 1e-9, w.force});
@@ -483,10 +512,10 @@ void FinishNode::follow_sand() {
 
 void FinishNode::send_sand(const SandCommand& sc) {
   msg::CartesianImpedanceCommand m;
-  m.model_version(static_cast<std::uint32_t>(current_version_));
+  m.model_version(static_cast<std::uint32_t>(command_version_));
   m.stamp_ns(now_ns());
   m.source(kSource);
-  m.end_effector(current_.reach->tcp_frame());
+  m.end_effector(run_->reach->tcp_frame());
   m.target(model::dds::to_pose_msg(sc.target));
   m.target_twist().linear().x(sc.velocity.x());
   m.target_twist().linear().y(sc.velocity.y());
@@ -629,7 +658,7 @@ void FinishNode::hold_here() {
   const Eigen::VectorXd q = q_of(*latest);
   msg::JointTrajectoryCommand t;
   t.request_id(next_trajectory_++);
-  t.model_version(static_cast<std::uint32_t>(current_version_));
+  t.model_version(static_cast<std::uint32_t>(command_version_));
   t.stamp_ns(now_ns());
   t.source(kSource);
   msg::JointTrajectorySample a, b;

@@ -87,6 +87,7 @@ class FinishNode {
     double wall_distance{0.0};
     std::chrono::steady_clock::time_point sent{};
     std::unique_ptr<SandSequence> sand;  // a sand run (no deposition)
+    std::shared_ptr<Reach> reach;        // the tool of the model the run was planned on
     std::chrono::steady_clock::time_point last_tick{}, last_status{};
     double silence{0.0};  // [s] without a force estimate (see NodeParams::wrench_timeout)
   };
@@ -113,6 +114,8 @@ class FinishNode {
                const std::string& report = {});
   void refuse(const msg::FinishCommand& c, const std::string& why);
   [[nodiscard]] Eigen::VectorXd q_of(const Measured& m) const;
+  /// The measured joints in `model`'s kinematics order (a joint it lacks is left out).
+  [[nodiscard]] static Eigen::VectorXd q_in(const model::RobotModel& model, const Measured& m);
   [[nodiscard]] WallFit measure_wall();
   /// measure_wall(), refused (FinishError) unless the wall is where `areas` were computed for.
   [[nodiscard]] WallFit measure_wall_for(const AreaMap& areas);
@@ -150,6 +153,9 @@ class FinishNode {
   std::uint64_t preparing_version_{0};
   Prepared current_;
   std::uint64_t current_version_{0};
+  /// The version the robot's commands carry: current_version_, or a new model's at once when a
+  /// run in contact leaves the wall under it (same_frame_pose) before its areas are computed.
+  std::uint64_t command_version_{0};
   concert::CommandOnce taken_;  // (request id, stamp) of the commands taken (a resent one is ignored)
   std::optional<Run> run_;
   std::atomic<bool> run_active_{false};  // joint states are queued only while a run is on
