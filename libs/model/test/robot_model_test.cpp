@@ -1,6 +1,7 @@
 // The parsed model on a small hand-written robot: a base with one steering + wheel leg and a
 // two-joint arm carrying a drill with a camera.
 #include "concert/model/robot_model.hpp"
+#include "concert/model/same_arm.hpp"
 
 #include <gtest/gtest.h>
 
@@ -109,6 +110,36 @@ TEST(RobotModel, ErrorsListTheCandidates) {
     EXPECT_STREQ(e.what(), "model version 7: no arm (chains: A (leg), B (other))");
   }
   EXPECT_THROW((void)n->tool(), ModelError);
+}
+
+// A new version whose arm is the same (a leg changed) keeps the tool where it was at the joints
+// measured now; a longer link, a turned tool or a frame the model lacks does not.
+TEST(SameArm, ANewVersionKeepsTheToolWhereItWasOnlyWithTheSameArm) {
+  const auto before = RobotModel::build(mini(7));
+  ModelDescription leg_swapped = mini(8);
+  const std::string wheel_origin = R"(<origin xyz="0 0 -0.2" rpy="1.5707963267948966 0 0"/>)";
+  leg_swapped.urdf.replace(leg_swapped.urdf.find(wheel_origin), wheel_origin.size(),
+                           R"(<origin xyz="0 0 -0.3" rpy="1.5707963267948966 0 0"/>)");
+  const auto same = RobotModel::build(leg_swapped);
+  const std::vector<std::string> names{"J1_B", "J2_B", "J1_A"};
+  const std::vector<double> q{0.4, -0.7, 1.0};
+  EXPECT_TRUE(same_frame_pose(*before, *same, "tcp_B", names, q));
+
+  // The tool 6 mm further out: beyond the 5 mm tolerance, within a 1 cm one.
+  ModelDescription longer = mini(8);
+  const std::string tcp = R"(<child link="tcp_B"/><origin xyz="0 0 0.4"/>)";
+  longer.urdf.replace(longer.urdf.find(tcp), tcp.size(), R"(<child link="tcp_B"/><origin xyz="0 0 0.406"/>)");
+  EXPECT_FALSE(same_frame_pose(*before, *RobotModel::build(longer), "tcp_B", names, q));
+  EXPECT_TRUE(same_frame_pose(*before, *RobotModel::build(longer), "tcp_B", names, q, 0.01));
+
+  // The tool turned 0.02 rad about its axis, in place: beyond the 0.01 rad tolerance.
+  ModelDescription turned = mini(8);
+  turned.urdf.replace(turned.urdf.find(tcp), tcp.size(),
+                      R"(<child link="tcp_B"/><origin xyz="0 0 0.4" rpy="0 0 0.02"/>)");
+  EXPECT_FALSE(same_frame_pose(*before, *RobotModel::build(turned), "tcp_B", names, q));
+
+  EXPECT_FALSE(same_frame_pose(*before, *same, "no_such_frame", names, q));
+  EXPECT_FALSE(same_frame_pose(*before, *same, "tcp_B", names, {0.4}));  // a malformed state
 }
 
 TEST(RobotModel, LegsGiveSteeringWheelJointsAndTheWheelRadius) {

@@ -17,6 +17,7 @@
 #include "surface_finish/areas.hpp"
 #include "surface_finish/deposition.hpp"
 #include "surface_finish/reach.hpp"
+#include "surface_finish/sand_sequence.hpp"
 #include "surface_finish/serpentine.hpp"
 #include "surface_finish/wall_fit.hpp"
 
@@ -274,22 +275,60 @@ TEST(Reach, TheWallClearanceCountsATiltedDiscsRim) {
 }
 
 // A new model version with the same arm and tool puts the disc where the old one did at the
-// joints measured now: a run in contact leaves the wall under it. Another arm and tool (the
-// spraying robot) does not: its joints no longer say where the disc is.
-TEST(Reach, ANewModelWithTheSameArmKeepsTheToolWhereItWas) {
+// joints measured now: a run in contact leaves the wall under it (leave_for_new_model). Another
+// arm and tool (the spraying robot), a model that did not build, or no joints measured yet:
+// the run stops where it is and the arm holds.
+TEST(SandSequence, ANewModelWithTheSameArmLeavesTheWallAnotherArmHolds) {
   SandingRig rig;
   const auto again = test::model_of(test::source_dir() / "deploy/demo/sanding_robot.yaml", test::project_db());
+  const auto spraying = spraying_project();
   const kinematics::Model& k = rig.model->kinematics();
   const Rect& centre = rig.m.area("centre").rect;
-  const Eigen::VectorXd& q = rig.m.posture_near(0.5 * (centre.x0 + centre.x1), 0.5 * (centre.y0 + centre.y1));
-  const std::vector<double> positions(q.data(), q.data() + q.size());
-  EXPECT_TRUE(same_frame_pose(*rig.model, *again, rig.reach.tcp_frame(), k.joint_names(), positions));
-  EXPECT_FALSE(same_frame_pose(*rig.model, *spraying_project(), rig.reach.tcp_frame(), k.joint_names(), positions));
-  // The same arm agrees at any joints measured; a frame neither model has is not the tool.
-  std::vector<double> moved = positions;
-  moved[static_cast<std::size_t>(rig.reach.arm_joints().front())] += 0.1;
-  EXPECT_TRUE(same_frame_pose(*rig.model, *again, rig.reach.tcp_frame(), k.joint_names(), moved));
-  EXPECT_FALSE(same_frame_pose(*rig.model, *again, "no_such_frame", k.joint_names(), positions));
+  const auto strokes = serpentine_strokes(centre, ToolSpec{Task::kSand, 0.0, 0.23, 0.1}, 0.0);
+  const SerpentinePlan plan = plan_serpentine(rig.reach, rig.wall, centre, ToolSpec{Task::kSand, 0.0, 0.23, 0.1},
+                                              rig.m.roll, PathParams{0.1, 0.5, 0.02, 0.05, 0.05, 0.0, 0.0, 0.8},
+                                              Eigen::VectorXd::Zero(k.dof()),
+                                              &rig.m.posture_near(strokes.front().x, strokes.front().y_start));
+  const Eigen::VectorXd& q = plan.samples[plan.samples.size() / 2].q;  // in contact, mid-run
+  const auto in_contact = [&]() {
+    auto seq = std::make_unique<SandSequence>(plan, SandParams{});
+    seq->start(0.0);
+    (void)seq->update(0.2);
+    return seq;
+  };
+  NewModel n;
+  n.version = 9;
+  n.before = rig.model.get();
+  n.tcp_frame = rig.reach.tcp_frame();
+  n.names = k.joint_names();
+  n.positions.assign(q.data(), q.data() + q.size());
+
+  n.after = again.get();
+  auto same = in_contact();
+  ASSERT_EQ(same->phase(), SandPhase::kApproach);
+  EXPECT_TRUE(leave_for_new_model(*same, n));
+  EXPECT_EQ(same->phase(), SandPhase::kLeaving);
+  EXPECT_EQ(same->reason(), "the robot model changed to version 9");
+
+  n.after = spraying.get();
+  auto other = in_contact();
+  EXPECT_FALSE(leave_for_new_model(*other, n));
+  EXPECT_EQ(other->phase(), SandPhase::kAborted);
+  EXPECT_EQ(other->reason(),
+            "the robot model changed to version 9; the new model's arm is another: the arm holds where it is");
+
+  n.after = nullptr;
+  n.error = "URDF: no root link";
+  auto broken = in_contact();
+  EXPECT_FALSE(leave_for_new_model(*broken, n));
+  EXPECT_EQ(broken->reason(), "the robot model changed to version 9 (URDF: no root link): the arm holds where it is");
+
+  n.after = again.get();
+  n.names.clear();
+  n.positions.clear();
+  auto unmeasured = in_contact();
+  EXPECT_FALSE(leave_for_new_model(*unmeasured, n));
+  EXPECT_EQ(unmeasured->phase(), SandPhase::kAborted);
 }
 
 // A run ends backed off the wall by the approach (5 cm); the next run starts there, a hair nearer

@@ -248,8 +248,6 @@ class DrillEngine final : public MissionPorts {
   // the hole's axis to the standoff, then the arm holds. False when the bit is clear already.
   bool start_leave();
   void leave_step();
-  // The tool tip's pose in the base frame at the latest joint sample with the current rig.
-  [[nodiscard]] std::optional<Eigen::Isometry3d> tip_now() const;
   void start_align(const Sample& s);
   // The hole's motion runs on the robot's clock, the stamp of the joint sample whose tip it
   // follows: a loaded machine slows the simulated robot, and a reference ramped or a timeout

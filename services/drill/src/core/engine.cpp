@@ -10,6 +10,7 @@
 
 #include "concert/bim/storey_map.hpp"
 #include "concert/bim/wall_goal.hpp"
+#include "concert/model/same_arm.hpp"
 
 namespace concert::drill {
 
@@ -208,13 +209,14 @@ std::string DrillEngine::apply_model(std::uint32_t version, std::shared_ptr<cons
   const std::uint64_t old = model_version_;
   // A bit in the wall leaves it under the new model only when the new model puts the tool where
   // the old one did (the same arm); with another arm the joints no longer say where the bit is.
-  const std::optional<Eigen::Isometry3d> old_tip = tip_now();
+  const std::optional<Sample> sample = inputs_.latest_sample();
+  leave_allowed_ = sample && rig_ && rig && rig_->tcp_frame() == rig->tcp_frame() &&
+                   model::same_frame_pose(rig_->model(), rig->model(), rig_->tcp_frame(), sample->joints.names,
+                                          sample->joints.positions);
   model_version_ = version;
   rig_ = rig;
   inputs_.set_rig(rig);
   rig_error_ = rig ? "" : why;
-  const std::optional<Eigen::Isometry3d> new_tip = tip_now();
-  leave_allowed_ = old_tip && new_tip && (old_tip->translation() - new_tip->translation()).norm() < 0.005;
   if (leaving_wall() && !leave_allowed_) {
     log_line("drill: the robot model changed while the bit left the wall, and the new model's arm is another: "
              "the arm holds where it is");
@@ -1167,16 +1169,6 @@ void DrillEngine::stop() {
   unacknowledged_.clear();  // not sent again: a planner taking it now would move the robot
   if (at_hole && !shutting_down_ && leave_allowed_ && start_leave()) return;
   send_hold();
-}
-
-std::optional<Eigen::Isometry3d> DrillEngine::tip_now() const {
-  const std::optional<Sample> s = inputs_.latest_sample();
-  if (!s || !rig_) return std::nullopt;
-  try {
-    return rig_->tip_in_base(rig_->q(s->joints));
-  } catch (const std::exception&) {
-    return std::nullopt;  // the sample names joints of another model
-  }
 }
 
 bool DrillEngine::start_leave() {

@@ -113,13 +113,4 @@ class Reach {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Whether `after` (a new model) puts `frame` where `before` does, at the joint positions
-/// measured now (`names`, `positions`; the joints not named at 0): within `tolerance` [m] and
-/// 0.01 rad. True for the same arm and tool under a new version (a module swapped elsewhere):
-/// a run in contact may then leave the wall under the new version. False when either model has
-/// no such frame: with another arm the joints no longer say where the tool is.
-bool same_frame_pose(const model::RobotModel& before, const model::RobotModel& after, const std::string& frame,
-                     const std::vector<std::string>& names, const std::vector<double>& positions,
-                     double tolerance = 0.005);
-
 }  // namespace concert::surface_finish

@@ -34,8 +34,11 @@
 #include <array>
 #include <limits>
 #include <optional>
+#include <cstdint>
 #include <string>
 #include <vector>
+
+#include "concert/model/robot_model.hpp"
 
 #include "surface_finish/admittance.hpp"
 #include "surface_finish/serpentine.hpp"
@@ -207,5 +210,24 @@ struct SandStep {
 /// its silence, fails the run; afterwards every estimate is fed to `seq` (the force pushed along
 /// its z_ee) and the newest one's command returned, and a silent force estimate aborts the run.
 SandStep supervise(SandSequence& seq, const SandCycle& cycle, const SandWatch& watch);
+
+/// A new robot model while a run is on: what the service knows of it.
+struct NewModel {
+  std::uint32_t version{0};
+  const model::RobotModel* before{nullptr};  ///< the run's model
+  const model::RobotModel* after{nullptr};   ///< the new one; null when it did not build
+  std::string error;                         ///< why it did not build
+  std::string tcp_frame;                     ///< the run's tool frame
+  std::vector<std::string> names;            ///< the joints measured now (none yet: empty)
+  std::vector<double> positions;
+};
+
+/// A new model during a run: the tool leaves the wall under the new version (as on a user's
+/// abort) when the new model puts it where the run's model does at the joints measured now
+/// (model::same_frame_pose: the same arm, a module swapped elsewhere); otherwise the run stops
+/// where it is and the arm holds, because another arm's joints no longer say where the tool is.
+/// Returns true when the run leaves (command it at the new version until it ends); `seq`'s
+/// reason names the version and, when the arm holds, why.
+bool leave_for_new_model(SandSequence& seq, const NewModel& m);
 
 }  // namespace concert::surface_finish

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "concert/model/same_arm.hpp"
+
 namespace concert::surface_finish {
 
 const char* to_string(SandPhase phase) {
@@ -400,6 +402,20 @@ SandStep supervise(SandSequence& seq, const SandCycle& c, const SandWatch& watch
     step.reason = seq.reason();
   }
   return step;
+}
+
+bool leave_for_new_model(SandSequence& seq, const NewModel& m) {
+  std::string why = "the robot model changed to version " + std::to_string(m.version);
+  const bool same_arm = m.before && m.after && !m.names.empty() &&
+                        model::same_frame_pose(*m.before, *m.after, m.tcp_frame, m.names, m.positions);
+  if (same_arm && seq.abort(why)) return true;
+  if (!m.after) {
+    why += " (" + m.error + "): the arm holds where it is";
+  } else if (!same_arm) {
+    why += "; the new model's arm is another: the arm holds where it is";
+  }
+  seq.stop(why);
+  return false;
 }
 
 }  // namespace concert::surface_finish

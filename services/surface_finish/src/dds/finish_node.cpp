@@ -110,31 +110,34 @@ void FinishNode::tick() {
 
 void FinishNode::on_model(const msg::RobotModel& m) {
   version_seen_ = m.version();
-  if (run_) {
-    // A sanding disc in contact leaves the wall under the new version when the new model puts
-    // the tool where the old one does at the joints now (the same arm); otherwise it holds.
-    std::string why = "the robot model changed to version " + std::to_string(m.version());
-    bool leave = false;
-    if (run_->sand && run_->reach) {
-      std::optional<Measured> latest;
-      {
-        std::lock_guard lock(mutex_);
-        latest = latest_;
-      }
-      try {
-        const auto after = model::RobotModel::build(model::dds::to_description(m));
-        leave = latest && same_frame_pose(run_->reach->model(), *after, run_->reach->tcp_frame(), latest->names,
-                                          latest->positions);
-      } catch (const std::exception& e) {
-        why += " (" + std::string(e.what()) + ")";
-      }
-      if (leave) {
-        command_version_ = m.version();
-      } else {
-        why += "; the new model's arm is another: the arm holds where it is";
+  if (run_ && run_->sand && run_->reach) {
+    NewModel n;
+    n.version = m.version();
+    n.before = &run_->reach->model();
+    n.tcp_frame = run_->reach->tcp_frame();
+    std::shared_ptr<const model::RobotModel> after;
+    try {
+      after = model::RobotModel::build(model::dds::to_description(m));
+      n.after = after.get();
+    } catch (const std::exception& e) {
+      n.error = e.what();
+    }
+    {
+      std::lock_guard lock(mutex_);
+      if (latest_) {
+        n.names = latest_->names;
+        n.positions = latest_->positions;
       }
     }
-    abort_run(why, leave);
+    if (leave_for_new_model(*run_->sand, n)) {
+      command_version_ = m.version();
+      log_line("surface_finish: request " + std::to_string(run_->request_id) + ": " + run_->sand->reason() +
+               ": the tool leaves the wall first");
+    } else {
+      end_run(msg::FINISH_ABORTED, run_->sand->reason());
+    }
+  } else if (run_) {
+    abort_run("the robot model changed to version " + std::to_string(m.version()), false);
   }
   status_.report(msg::SERVICE_RECONFIGURING, cdds::ModelId{m.version(), m.content_hash()},
                  "computing the areas of model version " + std::to_string(m.version()));

@@ -154,7 +154,7 @@ class FinishNode {
   Prepared current_;
   std::uint64_t current_version_{0};
   /// The version the robot's commands carry: current_version_, or a new model's at once when a
-  /// run in contact leaves the wall under it (same_frame_pose) before its areas are computed.
+  /// run in contact leaves the wall under it (leave_for_new_model) before its areas are computed.
   std::uint64_t command_version_{0};
   concert::CommandOnce taken_;  // (request id, stamp) of the commands taken (a resent one is ignored)
   std::optional<Run> run_;
