@@ -239,17 +239,21 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
   }
   check_assembly(assembly, module_dbs);
   if (world) check_world(*world);
-  if (!o.ifc.empty() && world) throw UsageError("give --world or --ifc, not both");
   if (!o.ifc.empty() && o.storey.empty()) throw UsageError("--ifc needs --storey NAME");
   if (o.ifc.empty() && !o.storey.empty()) throw UsageError("--storey goes with --ifc");
   // The building's storey: the simulator's world (bim::storey_world) and nav's map, one file.
+  // With --world too, that file is the simulated world (the storey as built, with what is drawn
+  // on its walls: marks, plaster) and the IFC is nav's map.
   std::string ifc_world;
   if (!o.ifc.empty()) {
     out << "concert up: importing " << o.ifc << " (storey " << o.storey << ")" << std::endl;
     try {
       const bim::BimModel model = bim::load_ifc(o.ifc);
-      ifc_world = bim::world_yaml(bim::storey_world(model, model.storey(o.storey)));
-      world::parse_world_yaml(ifc_world, o.ifc);
+      const bim::Storey& storey = model.storey(o.storey);
+      if (!world) {
+        ifc_world = bim::world_yaml(bim::storey_world(model, storey));
+        world::parse_world_yaml(ifc_world, o.ifc);
+      }
     } catch (const std::exception& e) {
       throw Failure(std::string("--ifc: nothing started: ") + e.what());
     }
@@ -482,7 +486,7 @@ void register_launcher_verbs(cli::Cli& concert) {
   up_verb.add_option("--assembly", up->assembly, "the mounted modules (an assembly file)")
       ->type_name("FILE")
       ->default_str(up->assembly);
-  up_verb.add_option("--world", up->world, "the simulated world (walls, obstacles)")
+  up_verb.add_option("--world", up->world, "the simulated world (walls, obstacles, marks, plaster); with --ifc, the building's storey as built (nav maps the IFC)")
       ->type_name("FILE");
   up_verb.add_option("--ifc", up->ifc, "a building: the simulated world and nav's map from one IFC storey")
       ->type_name("FILE");
