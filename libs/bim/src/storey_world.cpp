@@ -97,13 +97,12 @@ concert::world::World storey_world(const BimModel& model, const Storey& storey,
   return w;
 }
 
-concert::world::Mark mark_on_wall(const concert::world::World& world, const std::string& global_id,
-                                  const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
-                                  const std::string& name, double diameter) {
+WallSpot place_on_wall(const concert::world::World& world, const std::string& global_id, const Eigen::Vector3d& point,
+                       const Eigen::Vector3d& normal, const Eigen::Vector2d& half, const std::string& what) {
   using concert::world::Face;
   const std::string prefix = to_string(Category::kWall) + "_" + global_id + "_";
   const Eigen::Vector3d n = normal.normalized();
-  std::optional<concert::world::Mark> best;
+  std::optional<WallSpot> best;
   double best_distance = std::numeric_limits<double>::infinity();
   bool any_box = false;
   for (const auto& box : world.walls) {
@@ -114,35 +113,41 @@ concert::world::Mark mark_on_wall(const concert::world::World& world, const std:
       if (frame.linear().col(2).dot(n) < std::cos(0.3)) continue;
       const Eigen::Vector3d local = frame.inverse() * point;
       const Eigen::Vector2d size = concert::world::face_size(box, face);
-      const double r = diameter / 2;
-      if (std::abs(local.x()) > size.x() / 2 - r || std::abs(local.y()) > size.y() / 2 - r) continue;
+      if (std::abs(local.x()) > size.x() / 2 - half.x() || std::abs(local.y()) > size.y() / 2 - half.y()) continue;
       // Within a few map cells of the face: the IFC's face and the boxes' are a cell apart at most.
       if (std::abs(local.z()) > 0.15 || std::abs(local.z()) >= best_distance) continue;
       best_distance = std::abs(local.z());
-      concert::world::Mark m;
-      m.name = name;
-      m.type = concert::world::Mark::Type::kBlob;
-      m.diameter = diameter;
-      m.wall = box.name;
-      m.face = face;
-      m.at = {local.x(), point.z()};
-      best = m;
+      Eigen::Isometry3d on_face = frame;
+      on_face.translation() = frame * Eigen::Vector3d(local.x(), local.y(), 0.0);
+      best = WallSpot{box.name, face, {local.x(), point.z()}, on_face};
     }
   }
   if (!best) {
     std::ostringstream where;
     where << "(" << point.x() << ", " << point.y() << ", " << point.z() << ")";
-    throw BimError("mark '" + name + "': wall " + global_id +
-                   (any_box ? ": no face of its boxes looking that way holds the point (within 0.15 m) " + where.str()
+    throw BimError(what + ": wall " + global_id +
+                   (any_box ? ": no face of its boxes looking that way holds it (within 0.15 m) at " + where.str()
                             : ": not in this storey's world (no box named " + prefix + "*)"));
   }
   return *best;
 }
 
+concert::world::Mark mark_on_wall(const concert::world::World& world, const std::string& global_id,
+                                  const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                                  const std::string& name, double diameter) {
+  const WallSpot spot = place_on_wall(world, global_id, point, normal, Eigen::Vector2d::Constant(diameter / 2),
+                                      "mark '" + name + "'");
+  concert::world::Mark m;
+  m.name = name;
+  m.type = concert::world::Mark::Type::kBlob;
+  m.diameter = diameter;
+  m.wall = spot.wall;
+  m.face = spot.face;
+  m.at = spot.at;
+  return m;
+}
+
 std::string world_yaml(const concert::world::World& world) {
-  if (!world.surfaces.empty()) {
-    throw BimError("world_yaml writes floors, boxes and marks only, not sanding surfaces");
-  }
   YAML::Node root;
   root["floor"]["enabled"] = world.floor;
   root["floor"]["height"] = world.floor_height;
@@ -189,6 +194,37 @@ std::string world_yaml(const concert::world::World& world) {
       n["angle"] = m.angle;
     }
     root["marks"].push_back(n);
+  }
+  const auto pair = [](const Eigen::Vector2d& v) {
+    YAML::Node n(YAML::NodeType::Sequence);
+    n.SetStyle(YAML::EmitterStyle::Flow);
+    n.push_back(v.x());
+    n.push_back(v.y());
+    return n;
+  };
+  for (const auto& surface : world.surfaces) {
+    YAML::Node n;
+    n["name"] = surface.name;
+    n["wall"] = surface.wall;
+    n["face"] = concert::world::to_string(surface.face);
+    n["at"] = pair(surface.at);
+    n["size"] = pair(surface.size);
+    n["thickness"] = surface.thickness;
+    n["resolution"] = surface.resolution;
+    const auto features = [&](const std::vector<concert::world::SurfaceFeature>& list, const char* key,
+                              const char* height) {
+      for (const auto& f : list) {
+        YAML::Node feature;
+        feature.SetStyle(YAML::EmitterStyle::Flow);
+        feature["at"] = pair(f.at);
+        feature["radius"] = f.radius;
+        feature[height] = f.height;
+        n[key].push_back(feature);
+      }
+    };
+    features(surface.bumps, "bumps", "height");
+    features(surface.holes, "holes", "depth");
+    root["surfaces"].push_back(n);
   }
   YAML::Emitter out;
   out.SetDoublePrecision(9);

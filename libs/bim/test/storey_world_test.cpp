@@ -89,9 +89,44 @@ TEST(StoreyWorld, MarksGoOnTheSimulatedFaceOfTheWallABimGoalNames) {
   EXPECT_NEAR((truth[1].centre - truth[0].centre).dot(right), 0.1, 1e-9);
   // A point on another wall's face, and a wall not in the storey, are refused by name.
   EXPECT_THAT([&] { (void)mark_on_wall(w, wall, {2.05, 0.0, 1.2}, normal, "far", 0.025); },
-              ::testing::ThrowsMessage<BimError>(::testing::HasSubstr("holds the point")));
+              ::testing::ThrowsMessage<BimError>(::testing::HasSubstr("holds it")));
   EXPECT_THAT([&] { (void)mark_on_wall(w, "nope", {2.05, 4.0, 1.2}, normal, "x", 0.025); },
               ::testing::ThrowsMessage<BimError>(::testing::HasSubstr("not in this storey")));
+}
+
+// A plaster panel on the FZK house's interior wall east of the stair (Wand-Int-ERDG-4, its south
+// face at y = 4.01 m, x 7.41 .. 11.7 m): placed on the simulator's face, written and read back.
+TEST(StoreyWorld, APlasterPanelGoesOnTheFaceThatHoldsItWhole) {
+  const BimModel& m = shared_model("AC20-FZK-Haus.ifc");
+  world::World w = storey_world(m, m.storey("Erdgeschoss"));
+  const std::string wall = "2XPyKWY018sA1ygZKgQPtU";
+  const Eigen::Vector3d south(0.0, -1.0, 0.0);
+  const WallSpot spot = place_on_wall(w, wall, {10.6, 4.0, 2.175}, south, {0.8, 0.3}, "plaster");
+  EXPECT_LT((spot.frame.linear().col(2) - south).norm(), 1e-9);
+  EXPECT_NEAR(spot.frame.translation().x(), 10.6, 1e-9);
+  EXPECT_NEAR(spot.frame.translation().y(), 4.01, 0.05 + 1e-3);  // a map cell of the IFC's face
+  EXPECT_NEAR(spot.at.y(), 2.175, 1e-12);
+  world::Surface plaster;
+  plaster.name = "plaster";
+  plaster.wall = spot.wall;
+  plaster.face = spot.face;
+  plaster.at = spot.at;
+  plaster.size = {1.6, 0.6};
+  plaster.bumps.push_back({spot.at + Eigen::Vector2d(0.2, -0.1), 0.05, 0.003});
+  plaster.holes.push_back({spot.at + Eigen::Vector2d(-0.2, 0.1), 0.04, 0.004});
+  w.surfaces.push_back(plaster);
+  const world::World back = world::parse_world_yaml(world_yaml(w), "fzk_plaster.yaml");
+  ASSERT_EQ(back.surfaces.size(), 1u);
+  EXPECT_EQ(back.surfaces[0].wall, spot.wall);
+  EXPECT_EQ(back.surfaces[0].face, spot.face);
+  EXPECT_TRUE(back.surfaces[0].at.isApprox(spot.at, 1e-9));
+  EXPECT_TRUE(back.surfaces[0].size.isApprox(plaster.size, 1e-9));
+  ASSERT_EQ(back.surfaces[0].bumps.size(), 1u);
+  ASSERT_EQ(back.surfaces[0].holes.size(), 1u);
+  EXPECT_DOUBLE_EQ(back.surfaces[0].holes[0].height, 0.004);
+  // 1.6 m wide centred 0.5 m from the wall's east end: no face holds it whole.
+  EXPECT_THAT([&] { (void)place_on_wall(w, wall, {11.2, 4.0, 2.175}, south, {0.8, 0.3}, "plaster"); },
+              ::testing::ThrowsMessage<BimError>(::testing::HasSubstr("plaster: wall 2XPyKWY018sA1ygZKgQPtU")));
 }
 
 TEST(StoreyWorld, YamlRefusesWhatItDoesNotWrite) {

@@ -21,6 +21,23 @@ namespace concert::bim {
 concert::world::World storey_world(const BimModel& model, const Storey& storey,
                                    const SliceParams& params = {}, double max_height = 3.0);
 
+/// A spot on a wall face of the simulated world: the box, its face, the centre's [u, z] there
+/// (world::Mark::at, world::Surface::at) and the face's frame at that centre (z out of the wall).
+struct WallSpot {
+  std::string wall;
+  concert::world::Face face{concert::world::Face::kPlusX};
+  Eigen::Vector2d at{0.0, 0.0};
+  Eigen::Isometry3d frame{Eigen::Isometry3d::Identity()};
+};
+
+/// Where something of half extents `half` [u, z] centred at `point` goes on the building's wall
+/// `global_id` in a storey_world(): the box of that wall whose face looks along `normal` (within
+/// 0.3 rad) and holds it whole, `point` projected onto the nearest such face (within 0.15 m).
+/// Throws BimError naming `what`, the wall and the point when no box face holds it (a window or
+/// door splits a wall into several boxes).
+WallSpot place_on_wall(const concert::world::World& world, const std::string& global_id, const Eigen::Vector3d& point,
+                       const Eigen::Vector3d& normal, const Eigen::Vector2d& half, const std::string& what);
+
 /// Where a mark goes on the building's wall `global_id` in a storey_world(): the box of that wall
 /// whose face looks along `normal` (within 0.3 rad) and holds `point` (a world point, e.g. a
 /// bim::wall_goal area frame's origin, projected onto the nearest such face). Returns a blob mark
@@ -33,8 +50,9 @@ concert::world::Mark mark_on_wall(const concert::world::World& world, const std:
                                   const std::string& name, double diameter);
 
 /// The world file text (libs/world README "World file") of a world made of a floor, static boxes
-/// (as storey_world() makes) and marks (as mark_on_wall() makes). Throws BimError for what it
-/// does not write (sanding surfaces, cylinders, meshes, moving obstacles).
+/// (as storey_world() makes), marks (as mark_on_wall() makes) and plaster surfaces (placed with
+/// place_on_wall()). Throws BimError for what it does not write (cylinders, meshes, moving
+/// obstacles).
 std::string world_yaml(const concert::world::World& world);
 
 }  // namespace concert::bim
