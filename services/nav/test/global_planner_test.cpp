@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "nav/local_controller.hpp"
 #include "planning_fixtures.hpp"
 
 namespace concert::nav {
@@ -85,6 +86,58 @@ TEST(GlobalPlanner, RefusesStartAndGoalInWallsWithReasons) {
   r = planner.plan(map, {-1.0, 2.0, 0.0}, {8.0, 2.0, 0.0});
   EXPECT_EQ(r.status, PlanStatus::kStartOutsideMap);
   EXPECT_TRUE(r.path.empty());
+}
+
+// A task left the base with its footprint over a wall (the drill's whole-body placement stands
+// nearer a wall than the footprint, the hull of the steering sweep, allows): the path starts with
+// a short straight move off it, heading kept, touching no cell the start does not touch; the
+// controller follows it out and on to the goal without failing. Without the escape (0 m) the
+// start is refused naming why.
+TEST(GlobalPlanner, LeavesAStartWhoseFootprintCoversAWall) {
+  bim::OccupancyGrid grid = bim::OccupancyGrid::filled(200, 200, 0.05, {0.0, 0.0});
+  testing::add_box(grid, {5.1, 5.0}, {0.1, 3.0});  // a wall x 5.0 .. 5.2
+  const Costmap map(grid, test_robot(), {});
+  const Eigen::Vector3d start(4.68, 5.0, 0.0);  // the footprint's front edge at 5.03 m
+  const Eigen::Vector3d goal(2.0, 2.0, M_PI / 2);
+  const std::vector<std::size_t> stuck = map.lethal_under(start);
+  ASSERT_FALSE(stuck.empty());
+  ASSERT_TRUE(map.in_collision(start));
+  GlobalPlanner planner;
+  const PlanResult r = planner.plan(map, start, goal);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_NEAR((r.path.front() - start).norm(), 0.0, 1e-12);
+  std::size_t free_from = 0;
+  while (free_from < r.path.size() && map.in_collision(r.path[free_from])) {
+    EXPECT_NEAR(r.path[free_from].z(), start.z(), 1e-12) << "the heading is kept while escaping";
+    EXPECT_FALSE(map.in_collision(r.path[free_from], stuck)) << "pose " << free_from << " touches a new cell";
+    ++free_from;
+  }
+  EXPECT_GE(free_from, 1u);
+  EXPECT_LE((r.path[free_from] - start).head<2>().norm(), planner.params().escape_distance + 1e-9);
+  for (std::size_t i = free_from; i < r.path.size(); ++i) EXPECT_FALSE(map.in_collision(r.path[i])) << i;
+  EXPECT_NEAR((r.path.back() - goal).norm(), 0.0, 1e-9);
+
+  // Followed closed loop (exact tracking): never failed, never a new cell touched, at the goal.
+  LocalController controller;
+  controller.set_path(r.path);
+  Eigen::Vector3d pose = start;
+  bool reached = false;
+  for (int step = 0; step < 4000 && !reached; ++step) {
+    const ControlOutput out = controller.compute(map, pose, 0.05 * step);
+    ASSERT_NE(out.status, ControlStatus::kFailed) << out.reason;
+    ASSERT_NE(out.status, ControlStatus::kBlocked) << out.reason << " at " << pose.transpose();
+    reached = out.status == ControlStatus::kReached;
+    pose = integrate_twist(pose, out.cmd, 0.05);
+    ASSERT_FALSE(map.in_collision(pose, stuck)) << "step " << step << " at " << pose.transpose();
+  }
+  EXPECT_TRUE(reached);
+
+  PlannerParams stay;
+  stay.escape_distance = 0.0;
+  GlobalPlanner refusing(stay);
+  const PlanResult refused = refusing.plan(map, start, goal);
+  EXPECT_EQ(refused.status, PlanStatus::kStartInCollision);
+  EXPECT_THAT(refused.message, HasSubstr("no straight move of up to 0.00 m frees it"));
 }
 
 TEST(GlobalPlanner, GoalInUnknownSpace) {

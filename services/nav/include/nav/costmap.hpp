@@ -119,6 +119,14 @@ class Costmap {
   /// True when the footprint at `pose` covers a lethal (or, when unknown is lethal, unknown)
   /// cell, or leaves the map.
   [[nodiscard]] bool in_collision(const Eigen::Vector3d& pose) const;
+  /// The lethal (or, when unknown is lethal, unknown) cells the footprint at `pose` covers, as
+  /// sorted map indices (index()); empty when it covers none.
+  [[nodiscard]] std::vector<std::size_t> lethal_under(const Eigen::Vector3d& pose) const;
+  /// in_collision(), except that the cells of `allowed` (sorted, from lethal_under()) do not
+  /// count: a base whose footprint the check refuses where it stands (the footprint is the
+  /// hull of the steering legs' sweep and the transport posture, larger than the robot at work)
+  /// may leave without touching anything new.
+  [[nodiscard]] bool in_collision(const Eigen::Vector3d& pose, const std::vector<std::size_t>& allowed) const;
 
   /// Marks the obstacle layer from beams cast from `sensor_origin` (map frame [m]): every beam
   /// clears the cells it crosses up to its end (or raytrace_max_range), and a hit within

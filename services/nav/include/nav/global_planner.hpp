@@ -27,6 +27,9 @@ struct PlannerParams {
   int max_expansions{2'000'000};
   /// Planning time budget [s] (<= 0: unlimited).
   double max_planning_time{2.0};
+  /// A start whose footprint covers an obstacle (a task left the base near a wall) is left by
+  /// a straight move of up to this much, heading kept, that touches nothing new [m]; 0: refused.
+  double escape_distance{0.5};
   /// Smooth the path (shortcuts that are not costlier, then gradient smoothing).
   bool smooth{true};
   /// Gradient smoother: iterations, weight of the original path and of the smoothness term.

@@ -54,6 +54,8 @@ struct ControllerParams {
   /// Within approach_distance of the goal the speed falls linearly to min_approach_speed [m, m/s].
   double approach_distance{0.6};
   double min_approach_speed{0.03};
+  /// Speed of the straight move off a start whose footprint covers an obstacle [m/s].
+  double escape_speed{0.1};
   /// Goal tolerances: position [m], heading [rad].
   double xy_goal_tolerance{0.05};
   double yaw_goal_tolerance{2.0 * M_PI / 180.0};
@@ -134,10 +136,16 @@ class LocalController {
   [[nodiscard]] double safe_scale(const Costmap& costmap, const Eigen::Vector3d& pose,
                                   const BaseTwist& cmd, double max_tau) const;
   ControlOutput stop(ControlOutput out);
+  // The cycle of a path that starts with the footprint over an obstacle, until it is free.
+  ControlOutput escape(const Costmap& costmap, const Eigen::Vector3d& pose, double dt, ControlOutput out);
 
   ControllerParams params_;
   Path path_;
   std::size_t progress_{0};  // index of the path pose nearest the robot
+  // The lethal cells the footprint covered where the path started (sorted map indices): they do
+  // not count as collisions until the footprint is free of lethal cells.
+  std::vector<std::size_t> escape_cells_;
+  bool escape_checked_{false};
   bool xy_latched_{false};
   std::optional<double> last_stamp_;
   std::optional<double> blocked_since_;

@@ -310,6 +310,27 @@ bool Costmap::in_collision(const Eigen::Vector3d& pose) const {
   return !inside_map || hit;
 }
 
+std::vector<std::size_t> Costmap::lethal_under(const Eigen::Vector3d& pose) const {
+  std::vector<std::size_t> cells;
+  (void)visit_footprint(*this, shape_.footprint, pose, [&](int c, int r) {
+    if (cost(c, r) == kLethal) cells.push_back(index(c, r));
+    return true;
+  });
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  return cells;
+}
+
+bool Costmap::in_collision(const Eigen::Vector3d& pose, const std::vector<std::size_t>& allowed) const {
+  if (allowed.empty()) return in_collision(pose);
+  bool hit = false;
+  const bool inside_map = visit_footprint(*this, shape_.footprint, pose, [&](int c, int r) {
+    hit = cost(c, r) == kLethal && !std::binary_search(allowed.begin(), allowed.end(), index(c, r));
+    return !hit;
+  });
+  return !inside_map || hit;
+}
+
 void Costmap::touch(CostmapUpdate& up, int col, int row) const {
   if (up.window[0] > up.window[2]) {
     up.window = {col, row, col, row};

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include "grid_line.hpp"
@@ -188,6 +190,36 @@ GlobalPlanner::GlobalPlanner(const PlannerParams& params) : params_(params) {
   }
 }
 
+namespace {
+
+// The nearest pose, heading kept, within `reach` [m] of `start` in one of 16 directions where the
+// footprint is free at any heading, every pose on the way there touching only cells the start's
+// footprint touches (checked each half cell).
+std::optional<Eigen::Vector3d> escape_pose(const Costmap& map, const Eigen::Vector3d& start, double reach) {
+  // Only a footprint whose rim covers an obstacle leaves: a centre in one is no place to stand.
+  if (!(reach > 0.0) || map.cost_at(start.head<2>()) >= Costmap::kLethal) return std::nullopt;
+  const std::vector<std::size_t> stuck = map.lethal_under(start);
+  const double step = 0.5 * map.resolution();
+  constexpr int kDirections = 16;
+  std::vector<bool> blocked(kDirections, false);
+  for (double d = step; d <= reach + 1e-9; d += step) {
+    for (int k = 0; k < kDirections; ++k) {
+      if (blocked[k]) continue;
+      const double a = 2.0 * std::numbers::pi * k / kDirections;
+      const Eigen::Vector3d pose(start.x() + d * std::cos(a), start.y() + d * std::sin(a), start.z());
+      if (map.in_collision(pose, stuck)) {
+        blocked[k] = true;  // it would touch something new on the way
+        continue;
+      }
+      // Free at any heading, so that the path may turn from there.
+      if (map.cost_at(pose.head<2>()) < map.possibly_colliding_cost() && !map.in_collision(pose)) return pose;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 PlanResult GlobalPlanner::plan(const Costmap& map, const Eigen::Vector3d& start,
                                const Eigen::Vector3d& goal) {
   const Clock::time_point t0 = Clock::now();
@@ -198,17 +230,32 @@ PlanResult GlobalPlanner::plan(const Costmap& map, const Eigen::Vector3d& start,
     result.total_time = seconds_since(t0);
     return result;
   };
-  const Eigen::Vector2i s = map.cell_of(start.head<2>());
   const Eigen::Vector2i g = map.cell_of(goal.head<2>());
-  if (!start.allFinite() || !map.inside(s.x(), s.y())) {
+  if (!start.allFinite() || !map.inside(map.cell_of(start.head<2>()).x(), map.cell_of(start.head<2>()).y())) {
     return fail(PlanStatus::kStartOutsideMap,
                 "start " + detail::pose_text(start) + " is outside the map");
   }
+  // A start the footprint check refuses (a task left the base near a wall: the footprint is the
+  // hull of the steering sweep and the transport posture): the path begins with the shortest
+  // straight move, heading kept, that frees the footprint without touching a cell it does not
+  // touch already.
+  Path escape;
+  Eigen::Vector3d from = start;
   if (map.in_collision(start)) {
-    return fail(
-        PlanStatus::kStartInCollision,
-        "start " + detail::pose_text(start) + ": the robot's footprint there covers an obstacle");
+    const std::optional<Eigen::Vector3d> free = escape_pose(map, start, params_.escape_distance);
+    if (!free) {
+      char b[96];
+      std::snprintf(b, sizeof b, "; no straight move of up to %.2f m frees it", params_.escape_distance);
+      return fail(PlanStatus::kStartInCollision,
+                  "start " + detail::pose_text(start) + ": the robot's footprint there covers an obstacle" + b);
+    }
+    from = *free;
+    const double distance = (from - start).head<2>().norm();
+    const int steps = std::max(1, static_cast<int>(std::ceil(distance / map.resolution())));
+    for (int k = 0; k < steps; ++k) escape.push_back(start + (from - start) * (static_cast<double>(k) / steps));
+    result.length += distance;
   }
+  const Eigen::Vector2i s = map.cell_of(from.head<2>());
   if (!goal.allFinite() || !map.inside(g.x(), g.y())) {
     return fail(PlanStatus::kGoalOutsideMap,
                 "goal " + detail::pose_text(goal) + " is outside the map");
@@ -223,7 +270,7 @@ PlanResult GlobalPlanner::plan(const Costmap& map, const Eigen::Vector3d& start,
         "goal " + detail::pose_text(goal) + ": the robot's footprint there covers an obstacle");
   }
 
-  const Traversability trav(map, params_, start.head<2>(), goal.head<2>());
+  const Traversability trav(map, params_, from.head<2>(), goal.head<2>());
   const std::size_t n =
       static_cast<std::size_t>(map.width()) * static_cast<std::size_t>(map.height());
   if (g_.size() != n) {
@@ -318,7 +365,7 @@ PlanResult GlobalPlanner::plan(const Costmap& map, const Eigen::Vector3d& start,
   }
   std::reverse(pts.begin(), pts.end());
   std::reverse(cost_to_come.begin(), cost_to_come.end());
-  pts.front() = start.head<2>();
+  pts.front() = from.head<2>();
   if (pts.size() == 1) {
     pts.push_back(goal.head<2>());
   } else {
@@ -328,13 +375,15 @@ PlanResult GlobalPlanner::plan(const Costmap& map, const Eigen::Vector3d& start,
   pts = resample(pts, map.resolution());
   if (params_.smooth) smooth(map, trav, params_, pts);
 
-  result.path.reserve(pts.size());
+  result.path.reserve(escape.size() + pts.size());
+  result.path = escape;
   for (std::size_t i = 0; i < pts.size(); ++i) {
     double heading = goal.z();
     if (i + 1 < pts.size()) {
       const Eigen::Vector2d d = pts[i + 1] - pts[i];
       if (d.squaredNorm() > 1e-12) heading = std::atan2(d.y(), d.x());
     }
+    if (i == 0 && !escape.empty()) heading = start.z();  // where the escape ends, as it began
     result.path.emplace_back(pts[i].x(), pts[i].y(), heading);
     if (i > 0) result.length += (pts[i] - pts[i - 1]).norm();
   }

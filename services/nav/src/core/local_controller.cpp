@@ -79,6 +79,7 @@ LocalController::LocalController(const ControllerParams& params) : params_(param
           "must be > 0 [rad]");
   require(params_.min_approach_speed > 0.0, "min_approach_speed", params_.min_approach_speed,
           "must be > 0 [m/s]");
+  require(params_.escape_speed > 0.0, "escape_speed", params_.escape_speed, "must be > 0 [m/s]");
   require(params_.approach_distance > 0.0, "approach_distance", params_.approach_distance,
           "must be > 0 [m]");
   require(params_.proximity_distance > 0.0, "proximity_distance", params_.proximity_distance,
@@ -100,11 +101,15 @@ void LocalController::set_path(const Path& path) {
   progress_ = 0;
   xy_latched_ = false;
   blocked_since_.reset();
+  escape_checked_ = false;
+  escape_cells_.clear();
 }
 
 void LocalController::reset() {
   path_.clear();
   progress_ = 0;
+  escape_checked_ = false;
+  escape_cells_.clear();
   xy_latched_ = false;
   blocked_since_.reset();
   last_stamp_.reset();
@@ -153,7 +158,7 @@ double LocalController::safe_scale(const Costmap& costmap, const Eigen::Vector3d
       std::min({1.0 / (2.0 * alpha) + tau_margin + params_.control_period, kMaxCheckTime, max_tau});
   for (double tau = params_.collision_check_step; tau <= horizon + 1e-9;
        tau += params_.collision_check_step) {
-    if (costmap.in_collision(integrate_twist(pose, cmd, tau))) {
+    if (costmap.in_collision(integrate_twist(pose, cmd, tau), escape_cells_)) {
       return std::min(1.0, std::sqrt(2.0 * alpha * std::max(0.0, tau - tau_margin)));
     }
   }
@@ -164,6 +169,30 @@ ControlOutput LocalController::stop(ControlOutput out) {
   out.cmd = {};
   last_cmd_ = {};
   blocked_since_.reset();
+  return out;
+}
+
+ControlOutput LocalController::escape(const Costmap& costmap, const Eigen::Vector3d& pose, double dt,
+                                      ControlOutput out) {
+  // Straight to the path's first pose with a free footprint, heading held (a turn or a sideways
+  // step would sweep the footprint over cells it does not cover now), slowly: the footprint is
+  // the hull of what the base may occupy, not where its body is.
+  std::size_t target = 0;
+  while (target + 1 < path_.size() &&
+         (costmap.cost_at(path_[target].head<2>()) >= costmap.possibly_colliding_cost() ||
+          costmap.in_collision(path_[target])))
+    ++target;
+  const Eigen::Vector2d d = path_[target].head<2>() - pose.head<2>();
+  const double distance = d.norm();
+  const double speed = std::min(params_.escape_speed, distance / params_.control_period);
+  const Eigen::Vector2d v = Eigen::Rotation2Dd(-pose.z()) * (distance > 1e-9 ? Eigen::Vector2d(d / distance) : d);
+  BaseTwist want;
+  want.vx = speed * v.x();
+  want.vy = params_.drive == ControllerParams::Drive::kOmni ? speed * v.y() : 0.0;
+  out.cmd = limit_acceleration(want, dt);
+  if (costmap.in_collision(integrate_twist(pose, out.cmd, params_.control_period), escape_cells_)) out.cmd = {};
+  last_cmd_ = out.cmd;
+  out.status = ControlStatus::kFollowing;
   return out;
 }
 
@@ -188,11 +217,22 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
     out.reason = "the robot pose " + detail::pose_text(pose) + " is not finite";
     return stop(out);
   }
-  if (costmap.in_collision(pose)) {
+  // A path that starts where the footprint covers an obstacle (the planner's escape move): the
+  // robot may leave touching only the cells it touched there, until its footprint is free.
+  if (progress_ == 0 && !escape_checked_) {
+    escape_checked_ = true;
+    escape_cells_ = costmap.lethal_under(pose);
+  }
+  // Escaping until the footprint is free at any heading (the path may turn from there).
+  if (!escape_cells_.empty() && costmap.cost_at(p) < costmap.possibly_colliding_cost() &&
+      !costmap.in_collision(pose))
+    escape_cells_.clear();
+  if (costmap.in_collision(pose, escape_cells_)) {
     out.status = ControlStatus::kFailed;
     out.reason = "the robot's footprint at " + detail::pose_text(pose) + " covers an obstacle";
     return stop(out);
   }
+  if (!escape_cells_.empty()) return escape(costmap, pose, dt, out);
 
   // Progress: the nearest path pose within a stretch ahead of the last one.
   {

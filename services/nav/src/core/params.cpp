@@ -36,6 +36,7 @@ NavParams read_params(config::Document& doc) {
   planner.number("cost_penalty", p.planner.cost_penalty, Range::non_negative());
   planner.number("max_planning_time", p.planner.max_planning_time, Range::positive());
   planner.boolean("smooth", p.planner.smooth);
+  planner.number("escape_distance", p.planner.escape_distance, Range::non_negative());
 
   config::Map controller = root.section("controller");
   controller.number("lookahead_time", p.controller.lookahead_time, Range::positive());
@@ -45,6 +46,7 @@ NavParams read_params(config::Document& doc) {
   controller.number("yaw_goal_tolerance", p.controller.yaw_goal_tolerance, Range::positive());
   controller.number("approach_distance", p.controller.approach_distance, Range::non_negative());
   controller.number("min_approach_speed", p.controller.min_approach_speed, Range::positive());
+  controller.number("escape_speed", p.controller.escape_speed, Range::positive());
   controller.number("heading_gain", p.controller.heading_gain, Range::positive());
   controller.number("stop_margin", p.controller.stop_margin, Range::non_negative());
   controller.number("blocked_timeout", p.controller.blocked_timeout, Range::positive());
