@@ -16,7 +16,7 @@ FUZZ_CMAKE_ARGS ?=
 export CCACHE_BASEDIR ?= $(CURDIR)
 export CCACHE_NOHASHDIR ?= 1
 
-.PHONY: all deps configure build test demo bench chaos fuzz fuzz-configure fuzz-smoke idl-lock clean help
+.PHONY: all deps configure build test demo bench chaos shift fuzz fuzz-configure fuzz-smoke idl-lock clean help
 
 all: build
 
@@ -25,6 +25,7 @@ help:
 	@echo "make test   install what is missing, build, run every test with ctest"
 	@echo "make bench  build and run the benchmarks (BENCHES=\"bench_x ...\": some); figures go to docs/benchmarks.md"
 	@echo "make chaos  the chaos test: SIGKILL every service of concert up under a task"
+	@echo "make shift  a crew's shift on one stack (SHIFT_ARGS=\"--rounds 3 --load 2\")"
 	@echo "make fuzz   clang build of the fuzz targets, each run FUZZ_SECONDS (default 60)"
 	@echo "make fuzz-smoke  CI's short fuzz run (5 s a target, fixed seed, fuzz_cli left out)"
 	@echo "make idl-lock  rewrite idl/types.lock after changing a message type"
@@ -55,6 +56,13 @@ bench: build
 CHAOS_DOMAIN ?= 231
 chaos: build
 	CONCERT_DOMAIN_ID=$(CHAOS_DOMAIN) $(BUILD_DIR)/tests/system/system_chaos_test
+
+# A crew's shift on one simulated stack (tests/system/README.md, bench_shift): drilling, hot
+# swaps, sanding, spraying, round after round. SHIFT_ARGS: e.g. --rounds 3 --load 2 --seed 7.
+SHIFT_ARGS ?=
+SHIFT_DOMAIN ?= 44
+shift: build
+	CONCERT_DOMAIN_ID=$(SHIFT_DOMAIN) $(BUILD_DIR)/tests/system/bench_shift $(SHIFT_ARGS)
 
 # The fuzzing build: clang-16 with libFuzzer, ASan and UBSan, assertions on, -O1; only the fuzz
 # targets and what they link are built. Warnings are not errors there (clang warns where gcc,
