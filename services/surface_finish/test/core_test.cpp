@@ -384,6 +384,52 @@ SprayDeposition deposit(const SerpentinePlan& plan, const WallFrame& wall, doubl
   return dep;
 }
 
+// The measured postures are followed along the plan by the arm's joints alone: after nav drove
+// the base, the wheels stand at tens of radians and the steering elsewhere than in the plan's
+// seed postures. Every measured posture of the executed plan is tracked to its own sample, and
+// the strokes (tool on) are reached; over all joints the tracker stayed at the first sample and
+// a spray run in a shift painted nothing (0 % coverage).
+TEST(Serpentine, TheMeasuredPostureIsTrackedByTheArmsJointsWhereverTheBaseWasDriven) {
+  Reach reach(spraying_project(), model::EndEffectorKind::kSpraying);
+  const AreaMap& m = areas_of(reach, Task::kSpray, 0.3);
+  const WallFrame wall = wall_of(reach, m);
+  const Area& c = m.area("centre");
+  const auto first = serpentine_strokes(c.rect, spray_tool()).front();
+  Eigen::VectorXd driven = reach.neutral();
+  std::vector<bool> is_arm(static_cast<std::size_t>(driven.size()), false);
+  for (const int j : reach.arm_joints()) is_arm[static_cast<std::size_t>(j)] = true;
+  for (Eigen::Index j = 0; j < driven.size(); ++j) {
+    if (!is_arm[static_cast<std::size_t>(j)]) driven[j] = 40.0 + 0.5 * static_cast<double>(j);  // legs: where nav left them
+  }
+  const SerpentinePlan plan = plan_serpentine(reach, wall, c.rect, spray_tool(), m.roll, PathParams{}, driven,
+                                              &m.posture_near(first.x, first.y_start));
+  std::size_t at = 0, on = 0;
+  for (std::size_t i = 0; i < plan.samples.size(); ++i) {
+    Eigen::VectorXd measured = driven;  // the legs hold; the arm is at sample i
+    for (const int j : reach.arm_joints()) measured[j] = plan.samples[i].q[j];
+    at = track_sample(plan, reach.arm_joints(), at, measured);
+    // At sample i, or at an earlier one with the same arm posture (a stroke's end held).
+    double off = 0.0;
+    for (const int j : reach.arm_joints()) off += std::abs(plan.samples[at].q[j] - measured[j]);
+    EXPECT_LE(at, i);
+    EXPECT_LT(off, 1e-12) << "sample " << i << " tracked to " << at;
+    on += plan.samples[at].tool_on ? 1 : 0;
+  }
+  EXPECT_GT(on, plan.samples.size() / 3);
+  // Over every joint, as before: the plan's later samples have the legs where the seed postures
+  // have them, so the measured legs hold the tracker back before the strokes.
+  std::vector<int> every(static_cast<std::size_t>(driven.size()));
+  for (std::size_t j = 0; j < every.size(); ++j) every[j] = static_cast<int>(j);
+  std::size_t stuck = 0;
+  for (std::size_t i = 0; i < plan.samples.size(); ++i) {
+    Eigen::VectorXd measured = driven;
+    for (const int j : reach.arm_joints()) measured[j] = plan.samples[i].q[j];
+    stuck = track_sample(plan, every, stuck, measured);
+  }
+  std::printf("tracked over every joint: sample %zu of %zu\n", stuck, plan.samples.size());
+  EXPECT_LT(stuck, plan.samples.size() / 2);
+}
+
 TEST(Deposition, PlannedPathCoversTheRectangleWithCoatsOfTheToolsWidth) {
   Reach reach(spraying_project(), model::EndEffectorKind::kSpraying);
   const AreaMap& m = areas_of(reach, Task::kSpray, 0.3);

@@ -84,6 +84,13 @@ struct SerpentinePlan {
 /// valve follows the measured position, not the clock.
 bool valve_open(const Stroke& stroke, const Eigen::Vector3d& tcp_wall);
 
+/// The plan sample a measured posture `q` is at, tracked forwards from sample `from`: the nearest
+/// of the next `window` samples (and `from` itself) over the arm's joints `arm` alone. The legs'
+/// steering and wheel joints stand where the base was driven, which the plan's seed postures do
+/// not know.
+std::size_t track_sample(const SerpentinePlan& plan, const std::vector<int>& arm, std::size_t from,
+                         const Eigen::VectorXd& q, std::size_t window = 40);
+
 /// Number of strokes covering `width` [m] with coats `coat_width` wide overlapping by
 /// `overlap` (a fraction): 1 when width <= coat_width, else ceil((width - coat) / (coat (1 -
 /// overlap))) + 1. Throws FinishError for non-positive sizes or overlap outside [0, 0.9].

@@ -57,6 +57,28 @@ bool valve_open(const Stroke& stroke, const Eigen::Vector3d& tcp_wall) {
   return progress >= 0.0 && progress <= std::abs(stroke.y_end - stroke.y_start);
 }
 
+std::size_t track_sample(const SerpentinePlan& plan, const std::vector<int>& arm, std::size_t from,
+                         const Eigen::VectorXd& q, std::size_t window) {
+  const auto& samples = plan.samples;
+  if (samples.empty()) return 0;
+  from = std::min(from, samples.size() - 1);
+  const auto distance = [&](const Eigen::VectorXd& a) {
+    double d = 0.0;
+    for (const int j : arm) d += (a[j] - q[j]) * (a[j] - q[j]);
+    return d;
+  };
+  std::size_t best = from;
+  double best_d = distance(samples[from].q);
+  for (std::size_t i = from + 1; i < samples.size() && i <= from + window; ++i) {
+    const double d = distance(samples[i].q);
+    if (d < best_d) {
+      best_d = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
 int stroke_count(double width, double coat_width, double overlap) {
   if (!(width > 0.0) || !(coat_width > 0.0)) {
     throw FinishError("stroke count: width " + std::to_string(width) + " m and coat width " +

@@ -552,24 +552,19 @@ void FinishNode::follow_run() {
   const auto& samples = run.plan.samples;
   for (const Measured& m : measured) {
     const Eigen::VectorXd q = q_of(m);
-    std::size_t best = run.index;
-    double best_d = (samples[run.index].q - q).squaredNorm();
-    for (std::size_t i = run.index + 1; i < samples.size() && i <= run.index + 40; ++i) {
-      const double dist = (samples[i].q - q).squaredNorm();
-      if (dist < best_d) {
-        best_d = dist;
-        best = i;
-      }
-    }
+    const std::size_t best = track_sample(run.plan, run.reach->arm_joints(), run.index, q);
     run.index = best;
     const double dt = run.last_stamp > 0 ? static_cast<double>(m.stamp_ns - run.last_stamp) * 1e-9 : 0.0;
     run.last_stamp = m.stamp_ns;
     const std::size_t next = std::min(best + 1, samples.size() - 1);
     const PathSample& s = samples[next];
+    ++run.postures;
     if (!s.tool_on || dt <= 0.0 || dt > 0.1) continue;
+    ++run.tool_on;
     const Eigen::Isometry3d tcp = current_.reach->tcp_pose(q);
     if (valve_open(run.plan.strokes[static_cast<std::size_t>(s.stroke)], run.wall.coordinates(tcp.translation()))) {
       run.deposition->add(tcp, dt, s.stroke);
+      ++run.painted;
     }
   }
   if (ts) run.progress = ts->progress();
@@ -640,10 +635,12 @@ void FinishNode::end_run(msg::FinishState state, const std::string& reason) {
       log_line(std::string("surface_finish: cannot write the report: ") + e.what());
     }
   }
-  char b[200];
-  std::snprintf(b, sizeof b, "request %u: %s: coverage %.2f %%, max |dh| %.1f mm, max coat width error %.1f mm",
+  char b[300];
+  std::snprintf(b, sizeof b,
+                "request %u: %s: coverage %.2f %%, max |dh| %.1f mm, max coat width error %.1f mm (%zu measured "
+                "postures, %zu at a stroke, %zu painted)",
                 run.request_id, state == msg::FINISH_SUCCEEDED ? "done" : "stopped", rep.coverage * 100.0,
-                rep.max_abs_delta_h * 1e3, rep.max_width_error * 1e3);
+                rep.max_abs_delta_h * 1e3, rep.max_width_error * 1e3, run.postures, run.tool_on, run.painted);
   log_line(std::string("surface_finish: ") + b + (reason.empty() ? "" : " (" + reason + ")"));
   if (state == msg::FINISH_SUCCEEDED) run.progress = 1.0;
   publish(run.request_id, state, reason, &run, json);

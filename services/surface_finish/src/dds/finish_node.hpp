@@ -83,6 +83,9 @@ class FinishNode {
     std::unique_ptr<SprayDeposition> deposition;
     std::size_t index{0};          // plan sample the measured posture is at
     std::int64_t last_stamp{0};
+    // Measured postures followed, those at a plan sample with the tool on, and those the valve
+    // let paint (the report says so when the coverage is low).
+    std::size_t postures{0}, tool_on{0}, painted{0};
     double progress{0.0};
     double wall_distance{0.0};
     std::chrono::steady_clock::time_point sent{};
