@@ -119,14 +119,14 @@ class Costmap {
   /// True when the footprint at `pose` covers a lethal (or, when unknown is lethal, unknown)
   /// cell, or leaves the map.
   [[nodiscard]] bool in_collision(const Eigen::Vector3d& pose) const;
-  /// The lethal (or, when unknown is lethal, unknown) cells the footprint at `pose` covers, as
-  /// sorted map indices (index()); empty when it covers none.
-  [[nodiscard]] std::vector<std::size_t> lethal_under(const Eigen::Vector3d& pose) const;
-  /// in_collision(), except that the cells of `allowed` (sorted, from lethal_under()) do not
-  /// count: a base whose footprint the check refuses where it stands (the footprint is the
-  /// hull of the steering legs' sweep and the transport posture, larger than the robot at work)
-  /// may leave without touching anything new.
-  [[nodiscard]] bool in_collision(const Eigen::Vector3d& pose, const std::vector<std::size_t>& allowed) const;
+  /// How deep the lethal (or, when unknown is lethal, unknown) cells the footprint at `pose`
+  /// covers lie inside it: the largest distance from such a cell's centre to the footprint's
+  /// boundary [m]; 0 when it covers none (or only cells whose centres lie outside it); infinity
+  /// when the footprint leaves the map. A base whose footprint the check refuses where it stands
+  /// (the footprint is the hull of the steering sweep and the transport posture, larger than the
+  /// robot at work) may leave as long as this does not grow: it goes no deeper into anything,
+  /// whichever cells the lidars mark along the same wall.
+  [[nodiscard]] double lethal_depth(const Eigen::Vector3d& pose) const;
 
   /// Marks the obstacle layer from beams cast from `sensor_origin` (map frame [m]): every beam
   /// clears the cells it crosses up to its end (or raytrace_max_range), and a hit within

@@ -142,9 +142,9 @@ class LocalController {
   ControllerParams params_;
   Path path_;
   std::size_t progress_{0};  // index of the path pose nearest the robot
-  // The lethal cells the footprint covered where the path started (sorted map indices): they do
-  // not count as collisions until the footprint is free of lethal cells.
-  std::vector<std::size_t> escape_cells_;
+  // Where the path started with the footprint over an obstacle: how deep it may go into one
+  // (Costmap::lethal_depth) until the footprint is free at any heading.
+  std::optional<double> escape_depth_;
   bool escape_checked_{false};
   bool xy_latched_{false};
   std::optional<double> last_stamp_;

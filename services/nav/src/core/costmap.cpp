@@ -310,25 +310,31 @@ bool Costmap::in_collision(const Eigen::Vector3d& pose) const {
   return !inside_map || hit;
 }
 
-std::vector<std::size_t> Costmap::lethal_under(const Eigen::Vector3d& pose) const {
-  std::vector<std::size_t> cells;
-  (void)visit_footprint(*this, shape_.footprint, pose, [&](int c, int r) {
-    if (cost(c, r) == kLethal) cells.push_back(index(c, r));
+double Costmap::lethal_depth(const Eigen::Vector3d& pose) const {
+  const FootprintPolygon& fp = shape_.footprint;
+  const Eigen::Rotation2Dd to_base(-pose.z());
+  double area = 0.0;  // twice the signed area: > 0 for a counter-clockwise polygon
+  for (std::size_t i = 0; i < fp.size(); ++i) {
+    const Eigen::Vector2d& a = fp[i];
+    const Eigen::Vector2d& b = fp[(i + 1) % fp.size()];
+    area += a.x() * b.y() - a.y() * b.x();
+  }
+  const double turn = area >= 0.0 ? 1.0 : -1.0;
+  double depth = 0.0;
+  const bool inside_map = visit_footprint(*this, fp, pose, [&](int c, int r) {
+    if (cost(c, r) != kLethal) return true;
+    const Eigen::Vector2d p = to_base * (center_of(c, r) - pose.head<2>());
+    double inside = std::numeric_limits<double>::infinity();  // to the nearest edge; < 0: outside
+    for (std::size_t i = 0; i < fp.size(); ++i) {
+      const Eigen::Vector2d& e0 = fp[i];
+      const Eigen::Vector2d e = fp[(i + 1) % fp.size()] - e0;
+      const Eigen::Vector2d d = p - e0;
+      inside = std::min(inside, turn * (e.x() * d.y() - e.y() * d.x()) / e.norm());
+    }
+    depth = std::max(depth, inside);
     return true;
   });
-  std::sort(cells.begin(), cells.end());
-  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
-  return cells;
-}
-
-bool Costmap::in_collision(const Eigen::Vector3d& pose, const std::vector<std::size_t>& allowed) const {
-  if (allowed.empty()) return in_collision(pose);
-  bool hit = false;
-  const bool inside_map = visit_footprint(*this, shape_.footprint, pose, [&](int c, int r) {
-    hit = cost(c, r) == kLethal && !std::binary_search(allowed.begin(), allowed.end(), index(c, r));
-    return !hit;
-  });
-  return !inside_map || hit;
+  return inside_map ? depth : std::numeric_limits<double>::infinity();
 }
 
 void Costmap::touch(CostmapUpdate& up, int col, int row) const {

@@ -193,12 +193,13 @@ GlobalPlanner::GlobalPlanner(const PlannerParams& params) : params_(params) {
 namespace {
 
 // The nearest pose, heading kept, within `reach` [m] of `start` in one of 16 directions where the
-// footprint is free at any heading, every pose on the way there touching only cells the start's
-// footprint touches (checked each half cell).
+// footprint is free at any heading, every pose on the way there (checked each half cell) going
+// no deeper into an obstacle than the start does, give or take a cell (the pose estimate and the
+// lidars' marks jitter by that much).
 std::optional<Eigen::Vector3d> escape_pose(const Costmap& map, const Eigen::Vector3d& start, double reach) {
   // Only a footprint whose rim covers an obstacle leaves: a centre in one is no place to stand.
   if (!(reach > 0.0) || map.cost_at(start.head<2>()) >= Costmap::kLethal) return std::nullopt;
-  const std::vector<std::size_t> stuck = map.lethal_under(start);
+  const double allowed = map.lethal_depth(start) + map.resolution();
   const double step = 0.5 * map.resolution();
   constexpr int kDirections = 16;
   std::vector<bool> blocked(kDirections, false);
@@ -207,8 +208,8 @@ std::optional<Eigen::Vector3d> escape_pose(const Costmap& map, const Eigen::Vect
       if (blocked[k]) continue;
       const double a = 2.0 * std::numbers::pi * k / kDirections;
       const Eigen::Vector3d pose(start.x() + d * std::cos(a), start.y() + d * std::sin(a), start.z());
-      if (map.in_collision(pose, stuck)) {
-        blocked[k] = true;  // it would touch something new on the way
+      if (map.lethal_depth(pose) > allowed) {
+        blocked[k] = true;  // it would go deeper on the way
         continue;
       }
       // Free at any heading, so that the path may turn from there.

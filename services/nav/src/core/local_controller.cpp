@@ -102,14 +102,14 @@ void LocalController::set_path(const Path& path) {
   xy_latched_ = false;
   blocked_since_.reset();
   escape_checked_ = false;
-  escape_cells_.clear();
+  escape_depth_.reset();
 }
 
 void LocalController::reset() {
   path_.clear();
   progress_ = 0;
   escape_checked_ = false;
-  escape_cells_.clear();
+  escape_depth_.reset();
   xy_latched_ = false;
   blocked_since_.reset();
   last_stamp_.reset();
@@ -158,7 +158,8 @@ double LocalController::safe_scale(const Costmap& costmap, const Eigen::Vector3d
       std::min({1.0 / (2.0 * alpha) + tau_margin + params_.control_period, kMaxCheckTime, max_tau});
   for (double tau = params_.collision_check_step; tau <= horizon + 1e-9;
        tau += params_.collision_check_step) {
-    if (costmap.in_collision(integrate_twist(pose, cmd, tau), escape_cells_)) {
+    const Eigen::Vector3d ahead = integrate_twist(pose, cmd, tau);
+    if (escape_depth_ ? costmap.lethal_depth(ahead) > *escape_depth_ : costmap.in_collision(ahead)) {
       return std::min(1.0, std::sqrt(2.0 * alpha * std::max(0.0, tau - tau_margin)));
     }
   }
@@ -190,7 +191,7 @@ ControlOutput LocalController::escape(const Costmap& costmap, const Eigen::Vecto
   want.vx = speed * v.x();
   want.vy = params_.drive == ControllerParams::Drive::kOmni ? speed * v.y() : 0.0;
   out.cmd = limit_acceleration(want, dt);
-  if (costmap.in_collision(integrate_twist(pose, out.cmd, params_.control_period), escape_cells_)) out.cmd = {};
+  if (costmap.lethal_depth(integrate_twist(pose, out.cmd, params_.control_period)) > *escape_depth_) out.cmd = {};
   last_cmd_ = out.cmd;
   out.status = ControlStatus::kFollowing;
   return out;
@@ -221,18 +222,28 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
   // robot may leave touching only the cells it touched there, until its footprint is free.
   if (progress_ == 0 && !escape_checked_) {
     escape_checked_ = true;
-    escape_cells_ = costmap.lethal_under(pose);
+    if (costmap.in_collision(pose)) {
+      // A cell of slack: the pose estimate and the lidars' marks jitter by that much.
+      escape_depth_ = costmap.lethal_depth(pose) + costmap.resolution();
+    }
   }
   // Escaping until the footprint is free at any heading (the path may turn from there).
-  if (!escape_cells_.empty() && costmap.cost_at(p) < costmap.possibly_colliding_cost() &&
-      !costmap.in_collision(pose))
-    escape_cells_.clear();
-  if (costmap.in_collision(pose, escape_cells_)) {
+  if (escape_depth_ && costmap.cost_at(p) < costmap.possibly_colliding_cost() && !costmap.in_collision(pose))
+    escape_depth_.reset();
+  if (escape_depth_ ? costmap.lethal_depth(pose) > *escape_depth_ : costmap.in_collision(pose)) {
     out.status = ControlStatus::kFailed;
-    out.reason = "the robot's footprint at " + detail::pose_text(pose) + " covers an obstacle";
+    char b[160];
+    std::snprintf(b, sizeof b, "the robot's footprint at %s covers an obstacle",
+                  detail::pose_text(pose).c_str());
+    out.reason = b;
+    if (escape_depth_) {
+      std::snprintf(b, sizeof b, " %.2f m deep, more than where it started leaving it (%.2f m)",
+                    costmap.lethal_depth(pose), *escape_depth_ - costmap.resolution());
+      out.reason += b;
+    }
     return stop(out);
   }
-  if (!escape_cells_.empty()) return escape(costmap, pose, dt, out);
+  if (escape_depth_) return escape(costmap, pose, dt, out);
 
   // Progress: the nearest path pose within a stretch ahead of the last one.
   {
