@@ -134,6 +134,17 @@ TEST(GlobalPlanner, LeavesAStartWhoseFootprintCoversAWall) {
   }
   EXPECT_TRUE(reached);
 
+  // Along a path (not at its start) a pose over the wall is blocked, not failed: the navigator
+  // plans again from there, and the plan leaves it.
+  const PlanResult along = planner.plan(map, {3.0, 5.0, 0.0}, goal);
+  ASSERT_TRUE(along.ok()) << along.message;
+  LocalController following;
+  following.set_path(along.path);
+  ASSERT_EQ(following.compute(map, {3.0, 5.0, 0.0}, 0.0).status, ControlStatus::kFollowing);
+  const ControlOutput over = following.compute(map, start, 0.05);
+  EXPECT_EQ(over.status, ControlStatus::kBlocked);
+  EXPECT_THAT(over.reason, HasSubstr("covers an obstacle"));
+
   PlannerParams stay;
   stay.escape_distance = 0.0;
   GlobalPlanner refusing(stay);

@@ -231,7 +231,9 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
   if (escape_depth_ && costmap.cost_at(p) < costmap.possibly_colliding_cost() && !costmap.in_collision(pose))
     escape_depth_.reset();
   if (escape_depth_ ? costmap.lethal_depth(pose) > *escape_depth_ : costmap.in_collision(pose)) {
-    out.status = ControlStatus::kFailed;
+    // Along the path (the pose estimate corrected, a wall marked anew): blocked, so that the
+    // navigator plans again from here, leaving it; going deeper while leaving fails.
+    out.status = escape_depth_ ? ControlStatus::kFailed : ControlStatus::kBlocked;
     char b[160];
     std::snprintf(b, sizeof b, "the robot's footprint at %s covers an obstacle",
                   detail::pose_text(pose).c_str());
