@@ -17,6 +17,14 @@ std::vector<std::string> split(std::string_view text, char separator) {
   return out;
 }
 
+std::optional<std::size_t> yaml_control_character_at(std::string_view text) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f) return i;
+  }
+  return std::nullopt;
+}
+
 // Hand-written: neither the standard library nor a library every part links checks UTF-8
 // (nlohmann::json only while serialising, by throwing).
 std::optional<std::size_t> invalid_utf8_at(std::string_view text) {

@@ -49,6 +49,11 @@ TEST(Text, InvalidUtf8At) {
   EXPECT_EQ(invalid_utf8_at("\xc0\xaf"), 0u);                    // overlong '/'
   EXPECT_EQ(invalid_utf8_at("\xed\xa0\x80"), 0u);                // surrogate U+D800
   EXPECT_EQ(invalid_utf8_at("\xf4\x90\x80\x80"), 0u);            // above U+10FFFF
+  // YAML's printable set: tab, LF and CR pass; NUL, other C0 controls and DEL do not.
+  EXPECT_EQ(yaml_control_character_at("a: b\tc\r\nd: \"\xc3\xa9\"\n"), std::nullopt);
+  EXPECT_EQ(yaml_control_character_at(std::string("drill@mani\0_pc: x", 18)), 10u);
+  EXPECT_EQ(yaml_control_character_at("x\x1b[0m"), 1u);
+  EXPECT_EQ(yaml_control_character_at("ab\x7f"), 2u);
   EXPECT_EQ(invalid_utf8_at("\xff"), 0u);
 }
 

@@ -87,6 +87,10 @@ LatchedState parse_latched_state(const std::string& yaml, const std::string& ori
   if (const auto at = invalid_utf8_at(yaml)) {
     throw config::ConfigError(origin + ": not valid UTF-8 (byte " + std::to_string(*at) + ")");
   }
+  if (const auto at = yaml_control_character_at(yaml)) {
+    throw config::ConfigError(origin + ": a control character YAML does not allow (byte " + std::to_string(*at) +
+                              ")");
+  }
   return config::Document::parse(yaml, origin).read_with(read_state);
 }
 

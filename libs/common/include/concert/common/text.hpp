@@ -33,6 +33,11 @@ std::vector<std::string> split(std::string_view text, char separator = ',');
 /// U+10FFFF); nullopt for valid UTF-8.
 std::optional<std::size_t> invalid_utf8_at(std::string_view text);
 
+/// Index of the first control character of `text` that YAML does not allow in a document (its
+/// c-printable set: every C0 control but tab, line feed and carriage return, and DEL); nullopt
+/// when there is none. A NUL in a key reads into a name that yaml-cpp writes back unreadable.
+std::optional<std::size_t> yaml_control_character_at(std::string_view text);
+
 /// The whole content of `file`. Throws std::runtime_error "`what` file 'FILE' cannot be opened"
 /// when it cannot be read (`what` e.g. "parameters", "world").
 std::string read_file(const std::filesystem::path& file, std::string_view what = "the");
