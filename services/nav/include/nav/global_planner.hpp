@@ -25,7 +25,7 @@ struct PlannerParams {
   bool allow_unknown{false};
   /// Expansion budget of the A* search (0: unlimited).
   int max_expansions{2'000'000};
-  /// Planning time budget [s] (<= 0: unlimited).
+  /// Planning time budget [s of the planning thread's CPU time] (<= 0: unlimited).
   double max_planning_time{2.0};
   /// A start whose footprint covers an obstacle (a task left the base near a wall) is left by
   /// a straight move of up to this much, heading kept, that touches nothing new [m]; 0: refused.
