@@ -185,7 +185,6 @@ class Watch {
                     const model::ModelDescription d = model::dds::to_description(m);
                     continuous_.clear();
                     for (const auto& j : d.joints) continuous_[j.name] = j.continuous_torque;
-                    version_ = m.version();
                   } catch (const std::exception&) {
                   }
                 }),
@@ -242,7 +241,6 @@ class Watch {
   std::vector<std::string> stops_;
   bool stopped_{false}, heard_safety_{false};
   std::map<std::string, double> continuous_;
-  std::uint32_t version_{0};
   double last_t_{0.0};
   std::map<std::string, model::ThermalLoad> loads_;
   std::map<std::string, double> peak_;
@@ -414,7 +412,6 @@ int bench(int rounds, int load, unsigned seed) {
 
   for (int round = 0; round < rounds; ++round) {
     std::cout << "round " << round + 1 << " of " << rounds << std::endl;
-    const std::string n = std::to_string(round + 1);
     run_leg("drill A (" + site.a[round].name + ")", [&] { return drill(site.a[round]); });
     run_leg("swap: sanding", [&] { return swap("sanding_robot.yaml"); });
     run_leg("nav: plaster panel", [&] { return go(site.sand_stand); });

@@ -127,6 +127,12 @@ class Costmap {
   /// robot at work) may leave as long as this does not grow: it goes no deeper into anything,
   /// whichever cells the lidars mark along the same wall.
   [[nodiscard]] double lethal_depth(const Eigen::Vector3d& pose) const;
+  /// How deep a base leaving `start` may go (lethal_depth() there and a cell of slack: the pose
+  /// estimate and the lidars' marks along a wall jitter by that much) [m].
+  [[nodiscard]] double leaving_depth(const Eigen::Vector3d& start) const { return lethal_depth(start) + resolution_; }
+  /// Whether the footprint centred at `p` is free at any heading (its centre cost below
+  /// possibly_colliding_cost()): a path may turn there.
+  [[nodiscard]] bool free_at_any_heading(const Eigen::Vector2d& p) const { return cost_at(p) < possibly_colliding_; }
 
   /// Marks the obstacle layer from beams cast from `sensor_origin` (map frame [m]): every beam
   /// clears the cells it crosses up to its end (or raytrace_max_range), and a hit within

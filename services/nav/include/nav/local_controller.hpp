@@ -143,7 +143,7 @@ class LocalController {
   Path path_;
   std::size_t progress_{0};  // index of the path pose nearest the robot
   // Where the path started with the footprint over an obstacle: how deep it may go into one
-  // (Costmap::lethal_depth) until the footprint is free at any heading.
+  // (Costmap::leaving_depth) until the footprint is free at any heading.
   std::optional<double> escape_depth_;
   bool escape_checked_{false};
   bool xy_latched_{false};

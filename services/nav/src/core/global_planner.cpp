@@ -195,12 +195,11 @@ namespace {
 
 // The nearest pose, heading kept, within `reach` [m] of `start` in one of 16 directions where the
 // footprint is free at any heading, every pose on the way there (checked each half cell) going
-// no deeper into an obstacle than the start does, give or take a cell (the pose estimate and the
-// lidars' marks jitter by that much).
+// no deeper into an obstacle than Costmap::leaving_depth allows.
 std::optional<Eigen::Vector3d> escape_pose(const Costmap& map, const Eigen::Vector3d& start, double reach) {
   // Only a footprint whose rim covers an obstacle leaves: a centre in one is no place to stand.
   if (!(reach > 0.0) || map.cost_at(start.head<2>()) >= Costmap::kLethal) return std::nullopt;
-  const double allowed = map.lethal_depth(start) + map.resolution();
+  const double allowed = map.leaving_depth(start);
   const double step = 0.5 * map.resolution();
   constexpr int kDirections = 16;
   std::vector<bool> blocked(kDirections, false);
@@ -213,8 +212,7 @@ std::optional<Eigen::Vector3d> escape_pose(const Costmap& map, const Eigen::Vect
         blocked[k] = true;  // it would go deeper on the way
         continue;
       }
-      // Free at any heading, so that the path may turn from there.
-      if (map.cost_at(pose.head<2>()) < map.possibly_colliding_cost() && !map.in_collision(pose)) return pose;
+      if (map.free_at_any_heading(pose.head<2>())) return pose;  // the path may turn from there
     }
   }
   return std::nullopt;

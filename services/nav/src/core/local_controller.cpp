@@ -175,14 +175,11 @@ ControlOutput LocalController::stop(ControlOutput out) {
 
 ControlOutput LocalController::escape(const Costmap& costmap, const Eigen::Vector3d& pose, double dt,
                                       ControlOutput out) {
-  // Straight to the path's first pose with a free footprint, heading held (a turn or a sideways
-  // step would sweep the footprint over cells it does not cover now), slowly: the footprint is
-  // the hull of what the base may occupy, not where its body is.
+  // Straight to the path's first pose free at any heading, heading held (a turn would sweep the
+  // footprint deeper into what it covers), slowly: the footprint is the hull of what the base may
+  // occupy, not where its body is.
   std::size_t target = 0;
-  while (target + 1 < path_.size() &&
-         (costmap.cost_at(path_[target].head<2>()) >= costmap.possibly_colliding_cost() ||
-          costmap.in_collision(path_[target])))
-    ++target;
+  while (target + 1 < path_.size() && !costmap.free_at_any_heading(path_[target].head<2>())) ++target;
   const Eigen::Vector2d d = path_[target].head<2>() - pose.head<2>();
   const double distance = d.norm();
   const double speed = std::min(params_.escape_speed, distance / params_.control_period);
@@ -219,17 +216,12 @@ ControlOutput LocalController::compute(const Costmap& costmap, const Eigen::Vect
     return stop(out);
   }
   // A path that starts where the footprint covers an obstacle (the planner's escape move): the
-  // robot may leave touching only the cells it touched there, until its footprint is free.
+  // robot leaves going no deeper into it, until its footprint is free at any heading.
   if (progress_ == 0 && !escape_checked_) {
     escape_checked_ = true;
-    if (costmap.in_collision(pose)) {
-      // A cell of slack: the pose estimate and the lidars' marks jitter by that much.
-      escape_depth_ = costmap.lethal_depth(pose) + costmap.resolution();
-    }
+    if (costmap.in_collision(pose)) escape_depth_ = costmap.leaving_depth(pose);
   }
-  // Escaping until the footprint is free at any heading (the path may turn from there).
-  if (escape_depth_ && costmap.cost_at(p) < costmap.possibly_colliding_cost() && !costmap.in_collision(pose))
-    escape_depth_.reset();
+  if (escape_depth_ && costmap.free_at_any_heading(p)) escape_depth_.reset();
   if (escape_depth_ ? costmap.lethal_depth(pose) > *escape_depth_ : costmap.in_collision(pose)) {
     // Along the path (the pose estimate corrected, a wall marked anew): blocked, so that the
     // navigator plans again from here, leaving it; going deeper while leaving fails.
