@@ -20,11 +20,15 @@ Eigen::Isometry3d to_eigen(const urdf::Pose& p) {
   return t;
 }
 
-// SRDF <disable_collisions link1 link2>: the only SRDF content not already in the description,
-// so a small tinyxml2 read instead of a full SRDF model.
-std::vector<std::pair<std::string, std::string>> srdf_disabled_pairs(const std::string& srdf,
-                                                                     const std::string& where) {
-  std::vector<std::pair<std::string, std::string>> out;
+// What the model uses of the SRDF besides the description's lists: <disable_collisions> pairs
+// and the `home` group state. A small tinyxml2 read instead of a full SRDF model.
+struct SrdfContent {
+  std::vector<std::pair<std::string, std::string>> disabled;
+  std::map<std::string, double> home;
+};
+
+SrdfContent read_srdf(const std::string& srdf, const std::string& where) {
+  SrdfContent out;
   if (srdf.empty()) return out;
   tinyxml2::XMLDocument doc;
   if (doc.Parse(srdf.c_str()) != tinyxml2::XML_SUCCESS) {
@@ -38,7 +42,24 @@ std::vector<std::pair<std::string, std::string>> srdf_disabled_pairs(const std::
     const char* b = e->Attribute("link2");
     if (a == nullptr || b == nullptr)
       throw ModelError(where + ": SRDF: <disable_collisions> without link1/link2");
-    out.emplace_back(a, b);
+    out.disabled.emplace_back(a, b);
+  }
+  for (const tinyxml2::XMLElement* gs = robot->FirstChildElement("group_state"); gs != nullptr;
+       gs = gs->NextSiblingElement("group_state")) {
+    const char* name = gs->Attribute("name");
+    if (name == nullptr || std::string_view(name) != "home") continue;
+    for (const tinyxml2::XMLElement* j = gs->FirstChildElement("joint"); j != nullptr;
+         j = j->NextSiblingElement("joint")) {
+      const char* joint = j->Attribute("name");
+      double value = 0.0;
+      if (joint == nullptr || j->QueryDoubleAttribute("value", &value) != tinyxml2::XML_SUCCESS ||
+          !std::isfinite(value)) {
+        throw ModelError(where + ": SRDF home: joint '" + (joint != nullptr ? joint : "?") +
+                         "' has no numeric value");
+      }
+      out.home[joint] = value;
+    }
+    break;
   }
   return out;
 }
@@ -201,7 +222,9 @@ std::shared_ptr<const RobotModel> RobotModel::build(ModelDescription d) {
       };
   walk(urdf->getRoot(), -1, "");
 
-  for (const auto& [a, b] : srdf_disabled_pairs(desc.srdf, where)) {
+  SrdfContent srdf = read_srdf(desc.srdf, where);
+  m->home_ = std::move(srdf.home);
+  for (const auto& [a, b] : srdf.disabled) {
     const int ia = m->link_index(a);
     const int ib = m->link_index(b);
     if (ia < 0 || ib < 0)
@@ -210,6 +233,12 @@ std::shared_ptr<const RobotModel> RobotModel::build(ModelDescription d) {
     m->disabled_.emplace_back(std::min(ia, ib), std::max(ia, ib));
   }
   return m;
+}
+
+std::optional<double> RobotModel::home(std::string_view joint) const {
+  const auto it = home_.find(std::string(joint));
+  if (it == home_.end()) return std::nullopt;
+  return it->second;
 }
 
 int RobotModel::link_index(std::string_view name) const {

@@ -184,6 +184,31 @@ TEST(RobotModel, GeometryChainsOfLinksAndSrdfPairs) {
   EXPECT_EQ(m->planar_kinematics().joint_names()[0], "base_x");
 }
 
+TEST(RobotModel, TheSrdfHomeIsTheHomingPosture) {
+  EXPECT_TRUE(RobotModel::build(mini())->home().empty());
+  EXPECT_EQ(RobotModel::build(mini())->home("J2_B"), std::nullopt);
+  ModelDescription homed = mini();
+  homed.srdf = R"(<robot name="mini">
+  <disable_collisions link1="L_1_B" link2="L_2_B" reason="Adjacent"/>
+  <group_state name="ready" group="chains"><joint name="J2_B" value="-1.5"/></group_state>
+  <group_state name="home" group="chains"><joint name="J1_B" value="0"/><joint name="J2_B" value="0.75"/></group_state>
+</robot>)";
+  const auto m = RobotModel::build(homed);
+  EXPECT_EQ(m->home().size(), 2u);
+  EXPECT_EQ(m->home("J2_B"), 0.75);  // the state called home, not the first one
+  EXPECT_EQ(m->home("J1_A"), std::nullopt);
+  EXPECT_EQ(m->disabled_pairs().size(), 1u);
+
+  ModelDescription bad = mini();
+  bad.srdf = R"(<robot><group_state name="home"><joint name="J2_B" value="up"/></group_state></robot>)";
+  try {
+    RobotModel::build(bad);
+    FAIL() << "no throw";
+  } catch (const ModelError& e) {
+    EXPECT_STREQ(e.what(), "model version 7: SRDF home: joint 'J2_B' has no numeric value");
+  }
+}
+
 TEST(RobotModel, RejectsDescriptionsThatDisagreeWithTheUrdf) {
   ModelDescription ghost = mini();
   ghost.joints.push_back({"J3_B", "B", -1, 1, 1, 10, 10});

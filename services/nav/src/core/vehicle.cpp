@@ -1,6 +1,5 @@
 #include "nav/vehicle.hpp"
 
-#include <tinyxml2.h>
 
 #include <algorithm>
 #include <cmath>
@@ -203,35 +202,10 @@ std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> points) {
 Eigen::VectorXd transport_posture(const RobotModel& model, std::string* posture) {
   const kinematics::Model& kin = model.kinematics();
   Eigen::VectorXd q = Eigen::VectorXd::Zero(kin.dof());
-  std::string which = "q = 0";
-  const std::string& srdf = model.description().srdf;
-  if (!srdf.empty()) {
-    tinyxml2::XMLDocument doc;
-    if (doc.Parse(srdf.c_str()) != tinyxml2::XML_SUCCESS) {
-      throw VehicleError(model.where() + ": SRDF cannot be parsed: " + doc.ErrorStr());
-    }
-    const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
-    for (const tinyxml2::XMLElement* gs = robot != nullptr ? robot->FirstChildElement("group_state")
-                                                           : nullptr;
-         gs != nullptr; gs = gs->NextSiblingElement("group_state")) {
-      const char* name = gs->Attribute("name");
-      if (name == nullptr || std::string_view(name) != "home") continue;
-      which = "SRDF home";
-      for (const tinyxml2::XMLElement* j = gs->FirstChildElement("joint"); j != nullptr;
-           j = j->NextSiblingElement("joint")) {
-        const char* joint = j->Attribute("name");
-        double value = 0.0;
-        if (joint == nullptr || j->QueryDoubleAttribute("value", &value) != tinyxml2::XML_SUCCESS ||
-            !std::isfinite(value)) {
-          throw VehicleError(model.where() + ": SRDF home: joint '" + (joint ? joint : "?") +
-                             "' has no numeric value");
-        }
-        if (const auto index = kin.joint_index(joint)) q[*index] = value;
-      }
-      break;
-    }
+  for (const auto& [joint, value] : model.home()) {
+    if (const auto index = kin.joint_index(joint)) q[*index] = value;
   }
-  if (posture != nullptr) *posture = which;
+  if (posture != nullptr) *posture = model.home().empty() ? "q = 0" : "SRDF home";
   return q;
 }
 

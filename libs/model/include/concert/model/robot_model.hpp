@@ -5,6 +5,7 @@
 // end-effectors and sensors by role and kind through it, never by list position or by name.
 
 #include <Eigen/Geometry>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -80,6 +81,12 @@ class RobotModel {
   [[nodiscard]] int link_index(std::string_view name) const;
   /// Pairs of link indices (a < b) whose collisions the SRDF disables.
   [[nodiscard]] const std::vector<std::pair<int, int>>& disabled_pairs() const { return disabled_; }
+  /// The SRDF's `home` group state, joint name -> position [rad or m] (the homing posture the
+  /// model generator chose: the transport posture, where a new module's joint starts); empty
+  /// when the SRDF has none.
+  [[nodiscard]] const std::map<std::string, double>& home() const { return home_; }
+  /// The `home` position of a joint, or nullopt when the SRDF gives none.
+  [[nodiscard]] std::optional<double> home(std::string_view joint) const;
 
   /// The limits table (one row per moving joint); see limits.hpp for the limits rule.
   [[nodiscard]] const LimitsTable& limits() const { return limits_; }
@@ -127,6 +134,7 @@ class RobotModel {
   kinematics::Model planar_;
   std::vector<Link> links_;
   std::vector<std::pair<int, int>> disabled_;
+  std::map<std::string, double> home_;
   LimitsTable limits_;
 };
 
