@@ -607,6 +607,14 @@ TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {
   EXPECT_EQ(nlohmann::json::parse(lines.back()).at("state"), "succeeded");
   err.str("");
   out.str("");
+  // The arm home (planned only: this test has no robot to execute on).
+  EXPECT_EQ(plan({"home", "--plan-only", "--request-id", "34", "--timeout", "20"}), 0) << err.str();
+  EXPECT_NE(out.str().find("request 34: the arm home for model version 8, planning only"), std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find("goal 1/1 succeeded"), std::string::npos) << out.str();
+  EXPECT_EQ(plan({"home", "--at", "2.0", "0.1", "2.3"}), 2);
+  err.str("");
+  out.str("");
   // Out of reach: the posture search spends its whole budget (1.6 s of CPU) before it fails:
   // 1.8 s here, 3.3 s beside three busy loops. CI once saw no answer within 20 s (cause not
   // found): the bound is wider, and a failure prints what the command and the planner said.

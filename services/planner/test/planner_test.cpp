@@ -236,6 +236,71 @@ TEST(Planner, HotSwapRebuildsTheConfigurationSpace) {
   }
 }
 
+// After a task the arm stands where the task left it; nav drives with it home (its transport
+// posture, the footprint's). A home request plans the arm there from a drilling posture, the base
+// standing, collision free and within the limits, and ends on the SRDF's home values.
+TEST(Planner, AHomeRequestTakesTheArmToItsHomingPostureTheBaseStanding) {
+  const Params params = generous(31);
+  auto planner = planner_at_site(params, 'a', 4);
+  const auto model = planner->model();
+  ASSERT_FALSE(model->robot().home().empty()) << "the generated SRDF has no home group state";
+  const Eigen::Isometry3d area = fixtures::drilling_area(2.2, 0.3, 1.0);
+  const PlanResult approach = planner->plan(PlanRequest{1, 4, "", {{area}}}, start_state(*model), {});
+  ASSERT_EQ(approach.status, Status::kSucceeded) << approach.reason;
+  const Eigen::VectorXd drilling = model->to_full(approach.goals[0].trajectory.points.back().q, start_state(*model));
+
+  PlanRequest home{2, 4, "", {}};
+  home.home = true;
+  const PlanResult r = planner->plan(home, drilling, {});
+  ASSERT_EQ(r.status, Status::kSucceeded) << r.reason;
+  ASSERT_EQ(r.goals.size(), 1u);
+  const Trajectory& t = r.goals[0].trajectory;
+  ASSERT_GE(t.points.size(), 2u);
+  EXPECT_LT((t.points.front().q - model->to_planned(drilling)).norm(), 1e-9);
+  const Eigen::VectorXd end = t.points.back().q;
+  double moved = 0.0;
+  for (Eigen::Index j = 3; j < end.size(); ++j) {
+    const std::string& name = model->joint_names()[static_cast<std::size_t>(j)];
+    const double expected = std::clamp(model->robot().home(name).value_or(0.0), model->lower()[j], model->upper()[j]);
+    EXPECT_NEAR(end[j], expected, 1e-9) << name;
+    moved = std::max(moved, std::abs(drilling[model->planned_indices()[static_cast<std::size_t>(j)]] - expected));
+  }
+  EXPECT_GT(moved, 0.3) << "the drilling posture was already home: the test proves nothing";
+  StateChecker exact(model, environment_of(site(2.2), params), params, 0.0);
+  for (const TrajectoryPoint& p : t.points) {
+    EXPECT_EQ(p.q.head<3>(), model->to_planned(drilling).head<3>()) << "the base moved at " << p.time << " s";
+    const Validity v = exact.check(model->to_full(p.q, drilling));
+    EXPECT_TRUE(v.valid()) << p.time << " s: " << to_string(v.constraint) << ": " << v.detail;
+  }
+  EXPECT_TRUE(t.points.back().qd.isZero());
+  EXPECT_FALSE(r.goals[0].drives.empty());
+
+  // Already home: the request succeeds where the arm stands.
+  const PlanResult again = planner->plan(home, model->to_full(end, drilling), {});
+  ASSERT_EQ(again.status, Status::kSucceeded) << again.reason;
+  EXPECT_LT((again.goals[0].trajectory.points.back().q - end).norm(), 1e-9);
+
+  // Home with goals is a malformed request; home where the homing posture meets a wall is
+  // refused naming what it meets.
+  PlanRequest both = home;
+  both.goals = {{area}};
+  const PlanResult malformed = planner->plan(both, drilling, {});
+  EXPECT_EQ(malformed.status, Status::kInvalidRequest);
+  EXPECT_NE(malformed.reason.find("home"), std::string::npos) << malformed.reason;
+  Planner blocked(params);
+  blocked.set_model(morphology('a', 4));
+  // A crate where the homing posture puts the tool, over the base, clear of the drilling posture.
+  const Eigen::Vector3d tool_home = model->link_pose(model->to_full(end, drilling), model->tool("").frame).translation();
+  World crate = site(2.2);
+  crate.boxes.push_back({"crate", Eigen::Vector3d(0.15, 0.15, 0.15), tool_home, 0.0});
+  blocked.set_environment(environment_of(crate, params));
+  const PlanResult no_home = blocked.plan(home, drilling, {});
+  EXPECT_EQ(no_home.status, Status::kUnreachable) << no_home.reason;
+  EXPECT_NE(no_home.reason.find("home: the homing posture is rejected where the robot stands by environment collision"),
+            std::string::npos)
+      << no_home.reason;
+}
+
 TEST(Planner, ClearErrorsForBadRequests) {
   Params params;
   Planner planner(params);

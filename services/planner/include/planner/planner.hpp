@@ -51,6 +51,10 @@ std::optional<Eigen::VectorXd> reached_posture(const PlanningModel& model, const
                                                const std::string& frame, const Eigen::Vector3d& axis,
                                                double reach);
 
+/// The homing posture of `model` as planned joints: the base of `q_full`, every arm joint at
+/// its SRDF `home` value (0 where the SRDF names none) clamped into its limits.
+Eigen::VectorXd home_posture(const PlanningModel& model, const Eigen::VectorXd& q_full);
+
 /// The planner of the planner service. Thread-safe: set_model/set_environment may come from
 /// one thread while plan() runs in another (plan() uses the model it started with).
 class Planner {
@@ -92,6 +96,11 @@ class Planner {
   /// line, arm alone and drive, RRT-Connect; simplification), then its timing.
   /// `fixed_base`: the base joints keep their start values. `lead_in` (full q, or null): a
   /// state the trajectory starts from before `q_start_full` (a start moved out of the map).
+  /// The arm from `start` (full q, valid) to its homing posture (home_posture), the base
+  /// standing: a PlanRequest::home request.
+  GoalResult plan_home(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& start,
+                       uint64_t seed, const Eigen::VectorXd* lead_in = nullptr) const;
+
   GoalResult plan_path(const PlanningModel& model, StateChecker& checker,
                        const Eigen::VectorXd& q_start_full, const Eigen::VectorXd& q_goal,
                        double time_budget, uint64_t seed, bool fixed_base = false,

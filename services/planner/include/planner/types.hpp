@@ -203,6 +203,12 @@ struct PlanRequest {
   /// stiffness times the reference's largest lead) with a margin (services/drill's
   /// checked_thrust), or a lighter thrust for a placement checked again at half of it.
   double contact_force = 0.0;
+  /// No goals: the arm goes to its homing posture (the SRDF's `home` group state, joints it does
+  /// not name at 0, clamped into the limits), the base standing: the transport posture nav
+  /// drives with, where a swapped-in module's joints start. Planned like any path (collision
+  /// free, timed within the drives); refused with the reason when that posture is not free
+  /// where the robot stands.
+  bool home = false;
   /// The base keeps its start pose: only the arm moves (the drill service's hole postures:
   /// a base that moves lets odometry drift between holes).
   bool fixed_base = false;

@@ -1,4 +1,5 @@
-// `concert plan drill`: sends drilling-area goals to the planner service and follows them.
+// `concert plan drill` sends drilling-area goals to the planner service and follows them;
+// `concert plan home` moves the arm to its homing posture (the transport posture nav drives with).
 
 #include "planner/cli.hpp"
 
@@ -17,8 +18,11 @@
 namespace concert::planner {
 namespace {
 
-/// What `concert plan drill` sends.
-struct DrillOptions {
+/// What `concert plan drill` and `concert plan home` send.
+struct PlanOptions {
+  std::string verb = "drill";
+  bool home = false;                    ///< the arm home instead of goals
+  bool plan_only = false;               ///< home: plan without executing
   std::vector<std::vector<double>> at;  ///< goals, 3 numbers each [m]
   std::vector<double> normal{-1.0, 0.0, 0.0};
   bool execute = false;
@@ -38,12 +42,13 @@ const char* state_name(msg::PlanState s) {
   return "?";
 }
 
-int drill(const DrillOptions& o, std::ostream& out, std::ostream& err) {
+int send_request(const PlanOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<Eigen::Vector3d> points;
   for (const auto& p : o.at) points.emplace_back(p[0], p[1], p[2]);
   const Eigen::Vector3d normal(o.normal[0], o.normal[1], o.normal[2]);
   if (normal.norm() < 1e-9) throw cli::UsageError("--normal: must not be zero");
-  const bool execute = o.execute;
+  const bool execute = o.home ? !o.plan_only : o.execute;
+  const std::string who = "concert plan " + o.verb;
   const std::string& end_effector = o.end_effector;
   const double timeout_s = o.dds.timeout_s;
   const uint32_t request_id = o.request_id;
@@ -59,17 +64,17 @@ int drill(const DrillOptions& o, std::ostream& out, std::ostream& err) {
     };
     const auto model = models.wait(std::min(left(), std::chrono::milliseconds(5000)));
     if (!model) {
-      err << "concert plan drill: no robot model on domain " << participant.domain_id() << " (is concert_modelgen running?)\n";
+      err << who << ": no robot model on domain " << participant.domain_id() << " (is concert_modelgen running?)\n";
       return 1;
     }
     if (!requests.wait_for_readers(1, std::min(left(), std::chrono::milliseconds(5000)))) {
-      err << "concert plan drill: no planner listening on domain " << participant.domain_id() << " (is concert_planner running?)\n";
+      err << who << ": no planner listening on domain " << participant.domain_id() << " (is concert_planner running?)\n";
       return 1;
     }
     // The answer's path matched before the question is asked: a result written before our reader
     // matched the planner's writer would reach us only through the late joiner's history.
     if (!results.wait_for_writers(1, std::min(left(), std::chrono::milliseconds(5000)))) {
-      err << "concert plan drill: the planner's results do not reach this client on domain " << participant.domain_id() << "\n";
+      err << who << ": the planner's results do not reach this client on domain " << participant.domain_id() << "\n";
       return 1;
     }
     msg::PlanRequest req;
@@ -78,6 +83,7 @@ int drill(const DrillOptions& o, std::ostream& out, std::ostream& err) {
     req.source("concert plan");
     req.end_effector(end_effector);
     req.execute(execute);
+    req.arm_home(o.home);
     const Eigen::Vector3d z = normal.normalized();
     const Eigen::Vector3d up = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
     Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
@@ -93,13 +99,15 @@ int drill(const DrillOptions& o, std::ostream& out, std::ostream& err) {
     if (o.dds.json) {
       out << nlohmann::ordered_json{{"request_id", request_id},
                                     {"goals", points.size()},
+                                    {"home", o.home},
                                     {"model_version", model->version()},
                                     {"execute", execute}}
                  .dump()
           << std::endl;
     } else {
-      out << "request " << request_id << ": " << points.size() << " goal(s) for model version "
-          << model->version() << (execute ? ", executing" : ", planning only") << "\n";
+      out << "request " << request_id << ": "
+          << (o.home ? std::string("the arm home") : std::to_string(points.size()) + " goal(s)")
+          << " for model version " << model->version() << (execute ? ", executing" : ", planning only") << "\n";
     }
     // Execution progress arrives many times a second: one line per 10 % of each goal.
     long printed_goal = -1;
@@ -140,16 +148,16 @@ int drill(const DrillOptions& o, std::ostream& out, std::ostream& err) {
       }
       if (r->state() == msg::PLAN_SUCCEEDED) return 0;
       if (r->state() == msg::PLAN_FAILED) {
-        err << "concert plan drill: " << r->reason() << "\n";
+        err << who << ": " << r->reason() << "\n";
         return 1;
       }
     }
-    err << "concert plan drill: no final result within " << timeout_s << " s\n";
+    err << who << ": no final result within " << timeout_s << " s\n";
     return 1;
   } catch (const cli::UsageError&) {
     throw;
   } catch (const std::exception& e) {
-    err << "concert plan drill: " << e.what() << "\n";
+    err << "concert plan " << o.verb << ": " << e.what() << "\n";
     return 1;
   }
 }
@@ -159,10 +167,10 @@ int drill(const DrillOptions& o, std::ostream& out, std::ostream& err) {
 void register_verbs(cli::Cli& concert) {
   CLI::App& plan =
       concert.group(concert.app(), "plan", "whole-body planning requests to the planner service");
-  auto o = std::make_shared<DrillOptions>();
+  auto o = std::make_shared<PlanOptions>();
   CLI::App& verb =
       concert.verb(plan, "drill", "plan (and with --execute run) the approach to drilling areas",
-                   [&concert, o] { return drill(*o, concert.out(), concert.err()); });
+                   [&concert, o] { return send_request(*o, concert.out(), concert.err()); });
   verb.add_option("--at", o->at,
                   "a drilling-area centre in the world frame [m] (repeat for several goals)")
       ->type_size(3)
@@ -182,6 +190,20 @@ void register_verbs(cli::Cli& concert) {
       ->type_name("N")
       ->check(cli::number(0, 4294967295.0, true));
   concert.add_dds_options(verb, o->dds, 30.0, "how long to follow the request");
+
+  auto h = std::make_shared<PlanOptions>();
+  h->verb = "home";
+  h->home = true;
+  CLI::App& home = concert.verb(
+      plan, "home",
+      "move the arm to its homing posture, the base standing (the transport posture nav drives "
+      "with; planned collision free and within the drives)",
+      [&concert, h] { return send_request(*h, concert.out(), concert.err()); });
+  home.add_flag("--plan-only", h->plan_only, "plan the motion without executing it");
+  home.add_option("--request-id", h->request_id, "the request's id (default: random)")
+      ->type_name("N")
+      ->check(cli::number(0, 4294967295.0, true));
+  concert.add_dds_options(home, h->dds, 60.0, "how long to follow the request");
 }
 
 }  // namespace concert::planner

@@ -377,6 +377,32 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
   return r;
 }
 
+Eigen::VectorXd home_posture(const PlanningModel& model, const Eigen::VectorXd& q_full) {
+  Eigen::VectorXd home = model.to_planned(q_full);
+  for (Eigen::Index j = 3; j < home.size(); ++j) {
+    const std::string& name = model.joint_names()[static_cast<std::size_t>(j)];
+    home[j] = std::clamp(model.robot().home(name).value_or(0.0), model.lower()[j], model.upper()[j]);
+  }
+  return home;
+}
+
+GoalResult Planner::plan_home(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& start,
+                              uint64_t seed, const Eigen::VectorXd* lead_in) const {
+  const Eigen::VectorXd home = home_posture(model, start);
+  GoalResult r;
+  if (const Validity v = checker.check(model.to_full(home, start)); !v.valid()) {
+    r.goal_q = home;
+    r.status = Status::kUnreachable;
+    r.reason = std::string("home: the homing posture is rejected where the robot stands by ") +
+               to_string(v.constraint) + ": " + v.detail;
+    return r;
+  }
+  r = plan_path(model, checker, start, home, params_.planning_time, seed, true, lead_in);
+  r.index = 0;
+  if (r.status != Status::kSucceeded) r.reason = "home: " + r.reason;
+  return r;
+}
+
 PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_start_full,
                          const GoalCallback& on_goal) {
   PlanResult out;
@@ -395,7 +421,10 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
                 "request made for model version " + std::to_string(request.model_version) +
                     " but the planner runs model version " + std::to_string(model->version()));
   }
-  if (request.goals.empty()) return fail(Status::kInvalidRequest, "request has no goals");
+  if (request.home && !request.goals.empty()) {
+    return fail(Status::kInvalidRequest, "a home request has no goals (the arm goes home, nothing else)");
+  }
+  if (!request.home && request.goals.empty()) return fail(Status::kInvalidRequest, "request has no goals");
   if (std::isnan(request.tip_distance) || std::isinf(request.tip_distance)) {
     return fail(Status::kInvalidRequest, "tip_distance must be a finite number of metres");
   }
@@ -416,8 +445,10 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   }
   const EndEffectorInfo* tool = nullptr;
   try {
-    tool = &model->tool(request.end_effector);
-    (void)model->camera_frame(*tool);
+    if (!request.home) {
+      tool = &model->tool(request.end_effector);
+      (void)model->camera_frame(*tool);
+    }
   } catch (const PlannerError& e) {
     return fail(Status::kInvalidRequest, e.what());
   }
@@ -559,6 +590,17 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   }
   Eigen::VectorXd current = start;
   out.status = Status::kSucceeded;
+  if (request.home) {
+    GoalResult r = plan_home(*model, checker, start, params_.seed + 7919u * request.request_id,
+                             lead_in ? &*lead_in : nullptr);
+    if (r.status != Status::kSucceeded) {
+      out.status = r.status;
+      out.reason = r.reason;
+    }
+    if (on_goal) on_goal(r);
+    out.goals.push_back(std::move(r));
+    return out;
+  }
   for (std::size_t g = 0; g < request.goals.size(); ++g) {
     const auto t0 = ThreadCpuClock::now();
     const uint64_t seed = params_.seed + 7919u * request.request_id + 104729u * g;

@@ -277,7 +277,7 @@ msg::PlanResult PlannerNode::planning(const msg::PlanRequest& request) const {
   msg::PlanResult r;
   r.request_id(request.request_id());
   r.model_version(static_cast<uint32_t>(planner_.model_version()));
-  r.goal_count(static_cast<uint32_t>(request.goals().size()));
+  r.goal_count(static_cast<uint32_t>(request.arm_home() ? 1 : request.goals().size()));  // home: one path
   r.state(msg::PLAN_PLANNING);
   return r;
 }
@@ -318,6 +318,7 @@ ClientRequest to_client_request(const msg::PlanRequest& request) {
   core.fixed_base = request.fixed_base();
   core.environment_padding = request.environment_padding();
   core.base_travel = request.base_travel();
+  core.home = request.arm_home();
   for (const msg::Pose& g : request.goals()) core.goals.push_back({to_core(g)});
   c.start_names = request.start_names();
   c.start_position = request.start_position();
@@ -399,7 +400,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   }
 
   const bool execute = request.execute();
-  const std::size_t count = prepared.plan.goals.size();
+  const std::size_t count = prepared.plan.home ? 1 : prepared.plan.goals.size();
   msg::PlanResult last_planned;
   const PlanResult result = planner_.plan(prepared.plan, prepared.start, [&](const GoalResult& g) {
     const Trajectory trajectory = to_odometry_frame(g.trajectory, prepared.map_T_odom, prepared.yaw_offset);
