@@ -120,13 +120,14 @@ class NavigatorTest : public ::testing::Test {
     nav_.set_map(map_, "two rooms");
   }
   // Odometry and a first scan at the start, then the user's initial pose (off by 10 cm, 3 deg).
-  void start(const Eigen::Vector3d& truth) {
+  void start(const Eigen::Vector3d& truth) { start(nav_, truth); }
+  void start(Navigator& nav, const Eigen::Vector3d& truth) {
     drive_.truth = truth;
-    nav_.on_wheel_odometry(9.99, Eigen::Vector3d::Zero());
-    nav_.set_initial_pose({truth.x() + 0.1, truth.y() - 0.05, truth.z() + 0.05}, 0.0, 0.0);
+    nav.on_wheel_odometry(9.99, Eigen::Vector3d::Zero());
+    nav.set_initial_pose({truth.x() + 0.1, truth.y() - 0.05, truth.z() + 0.05}, 0.0, 0.0);
     for (int i = 0; i < 5; ++i) {
-      nav_.on_scan(9.99, scan_at(map_, truth, rng_));
-      nav_.step(9.99);
+      nav.on_scan(9.99, scan_at(map_, truth, rng_));
+      nav.step(9.99);
     }
   }
   GoalRequest goal(double x, double y, double yaw, std::uint32_t id = 7) {
@@ -195,15 +196,31 @@ TEST_F(NavigatorTest, TurnsTheBaseNoFasterThanTheArmItCarriesCanHold) {
             << budget.joint << " (" << 100.0 * budget.static_load << " % still, " << 100.0 * budget.dynamic_load
             << " % more at full)\n";
 
+  // Away from its transport posture, the arm is not driven at all: the goal is refused naming
+  // the joint and the way home.
   start({2.0, 2.5, 0.0});
   nav_.on_joint_positions(names, std::vector<double>(worst.data(), worst.data() + worst.size()));
-  ASSERT_EQ(nav_.submit(goal(2.0, 2.5, M_PI)).state, GoalState::kPlanning);
+  const GoalStatus refused = nav_.submit(goal(2.0, 2.5, M_PI));
+  EXPECT_EQ(refused.state, GoalState::kRefused);
+  EXPECT_THAT(refused.reason, HasSubstr("not in its transport posture"));
+  EXPECT_THAT(refused.reason, HasSubstr(arm.joints.at(1) + " at "));
+  EXPECT_THAT(refused.reason, HasSubstr("concert plan home"));
+
+  // A robot whose transport posture leans so (the check off): the budget rules the turn.
+  NavParams carried_params;
+  carried_params.arm_home_tolerance = 0.0;
+  Navigator carried(carried_params, 5);
+  carried.set_model(*model_);
+  carried.set_map(map_, "two rooms");
+  start(carried, {2.0, 2.5, 0.0});
+  carried.on_joint_positions(names, std::vector<double>(worst.data(), worst.data() + worst.size()));
+  ASSERT_EQ(carried.submit(goal(2.0, 2.5, M_PI)).state, GoalState::kPlanning);
   std::vector<std::pair<double, double>> yaw_rates;  // (stamp, commanded wz)
-  const GoalStatus s = run(nav_, drive_, map_, 60.0, rng_,
+  const GoalStatus s = run(carried, drive_, map_, 60.0, rng_,
                            [&](double t, const BaseTwist& c) { yaw_rates.emplace_back(t, c.wz); });
   ASSERT_EQ(s.state, GoalState::kReached) << s.reason;
-  EXPECT_NEAR(nav_.drive_budget().scale, budget.scale, 1e-9);
-  EXPECT_EQ(nav_.drive_budget().joint, budget.joint);
+  EXPECT_NEAR(carried.drive_budget().scale, budget.scale, 1e-9);
+  EXPECT_EQ(carried.drive_budget().joint, budget.joint);
   // The commands' yaw acceleration stays within the budget. The last command, the stop at the
   // goal, is a step to zero (within the heading tolerance; the wheels' drives take it).
   ASSERT_GE(yaw_rates.size(), 3u);
@@ -215,7 +232,7 @@ TEST_F(NavigatorTest, TurnsTheBaseNoFasterThanTheArmItCarriesCanHold) {
   EXPECT_EQ(yaw_rates.back().second, 0.0);
   EXPECT_LE(steepest, params.max_angular_acceleration * budget.scale + 1e-6);
   EXPECT_GT(steepest, 0.5 * params.max_angular_acceleration * budget.scale) << "it hardly turned";
-  const std::string note = nav_.take_budget_note();
+  const std::string note = carried.take_budget_note();
   EXPECT_THAT(note, HasSubstr(budget.joint));
   EXPECT_THAT(note, HasSubstr("% of the configured"));
 
@@ -223,6 +240,7 @@ TEST_F(NavigatorTest, TurnsTheBaseNoFasterThanTheArmItCarriesCanHold) {
   Eigen::VectorXd overload = worst;
   NavParams strict;
   strict.drive_torque_fraction = 1e-3;
+  strict.arm_home_tolerance = 0.0;
   Navigator weak(strict, 5);
   weak.set_model(*model_);
   weak.set_map(map_, "two rooms");

@@ -47,6 +47,11 @@ struct NavParams {
   /// Base accelerations keep every joint's and wheel's torque within this fraction of its
   /// continuous torque, the posture's static load included (0, 1] [-].
   double drive_torque_fraction{1.0};
+  /// A goal is refused while an arm joint stands farther than this from its transport posture
+  /// (the SRDF home) [rad or m]: the footprint the base plans with and the drive budget hold
+  /// the arm there, and an arm out in front (a drilling posture) sweeps past the footprint and
+  /// loads its drives while the base accelerates. 0: not checked.
+  double arm_home_tolerance{0.05};
   int max_replans{10};          ///< blocked this often -> the goal fails
   double initial_std_xy{0.2};   ///< default spread of an initial pose [m]
   double initial_std_yaw{0.1};  ///< [rad]
@@ -189,6 +194,9 @@ class Navigator {
   // Scales the controller's accelerations to the drives' budget at the current posture; fails
   // a running goal when the posture leaves the base no acceleration.
   void apply_drive_budget();
+  // Why a goal may not start with the arm where it is (an arm joint farther than
+  // arm_home_tolerance from its transport posture), or "".
+  [[nodiscard]] std::string arm_away_from_home() const;
   void update_drive_budget();
   void set_state(GoalState state, std::string reason);
   void localise();
@@ -211,6 +219,9 @@ class Navigator {
   std::unique_ptr<LocalController> controller_;
   std::unique_ptr<model::DriveBudget> drives_;
   Eigen::VectorXd posture_;  // in drives_->joint_names() order
+  Eigen::VectorXd home_;     // the transport posture, same order
+  std::vector<bool> arm_joint_;  // same order: the joint belongs to an arm chain
+  bool posture_measured_{false};  // a joint state of this model arrived
   bool budget_stale_{true};
   model::BaseBudget budget_;
   std::string budget_note_;

@@ -84,6 +84,16 @@ const VehicleConfig& Navigator::set_model(const model::RobotModel& model) {
     vehicle_ = recognise_vehicle(model, params_.vehicle);
     drives_ = std::make_unique<model::DriveBudget>(model);
     posture_ = drives_->neutral_posture();
+    posture_measured_ = false;
+    home_ = transport_posture(model);
+    arm_joint_.assign(drives_->joint_names().size(), false);
+    for (const model::ChainInfo* arm : model.chains(model::ChainRole::kArm)) {
+      for (const std::string& j : arm->joints) {
+        const auto& names = drives_->joint_names();
+        const auto it = std::find(names.begin(), names.end(), j);
+        if (it != names.end()) arm_joint_[static_cast<std::size_t>(it - names.begin())] = true;
+      }
+    }
     vehicle_error_.clear();
   } catch (const std::exception& e) {
     vehicle_.reset();
@@ -158,6 +168,30 @@ void Navigator::set_initial_pose(const Pose2& pose, double std_xy, double std_ya
   map_to_odom_ = localiser_->estimate().map_T_odom;
 }
 
+std::string Navigator::arm_away_from_home() const {
+  if (!(params_.arm_home_tolerance > 0.0) || !drives_ || !posture_measured_ ||
+      home_.size() != posture_.size()) {
+    return {};
+  }
+  std::string worst;
+  double farthest = params_.arm_home_tolerance;
+  int away = 0;
+  for (Eigen::Index i = 0; i < posture_.size(); ++i) {
+    const double d = std::abs(posture_(i) - home_(i));
+    if (!arm_joint_[static_cast<std::size_t>(i)] || d <= params_.arm_home_tolerance) continue;
+    ++away;
+    if (d >= farthest) {
+      farthest = d;
+      worst = drives_->joint_names()[static_cast<std::size_t>(i)] + " at " + fixed(posture_(i)) +
+              ", home " + fixed(home_(i));
+    }
+  }
+  if (away == 0) return {};
+  return "the arm is not in its transport posture (" + std::to_string(away) + " joint" +
+         (away == 1 ? "" : "s") + " away from home, farthest " + worst +
+         "): move it home first (concert plan home)";
+}
+
 void Navigator::on_joint_positions(const std::vector<std::string>& names,
                                    const std::vector<double>& positions) {
   if (!drives_) return;
@@ -166,6 +200,7 @@ void Navigator::on_joint_positions(const std::vector<std::string>& names,
   for (std::size_t k = 0; k < n; ++k) {
     const auto it = std::find(joints.begin(), joints.end(), names[k]);
     if (it == joints.end() || !std::isfinite(positions[k])) continue;
+    posture_measured_ = true;
     double& q = posture_(it - joints.begin());
     // A posture change below a milliradian changes the budget by nothing worth a recompute.
     if (std::abs(q - positions[k]) > 1e-3) {
@@ -375,6 +410,7 @@ GoalStatus Navigator::submit(const GoalRequest& goal) {
   if (!localiser_ || localiser_->estimate().status != LocaliserStatus::kTracking) {
     return refuse("not localised (give the robot's pose: concert nav init X Y THETA)");
   }
+  if (const std::string away = arm_away_from_home(); !away.empty()) return refuse(away);
   Pose2 target = goal.pose;
   std::optional<Eigen::Isometry3d> area;
   if (goal.kind == GoalRequest::Kind::kWall) {

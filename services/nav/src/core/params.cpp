@@ -15,6 +15,7 @@ NavParams read_params(config::Document& doc) {
   root.number("max_acceleration", p.max_acceleration, Range::positive());
   root.number("max_angular_acceleration", p.max_angular_acceleration, Range::positive());
   root.number("drive_torque_fraction", p.drive_torque_fraction, Range{0.0, 1.0, true});
+  root.number("arm_home_tolerance", p.arm_home_tolerance, Range::non_negative());
   root.integer("max_replans", p.max_replans, 0, 1000);
   root.number("initial_std_xy", p.initial_std_xy, Range::positive());
   root.number("initial_std_yaw", p.initial_std_yaw, Range::positive());
