@@ -31,7 +31,8 @@ struct FakeSink final : DrillSink {
                   const std::vector<PathSample>&) override {
     trajectories.push_back(id);
   }
-  void navigate(std::uint32_t, std::uint32_t, const BasePose&) override {}
+  std::vector<std::pair<std::uint32_t, BasePose>> goals;
+  void navigate(std::uint32_t id, std::uint32_t, const BasePose& goal) override { goals.emplace_back(id, goal); }
   void cancel_navigation() override { ++cancels; }
   void hold(std::uint32_t, const JointPositions& arm) override { holds.push_back(arm); }
   void cartesian(std::uint32_t, const std::string& frame, const CartesianReference& reference) override {
@@ -129,6 +130,41 @@ TEST_F(EngineTest, AnApproachWithoutAPathIsAskedAgainThenFailsWithThePlannersRea
       EXPECT_EQ(o.reason, "planner: no collision-free path");
     }
   }
+}
+
+// Nav drives with the arm in its transport posture: a navigation first asks the planner to take
+// the arm home (executed), and only then sends the goal; a homing the planner refuses fails the
+// navigation with its reason, and no goal is sent.
+TEST_F(EngineTest, ANavigationTakesTheArmHomeFirst) {
+  engine.tick(0.0);
+  engine.navigate(BasePose{1.0, 2.0, 0.5});
+  ASSERT_EQ(sink.plans.size(), 1u);
+  const PlanAsk home = sink.plans[0];
+  EXPECT_TRUE(home.home);
+  EXPECT_TRUE(home.execute);
+  EXPECT_TRUE(home.goals.empty());
+  EXPECT_TRUE(sink.goals.empty());
+  inputs.on_plan(reply(home.request_id, PlanState::kExecuting));
+  EXPECT_EQ(engine.navigation().progress, Progress::kRunning);
+  EXPECT_TRUE(sink.goals.empty()) << "the goal went to nav with the arm still moving";
+  inputs.on_plan(reply(home.request_id, PlanState::kSucceeded));
+  EXPECT_EQ(engine.navigation().progress, Progress::kRunning);
+  ASSERT_EQ(sink.goals.size(), 1u);
+  EXPECT_EQ(sink.goals[0].second.x, 1.0);
+  EXPECT_EQ(sink.goals[0].second.theta, 0.5);
+  inputs.on_nav(sink.goals[0].first, {Progress::kSucceeded, {}, {}});
+  EXPECT_EQ(engine.navigation().progress, Progress::kSucceeded);
+
+  engine.navigate(BasePose{3.0, 2.0, 0.0});
+  ASSERT_EQ(sink.plans.size(), 2u);
+  PlanReply refused = reply(sink.plans[1].request_id, PlanState::kFailed);
+  refused.failure = PlanFailure::kUnreachable;
+  refused.reason = "home: the homing posture is rejected where the robot stands by environment collision: L_4_E";
+  inputs.on_plan(refused);
+  const Outcome o = engine.navigation();
+  EXPECT_EQ(o.progress, Progress::kFailed);
+  EXPECT_EQ(o.reason, "the arm home before driving: " + refused.reason);
+  EXPECT_EQ(sink.goals.size(), 1u);
 }
 
 // Stopped (an abort, a failure), nothing is sent again: a planner taking the request then would

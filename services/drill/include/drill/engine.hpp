@@ -349,6 +349,10 @@ class DrillEngine final : public MissionPorts {
   void hole_seen_again(const Eigen::Vector3d& in_odom);
   [[nodiscard]] std::string landmark(std::size_t area, const std::string& label) const;
   std::uint32_t nav_request_{0};
+  // Before a navigation goal: the planner's request that takes the arm home (0: none running),
+  // and the goal sent once it is there.
+  std::uint32_t home_request_{0};
+  BasePose nav_goal_;
   std::map<std::size_t, Plan> plans_;
   std::optional<std::size_t> executing_area_;
   std::uint32_t trajectory_request_{0};

@@ -37,6 +37,7 @@ struct PlanAsk {
   double contact_force{0.0};        ///< [N]; <= 0: the planner's
   /// The odometry frame in the planner's map (x, y, yaw) from the marks seen again; none: nav's.
   std::optional<Eigen::Vector3d> odom_in_map;
+  bool home{false};  ///< no goals: the arm to its homing posture, the base standing
 };
 
 enum class PlanState { kPlanning, kPlanned, kExecuting, kSucceeded, kFailed };

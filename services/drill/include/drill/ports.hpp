@@ -69,7 +69,8 @@ class MissionPorts {
   virtual void resolve(std::size_t area, const AreaSpec& spec) = 0;
   virtual Outcome resolution(std::size_t area, ResolvedArea& out) = 0;
 
-  /// Drives the base to a pose (autonomous navigation).
+  /// Drives the base to a pose (autonomous navigation), the arm first taken to its homing
+  /// posture (the transport posture navigation drives with).
   virtual void navigate(const BasePose& goal) = 0;
   virtual Outcome navigation() = 0;
 

@@ -408,12 +408,34 @@ Outcome DrillEngine::resolution(std::size_t area, ResolvedArea& out) {
   return Outcome::succeeded();
 }
 
+// Nav drives with the arm in its transport posture (its footprint and drive budget hold it
+// there, and it refuses a goal otherwise): the arm first goes home, planned and executed by the
+// planner from wherever the last area left it, then the goal goes to nav. The holes' paths no
+// longer lead back to this area's approach.
 void DrillEngine::navigate(const BasePose& goal) {
-  nav_request_ = next_request_++;
-  sink_.navigate(nav_request_, static_cast<std::uint32_t>(model_version_), goal);
+  nav_goal_ = goal;
+  hole_chain_.clear();
+  PlanAsk r;
+  r.request_id = next_request_++;
+  r.model_version = static_cast<std::uint32_t>(model_version_);
+  r.end_effector = rig_ ? rig_->tool() : "";
+  r.home = true;
+  r.execute = true;
+  home_request_ = r.request_id;
+  send_plan(r);
 }
 
 Outcome DrillEngine::navigation() {
+  if (home_request_ != 0) {
+    const std::optional<PlanReply> home = inputs_.plan(home_request_);
+    if (!home || (home->state != PlanState::kSucceeded && home->state != PlanState::kFailed))
+      return Outcome::running();
+    home_request_ = 0;
+    if (home->state == PlanState::kFailed) return Outcome::failed("the arm home before driving: " + home->reason);
+    nav_request_ = next_request_++;
+    sink_.navigate(nav_request_, static_cast<std::uint32_t>(model_version_), nav_goal_);
+    return Outcome::running();
+  }
   const std::optional<MotionReply> reply = inputs_.nav(nav_request_);
   if (!reply || reply->progress == Progress::kRunning) return Outcome::running();
   nav_request_ = 0;
@@ -1164,6 +1186,7 @@ Outcome DrillEngine::retraction() { return motion_outcome_ ? *motion_outcome_ : 
 void DrillEngine::stop() {
   if (nav_request_ != 0) sink_.cancel_navigation();
   nav_request_ = 0;
+  home_request_ = 0;
   const bool at_hole = motion_ == Motion::kAlign || motion_ == Motion::kDrill || motion_ == Motion::kRetractOut;
   motion_ = Motion::kNone;
   unacknowledged_.clear();  // not sent again: a planner taking it now would move the robot

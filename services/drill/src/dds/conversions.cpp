@@ -121,6 +121,7 @@ msg::PlanRequest to_msg(const PlanAsk& a) {
   r.tip_distance(a.tip_distance);
   r.tip_reach(a.tip_reach);
   r.contact_force(a.contact_force);
+  r.arm_home(a.home);
   if (a.odom_in_map) r.odom_in_map({a.odom_in_map->x(), a.odom_in_map->y(), a.odom_in_map->z()});
   return r;
 }
