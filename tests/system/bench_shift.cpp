@@ -4,6 +4,8 @@
 // line a crew uses, round after round:
 //
 //   drill A   a BIM drilling mission on the living room's north wall (Wand-Int-ERDG-5)
+//   home      the arm to its homing posture (concert plan home), as before every swap: a tool
+//             swapped on an arm held out loads its drives, and nav drives only with the arm home
 //   swap      the sanding tool (deploy/demo/sanding_robot.yaml), every service ready at the new model
 //   sand      nav to the plaster panel on the wall east of the stair (Wand-Int-ERDG-4), sand its
 //             centre area at 30 N
@@ -371,6 +373,12 @@ int bench(int rounds, int load, unsigned seed) {
     ++version;
     return {ready(version), "every service ready at model version " + std::to_string(version)};
   };
+  const auto home = [&]() -> std::pair<bool, std::string> {
+    const auto r = cli({"plan", "home", "--json", "--timeout", "120"}, 140s);
+    std::string why = r.err;
+    if (const auto at = why.rfind("concert plan home: "); at != std::string::npos) why = why.substr(at);
+    return {r.code == 0, r.code == 0 ? "the arm home" : why};
+  };
   const auto go = [&](const std::array<double, 3>& pose) -> std::pair<bool, std::string> {
     const auto r = cli({"nav", "goto", number(pose[0]), number(pose[1]), number(pose[2]), "--timeout", "600"}, 620s);
     std::string why = r.err;
@@ -410,15 +418,20 @@ int bench(int rounds, int load, unsigned seed) {
     return {r.code == 0 && state == "succeeded" && aim, "state " + state + "; " + figures};
   };
 
+  constexpr int kLegsPerRound = 12;  // the run_leg calls below
+  const int planned_legs = rounds * kLegsPerRound;
   for (int round = 0; round < rounds; ++round) {
     std::cout << "round " << round + 1 << " of " << rounds << std::endl;
     run_leg("drill A (" + site.a[round].name + ")", [&] { return drill(site.a[round]); });
+    run_leg("home", home);
     run_leg("swap: sanding", [&] { return swap("sanding_robot.yaml"); });
     run_leg("nav: plaster panel", [&] { return go(site.sand_stand); });
     run_leg("sand centre 30 N", [&] { return finish({"sand", "--area", "centre", "--force", "30"}); });
+    run_leg("home", home);
     run_leg("swap: spraying", [&] { return swap("spraying_robot.yaml"); });
     run_leg("nav: spray wall", [&] { return go(site.spray_stand); });
     run_leg("spray 0.4 x 0.4 m", [&] { return finish({"spray", "--area", "all", "--rect", "-0.2", "0.2", "2.05", "2.45"}); });
+    run_leg("home", home);
     run_leg("swap: drill", [&] { return swap("drill_robot.yaml"); });
     run_leg("drill C (" + site.c[round].name + ")", [&] { return drill(site.c[round]); });
     if (round == 0) rss_first = service_rss(up.pid());
@@ -473,10 +486,10 @@ int bench(int rounds, int load, unsigned seed) {
   std::printf(
       "shift: %d of %d legs done, %zu of %zu holes within 5 cm (median %.1f mm, p95 %.1f mm), %zu safety stops, "
       "RSS growth at most %.1f %% (%s), %.0f min, %d busy processes\n",
-      done, rounds * 9, errors.size(), asked, pct(0.5), pct(0.95), stops.size(), worst_growth,
+      done, planned_legs, errors.size(), asked, pct(0.5), pct(0.95), stops.size(), worst_growth,
       worst_service.empty() ? "-" : worst_service.c_str(), minutes, load);
   up.stop(30s);
-  const bool ok = done == rounds * 9 && stops.empty();
+  const bool ok = done == planned_legs && stops.empty();
   if (ok) {
     fs::remove_all(dir.path());
   } else {
