@@ -112,9 +112,22 @@ int send_request(const PlanOptions& o, std::ostream& out, std::ostream& err) {
     // Execution progress arrives many times a second: one line per 10 % of each goal.
     long printed_goal = -1;
     long printed_percent = 0;
+    // The request is volatile: written before the planner's reader matched this writer (the
+    // match is seen from this side first), it is lost. Until the planner acknowledges it
+    // (PLAN_PLANNING, or any later answer) it is sent again every second, same id (the planner
+    // takes a source's id once).
+    constexpr auto kResend = std::chrono::milliseconds(1000);
+    bool acknowledged = false;
+    auto sent = std::chrono::steady_clock::now();
     while (left().count() > 0) {
-      const auto r = results.wait(left());
+      if (!acknowledged && std::chrono::steady_clock::now() - sent >= kResend) {
+        req.stamp_ns(now_ns());
+        requests.write(req);
+        sent = std::chrono::steady_clock::now();
+      }
+      const auto r = results.wait(acknowledged ? left() : std::min(left(), kResend));
       if (!r || r->request_id() != request_id) continue;
+      acknowledged = true;
       if (r->state() == msg::PLAN_EXECUTING) {
         const long percent = std::lround(100.0 * r->progress());
         const auto goal = static_cast<long>(r->goal_index());
