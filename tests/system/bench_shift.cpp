@@ -88,6 +88,7 @@ struct DrillArea {
   std::string wall;
   double s{0.0}, h{0.0};
   std::string name;
+  std::string face;  ///< "left" or "right": the face the marks are on (the room the crew works in)
 };
 
 /// The site: the storey's world with every round's marks, the plaster panel and the stands.
@@ -106,22 +107,29 @@ Site build_site(const fs::path& dir, int rounds, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> along(-0.05, 0.05), height(-0.1, 0.1);
   Site site;
-  const auto marks = [&](const std::string& wall, double s, double h, const std::string& name) {
-    const bim::WallGoal goal = bim::wall_goal(house, grid, wall, s, h, 1.05, 0.55, {});
+  // Every round's marks on the face the first round's goal chose (the room the crew works in):
+  // "auto" picks the face in the larger free region, which flips between rooms along a wall.
+  std::map<std::string, std::string> faces;
+  const auto marks = [&](DrillArea& area) {
+    bim::GoalOptions options;
+    if (const auto f = faces.find(area.wall); f != faces.end()) options.face = bim::face_choice(f->second);
+    const bim::WallGoal goal = bim::wall_goal(house, grid, area.wall, area.s, area.h, 1.05, 0.55, options);
+    area.face = goal.face == 0 ? "left" : "right";
+    faces.emplace(area.wall, area.face);
     const Eigen::Vector3d centre = goal.area_frame.translation();
     const Eigen::Vector3d normal = goal.area_frame.linear().col(2);
     const Eigen::Vector3d right = Eigen::Vector3d::UnitZ().cross(normal).normalized();
-    w.marks.push_back(bim::mark_on_wall(w, wall, centre - 0.05 * right, normal, name + "_left", 0.025));
-    w.marks.push_back(bim::mark_on_wall(w, wall, centre + 0.05 * right, normal, name + "_right", 0.025));
+    w.marks.push_back(bim::mark_on_wall(w, area.wall, centre - 0.05 * right, normal, area.name + "_left", 0.025));
+    w.marks.push_back(bim::mark_on_wall(w, area.wall, centre + 0.05 * right, normal, area.name + "_right", 0.025));
   };
   // Rounds' marks 0.5 m apart along each wall (a mission drills the two nearest its area's
   // centre); C stays west of the plaster panel and east of the stair.
   for (int r = 0; r < rounds; ++r) {
     const std::string n = std::to_string(r + 1);
-    DrillArea a{kWallA, 1.25 + 0.5 * (r % 5) + along(rng), 1.2 + height(rng), "a" + n};
-    DrillArea c{kWallC, 2.0 + 0.4 * (r % 3) + along(rng), 1.2 + height(rng), "c" + n};
-    marks(a.wall, a.s, a.h, a.name);
-    marks(c.wall, c.s, c.h, c.name);
+    DrillArea a{kWallA, 1.25 + 0.5 * (r % 5) + along(rng), 1.2 + height(rng), "a" + n, ""};
+    DrillArea c{kWallC, 2.0 + 0.4 * (r % 3) + along(rng), 1.2 + height(rng), "c" + n, ""};
+    marks(a);
+    marks(c);
     site.a.push_back(a);
     site.c.push_back(c);
   }
@@ -160,7 +168,7 @@ std::string mission_of(const DrillArea& area) {
   std::ostringstream m;
   m << "name: shift_" << area.name << "\ndepth: 0.03\nifc: " << kHouse << "\nstorey: " << kStorey
     << "\nareas:\n  - {name: " << area.name << ", marks: blobs, wall: \"" << area.wall << "\", at: [" << area.s
-    << ", " << area.h << "], face: auto, expected: 2}\n";
+    << ", " << area.h << "], face: " << area.face << ", expected: 2}\n";
   return m.str();
 }
 
