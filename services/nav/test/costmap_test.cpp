@@ -205,5 +205,42 @@ TEST(Costmap, FastPathAgreesWithTheFullCheck) {
   EXPECT_LT(collisions, 4900);
 }
 
+// "Free at any heading" (where an escape from a wall ends, and where a path may turn) must mean
+// what it says: no heading of the footprint covers a lethal cell there. With the inflation cost
+// as the test, the footprint touching a cell whose centre lies up to a cell's diagonal beyond
+// the circumscribed radius was missed, and an inflation radius hardly larger than that radius
+// (the demo base: 0.8 m against 0.794) left no cost to test at all: the controller then ended
+// an escape at once and reported the robot blocked (bench_shift, after a drilling mission).
+TEST(Costmap, FreeAtAnyHeadingMeansNoHeadingCollides) {
+  const testing::Building b = testing::make_building(3, 2, 4.0, 0.15, 1.0, 0.05, 7);
+  const RobotShape robot = test_robot();
+  CostmapParams tight;
+  tight.inflation_radius = robot.circumscribed_radius + 0.006;
+  for (const CostmapParams& params : {CostmapParams{}, tight}) {
+    const Costmap map(b.map, robot, params);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> ux(0.0, 12.15), uy(0.0, 8.15);
+    int free = 0, near_walls = 0, wrong = 0;
+    for (int i = 0; i < 20000; ++i) {
+      const Eigen::Vector2d p(ux(rng), uy(rng));
+      if (!map.free_at_any_heading(p)) continue;
+      ++free;
+      bool near = false;
+      for (int k = 0; k < 72; ++k) {
+        const Eigen::Vector3d pose(p.x(), p.y(), -M_PI + k * M_PI / 36.0);
+        if (map.in_collision(pose)) ++wrong;
+        near = near || map.footprint_cost(pose) > Costmap::kFree;
+      }
+      near_walls += near ? 1 : 0;
+    }
+    EXPECT_EQ(wrong, 0) << "inflation radius " << params.inflation_radius;
+    EXPECT_GT(free, 5000);
+    EXPECT_GT(near_walls, 100) << "no free position near a wall was tried";
+  }
+  // Outside the map nothing is free.
+  const Costmap map(b.map, robot, {});
+  EXPECT_FALSE(map.free_at_any_heading({-1.0, 2.0}));
+}
+
 }  // namespace
 }  // namespace concert::nav

@@ -130,9 +130,13 @@ class Costmap {
   /// How deep a base leaving `start` may go (lethal_depth() there and a cell of slack: the pose
   /// estimate and the lidars' marks along a wall jitter by that much) [m].
   [[nodiscard]] double leaving_depth(const Eigen::Vector3d& start) const { return lethal_depth(start) + resolution_; }
-  /// Whether the footprint centred at `p` is free at any heading (its centre cost below
-  /// possibly_colliding_cost()): a path may turn there.
-  [[nodiscard]] bool free_at_any_heading(const Eigen::Vector2d& p) const { return cost_at(p) < possibly_colliding_; }
+  /// Whether the footprint centred at `p` is free at any heading: no heading makes
+  /// in_collision() true there, so a path may turn there and an escape from a wall ends. Every
+  /// lethal cell's centre lies farther from `p` than the circumscribed radius plus half a cell's
+  /// diagonal (in_collision counts a cell the polygon touches), and the disc lies in the map.
+  /// Exact, not the inflation cost: that is measured between cell centres and ends at
+  /// inflation_radius, which may be hardly larger than the circumscribed radius.
+  [[nodiscard]] bool free_at_any_heading(const Eigen::Vector2d& p) const;
 
   /// Marks the obstacle layer from beams cast from `sensor_origin` (map frame [m]): every beam
   /// clears the cells it crosses up to its end (or raytrace_max_range), and a hit within

@@ -293,6 +293,19 @@ std::uint8_t Costmap::footprint_cost(const Eigen::Vector3d& pose) const {
   return inside_map ? worst : kLethal;
 }
 
+bool Costmap::free_at_any_heading(const Eigen::Vector2d& p) const {
+  const double reach = shape_.circumscribed_radius + std::sqrt(0.5) * resolution_;
+  const Eigen::Vector2i lo = cell_of(p - Eigen::Vector2d::Constant(reach));
+  const Eigen::Vector2i hi = cell_of(p + Eigen::Vector2d::Constant(reach));
+  if (!inside(lo.x(), lo.y()) || !inside(hi.x(), hi.y())) return false;
+  for (int r = lo.y(); r <= hi.y(); ++r) {
+    for (int c = lo.x(); c <= hi.x(); ++c) {
+      if (cost(c, r) == kLethal && (center_of(c, r) - p).norm() <= reach) return false;
+    }
+  }
+  return true;
+}
+
 bool Costmap::in_collision(const Eigen::Vector3d& pose) const {
   const Eigen::Vector2i centre = cell_of(pose.head<2>());
   if (!inside(centre.x(), centre.y())) return true;
