@@ -530,6 +530,47 @@ TEST(Planner, WarmUpFillsThePostureMemoryAndPlansStayValid) {
   }
 }
 
+// A crew swaps the drill off and back on: the model that comes back (a new version, the same
+// content hash) gets back the postures it remembered and the heights its warm-up searched, so
+// the first approach after the swap starts from them instead of from random seeds.
+TEST(Planner, ASwapBackToAModelKeepsItsPostureMemory) {
+  Params params = generous(23);
+  const ModelDescription a = morphology('a', 9);
+  ASSERT_FALSE(a.content_hash.empty());
+  Planner planner(params);
+  planner.set_environment(environment_of(site(2.2), params));
+  planner.set_model(a);
+  EXPECT_EQ(planner.remembered(), 0u);
+  ASSERT_EQ(planner.warm_up(1.0, 1.4, 0.2, 15.0), 3);
+  const std::size_t warmed = planner.remembered();
+  ASSERT_GT(warmed, 0u);
+  // Another model: its own, empty memory.
+  planner.set_model(morphology('b', 10));
+  EXPECT_EQ(planner.remembered(), 0u);
+  // A back (version 11): its postures, and a warm-up with no time finds every height searched.
+  ModelDescription a_again = a;
+  a_again.version = 11;
+  planner.set_model(a_again);
+  EXPECT_EQ(planner.remembered(), warmed);
+  EXPECT_EQ(planner.warm_up(1.0, 1.4, 0.2, 0.0), 3);
+  // A height no warm-up searched is searched (and with no time, found nowhere).
+  EXPECT_EQ(planner.warm_up(1.6, 1.6, 0.2, 0.0), 0);
+  // A new version of the same model keeps the memory as it is.
+  a_again.version = 12;
+  planner.set_model(a_again);
+  EXPECT_EQ(planner.remembered(), warmed);
+  // memory_models: 1 keeps no other model's memory.
+  params.memory_models = 1;
+  Planner forgetful(params);
+  forgetful.set_model(a);
+  ASSERT_EQ(forgetful.warm_up(1.2, 1.2, 0.2, 15.0), 1);
+  ASSERT_GT(forgetful.remembered(), 0u);
+  forgetful.set_model(morphology('b', 10));
+  forgetful.set_model(a_again);
+  EXPECT_EQ(forgetful.remembered(), 0u);
+  EXPECT_EQ(forgetful.warm_up(1.2, 1.2, 0.2, 0.0), 0);
+}
+
 namespace {
 
 // Morphology A (seed 5) before a low area on a bare wall 2.2 m ahead: the goal posture found

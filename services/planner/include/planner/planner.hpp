@@ -3,6 +3,8 @@
 // (x, y, yaw) + arm joints, path simplification, time parameterisation. Goals in FIFO order.
 
 #include <functional>
+#include <list>
+#include <map>
 #include <memory>
 #include <mutex>
 
@@ -62,8 +64,13 @@ class Planner {
   explicit Planner(Params params = {});
 
   /// Rebuilds the configuration space for a new model version (also after a hot swap).
-  /// Throws PlannerError and keeps the previous model on failure.
+  /// Throws PlannerError and keeps the previous model on failure. The posture memory follows
+  /// the model's content hash: a version of a model seen before (the drill swapped back on)
+  /// gets back what that model remembered (Params::memory_models); a model without a hash
+  /// starts empty.
   void set_model(const ModelDescription& description);
+  /// Goal postures the current model's memory holds (seeds for later goals).
+  [[nodiscard]] std::size_t remembered() const;
   /// Replaces the map.
   void set_environment(Environment environment);
   /// Current model version (0: none).
@@ -107,12 +114,18 @@ class Planner {
                        const Eigen::VectorXd* lead_in = nullptr) const;
 
  private:
-  /// Arm postures that solved earlier goals of this model version, with their camera height
-  /// (seeds for later goals at similar heights; cleared with every new model).
+  /// Arm postures that solved earlier goals of this model, with their camera height (seeds for
+  /// later goals at similar heights).
   struct Remembered {
     double height = 0.0;
     Eigen::VectorXd arm;
     std::vector<Eigen::VectorXd> arm_path;  // arm postures from the parked arm to `arm` (warm-up), or empty
+  };
+  /// One model's memory: its postures and the warm-up heights searched [mm] (with whether a
+  /// posture was found), which a later warm-up of the same model skips.
+  struct Memory {
+    std::vector<Remembered> postures;
+    std::map<long, bool> warmed;
   };
   std::vector<Eigen::VectorXd> hints_for(const PlanningModel& model, double height) const;
   void remember(const PlanningModel& model, double height, const Eigen::VectorXd& q, std::vector<Eigen::VectorXd> arm_path = {});
@@ -125,7 +138,10 @@ class Planner {
   mutable std::mutex mutex_;
   std::shared_ptr<const PlanningModel> model_;
   Environment environment_;
-  std::vector<Remembered> memory_;  // guarded by mutex_, for model_
+  std::string model_hash_;  // content hash of model_ ("" : none)
+  Memory memory_;           // guarded by mutex_, for model_
+  /// Other models' memories by content hash, most recently left first (guarded by mutex_).
+  std::list<std::pair<std::string, Memory>> kept_;
 };
 
 }  // namespace concert::planner

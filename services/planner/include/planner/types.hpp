@@ -98,7 +98,11 @@ struct Params {
   /// morphology B's low postures the searches take 0.23-4.4 s (0.43-0.46 s for some), so with a
   /// budget near those times what is remembered depends on the machine's speed.
   double warm_up_path_time = 0.5;
-  int nspg_memory = 128;             ///< goal postures remembered per model version as seeds for similar heights (0: off)
+  int nspg_memory = 128;             ///< goal postures remembered per model as seeds for similar heights (0: off)
+  /// Models whose posture memory is kept after a swap, by content hash (the least recently used
+  /// model's is dropped first): a crew swapping the drill off and back on finds the postures of
+  /// its earlier missions. The current model's memory always counts; 1 keeps no other.
+  int memory_models = 4;
   double nspg_tolerance = 1e-3;      ///< task error accepted [m, rad]
   double nspg_distance_weight = 1.0; ///< cost of the distance to the start [1/rad]
   double nspg_singularity_weight = 0.5;  ///< cost of 1/manipulability of the arm [-]

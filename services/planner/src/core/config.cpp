@@ -69,6 +69,7 @@ Params read_params(config::Document& doc) {
   for (const auto& [key, value] : counts) root.integer(key, *value, 0);
   root.number("drive_torque_fraction", p.drive_torque_fraction, config::Range::between(0.0, 1.0));
   root.number("max_drive_stretch", p.max_drive_stretch, config::Range::at_least(1.0));
+  root.integer("memory_models", p.memory_models, 1);
   root.integer("sensor_depth_stride", p.sensor_depth_stride, 1);
   root.integer("sensor_depth_frames", p.sensor_depth_frames, 1);
   root.number("sensor_depth_min_valid", p.sensor_depth_min_valid, config::Range{0.0, 1.0, true});

@@ -94,7 +94,22 @@ void Planner::set_model(const ModelDescription& description) {
   auto model = PlanningModel::build(description, params_);
   std::lock_guard lock(mutex_);
   model_ = std::move(model);
-  memory_.clear();
+  if (description.content_hash == model_hash_ && !model_hash_.empty()) return;  // a new version, the same model
+  if (!model_hash_.empty()) kept_.emplace_front(model_hash_, std::move(memory_));
+  memory_ = {};
+  model_hash_ = description.content_hash;
+  const auto same = std::find_if(kept_.begin(), kept_.end(),
+                                 [&](const auto& k) { return k.first == model_hash_; });
+  if (same != kept_.end() && !model_hash_.empty()) {
+    memory_ = std::move(same->second);
+    kept_.erase(same);
+  }
+  while (!kept_.empty() && static_cast<int>(kept_.size()) >= params_.memory_models) kept_.pop_back();
+}
+
+std::size_t Planner::remembered() const {
+  std::lock_guard lock(mutex_);
+  return memory_.postures.size();
 }
 
 int Planner::warm_up(double from, double to, double step, double seconds_per_height,
@@ -116,6 +131,16 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
   int index = 0;
   for (double z = from; z <= to + 1e-9; z += step, ++index) {
     if (this->model() != model || !keep_going()) break;  // a new model arrived, or shutdown
+    const long height_mm = std::lround(z * 1000.0);
+    {
+      // Searched by an earlier warm-up of this model (a version swapped back on): kept.
+      std::lock_guard lock(mutex_);
+      if (model_ != model) break;
+      if (const auto w = memory_.warmed.find(height_mm); w != memory_.warmed.end()) {
+        solved += w->second ? 1 : 0;
+        continue;
+      }
+    }
     // A wall facing the robot 2 m ahead, the area at height z.
     Eigen::Isometry3d area = Eigen::Isometry3d::Identity();
     area.linear() << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // z along -x (the wall's outward normal)
@@ -146,6 +171,8 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
       found = found || p.found;
     }
     if (found) solved += 1;
+    std::lock_guard lock(mutex_);
+    if (model_ == model) memory_.warmed[height_mm] = found;
   }
   return solved;
 }
@@ -155,7 +182,7 @@ std::vector<Eigen::VectorXd> Planner::hints_for(const PlanningModel& model, doub
   {
     std::lock_guard lock(mutex_);
     if (model_.get() != &model) return {};
-    for (const Remembered& m : memory_) {
+    for (const Remembered& m : memory_.postures) {
       if (std::abs(m.height - height) <= kHintHeight)
         near.emplace_back(std::abs(m.height - height), m.arm);
     }
@@ -174,7 +201,7 @@ void Planner::remember(const PlanningModel& model, double height, const Eigen::V
   std::lock_guard lock(mutex_);
   if (model_.get() != &model) return;
   const Eigen::VectorXd arm = q.tail(q.size() - 3);
-  for (Remembered& m : memory_) {
+  for (Remembered& m : memory_.postures) {
     // The same posture again (both warm-up passes, or a plan that started from it): one entry.
     if (std::abs(m.height - height) < kSamePosture &&
         (m.arm - arm).cwiseAbs().maxCoeff() < kSamePosture) {
@@ -182,8 +209,9 @@ void Planner::remember(const PlanningModel& model, double height, const Eigen::V
       return;
     }
   }
-  if (static_cast<int>(memory_.size()) >= params_.nspg_memory) memory_.erase(memory_.begin());
-  memory_.push_back({height, arm, std::move(arm_path)});
+  if (static_cast<int>(memory_.postures.size()) >= params_.nspg_memory)
+    memory_.postures.erase(memory_.postures.begin());
+  memory_.postures.push_back({height, arm, std::move(arm_path)});
 }
 
 std::vector<Eigen::VectorXd> Planner::arm_path_to(const PlanningModel& model,
@@ -197,7 +225,7 @@ std::vector<Eigen::VectorXd> Planner::arm_path_to(const PlanningModel& model,
   const Remembered* best = nullptr;
   bool best_mirrored = false;
   double best_d = kArmPathReuse;
-  for (const Remembered& m : memory_) {
+  for (const Remembered& m : memory_.postures) {
     if (m.arm_path.empty()) continue;
     for (const bool mirrored : {false, true}) {
       if (mirrored && !goal_mirror) continue;

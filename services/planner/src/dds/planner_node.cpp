@@ -222,6 +222,8 @@ void PlannerNode::on_model(const msg::RobotModel& model) {
     {
       std::ostringstream line;
       line << "planner: model version " << model.version() << ": " << note;
+      if (const std::size_t kept = planner_.remembered(); kept > 0)
+        line << "; " << kept << " goal postures remembered from an earlier version of this model";
       log_line(line.str());
     }
     {
