@@ -94,6 +94,29 @@ TEST_F(HubTest, StateTopicsGiveTheLatestSampleToALateSubscriberAndEveryNewOne) {
   EXPECT_EQ(sink_.of(1, "sample").size(), 6u);  // state samples are never rate-limited
 }
 
+// A per-request state topic gets an instance per request: a late subscriber gets the latest of
+// the most recently updated max_instances_kept, not every request of the shift.
+TEST(HubMemory, AStateTopicKeepsTheMostRecentlyUpdatedInstancesOnly) {
+  std::ostringstream log;
+  HubParams params;
+  params.max_instances_kept = 3;
+  Hub hub({{"concert/planner/result", "concert::msg::PlanResult", TopicKind::kState, ""}}, params, log);
+  FakeSink sink;
+  hub.attach(nullptr, &sink);
+  const auto result = [&](int request, const std::string& state, int64_t t) {
+    hub.on_sample("concert/planner/result", std::to_string(request),
+                  [&] { return Json{{"request_id", request}, {"state", state}}; }, t);
+  };
+  for (int request = 1; request <= 4; ++request) result(request, "PLANNED", request * kMs);
+  result(2, "SUCCEEDED", 5 * kMs);  // request 2 updated again: now newer than 3 and 4
+  result(5, "PLANNED", 6 * kMs);     // makes room by dropping request 3, the least recently updated
+  hub.connect(1, "late");
+  hub.on_message(1, Json{{"op", "subscribe"}, {"topic", "concert/planner/result"}}.dump(), 7 * kMs);
+  std::map<std::string, std::string> got;
+  for (const Json& m : sink.of(1, "sample")) got[m["instance"].get<std::string>()] = m["data"]["state"];
+  EXPECT_EQ(got, (std::map<std::string, std::string>{{"2", "SUCCEEDED"}, {"4", "PLANNED"}, {"5", "PLANNED"}}));
+}
+
 TEST_F(HubTest, StreamsAreRateLimitedPerClientAndDecodedOnlyWhenDue) {
   hub_.connect(1, "slow");
   hub_.connect(2, "fast");

@@ -54,6 +54,13 @@ struct HubParams {
   /// arrive: the e-stop inputs, written by several processes, where a late reader may be handed
   /// an old writer's history after a newer release.
   std::vector<std::string> newest_stamp_topics = {"concert/safety/estop"};
+  /// A state topic keeps the latest sample of at most this many instances for late
+  /// subscribers, the least recently updated dropped first. The per-request topics (a plan
+  /// result with its path per request, a trajectory's, a mission's status) get a new instance
+  /// with every request: unbounded, the gateway's memory grew 14-18 % over two rounds of a shift.
+  /// Topics keyed by service, sensor or e-stop source have far fewer instances. 64 is what
+  /// the writers keep registered (concert/dds kLiveInstances).
+  std::size_t max_instances_kept = 64;
 };
 
 /// The DDS side, implemented by the adapter.
@@ -130,7 +137,12 @@ class Hub {
   struct Topic {
     TopicEntry entry;
     RateMeter meter;
-    std::map<std::string, Json, std::less<>> latest;  // state topics: per instance
+    struct Kept {
+      std::string message;            // the sample message as sent: a few times smaller than its Json
+      std::optional<int64_t> stamp;   // its data's stamp_ns, when it has one
+      uint64_t update = 0;            // Hub::updates_ when it was kept
+    };
+    std::map<std::string, Kept, std::less<>> latest;  // state topics: per instance
     bool newest_stamp = false;                         // keep the newest stamp_ns per instance
   };
 
@@ -164,6 +176,7 @@ class Hub {
   std::map<std::string, Topic, std::less<>> topics_;
   std::map<ClientId, Client> clients_;
   uint64_t published_ = 0, refused_ = 0, dropped_ = 0;
+  uint64_t updates_ = 0;  // state samples kept so far (the order of Topic::latest's updates)
   std::vector<std::pair<std::string, bool>> wanted_changes_;  // for the bus, outside the lock
 };
 

@@ -139,9 +139,7 @@ void Hub::handle(ClientId id, Client& client, const Subscribe& s, int64_t /*now_
   Json ack = {{"op", "ack"}, {"topic", s.topic}, {"max_hz", hz}};
   if (s.id) ack["id"] = *s.id;
   send_locked(id, ack.dump(), false);
-  for (const auto& [instance, data] : t->second.latest) {
-    send_locked(id, sample_message(s.topic, instance, data), false);
-  }
+  for (const auto& [instance, kept] : t->second.latest) send_locked(id, kept.message, false);
   if (first) wanted_changes_.emplace_back(s.topic, true);
 }
 
@@ -389,19 +387,29 @@ void Hub::on_sample(std::string_view topic_name, std::string_view instance,
     log_ << "concert_gui: a sample of " << topic_name << " does not decode: " << e.what() << std::endl;
     return;
   }
+  std::string message = sample_message(topic_name, instance, data);
   if (state) {
+    std::optional<int64_t> stamp;
+    if (data.contains("stamp_ns") && data["stamp_ns"].is_number()) stamp = data["stamp_ns"].get<int64_t>();
     auto kept = topic.latest.find(instance);
-    if (topic.newest_stamp && kept != topic.latest.end() && data.contains("stamp_ns") &&
-        kept->second.contains("stamp_ns") && data["stamp_ns"].is_number() && kept->second["stamp_ns"].is_number() &&
-        data["stamp_ns"].get<int64_t>() < kept->second["stamp_ns"].get<int64_t>()) {
+    if (topic.newest_stamp && kept != topic.latest.end() && stamp && kept->second.stamp &&
+        *stamp < *kept->second.stamp) {
       // An older sample than the one kept (another writer's history handed to a late reader):
       // neither kept nor shown.
       return;
     }
-    topic.latest[std::string(instance)] = data;
+    if (kept == topic.latest.end() && params_.max_instances_kept > 0 &&
+        topic.latest.size() >= params_.max_instances_kept) {
+      // A new instance on a full topic: the least recently updated one makes room.
+      const auto oldest = std::min_element(topic.latest.begin(), topic.latest.end(), [](const auto& a, const auto& b) {
+        return a.second.update < b.second.update;
+      });
+      topic.latest.erase(oldest);
+    }
+    for (ClientId id : due) send_locked(id, message, false);
+    topic.latest[std::string(instance)] = {std::move(message), stamp, ++updates_};
+    return;
   }
-  if (due.empty()) return;
-  const std::string message = sample_message(topic_name, instance, data);
   for (ClientId id : due) send_locked(id, message, false);
 }
 
