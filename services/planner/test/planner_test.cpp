@@ -571,6 +571,22 @@ TEST(Planner, ASwapBackToAModelKeepsItsPostureMemory) {
   EXPECT_EQ(forgetful.warm_up(1.2, 1.2, 0.2, 0.0), 0);
 }
 
+// The service's warm-up ends when the service stops: within a height's search, not after it
+// (each costs seconds of CPU, minutes at nice 19 on a loaded PC), and the height cut short is
+// searched again by the next warm-up.
+TEST(Planner, WarmUpStopsWithinAHeightsSearchAndSearchesItAgainLater) {
+  Params params = generous(23);
+  Planner planner(params);
+  planner.set_model(morphology('a', 9));
+  int asked = 0;
+  EXPECT_EQ(planner.warm_up(1.2, 1.2, 0.2, 15.0, [&] { return ++asked == 1; }), 0);
+  // Asked before the height, then before each seed: the first seed's "no" ends it.
+  EXPECT_LE(asked, 3);
+  EXPECT_EQ(planner.remembered(), 0u);
+  EXPECT_EQ(planner.warm_up(1.2, 1.2, 0.2, 15.0), 1);
+  EXPECT_GT(planner.remembered(), 0u);
+}
+
 namespace {
 
 // Morphology A (seed 5) before a low area on a bare wall 2.2 m ahead: the goal posture found

@@ -37,9 +37,12 @@ struct PostureResult {
 /// posture reaches the area from another side) before random seeds.
 /// `first_seed`: skip the seeds before this index (a previous result's next_seed: another
 /// posture for the same goal, when no path reached the first one).
+/// `keep_going` (or empty): asked before each seed; false ends the search there, as the budget
+/// would (the warm-up's shutdown: a height's search costs seconds of CPU).
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker, const Params& params,
                                const EndEffectorInfo& tool, const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
-                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints = {}, int first_seed = 0);
+                               uint64_t seed, const std::vector<Eigen::VectorXd>& hints = {}, int first_seed = 0,
+                               const std::function<bool()>& keep_going = {});
 
 /// Task error of a full q against a drilling area: (position error [m], axis error [rad]).
 std::pair<double, double> task_error(const PlanningModel& model, const Params& params, const EndEffectorInfo& tool,
@@ -84,8 +87,8 @@ class Planner {
   /// [m], each searched twice for up to `seconds_per_height` (once seeded by the neighbouring
   /// heights, once from random seeds for other posture families). Later goals near those
   /// heights start from them (the low, torque-bound areas otherwise cost the NSPG most of its
-  /// budget). Stops
-  /// early if the model changes or `keep_going` returns false. Returns the number of heights
+  /// budget). Stops early, within a height's search, if the model changes or `keep_going`
+  /// returns false (a height cut short is searched again by the next warm-up). Returns the number of heights
   /// solved.
   int warm_up(double from, double to, double step, double seconds_per_height,
               const std::function<bool()>& keep_going = [] { return true; });

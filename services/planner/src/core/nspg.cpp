@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -142,9 +143,11 @@ PostureResult generate_posture(const PlanningModel& model, StateChecker& checker
                                const Params& params, const EndEffectorInfo& tool,
                                const Eigen::VectorXd& q_start_full, const Eigen::Isometry3d& area,
                                uint64_t seed, const std::vector<Eigen::VectorXd>& hints,
-                               int first_seed) {
+                               int first_seed, const std::function<bool()>& keep_going) {
   const auto t0 = detail::ThreadCpuClock::now();
-  const auto out_of_time = [&] { return detail::cpu_seconds_since(t0) > params.nspg_time; };
+  const auto out_of_time = [&] {
+    return detail::cpu_seconds_since(t0) > params.nspg_time || (keep_going && !keep_going());
+  };
   const Task task = make_task(params, area);
   const int n = model.dof();
   const Eigen::VectorXd start = model.to_planned(q_start_full);

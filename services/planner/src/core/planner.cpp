@@ -150,12 +150,14 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
     // wall), then from the start posture and random seeds only, for other families: near an
     // obstacle the one that fits is often another family.
     bool found = false;
+    bool cut = false;
     for (const bool seeded : {true, false}) {
       params.nspg_enough = seeded ? 1 : 2;
       const uint64_t seed = params.seed + 31u * static_cast<uint64_t>(index) + (seeded ? 0u : 17u);
       const PostureResult p =
           generate_posture(*model, checker, params, *tool, start, area, seed,
-                           seeded ? hints_for(*model, height) : std::vector<Eigen::VectorXd>{});
+                           seeded ? hints_for(*model, height) : std::vector<Eigen::VectorXd>{}, 0,
+                           [&] { return this->model() == model && keep_going(); });
       for (const Eigen::VectorXd& q : p.valid) {
         // The arm's way from the start posture to it, where the map cannot interfere: later
         // plans replay it (checked against their map) instead of searching for it.
@@ -169,7 +171,10 @@ int Planner::warm_up(double from, double to, double step, double seconds_per_hei
         remember(*model, height, q, std::move(arms));
       }
       found = found || p.found;
+      cut = this->model() != model || !keep_going();
+      if (cut) break;
     }
+    if (cut) break;  // the height not searched in full: not recorded
     if (found) solved += 1;
     std::lock_guard lock(mutex_);
     if (model_ == model) memory_.warmed[height_mm] = found;
