@@ -241,6 +241,23 @@ std::optional<double> RobotModel::home(std::string_view joint) const {
   return it->second;
 }
 
+Eigen::VectorXd RobotModel::home_posture() const {
+  const kinematics::Model& kin = kinematics();
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(kin.dof());
+  for (int i = 0; i < kin.dof(); ++i) {
+    if (kin.is_virtual_joint(i)) continue;
+    const std::string& joint = kin.joint_names()[static_cast<std::size_t>(i)];
+    double value = home(joint).value_or(0.0);
+    if (const JointLimits* row = limits_.find(joint)) {
+      const double lower = std::isfinite(row->lower) ? row->lower : -M_PI;
+      const double upper = std::isfinite(row->upper) ? row->upper : M_PI;
+      value = std::clamp(value, lower, upper);
+    }
+    q[i] = value;
+  }
+  return q;
+}
+
 int RobotModel::link_index(std::string_view name) const {
   for (std::size_t i = 0; i < links_.size(); ++i) {
     if (links_[i].name == name) return static_cast<int>(i);

@@ -198,6 +198,22 @@ TEST(RobotModel, TheSrdfHomeIsTheHomingPosture) {
   EXPECT_EQ(m->home("J2_B"), 0.75);  // the state called home, not the first one
   EXPECT_EQ(m->home("J1_A"), std::nullopt);
   EXPECT_EQ(m->disabled_pairs().size(), 1u);
+  // As a posture: the named joints at their values, the others at 0, each within its limits
+  // (J2_B's 2.5 onto its upper limit 2; the continuous J2_A's -4 onto -pi).
+  const Eigen::VectorXd q = m->home_posture();
+  const kinematics::Model& kin = m->kinematics();
+  ASSERT_EQ(q.size(), kin.dof());
+  EXPECT_EQ(q[kin.joint_index_or_throw("J2_B")], 0.75);
+  EXPECT_EQ(q[kin.joint_index_or_throw("J1_A")], 0.0);
+  ModelDescription beyond = mini();
+  beyond.srdf = R"(<robot name="mini">
+  <group_state name="home" group="chains"><joint name="J2_B" value="2.5"/><joint name="J2_A" value="-4"/><joint name="J1_B" value="-0.5"/></group_state>
+</robot>)";
+  const auto b = RobotModel::build(beyond);
+  const Eigen::VectorXd qb = b->home_posture();
+  EXPECT_EQ(qb[kin.joint_index_or_throw("J2_B")], 2.0);
+  EXPECT_DOUBLE_EQ(qb[kin.joint_index_or_throw("J2_A")], -M_PI);
+  EXPECT_EQ(qb[kin.joint_index_or_throw("J1_B")], -0.5);
 
   ModelDescription bad = mini();
   bad.srdf = R"(<robot><group_state name="home"><joint name="J2_B" value="up"/></group_state></robot>)";

@@ -124,9 +124,9 @@ struct VehicleParams {
 /// the origin outside the footprint.
 VehicleConfig recognise_vehicle(const model::RobotModel& model, const VehicleParams& params = {});
 
-/// The transport posture: the SRDF's `home` group state where the model has one
-/// (model::RobotModel::home; joints it does not name at 0), else q = 0; size
-/// model.kinematics().dof(). `posture` (if not null) receives "SRDF home" or "q = 0".
+/// The transport posture: model::RobotModel::home_posture (the SRDF's `home` group state, joints
+/// it does not name at 0, within the limits); size model.kinematics().dof(). `posture` (if not
+/// null) receives "SRDF home" or "q = 0" (no home state in the SRDF).
 Eigen::VectorXd transport_posture(const model::RobotModel& model, std::string* posture = nullptr);
 
 /// Convex hull (counter-clockwise, no collinear vertices) of planar points.

@@ -200,13 +200,8 @@ std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> points) {
 }
 
 Eigen::VectorXd transport_posture(const RobotModel& model, std::string* posture) {
-  const kinematics::Model& kin = model.kinematics();
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(kin.dof());
-  for (const auto& [joint, value] : model.home()) {
-    if (const auto index = kin.joint_index(joint)) q[*index] = value;
-  }
   if (posture != nullptr) *posture = model.home().empty() ? "q = 0" : "SRDF home";
-  return q;
+  return model.home_posture();  // the planner's `plan home` ends on it too
 }
 
 VehicleConfig recognise_vehicle(const RobotModel& model, const VehicleParams& params) {

@@ -412,10 +412,12 @@ GoalResult Planner::plan_path(const PlanningModel& model, StateChecker& checker,
 
 Eigen::VectorXd home_posture(const PlanningModel& model, const Eigen::VectorXd& q_full) {
   Eigen::VectorXd home = model.to_planned(q_full);
-  for (Eigen::Index j = 3; j < home.size(); ++j) {
-    const std::string& name = model.joint_names()[static_cast<std::size_t>(j)];
-    home[j] = std::clamp(model.robot().home(name).value_or(0.0), model.lower()[j], model.upper()[j]);
-  }
+  // Nav's transport posture too; indexed by the fixed-base kinematics, the planner's has the
+  // base's virtual joints first.
+  const Eigen::VectorXd full_home = model.robot().home_posture();
+  const kinematics::Model& fixed = model.robot().kinematics();
+  for (Eigen::Index j = 3; j < home.size(); ++j)
+    home[j] = full_home[fixed.joint_index_or_throw(model.joint_names()[static_cast<std::size_t>(j)])];
   return home;
 }
 

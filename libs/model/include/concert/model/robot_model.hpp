@@ -87,6 +87,11 @@ class RobotModel {
   [[nodiscard]] const std::map<std::string, double>& home() const { return home_; }
   /// The `home` position of a joint, or nullopt when the SRDF gives none.
   [[nodiscard]] std::optional<double> home(std::string_view joint) const;
+  /// The homing posture as joint positions of kinematics() (size dof()): each joint at its
+  /// `home` value, 0 where the SRDF names none, clamped into its limits-table position range (a
+  /// continuous joint into [-pi, pi], as the planner bounds it); virtual base joints at 0. The
+  /// one posture nav drives with and the planner's `plan home` ends on.
+  [[nodiscard]] Eigen::VectorXd home_posture() const;
 
   /// The limits table (one row per moving joint); see limits.hpp for the limits rule.
   [[nodiscard]] const LimitsTable& limits() const { return limits_; }
