@@ -167,6 +167,29 @@ TEST_F(EngineTest, ANavigationTakesTheArmHomeFirst) {
   EXPECT_EQ(sink.goals.size(), 1u);
 }
 
+// The mission's end: the arm home, the base standing; nothing goes to nav. The planner's refusal
+// is the outcome's reason.
+TEST_F(EngineTest, StowingTakesTheArmHomeAndSaysWhyNot) {
+  engine.tick(0.0);
+  engine.stow();
+  ASSERT_EQ(sink.plans.size(), 1u);
+  EXPECT_TRUE(sink.plans[0].home);
+  EXPECT_TRUE(sink.plans[0].execute);
+  EXPECT_EQ(engine.stowing().progress, Progress::kRunning);
+  inputs.on_plan(reply(sink.plans[0].request_id, PlanState::kSucceeded));
+  EXPECT_EQ(engine.stowing().progress, Progress::kSucceeded);
+  EXPECT_TRUE(sink.goals.empty());
+
+  engine.stow();
+  ASSERT_EQ(sink.plans.size(), 2u);
+  PlanReply refused = reply(sink.plans[1].request_id, PlanState::kFailed);
+  refused.reason = "home: no collision-free path";
+  inputs.on_plan(refused);
+  const Outcome o = engine.stowing();
+  EXPECT_EQ(o.progress, Progress::kFailed);
+  EXPECT_EQ(o.reason, "home: no collision-free path");
+}
+
 // Stopped (an abort, a failure), nothing is sent again: a planner taking the request then would
 // still move the robot.
 TEST_F(EngineTest, AfterAStopNoPlanRequestIsSentAgain) {

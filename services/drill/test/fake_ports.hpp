@@ -12,7 +12,7 @@
 //
 // Calls: "resolve I", "navigate I" (I: the area whose base pose it is), "plan I after J|none",
 // "execute I", "detect I", "place I N" (N: the holes to place for), "align I LABEL",
-// "drill I LABEL DEPTH", "retract I LABEL", "stop".
+// "drill I LABEL DEPTH", "retract I LABEL", "stow", "stop".
 
 #include <cstdio>
 #include <functional>
@@ -158,6 +158,12 @@ class FakePorts : public MissionPorts {
   void retract() override { retraction_ = start("retract " + label_); }
   Outcome retraction() override { return poll(retraction_); }
 
+  void stow() override {
+    stowing_ = start("stow");
+    posture_ = "home";
+  }
+  Outcome stowing() override { return poll(stowing_); }
+
   void stop() override { record("stop"); }
 
   /// The calls that start with `prefix`.
@@ -203,7 +209,7 @@ class FakePorts : public MissionPorts {
 
   std::map<std::size_t, Running> resolving_, planning_;
   std::map<std::size_t, std::string> plan_from_;
-  Running navigation_, execution_, detection_, placing_, alignment_, drilling_, retraction_;
+  Running navigation_, execution_, detection_, placing_, alignment_, drilling_, retraction_, stowing_;
   std::size_t executing_{0}, detecting_{0};
   std::string label_;
   std::string posture_{"start"};

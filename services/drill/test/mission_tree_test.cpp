@@ -20,7 +20,9 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::ElementsAreArray;
 using testing::FakePorts;
+using ::testing::HasSubstr;
 using ::testing::IsEmpty;
+using ::testing::Not;
 using testing::run;
 
 // --- the engine ---------------------------------------------------------------------------------
@@ -188,6 +190,8 @@ TEST(MissionTree, ThreeAreasInFigure11Order) {
                   holes_of(1),
                   {"execute 2", "detect 2"},
                   holes_of(2),
+                  // the arm home at the end: ready to drive or to have its tool swapped
+                  {"stow"},
               })));
   EXPECT_LT(fake.index_of("plan 2 after 1"), fake.index_of("drill 1 blob 1 0.050"));
   EXPECT_GT(fake.index_of("execute 2"), fake.index_of("retract 1 blob 2"));
@@ -493,7 +497,7 @@ TEST(MissionTree, ResumeSkipsDrilledHolesAndDoneAreas) {
     ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
     EXPECT_THAT(fake.calls,
                 ElementsAre("resolve 1", "plan 1 after none", "execute 1", "detect 1", "place 1 1",
-                            "align 1 blob 2", "drill 1 blob 2 0.050", "retract 1 blob 2"));
+                            "align 1 blob 2", "drill 1 blob 2 0.050", "retract 1 blob 2", "stow"));
     second = tree.report();
     EXPECT_EQ(second.areas[0].state, AreaState::kSkipped);
     EXPECT_EQ(second.areas[0].reason, kDoneBefore);
@@ -508,7 +512,7 @@ TEST(MissionTree, ResumeSkipsDrilledHolesAndDoneAreas) {
     MissionTree tree(mission_of(3), fake);
     tree.resume(second);
     ASSERT_EQ(run(tree, fake), MissionState::kSucceeded);
-    EXPECT_THAT(fake.calls, IsEmpty()) << "every area was done in one run or the other";
+    EXPECT_THAT(fake.calls, IsEmpty()) << "every area was done in one run or the other: nothing moved, nothing stowed";
   }
 }
 
@@ -541,6 +545,48 @@ TEST(MissionTree, ResumeRefusesAnotherMissionOrAStartedOne) {
             "resume(): mission 'test' has started already");
 }
 
+// The arm goes home after the last area, whatever the areas' outcome; a homing that fails fails
+// the mission with its reason and what to do, the holes drilled as they were. A fatal retraction
+// (the bit may be in the wall) and an abort end the mission without it.
+TEST(MissionTree, TheArmGoesHomeAtTheEndUnlessTheMissionHadToStop) {
+  {
+    FakePorts fake(2);
+    fake.scripts["detect 1"] = {1.0, "no drilling point found"};
+    MissionTree tree(mission_of(2), fake);
+    ASSERT_EQ(run(tree, fake), MissionState::kFailed);
+    EXPECT_EQ(fake.calls.back(), "stow") << "after a failed area too";
+    EXPECT_THAT(tree.report().reason, Not(HasSubstr("home")));
+  }
+  {
+    FakePorts fake(1);
+    fake.scripts["stow"] = {1.0, "home: the homing posture is rejected where the robot stands by environment collision"};
+    MissionTree tree(mission_of(1), fake);
+    ASSERT_EQ(run(tree, fake), MissionState::kFailed);
+    EXPECT_EQ(tree.report().holes_drilled(), 2);
+    EXPECT_EQ(tree.report().areas[0].state, AreaState::kDone);
+    EXPECT_THAT(tree.report().reason,
+                HasSubstr("the arm did not go home at the end (home: the homing posture is rejected where the "
+                          "robot stands by environment collision): move it clear, then `concert plan home`"));
+  }
+  {
+    FakePorts fake(2);
+    fake.scripts["retract 0 blob 1"] = {1.0, "bit stuck"};
+    MissionTree tree(mission_of(2), fake);
+    ASSERT_EQ(run(tree, fake), MissionState::kFailed);
+    EXPECT_THAT(fake.calls_of("stow"), IsEmpty()) << "the bit may be in the wall";
+  }
+  {
+    FakePorts fake(1);
+    fake.scripts["drill 0 blob 1 0.050"] = {5.0, ""};
+    MissionTree tree(mission_of(1), fake);
+    fake.on_call = [&](const std::string& call) {
+      if (call == "drill 0 blob 1 0.050") fake.unhealthy = "e-stop pressed";
+    };
+    ASSERT_EQ(run(tree, fake), MissionState::kAborted);
+    EXPECT_THAT(fake.calls_of("stow"), IsEmpty());
+  }
+}
+
 TEST(MissionTree, TimesAddUp) {
   FakePorts fake(3);
   fake.areas[2].base = BasePose{2.0, -1.0, 0.0};
@@ -563,7 +609,7 @@ TEST(MissionTree, TimesAddUp) {
   const MissionTimes& t = tree.report().times;
   EXPECT_DOUBLE_EQ(t.navigate, 6.0);
   EXPECT_DOUBLE_EQ(t.plan, 3.0 + 10.0 + 2.0);
-  EXPECT_DOUBLE_EQ(t.execute, 3 * 4.0);
+  EXPECT_DOUBLE_EQ(t.execute, 3 * 4.0 + 1.0);  // the approaches, the arm home at the end
   EXPECT_DOUBLE_EQ(t.drill, 3 * (1.0 + 1.0 + 2 * (1.0 + 2.0 + 1.0)));  // detect, place, holes
   const double resolve = 3 * 1.0;
   EXPECT_DOUBLE_EQ(t.total, fake.now);
@@ -612,7 +658,7 @@ TEST(MissionTree, StatusNamesTheActiveNode) {
           {"mission/area 'a1'/navigate", "mission/area 'a1'/plan", "mission/area 'a1'/execute",
            "mission/area 'a1'/detect"},
           holes("a1"),
-          {""},
+          {"mission/stow the arm", ""},
       })));
 }
 
@@ -639,7 +685,10 @@ TEST(MissionTree, DescribesItsShape) {
             "          align and drill (sequence)\n"
             "            align (action)\n"
             "            drill (action)\n"
-            "          retract (action)\n");
+            "          retract (action)\n"
+            "  stow the arm if anything moved (fallback)\n"
+            "    nothing moved (condition)\n"
+            "    stow the arm (action)\n");
 }
 
 TEST(MissionTree, StateNames) {

@@ -136,6 +136,8 @@ class DrillEngine final : public MissionPorts {
   Outcome drilling() override;
   void retract() override;
   Outcome retraction() override;
+  void stow() override;
+  Outcome stowing() override;
   void stop() override;
 
   /// A joint state with its odometry, as received (robot clock).
@@ -349,9 +351,13 @@ class DrillEngine final : public MissionPorts {
   void hole_seen_again(const Eigen::Vector3d& in_odom);
   [[nodiscard]] std::string landmark(std::size_t area, const std::string& label) const;
   std::uint32_t nav_request_{0};
-  // Before a navigation goal: the planner's request that takes the arm home (0: none running),
-  // and the goal sent once it is there.
+  // Before a navigation goal and at the mission's end: the planner's request that takes the arm
+  // home (0: none running), and the goal sent once it is there.
   std::uint32_t home_request_{0};
+  /// Asks the planner to take the arm home (executed), the base standing.
+  void send_home();
+  /// The homing's outcome: kRunning until the planner's answer, failed with its reason.
+  Outcome homing();
   BasePose nav_goal_;
   std::map<std::size_t, Plan> plans_;
   std::optional<std::size_t> executing_area_;

@@ -2,7 +2,8 @@
 // The drilling mission as a behaviour tree (paper Fig. 11): initialise -> per area in FIFO
 // order: navigate if the area has a base pose -> execute the approach (planned while the
 // previous area was drilled) -> detect the points -> place the base once for them (not in the
-// paper: drill/placement.hpp says why) -> per point: align, drill, retract.
+// paper: drill/placement.hpp says why) -> per point: align, drill, retract; then the arm home
+// (not in the paper: navigation and a tool swap start from the transport posture).
 // Plain C++, no DDS.
 
 #include <cstddef>
@@ -83,6 +84,8 @@ struct MissionStatus {
 /// where one was expected) fails that area with its reason and the mission goes on with the
 /// next area; a failed hole goes on with the next hole after retracting. health() failing
 /// (e-stop, lost service) stops every motion and ends the mission kAborted, as abort() does.
+/// After the last area the arm goes home (MissionPorts::stow); a homing that fails fails the
+/// mission with its reason, the holes' states as they are.
 /// A new tree built with resume() skips every hole a previous report drilled.
 class MissionTree {
  public:

@@ -112,6 +112,12 @@ class MissionPorts {
   virtual void retract() = 0;
   virtual Outcome retraction() = 0;
 
+  /// Takes the arm to its homing posture, the base standing: the mission's last step, so the
+  /// robot ends ready to drive (navigation refuses an arm out of its transport posture) or to
+  /// have its tool swapped.
+  virtual void stow() = 0;
+  virtual Outcome stowing() = 0;
+
   /// Stops every motion at once (aborting): cancels navigation, holds the arm where it is.
   virtual void stop() = 0;
 };

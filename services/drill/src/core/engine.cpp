@@ -414,6 +414,10 @@ Outcome DrillEngine::resolution(std::size_t area, ResolvedArea& out) {
 // longer lead back to this area's approach.
 void DrillEngine::navigate(const BasePose& goal) {
   nav_goal_ = goal;
+  send_home();
+}
+
+void DrillEngine::send_home() {
   hole_chain_.clear();
   PlanAsk r;
   r.request_id = next_request_++;
@@ -425,13 +429,26 @@ void DrillEngine::navigate(const BasePose& goal) {
   send_plan(r);
 }
 
+Outcome DrillEngine::homing() {
+  if (home_request_ == 0) return Outcome::failed("no homing was asked for");
+  const std::optional<PlanReply> home = inputs_.plan(home_request_);
+  if (!home || (home->state != PlanState::kSucceeded && home->state != PlanState::kFailed))
+    return Outcome::running();
+  home_request_ = 0;
+  if (home->state == PlanState::kFailed) return Outcome::failed(home->reason);
+  return Outcome::succeeded();
+}
+
+// The mission's end: the arm goes home from wherever the last hole or area left it.
+void DrillEngine::stow() { send_home(); }
+
+Outcome DrillEngine::stowing() { return homing(); }
+
 Outcome DrillEngine::navigation() {
   if (home_request_ != 0) {
-    const std::optional<PlanReply> home = inputs_.plan(home_request_);
-    if (!home || (home->state != PlanState::kSucceeded && home->state != PlanState::kFailed))
-      return Outcome::running();
-    home_request_ = 0;
-    if (home->state == PlanState::kFailed) return Outcome::failed("the arm home before driving: " + home->reason);
+    const Outcome home = homing();
+    if (home.progress == Progress::kRunning) return home;
+    if (home.progress == Progress::kFailed) return Outcome::failed("the arm home before driving: " + home.reason);
     nav_request_ = next_request_++;
     sink_.navigate(nav_request_, static_cast<std::uint32_t>(model_version_), nav_goal_);
     return Outcome::running();

@@ -116,6 +116,8 @@ struct MissionTree::Impl {
   double last_now{0.0};
   Work waiting{Work::kNone};
   std::string fatal;  // why the mission cannot go on safely (set by a failed retraction)
+  std::string stow_failure;  // why the arm did not go home at the end
+  bool moved{false};         // a motion was started (navigate, execute, place, align)
 
   AreaReport& area() { return report.areas[current_area]; }
   HoleReport& hole() { return area().holes[current_hole]; }
@@ -183,7 +185,11 @@ struct MissionTree::Impl {
         "navigate if the area has a base pose",
         std::make_unique<bt::Condition>("no base pose", [this] { return !area().located.base; }),
         action(
-            "navigate", Work::kNavigate, [this] { ports.navigate(*area().located.base); },
+            "navigate", Work::kNavigate,
+            [this] {
+              moved = true;
+              ports.navigate(*area().located.base);
+            },
             [this] { return ports.navigation(); }));
     // Waits for the area's plan; starts it from the robot's current state if it was not planned
     // ahead: the first area, an area the base navigated to, an area after one whose approach
@@ -195,7 +201,11 @@ struct MissionTree::Impl {
         },
         [this] { return ports.planning(current_area); });
     auto execute = action(
-        "execute", Work::kExecute, [this] { ports.execute(current_area); },
+        "execute", Work::kExecute,
+        [this] {
+          moved = true;
+          ports.execute(current_area);
+        },
         [this] { return executed(); });
     auto plan_next = action(
         "plan the next area", Work::kNone, [this] { plan_next_area(); },
@@ -209,6 +219,7 @@ struct MissionTree::Impl {
     auto place = action(
         "place", Work::kDrill,
         [this] {
+          moved = true;
           placing = pending_holes();
           hole_order.clear();
           ports.place(current_area, pending_points());
@@ -216,7 +227,11 @@ struct MissionTree::Impl {
         [this] { return placed(); });
 
     auto align = action(
-        "align", Work::kDrill, [this] { ports.align(hole().point); },
+        "align", Work::kDrill,
+        [this] {
+          moved = true;
+          ports.align(hole().point);
+        },
         [this] { return ports.alignment(); });
     auto drill = action(
         "drill", Work::kDrill, [this] { ports.drill(hole().point, mission.depth); },
@@ -248,7 +263,24 @@ struct MissionTree::Impl {
           return area_done(status, why);
         },
         hidden(std::move(area_body)));
-    return sequence("mission", std::move(initialise), std::move(areas));
+    // The arm home from wherever the last area left it: the robot ends ready to drive or to
+    // have its tool swapped. Not after a fatal retraction (the bit may be in the wall), an
+    // abort or a failed health check: those end the mission before this node.
+    // Nothing moved (every area done before, or none located): nothing to stow.
+    auto stow_action = action(
+        "stow the arm", Work::kExecute, [this] { ports.stow(); },
+        [this] {
+          Outcome outcome = ports.stowing();
+          if (outcome.progress == Progress::kFailed) {
+            stow_failure = outcome.reason;
+            return Outcome::succeeded();  // the holes' outcome stands; conclude() adds this
+          }
+          return outcome;
+        });
+    auto stow = bt::fallback("stow the arm if anything moved",
+                             std::make_unique<bt::Condition>("nothing moved", [this] { return !moved; }),
+                             std::move(stow_action));
+    return sequence("mission", std::move(initialise), std::move(areas), hidden(std::move(stow)));
   }
 
   // --- what the nodes do --------------------------------------------------------------------
@@ -467,6 +499,10 @@ struct MissionTree::Impl {
       if (a.state != AreaState::kDone && a.state != AreaState::kSkipped) {
         problems.push_back(quoted("area", a.name) + ": " + a.reason);
       }
+    }
+    if (!stow_failure.empty()) {
+      problems.push_back("the arm did not go home at the end (" + stow_failure +
+                         "): move it clear, then `concert plan home`");
     }
     if (problems.empty()) {
       finish(MissionState::kSucceeded, "");
