@@ -28,7 +28,7 @@ RawSubscription::RawSubscription(Participant& participant, const std::string& to
                                  const Resolved& r, Callback cb, Matched matched)
     : participant_(participant), callback_(std::move(cb)), matched_(std::move(matched)) {
   auto* t = participant.topic(topic, TypeSupport(new RawPubSubType(r.type, r.keyed)));
-  auto qos = reader_qos(r.reliable ? QosClass::kCommand : QosClass::kStream);
+  auto qos = raw_reader_qos(r.reliable ? QosClass::kCommand : QosClass::kStream);
   qos.durability().kind =
       r.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
   qos.history().depth = 1000;

@@ -4,13 +4,19 @@
 
 #include <fastrtps/utils/md5.h>
 
+#include "concert/idl_schema/cdr.hpp"
+#include "concert/idl_schema/schema.hpp"
+
 namespace concert::dds {
 
 RawPubSubType::RawPubSubType(const std::string& type_name, bool keyed) {
   setName(type_name.c_str());
-  // Initial buffer size only: writers and readers reallocate for larger samples.
+  // The size Fast DDS preallocates sample buffers at (they grow for larger samples); raw_*_qos
+  // endpoints allocate each sample at its own size instead.
   m_typeSize = 64 * 1024;
   m_isGetKeyDefined = keyed;
+  const auto* def = idl::Schema::builtin().find_struct(type_name);
+  key_layout_ = keyed && def != nullptr && def->keyed();
 }
 
 bool RawPubSubType::serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) {
@@ -44,6 +50,16 @@ bool RawPubSubType::getKey(void* data, eprosima::fastrtps::rtps::InstanceHandle_
     return true;
   }
   const auto& bytes = sample.bytes;
+  if (key_layout_) {
+    try {
+      if (const auto key = idl::key_hash_of_cdr(idl::Schema::builtin(), getName(), bytes)) {
+        for (size_t i = 0; i < 16; ++i) handle->value[i] = (*key)[i];
+        return true;
+      }
+    } catch (const idl::CdrError&) {
+      // Falls through: the bytes do not decode as the type, the sample gets an instance of its own.
+    }
+  }
   MD5 md5;
   md5.init();
   md5.update(bytes.data(), static_cast<unsigned int>(bytes.size()));

@@ -6,15 +6,23 @@
 #include <atomic>
 #include <chrono>
 #include <iostream>
+#include <map>
+#include <mutex>
+#include <span>
 #include <thread>
 #include <vector>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/qos.hpp"
+#include "concert/dds/raw_subscription.hpp"
+#include "concert/dds/raw_type.hpp"
+#include "concert/idl_schema/cdr.hpp"
+#include "concert/idl_schema/schema.hpp"
 #include "concert/dds/status_reporter.hpp"
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 
 namespace concert::dds {
 namespace {
@@ -119,6 +127,139 @@ TEST(Endpoint, CallbackReaderAndQosFromTheCatalogue) {
   writer.get()->get_qos(q);
   EXPECT_EQ(q.reliability().kind, eprosima::fastdds::dds::BEST_EFFORT_RELIABILITY_QOS);
   EXPECT_EQ(q.history().depth, 1);
+}
+
+// Endpoints of a raw type allocate each sample at its size (raw_writer_qos, raw_reader_qos), not
+// preallocated at the raw type's 64 KB: samples several times larger, and small ones after them,
+// arrive whole between a raw endpoint and a typed one, both ways.
+TEST(Endpoint, RawEndpointsCarrySamplesOfAnySize) {
+  namespace fdds = eprosima::fastdds::dds;
+  const auto& schema = idl::Schema::builtin();
+  const std::string topic(topics::robot_model.name);
+  const Resolved raw_type = *from_catalogue(topic);
+  Participant typed_side({.name = "typed"}), raw_side({.name = "raw"});
+
+  std::mutex mutex;
+  std::vector<size_t> typed_got;  // urdf sizes the typed reader received
+  Reader<msg::RobotModel> typed_reader(typed_side, topics::robot_model, [&](const msg::RobotModel& m, const auto&) {
+    std::lock_guard lock(mutex);
+    typed_got.push_back(m.urdf().size());
+  });
+  auto* t = raw_side.topic(topic, fdds::TypeSupport(new RawPubSubType(raw_type.type, raw_type.keyed)));
+  auto* raw_writer = raw_side.publisher()->create_datawriter(t, raw_writer_qos(QosClass::kLatched));
+  ASSERT_NE(raw_writer, nullptr);
+  std::vector<size_t> raw_got;  // urdf sizes the raw reader decoded
+  RawSubscription raw_reader(raw_side, topic, raw_type, [&](std::vector<uint8_t>& bytes, const auto&) {
+    const auto m = idl::decode(schema, raw_type.type, std::span<const uint8_t>(bytes));
+    std::lock_guard lock(mutex);
+    raw_got.push_back(m.at("urdf").get<std::string>().size());
+  });
+  Writer<msg::RobotModel> typed_writer(typed_side, topics::robot_model);
+  ASSERT_TRUE(typed_writer.wait_for_readers(2, 10s)) << "the raw reader did not match";
+  const auto arrived = [&](const std::vector<size_t>& got, size_t size) {
+    for (int i = 0; i < 1000; ++i) {  // bounded: 10 s
+      {
+        std::lock_guard lock(mutex);
+        if (std::find(got.begin(), got.end(), size) != got.end()) return true;
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+    return false;
+  };
+
+  uint32_t version = 10;
+  for (const size_t size : {size_t{300'000}, size_t{12}, size_t{200'000}}) {
+    idl::Json sample = idl::complete(schema, raw_type.type,
+                                     {{"version", ++version}, {"urdf", std::string(size, 'r')}});
+    RawSample raw{idl::encode(schema, raw_type.type, sample), idl::key_hash(schema, raw_type.type, sample)};
+    ASSERT_TRUE(raw_writer->write(&raw)) << size << " bytes";
+    EXPECT_TRUE(arrived(typed_got, size)) << "a raw writer's " << size << "-byte model did not reach a typed reader";
+
+    msg::RobotModel m = model(++version);
+    m.urdf(std::string(size + 1, 't'));
+    ASSERT_TRUE(typed_writer.write(m));
+    EXPECT_TRUE(arrived(raw_got, size + 1)) << "a typed writer's " << size + 1 << "-byte model did not reach a raw reader";
+  }
+  raw_side.publisher()->delete_datawriter(raw_writer);
+}
+
+// A raw type computes a keyed sample's instance from its key fields, as the typed endpoints do:
+// a reader computes it for every sample (Fast DDS writers send no key hash unless asked). From the whole bytes, each status report of a service was an instance of its own
+// in the GUI gateway: 110 000 instances in 10 minutes of a shift, never released.
+TEST(Endpoint, ARawTypesInstanceIsItsKeyNotItsBytes) {
+  const auto& schema = idl::Schema::builtin();
+  const std::string type = "concert::msg::ServiceStatus";
+  RawPubSubType raw(type, true);
+  const auto handle_of = [&](const idl::Json& partial) {
+    RawSample sample{idl::encode(schema, type, idl::complete(schema, type, partial)), std::nullopt};
+    eprosima::fastrtps::rtps::InstanceHandle_t handle;
+    EXPECT_TRUE(raw.getKey(&sample, &handle, false));
+    return handle;
+  };
+  const auto a1 = handle_of({{"id", 7}, {"service", "planner"}, {"stamp_ns", 1}});
+  const auto a2 = handle_of({{"id", 7}, {"service", "planner"}, {"stamp_ns", 2}, {"message", "ready"}});
+  const auto b = handle_of({{"id", 8}, {"service", "planner"}, {"stamp_ns", 1}});
+  EXPECT_EQ(a1, a2) << "two reports of one service are one instance";
+  EXPECT_NE(a1, b);
+  const auto key = idl::key_hash(schema, type, idl::complete(schema, type, {{"id", 7}}));
+  ASSERT_TRUE(key.has_value());
+  for (size_t i = 0; i < 16; ++i) EXPECT_EQ((*key)[i], a1.value[i]) << "byte " << i << " of the key hash typed endpoints compute";
+
+  // A type outside our IDL: no key layout, each sample its own instance.
+  RawPubSubType foreign("other::Sample", true);
+  RawSample x{{0, 1, 0, 0, 1, 2, 3, 4}, std::nullopt}, y{{0, 1, 0, 0, 1, 2, 3, 5}, std::nullopt};
+  eprosima::fastrtps::rtps::InstanceHandle_t hx, hy;
+  ASSERT_TRUE(foreign.getKey(&x, &hx, false));
+  ASSERT_TRUE(foreign.getKey(&y, &hy, false));
+  EXPECT_NE(hx, hy);
+}
+
+// The same between processes' participants: samples travel through the transport, not handed
+// over in the process with the writer's instance, as in the GUI gateway.
+TEST(Endpoint, ARawSubscriptionSeesOneInstancePerKey) {
+  using eprosima::fastrtps::LibrarySettingsAttributes;
+  using eprosima::fastrtps::xmlparser::XMLProfileManager;
+  const LibrarySettingsAttributes before = XMLProfileManager::library_settings();
+  LibrarySettingsAttributes interprocess = before;
+  interprocess.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  XMLProfileManager::library_settings(interprocess);
+  {
+    Participant writer_side({.name = "writer"}), reader_side({.name = "reader"});
+    const std::string topic(topics::status.name);
+    std::mutex mutex;
+    std::map<std::string, int> reports;  // "id instance" -> samples
+    RawSubscription reader(reader_side, topic, *from_catalogue(topic), [&](std::vector<uint8_t>& bytes, const auto& info) {
+      const auto m = idl::decode(idl::Schema::builtin(), "concert::msg::ServiceStatus", std::span<const uint8_t>(bytes));
+      std::string instance;
+      for (size_t k = 0; k < 16; ++k) instance += std::to_string(info.instance_handle.value[k]) + ".";
+      std::lock_guard lock(mutex);
+      ++reports[std::to_string(m.at("id").get<uint32_t>()) + " " + instance];
+    });
+    Writer<msg::ServiceStatus> writer(writer_side, topics::status);
+    ASSERT_TRUE(writer.wait_for_readers(1, 10s));
+    constexpr int kReports = 5;
+    for (int i = 0; i < kReports; ++i) {
+      for (const uint32_t id : {1u, 2u}) {
+        msg::ServiceStatus s;
+        s.id(id);
+        s.stamp_ns(i);
+        s.message("report " + std::to_string(i));
+        ASSERT_TRUE(writer.write(s));
+      }
+      // Each report taken before the next: keep-last 1 per instance.
+      const auto received = [&] {
+        std::lock_guard lock(mutex);
+        int got = 0;
+        for (const auto& [id_instance, n] : reports) got += n;
+        return got;
+      };
+      for (int wait = 0; wait < 1000 && received() < 2 * (i + 1); ++wait) std::this_thread::sleep_for(10ms);  // 10 s
+    }
+    std::lock_guard lock(mutex);
+    ASSERT_EQ(reports.size(), 2u) << "one instance per service id, not per report";
+    for (const auto& [id_instance, n] : reports) EXPECT_EQ(n, kReports) << id_instance;
+  }
+  XMLProfileManager::library_settings(before);
 }
 
 TEST(Endpoint, TopicsOutsideTheCatalogueAreRefused) {

@@ -126,7 +126,7 @@ struct Writer {
     const bool keyed = schema().at(info.type_name).keyed();
     auto* t = p.topic(topic, eprosima::fastdds::dds::TypeSupport(new concert::dds::RawPubSubType(
                                  std::string(info.type_name), keyed)));
-    writer = p.publisher()->create_datawriter(t, concert::dds::writer_qos(info.qos));
+    writer = p.publisher()->create_datawriter(t, concert::dds::raw_writer_qos(info.qos));
   }
   bool matched() const {
     eprosima::fastdds::dds::PublicationMatchedStatus m;

@@ -97,7 +97,7 @@ int play(const PlayOptions& o, std::ostream& out, std::ostream& err) {
   for (auto& [id, t] : tracks) {
     auto* topic = participant.topic(
         t.topic, eprosima::fastdds::dds::TypeSupport(new dds::RawPubSubType(t.type, t.keyed)));
-    t.writer = participant.publisher()->create_datawriter(topic, dds::writer_qos(t.qos));
+    t.writer = participant.publisher()->create_datawriter(topic, dds::raw_writer_qos(t.qos));
     if (t.writer == nullptr) throw cli::Failure("cannot create a writer on '" + t.topic + "'");
   }
   // Until every topic has a reader and no further reader has matched for a moment (readers of

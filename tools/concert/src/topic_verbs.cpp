@@ -297,7 +297,7 @@ int pub(const Publish& p, std::ostream& out) {
   auto* topic = participant.topic(
       p.topic,
       eprosima::fastdds::dds::TypeSupport(new dds::RawPubSubType(type, schema.at(type).keyed())));
-  auto* writer = participant.publisher()->create_datawriter(topic, dds::writer_qos(info->qos));
+  auto* writer = participant.publisher()->create_datawriter(topic, dds::raw_writer_qos(info->qos));
   if (writer == nullptr) {
     throw Failure("cannot create a writer on '" + p.topic + "'" + dds::why_refused(participant, p.topic, true));
   }

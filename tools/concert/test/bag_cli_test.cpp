@@ -64,7 +64,7 @@ class Publisher {
     const bool keyed = idl::Schema::builtin().at(type_).keyed();
     auto* t =
         p.topic(topic, eprosima::fastdds::dds::TypeSupport(new dds::RawPubSubType(type_, keyed)));
-    writer_ = p.publisher()->create_datawriter(t, dds::writer_qos(info.qos));
+    writer_ = p.publisher()->create_datawriter(t, dds::raw_writer_qos(info.qos));
   }
   ~Publisher() { participant_.publisher()->delete_datawriter(writer_); }
   /// Writes `sample` (every field given); returns its bytes.

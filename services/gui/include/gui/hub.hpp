@@ -57,7 +57,7 @@ struct HubParams {
   /// A state topic keeps the latest sample of at most this many instances for late
   /// subscribers, the least recently updated dropped first. The per-request topics (a plan
   /// result with its path per request, a trajectory's, a mission's status) get a new instance
-  /// with every request: unbounded, the gateway's memory grew 14-18 % over two rounds of a shift.
+  /// with every request: unbounded, the cache would grow with every request for good.
   /// Topics keyed by service, sensor or e-stop source have far fewer instances. 64 is what
   /// the writers keep registered (concert/dds kLiveInstances).
   std::size_t max_instances_kept = 64;

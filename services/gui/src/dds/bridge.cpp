@@ -84,7 +84,7 @@ Bridge::Bridge(concert::dds::Participant& participant, Hub& hub, JpegParams jpeg
     const std::string topic(c.topic);
     const std::string type(info->type_name);
     auto* t = participant.topic(topic, fdds::TypeSupport(new concert::dds::RawPubSubType(type, schema.at(type).keyed())));
-    auto* writer = participant.publisher()->create_datawriter(t, concert::dds::writer_qos(info->qos));
+    auto* writer = participant.publisher()->create_datawriter(t, concert::dds::raw_writer_qos(info->qos));
     if (writer == nullptr) {
       throw std::runtime_error("cannot create a writer on '" + topic + "'" +
                                concert::dds::why_refused(participant, topic, true));

@@ -20,4 +20,10 @@ inline constexpr std::size_t kLiveInstances = 64;
 eprosima::fastdds::dds::DataWriterQos writer_qos(QosClass qos);
 eprosima::fastdds::dds::DataReaderQos reader_qos(QosClass qos);
 
+/// The same for endpoints of a raw type (RawPubSubType: any topic as serialized bytes), whose
+/// sample memory is allocated at each sample's size and freed with the sample: preallocation
+/// would size every sample at the raw type's 64 KB, 100 of them per topic.
+eprosima::fastdds::dds::DataWriterQos raw_writer_qos(QosClass qos);
+eprosima::fastdds::dds::DataReaderQos raw_reader_qos(QosClass qos);
+
 }  // namespace concert::dds

@@ -28,9 +28,16 @@ class RawPubSubType : public eprosima::fastdds::dds::TopicDataType {
   std::function<uint32_t()> getSerializedSizeProvider(void* data) override;
   void* createData() override;
   void deleteData(void* data) override;
-  /// The sample's `key` when set; else, without the type's key layout, each sample is its own
-  /// instance (MD5 of its bytes).
+  /// The sample's `key` when set; else, for a type of our IDL (idl::Schema::builtin()), the key
+  /// hash of its key fields as Fast DDS and Cyclone compute it. A reader computes it for every
+  /// sample: Fast DDS writers send the key hash only to a reader that expects inline QoS, and
+  /// Cyclone's do not match such a reader. Without the type's key layout (a type not ours, a
+  /// sample that does not decode) each sample is its own instance: the MD5 of its bytes, held by
+  /// the reader for as long as its writer lives.
   bool getKey(void* data, eprosima::fastrtps::rtps::InstanceHandle_t* handle, bool force_md5) override;
+
+ private:
+  bool key_layout_ = false;  // the builtin schema knows the type's key fields
 };
 
 }  // namespace concert::dds
