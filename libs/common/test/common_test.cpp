@@ -1,4 +1,7 @@
 #include <gtest/gtest.h>
+#include <malloc.h>
+
+#include <cstdlib>
 
 #include <filesystem>
 #include <fstream>
@@ -6,6 +9,7 @@
 
 #include "concert/common/clock.hpp"
 #include "concert/common/enum_map.hpp"
+#include "concert/common/memory.hpp"
 #include "concert/common/text.hpp"
 
 namespace concert {
@@ -75,6 +79,22 @@ TEST(Clock, NowIsWallClockNanoseconds) {
   const int64_t b = now_ns();
   EXPECT_LE(a, b);
   EXPECT_GT(a, int64_t{1'600'000'000} * 1'000'000'000);  // after September 2020
+}
+
+// After a large mapped block is freed, a 1 MiB block is still mapped on its own (returned to the
+// system when freed), not carved from the heap: glibc's moving threshold would have risen to 8 MiB.
+TEST(Memory, FixedMallocThresholdsMapLargeBlocksAfterALargerOneWasFreed) {
+  ASSERT_TRUE(fix_malloc_thresholds());
+  auto* big = static_cast<volatile char*>(std::malloc(8u << 20));
+  ASSERT_NE(big, nullptr);
+  big[0] = 1;
+  std::free(const_cast<char*>(big));
+  const auto mapped_before = mallinfo2().hblks;
+  auto* block = static_cast<volatile char*>(std::malloc(1u << 20));
+  ASSERT_NE(block, nullptr);
+  block[0] = 1;
+  EXPECT_EQ(mallinfo2().hblks, mapped_before + 1) << "the 1 MiB block came from the heap";
+  std::free(const_cast<char*>(block));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <iostream>
 
+#include "concert/common/memory.hpp"
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "concert/dds/participant.hpp"
@@ -27,6 +28,7 @@ int run(const concert::collab::dds::NodeParams& params) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli("concert_collab", "Collaborative transportation: voice-commanded modes, follow-me MPC.",
                         std::cout, std::cerr);
   concert::collab::dds::NodeParams params;

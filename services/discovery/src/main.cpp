@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "concert/common/memory.hpp"
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "concert/dds/participant.hpp"
@@ -50,6 +51,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli("concert_discovery",
                         "The discovery service: EtherCAT scan -> module tree (versioned, latched).",
                         std::cout, std::cerr);

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "concert/common/memory.hpp"
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "concert/dds/participant.hpp"
@@ -54,6 +55,7 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli("concert_drill",
                         "Drilling missions: marks -> areas -> approach -> closed-loop drilling.",
                         std::cout, std::cerr);

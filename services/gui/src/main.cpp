@@ -6,11 +6,13 @@
 // Domain: CONCERT_DOMAIN_ID. Stops on SIGINT/SIGTERM.
 #include <iostream>
 
+#include "concert/common/memory.hpp"
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "gui/cli.hpp"
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli("concert_gui", "The operator GUI's gateway: web app + WebSocket API over DDS.", std::cout,
                         std::cerr);
   concert::gui::GatewayOptions o;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "concert/common/memory.hpp"
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "concert/dds/participant.hpp"
@@ -41,6 +42,7 @@ int run(Options options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli("concert_modelgen",
                         "The model generation service: module tree -> robot model (URDF, SRDF, controller "
                         "configuration), versioned and latched.",

@@ -11,6 +11,7 @@
 #include <iostream>
 #include <string>
 
+#include "concert/common/memory.hpp"
 #include "concert/bim/model.hpp"
 #include "concert/bim/storey_map.hpp"
 #include "concert/cli/cli.hpp"
@@ -75,6 +76,7 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli("concert_nav",
                         "Navigation of the mobile base in the building (BIM map, lidars).",
                         std::cout, std::cerr);

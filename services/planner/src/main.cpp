@@ -10,6 +10,7 @@
 #include <iostream>
 #include <string>
 
+#include "concert/common/memory.hpp"
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "concert/dds/participant.hpp"
@@ -52,6 +53,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli("concert_planner", "Whole-body planning for drilling (NSPG + RRT-Connect).",
                         std::cout, std::cerr);
   Options options;

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "concert/common/memory.hpp"
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "concert/common/text.hpp"
@@ -297,6 +298,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli(
       "concert_robot",
       "The robot service: hardware abstraction (simulated by default), 1 kHz loop.", std::cout,

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <string>
 
+#include "concert/common/memory.hpp"
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "concert/common/priority.hpp"
@@ -41,6 +42,7 @@ int run(const std::string& params_file, const std::string& state_file) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli(
       "concert_safety",
       "The safety layer: e-stop inputs, liveliness of the services, joint limits.", std::cout,

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <string>
 
+#include "concert/common/memory.hpp"
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "concert/dds/participant.hpp"
@@ -28,6 +29,7 @@ int run(const concert::surface_finish::dds::NodeParams& params) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  concert::fix_malloc_thresholds();  // a heap that does not grow with every hot swap
   concert::cli::Cli cli("concert_surface_finish", "Sanding and spraying of a wall area.", std::cout, std::cerr);
   concert::surface_finish::dds::NodeParams params;
   auto& app = cli.app();
