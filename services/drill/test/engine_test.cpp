@@ -382,6 +382,146 @@ TEST_F(RigEngineTest, APostureReachedIsMeasuredAgainThenTheBitAligned) {
   EXPECT_EQ(engine.alignment().progress, Progress::kRunning);
 }
 
+// --- Where the arm waits (Params::Rest) ---------------------------------------------------------
+// The robot reports each drive's torque; the drill keeps safety's thermal rule on it. An arm whose
+// drives run hot goes home before a hole's posture is asked and waits there, cooling, while the
+// planner's request is held back; a cool arm asks at once.
+
+struct RestTest : RigEngineTest {
+  std::string hot_joint;
+  double continuous = 0.0;
+
+  void SetUp() override {
+    RigEngineTest::SetUp();
+    for (const std::string& j : rig->model().arm().joints) {
+      const model::JointLimits& l = rig->model().limits().at(j);
+      if (l.continuous_torque > continuous) {
+        continuous = l.continuous_torque;
+        hot_joint = j;
+      }
+    }
+    ASSERT_GT(continuous, 0.0);
+  }
+
+  // Joint samples over `seconds` of robot time, `hot_joint` carrying `share` of its continuous
+  // torque, the other joints 1 N m.
+  void load(double share, double seconds) {
+    std::vector<double> efforts(joints.names.size(), 1.0);
+    const auto at = std::find(joints.names.begin(), joints.names.end(), hot_joint);
+    ASSERT_NE(at, joints.names.end());
+    efforts[static_cast<std::size_t>(at - joints.names.begin())] = share * continuous;
+    for (int i = 0; i < static_cast<int>(std::lround(seconds / 0.005)); ++i) {
+      stamp_ns += 5'000'000;
+      inputs.on_joints(stamp_ns, joints, Inputs::Clock::now(), efforts);
+    }
+  }
+  [[nodiscard]] double robot_seconds() const { return 1e-9 * static_cast<double>(stamp_ns); }
+};
+
+TEST_F(RestTest, ACoolArmAsksForTheHolesPostureAtOnce) {
+  load(0.8, 30.0);  // the RMS settles at 0.8 of continuous, below rest.above (0.85)
+  engine.align(hole_ahead());
+  ASSERT_EQ(sink.plans.size(), 1u);
+  EXPECT_FALSE(sink.plans[0].home);
+  EXPECT_EQ(sink.logged("rests at home"), 0u) << sink.log_text;
+}
+
+TEST_F(RestTest, AHotArmRestsAtHomeUntilItsDrivesCooledThenAsks) {
+  load(0.95, 30.0);  // the RMS over the 5 s window settles at 0.95 of continuous
+  const DrillPoint hole = hole_ahead();
+  engine.align(hole);
+  ASSERT_EQ(sink.plans.size(), 1u);
+  const PlanAsk home = sink.plans[0];
+  EXPECT_TRUE(home.home);
+  EXPECT_TRUE(home.execute);
+  EXPECT_EQ(sink.logged("drill: the arm rests at home before the planner's next answer (" + hot_joint + ": RMS "), 1u)
+      << sink.log_text;
+  EXPECT_EQ(sink.logged("0.95 of its continuous torque)"), 1u) << sink.log_text;
+  EXPECT_EQ(engine.alignment().progress, Progress::kRunning);
+
+  // At home, the drive carries little; the hole's request waits until the RMS is below
+  // rest.until (0.7): from 0.95 at 0.1 of continuous, 5 s x ln((0.95^2 - 0.1^2) / (0.7^2 - 0.1^2))
+  // = 3.1 s of robot time.
+  answer(PlanState::kSucceeded);
+  const double home_at = robot_seconds();
+  double asked_at = -1.0;
+  for (int i = 0; i < 2000 && asked_at < 0.0; ++i) {
+    load(0.1, 0.005);
+    step();
+    if (sink.plans.size() > 1) asked_at = robot_seconds();
+  }
+  ASSERT_GT(asked_at, 0.0) << sink.log_text;
+  EXPECT_NEAR(asked_at - home_at, 5.0 * std::log((0.95 * 0.95 - 0.01) / (0.49 - 0.01)), 0.05);
+  ASSERT_EQ(sink.plans.size(), 2u);
+  const PlanAsk asked = sink.plans[1];
+  EXPECT_FALSE(asked.home);
+  EXPECT_TRUE(asked.fixed_base);
+  ASSERT_EQ(asked.goals.size(), 1u);
+  EXPECT_TRUE(asked.goals[0].isApprox(hole.frame, 1e-9));
+  EXPECT_EQ(sink.logged("at home, its drives at 0.70 of continuous; 1 plan request sent"), 1u) << sink.log_text;
+
+  // The hole goes on as without the rest: its posture found, reached, the hole measured again.
+  answer(PlanState::kSucceeded);
+  step();
+  camera_sees_blob_at(hole.frame.translation(), tuning.camera.reanchor_frames);
+  step(2);
+  EXPECT_EQ(sink.logged("blob 1 measured again from its drilling posture"), 1u) << sink.log_text;
+  EXPECT_EQ(engine.alignment().progress, Progress::kRunning);
+}
+
+// A posture that loads a drive beyond its continuous torque is left before the wait, before
+// the RMS has risen: held through the planner's search it would pass safety's bound.
+TEST_F(RestTest, APostureHeldBeyondTheContinuousTorqueIsLeftBeforeTheWait) {
+  load(1.05, 3.0);  // the RMS from cold: 1.05 x sqrt(1 - e^-0.6) = 0.74 of continuous
+  engine.align(hole_ahead());
+  ASSERT_EQ(sink.plans.size(), 1u);
+  EXPECT_TRUE(sink.plans[0].home);
+  EXPECT_EQ(sink.logged("(" + hot_joint + ": holds "), 1u) << sink.log_text;
+}
+
+// A rest is bounded: drives still hot after rest.timeout of robot time (20 s) at home, the
+// request goes anyway, said so; a homing the planner refuses sends it at once from where the arm is.
+TEST_F(RestTest, ARestEndsAfterItsTimeoutOrWhenTheArmCannotGoHome) {
+  load(0.95, 30.0);
+  engine.align(hole_ahead());
+  ASSERT_TRUE(sink.plans.at(0).home);
+  answer(PlanState::kSucceeded);
+  const double home_at = robot_seconds();
+  for (int i = 0; i < 100 && sink.plans.size() == 1; ++i) {
+    load(0.95, 0.5);
+    step();
+  }
+  ASSERT_EQ(sink.plans.size(), 2u) << sink.log_text;
+  EXPECT_NEAR(robot_seconds() - home_at, tuning.rest.timeout, 0.5 + 1e-9);
+  EXPECT_EQ(sink.logged("at home, its drives still at 0.95 of continuous; 1 plan request sent"), 1u) << sink.log_text;
+
+  // The hole's next attempt, still hot: the planner cannot take the arm home.
+  answer(PlanState::kFailed, PlanFailure::kUnreachable, "no posture reaches the hole");
+  step();
+  ASSERT_EQ(sink.plans.size(), 3u) << sink.log_text;
+  EXPECT_TRUE(sink.plans[2].home);
+  answer(PlanState::kFailed, PlanFailure::kUnreachable, "home: no collision-free path");
+  step();
+  ASSERT_EQ(sink.plans.size(), 4u) << sink.log_text;
+  EXPECT_FALSE(sink.plans[3].home);
+  EXPECT_EQ(sink.logged("the arm could not go home to rest (home: no collision-free path); asked from where it "
+                        "stands; 1 plan request sent"),
+            1u)
+      << sink.log_text;
+}
+
+// A stop drops the requests a rest held back: none is sent after it.
+TEST_F(RestTest, AStopDropsTheRequestsARestHeldBack) {
+  load(0.95, 30.0);
+  engine.align(hole_ahead());
+  ASSERT_TRUE(sink.plans.at(0).home);
+  engine.stop();
+  answer(PlanState::kSucceeded);
+  load(0.0, 30.0);
+  step(10);
+  EXPECT_EQ(sink.plans.size(), 1u) << sink.log_text;
+}
+
 // A loaded machine slows the simulated robot: the alignment's time limit counts the robot's time
 // (the joint samples' stamps), so a wall clock running ten times faster fails nothing; the arm
 // not aligned after align_timeout of its own time fails the hole, saying so.

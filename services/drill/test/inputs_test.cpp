@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace concert::drill {
 namespace {
 
@@ -105,6 +107,24 @@ TEST(DrillInputs, RepliesAreKeptPerRequestAndPlansMerged) {
   in.on_nav(7, {Progress::kSucceeded, {}, {}});
   EXPECT_EQ(in.nav(7)->progress, Progress::kSucceeded);
   EXPECT_EQ(in.trajectory(7)->progress, Progress::kFailed);  // separate tables
+}
+
+// Each joint's heat from the efforts of every state (not only the samples kept): safety's
+// thermal rule (model::ThermalLoad) over its window and the present load over a short one. A
+// state without as many efforts as names feeds nothing; a new rig starts cold.
+TEST(DrillInputs, TheJointsHeatFollowsTheReportedEffortsAndANewRigStartsCold) {
+  Inputs in = make_inputs();
+  EXPECT_TRUE(in.heat().empty());
+  std::int64_t stamp = 1'000'000;
+  for (int i = 0; i < 5000; ++i) in.on_joints(stamp += 1'000'000, arm(0.0), kT0, {-100.0});  // 5 s at 1 kHz
+  ASSERT_EQ(in.heat().count("J1"), 1u);
+  // 5 s of 100 N m from cold: RMS 100 x sqrt(1 - e^-1), present 100 x sqrt(1 - e^-10).
+  EXPECT_NEAR(in.heat().at("J1").rms, 100.0 * std::sqrt(1.0 - std::exp(-1.0)), 0.05);
+  EXPECT_NEAR(in.heat().at("J1").present, 100.0, 0.05);
+  in.on_joints(stamp += 1'000'000, arm(0.0), kT0, {1.0, 2.0});  // efforts of another state
+  EXPECT_NEAR(in.heat().at("J1").present, 100.0, 0.05);
+  in.set_rig(nullptr);
+  EXPECT_TRUE(in.heat().empty());
 }
 
 }  // namespace

@@ -263,7 +263,7 @@ class DrillEngine final : public MissionPorts {
   PlanAsk look_plan(std::size_t attempt) const;
   void check_look(std::size_t attempt);
   void posture_reached();
-  void hole_request_write();
+  void hole_request_write(bool may_rest = false);
   /// Moves the area's blob holes by `shift` (world frame): odometry drifted by that much.
   void shift_area(const Eigen::Vector3d& shift);
   /// While the whole body moves to a blob hole's posture: the area's blobs followed in the
@@ -327,7 +327,22 @@ class DrillEngine final : public MissionPorts {
     int resends{0};
   };
   std::map<std::uint32_t, Unacknowledged> unacknowledged_;  // plan requests by id
-  void send_plan(const PlanAsk& r);
+  // A plan request goes to the planner at once, or, when the arm's drives run hot
+  // (Params::Rest), after the arm has gone home and cooled: the planner answers it from there.
+  // `may_rest`: the engine assumes nothing of where the arm waits for the answer (a hole's
+  // first posture request, its next attempt); the others expect the arm where it is.
+  void send_plan(const PlanAsk& r, bool may_rest = false);
+  void forward_plan(const PlanAsk& r);
+  // Why the arm must rest before `r` is planned ("J3_E: RMS 151 N m over the thermal window,
+  // 0.94 of continuous"), or "" when it may wait where it is.
+  [[nodiscard]] std::string rest_reason(const PlanAsk& r) const;
+  // The arm joints' largest RMS torque over the thermal window, as a fraction of continuous.
+  [[nodiscard]] double arm_rms_share() const;
+  void rest_step();
+  void release_held(const std::string& why);
+  std::vector<PlanAsk> held_requests_;  // waiting for the rest's end, in the order asked
+  std::uint32_t rest_request_{0};       // the arm's homing while it rests; 0 once home
+  double rest_since_{-1.0};             // robot time [s] the arm was home; < 0 before
   void resend_unacknowledged();
   std::map<std::size_t, std::future<ResolvedArea>> resolving_;
   std::map<std::size_t, std::int64_t> resolve_since_;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "concert/hardware/sensors.hpp"
+#include "concert/model/limits.hpp"
 #include "drill/drill_rig.hpp"
 #include "drill/params.hpp"
 #include "drill/paths.hpp"
@@ -43,8 +44,10 @@ class Inputs {
   Inputs(Params::Buffers buffers, Params::Liveness liveness);
 
   /// A joint state (robot clock `stamp_ns`) heard at `now`: kept at most one per
-  /// Buffers::sample_step, with the odometry last heard.
-  void on_joints(std::int64_t stamp_ns, JointPositions joints, Clock::time_point now);
+  /// Buffers::sample_step, with the odometry last heard. Every state's `efforts` (as many as
+  /// names, else none) feed each joint's thermal load (heat()).
+  void on_joints(std::int64_t stamp_ns, JointPositions joints, Clock::time_point now,
+                 const std::vector<double>& efforts = {});
   /// The wheel odometry (x, y, yaw), newest.
   void on_odometry(const Eigen::Vector3d& odometry);
   /// A service's status heard at `now`; `stopped`: it said it stops (no longer counted as alive).
@@ -76,6 +79,19 @@ class Inputs {
   /// The newest frame's intrinsics, when it has a focal length.
   [[nodiscard]] std::optional<hardware::CameraIntrinsics> intrinsics() const;
 
+  /// What a joint's drive has carried, from the efforts the robot reports: the RMS over the
+  /// thermal window (model::ThermalLoad, the safety layer's rule on the same stream) and the
+  /// load it holds now (the same over kPresentWindow) [N m].
+  struct Heat {
+    double rms{0.0};
+    double present{0.0};
+  };
+  /// The window of Heat::present [s]: long enough to average a settle's oscillation out, short
+  /// against the thermal window.
+  static constexpr double kPresentWindow = 0.5;
+  /// Each joint's heat since the rig was set (a new model starts cold, as safety's does).
+  [[nodiscard]] std::map<std::string, Heat> heat() const;
+
   [[nodiscard]] std::optional<PlanReply> plan(std::uint32_t request) const;
   [[nodiscard]] std::optional<MotionReply> trajectory(std::uint32_t request) const;
   [[nodiscard]] std::optional<MotionReply> nav(std::uint32_t request) const;
@@ -93,6 +109,12 @@ class Inputs {
   Params::Liveness liveness_;
   mutable std::mutex mutex_;
   std::deque<JointSample> samples_;
+  struct Load {
+    model::ThermalLoad rms{model::kThermalWindow};
+    model::ThermalLoad present{kPresentWindow};
+  };
+  std::map<std::string, Load> loads_;
+  std::int64_t load_stamp_ns_{0};
   std::optional<Eigen::Vector3d> odometry_;
   Clock::time_point joints_seen_{};
   std::map<std::string, Clock::time_point> services_seen_;

@@ -194,6 +194,22 @@ struct Params {
     double reanchor_distance{0.06};
   };
 
+  /// Where the arm waits (for the planner's answer, between a hole's attempts). Holding a
+  /// posture loads the arm's drives; safety stops when a drive's RMS torque over the thermal
+  /// window passes its continuous torque x (1 + its effort margin). Before a request is sent
+  /// to the planner, an arm whose drives are near that (measured: Inputs::heat) first goes to
+  /// its homing posture and waits there until they have cooled.
+  struct Rest {
+    /// An arm joint's RMS torque over the thermal window above this fraction of its continuous
+    /// torque, or the load it holds now above `hold` of it: the arm rests first.
+    double above{0.85};
+    double hold{1.0};
+    /// Rested until every arm joint's RMS is below this fraction of its continuous torque.
+    double until{0.7};
+    /// [s] of robot time rested at most; the request then goes as it is.
+    double timeout{20.0};
+  };
+
   Camera camera;
   Buffers buffers;
   Liveness liveness;
@@ -205,6 +221,7 @@ struct Params {
   Looks looks;
   Placement placement;
   Blobs blobs;
+  Rest rest;
   DrillParams motion;  ///< the drilling of one hole (drill_motion.hpp)
 };
 

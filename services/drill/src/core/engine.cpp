@@ -115,6 +115,7 @@ void DrillEngine::abort(const AbortOrder& a) {
 void DrillEngine::tick(double now) {
   now_ = now;
   resend_unacknowledged();
+  rest_step();
   if (leaving_wall()) {
     control_motion();
   } else if (mission_active()) {
@@ -134,6 +135,7 @@ void DrillEngine::tick(double now) {
 void DrillEngine::step_motion(double now) {
   now_ = now;
   resend_unacknowledged();
+  rest_step();
   control_motion();
 }
 
@@ -146,7 +148,120 @@ void DrillEngine::shutdown() {
 
 // A plan request to the planner, sent again (same id) while the planner acknowledges nothing
 // (resend_unacknowledged).
-void DrillEngine::send_plan(const PlanAsk& request) {
+void DrillEngine::send_plan(const PlanAsk& request, bool may_rest) {
+  const std::string why = held_requests_.empty() && may_rest ? rest_reason(request) : std::string();
+  if (held_requests_.empty() && why.empty()) {
+    forward_plan(request);
+    return;
+  }
+  if (held_requests_.empty()) {
+    log_line("drill: the arm rests at home before the planner's next answer (" + why +
+             "): holding the posture while the planner searches would pass the drive's thermal limit");
+    PlanAsk home;
+    home.request_id = next_request_++;
+    home.model_version = static_cast<std::uint32_t>(model_version_);
+    home.end_effector = rig_ ? rig_->tool() : "";
+    home.home = true;
+    home.execute = true;
+    rest_request_ = home.request_id;
+    rest_since_ = -1.0;
+    forward_plan(home);
+  }
+  held_requests_.push_back(request);
+}
+
+std::string DrillEngine::rest_reason(const PlanAsk& r) const {
+  // Only a request planned from where the robot stands: the arm is held there, still, while the
+  // planner searches. One from another start is planned while the robot does something else.
+  if (!rig_ || !r.start_names.empty()) return {};
+  const std::map<std::string, Inputs::Heat> heat = inputs_.heat();
+  const model::ModelDescription& d = rig_->model().description();
+  std::ostringstream why;
+  why.setf(std::ios::fixed);
+  for (const model::JointLimits& j : rig_->model().limits().rows()) {
+    const auto chain = std::find_if(d.chains.begin(), d.chains.end(),
+                                    [&](const model::ChainInfo& c) { return c.name == j.chain; });
+    if (chain == d.chains.end() || chain->role != model::ChainRole::kArm) continue;
+    const auto h = heat.find(j.name);
+    if (h == heat.end() || j.continuous_torque <= 0.0) continue;
+    const double rms = h->second.rms / j.continuous_torque, held = h->second.present / j.continuous_torque;
+    if (rms > tuning_.rest.above) {
+      why.precision(0);
+      why << j.name << ": RMS " << h->second.rms << " N m over the thermal window, ";
+      why.precision(2);
+      why << rms << " of its continuous torque";
+      return why.str();
+    }
+    if (held > tuning_.rest.hold) {
+      why.precision(0);
+      why << j.name << ": holds " << h->second.present << " N m, ";
+      why.precision(2);
+      why << held << " of its continuous torque";
+      return why.str();
+    }
+  }
+  return {};
+}
+
+double DrillEngine::arm_rms_share() const {
+  if (!rig_) return 0.0;
+  const std::map<std::string, Inputs::Heat> heat = inputs_.heat();
+  const model::ModelDescription& d = rig_->model().description();
+  double share = 0.0;
+  for (const model::JointLimits& j : rig_->model().limits().rows()) {
+    const auto chain = std::find_if(d.chains.begin(), d.chains.end(),
+                                    [&](const model::ChainInfo& c) { return c.name == j.chain; });
+    if (chain == d.chains.end() || chain->role != model::ChainRole::kArm || j.continuous_torque <= 0.0) continue;
+    if (const auto h = heat.find(j.name); h != heat.end()) share = std::max(share, h->second.rms / j.continuous_torque);
+  }
+  return share;
+}
+
+// While requests are held: the homing's answer, then the arm at home until its drives cooled
+// (Params::Rest::until) or the rest's timeout (robot time), then the requests to the planner.
+void DrillEngine::rest_step() {
+  if (held_requests_.empty()) return;
+  if (rest_request_ != 0) {
+    const std::optional<PlanReply> home = inputs_.plan(rest_request_);
+    if (!home || (home->state != PlanState::kSucceeded && home->state != PlanState::kFailed)) return;
+    rest_request_ = 0;
+    if (home->state == PlanState::kFailed) {
+      release_held("the arm could not go home to rest (" + home->reason + "); asked from where it stands");
+      return;
+    }
+    // The way back to the area's approach posture (execute()) now starts with the homing's
+    // path, reversed: the arm leaves home the way it came, collision free.
+    if (home->path.samples.size() >= 2) hole_chain_.push_back(home->path);
+  }
+  const std::optional<Sample> s = inputs_.latest_sample();
+  if (!s) return;
+  if (rest_since_ < 0.0) rest_since_ = robot_time(*s);
+  const double share = arm_rms_share();
+  const double rested = robot_time(*s) - rest_since_;
+  std::ostringstream why;
+  why.setf(std::ios::fixed);
+  why.precision(2);
+  if (share < tuning_.rest.until) {
+    why << "the arm rested " << std::setprecision(1) << rested << " s at home, its drives at " << std::setprecision(2)
+        << share << " of continuous";
+    release_held(why.str());
+  } else if (rested >= tuning_.rest.timeout) {
+    why << "the arm rested " << std::setprecision(1) << rested << " s at home, its drives still at "
+        << std::setprecision(2) << share << " of continuous";
+    release_held(why.str());
+  }
+}
+
+void DrillEngine::release_held(const std::string& why) {
+  log_line("drill: " + why + "; " + std::to_string(held_requests_.size()) + " plan request" +
+           (held_requests_.size() == 1 ? "" : "s") + " sent");
+  std::vector<PlanAsk> held;
+  held.swap(held_requests_);
+  rest_since_ = -1.0;
+  for (const PlanAsk& r : held) forward_plan(r);
+}
+
+void DrillEngine::forward_plan(const PlanAsk& request) {
   PlanAsk r = request;
   // The odometry frame where the marks seen again put it, while nav localises nothing: the
   // planner's map (the world) then has the wall where the camera sees it, not where odometry
@@ -1133,16 +1248,16 @@ void DrillEngine::align(const DrillPoint& point) {
   checked_path_ = {};
   set_hole_task(r, tuning_.hole.attempts[hole_attempt_], hole_distance_, hole_depth(), tuning_);
   hole_request_ = r;
-  hole_request_write();
+  hole_request_write(true);  // the arm waits where the last hole or the placement left it
   hole_path_ = {};
   motion_ = Motion::kApproachHole;
 }
 
 // hole_request_ to the planner. A marker hole's whole-body posture is only planned: before the
 // base moves, check_look() asks whether the camera can be turned onto the marker from it.
-void DrillEngine::hole_request_write() {
+void DrillEngine::hole_request_write(bool may_rest) {
   hole_request_.execute = !(point_.marker >= 0 && patterns_ && !hole_request_.fixed_base);
-  send_plan(hole_request_);
+  send_plan(hole_request_, may_rest);
 }
 
 double DrillEngine::hole_depth() const { return mission_ ? mission_->depth : tuning_.hole.default_depth; }
@@ -1207,6 +1322,9 @@ void DrillEngine::stop() {
   const bool at_hole = motion_ == Motion::kAlign || motion_ == Motion::kDrill || motion_ == Motion::kRetractOut;
   motion_ = Motion::kNone;
   unacknowledged_.clear();  // not sent again: a planner taking it now would move the robot
+  held_requests_.clear();
+  rest_request_ = 0;
+  rest_since_ = -1.0;
   if (at_hole && !shutting_down_ && leave_allowed_ && start_leave()) return;
   send_hold();
 }
@@ -1911,7 +2029,7 @@ void DrillEngine::next_hole_attempt(const PlanReply& r) {
   line << hole_task_text(hole_request_) << thrust_text(next.lead, tuning_.motion);
   log_line(line.str());
   body_draws_ = 0;
-  hole_request_write();
+  hole_request_write(!look_pushed_);  // a look's path stays the last of hole_chain_
 }
 
 void DrillEngine::check_look_step() {

@@ -1,6 +1,7 @@
 #include "drill/inputs.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "drill/perception.hpp"
@@ -18,9 +19,19 @@ double seconds_between(Inputs::Clock::time_point from, Inputs::Clock::time_point
 Inputs::Inputs(Params::Buffers buffers, Params::Liveness liveness)
     : buffers_(buffers), liveness_(liveness) {}
 
-void Inputs::on_joints(std::int64_t stamp_ns, JointPositions joints, Clock::time_point now) {
+void Inputs::on_joints(std::int64_t stamp_ns, JointPositions joints, Clock::time_point now,
+                       const std::vector<double>& efforts) {
   std::lock_guard lock(mutex_);
   joints_seen_ = now;
+  if (efforts.size() == joints.names.size() && stamp_ns > load_stamp_ns_) {
+    const double dt = load_stamp_ns_ > 0 ? 1e-9 * static_cast<double>(stamp_ns - load_stamp_ns_) : 0.0;
+    load_stamp_ns_ = stamp_ns;
+    for (std::size_t i = 0; i < efforts.size(); ++i) {
+      Load& l = loads_[joints.names[i]];
+      l.rms.add(std::abs(efforts[i]), dt);
+      l.present.add(std::abs(efforts[i]), dt);
+    }
+  }
   if (!samples_.empty() && stamp_ns - samples_.back().stamp_ns < buffers_.sample_step.count()) return;
   JointSample sample;
   sample.stamp_ns = stamp_ns;
@@ -68,6 +79,15 @@ void Inputs::set_rig(std::shared_ptr<const DrillRig> rig) {
   std::lock_guard lock(mutex_);
   rig_ = std::move(rig);
   frames_.clear();
+  loads_.clear();
+  load_stamp_ns_ = 0;
+}
+
+std::map<std::string, Inputs::Heat> Inputs::heat() const {
+  std::lock_guard lock(mutex_);
+  std::map<std::string, Heat> out;
+  for (const auto& [name, l] : loads_) out[name] = {l.rms.rms(), l.present.rms()};
+  return out;
 }
 
 bool Inputs::on_frame(std::int64_t stamp_ns, hardware::RgbdFrame frame) {

@@ -2,6 +2,8 @@
 // with libs/config, then checks the rules across keys the mission relies on.
 #include "drill/params.hpp"
 
+#include <sstream>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -51,6 +53,19 @@ void read_service_bounds(Map liveness, Map plan_requests, Map approach, Map bim,
   approach.number("thrust_checked", p.approach.thrust_checked, Range::positive());
   bim.number("wall_standoff", p.bim.wall_standoff, Range::positive());
   bim.number("robot_radius", p.bim.robot_radius, Range::positive());
+}
+
+void read_rest(Map m, Params::Rest& r) {
+  m.number("above", r.above, Range::positive());
+  m.number("hold", r.hold, Range::positive());
+  m.number("until", r.until, Range::positive());
+  m.number("timeout", r.timeout, Range::non_negative());
+  if (r.until >= r.above) {
+    std::ostringstream what;
+    what << "expected below rest.above (" << r.above
+         << "): a rest ends when the arm is cooler than a rest starts at";
+    m.fail("until", what.str());
+  }
 }
 
 /// Reads the hole section; returns the items of hole.attempts (none when the file leaves the
@@ -264,6 +279,7 @@ Params read_params(config::Document& doc) {
   read_looks(at.looks, p.looks);
   read_placement(at.placement, p.placement);
   read_blobs(root.section("blobs"), p.blobs);
+  read_rest(root.section("rest"), p.rest);
   read_motion(at.motion, p.motion);
   doc.finish();
   check_rules(p, rows, at);

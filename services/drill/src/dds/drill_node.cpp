@@ -40,7 +40,7 @@ DrillNode::DrillNode(cdds::Participant& participant, NodeParams params, std::ost
               }),
       joints_in_(participant, cdds::topics::joint_state,
                  [this](const msg::JointState& s, const auto&) {
-                   inputs_.on_joints(s.stamp_ns(), {s.name(), s.position()}, Clock::now());
+                   inputs_.on_joints(s.stamp_ns(), {s.name(), s.position()}, Clock::now(), s.effort());
                  }),
       odometry_in_(participant, cdds::topics::odometry,
                    [this](const msg::Odometry& o, const auto&) {
