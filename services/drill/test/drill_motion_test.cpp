@@ -207,6 +207,50 @@ TEST(DrillMotion, ALightDrillingCutsTheWallAtAFractionOfTheThrust) {
   EXPECT_NEAR(light_drilling(full, 0.01).max_lead, full.contact_lead + kLeadOverContact, 1e-12);
 }
 
+// The drives' thermal foldback: at half the share the lead stays between the floor and the
+// tuned one; at 0, in the wall, the feed stops with no lead and the time limit waits; back at 1
+// the hole is cut to depth.
+TEST(DrillMotion, AFoldedBackThrustLeadsLessAndAStoppedFeedPausesTheTimeLimit) {
+  DrillParams params;
+  params.drill_timeout = 12.0;
+  DrillMotion m(params);
+  double now = 0.0;
+  Plant p = aligned(m, params, now);
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
+  m.start_drill(0.03, false, p.tip, now);
+  m.set_thrust_share(0.5);
+  const double floor = params.contact_lead + kLeadOverContact;
+  double largest_lead = 0.0;
+  const double started = now;
+  while (now - started < 6.0) {  // the wall 40 mm ahead at 10 mm/s, then 2 s in it
+    const CartesianReference r = m.update(p.tip, now);
+    largest_lead = std::max(largest_lead, r.pose.translation().x() - p.tip.translation().x());
+    p.step(r);
+    now += kDt;
+  }
+  ASSERT_TRUE(m.contact());
+  EXPECT_LE(largest_lead, floor + 0.5 * (params.max_lead - floor) + 1e-6);
+  EXPECT_GT(largest_lead, floor);
+  // Stopped for twice the time limit: the bit rests (no lead), nothing fails, nothing is cut.
+  m.set_thrust_share(0.0);
+  const double bottom = p.hole_bottom;
+  double lead_at_rest = 1.0;
+  for (int i = 0; i < static_cast<int>(2.0 * params.drill_timeout / kDt); ++i) {
+    const CartesianReference r = m.update(p.tip, now);
+    lead_at_rest = r.pose.translation().x() - p.tip.translation().x();
+    p.step(r);
+    now += kDt;
+  }
+  EXPECT_EQ(m.phase(), DrillMotion::Phase::kDrilling) << m.reason();
+  EXPECT_LT(lead_at_rest, 0.0005);
+  EXPECT_LT(p.hole_bottom - bottom, 0.0005);
+  EXPECT_NEAR(m.paused(), 2.0 * params.drill_timeout, 0.01);
+  m.set_thrust_share(1.0);
+  drill_until_done(m, p, now);
+  ASSERT_EQ(m.phase(), DrillMotion::Phase::kDone) << m.reason();
+  EXPECT_GE(p.hole_bottom - 1.0, 0.03);
+}
+
 // The camera's surface off along the normal (a re-measure after a base move: holes came out
 // up to 20 mm short): the depth is counted from where the bit meets the wall.
 TEST(DrillMotion, TheDepthIsCountedFromWhereTheBitMeetsTheWall) {

@@ -676,6 +676,45 @@ TEST_F(LeaveTest, ABitClearOfTheWallIsHeldAtOnce) {
 
 // Odometry drifted while the whole body moved: the blob is seen 3 cm off its prediction, and
 // the posture is planned again, the arm alone, for the hole where the camera sees it.
+// While drilling, the thrust folds back as the hottest arm drive's RMS nears safety's bound
+// (Params::Thermal), and the feed stops at fold_end until the drive cooled; said in the log once
+// each.
+TEST_F(LeaveTest, TheThrustFoldsBackAsTheArmsDrivesHeatUpAndTheFeedStopsAtTheBound) {
+  std::string hot;
+  double continuous = 0.0;
+  for (const std::string& j : rig->model().arm().joints) {
+    const model::JointLimits& l = rig->model().limits().at(j);
+    if (l.continuous_torque > continuous) {
+      continuous = l.continuous_torque;
+      hot = j;
+    }
+  }
+  const auto load = [&](double share, double seconds) {
+    std::vector<double> efforts(joints.names.size(), 1.0);
+    efforts[static_cast<std::size_t>(std::find(joints.names.begin(), joints.names.end(), hot) - joints.names.begin())] =
+        share * continuous;
+    for (int i = 0; i < static_cast<int>(std::lround(seconds / 0.005)); ++i) {
+      stamp_ns += 5'000'000;
+      inputs.on_joints(stamp_ns, joints, Inputs::Clock::now(), efforts);
+      step();
+    }
+  };
+  engine.drill(hole, 0.03);
+  // Within the drilling's 30 s time limit: the bit stands still, so it is in contact at once.
+  load(0.9, 9.0);  // RMS 0.82 of continuous
+  EXPECT_EQ(sink.logged("thrust folds back"), 0u) << sink.log_text;
+  load(1.0, 7.0);  // RMS 0.96: past fold_start (0.95), short of fold_end (1.05)
+  EXPECT_EQ(sink.logged("blob 1: the arm's drives at 0.95 of their continuous torque (RMS): the thrust folds back"), 1u)
+      << sink.log_text;
+  EXPECT_EQ(sink.logged("the feed stops"), 0u) << sink.log_text;
+  load(1.1, 8.0);  // RMS 1.07
+  EXPECT_EQ(sink.logged("blob 1: the arm's drives at 1.05 of their continuous torque (RMS): the feed stops until "
+                        "they cool below 0.95"),
+            1u)
+      << sink.log_text;
+  EXPECT_EQ(engine.drilling().progress, Progress::kRunning) << sink.log_text;
+}
+
 TEST_F(RigEngineTest, ADriftedOdometryPlansThePostureAgainWhereTheCameraSeesTheHole) {
   const DrillPoint hole = hole_ahead();
   engine.align(hole);

@@ -50,6 +50,8 @@ void expect_same(const Params& a, const Params& b) {
   EXPECT_EQ(a.rest.hold, b.rest.hold);
   EXPECT_EQ(a.rest.until, b.rest.until);
   EXPECT_EQ(a.rest.timeout, b.rest.timeout);
+  EXPECT_EQ(a.thermal.fold_start, b.thermal.fold_start);
+  EXPECT_EQ(a.thermal.fold_end, b.thermal.fold_end);
   EXPECT_EQ(a.approach.padding, b.approach.padding);
   EXPECT_EQ(a.approach.attempts, b.approach.attempts);
   EXPECT_EQ(a.approach.thrust_checked, b.approach.thrust_checked);
@@ -125,9 +127,9 @@ TEST(DrillParamsFile, TheShippedFileHoldsEveryDefault) {
   const Params p = read_params(doc);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
-  // Every key read: 60 single values (look_further one of them), the 3 tables' lengths, and
+  // Every key read: 62 single values (look_further one of them), the 3 tables' lengths, and
   // their rows' keys: 27 attempts x 5, 5 looks x 2, 3 draws x 2.
-  EXPECT_EQ(doc.keys().size(), 60u + 3u + 27u * 5u + 5u * 2u + 3u * 2u);
+  EXPECT_EQ(doc.keys().size(), 62u + 3u + 27u * 5u + 5u * 2u + 3u * 2u);
   expect_same(p, Params{});
   expect_same(load_params(kShipped), Params{});
 }
@@ -202,7 +204,7 @@ TEST(DrillParamsFile, AnUnknownKeyIsRefusedNamingIt) {
             "looks.attempts[0]: between, further");
   EXPECT_EQ(error_of("cameras: {}\n"),
             "drill.yaml: cameras: unknown key (line 1); known keys: approach, bim, blobs, buffers, "
-            "camera, hole, liveness, looks, motion, paths, placement, plan_requests, rest");
+            "camera, hole, liveness, looks, motion, paths, placement, plan_requests, rest, thermal");
   EXPECT_THAT(error_of("motion:\n  feed: 0.01\n"),
               StartsWith("drill.yaml: motion.feed: unknown key (line 2); known keys of motion: "));
 }
@@ -260,6 +262,9 @@ TEST(DrillParamsFile, ABrokenRuleAcrossKeysIsRefused) {
   EXPECT_EQ(error_of("rest:\n  above: 0.8\n  until: 0.8\n"),
             "drill.yaml: rest.until: expected below rest.above (0.8): a rest ends when the arm is "
             "cooler than a rest starts at (line 3)");
+  EXPECT_EQ(error_of("thermal:\n  fold_end: 0.9\n"),
+            "drill.yaml: thermal.fold_end: expected above thermal.fold_start (0.95): the thrust folds "
+            "back between them (line 2)");
   // An averaged view needs that many frames kept.
   EXPECT_EQ(error_of("buffers:\n  frames: 4\n"),
             "drill.yaml: buffers.frames: expected at least camera.averaged_frames and "

@@ -103,6 +103,16 @@ class DrillMotion {
   /// Pulls the tip back to `standoff` in front of the surface.
   void start_retract(const Eigen::Isometry3d& tip, double now);
 
+  /// The drives' thermal foldback, from the engine's measure of their RMS torque: the share of
+  /// the tuned thrust the drilling may push with, in [0, 1]. Below 1 the reference leads the tip
+  /// less, down to light_drilling's floor (the bit still feels the wall); at 0, once the bit has
+  /// met the wall, the feed stops with the bit at rest in the hole (no thrust) and the drilling's
+  /// time limit waits with it. Kept across phases until set again.
+  void set_thrust_share(double share);
+  [[nodiscard]] double thrust_share() const { return thrust_share_; }
+  /// Robot time the feed stood still at share 0 in this drilling [s].
+  [[nodiscard]] double paused() const { return paused_; }
+
   /// A new estimate of the hole (visual servoing): used while aligning and, with servo, while
   /// the tip is still in front of the surface; an outlier (servo_jump) is ignored. Returns
   /// whether it was used.
@@ -151,6 +161,8 @@ class DrillMotion {
   double contact_offset_{0.0};
   double last_depth_{0.0};
   double axial_speed_{0.0};  ///< the tip's feed along the bit, filtered [m/s]
+  double thrust_share_{1.0};
+  double paused_{0.0};
 };
 
 const char* to_string(DrillMotion::Phase phase);

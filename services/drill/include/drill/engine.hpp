@@ -339,6 +339,7 @@ class DrillEngine final : public MissionPorts {
   // The arm joints' largest RMS torque over the thermal window, as a fraction of continuous.
   [[nodiscard]] double arm_rms_share() const;
   void rest_step();
+  void fold_thrust();
   void release_held(const std::string& why);
   std::vector<PlanAsk> held_requests_;  // waiting for the rest's end, in the order asked
   std::uint32_t rest_request_{0};       // the arm's homing while it rests; 0 once home

@@ -210,6 +210,15 @@ struct Params {
     double timeout{20.0};
   };
 
+  /// While drilling, the thrust folds back as the hottest arm drive's RMS torque over the
+  /// thermal window (measured: Inputs::heat) rises from `fold_start` to `fold_end` of its
+  /// continuous torque (safety stops at 1 + its effort margin, 1.1); at `fold_end` the feed
+  /// stops, the bit at rest in the hole, until the drive cooled below `fold_start`.
+  struct Thermal {
+    double fold_start{0.95};
+    double fold_end{1.05};
+  };
+
   Camera camera;
   Buffers buffers;
   Liveness liveness;
@@ -222,6 +231,7 @@ struct Params {
   Placement placement;
   Blobs blobs;
   Rest rest;
+  Thermal thermal;
   DrillParams motion;  ///< the drilling of one hole (drill_motion.hpp)
 };
 

@@ -47,6 +47,7 @@ void DrillMotion::start_align(const Eigen::Isometry3d& hole, const Eigen::Isomet
   phase_ = Phase::kAligning;
   reason_.clear();
   started_ = last_ = now;
+  paused_ = 0.0;
   settled_since_ = -1.0;
   ref_ = tip;
 }
@@ -55,6 +56,7 @@ void DrillMotion::start_drill(double depth, bool servo, const Eigen::Isometry3d&
   phase_ = Phase::kDrilling;
   reason_.clear();
   started_ = last_ = now;
+  paused_ = 0.0;
   target_depth_ = depth;
   servo_ = servo;
   contact_ = false;
@@ -69,6 +71,7 @@ void DrillMotion::start_retract(const Eigen::Isometry3d& tip, double now) {
   phase_ = Phase::kRetracting;
   reason_.clear();
   started_ = last_ = now;
+  paused_ = 0.0;
   depth_ref_ = depth_of(tip);
   // The bit pulls straight back as it is: turning it onto the hole's axis here would wrench a
   // bit that never got aligned (an alignment that failed far from the hole).
@@ -119,10 +122,12 @@ CartesianReference DrillMotion::reference(double depth, double feed,
   return r;
 }
 
+void DrillMotion::set_thrust_share(double share) { thrust_share_ = std::clamp(std::isfinite(share) ? share : 1.0, 0.0, 1.0); }
+
 CartesianReference DrillMotion::update(const Eigen::Isometry3d& tip, double now) {
   const double dt = std::max(0.0, now - last_);
   last_ = now;
-  const double elapsed = now - started_;
+  const double elapsed = now - started_ - paused_;
   const double depth = depth_of(tip);
   switch (phase_) {
     case Phase::kAligning: {
@@ -179,7 +184,16 @@ CartesianReference DrillMotion::update(const Eigen::Isometry3d& tip, double now)
       // contact_lead beyond it, a lead that still pushes past the wall's threshold (at 2 mm,
       // 16 N of 20: the light drilling's bit, slower, stops 0.2 mm short of its depth).
       const double limit = target_depth_ + (contact_ ? params_.contact_lead : params_.contact_search);
-      depth_ref_ = std::min({depth_ref_ + params_.feed_rate * dt, d + params_.max_lead, limit});
+      // The thermal foldback (set_thrust_share): the lead between light_drilling's floor and
+      // max_lead; at 0 in the wall, the reference waits at the tip.
+      const double floor = std::min(params_.max_lead, params_.contact_lead + kLeadOverContact);
+      const double lead = floor + thrust_share_ * (params_.max_lead - floor);
+      if (contact_ && thrust_share_ <= 0.0) {
+        paused_ += dt;
+        depth_ref_ = std::min(depth_ref_, d);
+      } else {
+        depth_ref_ = std::min({depth_ref_ + params_.feed_rate * dt, d + lead, limit});
+      }
       if (contact_ && d >= target_depth_) {
         phase_ = Phase::kDone;
       } else if (!contact_ && d >= limit - params_.contact_lead) {

@@ -217,6 +217,33 @@ double DrillEngine::arm_rms_share() const {
   return share;
 }
 
+// The thrust's share while drilling (Params::Thermal): full below fold_start, falling to the
+// floor at fold_end, where the feed stops until the drive cooled below fold_start again. Said in
+// the log when it starts folding and when the feed stops.
+void DrillEngine::fold_thrust() {
+  const double h = arm_rms_share();
+  const Params::Thermal& t = tuning_.thermal;
+  const double was = drill_motion_.thrust_share();
+  double share = std::clamp((t.fold_end - h) / (t.fold_end - t.fold_start), 0.0, 1.0);
+  if (was <= 0.0 && h >= t.fold_start) share = 0.0;  // stopped: until cooled below fold_start
+  if (share > 0.0 && share < 1.0 && was >= 1.0) {
+    std::ostringstream line;
+    line.setf(std::ios::fixed);
+    line.precision(2);
+    line << "drill: " << point_.label << ": the arm's drives at " << h
+         << " of their continuous torque (RMS): the thrust folds back";
+    log_line(line.str());
+  } else if (share <= 0.0 && was > 0.0) {
+    std::ostringstream line;
+    line.setf(std::ios::fixed);
+    line.precision(2);
+    line << "drill: " << point_.label << ": the arm's drives at " << h
+         << " of their continuous torque (RMS): the feed stops until they cool below " << t.fold_start;
+    log_line(line.str());
+  }
+  drill_motion_.set_thrust_share(share);
+}
+
 // While requests are held: the homing's answer, then the arm at home until its drives cooled
 // (Params::Rest::until) or the rest's timeout (robot time), then the requests to the planner.
 void DrillEngine::rest_step() {
@@ -1882,6 +1909,7 @@ void DrillEngine::cartesian_step() {
       if (seen) drill_motion_.observe(base_T_world_ * *seen);
     }
   }
+  if (motion_ == Motion::kDrill) fold_thrust();
   const CartesianReference r = drill_motion_.update(rig_->tip_in_base(rig_->q(s->joints)), robot_time(*s));
   send_cartesian(r);
   if (drill_motion_.phase() == DrillMotion::Phase::kFailed) {

@@ -68,6 +68,16 @@ void read_rest(Map m, Params::Rest& r) {
   }
 }
 
+void read_thermal(Map m, Params::Thermal& t) {
+  m.number("fold_start", t.fold_start, Range::positive());
+  m.number("fold_end", t.fold_end, Range::positive());
+  if (t.fold_end <= t.fold_start) {
+    std::ostringstream what;
+    what << "expected above thermal.fold_start (" << t.fold_start << "): the thrust folds back between them";
+    m.fail("fold_end", what.str());
+  }
+}
+
 /// Reads the hole section; returns the items of hole.attempts (none when the file leaves the
 /// list out) for the rules across keys.
 std::vector<Map> read_hole(Map m, Params::Hole& h) {
@@ -280,6 +290,7 @@ Params read_params(config::Document& doc) {
   read_placement(at.placement, p.placement);
   read_blobs(root.section("blobs"), p.blobs);
   read_rest(root.section("rest"), p.rest);
+  read_thermal(root.section("thermal"), p.thermal);
   read_motion(at.motion, p.motion);
   doc.finish();
   check_rules(p, rows, at);
