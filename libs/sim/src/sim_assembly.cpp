@@ -156,6 +156,9 @@ SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const s
     out.sensors = sensor_mounts(model.sensor_frames);
     out.drill_bits = drill_bits(model.end_effectors);
     out.sanding_links = sanding_links(model.urdf, model.end_effectors);
+    for (const auto& ee : model.end_effectors) {
+      if (ee.kind == model::EndEffectorKind::kGripper) out.gripper_tcps.push_back(ee.frame);
+    }
     out.legs = steering_legs(model);
     std::map<int, int> joints_of_module;  // a module's moving joints so far (model order)
     for (const model_generation::JointInfo& j : model.joints) {

@@ -570,6 +570,132 @@ struct SimHardware::Impl {
     }
   }
 
+  // The simulated person (person()): orders queued by any thread under person_mutex, taken by
+  // step() when it gets the lock (the control thread never waits); the person, its body and the
+  // TCP's last position are the control thread's.
+  std::mutex person_mutex;
+  std::vector<world::PersonOrder> person_orders;
+  world::SimPerson person_sim;
+  std::string person_link;
+  int person_body{-1};
+  const Instance* person_instance{nullptr};
+  Eigen::Vector3d person_last_tcp{Eigen::Vector3d::Zero()};
+  bool person_fresh{true};  // no previous position to take the TCP's velocity from
+  std::uint64_t person_taken{0};
+  world::PersonReport person_copy;  // under truth_mutex
+  world::PersonPhase person_copied_phase{world::PersonPhase::kAbsent};
+
+  void take_person_orders() {
+    if (!person_mutex.try_lock()) return;
+    std::vector<world::PersonOrder> orders;
+    orders.swap(person_orders);
+    person_mutex.unlock();
+    for (const world::PersonOrder& o : orders) take_person_order(o);
+  }
+
+  void take_person_order(const world::PersonOrder& o) {
+    ++person_taken;
+    Instance& in = *active;
+    switch (o.action) {
+      case world::PersonOrder::Action::kGrip: {
+        const int body = mj_name2id(in.m, mjOBJ_BODY, o.link.c_str());
+        release_person_body();
+        if (body < 0) {
+          // Checked against the URDF; MuJoCo merges a fixed link into its parent.
+          person_sim = world::SimPerson(o.params);
+          person_link = o.link;
+          person_sim.grip(in.d->time, Eigen::Vector3d::Zero());
+          person_sim.let_go("no body '" + o.link + "' in the simulated robot (a fixed link merged into its parent?)");
+          return;
+        }
+        person_sim = world::SimPerson(o.params);
+        person_link = o.link;
+        person_body = body;
+        person_instance = &in;
+        const Eigen::Vector3d tcp(in.d->xpos[3 * body], in.d->xpos[3 * body + 1], in.d->xpos[3 * body + 2]);
+        person_sim.grip(in.d->time, tcp, o.guide, o.guide_time);
+        person_last_tcp = tcp;
+        person_fresh = false;
+        return;
+      }
+      case world::PersonOrder::Action::kWalk: {
+        if (!person_sim.gripping()) return;  // let go since the order was checked: nothing to walk
+        std::vector<Eigen::Vector2d> route = o.route;
+        if (o.relative) {
+          for (Eigen::Vector2d& p : route) p += person_sim.hand().head<2>();
+        }
+        person_sim.walk(in.d->time, std::move(route));
+        return;
+      }
+      case world::PersonOrder::Action::kRelease:
+        person_sim.let_go("released");
+        release_person_body();
+        return;
+    }
+  }
+
+  void release_person_body() {
+    if (person_body >= 0 && person_instance == active.get() && person_body != external_body) {
+      std::fill_n(active->d->xfrc_applied + 6 * person_body, 6, 0.0);
+    }
+    person_body = -1;
+    person_instance = nullptr;
+  }
+
+  // The person's pull on its body for one physics step, added to a force the test put on the
+  // same body (set_external_force), else in place of what was there.
+  void apply_person() {
+    if (!person_sim.gripping()) return;
+    Instance& in = *active;
+    if (person_instance != &in) {
+      person_body = mj_name2id(in.m, mjOBJ_BODY, person_link.c_str());
+      person_instance = &in;
+      person_fresh = true;
+      if (person_body < 0) {
+        person_sim.let_go("the link '" + person_link + "' is gone from the simulated robot");
+        person_instance = nullptr;
+        return;
+      }
+    }
+    const int b = person_body;
+    const Eigen::Vector3d tcp(in.d->xpos[3 * b], in.d->xpos[3 * b + 1], in.d->xpos[3 * b + 2]);
+    const double dt = in.m->opt.timestep;
+    const Eigen::Vector3d velocity = person_fresh ? Eigen::Vector3d::Zero() : Eigen::Vector3d((tcp - person_last_tcp) / dt);
+    person_last_tcp = tcp;
+    person_fresh = false;
+    const Eigen::Vector3d force = person_sim.force(in.d->time + dt, tcp, velocity);
+    double* f = in.d->xfrc_applied + 6 * b;
+    const bool shared = b == external_body && external_instance == &in && !external_link.empty();
+    if (!shared) std::fill_n(f, 6, 0.0);
+    if (!person_sim.gripping()) return;
+    const double* com = in.d->xipos + 3 * b;
+    const Eigen::Vector3d moment = (tcp - Eigen::Vector3d(com[0], com[1], com[2])).cross(force);
+    for (int i = 0; i < 3; ++i) {
+      f[i] += force[i];
+      f[3 + i] += moment[i];
+    }
+  }
+
+  // Under truth_mutex: the numbers every step, the strings only when the phase changes (the
+  // control loop does not allocate in its steady state).
+  void copy_person() {
+    world::PersonReport& r = person_copy;
+    if (person_sim.phase() != person_copied_phase || r.orders != person_taken) {
+      r.link = person_link;
+      r.reason = person_sim.reason();
+      person_copied_phase = person_sim.phase();
+    }
+    r.phase = person_sim.phase();
+    r.hand = person_sim.hand();
+    r.tcp = person_last_tcp;
+    r.pull = person_sim.pull();
+    r.walked = person_sim.walked();
+    r.route_length = person_sim.route_length();
+    r.peak_pull = person_sim.peak_pull();
+    r.time = active->d->time;
+    r.orders = person_taken;
+  }
+
   void submit(std::unique_ptr<Instance> in) { prepared.submit(std::move(in)); }
 
   void apply_drives() {
@@ -687,6 +813,11 @@ bool SimHardware::switch_prepared() {
     return false;
   }
   carry_state(*impl_->active, *next);
+  if (!next->same_robot && impl_->person_sim.gripping()) {
+    impl_->person_sim.let_go("hot swap: the robot changed");
+    impl_->person_body = -1;
+    impl_->person_instance = nullptr;
+  }
   Instance* old = impl_->active.release();
   impl_->active.reset(next);
   // The old scene stays referenced by the retired instance (deleted off this thread).
@@ -729,9 +860,11 @@ void SimHardware::write(const std::vector<DriveCommand>& commands) {
 
 void SimHardware::step(double dt) {
   const int n = std::max(1, static_cast<int>(std::lround(dt / impl_->params.timestep)));
+  impl_->take_person_orders();
   for (int k = 0; k < n; ++k) {
     impl_->apply_drives();
     impl_->apply_external_force();
+    impl_->apply_person();
     impl_->active->obstacles.apply(impl_->active->d, impl_->active->d->time);
     if (!impl_->active->drilling.empty() &&
         impl_->active->drilling.apply(impl_->active->m, impl_->active->d, impl_->holes)) {
@@ -755,6 +888,7 @@ void SimHardware::step(double dt) {
       impl_->holes_copy = impl_->holes;  // allocates only when a hole opened or deepened
       impl_->holes_dirty = false;
     }
+    impl_->copy_person();
     impl_->truth_mutex.unlock();
   }
   // As on real drives, measured efforts and contacts lag the positions by one physics step
@@ -836,6 +970,74 @@ void SimHardware::clear_external_force() {
   impl_->external_link.clear();
   impl_->external_body = -1;
   impl_->external_instance = nullptr;
+}
+
+std::string SimHardware::person(const world::PersonOrder& order) {
+  std::ostringstream what;
+  what.setf(std::ios::fixed);
+  what.precision(2);
+  world::PersonOrder o = order;
+  if (o.action == world::PersonOrder::Action::kGrip) {
+    try {
+      world::check(o.params);
+    } catch (const std::invalid_argument& e) {
+      throw HardwareError(std::string("sim: ") + e.what());
+    }
+    if (!o.guide.allFinite() || !std::isfinite(o.guide_time) || o.guide_time < 0.0)
+      throw HardwareError("sim: person: grip: the guide must be finite and its time >= 0");
+    std::lock_guard lock(impl_->mutex);
+    const std::vector<std::string>& grippers = impl_->latest_robot.gripper_tcps;
+    if (o.link.empty()) {
+      if (grippers.size() != 1) {
+        std::string all;
+        for (const std::string& g : grippers) all += (all.empty() ? "" : ", ") + g;
+        throw HardwareError(grippers.empty()
+                                ? "sim: person: the mounted robot has no gripper to hold; name a link"
+                                : "sim: person: the mounted robot has " + std::to_string(grippers.size()) +
+                                      " grippers (" + all + "); name the link to hold");
+      }
+      o.link = grippers.front();
+    } else if (impl_->latest_robot.urdf.find("<link name=\"" + o.link + "\"") == std::string::npos) {
+      throw HardwareError("sim: person: no link '" + o.link + "' in the mounted robot");
+    }
+    what << "person: gripping " << o.link;
+    if (o.guide_time > 0.0)
+      what << ", guiding it by (" << o.guide.x() << ", " << o.guide.y() << ", " << o.guide.z() << ") m over "
+           << o.guide_time << " s";
+  } else if (o.action == world::PersonOrder::Action::kWalk) {
+    if (o.route.empty()) throw HardwareError("sim: person: walk: the route has no point");
+    for (const Eigen::Vector2d& p : o.route) {
+      if (!p.allFinite()) throw HardwareError("sim: person: walk: a route point is not finite");
+    }
+    bool pending_grip = false;
+    {
+      std::lock_guard lock(impl_->person_mutex);
+      for (const world::PersonOrder& q : impl_->person_orders) pending_grip = q.action == world::PersonOrder::Action::kGrip;
+    }
+    const world::PersonReport now = person_report();
+    const bool holding = now.phase != world::PersonPhase::kAbsent && now.phase != world::PersonPhase::kLetGo;
+    if (!holding && !pending_grip)
+      throw HardwareError("sim: person: walk: the person holds nothing (" +
+                          std::string(now.phase == world::PersonPhase::kLetGo ? "let go: " + now.reason : "grip first") + ")");
+    double length = 0.0;
+    Eigen::Vector2d last = o.relative ? Eigen::Vector2d::Zero() : o.route.front();
+    for (const Eigen::Vector2d& p : o.route) {
+      length += (p - last).norm();
+      last = p;
+    }
+    what << "person: walking " << (o.relative ? "" : "at least ") << length << " m through " << o.route.size()
+         << " point" << (o.route.size() == 1 ? "" : "s");
+  } else {
+    what << "person: letting go";
+  }
+  std::lock_guard lock(impl_->person_mutex);
+  impl_->person_orders.push_back(std::move(o));
+  return what.str();
+}
+
+world::PersonReport SimHardware::person_report() const {
+  std::lock_guard lock(impl_->truth_mutex);
+  return impl_->person_copy;
 }
 
 double SimHardware::time() const { return impl_->active->d->time; }

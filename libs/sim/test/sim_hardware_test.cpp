@@ -111,6 +111,63 @@ TEST(SimHardware, ExternalForceIsAppliedUntilCleared) {
                HardwareError);
 }
 
+// The simulated person: orders checked at once against the mounted robot, taken at the next
+// step; its pull acts on the link held; a new world keeps the grip, a new robot makes it let go.
+TEST(SimHardware, APersonPullsTheLinkItHoldsAndLetsGoWhenTheRobotIsSwapped) {
+  SimHardware sim(read_fixture("mobile_drill.urdf"), World{}, {});
+  for (int i = 0; i < 200; ++i) sim.step(0.001);
+  world::PersonOrder grip;
+  try {
+    sim.person(grip);
+    FAIL() << "gripped a robot without a gripper";
+  } catch (const HardwareError& e) {
+    EXPECT_STREQ(e.what(), "sim: person: the mounted robot has no gripper to hold; name a link");
+  }
+  grip.link = "no_such_link";
+  EXPECT_THROW(sim.person(grip), HardwareError);
+  world::PersonOrder walk;
+  walk.action = world::PersonOrder::Action::kWalk;
+  walk.route = {{0.5, 0.0}};
+  try {
+    sim.person(walk);
+    FAIL() << "walked holding nothing";
+  } catch (const HardwareError& e) {
+    EXPECT_STREQ(e.what(), "sim: person: walk: the person holds nothing (grip first)");
+  }
+
+  // Holding the base standing on its held wheels: the person walks 0.5 m off and pulls 150 N/m x
+  // 0.5 m; the base stays (far below its friction), so the person has not arrived.
+  grip.link = "mobile_base";
+  EXPECT_EQ(sim.person(grip), "person: gripping mobile_base");
+  EXPECT_EQ(sim.person(walk), "person: walking 0.50 m through 1 point");
+  const Eigen::Vector3d start = sim.base_pose().translation();
+  for (int i = 0; i < 3000; ++i) sim.step(0.001);
+  world::PersonReport r = sim.person_report();
+  EXPECT_EQ(r.orders, 2u);
+  EXPECT_EQ(r.link, "mobile_base");
+  EXPECT_EQ(r.phase, world::PersonPhase::kWalking) << world::to_string(r.phase) << " " << r.reason;
+  EXPECT_NEAR(r.walked, 0.5, 1e-9);
+  EXPECT_NEAR(r.pull.x(), 150.0 * 0.5, 2.0);
+  EXPECT_NEAR(r.time, sim.time(), 1e-9);
+  EXPECT_LT((sim.base_pose().translation() - start).head<2>().norm(), 0.005);
+
+  // A new world: still held.
+  World world;
+  world.obstacles.push_back({.name = "crate", .size = {0.5, 0.5, 0.5}, .position = {3.0, 0.0, 0.25}});
+  sim.set_world(world);
+  ASSERT_TRUE(sim.switch_prepared());
+  for (int i = 0; i < 10; ++i) sim.step(0.001);
+  EXPECT_NEAR(sim.person_report().pull.x(), 150.0 * 0.5, 2.0);
+  // Another robot: the person lets go, and its pull is gone.
+  ASSERT_TRUE(sim.swap_model(read_fixture("mobile_sander.urdf")));
+  ASSERT_TRUE(sim.switch_prepared());
+  for (int i = 0; i < 10; ++i) sim.step(0.001);
+  r = sim.person_report();
+  EXPECT_EQ(r.phase, world::PersonPhase::kLetGo);
+  EXPECT_EQ(r.reason, "hot swap: the robot changed");
+  EXPECT_EQ(r.pull, Eigen::Vector3d::Zero());
+}
+
 // Coulomb friction: a base standing on its held wheels stays where it is under a push well
 // below mu N, and slides under one above it. At MuJoCo's soft friction it crept (0.9 mm/s under
 // 150 N, 2.6 mm/s under 400 N, 1230 N of friction available), unseen by wheel odometry.

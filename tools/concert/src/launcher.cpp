@@ -1,4 +1,5 @@
 #include "launcher.hpp"
+#include "sim_channel.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -387,6 +388,77 @@ int run_up(const UpOptions& o, std::ostream& out, std::ostream& err) {
   return 0;
 }
 
+struct SimChannel::Impl {
+  dds::Participant participant;
+  std::mutex m;
+  std::condition_variable cv;
+  std::optional<msg::SimCommandReply> reply;
+  std::uint32_t awaited{0};
+  dds::Reader<msg::SimCommandReply> replies;
+  dds::Writer<msg::SimCommand> commands;
+  std::uint32_t next_id;
+  bool matched{false};
+
+  explicit Impl(std::int32_t domain)
+      : participant({.name = "concert_sim", .domain_id = domain}),
+        replies(participant, dds::topics::sim_reply,
+                [this](const msg::SimCommandReply& r, const auto&) {
+                  {
+                    std::lock_guard lock(m);
+                    if (r.request_id() != awaited) return;
+                    reply = r;
+                  }
+                  cv.notify_all();
+                }),
+        commands(participant, dds::topics::sim_command),
+        next_id(static_cast<std::uint32_t>(std::chrono::steady_clock::now().time_since_epoch().count() & 0x7fffffff)) {}
+};
+
+SimChannel::SimChannel(std::int32_t domain) : impl_(std::make_unique<Impl>(domain)) {}
+SimChannel::~SimChannel() = default;
+
+std::int32_t SimChannel::domain() const { return impl_->participant.domain_id(); }
+
+msg::SimCommandReply SimChannel::send(msg::SimCommandKind kind, const std::string& name, const std::string& content,
+                                      std::chrono::milliseconds timeout) {
+  Impl& i = *impl_;
+  msg::SimCommand c;
+  {
+    std::lock_guard lock(i.m);
+    i.awaited = i.next_id++;
+    i.reply.reset();
+    c.request_id(i.awaited);
+  }
+  c.stamp_ns(now_ns());
+  c.source("concert sim");
+  c.kind(kind);
+  c.name(name);
+  c.content(content);
+  // The command topic is volatile: wait for the simulator's reader before writing.
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  if (!i.matched && !i.commands.wait_for_readers(1, timeout)) {
+    throw Failure("no simulator on domain " + std::to_string(domain()) + " (start one with `concert up`)");
+  }
+  i.matched = true;
+  // The reader matched may be another tool's (the GUI's gateway, a recorder) before the
+  // simulator's: the command is written again every second until the reply comes (the
+  // simulator answers a command it has seen again without applying it twice).
+  std::unique_lock lock(i.m);
+  while (!i.reply) {
+    lock.unlock();
+    i.commands.write(c);
+    lock.lock();
+    const auto next = std::min(deadline, std::chrono::steady_clock::now() + std::chrono::seconds(1));
+    if (!i.cv.wait_until(lock, next, [&] { return i.reply.has_value(); }) &&
+        std::chrono::steady_clock::now() >= deadline) {
+      std::ostringstream s;
+      s << "the simulator did not answer within " << std::chrono::duration<double>(timeout).count() << " s";
+      throw Failure(s.str());
+    }
+  }
+  return *i.reply;
+}
+
 int run_sim(const SimOptions& o, std::ostream& out, std::ostream& /*err*/) {
   if (o.verb != "assemble" && o.verb != "swap" && o.verb != "world") {
     throw UsageError("unknown sim verb '" + o.verb + "' (assemble, swap, world)");
@@ -420,49 +492,9 @@ int run_sim(const SimOptions& o, std::ostream& out, std::ostream& /*err*/) {
     content << in.rdbuf();
   }
 
-  dds::Participant participant({.name = "concert_sim", .domain_id = o.dds.domain_id()});
-  std::mutex m;
-  std::condition_variable cv;
-  std::optional<msg::SimCommandReply> reply;
-  const auto request_id = static_cast<uint32_t>(
-      std::chrono::steady_clock::now().time_since_epoch().count() & 0x7fffffff);
-  dds::Reader<msg::SimCommandReply> replies(participant, dds::topics::sim_reply,
-                                            [&](const msg::SimCommandReply& r, const auto&) {
-                                              if (r.request_id() != request_id) return;
-                                              {
-                                                std::lock_guard lock(m);
-                                                reply = r;
-                                              }
-                                              cv.notify_all();
-                                            });
-  dds::Writer<msg::SimCommand> commands(participant, dds::topics::sim_command);
-  msg::SimCommand c;
-  c.request_id(request_id);
-  c.stamp_ns(now_ns());
-  c.source("concert sim");
-  c.kind(assembly ? msg::SIM_SWAP_ASSEMBLY : msg::SIM_SET_WORLD);
-  c.name(name);
-  c.content(content.str());
-  // The command topic is volatile: wait for the simulator's reader before writing.
-  const auto deadline = std::chrono::steady_clock::now() + o.dds.timeout();
-  if (!commands.wait_for_readers(1, o.dds.timeout())) {
-    throw Failure("no simulator on domain " + std::to_string(participant.domain_id()) +
-                  " (start one with `concert up`)");
-  }
-  // The reader matched may be another tool's (the GUI's gateway, a recorder) before the
-  // simulator's: the command is written again every second until the reply comes (the
-  // simulator answers a command it has seen again without applying it twice).
-  std::unique_lock lock(m);
-  while (!reply) {
-    lock.unlock();
-    commands.write(c);
-    lock.lock();
-    const auto next = std::min(deadline, std::chrono::steady_clock::now() + std::chrono::seconds(1));
-    if (!cv.wait_until(lock, next, [&] { return reply.has_value(); }) &&
-        std::chrono::steady_clock::now() >= deadline) {
-      throw Failure("the simulator did not answer within " + std::to_string(o.dds.timeout_s) + " s");
-    }
-  }
+  SimChannel channel(o.dds.domain_id());
+  const std::optional<msg::SimCommandReply> reply =
+      channel.send(assembly ? msg::SIM_SWAP_ASSEMBLY : msg::SIM_SET_WORLD, name, content.str(), o.dds.timeout());
   if (!reply->accepted()) throw Failure(reply->message());
   if (o.dds.json) {
     out << idl::Json{{"verb", o.verb}, {"file", from_ifc ? o.ifc : o.file}, {"accepted", true},
@@ -533,7 +565,7 @@ void register_launcher_verbs(cli::Cli& concert) {
   cli::Cli::add_domain_option(up_verb, up->domain);
 
   CLI::App& sim =
-      concert.group(concert.app(), "sim", "the running simulated robot: mounted modules and world");
+      concert.group(concert.app(), "sim", "the running simulated robot: mounted modules, world, and the person holding it");
   for (const auto& [name, what] : std::vector<std::pair<std::string, std::string>>{
            {"assemble", "mount another assembly on the running simulated robot"},
            {"swap", "hot swap: mount another assembly on the running simulated robot"},
@@ -559,6 +591,7 @@ void register_launcher_verbs(cli::Cli& concert) {
     }
     concert.add_dds_options(verb, o->dds, 10.0, "how long to wait for the simulator and its answer");
   }
+  register_person_verbs(concert, sim);
 }
 
 }  // namespace concert::tool

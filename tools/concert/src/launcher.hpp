@@ -5,7 +5,9 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -110,6 +112,23 @@ struct SimOptions {
   std::vector<std::string> module_dbs;  ///< extra module databases to check the assembly against
   cli::DdsOptions dds;  ///< --domain, --timeout (for the simulator and its answer), --json
 };
+
+/// `concert sim person grip|walk|release|status`: the simulated person holding the robot.
+struct PersonOptions {
+  std::string verb;  ///< grip, walk, release, status
+  std::string link;
+  std::vector<double> guide;  ///< grip: DX DY DZ
+  double guide_time{2.0};
+  double stiffness{150.0}, damping{30.0}, speed{0.5}, wait_stretch{0.6}, let_go_stretch{1.0};
+  std::vector<double> route;  ///< walk: DX DY pairs
+  bool world_frame{false};    ///< walk: the route in world coordinates, not offsets from the hand
+  bool wait{false};           ///< grip: until holding; walk: until arrived
+  std::string until;          ///< status: wait for this phase
+  cli::DdsOptions dds;
+};
+int run_sim_person(const PersonOptions& options, std::ostream& out, std::ostream& err);
+/// Registers `concert sim person ...` under the `sim` group.
+void register_person_verbs(cli::Cli& concert, CLI::App& sim);
 
 int run_up(const UpOptions& options, std::ostream& out, std::ostream& err);
 int run_sim(const SimOptions& options, std::ostream& out, std::ostream& err);

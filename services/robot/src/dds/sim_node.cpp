@@ -156,17 +156,24 @@ void SimNode::handle(const msg::SimCommand& c) {
   }
   msg::SimCommandReply reply;
   reply.request_id(c.request_id());
-  const std::string what = c.kind() == msg::SIM_SWAP_ASSEMBLY ? "assembly" : "world";
+  const bool person_order = c.kind() == msg::SIM_PERSON;
+  const std::string what = c.kind() == msg::SIM_SWAP_ASSEMBLY ? "assembly" : person_order ? "person" : "world";
+  const std::string kept = c.kind() == msg::SIM_SWAP_ASSEMBLY ? "modules" : person_order ? "person as it is" : "world";
+  bool quiet = false;  // a status query is not news in the log
   try {
-    reply.message(c.kind() == msg::SIM_SWAP_ASSEMBLY ? swap_assembly(c.content(), c.name())
-                                                     : set_world(c.content(), c.name()));
+    if (person_order) {
+      reply.message(person(c.content(), c.name(), quiet));
+    } else {
+      reply.message(c.kind() == msg::SIM_SWAP_ASSEMBLY ? swap_assembly(c.content(), c.name())
+                                                       : set_world(c.content(), c.name()));
+    }
     reply.accepted(true);
-    std::cerr << "concert_robot: " << what << " from '" << c.name() << "' (" << c.source()
-              << "): " << reply.message() << "\n";
+    if (!quiet)
+      std::cerr << "concert_robot: " << what << " from '" << c.name() << "' (" << c.source()
+                << "): " << reply.message() << "\n";
   } catch (const std::exception& e) {
     reply.accepted(false);
-    reply.message(what + " '" + c.name() + "' refused, the simulator keeps its " +
-                  (c.kind() == msg::SIM_SWAP_ASSEMBLY ? "modules" : "world") + ": " + e.what());
+    reply.message(what + " '" + c.name() + "' refused, the simulator keeps its " + kept + ": " + e.what());
     std::cerr << "concert_robot: " << reply.message() << "\n";
   }
   reply.stamp_ns(now_ns());
@@ -174,6 +181,13 @@ void SimNode::handle(const msg::SimCommand& c) {
   answered_.emplace_back(key, reply);
   constexpr std::size_t kAnswersKept = 64;
   if (answered_.size() > kAnswersKept) answered_.pop_front();
+}
+
+std::string SimNode::person(const std::string& yaml, const std::string& name, bool& status) {
+  const std::optional<world::PersonOrder> order = world::parse_person_order(yaml, name);
+  status = !order;
+  if (!order) return world::person_report_yaml(sim_.person_report());
+  return sim_.person(*order);
 }
 
 std::string SimNode::swap_assembly(const std::string& yaml, const std::string& name) {

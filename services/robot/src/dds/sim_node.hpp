@@ -1,6 +1,7 @@
 #pragma once
 // DDS face of the simulator (the robot service's sim backend): SimCommand in (mount another
-// assembly, change the world: the content travels, so it works from any host), SimCommandReply
+// assembly, change the world, tell the simulated person what to do: the content travels, so it
+// works from any host), SimCommandReply
 // out (accepted, or refused with the reason: the robot keeps its modules and world), and the
 // world it simulates on the latched World topic that every service reads; and the base's true
 // pose (SimTruth, 50 Hz) for tests and benchmarks.
@@ -47,6 +48,9 @@ class SimNode {
   std::string swap_assembly(const std::string& yaml, const std::string& name);
   /// Replaces the world the same way, and publishes it.
   std::string set_world(const std::string& yaml, const std::string& name);
+  /// An order to the simulated person (sim/person_order.hpp): what will happen, or for a
+  /// status query (`status` set) the person's state as one line of YAML. Throws with the reason.
+  std::string person(const std::string& yaml, const std::string& name, bool& status);
 
  private:
   void work();

@@ -33,6 +33,8 @@ struct SimulatedRobot {
   /// The links moved with its sanding tools (the subtree of the last joint moving each sanding
   /// end-effector's TCP: the tool and its flange), for SimParams::sanding_disc_friction.
   std::vector<std::string> sanding_links;
+  /// The TCP links of its gripper end-effectors: what a simulated person grips (person.hpp).
+  std::vector<std::string> gripper_tcps;
   /// The steering legs by role (the wheels that roll on the floor). nullopt for a bare URDF,
   /// which carries no roles: the simulator then finds them by their axes (mobile_base::detect_legs).
   std::optional<std::vector<SimLeg>> legs;

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -11,6 +12,7 @@
 
 #include "concert/hardware/hardware.hpp"
 #include "concert/sim/drilling.hpp"
+#include "concert/world/person_order.hpp"
 #include "concert/sim/sensor_params.hpp"
 #include "concert/sim/sim_assembly.hpp"
 #include "concert/world/world.hpp"
@@ -131,6 +133,15 @@ class SimHardware final : public hardware::Hardware {
   /// (switch_prepared) keeps it when the new model has the link, else clears it.
   void set_external_force(const std::string& link, const Eigen::Vector3d& force, const Eigen::Vector3d& point);
   void clear_external_force();
+
+  /// Checks `order` (world/person_order.hpp) against the mounted robot (the link, someone gripping
+  /// for a walk) and queues it for the next step() (any thread); returns what will happen.
+  /// Throws HardwareError naming what is wrong, and nothing changes. The person lets go when the
+  /// robot is swapped for another (a new world keeps the grip), and when the link falls too far
+  /// behind.
+  std::string person(const world::PersonOrder& order);
+  /// The person after the latest step() (any thread; the control thread never waits for it).
+  [[nodiscard]] world::PersonReport person_report() const;
 
   // Ground truth, for tests and benchmarks.
   [[nodiscard]] double time() const;
