@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "concert/dds/endpoint.hpp"
+#include "concert/world/person_order.hpp"
 
 namespace {
 
@@ -188,6 +189,37 @@ TEST(RobotMain, SimCommandsSwapTheAssemblyAndChangeTheWorld) {
   ASSERT_EQ(world->obstacles().size(), 1u);
   EXPECT_EQ(world->obstacles()[0].name(), "crate");
   EXPECT_EQ(world->source(), "site.yaml");
+
+  // The simulated person: a status query answers with its state as YAML; an order the mounted
+  // robot cannot take (no gripper on the paper's drilling robot) is refused with the reason; a
+  // malformed one names the key and line.
+  concert::msg::SimCommand p = bad;
+  p.kind(concert::msg::SIM_PERSON);
+  p.request_id(6);
+  p.name("concert sim person status");
+  p.content("action: status\n");
+  reply = send(commands, replies, p);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_TRUE(reply->accepted()) << reply->message();
+  EXPECT_EQ(concert::world::parse_person_report(reply->message()).phase, concert::world::PersonPhase::kAbsent)
+      << reply->message();
+  p.request_id(7);
+  p.name("grip");
+  p.content("action: grip\n");
+  reply = send(commands, replies, p);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_FALSE(reply->accepted());
+  EXPECT_EQ(reply->message(), "person 'grip' refused, the simulator keeps its person as it is: sim: person: the "
+                              "mounted robot has no gripper to hold; name a link");
+  p.request_id(8);
+  p.name("walk.yaml");
+  p.content("action: walk\nroute: [1.0]\n");
+  reply = send(commands, replies, p);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_FALSE(reply->accepted());
+  EXPECT_NE(reply->message().find("walk.yaml: route: expected x, y pairs [m], at least one (got 1 numbers) (line 2)"),
+            std::string::npos)
+      << reply->message();
 }
 
 }  // namespace

@@ -107,7 +107,8 @@ class DrillMotion {
   /// the tuned thrust the drilling may push with, in [0, 1]. Below 1 the reference leads the tip
   /// less, down to light_drilling's floor (the bit still feels the wall); at 0, once the bit has
   /// met the wall, the feed stops with the bit at rest in the hole (no thrust) and the drilling's
-  /// time limit waits with it. Kept across phases until set again.
+  /// time limit waits with it, for at most another drill_timeout (then the hole fails, saying
+  /// so). Kept across phases until set again.
   void set_thrust_share(double share);
   [[nodiscard]] double thrust_share() const { return thrust_share_; }
   /// Robot time the feed stood still at share 0 in this drilling [s].

@@ -191,6 +191,14 @@ CartesianReference DrillMotion::update(const Eigen::Isometry3d& tip, double now)
       if (contact_ && thrust_share_ <= 0.0) {
         paused_ += dt;
         depth_ref_ = std::min(depth_ref_, d);
+        if (paused_ > params_.drill_timeout) {
+          // The drive does not cool with the bit at rest: the posture itself loads it too much.
+          std::ostringstream s;
+          s << "the feed stood still " << params_.drill_timeout << " s for the arm's drives to cool, in vain: hole "
+            << std::max(0.0, reached_) * 1000.0 << " of " << target_depth_ * 1000.0 << " mm deep";
+          fail(s.str());
+          return reference(depth_ref_, 0.0, tip);
+        }
       } else {
         depth_ref_ = std::min({depth_ref_ + params_.feed_rate * dt, d + lead, limit});
       }
