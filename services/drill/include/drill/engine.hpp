@@ -333,6 +333,7 @@ class DrillEngine final : public MissionPorts {
   // first posture request, its next attempt); the others expect the arm where it is.
   void send_plan(const PlanAsk& r, bool may_rest = false);
   void forward_plan(const PlanAsk& r);
+  PlanAsk home_ask();
   // Why the arm must rest before `r` is planned ("J3_E: RMS 151 N m over the thermal window,
   // 0.94 of continuous"), or "" when it may wait where it is.
   [[nodiscard]] std::string rest_reason(const PlanAsk& r) const;

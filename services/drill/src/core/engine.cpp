@@ -157,12 +157,7 @@ void DrillEngine::send_plan(const PlanAsk& request, bool may_rest) {
   if (held_requests_.empty()) {
     log_line("drill: the arm rests at home before the planner's next answer (" + why +
              "): holding the posture while the planner searches would pass the drive's thermal limit");
-    PlanAsk home;
-    home.request_id = next_request_++;
-    home.model_version = static_cast<std::uint32_t>(model_version_);
-    home.end_effector = rig_ ? rig_->tool() : "";
-    home.home = true;
-    home.execute = true;
+    const PlanAsk home = home_ask();
     rest_request_ = home.request_id;
     rest_since_ = -1.0;
     forward_plan(home);
@@ -559,14 +554,20 @@ void DrillEngine::navigate(const BasePose& goal) {
   send_home();
 }
 
-void DrillEngine::send_home() {
-  hole_chain_.clear();
+// The planner's home request, executed: the arm to its homing posture, the base standing.
+PlanAsk DrillEngine::home_ask() {
   PlanAsk r;
   r.request_id = next_request_++;
   r.model_version = static_cast<std::uint32_t>(model_version_);
   r.end_effector = rig_ ? rig_->tool() : "";
   r.home = true;
   r.execute = true;
+  return r;
+}
+
+void DrillEngine::send_home() {
+  hole_chain_.clear();
+  const PlanAsk r = home_ask();
   home_request_ = r.request_id;
   send_plan(r);
 }
