@@ -164,7 +164,7 @@ TEST(ConcertCli, TheExecutableUsesTheSameExitCodes) {
   EXPECT_THAT(help.out(), HasSubstr("Usage: concert sim"));
   testing::Process missing({CONCERT_BIN, "sim"});
   EXPECT_EQ(missing.wait(30s), 2);
-  EXPECT_THAT(missing.err(), HasSubstr("concert sim: missing verb (one of: assemble, swap, world)"));
+  EXPECT_THAT(missing.err(), HasSubstr("concert sim: missing verb (one of: assemble, swap, world, person)"));
 }
 
 }  // namespace
