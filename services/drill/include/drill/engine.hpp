@@ -337,6 +337,13 @@ class DrillEngine final : public MissionPorts {
   // Why the arm must rest before `r` is planned ("J3_E: RMS 151 N m over the thermal window,
   // 0.94 of continuous"), or "" when it may wait where it is.
   [[nodiscard]] std::string rest_reason(const PlanAsk& r) const;
+  // Each arm joint's heat (Inputs::heat) with its continuous torque [N m].
+  struct ArmHeat {
+    std::string joint;
+    Inputs::Heat heat;
+    double continuous{0.0};
+  };
+  [[nodiscard]] std::vector<ArmHeat> arm_heat() const;
   // The arm joints' largest RMS torque over the thermal window, as a fraction of continuous.
   [[nodiscard]] double arm_rms_share() const;
   void rest_step();

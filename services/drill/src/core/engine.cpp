@@ -165,31 +165,38 @@ void DrillEngine::send_plan(const PlanAsk& request, bool may_rest) {
   held_requests_.push_back(request);
 }
 
-std::string DrillEngine::rest_reason(const PlanAsk& r) const {
-  // Only a request planned from where the robot stands: the arm is held there, still, while the
-  // planner searches. One from another start is planned while the robot does something else.
-  if (!rig_ || !r.start_names.empty()) return {};
+std::vector<DrillEngine::ArmHeat> DrillEngine::arm_heat() const {
+  std::vector<ArmHeat> out;
+  if (!rig_) return out;
   const std::map<std::string, Inputs::Heat> heat = inputs_.heat();
   const model::ModelDescription& d = rig_->model().description();
-  std::ostringstream why;
-  why.setf(std::ios::fixed);
   for (const model::JointLimits& j : rig_->model().limits().rows()) {
     const auto chain = std::find_if(d.chains.begin(), d.chains.end(),
                                     [&](const model::ChainInfo& c) { return c.name == j.chain; });
-    if (chain == d.chains.end() || chain->role != model::ChainRole::kArm) continue;
-    const auto h = heat.find(j.name);
-    if (h == heat.end() || j.continuous_torque <= 0.0) continue;
-    const double rms = h->second.rms / j.continuous_torque, held = h->second.present / j.continuous_torque;
+    if (chain == d.chains.end() || chain->role != model::ChainRole::kArm || j.continuous_torque <= 0.0) continue;
+    if (const auto h = heat.find(j.name); h != heat.end()) out.push_back({j.name, h->second, j.continuous_torque});
+  }
+  return out;
+}
+
+std::string DrillEngine::rest_reason(const PlanAsk& r) const {
+  // Only a request planned from where the robot stands: the arm is held there, still, while the
+  // planner searches. One from another start is planned while the robot does something else.
+  if (!r.start_names.empty()) return {};
+  std::ostringstream why;
+  why.setf(std::ios::fixed);
+  for (const ArmHeat& a : arm_heat()) {
+    const double rms = a.heat.rms / a.continuous, held = a.heat.present / a.continuous;
     if (rms > tuning_.rest.above) {
       why.precision(0);
-      why << j.name << ": RMS " << h->second.rms << " N m over the thermal window, ";
+      why << a.joint << ": RMS " << a.heat.rms << " N m over the thermal window, ";
       why.precision(2);
       why << rms << " of its continuous torque";
       return why.str();
     }
     if (held > tuning_.rest.hold) {
       why.precision(0);
-      why << j.name << ": holds " << h->second.present << " N m, ";
+      why << a.joint << ": holds " << a.heat.present << " N m, ";
       why.precision(2);
       why << held << " of its continuous torque";
       return why.str();
@@ -199,16 +206,8 @@ std::string DrillEngine::rest_reason(const PlanAsk& r) const {
 }
 
 double DrillEngine::arm_rms_share() const {
-  if (!rig_) return 0.0;
-  const std::map<std::string, Inputs::Heat> heat = inputs_.heat();
-  const model::ModelDescription& d = rig_->model().description();
   double share = 0.0;
-  for (const model::JointLimits& j : rig_->model().limits().rows()) {
-    const auto chain = std::find_if(d.chains.begin(), d.chains.end(),
-                                    [&](const model::ChainInfo& c) { return c.name == j.chain; });
-    if (chain == d.chains.end() || chain->role != model::ChainRole::kArm || j.continuous_torque <= 0.0) continue;
-    if (const auto h = heat.find(j.name); h != heat.end()) share = std::max(share, h->second.rms / j.continuous_torque);
-  }
+  for (const ArmHeat& a : arm_heat()) share = std::max(share, a.heat.rms / a.continuous);
   return share;
 }
 
