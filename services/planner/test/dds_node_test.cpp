@@ -616,6 +616,31 @@ TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {
   EXPECT_EQ(plan({"home", "--at", "2.0", "0.1", "2.3"}), 2);
   err.str("");
   out.str("");
+  // The first arm joint turned by 0.3 rad (planned only); words that are no NAME=POSITION are
+  // usage errors, a joint the model lacks is the planner's refusal.
+  const auto model = planner_->model();
+  ASSERT_TRUE(model);
+  const std::string first = model->joint_names()[3];
+  EXPECT_EQ(plan({"posture", first + "=0.3", "--plan-only", "--request-id", "35", "--timeout", "20"}), 0)
+      << err.str() << "the planner logged:\n" << log_.str();
+  EXPECT_NE(out.str().find("request 35: the arm to 1 joint position(s) for model version 8, planning only"),
+            std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find("goal 1/1 succeeded"), std::string::npos) << out.str();
+  EXPECT_EQ(plan({"posture"}), 2);
+  EXPECT_EQ(plan({"posture", first}), 2);
+  EXPECT_NE(err.str().find("'" + first + "': a joint's position is NAME=POSITION, e.g. J2_E=0.65"), std::string::npos)
+      << err.str();
+  EXPECT_EQ(plan({"posture", first + "=0.3rad"}), 2);
+  EXPECT_NE(err.str().find("'0.3rad' is not a number"), std::string::npos) << err.str();
+  err.str("");
+  out.str("");
+  EXPECT_EQ(plan({"posture", "J9_Z=0.1", "--plan-only", "--request-id", "36", "--timeout", "20"}), 1);
+  EXPECT_NE(err.str().find("concert plan posture: posture: 'J9_Z' is not an arm joint of model version 8"),
+            std::string::npos)
+      << err.str();
+  err.str("");
+  out.str("");
   // Out of reach: the posture search spends its whole budget (1.6 s of CPU) before it fails:
   // 1.8 s here, 3.3 s beside three busy loops. CI once saw no answer within 20 s, and ctest -j2
   // once saw none to `plan home` (the command printed its request, then nothing): a request

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <sstream>
 #include <vector>
 
 #include "planner/fixtures.hpp"
@@ -299,6 +300,70 @@ TEST(Planner, AHomeRequestTakesTheArmToItsHomingPostureTheBaseStanding) {
   EXPECT_NE(no_home.reason.find("home: the homing posture is rejected where the robot stands by environment collision"),
             std::string::npos)
       << no_home.reason;
+}
+
+// A task that starts from a posture of its own (collab's carrying posture) asks for it by joint:
+// the named joints end on the positions asked, the others where they stood, the base standing,
+// every sample collision free and within the limits. A name the model has no arm joint for, a
+// position beyond its limits, a joint named twice, or goals beside it are refused naming what.
+TEST(Planner, APostureRequestTakesTheNamedJointsThereTheRestStanding) {
+  const Params params = generous(37);
+  auto planner = planner_at_site(params, 'a', 4);
+  const auto model = planner->model();
+  const Eigen::VectorXd start = start_state(*model);
+  PlanRequest home{1, 4, "", {}};
+  home.home = true;
+  const PlanResult at_home = planner->plan(home, start, {});
+  ASSERT_EQ(at_home.status, Status::kSucceeded) << at_home.reason;
+  const Eigen::VectorXd from = model->to_full(at_home.goals[0].trajectory.points.back().q, start);
+  const Eigen::VectorXd planned_from = model->to_planned(from);
+
+  // Two arm joints halfway towards a limit each.
+  const std::string a = model->joint_names()[4];
+  const std::string b = model->joint_names()[6];
+  const double a_to = 0.5 * (planned_from[4] + model->upper()[4]);
+  const double b_to = 0.5 * (planned_from[6] + model->lower()[6]);
+  ASSERT_GT(std::abs(a_to - planned_from[4]) + std::abs(b_to - planned_from[6]), 0.3)
+      << "the posture is where the arm stands: the test proves nothing";
+  PlanRequest posture{2, 4, "", {}};
+  posture.posture = {{a, a_to}, {b, b_to}};
+  const PlanResult r = planner->plan(posture, from, {});
+  ASSERT_EQ(r.status, Status::kSucceeded) << r.reason;
+  ASSERT_EQ(r.goals.size(), 1u);
+  const Trajectory& t = r.goals[0].trajectory;
+  ASSERT_GE(t.points.size(), 2u);
+  const Eigen::VectorXd end = t.points.back().q;
+  for (Eigen::Index j = 0; j < end.size(); ++j) {
+    const double expected = j == 4 ? a_to : j == 6 ? b_to : planned_from[j];
+    EXPECT_NEAR(end[j], expected, 1e-9) << model->joint_names()[static_cast<std::size_t>(j)];
+  }
+  StateChecker exact(model, environment_of(site(2.2), params), params, 0.0);
+  for (const TrajectoryPoint& p : t.points) {
+    EXPECT_EQ(p.q.head<3>(), planned_from.head<3>()) << "the base moved at " << p.time << " s";
+    const Validity v = exact.check(model->to_full(p.q, from));
+    EXPECT_TRUE(v.valid()) << p.time << " s: " << to_string(v.constraint) << ": " << v.detail;
+  }
+  EXPECT_TRUE(t.points.back().qd.isZero());
+
+  const auto refused = [&](std::vector<std::pair<std::string, double>> joints, std::vector<Goal> goals = {}) {
+    PlanRequest bad{3, 4, "", std::move(goals)};
+    bad.posture = std::move(joints);
+    const PlanResult out = planner->plan(bad, from, {});
+    EXPECT_EQ(out.status, Status::kInvalidRequest) << out.reason;
+    EXPECT_TRUE(out.goals.empty());
+    return out.reason;
+  };
+  EXPECT_NE(refused({{"J9_Z", 0.1}}).find("'J9_Z' is not an arm joint of model version 4 (its arm joints: " +
+                                           model->joint_names()[3]),
+            std::string::npos);
+  EXPECT_NE(refused({{"base_x", 0.1}}).find("'base_x' is not an arm joint"), std::string::npos);
+  std::ostringstream beyond;
+  beyond << "joint '" << a << "' to " << model->upper()[4] + 0.1 << " is beyond its limits [";
+  EXPECT_NE(refused({{a, model->upper()[4] + 0.1}}).find(beyond.str()), std::string::npos) << beyond.str();
+  EXPECT_NE(refused({{a, std::nan("")}}).find("is beyond its limits"), std::string::npos);
+  EXPECT_NE(refused({{a, a_to}, {a, a_to}}).find("joint '" + a + "' is named twice"), std::string::npos);
+  EXPECT_NE(refused({{a, a_to}}, {{fixtures::drilling_area(2.2, 0.3, 1.0)}}).find("a posture request has no goals"),
+            std::string::npos);
 }
 
 TEST(Planner, ClearErrorsForBadRequests) {

@@ -9,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "concert/model/description.hpp"
@@ -213,6 +214,11 @@ struct PlanRequest {
   /// free, timed within the drives); refused with the reason when that posture is not free
   /// where the robot stands.
   bool home = false;
+  /// No goals, not with `home`: these arm joints to these positions, the joints not named
+  /// keeping their start positions, the base standing (a task's start posture, e.g. collab's
+  /// carrying posture). Planned like `home`; refused naming the joint when it is not an arm
+  /// joint of the model or its position is beyond the joint's limits.
+  std::vector<std::pair<std::string, double>> posture;
   /// The base keeps its start pose: only the arm moves (the drill service's hole postures:
   /// a base that moves lets odometry drift between holes).
   bool fixed_base = false;

@@ -1,5 +1,6 @@
 // `concert plan drill` sends drilling-area goals to the planner service and follows them;
-// `concert plan home` moves the arm to its homing posture (the transport posture nav drives with).
+// `concert plan home` moves the arm to its homing posture (the transport posture nav drives with);
+// `concert plan posture J2_E=0.65 ...` moves named arm joints to given positions (a task's start).
 
 #include "planner/cli.hpp"
 
@@ -18,11 +19,12 @@
 namespace concert::planner {
 namespace {
 
-/// What `concert plan drill` and `concert plan home` send.
+/// What `concert plan drill`, `home` and `posture` send.
 struct PlanOptions {
   std::string verb = "drill";
   bool home = false;                    ///< the arm home instead of goals
-  bool plan_only = false;               ///< home: plan without executing
+  std::vector<std::string> posture;     ///< NAME=POSITION: these joints instead of goals
+  bool plan_only = false;               ///< home, posture: plan without executing
   std::vector<std::vector<double>> at;  ///< goals, 3 numbers each [m]
   std::vector<double> normal{-1.0, 0.0, 0.0};
   bool execute = false;
@@ -30,6 +32,24 @@ struct PlanOptions {
   uint32_t request_id = std::random_device{}() & 0x7fffffffu;
   cli::DdsOptions dds;
 };
+
+/// "J2_E=0.65" as a name and a position; a usage error naming the word otherwise.
+std::pair<std::string, double> joint_position(const std::string& word) {
+  const std::size_t eq = word.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == word.size())
+    throw cli::UsageError("'" + word + "': a joint's position is NAME=POSITION, e.g. J2_E=0.65");
+  const std::string value = word.substr(eq + 1);
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != value.size() || !std::isfinite(v))
+    throw cli::UsageError("'" + word + "': '" + value + "' is not a number (rad, or m for a prismatic joint)");
+  return {word.substr(0, eq), v};
+}
 
 const char* state_name(msg::PlanState s) {
   switch (s) {
@@ -47,7 +67,9 @@ int send_request(const PlanOptions& o, std::ostream& out, std::ostream& err) {
   for (const auto& p : o.at) points.emplace_back(p[0], p[1], p[2]);
   const Eigen::Vector3d normal(o.normal[0], o.normal[1], o.normal[2]);
   if (normal.norm() < 1e-9) throw cli::UsageError("--normal: must not be zero");
-  const bool execute = o.home ? !o.plan_only : o.execute;
+  std::vector<std::pair<std::string, double>> posture;
+  for (const std::string& word : o.posture) posture.push_back(joint_position(word));
+  const bool execute = o.home || !posture.empty() ? !o.plan_only : o.execute;
   const std::string who = "concert plan " + o.verb;
   const std::string& end_effector = o.end_effector;
   const double timeout_s = o.dds.timeout_s;
@@ -84,6 +106,10 @@ int send_request(const PlanOptions& o, std::ostream& out, std::ostream& err) {
     req.end_effector(end_effector);
     req.execute(execute);
     req.arm_home(o.home);
+    for (const auto& [name, position] : posture) {
+      req.posture_names().push_back(name);
+      req.posture_position().push_back(position);
+    }
     const Eigen::Vector3d z = normal.normalized();
     const Eigen::Vector3d up = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
     Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
@@ -100,13 +126,16 @@ int send_request(const PlanOptions& o, std::ostream& out, std::ostream& err) {
       out << nlohmann::ordered_json{{"request_id", request_id},
                                     {"goals", points.size()},
                                     {"home", o.home},
+                                    {"posture", o.posture},
                                     {"model_version", model->version()},
                                     {"execute", execute}}
                  .dump()
           << std::endl;
     } else {
       out << "request " << request_id << ": "
-          << (o.home ? std::string("the arm home") : std::to_string(points.size()) + " goal(s)")
+          << (o.home              ? std::string("the arm home")
+              : !posture.empty() ? "the arm to " + std::to_string(posture.size()) + " joint position(s)"
+                                 : std::to_string(points.size()) + " goal(s)")
           << " for model version " << model->version() << (execute ? ", executing" : ", planning only") << "\n";
     }
     // Execution progress arrives many times a second: one line per 10 % of each goal.
@@ -217,6 +246,22 @@ void register_verbs(cli::Cli& concert) {
       ->type_name("N")
       ->check(cli::number(0, 4294967295.0, true));
   concert.add_dds_options(home, h->dds, 60.0, "how long to follow the request");
+
+  auto p = std::make_shared<PlanOptions>();
+  p->verb = "posture";
+  CLI::App& posture = concert.verb(
+      plan, "posture",
+      "move arm joints to given positions, the others keeping theirs, the base standing (e.g. the "
+      "carrying posture a transport starts from; planned collision free and within the drives)",
+      [&concert, p] { return send_request(*p, concert.out(), concert.err()); });
+  posture.add_option("joints", p->posture, "a joint and its position [rad, m], e.g. J2_E=0.65 (repeat)")
+      ->type_name("NAME=POSITION")
+      ->required();
+  posture.add_flag("--plan-only", p->plan_only, "plan the motion without executing it");
+  posture.add_option("--request-id", p->request_id, "the request's id (default: random)")
+      ->type_name("N")
+      ->check(cli::number(0, 4294967295.0, true));
+  concert.add_dds_options(posture, p->dds, 60.0, "how long to follow the request");
 }
 
 }  // namespace concert::planner

@@ -13,6 +13,7 @@
 #include <optional>
 #include <random>
 #include <sstream>
+#include <variant>
 
 #include "path_search.hpp"
 #include "planner/trajectory.hpp"
@@ -423,20 +424,59 @@ Eigen::VectorXd home_posture(const PlanningModel& model, const Eigen::VectorXd& 
 
 GoalResult Planner::plan_home(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& start,
                               uint64_t seed, const Eigen::VectorXd* lead_in) const {
-  const Eigen::VectorXd home = home_posture(model, start);
+  return plan_posture(model, checker, start, home_posture(model, start), "home: the homing posture", seed,
+                      lead_in);
+}
+
+GoalResult Planner::plan_posture(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& start,
+                                 const Eigen::VectorXd& target, const std::string& what, uint64_t seed,
+                                 const Eigen::VectorXd* lead_in) const {
   GoalResult r;
-  if (const Validity v = checker.check(model.to_full(home, start)); !v.valid()) {
-    r.goal_q = home;
+  if (const Validity v = checker.check(model.to_full(target, start)); !v.valid()) {
+    r.goal_q = target;
     r.status = Status::kUnreachable;
-    r.reason = std::string("home: the homing posture is rejected where the robot stands by ") +
-               to_string(v.constraint) + ": " + v.detail;
+    r.reason = what + " is rejected where the robot stands by " + to_string(v.constraint) + ": " + v.detail;
     return r;
   }
-  r = plan_path(model, checker, start, home, params_.planning_time, seed, true, lead_in);
+  r = plan_path(model, checker, start, target, params_.planning_time, seed, true, lead_in);
   r.index = 0;
-  if (r.status != Status::kSucceeded) r.reason = "home: " + r.reason;
+  if (r.status != Status::kSucceeded) r.reason = what.substr(0, what.find(':') + 1) + " " + r.reason;
   return r;
 }
+
+namespace {
+
+/// The planned posture a PlanRequest::posture asks for from `start` (full q), or the reason it
+/// is malformed (a name that is no arm joint the planner moves, twice, or beyond its limits).
+std::variant<Eigen::VectorXd, std::string> requested_posture(const PlanningModel& model,
+                                                             const Eigen::VectorXd& start,
+                                                             const std::vector<std::pair<std::string, double>>& posture) {
+  Eigen::VectorXd q = model.to_planned(start);
+  const std::vector<std::string>& names = model.joint_names();
+  std::vector<bool> named(names.size(), false);
+  for (const auto& [name, value] : posture) {
+    const auto it = std::find(names.begin() + 3, names.end(), name);
+    if (it == names.end()) {
+      std::string known;
+      for (auto n = names.begin() + 3; n != names.end(); ++n) known += (known.empty() ? "" : ", ") + *n;
+      return "posture: '" + name + "' is not an arm joint of model version " + std::to_string(model.version()) +
+             " (its arm joints: " + known + ")";
+    }
+    const auto j = static_cast<Eigen::Index>(it - names.begin());
+    if (named[static_cast<std::size_t>(j)]) return "posture: joint '" + name + "' is named twice";
+    named[static_cast<std::size_t>(j)] = true;
+    if (!std::isfinite(value) || value < model.lower()[j] || value > model.upper()[j]) {
+      std::ostringstream why;
+      why << "posture: joint '" << name << "' to " << value << " is beyond its limits [" << model.lower()[j]
+          << ", " << model.upper()[j] << "]";
+      return why.str();
+    }
+    q[j] = value;
+  }
+  return q;
+}
+
+}  // namespace
 
 PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_start_full,
                          const GoalCallback& on_goal) {
@@ -459,7 +499,12 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   if (request.home && !request.goals.empty()) {
     return fail(Status::kInvalidRequest, "a home request has no goals (the arm goes home, nothing else)");
   }
-  if (!request.home && request.goals.empty()) return fail(Status::kInvalidRequest, "request has no goals");
+  if (!request.posture.empty() && (request.home || !request.goals.empty())) {
+    return fail(Status::kInvalidRequest,
+                "a posture request has no goals and is no home request (the arm goes to the posture, nothing else)");
+  }
+  if (!request.home && request.posture.empty() && request.goals.empty())
+    return fail(Status::kInvalidRequest, "request has no goals");
   if (std::isnan(request.tip_distance) || std::isinf(request.tip_distance)) {
     return fail(Status::kInvalidRequest, "tip_distance must be a finite number of metres");
   }
@@ -480,12 +525,16 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   }
   const EndEffectorInfo* tool = nullptr;
   try {
-    if (!request.home) {
+    if (!request.home && request.posture.empty()) {
       tool = &model->tool(request.end_effector);
       (void)model->camera_frame(*tool);
     }
   } catch (const PlannerError& e) {
     return fail(Status::kInvalidRequest, e.what());
+  }
+  if (!request.posture.empty()) {
+    const auto posture = requested_posture(*model, q_start_full, request.posture);
+    if (const auto* why = std::get_if<std::string>(&posture)) return fail(Status::kInvalidRequest, *why);
   }
   for (std::size_t g = 0; g < request.goals.size(); ++g) {
     const Eigen::Isometry3d& a = request.goals[g].area;
@@ -625,9 +674,13 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   }
   Eigen::VectorXd current = start;
   out.status = Status::kSucceeded;
-  if (request.home) {
-    GoalResult r = plan_home(*model, checker, start, params_.seed + 7919u * request.request_id,
-                             lead_in ? &*lead_in : nullptr);
+  if (request.home || !request.posture.empty()) {
+    const uint64_t seed = params_.seed + 7919u * request.request_id;
+    GoalResult r = request.home ? plan_home(*model, checker, start, seed, lead_in ? &*lead_in : nullptr)
+                                : plan_posture(*model, checker, start,
+                                               std::get<Eigen::VectorXd>(requested_posture(*model, start, request.posture)),
+                                               "posture: the posture", seed,
+                                               lead_in ? &*lead_in : nullptr);
     if (r.status != Status::kSucceeded) {
       out.status = r.status;
       out.reason = r.reason;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -279,7 +280,9 @@ msg::PlanResult PlannerNode::planning(const msg::PlanRequest& request) const {
   msg::PlanResult r;
   r.request_id(request.request_id());
   r.model_version(static_cast<uint32_t>(planner_.model_version()));
-  r.goal_count(static_cast<uint32_t>(request.arm_home() ? 1 : request.goals().size()));  // home: one path
+  // Home or a posture: one path.
+  const bool one_path = request.arm_home() || !request.posture_names().empty();
+  r.goal_count(static_cast<uint32_t>(one_path ? 1 : request.goals().size()));
   r.state(msg::PLAN_PLANNING);
   return r;
 }
@@ -321,6 +324,14 @@ ClientRequest to_client_request(const msg::PlanRequest& request) {
   core.environment_padding = request.environment_padding();
   core.base_travel = request.base_travel();
   core.home = request.arm_home();
+  // Names and positions pair up; a count that differs is refused by the planner (an unpaired
+  // name is read as NaN, beyond every limit).
+  const auto& names = request.posture_names();
+  const auto& positions = request.posture_position();
+  for (std::size_t i = 0; i < std::max(names.size(), positions.size()); ++i) {
+    core.posture.emplace_back(i < names.size() ? names[i] : std::string("(unnamed)"),
+                              i < positions.size() ? positions[i] : std::numeric_limits<double>::quiet_NaN());
+  }
   for (const msg::Pose& g : request.goals()) core.goals.push_back({to_core(g)});
   c.start_names = request.start_names();
   c.start_position = request.start_position();
@@ -402,7 +413,7 @@ void PlannerNode::handle(const msg::PlanRequest& request) {
   }
 
   const bool execute = request.execute();
-  const std::size_t count = prepared.plan.home ? 1 : prepared.plan.goals.size();
+  const std::size_t count = prepared.plan.home || !prepared.plan.posture.empty() ? 1 : prepared.plan.goals.size();
   msg::PlanResult last_planned;
   const PlanResult result = planner_.plan(prepared.plan, prepared.start, [&](const GoalResult& g) {
     const Trajectory trajectory = to_odometry_frame(g.trajectory, prepared.map_T_odom, prepared.yaw_offset);
