@@ -583,6 +583,10 @@ struct SimHardware::Impl {
   bool person_fresh{true};  // no previous position to take the TCP's velocity from
   std::uint64_t person_taken{0};
   world::PersonReport person_copy;  // under truth_mutex
+  // The held (or last held) link's body in the active instance, for the report's `tcp`: found
+  // again when the instance or the link changes.
+  int report_body{-1};
+  const Instance* report_instance{nullptr};
   world::PersonPhase person_copied_phase{world::PersonPhase::kAbsent};
 
   void take_person_orders() {
@@ -614,6 +618,7 @@ struct SimHardware::Impl {
         person_instance = &in;
         const Eigen::Vector3d tcp(in.d->xpos[3 * body], in.d->xpos[3 * body + 1], in.d->xpos[3 * body + 2]);
         person_sim.grip(in.d->time, tcp, o.guide, o.guide_time);
+        report_instance = nullptr;
         person_last_tcp = tcp;
         person_fresh = false;
         return;
@@ -687,7 +692,18 @@ struct SimHardware::Impl {
     }
     r.phase = person_sim.phase();
     r.hand = person_sim.hand();
+    // Where the link is now, also after the person let go (a lift or a placing is measured there).
     r.tcp = person_last_tcp;
+    if (!person_link.empty()) {
+      if (report_instance != active.get()) {
+        report_body = mj_name2id(active->m, mjOBJ_BODY, person_link.c_str());
+        report_instance = active.get();
+      }
+      if (report_body >= 0) {
+        const double* x = active->d->xpos + 3 * report_body;
+        r.tcp = Eigen::Vector3d(x[0], x[1], x[2]);
+      }
+    }
     r.pull = person_sim.pull();
     r.walked = person_sim.walked();
     r.route_length = person_sim.route_length();

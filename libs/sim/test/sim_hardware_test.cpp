@@ -168,6 +168,37 @@ TEST(SimHardware, APersonPullsTheLinkItHoldsAndLetsGoWhenTheRobotIsSwapped) {
   EXPECT_EQ(r.pull, Eigen::Vector3d::Zero());
 }
 
+// After the person let go, its report still says where the link it held is: a lift or a placing
+// that follows is measured there.
+TEST(SimHardware, APersonsReportFollowsTheLinkItLetGo) {
+  SimHardware sim(read_fixture("mobile_drill.urdf"), World{}, {});
+  for (int i = 0; i < 200; ++i) sim.step(0.001);
+  world::PersonOrder grip;
+  grip.link = "arm_link_6";
+  EXPECT_EQ(sim.person(grip), "person: gripping arm_link_6");
+  for (int i = 0; i < 10; ++i) sim.step(0.001);
+  world::PersonOrder release;
+  release.action = world::PersonOrder::Action::kRelease;
+  sim.person(release);
+  for (int i = 0; i < 10; ++i) sim.step(0.001);
+  const Eigen::Vector3d let_go_at = sim.person_report().tcp;
+  EXPECT_LT((let_go_at - sim.link_pose("arm_link_6").translation()).norm(), 1e-9);
+  // The arm bends 0.4 rad at its second joint.
+  HardwareState s;
+  sim.read(s);
+  std::vector<DriveCommand> turn(sim.joint_names().size());
+  for (std::size_t i = 0; i < turn.size(); ++i) {
+    turn[i].mode = DriveMode::kPosition;
+    turn[i].position = s.position[i] + (sim.joint_names()[i] == "J2_A" ? 0.4 : 0.0);
+  }
+  sim.write(turn);
+  for (int i = 0; i < 1500; ++i) sim.step(0.001);
+  const world::PersonReport r = sim.person_report();
+  EXPECT_EQ(r.phase, world::PersonPhase::kLetGo);
+  EXPECT_GT((r.tcp - let_go_at).norm(), 0.05) << "the arm did not move: the test proves nothing";
+  EXPECT_LT((r.tcp - sim.link_pose("arm_link_6").translation()).norm(), 1e-9);
+}
+
 // Coulomb friction: a base standing on its held wheels stays where it is under a push well
 // below mu N, and slides under one above it. At MuJoCo's soft friction it crept (0.9 mm/s under
 // 150 N, 2.6 mm/s under 400 N, 1230 N of friction available), unseen by wheel odometry.

@@ -40,7 +40,9 @@ struct PersonReport {
   PersonPhase phase{PersonPhase::kAbsent};
   std::string link;    ///< the body held or last held
   std::string reason;  ///< why it let go
-  Eigen::Vector3d hand{Eigen::Vector3d::Zero()}, tcp{Eigen::Vector3d::Zero()}, pull{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d hand{Eigen::Vector3d::Zero()};  ///< the person's hand (world) [m]
+  Eigen::Vector3d tcp{Eigen::Vector3d::Zero()};   ///< the link held or last held, where it is now (world) [m]
+  Eigen::Vector3d pull{Eigen::Vector3d::Zero()};  ///< the person's force on it [N]
   double walked{0.0}, route_length{0.0}, peak_pull{0.0};
   double time{0.0};          ///< simulated time [s]
   std::uint64_t orders{0};   ///< orders taken so far
