@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -123,11 +124,21 @@ TEST_F(CollabDds, StateMachineOverDdsWithRobotCommands) {
   EXPECT_EQ(s.state(), "teaching/general");
   EXPECT_EQ(s.mode(), msg::COLLAB_TEACHING);
   EXPECT_EQ(s.model_version(), 1u);
-  // Teaching: gravity compensation, a zero-gain Cartesian command on the gripper's TCP.
+  // Teaching: gravity compensation, a zero-gain Cartesian command on the gripper's TCP, one the
+  // robot service takes: its target a pose (a unit quaternion, services/robot's rule) even at zero
+  // gains. A zero quaternion there was refused every time and left the arm stiff under the hand.
+  const auto robot_refuses = [](const msg::CartesianImpedanceCommand& c) -> std::string {
+    const auto& o = c.target().orientation();
+    const double norm = std::sqrt(o.w() * o.w() + o.x() * o.x() + o.y() * o.y() + o.z() * o.z());
+    return std::abs(norm - 1.0) <= 1e-3 ? "" : "target.orientation's norm is " + std::to_string(norm);
+  };
   bool gravity = false;
   for (int i = 0; i < 20 && !gravity; ++i) {
     const auto c = cartesian_->wait(250ms);
     gravity = c && c->stiffness()[0] == 0.0 && c->damping()[0] == 0.0 && c->model_version() == 1u;
+    if (gravity) {
+      EXPECT_EQ(robot_refuses(*c), "");
+    }
   }
   EXPECT_TRUE(gravity);
   // Close: the active gripper's jaw to its lower limit.
@@ -174,7 +185,7 @@ TEST_F(CollabDds, StateMachineOverDdsWithRobotCommands) {
   auto payload_seen = [&](double kg) {
     for (int i = 0; i < 40; ++i) {
       const auto c = cartesian_->wait(250ms);
-      if (c && c->stiffness()[0] == 0.0 && c->payload_mass() == kg) return true;
+      if (c && c->stiffness()[0] == 0.0 && c->payload_mass() == kg) return robot_refuses(*c).empty();
     }
     return false;
   };

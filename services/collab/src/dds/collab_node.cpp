@@ -300,6 +300,8 @@ void CollabNode::gravity_compensation() {
   c.stamp_ns(now_ns());
   c.source("collab");
   c.end_effector(rig_->tool_frame);
+  // Unused at zero gains, but a pose all the same: the robot refuses a target that is not one.
+  c.target(model::dds::to_pose_msg(Eigen::Isometry3d::Identity()));
   c.stiffness().fill(0.0);
   c.damping().fill(0.0);
   c.admittance_axis(255);
