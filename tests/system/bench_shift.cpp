@@ -11,6 +11,10 @@
 //             centre area at 30 N
 //   swap      the spraying tool (deploy/demo/spraying_robot.yaml)
 //   spray     nav to the south wall between the window and the terrace door, spray 0.4 x 0.4 m
+//   swap      the transport robot (deploy/demo/transport_robot.yaml: 7-DoF arm, active gripper)
+//   transport nav to the open floor south of the living room; the simulated person (concert sim
+//             person) guides the gripper onto the object, the robot closes and lifts it, follows
+//             the person 3 m west (follow-me), places it and opens (concert collab mode ...)
 //   swap      the drill again (deploy/demo/drill_robot.yaml)
 //   drill C   a BIM drilling mission on Wand-Int-ERDG-4, west of the panel
 //
@@ -20,9 +24,7 @@
 // service's resident memory is read from /proc after round 1 and after the last round; the
 // robot's 1 kHz loop from its log's timing line. The last line sums it up; the exit code is 0
 // only for every mission done and no safety stop.
-//
-// Not yet in the shift: the collaborative transport leg (its simulated person exists only in
-// process, tests/system/collab_transport.hpp).
+
 
 #include <signal.h>
 #include <sys/types.h>
@@ -96,6 +98,9 @@ struct Site {
   std::string world_file;
   std::vector<DrillArea> a, c;  // per round
   std::array<double, 3> sand_stand{}, spray_stand{};
+  /// Where the transport starts: the open floor south of the living room (x 0.3-6.6 m, y
+  /// 0.3-4.0 m west of the stair), facing west, 3 m of free floor ahead and 1 m each side.
+  std::array<double, 3> carry_start{5.4, 1.8, M_PI};
   std::vector<Target> targets;  // every mark's truth
 };
 
@@ -426,7 +431,102 @@ int bench(int rounds, int load, unsigned seed) {
     return {r.code == 0 && state == "succeeded" && aim, "state " + state + "; " + figures};
   };
 
-  constexpr int kLegsPerRound = 12;  // the run_leg calls below
+  // The collaborative transport (paper 5.5-5.6) through the command line, the simulated person
+  // holding the gripper (concert sim person): taught onto the object, close, lift, follow the
+  // person 3 m west along the corridor south of the living room, place, open, stop. Done when
+  // every command is taken, the person arrived without letting go, the TCP rose and sank by the
+  // lift (0.15 +- 0.05 m), and it ended 3 m west of where the walk began (+- 0.3 m).
+  const auto person = [&](std::vector<std::string> args, std::chrono::seconds timeout) {
+    args.insert(args.begin(), {"sim", "person"});
+    args.insert(args.end(), {"--json", "--timeout", std::to_string(timeout.count())});
+    const auto r = cli(args, timeout + 20s);
+    nlohmann::json j;
+    try {
+      if (const auto brace = r.out.find('{'); brace != std::string::npos) j = nlohmann::json::parse(r.out.substr(brace));
+    } catch (const std::exception&) {
+    }
+    return std::make_pair(r, j);
+  };
+  const auto sim_time = [&]() -> double {
+    const auto [r, j] = person({"status"}, 10s);
+    return r.code == 0 && j.contains("person") ? j["person"]["time"].get<double>() : -1.0;
+  };
+  const auto tcp = [&]() -> Eigen::Vector3d {
+    const auto [r, j] = person({"status"}, 10s);
+    if (r.code != 0 || !j.contains("person")) return Eigen::Vector3d::Constant(std::nan(""));
+    const auto& t = j["person"]["tcp"];
+    return {t[0].get<double>(), t[1].get<double>(), t[2].get<double>()};
+  };
+  // Simulated seconds pass (the robot runs slower than the wall clock on a loaded machine).
+  const auto wait_sim = [&](double seconds) {
+    const double t0 = sim_time();
+    for (int i = 0; i < 240 && t0 >= 0.0; ++i) {  // 2 min of wall time at most
+      if (sim_time() >= t0 + seconds) return;
+      std::this_thread::sleep_for(500ms);  // a poll of the simulator's clock
+    }
+  };
+  const auto collab = [&](const std::string& mode, const std::string& expect) -> std::string {
+    const auto r = cli({"collab", "mode", mode, "--json", "--timeout", "10"}, 30s);
+    std::string state;
+    try {
+      state = nlohmann::json::parse(r.out.substr(r.out.find('{'))).value("state", "");
+    } catch (const std::exception&) {
+    }
+    if (r.code != 0 || state != expect)
+      return "collab mode " + mode + ": state '" + state + "', not '" + expect + "' (exit " + std::to_string(r.code) + ") " + r.err;
+    return {};
+  };
+  // The arm from home (where a swapped-in arm starts) to the carrying posture the transport is
+  // taught from: elbow down, the gripper 1.26 m ahead of the base at 1 m (collab_transport.hpp).
+  const auto carrying_posture = [&]() -> std::pair<bool, std::string> {
+    const auto r = cli({"plan", "posture", "J2_E=0.65", "J4_E=1.05", "J6_E=1.40", "--timeout", "120"}, 140s);
+    std::string why = r.err;
+    if (const auto at = why.rfind("concert plan posture: "); at != std::string::npos) why = why.substr(at);
+    return {r.code == 0, r.code == 0 ? "J2_E 0.65, J4_E 1.05, J6_E 1.40 rad" : why};
+  };
+  const auto transport = [&]() -> std::pair<bool, std::string> {
+    for (const auto& [mode, expect] : std::vector<std::pair<std::string, std::string>>{{"teaching", "teaching/general"}})
+      if (const std::string e = collab(mode, expect); !e.empty()) return {false, e};
+    if (const auto [r, j] = person({"grip", "--guide", "0.1", "0", "-0.1", "--guide-time", "2", "--wait"}, 60s); r.code != 0)
+      return {false, "sim person grip: " + r.err};
+    if (const std::string e = collab("close", "teaching/close"); !e.empty()) return {false, e};
+    wait_sim(1.5);
+    const Eigen::Vector3d before_lift = tcp();
+    if (const std::string e = collab("lift", "autonomous/lift"); !e.empty()) return {false, e};
+    person({"release"}, 10s);
+    wait_sim(2.5);
+    const Eigen::Vector3d lifted = tcp();
+    if (const std::string e = collab("follow-me", "follow-me"); !e.empty()) return {false, e};
+    if (const auto [r, j] = person({"grip"}, 10s); r.code != 0) return {false, "sim person grip: " + r.err};
+    const Eigen::Vector3d walk_from = tcp();
+    const auto [walk, walked] = person({"walk", "-3.0", "0", "--wait"}, 300s);
+    const double peak = walked.contains("person") ? walked["person"]["peak_pull"].get<double>() : std::nan("");
+    person({"release"}, 10s);
+    if (walk.code != 0) {
+      if (const std::string e = collab("stop", "stop"); !e.empty()) std::cout << "    " << e << "\n";
+      return {false, "sim person walk: " + walk.err};
+    }
+    const Eigen::Vector3d walk_to = tcp();
+    if (const std::string e = collab("place", "autonomous/place"); !e.empty()) return {false, e};
+    wait_sim(2.5);
+    const Eigen::Vector3d placed = tcp();
+    for (const auto& [mode, expect] : std::vector<std::pair<std::string, std::string>>{
+             {"teaching", "teaching/general"}, {"open", "teaching/open"}})
+      if (const std::string e = collab(mode, expect); !e.empty()) return {false, e};
+    wait_sim(1.5);
+    if (const std::string e = collab("stop", "stop"); !e.empty()) return {false, e};
+    const double lift = lifted.z() - before_lift.z(), place = lifted.z() - placed.z();
+    const Eigen::Vector2d moved = (walk_to - walk_from).head<2>();
+    std::ostringstream f;
+    f.precision(3);
+    f << "lifted " << lift << " m, placed " << place << " m, walked (" << moved.x() << ", " << moved.y()
+      << ") m, peak pull " << peak << " N";
+    const bool ok = std::abs(lift - 0.15) <= 0.05 && std::abs(place - 0.15) <= 0.05 &&
+                    (moved - Eigen::Vector2d(-3.0, 0.0)).norm() <= 0.3;
+    return {ok, f.str() + (ok ? "" : " (short of the aim)")};
+  };
+
+  constexpr int kLegsPerRound = 17;  // the run_leg calls below
   const int planned_legs = rounds * kLegsPerRound;
   for (int round = 0; round < rounds; ++round) {
     std::cout << "round " << round + 1 << " of " << rounds << std::endl;
@@ -439,6 +539,11 @@ int bench(int rounds, int load, unsigned seed) {
     run_leg("swap: spraying", [&] { return swap("spraying_robot.yaml"); });
     run_leg("nav: spray wall", [&] { return go(site.spray_stand); });
     run_leg("spray 0.4 x 0.4 m", [&] { return finish({"spray", "--area", "all", "--rect", "-0.2", "0.2", "2.05", "2.45"}); });
+    run_leg("home", home);
+    run_leg("swap: transport", [&] { return swap("transport_robot.yaml"); });
+    run_leg("nav: corridor", [&] { return go(site.carry_start); });
+    run_leg("carrying posture", carrying_posture);
+    run_leg("transport 3 m", transport);
     run_leg("home", home);
     run_leg("swap: drill", [&] { return swap("drill_robot.yaml"); });
     run_leg("drill C (" + site.c[round].name + ")", [&] { return drill(site.c[round]); });
