@@ -2,7 +2,8 @@
 // whole stack on this machine, a hot swap, a bad file refused without disturbing it, a killed
 // service restarted, a clean stop; the planner planning against the world the simulator
 // publishes, `concert sim world` (over DDS) changing the plan, and `concert plan --execute`
-// running through the robot's joint-trajectory command.
+// running through the robot's joint-trajectory command; a collaborative transport with the
+// simulated person (`concert plan posture`, `concert sim person`, `concert collab mode`).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -18,6 +19,8 @@
 #include <regex>
 #include <sstream>
 #include <thread>
+
+#include <Eigen/Core>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/idl_schema/cdr.hpp"
@@ -251,6 +254,104 @@ TEST_F(UpTest, WorldFromTheSimulatorChangesThePlanAndExecutionRunsInTheRobot) {
     EXPECT_EQ(executed->failure(), msg::PLAN_EXECUTION_ABORTED);
     EXPECT_THAT(executed->reason(), HasSubstr("aborted by the robot: " + by_robot->reason()))
         << executed->reason() << " / " << by_robot->reason();
+  }
+  EXPECT_EQ(up.stop(20s), 0);
+}
+
+// The collaborative transport through the command line a crew uses, on the whole stack: the arm
+// from home to its carrying posture (concert plan posture), the simulated person in the robot's
+// simulator guiding the gravity-compensated gripper (concert sim person), collab's modes
+// (concert collab mode). Judged against the simulator's truth of the gripper (the person's
+// report) and the services' status: nothing refused, safety RUNNING.
+TEST_F(UpTest, ATransportWithTheSimulatedPersonThroughTheCommandLine) {
+  Process up({CONCERT_BIN, "up", "--assembly", CONCERT_SOURCE_DIR "/deploy/demo/transport_robot.yaml", "--duration", "300"},
+             env_);
+  auto r = concert({"status", "--until-version", "1", "--timeout", "90"});
+  ASSERT_EQ(r.code, 0) << r.out << r.err << up.out();
+  const auto json_of = [](const testing::Outcome& o) {
+    const auto brace = o.out.rfind("\n{");
+    const std::string line = brace == std::string::npos ? o.out : o.out.substr(brace + 1);
+    try {
+      return idl::Json::parse(line);
+    } catch (const std::exception&) {
+      return idl::Json::object();
+    }
+  };
+  const auto person = [&](std::vector<std::string> args, std::chrono::seconds timeout = 30s) {
+    args.insert(args.begin(), {"sim", "person"});
+    args.insert(args.end(), {"--json", "--timeout", std::to_string(timeout.count())});
+    const auto o = concert(args, timeout + 30s);
+    EXPECT_EQ(o.code, 0) << args[2] << ": " << o.out << o.err;
+    return json_of(o).value("person", idl::Json::object());
+  };
+  const auto tcp = [&]() {
+    const idl::Json p = person({"status"});
+    return p.contains("tcp") ? Eigen::Vector3d(p["tcp"][0].get<double>(), p["tcp"][1].get<double>(),
+                                               p["tcp"][2].get<double>())
+                             : Eigen::Vector3d::Constant(std::nan(""));
+  };
+  // The gripper settles near `z` (a lift or a placing): polled through the simulator's report, at
+  // most 40 times (a status answer takes a few hundred milliseconds).
+  const auto settled_near = [&](double z) {
+    Eigen::Vector3d at = tcp();
+    for (int i = 0; i < 40 && !(std::abs(at.z() - z) < 0.01); ++i) at = tcp();
+    return at;
+  };
+  const auto collab = [&](const std::string& mode, const std::string& state) {
+    const auto o = concert({"collab", "mode", mode, "--json", "--timeout", "10"});
+    EXPECT_EQ(o.code, 0) << mode << ": " << o.out << o.err;
+    EXPECT_EQ(json_of(o).value("state", ""), state) << mode << ": " << o.out;
+  };
+
+  // After the swap-in the arm stands at home, straight up; the transport starts elbow down.
+  r = concert({"plan", "posture", "J2_E=0.65", "J4_E=1.05", "J6_E=1.40", "--timeout", "60"});
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_THAT(r.out, HasSubstr("goal 1/1 succeeded"));
+  r = concert({"plan", "posture", "J9_Z=0.1", "--plan-only", "--timeout", "30"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.err, HasSubstr("'J9_Z' is not an arm joint of model version 1 (its arm joints: J1_E"));
+
+  // Teaching: the hand guides the gravity-compensated gripper 10 cm ahead and 10 cm down.
+  collab("teaching", "teaching/general");
+  const Eigen::Vector3d taught_from = tcp();
+  idl::Json p = person({"grip", "--guide", "0.1", "0", "-0.1", "--guide-time", "2", "--wait"}, 60s);
+  const Eigen::Vector3d guided = tcp();
+  EXPECT_GT((guided - taught_from).norm(), 0.1) << "the arm did not follow the hand: " << p.dump();
+  EXPECT_LT(p.value("pull", 1e9), 10.0) << p.dump();
+  collab("close", "teaching/close");
+
+  // Lift: 0.15 m up, the person lets go.
+  collab("lift", "autonomous/lift");
+  person({"release"});
+  const Eigen::Vector3d lifted = settled_near(guided.z() + 0.15);
+  EXPECT_NEAR(lifted.z() - guided.z(), 0.15, 0.03);
+
+  // Follow me: the person grips again and walks 3 m west; the robot follows.
+  collab("follow-me", "follow-me");
+  person({"grip"});
+  p = person({"walk", "-3.0", "0", "--wait"}, 180s);
+  EXPECT_EQ(p.value("phase", ""), "arrived") << p.dump();
+  person({"release"});
+  const Eigen::Vector3d walked = tcp();
+  EXPECT_NEAR(walked.x() - lifted.x(), -3.0, 0.3);
+  EXPECT_NEAR(walked.y() - lifted.y(), 0.0, 0.3);
+
+  // Place: 0.15 m down; open; stop.
+  collab("place", "autonomous/place");
+  const Eigen::Vector3d placed = settled_near(walked.z() - 0.15);
+  EXPECT_NEAR(walked.z() - placed.z(), 0.15, 0.03);
+  collab("teaching", "teaching/general");
+  collab("open", "teaching/open");
+  collab("stop", "stop");
+
+  // Nothing refused on the way, safety running.
+  r = concert({"status", "--json", "--timeout", "1.5"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const auto& s : idl::Json::parse(r.out)) {
+    EXPECT_EQ(s.value("refusals", 0), 0) << s.dump();
+    if (s.at("service") == "safety") {
+      EXPECT_EQ(s.value("message", ""), "RUNNING") << s.dump();
+    }
   }
   EXPECT_EQ(up.stop(20s), 0);
 }
