@@ -111,10 +111,11 @@ class Planner {
   GoalResult plan_home(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& start,
                        uint64_t seed, const Eigen::VectorXd* lead_in = nullptr) const;
   /// The arm from `start` (full q, valid) to `target` (planned q, the base's as start's), the
-  /// base standing; `what` names the posture in a refusal ("home: the homing posture").
+  /// base standing. A failure's reason starts with `request` ("home"); a target that is not free
+  /// is named `posture` ("the homing posture") in it.
   GoalResult plan_posture(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& start,
-                          const Eigen::VectorXd& target, const std::string& what, uint64_t seed,
-                          const Eigen::VectorXd* lead_in = nullptr) const;
+                          const Eigen::VectorXd& target, const std::string& request, const std::string& posture,
+                          uint64_t seed, const Eigen::VectorXd* lead_in = nullptr) const;
 
   GoalResult plan_path(const PlanningModel& model, StateChecker& checker,
                        const Eigen::VectorXd& q_start_full, const Eigen::VectorXd& q_goal,

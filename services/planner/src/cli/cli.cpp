@@ -4,6 +4,7 @@
 
 #include "planner/cli.hpp"
 
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -39,14 +40,9 @@ std::pair<std::string, double> joint_position(const std::string& word) {
   if (eq == std::string::npos || eq == 0 || eq + 1 == word.size())
     throw cli::UsageError("'" + word + "': a joint's position is NAME=POSITION, e.g. J2_E=0.65");
   const std::string value = word.substr(eq + 1);
-  std::size_t used = 0;
   double v = 0.0;
-  try {
-    v = std::stod(value, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != value.size() || !std::isfinite(v))
+  const auto r = std::from_chars(value.data(), value.data() + value.size(), v);  // as cli::number: no locale
+  if (r.ec != std::errc() || r.ptr != value.data() + value.size() || !std::isfinite(v))
     throw cli::UsageError("'" + word + "': '" + value + "' is not a number (rad, or m for a prismatic joint)");
   return {word.substr(0, eq), v};
 }

@@ -424,23 +424,24 @@ Eigen::VectorXd home_posture(const PlanningModel& model, const Eigen::VectorXd& 
 
 GoalResult Planner::plan_home(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& start,
                               uint64_t seed, const Eigen::VectorXd* lead_in) const {
-  return plan_posture(model, checker, start, home_posture(model, start), "home: the homing posture", seed,
+  return plan_posture(model, checker, start, home_posture(model, start), "home", "the homing posture", seed,
                       lead_in);
 }
 
 GoalResult Planner::plan_posture(const PlanningModel& model, StateChecker& checker, const Eigen::VectorXd& start,
-                                 const Eigen::VectorXd& target, const std::string& what, uint64_t seed,
-                                 const Eigen::VectorXd* lead_in) const {
+                                 const Eigen::VectorXd& target, const std::string& request,
+                                 const std::string& posture, uint64_t seed, const Eigen::VectorXd* lead_in) const {
   GoalResult r;
   if (const Validity v = checker.check(model.to_full(target, start)); !v.valid()) {
     r.goal_q = target;
     r.status = Status::kUnreachable;
-    r.reason = what + " is rejected where the robot stands by " + to_string(v.constraint) + ": " + v.detail;
+    r.reason = request + ": " + posture + " is rejected where the robot stands by " + to_string(v.constraint) + ": " +
+               v.detail;
     return r;
   }
   r = plan_path(model, checker, start, target, params_.planning_time, seed, true, lead_in);
   r.index = 0;
-  if (r.status != Status::kSucceeded) r.reason = what.substr(0, what.find(':') + 1) + " " + r.reason;
+  if (r.status != Status::kSucceeded) r.reason = request + ": " + r.reason;
   return r;
 }
 
@@ -679,7 +680,7 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     GoalResult r = request.home ? plan_home(*model, checker, start, seed, lead_in ? &*lead_in : nullptr)
                                 : plan_posture(*model, checker, start,
                                                std::get<Eigen::VectorXd>(requested_posture(*model, start, request.posture)),
-                                               "posture: the posture", seed,
+                                               "posture", "the posture", seed,
                                                lead_in ? &*lead_in : nullptr);
     if (r.status != Status::kSucceeded) {
       out.status = r.status;
