@@ -67,8 +67,9 @@ TEST(DrillInputs, ASafetyStopALostServiceOrSilentJointsStopTheMission) {
   Inputs in = make_inputs();
   all_heard(in, kT0);
   EXPECT_EQ(in.health(kT0, true, kT0 + 500ms).progress, Progress::kSucceeded);
-  // Joint states older than liveness.joints_lost (1 s).
-  EXPECT_EQ(in.health(kT0, true, kT0 + 2s).reason, "no joint state from the robot service (lost)");
+  // Joint states older than liveness.joints_lost (1 s), the robot's status never heard.
+  EXPECT_EQ(in.health(kT0, true, kT0 + 2s).reason,
+            "no joint state from the robot service (lost: none for 2.0 s, its status silent too)");
   in.on_joints(2, arm(0.0), kT0 + 2s);
   in.on_service("planner", false, kT0 + 2s);
   // Nav heard at kT0 only: lost after liveness.service_lost (5 s), but only a mission using it fails.
@@ -83,6 +84,42 @@ TEST(DrillInputs, ASafetyStopALostServiceOrSilentJointsStopTheMission) {
   in.on_safety({false, {"estop: software engaged (gui)", "limits: joint J1_E position"}});
   EXPECT_EQ(in.health(kT0, false, kT0 + 6s).reason,
             "safety stop (estop: software engaged (gui), limits: joint J1_E position)");
+}
+
+TEST(DrillInputs, LateJointStatesWhileTheRobotsStatusBeatsPauseTheMissionUntilServiceLost) {
+  Inputs in = make_inputs();
+  all_heard(in, kT0);
+  in.on_service("robot", false, kT0);
+  // 1.5 s without a joint state, the robot's status heard each second: wait, do not abort.
+  in.on_service("robot", false, kT0 + 1s);
+  in.on_service("planner", false, kT0 + 1s);
+  EXPECT_EQ(in.health(kT0, false, kT0 + 1500ms).progress, Progress::kRunning);
+  // The stream comes back: healthy again.
+  in.on_joints(2, arm(0.0), kT0 + 1600ms);
+  EXPECT_EQ(in.health(kT0, false, kT0 + 1600ms).progress, Progress::kSucceeded);
+  // Silent beyond service_lost (5 s) though the status still beats: the stream is gone.
+  for (int s = 2; s <= 7; ++s) {
+    in.on_service("robot", false, kT0 + std::chrono::seconds(s));
+    in.on_service("planner", false, kT0 + std::chrono::seconds(s));
+  }
+  EXPECT_EQ(in.health(kT0, false, kT0 + 4s).progress, Progress::kRunning);
+  EXPECT_EQ(in.health(kT0, false, kT0 + 7s).reason, "no joint state from the robot service (lost: none for 5.4 s)");
+  // The robot's status silent too (a service lost after service_lost): at once.
+  Inputs dead = make_inputs();
+  all_heard(dead, kT0);
+  dead.on_service("robot", false, kT0 - 5s);
+  dead.on_service("planner", false, kT0 + 1s);
+  EXPECT_EQ(dead.health(kT0 - 10s, false, kT0 + 1500ms).reason,
+            "no joint state from the robot service (lost: none for 1.5 s, its status silent too)");
+  // A robot service of another name is watched by that name.
+  Params p;
+  p.liveness.robot_service = "arm_robot";
+  Inputs named(p.buffers, p.liveness);
+  all_heard(named, kT0);
+  named.on_service("robot", false, kT0 + 1s);
+  EXPECT_EQ(named.health(kT0, false, kT0 + 1500ms).progress, Progress::kFailed);
+  named.on_service("arm_robot", false, kT0 + 1s);
+  EXPECT_EQ(named.health(kT0, false, kT0 + 1500ms).progress, Progress::kRunning);
 }
 
 TEST(DrillInputs, RepliesAreKeptPerRequestAndPlansMerged) {

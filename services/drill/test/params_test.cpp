@@ -44,6 +44,7 @@ void expect_same(const Params& a, const Params& b) {
   EXPECT_EQ(a.buffers.frames, b.buffers.frames);
   EXPECT_EQ(a.liveness.service_lost, b.liveness.service_lost);
   EXPECT_EQ(a.liveness.joints_lost, b.liveness.joints_lost);
+  EXPECT_EQ(a.liveness.robot_service, b.liveness.robot_service);
   EXPECT_EQ(a.plan_requests.ack_bound, b.plan_requests.ack_bound);
   EXPECT_EQ(a.plan_requests.resends, b.plan_requests.resends);
   EXPECT_EQ(a.rest.above, b.rest.above);
@@ -127,9 +128,9 @@ TEST(DrillParamsFile, TheShippedFileHoldsEveryDefault) {
   const Params p = read_params(doc);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
-  // Every key read: 62 single values (look_further one of them), the 3 tables' lengths, and
+  // Every key read: 63 single values (look_further one of them), the 3 tables' lengths, and
   // their rows' keys: 27 attempts x 5, 5 looks x 2, 3 draws x 2.
-  EXPECT_EQ(doc.keys().size(), 62u + 3u + 27u * 5u + 5u * 2u + 3u * 2u);
+  EXPECT_EQ(doc.keys().size(), 63u + 3u + 27u * 5u + 5u * 2u + 3u * 2u);
   expect_same(p, Params{});
   expect_same(load_params(kShipped), Params{});
 }

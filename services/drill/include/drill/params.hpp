@@ -74,8 +74,12 @@ struct Params {
   struct Liveness {
     /// [s] a service's status older than this: lost (they beat every 1 s); a mission's start grace.
     double service_lost{5.0};
-    /// [s] joint states older than this: the robot service is gone.
+    /// [s] joint states older than this: the mission waits (decides nothing on stale joints)
+    /// while the robot service's status still beats, and fails once they are older than
+    /// service_lost or the robot's status is lost too.
     double joints_lost{1.0};
+    /// The robot service's name in the service status (its `node.service_name`).
+    std::string robot_service{"robot"};
   };
 
   /// Plan requests not acknowledged (one written before the planner's reader matched is lost).

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <utility>
 
 #include "drill/perception.hpp"
@@ -207,13 +209,25 @@ Outcome Inputs::health(Clock::time_point mission_started, bool uses_nav, Clock::
     if (starting) return Outcome::running();
     return Outcome::failed("no joint state from the robot service (never heard)");
   }
-  if (seconds_between(joints_seen_, now) > liveness_.joints_lost) {
-    return Outcome::failed("no joint state from the robot service (lost)");
-  }
   const auto lost = [&](const std::string& service) {
     const auto seen = services_seen_.find(service);
     return seen == services_seen_.end() || seconds_between(seen->second, now) > liveness_.service_lost;
   };
+  // Joint states late while the robot service's status still beats: a loaded machine delays
+  // the 1 kHz stream by a second now and then (safety, watching the status, sees the robot
+  // alive). The mission waits, deciding nothing on stale joints, instead of aborting a drilling
+  // half done; joints silent for service_lost, or the robot's status silent too, end it.
+  const double joints_age = seconds_between(joints_seen_, now);
+  if (joints_age > liveness_.joints_lost) {
+    if (joints_age > liveness_.service_lost || lost(liveness_.robot_service)) {
+      std::ostringstream why;
+      why << "no joint state from the robot service (lost: none for " << std::fixed << std::setprecision(1)
+          << joints_age << " s"
+          << (lost(liveness_.robot_service) ? ", its status silent too)" : ")");
+      return Outcome::failed(why.str());
+    }
+    return Outcome::running();
+  }
   if (services_seen_.count("planner") == 0 && starting) return Outcome::running();
   if (lost("planner")) return Outcome::failed("the planner service is lost");
   if (uses_nav && lost("nav")) return Outcome::failed("the nav service is lost");

@@ -46,6 +46,7 @@ void read_buffers(Map m, Params::Buffers& b) {
 void read_service_bounds(Map liveness, Map plan_requests, Map approach, Map bim, Params& p) {
   liveness.number("service_lost", p.liveness.service_lost, Range::positive());
   liveness.number("joints_lost", p.liveness.joints_lost, Range::positive());
+  liveness.string("robot_service", p.liveness.robot_service, false);
   plan_requests.number("ack_bound", p.plan_requests.ack_bound, Range::positive());
   plan_requests.integer("resends", p.plan_requests.resends, 0, 1000);
   approach.number("padding", p.approach.padding, Range::non_negative());
