@@ -10,6 +10,7 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fastrtps/utils/IPLocator.h>
 
 #include "concert/security/dds_config.hpp"
@@ -55,6 +56,25 @@ void check_domain_ports(int32_t domain_id) {
   if (!(in >> low >> high)) return;
   const std::string warning = domain_port_warning(domain_id, low, high);
   if (!warning.empty()) std::cerr << warning << "\n";
+}
+
+// Once per process, before its first participant: samples between endpoints of one process
+// travel through the transport like any other, not handed over in the process. Fast DDS 2.9's
+// intra-process path races when a participant of the process is deleted and another created
+// (of the kind fixed upstream later, Fast-DDS PR 5034): in planner_dds_test the second
+// `concert plan` client of the process matched the planner both ways and for 20 s received
+// nothing the planner wrote (3 runs in 44 beside two busy loops; 0 in 30 without the
+// intra-process path). Under load a keep-last-1 reader fed from the writer's background thread
+// also trips an assertion there (ReaderProxy::from_unsent_to_status: the safety service reads
+// its own heartbeat). A service runs one participant; tests and tools with several lose only
+// the in-process shortcut. A DDS profiles file's <library_settings>, loaded after this, wins.
+void use_interprocess_delivery_only() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    auto settings = eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings();
+    settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+    eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+  });
 }
 
 void use_localhost_only(DomainParticipantQos& qos) {
@@ -122,6 +142,7 @@ void Participant::use_security(DomainParticipantQos& qos, const std::filesystem:
 Participant::Participant(ParticipantOptions options) : name_(options.name) {
   domain_id_ = options.domain_id >= 0 ? options.domain_id : domain_id_from_env();
   auto* factory = DomainParticipantFactory::get_instance();
+  use_interprocess_delivery_only();
 
   DomainParticipantQos qos = PARTICIPANT_QOS_DEFAULT;
   std::string profiles = options.profiles_file;

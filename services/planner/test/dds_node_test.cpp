@@ -600,7 +600,7 @@ TEST_F(PlannerNodeTest, CliSendsAGoalAndFollowsIt) {
   EXPECT_EQ(plan({"drill", "--at", "2.0", "0.1", "2.3", "--request-id", "33", "--timeout", "20",
                   "--json"}),
             0)
-      << err.str();
+      << err.str() << "the planner logged:\n" << log_.str();
   const auto lines = concert::split(out.str(), '\n');
   ASSERT_GE(lines.size(), 2u) << out.str();
   EXPECT_EQ(nlohmann::json::parse(lines.front()).at("request_id"), 33);

@@ -79,7 +79,6 @@ bool wait_mode(dds::Reader<msg::SafetyState>& states, msg::SafetyMode mode, F&& 
 }
 
 void bench_dds(int repetitions) {
-  safety::dds::use_interprocess_delivery_only();
   dds::Participant service_side({.name = "bench_safety_service"});
   std::ostringstream log;
   safety::dds::SafetyNode node(service_side, safety::Params{}, log);

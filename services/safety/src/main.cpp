@@ -28,7 +28,6 @@ int run(const std::string& params_file, const std::string& state_file) {
               << std::endl;
   }
   const std::atomic<bool>& stop = concert::cli::stop_on_signals();
-  safety::dds::use_interprocess_delivery_only();
   concert::dds::Participant participant(concert::dds::ParticipantOptions{.name = "safety"});
   safety::dds::SafetyNode node(participant, params, std::cerr, state_file);
   std::string watched = params.robot_service;

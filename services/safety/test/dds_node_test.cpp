@@ -41,13 +41,6 @@ msg::EStopInput estop(msg::EStopSource source, bool engaged) {
   return in;
 }
 
-/// As in concert_safety: no intra-process delivery (see use_interprocess_delivery_only()).
-const auto* const kInterprocessOnly = ::testing::AddGlobalTestEnvironment([] {
-  struct Env : ::testing::Environment {
-    void SetUp() override { use_interprocess_delivery_only(); }
-  };
-  return new Env;
-}());
 
 TEST(StatusHeartbeat, StatusIsRepublishedPeriodicallyThenStops) {
   Participant p({.name = "hb"});

@@ -1,6 +1,5 @@
 #include "dds/safety_node.hpp"
 
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 
 #include <filesystem>
 #include <optional>
@@ -26,12 +25,6 @@ std::string summary(const SafetyStatus& status) {
 }
 
 }  // namespace
-
-void use_interprocess_delivery_only() {
-  eprosima::fastrtps::LibrarySettingsAttributes settings;
-  settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
-  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
-}
 
 SafetyNode::SafetyNode(concert::dds::Participant& participant, Params params, std::ostream& log,
                        std::string state_file)

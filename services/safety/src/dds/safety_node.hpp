@@ -20,13 +20,6 @@
 
 namespace concert::safety::dds {
 
-/// Turns off Fast DDS intra-process delivery for this process (call before any participant
-/// exists). The safety process reads the status topic it also writes (its own heartbeat);
-/// Fast DDS 2.9's intra-process path to a keep-last-1 reader from the writer's background
-/// thread trips an internal assertion (ReaderProxy::from_unsent_to_status) under load, so
-/// local samples take the shared-memory/UDP path like any other.
-void use_interprocess_delivery_only();
-
 class SafetyNode {
  public:
   /// `participant` must outlive the node. `log` gets one line per state change and reset.
