@@ -22,7 +22,6 @@
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 
 namespace concert::dds {
 namespace {
@@ -214,15 +213,9 @@ TEST(Endpoint, ARawTypesInstanceIsItsKeyNotItsBytes) {
   EXPECT_NE(hx, hy);
 }
 
-// The same between processes' participants: samples travel through the transport, not handed
-// over in the process with the writer's instance, as in the GUI gateway.
+// The same between two participants: samples travel through the transport (Participant turns
+// intra-process delivery off), not handed over with the writer's instance, as in the GUI gateway.
 TEST(Endpoint, ARawSubscriptionSeesOneInstancePerKey) {
-  using eprosima::fastrtps::LibrarySettingsAttributes;
-  using eprosima::fastrtps::xmlparser::XMLProfileManager;
-  const LibrarySettingsAttributes before = XMLProfileManager::library_settings();
-  LibrarySettingsAttributes interprocess = before;
-  interprocess.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
-  XMLProfileManager::library_settings(interprocess);
   {
     Participant writer_side({.name = "writer"}), reader_side({.name = "reader"});
     const std::string topic(topics::status.name);
@@ -259,7 +252,6 @@ TEST(Endpoint, ARawSubscriptionSeesOneInstancePerKey) {
     ASSERT_EQ(reports.size(), 2u) << "one instance per service id, not per report";
     for (const auto& [id_instance, n] : reports) EXPECT_EQ(n, kReports) << id_instance;
   }
-  XMLProfileManager::library_settings(before);
 }
 
 TEST(Endpoint, TopicsOutsideTheCatalogueAreRefused) {

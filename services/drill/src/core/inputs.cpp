@@ -219,11 +219,11 @@ Outcome Inputs::health(Clock::time_point mission_started, bool uses_nav, Clock::
   // half done; joints silent for service_lost, or the robot's status silent too, end it.
   const double joints_age = seconds_between(joints_seen_, now);
   if (joints_age > liveness_.joints_lost) {
-    if (joints_age > liveness_.service_lost || lost(liveness_.robot_service)) {
+    const bool robot_lost = lost(liveness_.robot_service);
+    if (joints_age > liveness_.service_lost || robot_lost) {
       std::ostringstream why;
       why << "no joint state from the robot service (lost: none for " << std::fixed << std::setprecision(1)
-          << joints_age << " s"
-          << (lost(liveness_.robot_service) ? ", its status silent too)" : ")");
+          << joints_age << " s" << (robot_lost ? ", its status silent too)" : ")");
       return Outcome::failed(why.str());
     }
     return Outcome::running();
