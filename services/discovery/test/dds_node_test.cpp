@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <sstream>
+#include <string>
 
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/dds/conversions.hpp"
@@ -49,11 +50,14 @@ TEST(DdsConversions, RoundTrip) {
 }
 
 /// Waits (bounded) for a status sample of the discovery service in `state`.
+// The discovery service's next status in `state` whose message starts with `prefix` (an
+// earlier scan's status may still be unread when the next scan is written).
 std::optional<msg::ServiceStatus> wait_status(concert::dds::Reader<msg::ServiceStatus>& reader,
-                                              msg::ServiceState state) {
+                                              msg::ServiceState state, const std::string& prefix = "") {
   const auto deadline = std::chrono::steady_clock::now() + 10s;
   while (std::chrono::steady_clock::now() < deadline) {
-    if (auto s = reader.wait(200ms); s && s->service() == "discovery" && s->state() == state) {
+    if (auto s = reader.wait(200ms); s && s->service() == "discovery" && s->state() == state &&
+                                     s->message().rfind(prefix, 0) == 0) {
       return s;
     }
   }
@@ -134,7 +138,7 @@ TEST(DiscoveryNode, PublishesVersionedTreesAndKeepsThemOnFaultyScans) {
   EXPECT_EQ(core.unknown_modules().size(), 1u);
   ASSERT_EQ(core.issues.size(), 1u);
   EXPECT_EQ(core.issues[0].position, 12);
-  const auto ready = wait_status(status, msg::SERVICE_READY);
+  const auto ready = wait_status(status, msg::SERVICE_READY, "scan 4:");
   ASSERT_TRUE(ready);
   EXPECT_NE(ready->message().find("1 unknown; 1 warning: slave 12: blank module identity"),
             std::string::npos)
