@@ -20,9 +20,14 @@
 //   experiments  scenario 3 as the paper ran it: 22 missions of one 60 cm row each, heights
 //             0.35-2.90 m evenly, morphology A up to 2.4 m and C above, a fresh stack each
 //             (not in all: about 90 minutes)
+//   generated  drilling sites nobody rehearsed, drawn from --seed (tests/system/drill_sites.hpp):
+//             --count walls at a yaw within +-0.25 rad 1.6-2.8 m away, a blob pair or an ArUco
+//             marker of any pattern at 0.4-2.6 m, boxes beside the area; morphology A, C above
+//             2.4 m; one mission on a fresh stack each (not in all: 3-8 minutes a site)
 // CONCERT_STACK_DIR=DIR runs the services' binaries of that name in DIR (a copy taken before a
 // long run, so that building on meanwhile does not change them).
-// Usage: bench_drill_mission [--scenario blobs|patterns|high|row|low|lowest|bim|demo|experiments|all] [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both]
+// Usage: bench_drill_mission [--scenario blobs|patterns|high|row|low|lowest|bim|demo|experiments|generated|all]
+//          [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both] [--seed S --count N]
 //        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
@@ -43,6 +48,7 @@
 
 #include "concert/cli/cli.hpp"
 #include "drill_runner.hpp"
+#include "drill_sites.hpp"
 
 using namespace concert::system_test;
 using concert::msg::DrillStatus;
@@ -78,6 +84,7 @@ struct Tally {
   std::vector<double> errors;  // [m] in the wall's plane, of the holes drilled
   std::size_t drilled{0}, marked{0};
   double nav{0}, plan{0}, exec{0}, drill{0}, total{0};  // [s]
+  int safety_stops{0};
 
   Tally& operator+=(const Tally& o) {
     errors.insert(errors.end(), o.errors.begin(), o.errors.end());
@@ -88,14 +95,17 @@ struct Tally {
     exec += o.exec;
     drill += o.drill;
     total += o.total;
+    safety_stops += o.safety_stops;
     return *this;
   }
   void print(const std::string& what, int runs) const {
     std::printf(
         "== %s: %zu of %zu marked holes drilled; error median %.2f mm, p95 %.2f mm, max %.2f mm; "
-        "time per run: navigate %.0f s, plan %.0f s, execute %.0f s, drill %.0f s, total %.0f s\n",
+        "time per run: navigate %.0f s, plan %.0f s, execute %.0f s, drill %.0f s, total %.0f s; "
+        "%.0f s per hole drilled; %d safety stops\n",
         what.c_str(), drilled, marked, percentile(errors, 0.5) * 1e3, percentile(errors, 0.95) * 1e3,
-        percentile(errors, 1.0) * 1e3, nav / runs, plan / runs, exec / runs, drill / runs, total / runs);
+        percentile(errors, 1.0) * 1e3, nav / runs, plan / runs, exec / runs, drill / runs, total / runs,
+        drilled > 0 ? total / static_cast<double>(drilled) : std::nan(""), safety_stops);
     std::fflush(stdout);
   }
 };
@@ -110,10 +120,19 @@ void score(const std::string& what, const MissionRun& run, const std::vector<Tar
     return;
   }
   const DrillStatus& s = *run.status;
-  std::printf("%s: mission %s, %u of %u marked holes drilled, safety %s%s%s\n", what.c_str(),
+  std::printf("%s: mission %s, %u of %u marked holes drilled, safety %s, %d safety stops%s%s\n", what.c_str(),
               s.state() == concert::msg::DRILL_SUCCEEDED ? "succeeded" : "did not succeed",
               s.holes_drilled(), s.holes_marked(), run.safety_running ? "RUNNING" : "STOPPED",
-              s.reason().empty() ? "" : ": ", s.reason().c_str());
+              run.safety_stops, s.reason().empty() ? "" : ": ", s.reason().c_str());
+  for (const std::string& causes : run.stop_causes) std::printf("  safety stop: %s\n", causes.c_str());
+  tally.safety_stops += run.safety_stops;
+  // The report's holes that were not drilled, with its reason.
+  for (const concert::msg::DrillArea& a : s.areas()) {
+    for (const concert::msg::DrillHole& h : a.holes()) {
+      if (h.state() != concert::msg::HOLE_DRILLED)
+        std::printf("  report: %s %s: %s\n", a.name().c_str(), h.label().c_str(), h.reason().c_str());
+    }
+  }
   bool off = false;  // a hole past 5 mm, or a mark not drilled: the logs say why
   for (const Target& t : targets) {
     tally.marked += 1;
@@ -211,8 +230,37 @@ int experiments(int runs, bool logs, const std::string& map, const concert::dril
   return 0;
 }
 
+// Drilling sites nobody rehearsed (issue #51), drawn from `seed`: one mission on a fresh stack
+// each, scored against the simulator's truth. A site's world is a file in the temp directory.
+int generated(std::uint64_t seed, int count, bool logs, const std::string& map,
+              const concert::drill::PatternTable& patterns) {
+  Tally all;
+  int missions = 0;
+  for (const GeneratedSite& site : generate_sites(seed, count, patterns)) {
+    const std::filesystem::path world = std::filesystem::temp_directory_path() /
+                                        ("bench_drill_generated_" + std::to_string(::getpid()) + ".yaml");
+    std::ofstream(world) << site.world_yaml;
+    const std::vector<Target> targets = targets_of(concert::world::parse_world_yaml(site.world_yaml, site.name), patterns);
+    std::printf("%s of seed %llu (%d of %d): %s\n", site.name.c_str(), static_cast<unsigned long long>(seed),
+                missions + 1, count, site.description.c_str());
+    std::fflush(stdout);
+    const std::string assembly = source(site.morphology_c ? "services/planner/data/morphology_c.yaml"
+                                                          : "services/planner/data/morphology_a.yaml");
+    const MissionRun run = run_mission(assembly, world.string(), site.mission_yaml, std::chrono::seconds(1800),
+                                       std::nullopt, map);
+    std::filesystem::remove(world);
+    Tally one;
+    score("  " + site.name, run, targets, logs, one);
+    all += one;
+    ++missions;
+  }
+  all.print("generated sites of seed " + std::to_string(seed) + " (" + std::to_string(missions) + " missions)",
+            missions);
+  return 0;
+}
+
 int bench(const std::string& which, int runs, const std::string& assembly, bool logs,
-          const std::string& map, std::pair<double, double> rows) {
+          const std::string& map, std::pair<double, double> rows, std::uint64_t seed, int count) {
   const std::vector<Scenario> all{
       {"blobs", source("services/planner/data/morphology_b.yaml"),
        source("deploy/bench/drill_blobs_site.yaml"), source("deploy/bench/drill_blobs_mission.yaml")},
@@ -242,6 +290,11 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
   const concert::drill::PatternTable patterns =
       concert::drill::load_patterns(source("services/drill/config/patterns.yaml"));
   if (which == "experiments") return experiments(runs, logs, map, patterns, rows);
+  if (which == "generated") {
+    int status = 0;
+    for (int r = 0; r < runs && status == 0; ++r) status = generated(seed, count, logs, map, patterns);
+    return status;
+  }
   bool known = false;
   for (const Scenario& sc : all) {
     // all: row and low are in patterns
@@ -267,7 +320,7 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
   }
   if (!known) {
     std::cerr << "bench_drill_mission: unknown scenario '" << which
-              << "' (blobs, patterns, high, row, low, lowest, bim, demo, experiments or all)\n";
+              << "' (blobs, patterns, high, row, low, lowest, bim, demo, experiments, generated or all)\n";
     return 2;
   }
   return 0;
@@ -283,7 +336,7 @@ int main(int argc, char** argv) {
   std::string which = "all";
   int runs = 1;
   auto& app = cli.app();
-  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "high", "row", "low", "lowest", "bim", "demo", "experiments", "all"},
+  concert::cli::Cli::add_choice(app, "--scenario", which, {"blobs", "patterns", "high", "row", "low", "lowest", "bim", "demo", "experiments", "generated", "all"},
                                 "scenario to run")
       ->capture_default_str();
   std::string assembly;
@@ -305,6 +358,12 @@ int main(int argc, char** argv) {
                  "0.35-2.90 m)")
       ->expected(2)
       ->check(concert::cli::number(0.0, 10.0, false));
+  std::uint64_t seed = 1;
+  app.add_option("--seed", seed, "generated only: the seed the sites are drawn from")->capture_default_str();
+  int count = 20;
+  app.add_option("--count", count, "generated only: how many sites")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 1000, true));
   bool logs = false;
   app.add_flag("--logs", logs, "print the services' logs after every run (default: after a failed one, or one with a hole past 5 mm)");
   cli.on_run(app, [&] {
@@ -312,7 +371,7 @@ int main(int argc, char** argv) {
       throw concert::cli::UsageError("--rows: MIN " + std::to_string(rows[0]) + " is above MAX " +
                                      std::to_string(rows[1]));
     }
-    return bench(which, runs, assembly, logs, map, {rows[0], rows[1]});
+    return bench(which, runs, assembly, logs, map, {rows[0], rows[1]}, seed, count);
   });
   return cli.run(argc, argv);
 }

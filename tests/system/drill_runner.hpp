@@ -134,6 +134,10 @@ struct MissionRun {
   std::optional<msg::DrillStatus> status;
   std::vector<msg::SimHole> holes;
   bool safety_running{false};
+  /// Times the safety layer went from RUNNING to STOPPED after the mission was sent, and its
+  /// causes each time.
+  int safety_stops{0};
+  std::vector<std::string> stop_causes;
   std::string logs;
   std::vector<TrackPoint> track;  // every half second or so while the mission ran
   std::vector<std::string> joint_names;
@@ -338,7 +342,21 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   };
   concert::dds::Participant p({.name = "drill_mission_runner"});
   concert::dds::Reader<msg::SimHoles> holes(p, concert::dds::topics::sim_holes);
-  concert::dds::Reader<msg::SafetyState> safety_states(p, concert::dds::topics::safety_state);
+  // The safety layer's stops after the mission was sent (its latest mode, its stops' causes).
+  std::mutex safety_mutex;
+  bool mission_sent = false;
+  std::optional<msg::SafetyMode> last_mode;
+  std::vector<std::string> stop_causes;
+  concert::dds::Reader<msg::SafetyState> safety_states(
+      p, concert::dds::topics::safety_state, [&](const msg::SafetyState& st, const auto&) {
+        std::lock_guard lock(safety_mutex);
+        if (mission_sent && last_mode == msg::SAFETY_RUNNING && st.mode() == msg::SAFETY_STOPPED) {
+          std::string causes;
+          for (const std::string& c : st.causes()) causes += (causes.empty() ? "" : "; ") + c;
+          stop_causes.push_back(causes);
+        }
+        last_mode = st.mode();
+      });
   concert::dds::Reader<msg::DrillStatus> statuses(p, concert::dds::topics::drill_status);
   concert::dds::Writer<msg::DrillMission> missions(p, concert::dds::topics::drill_mission);
   // The base as odometry and as the simulator have it, the latest of each (a stream).
@@ -410,6 +428,10 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
   m.name("runner");
   m.yaml(mission);
   m.base_dir(std::filesystem::temp_directory_path().string());
+  {
+    std::lock_guard lock(safety_mutex);
+    mission_sent = true;
+  }
   missions.write(m);
   const auto mean_force = [&] {  // under base_mutex
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -464,8 +486,12 @@ inline MissionRun run_mission(const std::string& assembly, const std::string& si
     if (cut && cut->holes().size() >= drilled) break;
   }
   if (cut) run.holes = cut->holes();
-  const auto state = safety_states.wait(5s);
-  run.safety_running = state && state->mode() == msg::SAFETY_RUNNING;
+  {
+    std::lock_guard lock(safety_mutex);
+    run.safety_running = last_mode == msg::SAFETY_RUNNING;
+    run.safety_stops = static_cast<int>(stop_causes.size());
+    run.stop_causes = stop_causes;
+  }
   run.logs = logs();
   return run;
 }
