@@ -83,6 +83,7 @@ double percentile(std::vector<double> v, double p) {
 struct Tally {
   std::vector<double> errors;  // [m] in the wall's plane, of the holes drilled
   std::size_t drilled{0}, marked{0};
+  std::size_t reachable{0}, judged_unreachable{0};  // as the report judged them before moving
   double nav{0}, plan{0}, exec{0}, drill{0}, total{0};  // [s]
   int safety_stops{0};
 
@@ -90,6 +91,8 @@ struct Tally {
     errors.insert(errors.end(), o.errors.begin(), o.errors.end());
     drilled += o.drilled;
     marked += o.marked;
+    reachable += o.reachable;
+    judged_unreachable += o.judged_unreachable;
     nav += o.nav;
     plan += o.plan;
     exec += o.exec;
@@ -100,10 +103,13 @@ struct Tally {
   }
   void print(const std::string& what, int runs) const {
     std::printf(
-        "== %s: %zu of %zu marked holes drilled; error median %.2f mm, p95 %.2f mm, max %.2f mm; "
+        "== %s: %zu of %zu marked holes drilled; reachable as the report judged: %zu of the marked "
+        "(unreachable %zu), drilled %.1f %% of those; error median %.2f mm, p95 %.2f mm, max %.2f mm; "
         "time per run: navigate %.0f s, plan %.0f s, execute %.0f s, drill %.0f s, total %.0f s; "
         "%.0f s per hole drilled; %d safety stops\n",
-        what.c_str(), drilled, marked, percentile(errors, 0.5) * 1e3, percentile(errors, 0.95) * 1e3,
+        what.c_str(), drilled, marked, reachable, judged_unreachable,
+        reachable > 0 ? 100.0 * static_cast<double>(drilled) / static_cast<double>(reachable) : std::nan(""),
+        percentile(errors, 0.5) * 1e3, percentile(errors, 0.95) * 1e3,
         percentile(errors, 1.0) * 1e3, nav / runs, plan / runs, exec / runs, drill / runs, total / runs,
         drilled > 0 ? total / static_cast<double>(drilled) : std::nan(""), safety_stops);
     std::fflush(stdout);
@@ -126,11 +132,17 @@ void score(const std::string& what, const MissionRun& run, const std::vector<Tar
               run.safety_stops, s.reason().empty() ? "" : ": ", s.reason().c_str());
   for (const std::string& causes : run.stop_causes) std::printf("  safety stop: %s\n", causes.c_str());
   tally.safety_stops += run.safety_stops;
-  // The report's holes that were not drilled, with its reason.
+  // The report's holes: how their reach was judged, and those not drilled with the reason.
   for (const concert::msg::DrillArea& a : s.areas()) {
     for (const concert::msg::DrillHole& h : a.holes()) {
-      if (h.state() != concert::msg::HOLE_DRILLED)
-        std::printf("  report: %s %s: %s\n", a.name().c_str(), h.label().c_str(), h.reason().c_str());
+      tally.reachable += h.reach() == concert::msg::REACH_REACHABLE;
+      tally.judged_unreachable += h.reach() == concert::msg::REACH_UNREACHABLE;
+      const char* reach = h.reach() == concert::msg::REACH_REACHABLE     ? "reachable"
+                          : h.reach() == concert::msg::REACH_UNREACHABLE ? "unreachable"
+                                                                         : "not judged";
+      std::printf("  report: %s %s: %s (%s)%s%s\n", a.name().c_str(), h.label().c_str(), reach,
+                  h.reach_reason().c_str(), h.state() == concert::msg::HOLE_DRILLED ? "" : "; not drilled: ",
+                  h.state() == concert::msg::HOLE_DRILLED ? "" : h.reason().c_str());
     }
   }
   bool off = false;  // a hole past 5 mm, or a mark not drilled: the logs say why

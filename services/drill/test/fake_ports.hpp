@@ -11,7 +11,8 @@
 //   run(tree, fake);                                  // ticks at 0, 1, 2, ... s until done
 //
 // Calls: "resolve I", "navigate I" (I: the area whose base pose it is), "plan I after J|none",
-// "execute I", "detect I", "place I N" (N: the holes to place for), "align I LABEL",
+// "execute I", "detect I", "survey I N" (N: the holes asked about), "place I N" (N: the holes to
+// place for), "align I LABEL",
 // "drill I LABEL DEPTH", "retract I LABEL", "stow", "stop".
 
 #include <cstdio>
@@ -62,6 +63,8 @@ class FakePorts : public MissionPorts {
   std::vector<ResolvedArea> areas;                  ///< what resolution() finds, per area
   std::vector<std::vector<DrillPoint>> points;      ///< what detection() finds, per area
   std::vector<std::size_t> placement_order;          ///< what placement() says (empty: as given)
+  /// What classification() says of a hole, by "AREA LABEL" (others: reachable at full thrust).
+  std::map<std::string, HoleReach> verdicts;
   std::string unhealthy;                            ///< health() fails with this when set
   std::function<void(const std::string&)> on_call;  ///< called after each recorded call
   std::vector<std::string> violations;              ///< what the robot would have refused
@@ -130,6 +133,21 @@ class FakePorts : public MissionPorts {
   Outcome detection(std::vector<DrillPoint>& found) override {
     Outcome o = poll(detection_);
     if (o.progress == Progress::kSucceeded) found = points.at(detecting_);
+    return o;
+  }
+
+  void classify(std::size_t area, const std::vector<DrillPoint>& holes) override {
+    surveyed_ = holes;
+    survey_ = start("survey " + std::to_string(area) + " " + std::to_string(holes.size()));
+  }
+  Outcome classification(std::vector<HoleReach>& reach) override {
+    const Outcome o = poll(survey_);
+    if (o.progress != Progress::kSucceeded) return o;
+    reach.clear();
+    for (const DrillPoint& p : surveyed_) {
+      const auto v = verdicts.find(std::to_string(detecting_) + " " + p.label);
+      reach.push_back(v == verdicts.end() ? HoleReach{Reach::kReachable, "at full thrust"} : v->second);
+    }
     return o;
   }
 
@@ -209,7 +227,8 @@ class FakePorts : public MissionPorts {
 
   std::map<std::size_t, Running> resolving_, planning_;
   std::map<std::size_t, std::string> plan_from_;
-  Running navigation_, execution_, detection_, placing_, alignment_, drilling_, retraction_, stowing_;
+  std::vector<DrillPoint> surveyed_;
+  Running navigation_, execution_, detection_, survey_, placing_, alignment_, drilling_, retraction_, stowing_;
   std::size_t executing_{0}, detecting_{0};
   std::string label_;
   std::string posture_{"start"};

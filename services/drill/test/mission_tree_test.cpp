@@ -156,9 +156,9 @@ Mission mission_of(std::size_t n) {
   return m;
 }
 
-// The calls of drilling both blobs of area `i`, the base placed for them first.
+// The calls of drilling both blobs of area `i`, surveyed and the base placed for them first.
 std::vector<std::string> holes_of(std::size_t i) {
-  std::vector<std::string> out{"place " + std::to_string(i) + " 2"};
+  std::vector<std::string> out{"survey " + std::to_string(i) + " 2", "place " + std::to_string(i) + " 2"};
   for (const char* blob : {"blob 1", "blob 2"}) {
     const std::string hole = std::to_string(i) + " " + blob;
     out.insert(out.end(), {"align " + hole, "drill " + hole + " 0.050", "retract " + hole});
@@ -341,6 +341,43 @@ TEST(MissionTree, APlacementsOrderCountsOnlyTheHolesStillToDrill) {
   EXPECT_THAT(fake.calls_of("drill"), ElementsAre("drill 0 blob 3 0.050", "drill 0 blob 2 0.050"));
 }
 
+TEST(MissionTree, HolesTheSurveyFindsUnreachableAreReportedNotAttempted) {
+  FakePorts fake(2);
+  fake.verdicts["0 blob 2"] = {Reach::kUnreachable, "no posture: J3_E 163.9 N m over 160 continuous"};
+  fake.verdicts["1 blob 1"] = {Reach::kUnknown, "the planner refused: another model"};
+  MissionTree tree(mission_of(2), fake);
+  ASSERT_EQ(run(tree, fake), MissionState::kFailed);
+  EXPECT_THAT(fake.calls_of("survey"), ElementsAre("survey 0 2", "survey 1 2"));
+  EXPECT_THAT(fake.calls_of("place"), ElementsAre("place 0 1", "place 1 2")) << "placed for the reachable only";
+  EXPECT_THAT(fake.calls_of("drill"),
+              ElementsAre("drill 0 blob 1 0.050", "drill 1 blob 1 0.050", "drill 1 blob 2 0.050"));
+  const MissionReport& r = tree.report();
+  const HoleReport& skipped = r.areas[0].holes[1];
+  EXPECT_EQ(skipped.state, HoleState::kSkipped);
+  EXPECT_EQ(skipped.reason, "unreachable: no posture: J3_E 163.9 N m over 160 continuous");
+  EXPECT_EQ(skipped.reach.reach, Reach::kUnreachable);
+  EXPECT_EQ(r.areas[0].holes[0].reach.reach, Reach::kReachable);
+  EXPECT_EQ(r.areas[0].holes[0].reach.why, "at full thrust");
+  EXPECT_EQ(r.areas[0].state, AreaState::kFailed);
+  EXPECT_EQ(r.areas[0].reason,
+            "1 of 2 holes unreachable (hole 'blob 2': no posture: J3_E 163.9 N m over 160 continuous)");
+  // A hole the planner could not judge is drilled as if never asked.
+  EXPECT_EQ(r.areas[1].holes[0].reach.reach, Reach::kUnknown);
+  EXPECT_EQ(r.areas[1].holes[0].state, HoleState::kDrilled);
+  EXPECT_EQ(r.areas[1].state, AreaState::kDone);
+  EXPECT_EQ(r.holes_drilled(), 3);
+  EXPECT_EQ(r.holes_marked(), 4);
+}
+
+TEST(MissionTree, AFailedSurveyLeavesTheHolesToBeAttempted) {
+  FakePorts fake(1);
+  fake.scripts["survey 0 2"] = {1.0, "no joint state"};
+  MissionTree tree(mission_of(1), fake);
+  ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
+  EXPECT_EQ(tree.report().holes_drilled(), 2);
+  EXPECT_EQ(tree.report().areas[0].holes[0].reach.reach, Reach::kUnknown);
+}
+
 TEST(MissionTree, AFailedPlanFailsItsAreaOnly) {
   FakePorts fake(2);
   fake.scripts["plan 0 after none"] = {2.0, "no approach without collision"};
@@ -496,7 +533,7 @@ TEST(MissionTree, ResumeSkipsDrilledHolesAndDoneAreas) {
     tree.resume(first);
     ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
     EXPECT_THAT(fake.calls,
-                ElementsAre("resolve 1", "plan 1 after none", "execute 1", "detect 1", "place 1 1",
+                ElementsAre("resolve 1", "plan 1 after none", "execute 1", "detect 1", "survey 1 1", "place 1 1",
                             "align 1 blob 2", "drill 1 blob 2 0.050", "retract 1 blob 2", "stow"));
     second = tree.report();
     EXPECT_EQ(second.areas[0].state, AreaState::kSkipped);
@@ -590,9 +627,9 @@ TEST(MissionTree, TheArmGoesHomeAtTheEndUnlessTheMissionHadToStop) {
 TEST(MissionTree, TimesAddUp) {
   FakePorts fake(3);
   fake.areas[2].base = BasePose{2.0, -1.0, 0.0};
-  fake.default_seconds = 1.0;  // resolve, detect, place, align, retract
+  fake.default_seconds = 1.0;  // resolve, detect, survey, place, align, retract
   fake.scripts = {{"plan 0 after none", {3.0, ""}},
-                  {"plan 1 after 0", {20.0, ""}},  // 10 s of it while area 0 is drilled
+                  {"plan 1 after 0", {20.0, ""}},  // 11 s of it while area 0 is surveyed and drilled
                   {"plan 2 after none", {2.0, ""}},
                   {"navigate 2", {6.0, ""}}};
   for (const char* call : {"execute 0", "execute 1", "execute 2"}) fake.scripts[call] = {4.0, ""};
@@ -608,7 +645,7 @@ TEST(MissionTree, TimesAddUp) {
 
   const MissionTimes& t = tree.report().times;
   EXPECT_DOUBLE_EQ(t.navigate, 6.0);
-  EXPECT_DOUBLE_EQ(t.plan, 3.0 + 10.0 + 2.0);
+  EXPECT_DOUBLE_EQ(t.plan, 3.0 + 9.0 + 2.0 + 3 * 1.0);  // the approaches waited for, the surveys
   EXPECT_DOUBLE_EQ(t.execute, 3 * 4.0 + 1.0);  // the approaches, the arm home at the end
   EXPECT_DOUBLE_EQ(t.drill, 3 * (1.0 + 1.0 + 2 * (1.0 + 2.0 + 1.0)));  // detect, place, holes
   const double resolve = 3 * 1.0;
@@ -646,7 +683,7 @@ TEST(MissionTree, StatusNamesTheActiveNode) {
         out.push_back("mission/area '" + area + "'/hole '" + blob + "'/" + step);
       }
     }
-    out.insert(out.begin(), "mission/area '" + area + "'/place");
+    out.insert(out.begin(), {"mission/area '" + area + "'/survey", "mission/area '" + area + "'/place"});
     return out;
   };
   EXPECT_THAT(
@@ -679,6 +716,7 @@ TEST(MissionTree, DescribesItsShape) {
             "      execute (action)\n"
             "      plan the next area (action)\n"
             "      detect (action)\n"
+            "      survey (action)\n"
             "      place (action)\n"
             "      holes (for each)\n"
             "        hole (finally)\n"

@@ -96,6 +96,10 @@ void expect_same(const Params& a, const Params& b) {
     EXPECT_EQ(x.out, y.out) << "placement.draws[" << i << "]";
     EXPECT_EQ(x.toward, y.toward) << "placement.draws[" << i << "]";
   }
+  EXPECT_EQ(a.survey.tries, b.survey.tries);
+  ASSERT_EQ(a.survey.attempts.size(), b.survey.attempts.size());
+  for (std::size_t i = 0; i < a.survey.attempts.size(); ++i)
+    EXPECT_EQ(a.survey.attempts[i], b.survey.attempts[i]) << "survey.attempts[" << i << "]";
   EXPECT_EQ(a.blobs.match, b.blobs.match);
   EXPECT_EQ(a.blobs.track_window, b.blobs.track_window);
   EXPECT_EQ(a.blobs.set_shift, b.blobs.set_shift);
@@ -128,9 +132,9 @@ TEST(DrillParamsFile, TheShippedFileHoldsEveryDefault) {
   const Params p = read_params(doc);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
-  // Every key read: 63 single values (look_further one of them), the 3 tables' lengths, and
-  // their rows' keys: 27 attempts x 5, 5 looks x 2, 3 draws x 2.
-  EXPECT_EQ(doc.keys().size(), 63u + 3u + 27u * 5u + 5u * 2u + 3u * 2u);
+  // Every key read: 64 single values (look_further one of them), the 4 tables' lengths, and
+  // their rows' keys: 27 attempts x 5, 5 looks x 2, 3 draws x 2, 3 survey attempts x 5.
+  EXPECT_EQ(doc.keys().size(), 64u + 4u + 27u * 5u + 5u * 2u + 3u * 2u + 3u * 5u);
   expect_same(p, Params{});
   expect_same(load_params(kShipped), Params{});
 }
@@ -205,7 +209,7 @@ TEST(DrillParamsFile, AnUnknownKeyIsRefusedNamingIt) {
             "looks.attempts[0]: between, further");
   EXPECT_EQ(error_of("cameras: {}\n"),
             "drill.yaml: cameras: unknown key (line 1); known keys: approach, bim, blobs, buffers, "
-            "camera, hole, liveness, looks, motion, paths, placement, plan_requests, rest, thermal");
+            "camera, hole, liveness, looks, motion, paths, placement, plan_requests, rest, survey, thermal");
   EXPECT_THAT(error_of("motion:\n  feed: 0.01\n"),
               StartsWith("drill.yaml: motion.feed: unknown key (line 2); known keys of motion: "));
 }

@@ -191,5 +191,54 @@ TEST(PlacementChoice, CountsNoMoreThanTheAreasHoles) {
   EXPECT_NE(c.summary().find("2 of 2"), std::string::npos) << c.summary();
 }
 
+TEST(ReachSurvey, AHoleIsReachableAtTheFirstAttemptAnsweredWithAPosture) {
+  ReachSurvey s(2, 3, 2);
+  EXPECT_EQ(s.next(0), 0u);
+  s.not_found(0, "no posture: self collision");  // a first try: the same attempt again
+  EXPECT_EQ(s.next(0), 0u);
+  s.not_found(0, "no posture: self collision");  // tries spent: the next attempt
+  EXPECT_EQ(s.next(0), 1u);
+  s.found(0, "at 35 % of the thrust");
+  EXPECT_EQ(s.next(0), std::nullopt);
+  EXPECT_FALSE(s.done()) << "hole 2 has no verdict yet";
+  s.found(1, "at full thrust");
+  ASSERT_TRUE(s.done());
+  EXPECT_EQ(s.verdicts()[0].reach, Reach::kReachable);
+  EXPECT_EQ(s.verdicts()[0].why, "at 35 % of the thrust");
+  EXPECT_EQ(s.summary(), "2 of 2 holes reachable");
+}
+
+TEST(ReachSurvey, AHoleIsUnreachableOnlyOnceEveryAttemptsTriesFailedWithTheLastReason) {
+  ReachSurvey s(1, 2, 2);
+  for (int k = 0; k < 3; ++k) {
+    s.not_found(0, "why " + std::to_string(k));
+    EXPECT_FALSE(s.done()) << "after " << k + 1 << " failures of 4";
+  }
+  s.not_found(0, "no posture: J3_E 163.9 N m over 160 continuous");
+  ASSERT_TRUE(s.done());
+  EXPECT_EQ(s.verdicts()[0].reach, Reach::kUnreachable);
+  EXPECT_EQ(s.summary(), "0 of 1 hole reachable; unreachable: hole 1 (no posture: J3_E 163.9 N m over 160 continuous)");
+  s.found(0, "late answer");  // a verdict stands
+  EXPECT_EQ(s.verdicts()[0].reach, Reach::kUnreachable);
+}
+
+TEST(ReachSurvey, APlannerThatCannotJudgeLeavesTheHoleUnknown) {
+  ReachSurvey s(2, 1, 1);
+  s.unknown(0, "the planner refused: another model");
+  s.not_found(1, "no posture");
+  ASSERT_TRUE(s.done());
+  EXPECT_EQ(s.verdicts()[0].reach, Reach::kUnknown);
+  EXPECT_EQ(s.verdicts()[1].reach, Reach::kUnreachable);
+  EXPECT_EQ(s.summary(),
+            "0 of 2 holes reachable; unreachable: hole 2 (no posture); not judged: hole 1 (the planner "
+            "refused: another model)");
+}
+
+TEST(ReachSurvey, NoHolesIsDoneAndNoAttemptsIsRefused) {
+  EXPECT_TRUE(ReachSurvey(0, 1, 1).done());
+  EXPECT_THROW(ReachSurvey(1, 0, 1), DrillError);
+  EXPECT_THROW(ReachSurvey(1, 1, 0), DrillError);
+}
+
 }  // namespace
 }  // namespace concert::drill

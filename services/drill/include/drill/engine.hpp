@@ -128,6 +128,8 @@ class DrillEngine final : public MissionPorts {
   Outcome execution() override;
   void detect(std::size_t area, const AreaSpec& spec, const ResolvedArea& located) override;
   Outcome detection(std::vector<DrillPoint>& points) override;
+  void classify(std::size_t area, const std::vector<DrillPoint>& holes) override;
+  Outcome classification(std::vector<HoleReach>& reach) override;
   void place(std::size_t area, const std::vector<DrillPoint>& holes) override;
   Outcome placement(std::vector<std::size_t>& order) override;
   void align(const DrillPoint& point) override;
@@ -179,6 +181,17 @@ class DrillEngine final : public MissionPorts {
     kPlaceSee,
     kPlaceLookAgain  // the marker not seen: the camera further out, the arm alone (executed)
   };
+
+  // The survey of an area's holes (classify(), ReachSurvey): one planned-only whole-body
+  // request out per hole undecided (its id, 0: none).
+  struct Survey {
+    std::vector<DrillPoint> holes;
+    std::optional<ReachSurvey> survey;
+    std::vector<std::uint32_t> ids;
+    double started{0.0};  // now_ [s]
+    bool logged{false};
+  } survey_;
+  void survey_ask(std::size_t i);
 
   // An area's base placement (place(), drill/placement.hpp): its holes, the tally, the
   // requests out, the postures drawn and each one's look.

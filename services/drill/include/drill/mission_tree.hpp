@@ -1,8 +1,9 @@
 #pragma once
 // The drilling mission as a behaviour tree (paper Fig. 11): initialise -> per area in FIFO
 // order: navigate if the area has a base pose -> execute the approach (planned while the
-// previous area was drilled) -> detect the points -> place the base once for them (not in the
-// paper: drill/placement.hpp says why) -> per point: align, drill, retract; then the arm home
+// previous area was drilled) -> detect the points -> survey which of them the robot can reach
+// (not in the paper: those it cannot are reported, not attempted) -> place the base once for them
+// (not in the paper: drill/placement.hpp says why) -> per point: align, drill, retract; then the arm home
 // (not in the paper: navigation and a tool swap start from the transport posture).
 // Plain C++, no DDS.
 
@@ -36,6 +37,7 @@ struct HoleReport {
   DrillPoint point;
   HoleState state{HoleState::kPending};
   std::string reason;  ///< why it failed or was skipped
+  HoleReach reach;     ///< the survey's verdict before anything moved for it (unknown until then)
 };
 
 struct AreaReport {

@@ -184,6 +184,18 @@ struct Params {
         std::vector<PlacementDraw>(std::begin(kPlacementDraws), std::end(kPlacementDraws));
   };
 
+  /// Whether each of an area's holes can be drilled, asked before anything moves for them
+  /// (ReachSurvey, placement.hpp): whole-body postures, the base anywhere, from the full thrust
+  /// to the most lenient; a hole none of them finds is not attempted.
+  struct Survey {
+    /// In order; a hole is reachable at the first that finds a posture.
+    std::vector<HoleAttempt> attempts{{true, false, 0.0, 0.0, 1.0},
+                                      {true, false, 0.0, 0.0, 0.35},
+                                      {false, false, 0.0, 0.07, 1.0}};
+    /// Each attempt asked up to this many times (the planner's search is randomised).
+    int tries{2};
+  };
+
   /// Blob holes: predicted blobs matched to seen ones across the odometry's drift.
   struct Blobs {
     /// [m] a predicted blob lies this near a seen one (also: a start view's blob near the surface).
@@ -233,6 +245,7 @@ struct Params {
   Paths paths;
   Looks looks;
   Placement placement;
+  Survey survey;
   Blobs blobs;
   Rest rest;
   Thermal thermal;

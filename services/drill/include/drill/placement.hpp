@@ -110,4 +110,43 @@ class PlacementChoice {
   std::vector<Drawn> drawn_;
 };
 
+/// Whether each of an area's holes can be drilled, asked of the planner before anything moves
+/// for them: per hole, whole-body postures (the base anywhere) of a list of attempts from the
+/// full thrust to the most lenient (Params::reach.attempts), each asked up to `tries` times, as
+/// the planner's posture search is randomised and one failure is no verdict. A hole is reachable
+/// at the first attempt answered with a posture; unreachable once every attempt failed to find
+/// one, with the last failure's reason; unknown when the planner could not judge (a refused
+/// request, another model): such a hole is drilled as if never asked.
+class ReachSurvey {
+ public:
+  /// `holes` >= 0, `attempts` >= 1, `tries` >= 1.
+  ReachSurvey(std::size_t holes, std::size_t attempts, int tries);
+
+  /// The attempt to ask for hole `i` next; none once its verdict is in.
+  [[nodiscard]] std::optional<std::size_t> next(std::size_t i) const;
+  /// Hole `i`'s current attempt found a posture; `how` names the attempt ("at full thrust").
+  void found(std::size_t i, const std::string& how);
+  /// Hole `i`'s current attempt found none (`why`: the planner's reason): the same attempt
+  /// again until its tries are spent, then the next attempt.
+  void not_found(std::size_t i, const std::string& why);
+  /// The planner could not judge hole `i` (`why`): its verdict is unknown.
+  void unknown(std::size_t i, const std::string& why);
+
+  [[nodiscard]] bool done() const;
+  [[nodiscard]] const std::vector<HoleReach>& verdicts() const { return verdicts_; }
+  /// For the log and the report: "3 of 4 holes reachable; unreachable: hole 2 (no posture: ...)".
+  [[nodiscard]] std::string summary() const;
+
+ private:
+  struct State {
+    std::size_t attempt{0};
+    int tried{0};
+    bool decided{false};
+  };
+  std::size_t attempts_;
+  int tries_;
+  std::vector<State> states_;
+  std::vector<HoleReach> verdicts_;
+};
+
 }  // namespace concert::drill

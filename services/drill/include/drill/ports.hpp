@@ -53,6 +53,19 @@ struct DrillPoint {
   int pattern_index{-1};  ///< ArUco holes: the hole's index in the marker's pattern
 };
 
+/// Whether the mounted robot can drill a hole, as the planner judged it before anything moved
+/// for it (ReachSurvey, drill/placement.hpp).
+enum class Reach {
+  kUnknown,      ///< not asked, or the planner could not say (refused, another model)
+  kReachable,    ///< a whole-body posture was found; `why` says at which thrust
+  kUnreachable,  ///< no posture at any thrust; `why` is the planner's reason
+};
+struct HoleReach {
+  Reach reach{Reach::kUnknown};
+  std::string why;
+};
+const char* to_string(Reach r);
+
 /// The robot as the mission's tree sees it.
 class MissionPorts {
  public:
@@ -89,6 +102,12 @@ class MissionPorts {
   /// marker and its pattern).
   virtual void detect(std::size_t area, const AreaSpec& spec, const ResolvedArea& located) = 0;
   virtual Outcome detection(std::vector<DrillPoint>& points) = 0;
+
+  /// Asks, before anything moves for them, whether the robot can drill each of the area's holes
+  /// still to drill (ReachSurvey): `reach` gets one verdict per hole of `holes`, in order. A hole
+  /// judged unreachable is not attempted; the report says why.
+  virtual void classify(std::size_t area, const std::vector<DrillPoint>& holes) = 0;
+  virtual Outcome classification(std::vector<HoleReach>& reach) = 0;
 
   /// Places the base for the area's holes still to drill (drill/placement.hpp): the whole body
   /// moves once, to where the arm alone reaches them all and the camera the area's mark, or the

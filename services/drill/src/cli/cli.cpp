@@ -71,6 +71,18 @@ const char* hole_state(msg::DrillHoleState s) {
   return "?";
 }
 
+const char* reach_name(msg::DrillReach r) {
+  switch (r) {
+    case msg::REACH_REACHABLE:
+      return "reachable";
+    case msg::REACH_UNREACHABLE:
+      return "unreachable";
+    case msg::REACH_UNKNOWN:
+      break;
+  }
+  return "unknown";
+}
+
 nlohmann::ordered_json status_json(const msg::DrillStatus& s) {
   nlohmann::ordered_json areas = nlohmann::ordered_json::array();
   for (const auto& a : s.areas()) {
@@ -80,6 +92,8 @@ nlohmann::ordered_json status_json(const msg::DrillStatus& s) {
       holes.push_back({{"label", h.label()},
                        {"state", hole_state(h.state())},
                        {"reason", h.reason()},
+                       {"reach", reach_name(h.reach())},
+                       {"reach_reason", h.reach_reason()},
                        {"position", {p.x(), p.y(), p.z()}}});
     }
     areas.push_back({{"name", a.name()},
@@ -118,6 +132,9 @@ void print_report(const msg::DrillStatus& s, std::ostream& out) {
           << hole_state(h.state()) << std::fixed << std::setprecision(3) << "  at (" << p.x()
           << ", " << p.y() << ", " << p.z() << ")" << std::defaultfloat;
       if (!h.reason().empty()) out << ": " << h.reason();
+      // Reachable holes say at which thrust (their reason tells the rest); an unreachable one's
+      // reason already names why.
+      if (h.reach() == msg::REACH_REACHABLE) out << " (reachable: " << h.reach_reason() << ")";
       out << "\n";
     }
   }
@@ -187,6 +204,7 @@ int run_mission(const RunOptions& o, std::ostream& out, std::ostream& err) {
     return 1;
   }
   std::string printed;
+  std::set<std::string> judged;  // "area/hole" whose reach was printed
   while (first || left_until(deadline).count() > 0) {
     const auto s = first ? first : statuses.wait(left_until(deadline));
     first.reset();
@@ -195,6 +213,15 @@ int run_mission(const RunOptions& o, std::ostream& out, std::ostream& err) {
       if (!o.dds.json && s->active() != printed) {
         printed = s->active();
         out << "  " << s->active() << std::endl;
+      }
+      // Each hole's reach as soon as it was judged, before anything moves for it.
+      for (const auto& a : s->areas()) {
+        for (const auto& h : a.holes()) {
+          if (o.dds.json || h.reach() == msg::REACH_UNKNOWN || !judged.insert(a.name() + "/" + h.label()).second)
+            continue;
+          out << "    area '" << a.name() << "' hole '" << h.label() << "': " << reach_name(h.reach()) << ": "
+              << h.reach_reason() << std::endl;
+        }
       }
       continue;
     }

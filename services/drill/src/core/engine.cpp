@@ -823,6 +823,79 @@ Outcome DrillEngine::detection(std::vector<DrillPoint>& points) {
   return Outcome::succeeded();
 }
 
+// --- Ports: which of an area's holes the robot can reach (ReachSurvey) -------------------------
+
+// "a whole-body posture at full thrust", "... at 35 % of the thrust", "..., the bit's reach to
+// the hole's depth unchecked": what a survey attempt asks, for the report.
+static std::string survey_text(const HoleAttempt& a, const DrillParams& motion) {
+  std::string t = "a whole-body posture";
+  t += a.lead >= 1.0 ? " at full thrust" : thrust_text(a.lead, motion).substr(1);
+  if (!a.reach) t += ", the bit's reach to the hole's depth unchecked";
+  return t;
+}
+
+// Every hole's first survey attempt goes out at once (planned only, from where the robot stands);
+// classification() reads the answers.
+void DrillEngine::classify(std::size_t area, const std::vector<DrillPoint>& holes) {
+  survey_ = Survey{};
+  survey_.holes = holes;
+  survey_.survey.emplace(holes.size(), tuning_.survey.attempts.size(), tuning_.survey.tries);
+  survey_.ids.assign(holes.size(), 0);
+  survey_.started = now_;
+  if (!rig_) {  // no model to ask about: nothing judged, the holes attempted as they are
+    for (std::size_t i = 0; i < holes.size(); ++i) survey_.survey->unknown(i, "no drill model");
+    return;
+  }
+  log_line("drill: area " + std::to_string(area) + ": can the robot reach its " + std::to_string(holes.size()) +
+           (holes.size() == 1 ? " hole?" : " holes?"));
+  for (std::size_t i = 0; i < holes.size(); ++i) survey_ask(i);
+}
+
+void DrillEngine::survey_ask(std::size_t i) {
+  const std::optional<std::size_t> a = survey_.survey->next(i);
+  if (!a) return;
+  PlanAsk r = placement_request(survey_.holes[i].frame);
+  set_hole_task(r, tuning_.survey.attempts[*a], tuning_.motion.standoff + tuning_.hole.align_margin, hole_depth(),
+                tuning_);
+  survey_.ids[i] = r.request_id;
+  send_plan(r);
+}
+
+// Each answer moves its hole's verdict on (ReachSurvey): a posture found, none found (the
+// attempt again or the next one), or a request the planner could not judge (refused, another
+// model: unknown). Succeeded once every hole has its verdict.
+Outcome DrillEngine::classification(std::vector<HoleReach>& reach) {
+  if (!survey_.survey) return Outcome::failed("no survey started");
+  ReachSurvey& s = *survey_.survey;
+  for (std::size_t i = 0; i < survey_.holes.size() && !s.done(); ++i) {
+    const std::optional<std::size_t> a = s.next(i);
+    if (!a || survey_.ids[i] == 0) continue;
+    const std::optional<PlanReply> r = answered(survey_.ids[i]);
+    if (!r) continue;
+    survey_.ids[i] = 0;
+    const HoleAttempt& attempt = tuning_.survey.attempts[*a];
+    if (r->state == PlanState::kSucceeded) {
+      s.found(i, survey_text(attempt, tuning_.motion));
+    } else if (r->failure == PlanFailure::kUnreachable || r->failure == PlanFailure::kNoPath) {
+      s.not_found(i, "no posture found, even " + survey_text(attempt, tuning_.motion) + ": " + r->reason);
+      survey_ask(i);
+    } else {
+      s.unknown(i, "the planner could not judge: " + r->reason);
+    }
+  }
+  if (!s.done()) return Outcome::running();
+  if (!survey_.logged) {
+    survey_.logged = true;
+    std::ostringstream t;
+    t.setf(std::ios::fixed);
+    t.precision(1);
+    t << now_ - survey_.started;
+    log_line("drill: " + s.summary() + " (asked in " + t.str() + " s)");
+  }
+  reach = s.verdicts();
+  return Outcome::succeeded();
+}
+
 // --- Ports: the base's placement for an area's holes (drill/placement.hpp) --------------------
 
 // A planned-only request for a posture at `goal` from the robot's current state; the task is the

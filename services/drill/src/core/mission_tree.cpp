@@ -107,6 +107,7 @@ struct MissionTree::Impl {
   std::vector<std::vector<Eigen::Vector3d>> drilled_before;  // per area: hole origins [m]
   std::vector<bool> plan_started;                            // per area
   std::vector<DrillPoint> detected;
+  std::vector<std::size_t> surveying;   // the area's holes surveyed (report indices)
   std::vector<std::size_t> placing;     // the area's holes placed for (report indices)
   std::vector<std::size_t> hole_order;  // the order to drill them, as the placement said
   std::size_t current_area{0};
@@ -215,6 +216,16 @@ struct MissionTree::Impl {
         [this] { ports.detect(current_area, mission.areas[current_area], area().located); },
         [this] { return detection(); });
 
+    // Which holes the robot can reach at all, before anything moves for them: the others are
+    // reported with the planner's reason and not attempted.
+    auto survey = action(
+        "survey", Work::kPlan,
+        [this] {
+          surveying = pending_holes();
+          ports.classify(current_area, pending_points());
+        },
+        [this] { return surveyed(); });
+
     // One base placement for the area's holes (drill/placement.hpp), before the first.
     auto place = action(
         "place", Work::kDrill,
@@ -256,7 +267,8 @@ struct MissionTree::Impl {
 
     auto area_body =
         sequence("area", hidden(std::move(navigate)), std::move(plan), std::move(execute),
-                 std::move(plan_next), std::move(detect), std::move(place), std::move(holes));
+                 std::move(plan_next), std::move(detect), std::move(survey), std::move(place),
+                 std::move(holes));
     auto areas = for_each_area(
         "areas", true,
         [this](std::size_t, bt::Status status, const std::string& why) {
@@ -367,6 +379,27 @@ struct MissionTree::Impl {
     }
   }
 
+  // The survey's verdicts onto the holes: an unreachable one is skipped with the planner's
+  // reason. Verdicts that do not name each hole surveyed once leave every hole as it was. A
+  // survey that failed (nothing moved) leaves them unjudged: the holes are attempted.
+  Outcome surveyed() {
+    std::vector<HoleReach> reach;
+    const Outcome outcome = ports.classification(reach);
+    if (outcome.progress == Progress::kRunning) return outcome;
+    if (outcome.progress == Progress::kSucceeded && reach.size() == surveying.size()) {
+      auto& holes = area().holes;
+      for (std::size_t k = 0; k < reach.size(); ++k) {
+        HoleReport& h = holes[surveying[k]];
+        h.reach = reach[k];
+        if (reach[k].reach == Reach::kUnreachable) {
+          h.state = HoleState::kSkipped;
+          h.reason = "unreachable: " + reach[k].why;
+        }
+      }
+    }
+    return Outcome::succeeded();
+  }
+
   // A placement that failed left the whole body somewhere along its move: held there, and the
   // area fails (as an approach does, executed()). One that succeeded says the holes' order:
   // kept when it names each hole placed for once (else the order they came in).
@@ -452,6 +485,16 @@ struct MissionTree::Impl {
       problems.push_back(std::to_string(n_failed) + " of " + std::to_string(a.holes.size()) +
                          " holes failed (" + quoted("hole", first->point.label) + ": " +
                          first->reason + ")");
+    }
+    const auto unreachable = [](const HoleReport& h) {
+      return h.state == HoleState::kSkipped && h.reach.reach == Reach::kUnreachable;
+    };
+    const auto n_unreachable = std::count_if(a.holes.begin(), a.holes.end(), unreachable);
+    if (n_unreachable > 0) {
+      const auto first = std::find_if(a.holes.begin(), a.holes.end(), unreachable);
+      problems.push_back(std::to_string(n_unreachable) + " of " + std::to_string(a.holes.size()) +
+                         " holes unreachable (" + quoted("hole", first->point.label) + ": " +
+                         first->reach.why + ")");
     }
     const int expected = mission.areas[current_area].expected;
     const int found = static_cast<int>(a.holes.size());

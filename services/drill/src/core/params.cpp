@@ -79,6 +79,14 @@ void read_thermal(Map m, Params::Thermal& t) {
   }
 }
 
+void read_attempt(Map& item, HoleAttempt& a) {
+  item.boolean("reach", a.reach);
+  item.boolean("fixed_base", a.fixed_base);
+  item.number("base_travel", a.base_travel, Range::non_negative());
+  item.number("further", a.further, Range::non_negative());
+  item.number("lead", a.lead, kLead);
+}
+
 /// Reads the hole section; returns the items of hole.attempts (none when the file leaves the
 /// list out) for the rules across keys.
 std::vector<Map> read_hole(Map m, Params::Hole& h) {
@@ -88,13 +96,12 @@ std::vector<Map> read_hole(Map m, Params::Hole& h) {
   m.integer("body_replans", h.body_replans, 0, 100);
   m.integer("body_draws", h.body_draws, 1, 100);
   m.number("lightest_lead", h.lightest_lead, kLead);
-  return m.sequence("attempts", h.attempts, [](Map& item, HoleAttempt& a) {
-    item.boolean("reach", a.reach);
-    item.boolean("fixed_base", a.fixed_base);
-    item.number("base_travel", a.base_travel, Range::non_negative());
-    item.number("further", a.further, Range::non_negative());
-    item.number("lead", a.lead, kLead);
-  });
+  return m.sequence("attempts", h.attempts, read_attempt);
+}
+
+void read_survey(Map m, Params::Survey& s) {
+  m.sequence("attempts", s.attempts, read_attempt);
+  m.integer("tries", s.tries, 1, 100);
 }
 
 void read_paths(Map m, Params::Paths& p) {
@@ -173,6 +180,7 @@ struct Sections {
   Map hole;
   Map looks;
   Map placement;
+  Map survey;
   Map motion;
 };
 
@@ -254,6 +262,9 @@ void check_rules(const Params& p, const std::vector<Map>& rows, const Sections& 
     at.placement.fail("look_further",
                       "expected at least one distance: a placement's look starts there");
   }
+  if (p.survey.attempts.empty()) {
+    at.survey.fail("attempts", "expected at least one attempt: a hole's reach is judged by them");
+  }
   if (p.placement.draws.empty()) {
     at.placement.fail("draws", "expected at least one draw: a placement draws one posture or more");
   }
@@ -278,6 +289,7 @@ Params read_params(config::Document& doc) {
                     root.section("hole"),
                     root.section("looks"),
                     root.section("placement"),
+                    root.section("survey"),
                     root.section("motion")};
   read_camera(root.section("camera"), p.camera);
   read_buffers(at.buffers, p.buffers);
@@ -289,6 +301,7 @@ Params read_params(config::Document& doc) {
   read_paths(root.section("paths"), p.paths);
   read_looks(at.looks, p.looks);
   read_placement(at.placement, p.placement);
+  read_survey(at.survey, p.survey);
   read_blobs(root.section("blobs"), p.blobs);
   read_rest(root.section("rest"), p.rest);
   read_thermal(root.section("thermal"), p.thermal);

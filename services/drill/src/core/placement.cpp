@@ -1,5 +1,6 @@
 #include "drill/placement.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -91,6 +92,71 @@ std::string PlacementChoice::summary() const {
       << holes_ << (drawn_[i].look ? " with" : " without") << " a look at the mark";
   }
   return s.str();
+}
+
+const char* to_string(Reach r) {
+  switch (r) {
+    case Reach::kReachable:
+      return "reachable";
+    case Reach::kUnreachable:
+      return "unreachable";
+    case Reach::kUnknown:
+      break;
+  }
+  return "unknown";
+}
+
+ReachSurvey::ReachSurvey(std::size_t holes, std::size_t attempts, int tries)
+    : attempts_(attempts), tries_(tries), states_(holes), verdicts_(holes) {
+  if (attempts == 0 || tries < 1) throw DrillError("reach survey: needs at least one attempt and one try");
+}
+
+std::optional<std::size_t> ReachSurvey::next(std::size_t i) const {
+  if (states_.at(i).decided) return std::nullopt;
+  return states_[i].attempt;
+}
+
+void ReachSurvey::found(std::size_t i, const std::string& how) {
+  if (states_.at(i).decided) return;
+  states_[i].decided = true;
+  verdicts_[i] = {Reach::kReachable, how};
+}
+
+void ReachSurvey::not_found(std::size_t i, const std::string& why) {
+  State& s = states_.at(i);
+  if (s.decided) return;
+  if (++s.tried < tries_) return;
+  s.tried = 0;
+  if (++s.attempt < attempts_) return;
+  s.decided = true;
+  verdicts_[i] = {Reach::kUnreachable, why};
+}
+
+void ReachSurvey::unknown(std::size_t i, const std::string& why) {
+  if (states_.at(i).decided) return;
+  states_[i].decided = true;
+  verdicts_[i] = {Reach::kUnknown, why};
+}
+
+bool ReachSurvey::done() const {
+  return std::all_of(states_.begin(), states_.end(), [](const State& s) { return s.decided; });
+}
+
+std::string ReachSurvey::summary() const {
+  std::size_t reachable = 0;
+  std::string unreachable, unknown;
+  for (std::size_t i = 0; i < verdicts_.size(); ++i) {
+    const HoleReach& v = verdicts_[i];
+    const std::string item = "hole " + std::to_string(i + 1) + " (" + v.why + ")";
+    if (v.reach == Reach::kReachable) ++reachable;
+    if (v.reach == Reach::kUnreachable) unreachable += (unreachable.empty() ? "" : ", ") + item;
+    if (v.reach == Reach::kUnknown) unknown += (unknown.empty() ? "" : ", ") + item;
+  }
+  std::string out = std::to_string(reachable) + " of " + std::to_string(verdicts_.size()) +
+                    (verdicts_.size() == 1 ? " hole reachable" : " holes reachable");
+  if (!unreachable.empty()) out += "; unreachable: " + unreachable;
+  if (!unknown.empty()) out += "; not judged: " + unknown;
+  return out;
 }
 
 }  // namespace concert::drill

@@ -32,6 +32,11 @@ constexpr EnumMap kHoleStates{std::array{
     std::pair{HoleState::kFailed, msg::HOLE_FAILED},
     std::pair{HoleState::kSkipped, msg::HOLE_SKIPPED},
 }};
+constexpr EnumMap kReaches{std::array{
+    std::pair{Reach::kUnknown, msg::REACH_UNKNOWN},
+    std::pair{Reach::kReachable, msg::REACH_REACHABLE},
+    std::pair{Reach::kUnreachable, msg::REACH_UNREACHABLE},
+}};
 
 // The planner's states and failures and their wire twins, one row each.
 constexpr EnumMap kPlanStates{std::array{
@@ -149,6 +154,8 @@ msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
       hole.frame(model::dds::to_pose_msg(h.point.frame));
       hole.state(kHoleStates.to(h.state).value_or(msg::HOLE_FAILED));
       hole.reason(h.reason);
+      hole.reach(kReaches.to(h.reach.reach).value_or(msg::REACH_UNKNOWN));
+      hole.reach_reason(h.reach.why);
       area.holes().push_back(hole);
     }
     out.areas().push_back(area);
