@@ -86,6 +86,8 @@ struct Tally {
   std::size_t reachable{0}, judged_unreachable{0};  // as the report judged them before moving
   double nav{0}, plan{0}, exec{0}, drill{0}, total{0};  // [s]
   int safety_stops{0};
+  // [s] summed over the areas and holes of the report (AreaTimes, HoleTimes)
+  double approach{0}, detect{0}, survey{0}, place{0}, align{0}, feed{0}, retract{0};
 
   Tally& operator+=(const Tally& o) {
     errors.insert(errors.end(), o.errors.begin(), o.errors.end());
@@ -99,6 +101,13 @@ struct Tally {
     drill += o.drill;
     total += o.total;
     safety_stops += o.safety_stops;
+    approach += o.approach;
+    detect += o.detect;
+    survey += o.survey;
+    place += o.place;
+    align += o.align;
+    feed += o.feed;
+    retract += o.retract;
     return *this;
   }
   void print(const std::string& what, int runs) const {
@@ -112,6 +121,11 @@ struct Tally {
         percentile(errors, 0.5) * 1e3, percentile(errors, 0.95) * 1e3,
         percentile(errors, 1.0) * 1e3, nav / runs, plan / runs, exec / runs, drill / runs, total / runs,
         drilled > 0 ? total / static_cast<double>(drilled) : std::nan(""), safety_stops);
+    const double n = drilled > 0 ? static_cast<double>(drilled) : std::nan("");
+    std::printf(
+        "   time per hole drilled: approach %.1f s, detect %.1f s, survey %.1f s, place %.1f s, align %.1f s "
+        "(posture, looks, alignment), drill %.1f s, retract %.1f s\n",
+        approach / n, detect / n, survey / n, place / n, align / n, feed / n, retract / n);
     std::fflush(stdout);
   }
 };
@@ -134,14 +148,22 @@ void score(const std::string& what, const MissionRun& run, const std::vector<Tar
   tally.safety_stops += run.safety_stops;
   // The report's holes: how their reach was judged, and those not drilled with the reason.
   for (const concert::msg::DrillArea& a : s.areas()) {
+    tally.approach += a.time_approach();
+    tally.detect += a.time_detect();
+    tally.survey += a.time_survey();
+    tally.place += a.time_place();
     for (const concert::msg::DrillHole& h : a.holes()) {
+      tally.align += h.time_align();
+      tally.feed += h.time_drill();
+      tally.retract += h.time_retract();
       tally.reachable += h.reach() == concert::msg::REACH_REACHABLE;
       tally.judged_unreachable += h.reach() == concert::msg::REACH_UNREACHABLE;
       const char* reach = h.reach() == concert::msg::REACH_REACHABLE     ? "reachable"
                           : h.reach() == concert::msg::REACH_UNREACHABLE ? "unreachable"
                                                                          : "not judged";
-      std::printf("  report: %s %s: %s (%s)%s%s\n", a.name().c_str(), h.label().c_str(), reach,
-                  h.reach_reason().c_str(), h.state() == concert::msg::HOLE_DRILLED ? "" : "; not drilled: ",
+      std::printf("  report: %s %s: %s (%s); align %.1f s, drill %.1f s, retract %.1f s%s%s\n", a.name().c_str(),
+                  h.label().c_str(), reach, h.reach_reason().c_str(), h.time_align(), h.time_drill(),
+                  h.time_retract(), h.state() == concert::msg::HOLE_DRILLED ? "" : "; not drilled: ",
                   h.state() == concert::msg::HOLE_DRILLED ? "" : h.reason().c_str());
     }
   }

@@ -652,6 +652,21 @@ TEST(MissionTree, TimesAddUp) {
   EXPECT_DOUBLE_EQ(t.total, fake.now);
   EXPECT_DOUBLE_EQ(t.navigate + t.plan + t.execute + t.drill + resolve, t.total);
   EXPECT_EQ(fake.health_checks, static_cast<int>(fake.now) + 1) << "one check a tick";
+
+  // Per area and hole: the approach is navigating, the plan waited for and its execution.
+  const std::vector<double> approach{3.0 + 4.0, 9.0 + 4.0, 6.0 + 2.0 + 4.0};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const AreaReport& a = tree.report().areas[i];
+    EXPECT_DOUBLE_EQ(a.times.approach, approach[i]) << "area " << i;
+    EXPECT_DOUBLE_EQ(a.times.detect, 1.0) << "area " << i;
+    EXPECT_DOUBLE_EQ(a.times.survey, 1.0) << "area " << i;
+    EXPECT_DOUBLE_EQ(a.times.place, 1.0) << "area " << i;
+    for (const HoleReport& h : a.holes) {
+      EXPECT_DOUBLE_EQ(h.times.align, 1.0) << "area " << i << " " << h.point.label;
+      EXPECT_DOUBLE_EQ(h.times.drill, 2.0) << "area " << i << " " << h.point.label;
+      EXPECT_DOUBLE_EQ(h.times.retract, 1.0) << "area " << i << " " << h.point.label;
+    }
+  }
 }
 
 TEST(MissionTree, StatusNamesTheActiveNode) {

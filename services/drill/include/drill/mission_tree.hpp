@@ -33,11 +33,32 @@ const char* to_string(HoleState s);
 const char* to_string(AreaState s);
 const char* to_string(MissionState s);
 
+/// Where one hole's time went [s of the clock given to tick()]: `align` is everything from the
+/// hole's start to the bit aligned in front of it (its posture planned and reached, the looks at
+/// its mark, the alignment), `drill` the feed into the wall, `retract` the way back out and onto
+/// the area's postures.
+struct HoleTimes {
+  double align{0.0};
+  double drill{0.0};
+  double retract{0.0};
+};
+
+/// Where one area's own time went [s]: `approach` navigating to it, waiting for its approach
+/// plan and executing it; `detect` finding its marks; `survey` judging its holes' reach; `place`
+/// placing the base for them. Its holes' times are theirs.
+struct AreaTimes {
+  double approach{0.0};
+  double detect{0.0};
+  double survey{0.0};
+  double place{0.0};
+};
+
 struct HoleReport {
   DrillPoint point;
   HoleState state{HoleState::kPending};
   std::string reason;  ///< why it failed or was skipped
   HoleReach reach;     ///< the survey's verdict before anything moved for it (unknown until then)
+  HoleTimes times;
 };
 
 struct AreaReport {
@@ -46,6 +67,7 @@ struct AreaReport {
   std::string reason;
   ResolvedArea located;
   std::vector<HoleReport> holes;  ///< once detected
+  AreaTimes times;
 };
 
 /// Time spent in each kind of work [s of the clock given to tick()]: navigate, plan (only the

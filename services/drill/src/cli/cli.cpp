@@ -94,11 +94,17 @@ nlohmann::ordered_json status_json(const msg::DrillStatus& s) {
                        {"reason", h.reason()},
                        {"reach", reach_name(h.reach())},
                        {"reach_reason", h.reach_reason()},
-                       {"position", {p.x(), p.y(), p.z()}}});
+                       {"position", {p.x(), p.y(), p.z()}},
+                       {"time", {{"align", h.time_align()}, {"drill", h.time_drill()}, {"retract", h.time_retract()}}}});
     }
     areas.push_back({{"name", a.name()},
                      {"state", area_state(a.state())},
                      {"reason", a.reason()},
+                     {"time",
+                      {{"approach", a.time_approach()},
+                       {"detect", a.time_detect()},
+                       {"survey", a.time_survey()},
+                       {"place", a.time_place()}}},
                      {"holes", holes}});
   }
   return {{"mission_id", s.mission_id()},
@@ -125,7 +131,9 @@ void print_report(const msg::DrillStatus& s, std::ostream& out) {
   for (const auto& a : s.areas()) {
     out << "  area '" << a.name() << "': " << area_state(a.state());
     if (!a.reason().empty()) out << ": " << a.reason();
-    out << "\n";
+    out << std::fixed << std::setprecision(1) << " (approach " << a.time_approach() << " s, detect "
+        << a.time_detect() << " s, survey " << a.time_survey() << " s, place " << a.time_place() << " s)"
+        << std::defaultfloat << "\n";
     for (const auto& h : a.holes()) {
       const auto& p = h.frame().position();
       out << "    " << std::left << std::setw(18) << h.label() << std::right << " " << std::setw(8)
@@ -135,6 +143,10 @@ void print_report(const msg::DrillStatus& s, std::ostream& out) {
       // Reachable holes say at which thrust (their reason tells the rest); an unreachable one's
       // reason already names why.
       if (h.reach() == msg::REACH_REACHABLE) out << " (reachable: " << h.reach_reason() << ")";
+      if (h.state() == msg::HOLE_DRILLED || h.state() == msg::HOLE_FAILED) {
+        out << std::fixed << std::setprecision(1) << "; align " << h.time_align() << " s, drill "
+            << h.time_drill() << " s, retract " << h.time_retract() << " s" << std::defaultfloat;
+      }
       out << "\n";
     }
   }

@@ -13,6 +13,8 @@ constexpr double kSameHole = 0.01;  // [m] a hole of a previous run within this 
 
 // What the running action waits for: the time until the next tick is counted there.
 enum class Work { kNone, kNavigate, kPlan, kExecute, kDrill };
+// Which part of an area's or a hole's time it is (AreaTimes, HoleTimes).
+enum class Step { kNone, kApproach, kDetect, kSurvey, kPlace, kAlign, kDrill, kRetract };
 
 bool was_drilled(const HoleReport& hole) {
   return hole.state == HoleState::kDrilled ||
@@ -116,6 +118,8 @@ struct MissionTree::Impl {
   bool started{false};
   double last_now{0.0};
   Work waiting{Work::kNone};
+  Step waiting_step{Step::kNone};
+  std::size_t step_area{0}, step_hole{0};  // whose step it is
   std::string fatal;  // why the mission cannot go on safely (set by a failed retraction)
   std::string stow_failure;  // why the arm did not go home at the end
   bool moved{false};         // a motion was started (navigate, execute, place, align)
@@ -128,14 +132,17 @@ struct MissionTree::Impl {
 
   // --- the tree ---------------------------------------------------------------------------
 
-  // An action whose waiting time counts as `work`.
+  // An action whose waiting time counts as `work`, and as `step` of the current area or hole.
   bt::NodePtr action(std::string name, Work work, std::function<void()> start,
-                     std::function<Outcome()> poll) {
+                     std::function<Outcome()> poll, Step step = Step::kNone) {
     return std::make_unique<bt::Action>(std::move(name), std::move(start),
-                                        [this, work, poll = std::move(poll)] {
+                                        [this, work, step, poll = std::move(poll)] {
                                           Outcome outcome = poll();
                                           if (outcome.progress == Progress::kRunning) {
                                             waiting = work;
+                                            waiting_step = step;
+                                            step_area = current_area;
+                                            step_hole = current_hole;
                                           }
                                           return outcome;
                                         });
@@ -191,7 +198,7 @@ struct MissionTree::Impl {
               moved = true;
               ports.navigate(*area().located.base);
             },
-            [this] { return ports.navigation(); }));
+            [this] { return ports.navigation(); }, Step::kApproach));
     // Waits for the area's plan; starts it from the robot's current state if it was not planned
     // ahead: the first area, an area the base navigated to, an area after one whose approach
     // failed.
@@ -200,21 +207,21 @@ struct MissionTree::Impl {
         [this] {
           if (!plan_started[current_area]) start_plan(current_area, std::nullopt);
         },
-        [this] { return ports.planning(current_area); });
+        [this] { return ports.planning(current_area); }, Step::kApproach);
     auto execute = action(
         "execute", Work::kExecute,
         [this] {
           moved = true;
           ports.execute(current_area);
         },
-        [this] { return executed(); });
+        [this] { return executed(); }, Step::kApproach);
     auto plan_next = action(
         "plan the next area", Work::kNone, [this] { plan_next_area(); },
         [] { return Outcome::succeeded(); });
     auto detect = action(
         "detect", Work::kDrill,
         [this] { ports.detect(current_area, mission.areas[current_area], area().located); },
-        [this] { return detection(); });
+        [this] { return detection(); }, Step::kDetect);
 
     // Which holes the robot can reach at all, before anything moves for them: the others are
     // reported with the planner's reason and not attempted.
@@ -224,7 +231,7 @@ struct MissionTree::Impl {
           surveying = pending_holes();
           ports.classify(current_area, pending_points());
         },
-        [this] { return surveyed(); });
+        [this] { return surveyed(); }, Step::kSurvey);
 
     // One base placement for the area's holes (drill/placement.hpp), before the first.
     auto place = action(
@@ -235,7 +242,7 @@ struct MissionTree::Impl {
           hole_order.clear();
           ports.place(current_area, pending_points());
         },
-        [this] { return placed(); });
+        [this] { return placed(); }, Step::kPlace);
 
     auto align = action(
         "align", Work::kDrill,
@@ -243,12 +250,13 @@ struct MissionTree::Impl {
           moved = true;
           ports.align(hole().point);
         },
-        [this] { return ports.alignment(); });
+        [this] { return ports.alignment(); }, Step::kAlign);
     auto drill = action(
         "drill", Work::kDrill, [this] { ports.drill(hole().point, mission.depth); },
-        [this] { return ports.drilling(); });
+        [this] { return ports.drilling(); }, Step::kDrill);
     auto retract = action(
-        "retract", Work::kDrill, [this] { ports.retract(); }, [this] { return retraction(); });
+        "retract", Work::kDrill, [this] { ports.retract(); }, [this] { return retraction(); },
+        Step::kRetract);
     auto hole_body = std::make_unique<bt::Finally>(
         "hole", hidden(sequence("align and drill", std::move(align), std::move(drill))),
         std::move(retract));
@@ -581,6 +589,39 @@ struct MissionTree::Impl {
       case Work::kNone:
         break;
     }
+    account_step(dt);
+  }
+
+  void account_step(double dt) {
+    if (waiting_step == Step::kNone || step_area >= report.areas.size()) return;
+    AreaReport& a = report.areas[step_area];
+    AreaTimes& at = a.times;
+    HoleTimes* ht = step_hole < a.holes.size() ? &a.holes[step_hole].times : nullptr;
+    switch (waiting_step) {
+      case Step::kApproach:
+        at.approach += dt;
+        break;
+      case Step::kDetect:
+        at.detect += dt;
+        break;
+      case Step::kSurvey:
+        at.survey += dt;
+        break;
+      case Step::kPlace:
+        at.place += dt;
+        break;
+      case Step::kAlign:
+        if (ht) ht->align += dt;
+        break;
+      case Step::kDrill:
+        if (ht) ht->drill += dt;
+        break;
+      case Step::kRetract:
+        if (ht) ht->retract += dt;
+        break;
+      case Step::kNone:
+        break;
+    }
   }
 };
 
@@ -632,6 +673,7 @@ MissionState MissionTree::tick(double now) {
     return m.report.state;
   }
   m.waiting = Work::kNone;
+  m.waiting_step = Step::kNone;
   const bt::Status status = m.root->tick();
   if (!m.fatal.empty()) {
     m.ports.stop();

@@ -148,6 +148,10 @@ msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
     area.state(kAreaStates.to(a.state).value_or(msg::AREA_FAILED));
     area.reason(a.reason);
     area.frame(model::dds::to_pose_msg(a.located.frame));
+    area.time_approach(a.times.approach);
+    area.time_detect(a.times.detect);
+    area.time_survey(a.times.survey);
+    area.time_place(a.times.place);
     for (const HoleReport& h : a.holes) {
       msg::DrillHole hole;
       hole.label(h.point.label);
@@ -156,6 +160,9 @@ msg::DrillStatus to_msg(std::uint32_t mission_id, const MissionStatus& status,
       hole.reason(h.reason);
       hole.reach(kReaches.to(h.reach.reach).value_or(msg::REACH_UNKNOWN));
       hole.reach_reason(h.reach.why);
+      hole.time_align(h.times.align);
+      hole.time_drill(h.times.drill);
+      hole.time_retract(h.times.retract);
       area.holes().push_back(hole);
     }
     out.areas().push_back(area);
