@@ -382,6 +382,43 @@ TEST_F(RigEngineTest, APostureReachedIsMeasuredAgainThenTheBitAligned) {
   EXPECT_EQ(engine.alignment().progress, Progress::kRunning);
 }
 
+// The mission's end after a hole: the arm goes back along the holes' paths to the area's approach
+// posture first (the planner's way home from a hole's posture does not keep the bit, which has no
+// collision shape, off the wall), then the planner takes it home; the way back failing fails the
+// stow with its reason.
+TEST_F(RigEngineTest, StowingAfterAHoleGoesBackAlongItsPathsBeforeTheHoming) {
+  engine.align(hole_ahead());
+  answer(PlanState::kSucceeded);
+  step();
+  const std::size_t plans = sink.plans.size();
+  engine.stow();
+  ASSERT_EQ(sink.trajectories.size(), 1u) << sink.log_text;
+  EXPECT_EQ(sink.plans.size(), plans) << "home asked before the way back ended";
+  EXPECT_EQ(engine.stowing().progress, Progress::kRunning);
+  inputs.on_trajectory(sink.trajectories.back(), {Progress::kSucceeded, "", ""});
+  EXPECT_EQ(engine.stowing().progress, Progress::kRunning);
+  ASSERT_EQ(sink.plans.size(), plans + 1);
+  EXPECT_TRUE(sink.plans.back().home);
+  inputs.on_plan(reply(sink.plans.back().request_id, PlanState::kSucceeded));
+  EXPECT_EQ(engine.stowing().progress, Progress::kSucceeded);
+  // Nothing to go back along now: straight home.
+  engine.stow();
+  EXPECT_EQ(sink.trajectories.size(), 1u);
+  EXPECT_TRUE(sink.plans.back().home);
+}
+
+TEST_F(RigEngineTest, AStowWhoseWayBackFailsSaysWhy) {
+  engine.align(hole_ahead());
+  answer(PlanState::kSucceeded);
+  step();
+  engine.stow();
+  ASSERT_EQ(sink.trajectories.size(), 1u);
+  inputs.on_trajectory(sink.trajectories.back(), {Progress::kFailed, "aborted", "safety stop"});
+  const Outcome o = engine.stowing();
+  EXPECT_EQ(o.progress, Progress::kFailed);
+  EXPECT_EQ(o.reason, "robot: the way back from the holes aborted: safety stop");
+}
+
 // --- Where the arm waits (Params::Rest) ---------------------------------------------------------
 // The robot reports each drive's torque; the drill keeps safety's thermal rule on it. An arm whose
 // drives run hot goes home before a hole's posture is asked and waits there, cooling, while the

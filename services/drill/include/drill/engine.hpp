@@ -192,6 +192,7 @@ class DrillEngine final : public MissionPorts {
     bool logged{false};
   } survey_;
   void survey_ask(std::size_t i);
+  bool stow_returning_{false};  // stow(): back along the holes' paths before the homing
 
   // An area's base placement (place(), drill/placement.hpp): its holes, the tally, the
   // requests out, the postures drawn and each one's look.

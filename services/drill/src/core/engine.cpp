@@ -582,9 +582,33 @@ Outcome DrillEngine::homing() {
 }
 
 // The mission's end: the arm goes home from wherever the last hole or area left it.
-void DrillEngine::stow() { send_home(); }
+// The arm home at the mission's end: first back along the last area's holes' paths to its
+// approach posture, as before the next area, then the planner's homing from there. The planner
+// checks its path with the drill module's shapes and not the bit's (it has none): planned from a
+// hole's posture, in front of the wall, its way home can sweep the bit through the wall.
+void DrillEngine::stow() {
+  stow_returning_ = false;
+  if (!hole_chain_.empty()) {
+    if (const std::optional<Sample> s = inputs_.latest_sample()) {
+      trajectory_request_ =
+          send_trajectory(hole_chain_.front().names, return_path(hole_chain_, *s, path_timing(tuning_)));
+      stow_returning_ = true;
+      return;
+    }
+  }
+  send_home();
+}
 
-Outcome DrillEngine::stowing() { return homing(); }
+Outcome DrillEngine::stowing() {
+  if (!stow_returning_) return homing();
+  const std::optional<MotionReply> status = inputs_.trajectory(trajectory_request_);
+  if (!status || status->progress == Progress::kRunning) return Outcome::running();
+  stow_returning_ = false;
+  if (status->progress != Progress::kSucceeded)
+    return Outcome::failed("robot: the way back from the holes " + status->failure + ": " + status->reason);
+  send_home();
+  return Outcome::running();
+}
 
 Outcome DrillEngine::navigation() {
   if (home_request_ != 0) {
