@@ -455,6 +455,43 @@ struct RestTest : RigEngineTest {
   [[nodiscard]] double robot_seconds() const { return 1e-9 * static_cast<double>(stamp_ns); }
 };
 
+// A hot arm at a hole's posture goes back along the holes' paths to the area's approach posture
+// before the planner takes it home: the planner's way home from in front of the wall does not
+// keep the bit off it. A way back that fails sends the held request from where the arm stands.
+TEST_F(RestTest, AHotArmAtAHolesPostureGoesBackAlongItsPathsBeforeResting) {
+  engine.align(hole_ahead());
+  answer(PlanState::kSucceeded);  // the hole's posture reached: its path joins the area's chain
+  step();
+  const std::size_t plans = sink.plans.size();
+  load(0.95, 30.0);
+  engine.align(hole_ahead());  // the next hole's posture request, held back
+  ASSERT_EQ(sink.trajectories.size(), 1u) << sink.log_text;
+  EXPECT_EQ(sink.plans.size(), plans) << "home or the hole asked before the way back ended";
+  step();
+  inputs.on_trajectory(sink.trajectories.back(), {Progress::kSucceeded, "", ""});
+  step();
+  ASSERT_EQ(sink.plans.size(), plans + 1);
+  EXPECT_TRUE(sink.plans.back().home);
+
+  // Another hole, the arm hot again at its posture; the way back fails.
+  answer(PlanState::kSucceeded);  // home reached (a one-sample path: nothing joins the chain)
+  load(0.1, 30.0);
+  step();  // rested: the held request goes out
+  ASSERT_FALSE(sink.plans.back().home);
+  answer(PlanState::kSucceeded);
+  step();
+  load(0.95, 30.0);
+  engine.align(hole_ahead());
+  ASSERT_EQ(sink.trajectories.size(), 2u) << sink.log_text;
+  inputs.on_trajectory(sink.trajectories.back(), {Progress::kFailed, "aborted", "tracking error"});
+  const std::size_t before = sink.plans.size();
+  step();
+  ASSERT_EQ(sink.plans.size(), before + 1);
+  EXPECT_FALSE(sink.plans.back().home);
+  EXPECT_EQ(sink.logged("the arm could not go back from the holes to rest (aborted: tracking error)"), 1u)
+      << sink.log_text;
+}
+
 TEST_F(RestTest, ACoolArmAsksForTheHolesPostureAtOnce) {
   load(0.8, 30.0);  // the RMS settles at 0.8 of continuous, below rest.above (0.85)
   engine.align(hole_ahead());

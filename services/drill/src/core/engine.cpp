@@ -157,12 +157,23 @@ void DrillEngine::send_plan(const PlanAsk& request, bool may_rest) {
   if (held_requests_.empty()) {
     log_line("drill: the arm rests at home before the planner's next answer (" + why +
              "): holding the posture while the planner searches would pass the drive's thermal limit");
-    const PlanAsk home = home_ask();
-    rest_request_ = home.request_id;
     rest_since_ = -1.0;
-    forward_plan(home);
+    // From a hole's posture, first back along the area's holes' paths to its approach posture:
+    // the planner's way home does not keep the bit (no collision shape) off the wall.
+    const std::optional<Sample> s = inputs_.latest_sample();
+    if (!hole_chain_.empty() && s) {
+      rest_return_ = send_trajectory(hole_chain_.front().names, return_path(hole_chain_, *s, path_timing(tuning_)));
+    } else {
+      rest_home();
+    }
   }
   held_requests_.push_back(request);
+}
+
+void DrillEngine::rest_home() {
+  const PlanAsk home = home_ask();
+  rest_request_ = home.request_id;
+  forward_plan(home);
 }
 
 std::vector<DrillEngine::ArmHeat> DrillEngine::arm_heat() const {
@@ -242,6 +253,19 @@ void DrillEngine::fold_thrust() {
 // (Params::Rest::until) or the rest's timeout (robot time), then the requests to the planner.
 void DrillEngine::rest_step() {
   if (held_requests_.empty()) return;
+  if (rest_return_ != 0) {
+    const std::optional<MotionReply> back = inputs_.trajectory(rest_return_);
+    if (!back || back->progress == Progress::kRunning) return;
+    rest_return_ = 0;
+    if (back->progress != Progress::kSucceeded) {
+      release_held("the arm could not go back from the holes to rest (" + back->failure + ": " + back->reason +
+                   "); asked from where it stands");
+      return;
+    }
+    hole_chain_.clear();  // at the area's approach posture: nothing left to go back along
+    rest_home();
+    return;
+  }
   if (rest_request_ != 0) {
     const std::optional<PlanReply> home = inputs_.plan(rest_request_);
     if (!home || (home->state != PlanState::kSucceeded && home->state != PlanState::kFailed)) return;
@@ -1448,6 +1472,7 @@ void DrillEngine::stop() {
   unacknowledged_.clear();  // not sent again: a planner taking it now would move the robot
   held_requests_.clear();
   rest_request_ = 0;
+  rest_return_ = 0;
   rest_since_ = -1.0;
   if (at_hole && !shutting_down_ && leave_allowed_ && start_leave()) return;
   send_hold();
