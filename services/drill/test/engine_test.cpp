@@ -382,6 +382,60 @@ TEST_F(RigEngineTest, APostureReachedIsMeasuredAgainThenTheBitAligned) {
   EXPECT_EQ(engine.alignment().progress, Progress::kRunning);
 }
 
+// The survey asks the planner, plan only, for each hole's whole-body posture from the full thrust
+// on; a posture not found is asked again (survey.tries) before the next attempt, and a hole none
+// reaches is unreachable with the planner's reason; a refused request leaves it unjudged.
+TEST_F(RigEngineTest, TheSurveyAsksWholeBodyPosturesAndJudgesEachHole) {
+  const DrillPoint hole = hole_ahead();
+  engine.classify(0, {hole, hole});
+  ASSERT_EQ(sink.plans.size(), 2u);
+  for (const PlanAsk& r : sink.plans) {
+    EXPECT_FALSE(r.execute);
+    EXPECT_FALSE(r.fixed_base);
+    EXPECT_EQ(r.base_travel, 0.0);
+  }
+  std::vector<HoleReach> reach;
+  EXPECT_EQ(engine.classification(reach).progress, Progress::kRunning);
+  const std::uint32_t first = sink.plans[0].request_id, second = sink.plans[1].request_id;
+  PlanReply refused = reply(second, PlanState::kFailed);
+  refused.failure = PlanFailure::kStaleModel;
+  refused.reason = "another model";
+  inputs.on_plan(refused);
+  // Hole 1: every attempt fails, each survey.tries times.
+  std::uint32_t id = first;
+  const std::size_t asks = tuning.survey.attempts.size() * static_cast<std::size_t>(tuning.survey.tries);
+  for (std::size_t k = 0; k < asks; ++k) {
+    PlanReply none = reply(id, PlanState::kFailed);
+    none.failure = PlanFailure::kUnreachable;
+    none.reason = "torque limit x120";
+    inputs.on_plan(none);
+    const Outcome o = engine.classification(reach);
+    if (k + 1 < asks) {
+      ASSERT_EQ(o.progress, Progress::kRunning) << k;
+      id = sink.plans.back().request_id;
+      EXPECT_NE(id, first);
+    } else {
+      ASSERT_EQ(o.progress, Progress::kSucceeded) << sink.log_text;
+    }
+  }
+  EXPECT_EQ(sink.plans.size(), 2u + asks - 1);
+  ASSERT_EQ(reach.size(), 2u);
+  EXPECT_EQ(reach[0].reach, Reach::kUnreachable);
+  EXPECT_EQ(reach[0].why.rfind("no posture found, even a whole-body posture", 0), 0u) << reach[0].why;
+  EXPECT_NE(reach[0].why.find("torque limit x120"), std::string::npos) << reach[0].why;
+  EXPECT_EQ(reach[1].reach, Reach::kUnknown);
+  EXPECT_EQ(reach[1].why, "the planner could not judge: another model");
+  EXPECT_EQ(sink.logged("0 of 2 holes reachable"), 1u) << sink.log_text;
+
+  // Found at once: reachable at full thrust.
+  engine.classify(1, {hole});
+  answer(PlanState::kSucceeded);
+  ASSERT_EQ(engine.classification(reach).progress, Progress::kSucceeded);
+  ASSERT_EQ(reach.size(), 1u);
+  EXPECT_EQ(reach[0].reach, Reach::kReachable);
+  EXPECT_EQ(reach[0].why, "a whole-body posture at full thrust");
+}
+
 // The mission's end after a hole: the arm goes back along the holes' paths to the area's approach
 // posture first (the planner's way home from a hole's posture does not keep the bit, which has no
 // collision shape, off the wall), then the planner takes it home; the way back failing fails the

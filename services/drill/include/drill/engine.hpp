@@ -367,6 +367,7 @@ class DrillEngine final : public MissionPorts {
   std::uint32_t rest_request_{0};       // the arm's homing while it rests; 0 once home
   std::uint32_t rest_return_{0};        // before it: the way back along the holes' paths (trajectory); 0 once back
   void rest_home();
+  std::optional<std::uint32_t> send_way_back();
   double rest_since_{-1.0};             // robot time [s] the arm was home; < 0 before
   void resend_unacknowledged();
   std::map<std::size_t, std::future<ResolvedArea>> resolving_;

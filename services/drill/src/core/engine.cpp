@@ -160,14 +160,22 @@ void DrillEngine::send_plan(const PlanAsk& request, bool may_rest) {
     rest_since_ = -1.0;
     // From a hole's posture, first back along the area's holes' paths to its approach posture:
     // the planner's way home does not keep the bit (no collision shape) off the wall.
-    const std::optional<Sample> s = inputs_.latest_sample();
-    if (!hole_chain_.empty() && s) {
-      rest_return_ = send_trajectory(hole_chain_.front().names, return_path(hole_chain_, *s, path_timing(tuning_)));
+    if (const std::optional<std::uint32_t> back = send_way_back()) {
+      rest_return_ = *back;
     } else {
       rest_home();
     }
   }
   held_requests_.push_back(request);
+}
+
+// The arm back along the area's holes' paths, reversed, to its approach posture: the id of the
+// trajectory sent, or none when there is nothing to go back along (or no joint state yet).
+std::optional<std::uint32_t> DrillEngine::send_way_back() {
+  if (hole_chain_.empty()) return std::nullopt;
+  const std::optional<Sample> s = inputs_.latest_sample();
+  if (!s) return std::nullopt;
+  return send_trajectory(hole_chain_.front().names, return_path(hole_chain_, *s, path_timing(tuning_)));
 }
 
 void DrillEngine::rest_home() {
@@ -605,20 +613,16 @@ Outcome DrillEngine::homing() {
   return Outcome::succeeded();
 }
 
-// The mission's end: the arm goes home from wherever the last hole or area left it.
 // The arm home at the mission's end: first back along the last area's holes' paths to its
 // approach posture, as before the next area, then the planner's homing from there. The planner
 // checks its path with the drill module's shapes and not the bit's (it has none): planned from a
 // hole's posture, in front of the wall, its way home can sweep the bit through the wall.
 void DrillEngine::stow() {
   stow_returning_ = false;
-  if (!hole_chain_.empty()) {
-    if (const std::optional<Sample> s = inputs_.latest_sample()) {
-      trajectory_request_ =
-          send_trajectory(hole_chain_.front().names, return_path(hole_chain_, *s, path_timing(tuning_)));
-      stow_returning_ = true;
-      return;
-    }
+  if (const std::optional<std::uint32_t> back = send_way_back()) {
+    trajectory_request_ = *back;
+    stow_returning_ = true;
+    return;
   }
   send_home();
 }
@@ -720,12 +724,10 @@ std::uint32_t DrillEngine::send_trajectory(const std::vector<std::string>& names
 // reversed, from the last hole to the first.
 void DrillEngine::execute(std::size_t area) {
   executing_area_ = area;
-  if (!hole_chain_.empty()) {
-    if (const std::optional<Sample> s = inputs_.latest_sample()) {
-      trajectory_request_ = send_trajectory(hole_chain_.front().names, return_path(hole_chain_, *s, path_timing(tuning_)));
-      returning_ = true;
-      return;
-    }
+  if (const std::optional<std::uint32_t> back = send_way_back()) {
+    trajectory_request_ = *back;
+    returning_ = true;
+    return;
   }
   returning_ = false;
   const Plan& p = plans_.at(area);
