@@ -927,5 +927,114 @@ TEST_F(RigEngineTest, ASafetyStopWhileTheCameraTurnsOntoTheMarkerFailsTheHole) {
   EXPECT_TRUE(marker_sink.cartesian_frames.empty());
 }
 
+// A marker hole none of whose whole-body postures lets the camera see the marker: the base is
+// placed for it alone (postures drawn further out, each checked for the arm alone onto the hole
+// and a look at the marker), moved there, and the camera turned onto the marker before the hole
+// is aligned. Without a placement with a look either, the last posture drawn is taken.
+struct UnseenMarkerTest : RigEngineTest {
+  FakeSink ms;
+  DrillEngine me{EngineParams{std::string(CONCERT_SOURCE_DIR) + "/services/drill/config/patterns.yaml", {}, tuning},
+                 inputs, map_frame, ms};
+  std::vector<std::uint32_t> answered;
+
+  void SetUp() override {
+    RigEngineTest::SetUp();
+    me.apply_model(2, rig, "");
+  }
+
+  // Answers every plan request not answered yet: a posture for the bit (the hole's, the arm
+  // alone or the whole body, or a placement's draw) found, the arm alone's from where the base
+  // stands not; a look at the marker found when `looks` says so.
+  void answer_pending(bool looks) {
+    for (const PlanAsk& r : std::vector<PlanAsk>(ms.plans)) {
+      if (std::find(answered.begin(), answered.end(), r.request_id) != answered.end()) continue;
+      answered.push_back(r.request_id);
+      const bool look = r.camera_distance > 0.0;
+      const bool standing = r.fixed_base && r.tip_distance > 0.0 && r.start_position.empty() && !r.execute;
+      const bool found = look ? looks : !(standing || (r.fixed_base && r.execute && r.start_position.empty()));
+      PlanReply p = reply(r.request_id, found ? PlanState::kSucceeded : PlanState::kFailed);
+      if (found) {
+        p.path.names = {"base_x", "base_y", "base_yaw"};
+        p.path.samples = {{0.0, {0.0, 0.0, 0.0}, {}}};
+        for (const std::string& j : rig->model().arm().joints) {
+          p.path.names.push_back(j);
+          p.path.samples[0].position.push_back(0.0);
+        }
+      } else {
+        p.failure = PlanFailure::kUnreachable;
+        p.reason = "no feasible posture";
+      }
+      inputs.on_plan(p);
+    }
+  }
+
+  DrillPoint marker_hole() const {
+    DrillPoint hole = hole_ahead();
+    hole.label = "aruco 0 hole 1";
+    hole.marker = 0;
+    hole.pattern_index = 0;
+    return hole;
+  }
+
+  // Aligns the hole, the arm alone never reaching it and no whole-body posture with a look,
+  // until the robot is sent a trajectory (bounded).
+  void until_trajectory(bool placement_looks) {
+    me.align(marker_hole());
+    for (int i = 0; i < 400 && ms.trajectories.empty(); ++i) {
+      const bool placing = ms.logged("placed for this hole alone") > 0;
+      answer_pending(placing && placement_looks);
+      me.step_motion(now += 0.005);
+    }
+  }
+};
+
+TEST_F(UnseenMarkerTest, TheBaseIsPlacedForTheHoleAloneThenTheMarkerLookedAt) {
+  until_trajectory(true);
+  ASSERT_EQ(ms.trajectories.size(), 1u) << ms.log_text;
+  EXPECT_EQ(ms.logged("whole-body postures drawn; the base placed for this hole alone"), 1u) << ms.log_text;
+  // The placement's draw: the whole body, planned only, the bit further out than the hole's.
+  const auto draw = std::find_if(ms.plans.begin(), ms.plans.end(), [](const PlanAsk& r) {
+    return !r.fixed_base && !r.execute && r.tip_distance > 0.2;
+  });
+  ASSERT_NE(draw, ms.plans.end()) << ms.log_text;
+  EXPECT_NEAR(draw->tip_distance, tuning.motion.standoff + tuning.hole.align_margin + tuning.placement.draws[0].out,
+              1e-9);
+  EXPECT_EQ(ms.logged("the whole body to posture 1 drawn"), 1u) << ms.log_text;
+  // The move ran: the camera turned onto the marker from where the base stands, executed.
+  const std::size_t asked = ms.plans.size();
+  inputs.on_trajectory(ms.trajectories.back(), {Progress::kSucceeded, "", ""});
+  me.step_motion(now += 0.005);
+  ASSERT_EQ(ms.plans.size(), asked + 1) << ms.log_text;
+  EXPECT_GT(ms.plans.back().camera_distance, 0.0);
+  EXPECT_TRUE(ms.plans.back().fixed_base);
+  EXPECT_TRUE(ms.plans.back().execute);
+  EXPECT_EQ(me.alignment().progress, Progress::kRunning);
+}
+
+TEST_F(UnseenMarkerTest, WithoutAPlacementWithALookTheLastPostureDrawnIsTaken) {
+  until_trajectory(false);
+  ASSERT_EQ(ms.trajectories.size(), 1u) << ms.log_text;
+  EXPECT_EQ(ms.logged("the base placed for this hole alone"), 1u) << ms.log_text;
+  EXPECT_EQ(ms.logged("no placement reaches it with a look at marker 0 either; the last whole-body posture drawn taken"),
+            1u)
+      << ms.log_text;
+  EXPECT_EQ(me.alignment().progress, Progress::kRunning);
+}
+
+TEST_F(UnseenMarkerTest, PlacingForAnUnseenHoleCanBeTurnedOff) {
+  tuning.hole.place_unseen = false;
+  DrillEngine off{EngineParams{std::string(CONCERT_SOURCE_DIR) + "/services/drill/config/patterns.yaml", {}, tuning},
+                  inputs, map_frame, ms};
+  off.apply_model(2, rig, "");
+  off.align(marker_hole());
+  for (int i = 0; i < 400 && ms.trajectories.empty(); ++i) {
+    answer_pending(false);
+    off.step_motion(now += 0.005);
+  }
+  ASSERT_EQ(ms.trajectories.size(), 1u) << ms.log_text;
+  EXPECT_EQ(ms.logged("placed for this hole alone"), 0u) << ms.log_text;
+  EXPECT_EQ(ms.logged("whole-body postures drawn; the last one taken"), 1u) << ms.log_text;
+}
+
 }  // namespace
 }  // namespace concert::drill

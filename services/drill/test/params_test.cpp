@@ -63,6 +63,7 @@ void expect_same(const Params& a, const Params& b) {
   EXPECT_EQ(a.hole.replan_shift, b.hole.replan_shift);
   EXPECT_EQ(a.hole.body_replans, b.hole.body_replans);
   EXPECT_EQ(a.hole.body_draws, b.hole.body_draws);
+  EXPECT_EQ(a.hole.place_unseen, b.hole.place_unseen);
   EXPECT_EQ(a.hole.lightest_lead, b.hole.lightest_lead);
   ASSERT_EQ(a.hole.attempts.size(), b.hole.attempts.size());
   for (std::size_t i = 0; i < a.hole.attempts.size(); ++i) {
@@ -132,9 +133,9 @@ TEST(DrillParamsFile, TheShippedFileHoldsEveryDefault) {
   const Params p = read_params(doc);
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
-  // Every key read: 64 single values (look_further one of them), the 4 tables' lengths, and
+  // Every key read: 65 single values (look_further one of them), the 4 tables' lengths, and
   // their rows' keys: 27 attempts x 5, 5 looks x 2, 3 draws x 2, 3 survey attempts x 5.
-  EXPECT_EQ(doc.keys().size(), 64u + 4u + 27u * 5u + 5u * 2u + 3u * 2u + 3u * 5u);
+  EXPECT_EQ(doc.keys().size(), 65u + 4u + 27u * 5u + 5u * 2u + 3u * 2u + 3u * 5u);
   expect_same(p, Params{});
   expect_same(load_params(kShipped), Params{});
 }
@@ -203,7 +204,8 @@ TEST(DrillParamsFile, ABadValueNamesFileKeyAndLine) {
 TEST(DrillParamsFile, AnUnknownKeyIsRefusedNamingIt) {
   EXPECT_EQ(error_of("hole:\n  atempts: []\n"),
             "drill.yaml: hole.atempts: unknown key (line 2); known keys of hole: align_margin, "
-            "attempts, body_draws, body_replans, default_depth, lightest_lead, replan_shift");
+            "attempts, body_draws, body_replans, default_depth, lightest_lead, place_unseen, "
+            "replan_shift");
   EXPECT_EQ(error_of("looks:\n  attempts:\n    - {between: false, furthr: 0.1}\n"),
             "drill.yaml: looks.attempts[0].furthr: unknown key (line 3); known keys of "
             "looks.attempts[0]: between, further");

@@ -241,6 +241,10 @@ class DrillEngine final : public MissionPorts {
   void resend(Placement::Check& c);
   void place_look(std::size_t attempt);
   [[nodiscard]] std::string placement_time() const;
+  // A placement's end: an area's (the mission tree's place() port) succeeded, or a hole's
+  // (place_for_hole) goes on to the hole's alignment; `stood`: the base stays where it stands.
+  void placement_done(bool stood);
+  void place_for_hole();
   void publish_status(bool force);
   void control_motion();
   // control_motion's steps, one per Motion state, and the Cartesian phases.
@@ -455,6 +459,13 @@ class DrillEngine final : public MissionPorts {
   std::size_t check_attempt_{0};
   std::size_t checked_look_{0};  // the Params::looks.attempts attempt the check found (the look starts there)
   PlannedPath checked_path_;     // its path from the candidate's end; empty: none found
+  // No candidate has a look: the base is placed for the hole alone (Params::hole.place_unseen),
+  // from further out, with a look at the marker, once per hole. The area's placement is kept
+  // aside meanwhile (align() reads which holes it reached at which thrust).
+  bool hole_placing_{false};
+  std::string placed_for_;            // the hole (label) last placed for, this area
+  std::optional<double> placed_lead_;  // the thrust its placement reached it at; none: not reached
+  Placement area_placement_;
   bool trajectory_ran(const std::string& what);
   std::optional<PlanReply> plan_result(std::uint32_t id) const;
   void move_to_candidate();

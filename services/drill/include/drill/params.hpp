@@ -124,6 +124,10 @@ struct Params {
     std::size_t body_replans{2};
     /// Whole-body postures drawn for a marker hole until one lets the camera see its marker.
     std::size_t body_draws{3};
+    /// A marker hole none of whose whole-body postures drawn lets the camera see the marker: the
+    /// base placed for it alone (as an area's placement: from further out, with a look at the
+    /// marker), instead of drilling it where odometry puts it.
+    bool place_unseen{true};
     /// Lead drilled with when the alignment must reach past the posture checked (the least thrust).
     double lightest_lead{kLightestLead};
     /// Postures in the order asked: the base moves as little as it can, full thrust before lighter.

@@ -95,6 +95,7 @@ std::vector<Map> read_hole(Map m, Params::Hole& h) {
   m.number("replan_shift", h.replan_shift, Range::non_negative());
   m.integer("body_replans", h.body_replans, 0, 100);
   m.integer("body_draws", h.body_draws, 1, 100);
+  m.boolean("place_unseen", h.place_unseen);
   m.number("lightest_lead", h.lightest_lead, kLead);
   return m.sequence("attempts", h.attempts, read_attempt);
 }
