@@ -27,7 +27,7 @@
 // CONCERT_STACK_DIR=DIR runs the services' binaries of that name in DIR (a copy taken before a
 // long run, so that building on meanwhile does not change them).
 // Usage: bench_drill_mission [--scenario blobs|patterns|high|row|low|lowest|bim|demo|experiments|generated|all]
-//          [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both] [--seed S --count N]
+//          [--runs N] [--assembly FILE] [--logs] [--map world|sensors|both] [--seed S [--first K] --count N]
 //        (default: all, 1, each scenario's robot)
 // Prints per hole the error in the wall's plane, then per scenario: holes drilled / holes
 // marked, error median / p95 / max, and the mission time split. Minutes per run.
@@ -266,11 +266,12 @@ int experiments(int runs, bool logs, const std::string& map, const concert::dril
 
 // Drilling sites nobody rehearsed (issue #51), drawn from `seed`: one mission on a fresh stack
 // each, scored against the simulator's truth. A site's world is a file in the temp directory.
-int generated(std::uint64_t seed, int count, bool logs, const std::string& map,
+int generated(std::uint64_t seed, int first, int count, bool logs, const std::string& map,
               const concert::drill::PatternTable& patterns) {
   Tally all;
   int missions = 0;
-  for (const GeneratedSite& site : generate_sites(seed, count, patterns)) {
+  for (int k = first; k < first + count; ++k) {
+    const GeneratedSite site = generate_site(seed, k, patterns);
     const std::filesystem::path world = std::filesystem::temp_directory_path() /
                                         ("bench_drill_generated_" + std::to_string(::getpid()) + ".yaml");
     std::ofstream(world) << site.world_yaml;
@@ -294,7 +295,7 @@ int generated(std::uint64_t seed, int count, bool logs, const std::string& map,
 }
 
 int bench(const std::string& which, int runs, const std::string& assembly, bool logs,
-          const std::string& map, std::pair<double, double> rows, std::uint64_t seed, int count) {
+          const std::string& map, std::pair<double, double> rows, std::uint64_t seed, int first, int count) {
   const std::vector<Scenario> all{
       {"blobs", source("services/planner/data/morphology_b.yaml"),
        source("deploy/bench/drill_blobs_site.yaml"), source("deploy/bench/drill_blobs_mission.yaml")},
@@ -326,7 +327,7 @@ int bench(const std::string& which, int runs, const std::string& assembly, bool 
   if (which == "experiments") return experiments(runs, logs, map, patterns, rows);
   if (which == "generated") {
     int status = 0;
-    for (int r = 0; r < runs && status == 0; ++r) status = generated(seed, count, logs, map, patterns);
+    for (int r = 0; r < runs && status == 0; ++r) status = generated(seed, first, count, logs, map, patterns);
     return status;
   }
   bool known = false;
@@ -398,6 +399,10 @@ int main(int argc, char** argv) {
   app.add_option("--count", count, "generated only: how many sites")
       ->capture_default_str()
       ->check(concert::cli::number(1, 1000, true));
+  int first = 1;
+  app.add_option("--first", first, "generated only: the first site's number (site K is the same whatever --count is)")
+      ->capture_default_str()
+      ->check(concert::cli::number(1, 1000, true));
   bool logs = false;
   app.add_flag("--logs", logs, "print the services' logs after every run (default: after a failed one, or one with a hole past 5 mm)");
   cli.on_run(app, [&] {
@@ -405,7 +410,7 @@ int main(int argc, char** argv) {
       throw concert::cli::UsageError("--rows: MIN " + std::to_string(rows[0]) + " is above MAX " +
                                      std::to_string(rows[1]));
     }
-    return bench(which, runs, assembly, logs, map, {rows[0], rows[1]}, seed, count);
+    return bench(which, runs, assembly, logs, map, {rows[0], rows[1]}, seed, first, count);
   });
   return cli.run(argc, argv);
 }
