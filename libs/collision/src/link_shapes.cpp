@@ -58,7 +58,8 @@ struct LinkShapes::Impl {
   double padding = 0.0;
 };
 
-LinkShapes::LinkShapes(const model::RobotModel& model, const std::vector<int>& groups, double padding)
+LinkShapes::LinkShapes(const model::RobotModel& model, const std::vector<int>& groups, double padding,
+                       const std::map<int, std::vector<model::CollisionShape>>& extra)
     : impl_(std::make_unique<Impl>()) {
   const auto& links = model.links();
   if (groups.size() != links.size()) {
@@ -69,7 +70,10 @@ LinkShapes::LinkShapes(const model::RobotModel& model, const std::vector<int>& g
   impl_->padding = padding;
   for (std::size_t l = 0; l < links.size(); ++l) {
     bool any = false;
-    for (const model::CollisionShape& c : links[l].shapes) {
+    std::vector<model::CollisionShape> own = links[l].shapes;
+    if (const auto more = extra.find(static_cast<int>(l)); more != extra.end())
+      own.insert(own.end(), more->second.begin(), more->second.end());
+    for (const model::CollisionShape& c : own) {
       if (c.type == Type::kMesh) {
         impl_->ignored.push_back(links[l].name + ": mesh");
         continue;

@@ -21,7 +21,7 @@ TEST(Config, ShippedParamsFileListsEveryParameterWithItsDefault) {
   auto doc = concert::config::Document::load(std::string(CONCERT_SOURCE_DIR) +
                                              "/services/planner/config/planner.yaml");
   (void)read_params(doc);
-  EXPECT_EQ(doc.keys().size(), 48u);  // every parameter of Params
+  EXPECT_EQ(doc.keys().size(), 49u);  // every parameter of Params
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
 }

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <optional>
 #include <random>
@@ -201,6 +202,49 @@ TEST(PlanningModel, BadModelsNameTheProblem) {
   ModelDescription bad_urdf = d;
   bad_urdf.urdf = "<robot";
   EXPECT_THROW((void)PlanningModel::build(bad_urdf, {}), PlannerError);
+}
+
+// The module database gives the drill's body, whose shapes end behind its TCP: the planner adds
+// the bit, a cylinder from the TCP back to them. A wall the bit's tip goes into, the body clear
+// of it, is a collision; without the bit (drill_bit_radius 0) it was not.
+TEST(PlanningModel, TheDrillsBitIsACylinderFromTheTcpBackToTheDrillsBody) {
+  const auto m = morphology('a');
+  const auto tcp = std::find_if(m->links().begin(), m->links().end(),
+                                [&](const LinkNode& l) { return l.name == m->tool("").frame; });
+  ASSERT_NE(tcp, m->links().end());
+  ASSERT_EQ(tcp->shapes.size(), 1u);
+  const LinkShape& bit = tcp->shapes.front();
+  EXPECT_EQ(bit.type, LinkShape::Type::kCylinder);
+  EXPECT_DOUBLE_EQ(bit.size.x(), Params{}.drill_bit_radius);
+  // The CONCERT drill's box ends 0.105 m behind its TCP (module database, concert_drill).
+  EXPECT_NEAR(bit.size.z(), 0.105, 0.01);
+  EXPECT_NEAR(bit.origin.translation().z(), -0.5 * bit.size.z(), 1e-12);
+  Params no_bit;
+  no_bit.drill_bit_radius = 0.0;
+  const auto bare = morphology('a', no_bit);
+  const auto bare_tcp = std::find_if(bare->links().begin(), bare->links().end(),
+                                     [&](const LinkNode& l) { return l.name == bare->tool("").frame; });
+  ASSERT_NE(bare_tcp, bare->links().end());
+  EXPECT_TRUE(bare_tcp->shapes.empty());
+
+  // A plate across the bit's tip, 4 cm deep along the tool's axis, the drill's body behind it.
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(m->full_dof());
+  std::vector<Eigen::Isometry3d> poses;
+  m->link_poses(q, poses);
+  const Eigen::Isometry3d at = poses[static_cast<std::size_t>(tcp - m->links().begin())];
+  // World boxes turn about z only: the tool's axis is horizontal at q = 0, the plate upright
+  // across it, 4 cm thick along it.
+  const Eigen::Vector3d axis = at.linear().col(2);
+  ASSERT_LT(std::abs(axis.z()), 0.01);
+  World world;
+  world.boxes.push_back({"plate", Eigen::Vector3d(0.04, 0.2, 0.2), at * Eigen::Vector3d(0.0, 0.0, -0.025),
+                         std::atan2(axis.y(), axis.x())});
+  Environment env(0.01);
+  env.add_world(world);
+  const Validity with_bit = StateChecker(m, env, Params{}, 0.0).check(q);
+  EXPECT_EQ(with_bit.constraint, Constraint::kEnvironmentCollision) << with_bit.detail;
+  const Validity without = StateChecker(bare, env, no_bit, 0.0).check(q);
+  EXPECT_NE(without.constraint, Constraint::kEnvironmentCollision) << without.detail;
 }
 
 TEST(StateChecker, EachConstraintRejects) {

@@ -4,6 +4,7 @@
 // FCL, SRDF-disabled pairs, limits (with the limits rule: static torques within the continuous
 // torque). Immutable once built (Model/Data split: per-thread state lives in StateChecker).
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -76,6 +77,9 @@ class PlanningModel {
   [[nodiscard]] bool pair_disabled(int a, int b) const;
   /// Collision elements the model has but the planner ignores (meshes), as "link: reason".
   [[nodiscard]] const std::vector<std::string>& ignored_shapes() const { return ignored_; }
+  /// Collision primitives the planner adds to the model's (by link index): each drill's bit
+  /// (Params::drill_bit_radius). Also in links()' shapes.
+  [[nodiscard]] const std::map<int, std::vector<model::CollisionShape>>& added_shapes() const { return added_; }
 
   /// The tool end-effector: `name`, or the arm's tool (model::RobotModel::tool) when empty;
   /// throws PlannerError listing the candidates.
@@ -128,6 +132,8 @@ class PlanningModel {
   std::vector<std::string> planned_names_;
   Eigen::VectorXd lower_, upper_, velocity_, torque_;
   double base_height_ = 0.0;
+  std::map<int, std::vector<model::CollisionShape>> added_;
+  void add_drill_bits(double radius);
   std::vector<LinkNode> links_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d(0.0, 0.0, -9.81);
   std::vector<std::vector<bool>> disabled_;

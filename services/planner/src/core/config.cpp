@@ -25,6 +25,7 @@ Params read_params(config::Document& doc) {
       {"torque_margin", &p.torque_margin},
       {"posture_limit_margin", &p.posture_limit_margin},
       {"environment_padding", &p.environment_padding},
+      {"drill_bit_radius", &p.drill_bit_radius},
       {"start_tolerance", &p.start_tolerance},
       {"start_joint_tolerance", &p.start_joint_tolerance},
       {"floor_clearance", &p.floor_clearance},

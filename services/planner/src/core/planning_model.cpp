@@ -38,6 +38,60 @@ const char* to_string(Status status) {
 // An axis within this (cosine) of a plane's normal crosses it; within this of 0, lies in it.
 constexpr double kAxisTolerance = 1e-3;
 
+namespace {
+
+// The furthest a shape (pose `at` in some frame) reaches along that frame's z.
+double top_along_z(const LinkShape& shape, const Eigen::Isometry3d& at) {
+  Eigen::Vector3d half = 0.5 * shape.size;
+  if (shape.type == LinkShape::Type::kCylinder) half = {shape.size.x(), shape.size.x(), 0.5 * shape.size.z()};
+  if (shape.type == LinkShape::Type::kSphere) half = Eigen::Vector3d::Constant(shape.size.x());
+  double top = -std::numeric_limits<double>::infinity();
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d v((corner & 1) ? half.x() : -half.x(), (corner & 2) ? half.y() : -half.y(),
+                            (corner & 4) ? half.z() : -half.z());
+    top = std::max(top, (at * shape.origin * v).z());
+  }
+  return top;
+}
+
+}  // namespace
+
+// The module database describes a drill module's body and not its bit: its shapes end behind the
+// TCP (0.105 m on the CONCERT drill), so without a shape of its own the bit passes through walls
+// unseen, and planned paths swept it into them (holes cut at no mark, safety stops on the arm's
+// RMS torque as it dragged). The bit is a cylinder along the TCP's z, from the TCP back to where
+// the shapes rigidly attached to it end (the bounding box of each, a little conservative).
+void PlanningModel::add_drill_bits(double radius) {
+  std::vector<LinkNode>& links = links_;
+  for (const EndEffectorInfo* ee : robot_->end_effectors(model::EndEffectorKind::kDrill)) {
+    const int tcp = robot_->link_index(ee->frame);
+    if (tcp < 0) continue;
+    // Up from the TCP through fixed joints to the moving link carrying it, each link's pose in
+    // the TCP's frame.
+    double top = -std::numeric_limits<double>::infinity();
+    Eigen::Isometry3d tcp_T_link = Eigen::Isometry3d::Identity();
+    for (int l = tcp; l >= 0;) {
+      const LinkNode& node = links[static_cast<std::size_t>(l)];
+      for (const LinkShape& shape : node.shapes) top = std::max(top, top_along_z(shape, tcp_T_link));
+      if (node.full_index >= 0 || node.parent < 0) break;
+      tcp_T_link = tcp_T_link * node.origin.inverse();
+      l = node.parent;
+    }
+    const double length = -top;
+    if (!std::isfinite(length) || length <= 0.0) continue;  // the body reaches the TCP: nothing sticks out
+    LinkShape bit;
+    bit.type = LinkShape::Type::kCylinder;
+    bit.size = {radius, radius, length};
+    bit.origin = Eigen::Translation3d(0.0, 0.0, -0.5 * length) * Eigen::Isometry3d::Identity();
+    links[static_cast<std::size_t>(tcp)].shapes.push_back(bit);
+    model::CollisionShape shape;
+    shape.type = model::CollisionShape::Type::kCylinder;
+    shape.size = bit.size;
+    shape.origin = bit.origin;
+    added_[tcp].push_back(shape);
+  }
+}
+
 std::shared_ptr<const PlanningModel> PlanningModel::build(const ModelDescription& description, const Params& params) {
   try {
     return build(model::RobotModel::build(description), params);
@@ -117,6 +171,8 @@ std::shared_ptr<const PlanningModel> PlanningModel::build(std::shared_ptr<const 
     }
     m->links_.push_back(std::move(node));
   }
+
+  if (params.drill_bit_radius > 0.0) m->add_drill_bits(params.drill_bit_radius);
 
   const std::size_t nl = m->links_.size();
   m->disabled_.assign(nl, std::vector<bool>(nl, false));

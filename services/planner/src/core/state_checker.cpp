@@ -26,7 +26,7 @@ StateChecker::StateChecker(std::shared_ptr<const PlanningModel> model, const Env
     : model_(std::move(model)), environment_(environment), params_(params), padding_(padding) {
   std::vector<int> groups;
   for (const LinkNode& link : model_->links()) groups.push_back(link.rigid_group);
-  impl_.reset(new Impl{model_->kinematics().make_data(), collision::LinkShapes(model_->robot(), groups, padding), nullptr, {}, true, {}, {},
+  impl_.reset(new Impl{model_->kinematics().make_data(), collision::LinkShapes(model_->robot(), groups, padding, model_->added_shapes()), nullptr, {}, true, {}, {},
                        nullptr});
   const std::shared_ptr<const octomap::OcTree> tree = environment.octree();
   if (tree->size() > 0) {

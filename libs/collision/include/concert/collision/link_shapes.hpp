@@ -12,6 +12,7 @@
 #include <fcl/fcl.h>
 
 #include <Eigen/Geometry>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -38,8 +39,11 @@ class LinkShapes {
  public:
   /// The primitives of every link of `model` (mesh shapes are skipped and named in ignored());
   /// self-collision pairs between links whose `groups` differ (one entry per link, e.g.
-  /// rigid_groups()) and whose pair the model does not disable. `padding` >= 0 [m].
-  LinkShapes(const model::RobotModel& model, const std::vector<int>& groups, double padding = 0.0);
+  /// rigid_groups()) and whose pair the model does not disable. `padding` >= 0 [m]. `extra`:
+  /// primitives a link has beyond the model's (by link index; a drill's bit, which the module
+  /// database does not describe).
+  LinkShapes(const model::RobotModel& model, const std::vector<int>& groups, double padding = 0.0,
+             const std::map<int, std::vector<model::CollisionShape>>& extra = {});
   ~LinkShapes();
   LinkShapes(LinkShapes&&) noexcept;
   LinkShapes& operator=(LinkShapes&&) noexcept;
