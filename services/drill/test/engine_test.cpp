@@ -1021,36 +1021,6 @@ TEST_F(UnseenMarkerTest, WithoutAPlacementWithALookTheLastPostureDrawnIsTaken) {
   EXPECT_EQ(me.alignment().progress, Progress::kRunning);
 }
 
-TEST_F(UnseenMarkerTest, AfterAnotherHoleThePlacementIsDrawnFromTheChainsStartAndGoesBackThereFirst) {
-  // A first hole's posture reached, the arm alone: its path is the area's chain.
-  me.align(hole_ahead());
-  PlanReply first = reply(ms.plans.back().request_id, PlanState::kSucceeded);
-  first.path.names = {"base_x", "base_y", "base_yaw"};
-  first.path.samples = {{0.0, {0.0, 0.0, 0.0}, {}}, {1.0, {0.0, 0.0, 0.0}, {}}};
-  for (const std::string& j : rig->model().arm().joints) {
-    first.path.names.push_back(j);
-    first.path.samples[0].position.push_back(0.1);
-    first.path.samples[1].position.push_back(0.0);
-  }
-  inputs.on_plan(first);
-  me.step_motion(now += 0.005);
-  answered.push_back(first.request_id);
-  until_trajectory(true);
-  // The placement's draws start where the chain does; the first trajectory is the way back.
-  const auto draw = std::find_if(ms.plans.begin(), ms.plans.end(), [](const PlanAsk& r) {
-    return !r.fixed_base && !r.execute && r.tip_distance > 0.2;
-  });
-  ASSERT_NE(draw, ms.plans.end()) << ms.log_text;
-  EXPECT_EQ(draw->start_position, first.path.samples.front().position);
-  ASSERT_EQ(ms.trajectories.size(), 1u) << ms.log_text;
-  EXPECT_EQ(ms.logged("back along the area's holes' paths to where the posture was drawn from"), 1u) << ms.log_text;
-  // Back there: then the move to the posture drawn.
-  inputs.on_trajectory(ms.trajectories.back(), {Progress::kSucceeded, "", ""});
-  me.step_motion(now += 0.005);
-  EXPECT_EQ(ms.trajectories.size(), 2u) << ms.log_text;
-  EXPECT_EQ(me.alignment().progress, Progress::kRunning);
-}
-
 TEST_F(UnseenMarkerTest, PlacingForAnUnseenHoleCanBeTurnedOff) {
   tuning.hole.place_unseen = false;
   DrillEngine off{EngineParams{std::string(CONCERT_SOURCE_DIR) + "/services/drill/config/patterns.yaml", {}, tuning},

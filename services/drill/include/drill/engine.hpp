@@ -176,7 +176,6 @@ class DrillEngine final : public MissionPorts {
     // drawn; the move there; the camera onto the mark; the mark measured again.
     kPlaceCheck,
     kPlaceDraw,
-    kPlaceReturn,  // a hole's placement: back along the area's holes' paths before its move
     kPlaceMove,
     kPlaceLook,
     kPlaceSee,
@@ -225,10 +224,6 @@ class DrillEngine final : public MissionPorts {
     double look_distance{0.0};           // its camera distance [m]
     std::uint32_t look_again{0};         // its request
     PlannedPath again_path;
-    // Where the draws start: empty, where the robot stands; a hole's placement after other
-    // holes, the start of the area's chain (the robot goes back there before its move).
-    std::vector<std::string> start_names;
-    std::vector<double> start_position;
   } placement_;
   [[nodiscard]] PlanAsk placement_request(const Eigen::Isometry3d& goal);
   void place_check(bool drawn);
@@ -237,7 +232,6 @@ class DrillEngine final : public MissionPorts {
   // control_placement's steps, one per placement state.
   void place_check_step();
   void place_draw_step();
-  void place_return_step();
   void place_move_step();
   void place_look_step();
   void place_look_again_step();

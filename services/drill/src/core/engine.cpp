@@ -1069,8 +1069,6 @@ void DrillEngine::place_next() {
         mark = m->translation();
       PlanAsk r = placement_request(placement_goal(placement_.holes, mark, d.toward));
       set_hole_task(r, {true, false, 0.0, d.out, placement_.lead}, hole_distance_, hole_depth(), tuning_);
-      r.start_names = placement_.start_names;
-      r.start_position = placement_.start_position;
       placement_.draw = r.request_id;
       send_plan(r);
       motion_ = Motion::kPlaceDraw;
@@ -1104,14 +1102,6 @@ void DrillEngine::place_next() {
       log_line("drill: " + c.summary() + thrust_text(placement_.lead, tuning_.motion) +
                "; the whole body to posture " + std::to_string(k + 1) +
                " drawn (" + placement_time() + ")" + last_holes(placement_.reached[k]));
-      if (!placement_.start_names.empty()) {
-        if (const std::optional<std::uint32_t> back = send_way_back()) {
-          log_line("drill: back along the area's holes' paths to where the posture was drawn from");
-          trajectory_request_ = *back;
-          motion_ = Motion::kPlaceReturn;
-          return;
-        }
-      }
       trajectory_request_ = send_trajectory(placement_.names[k], placement_.bodies[k]);
       motion_ = Motion::kPlaceMove;
       return;
@@ -1134,10 +1124,6 @@ void DrillEngine::control_placement() {
   }
   if (motion_ == Motion::kPlaceDraw) {
     place_draw_step();
-    return;
-  }
-  if (motion_ == Motion::kPlaceReturn) {
-    place_return_step();
     return;
   }
   if (motion_ == Motion::kPlaceMove) {
@@ -1234,16 +1220,6 @@ void DrillEngine::place_draw_step() {
   log_line("drill: no whole-body posture drawn for the placement (" + r->reason + ")");
   placement_.choice->drawn(0, false);
   place_next();
-}
-
-// A hole's placement was drawn from the start of the area's chain: the robot back there, the
-// chain done with, then the move to the posture drawn.
-void DrillEngine::place_return_step() {
-  if (!trajectory_ran("the way back along the holes' paths before the hole's placement")) return;
-  hole_chain_.clear();
-  const std::size_t k = chosen_draw();
-  trajectory_request_ = send_trajectory(placement_.names[k], placement_.bodies[k]);
-  motion_ = Motion::kPlaceMove;
 }
 
 void DrillEngine::place_move_step() {
@@ -1402,15 +1378,6 @@ void DrillEngine::place_for_hole() {
   placement_.started = now_;
   placement_.lead = tuning_.hole.attempts[hole_attempt_].lead;
   placement_.choice.emplace(1, tuning_.placement.draws.size());
-  // Drawn from the start of the area's chain (its approach or placement posture), the robot going
-  // back there along the chain before the move: planned from a hole's posture in front of the
-  // wall, a whole-body path can sweep the bit (no collision shape) through the wall, as the
-  // planner's way home did (stow, rest). From the chain's start it leaves the wall as the area's
-  // placement does.
-  if (!hole_chain_.empty() && !hole_chain_.front().samples.empty()) {
-    placement_.start_names = hole_chain_.front().names;
-    placement_.start_position = hole_chain_.front().samples.front().position;
-  }
   // The arm alone does not reach it from where the base stands: the hole's first attempts said so.
   placement_.standing_reached = {false};
   placement_.choice->standing(0);
