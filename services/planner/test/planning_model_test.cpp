@@ -208,14 +208,16 @@ TEST(PlanningModel, BadModelsNameTheProblem) {
 // the bit, a cylinder from the TCP back to them. A wall the bit's tip goes into, the body clear
 // of it, is a collision; without the bit (drill_bit_radius 0) it was not.
 TEST(PlanningModel, TheDrillsBitIsACylinderFromTheTcpBackToTheDrillsBody) {
-  const auto m = morphology('a');
+  Params with_bit;
+  with_bit.drill_bit_radius = 0.008;
+  const auto m = morphology('a', with_bit);
   const auto tcp = std::find_if(m->links().begin(), m->links().end(),
                                 [&](const LinkNode& l) { return l.name == m->tool("").frame; });
   ASSERT_NE(tcp, m->links().end());
   ASSERT_EQ(tcp->shapes.size(), 1u);
   const LinkShape& bit = tcp->shapes.front();
   EXPECT_EQ(bit.type, LinkShape::Type::kCylinder);
-  EXPECT_DOUBLE_EQ(bit.size.x(), Params{}.drill_bit_radius);
+  EXPECT_DOUBLE_EQ(bit.size.x(), with_bit.drill_bit_radius);
   // The CONCERT drill's box ends 0.105 m behind its TCP (module database, concert_drill).
   EXPECT_NEAR(bit.size.z(), 0.105, 0.01);
   EXPECT_NEAR(bit.origin.translation().z(), -0.5 * bit.size.z(), 1e-12);
@@ -241,8 +243,8 @@ TEST(PlanningModel, TheDrillsBitIsACylinderFromTheTcpBackToTheDrillsBody) {
                          std::atan2(axis.y(), axis.x())});
   Environment env(0.01);
   env.add_world(world);
-  const Validity with_bit = StateChecker(m, env, Params{}, 0.0).check(q);
-  EXPECT_EQ(with_bit.constraint, Constraint::kEnvironmentCollision) << with_bit.detail;
+  const Validity hit = StateChecker(m, env, with_bit, 0.0).check(q);
+  EXPECT_EQ(hit.constraint, Constraint::kEnvironmentCollision) << hit.detail;
   const Validity without = StateChecker(bare, env, no_bit, 0.0).check(q);
   EXPECT_NE(without.constraint, Constraint::kEnvironmentCollision) << without.detail;
 }
