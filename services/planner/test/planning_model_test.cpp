@@ -211,8 +211,12 @@ TEST(PlanningModel, TheDrillsBitIsACylinderFromTheTcpBackToTheDrillsBody) {
   Params with_bit;
   with_bit.drill_bit_radius = 0.008;
   const auto m = morphology('a', with_bit);
-  const auto tcp = std::find_if(m->links().begin(), m->links().end(),
-                                [&](const LinkNode& l) { return l.name == m->tool("").frame; });
+  // The drill's TCP link of a model; end() when it has none.
+  const auto tcp_of = [](const PlanningModel& model) {
+    return std::find_if(model.links().begin(), model.links().end(),
+                        [&](const LinkNode& l) { return l.name == model.tool("").frame; });
+  };
+  const auto tcp = tcp_of(*m);
   ASSERT_NE(tcp, m->links().end());
   ASSERT_EQ(tcp->shapes.size(), 1u);
   const LinkShape& bit = tcp->shapes.front();
@@ -224,8 +228,7 @@ TEST(PlanningModel, TheDrillsBitIsACylinderFromTheTcpBackToTheDrillsBody) {
   Params no_bit;
   no_bit.drill_bit_radius = 0.0;
   const auto bare = morphology('a', no_bit);
-  const auto bare_tcp = std::find_if(bare->links().begin(), bare->links().end(),
-                                     [&](const LinkNode& l) { return l.name == bare->tool("").frame; });
+  const auto bare_tcp = tcp_of(*bare);
   ASSERT_NE(bare_tcp, bare->links().end());
   EXPECT_TRUE(bare_tcp->shapes.empty());
 
