@@ -34,6 +34,17 @@ double bounding_radius(const model::CollisionShape& s) {
   return 0.0;
 }
 
+// Of geometry(s, pad), about its origin [m].
+double padded_bounding_radius(const model::CollisionShape& s, double pad) {
+  switch (s.type) {
+    case Type::kBox: return 0.5 * (s.size + Eigen::Vector3d::Constant(2.0 * pad)).norm();
+    case Type::kCylinder: return std::hypot(s.size.x() + pad, 0.5 * s.size.z() + pad);
+    case Type::kSphere: return s.size.x() + pad;
+    case Type::kMesh: break;
+  }
+  return 0.0;
+}
+
 }  // namespace
 
 std::vector<int> rigid_groups(const model::RobotModel& model, const std::vector<std::string>& joints) {
@@ -52,6 +63,7 @@ struct LinkShapes::Impl {
   std::vector<Shape> shapes;
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> exact;
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> padded;
+  std::vector<Eigen::Isometry3d> padded_origin;  // of each padded shape, in its link's frame
   std::vector<std::pair<int, int>> pairs;
   std::vector<int> links;
   std::vector<std::string> ignored;
@@ -71,16 +83,32 @@ LinkShapes::LinkShapes(const model::RobotModel& model, const std::vector<int>& g
   for (std::size_t l = 0; l < links.size(); ++l) {
     bool any = false;
     std::vector<model::CollisionShape> own = links[l].shapes;
+    const std::size_t model_shapes = own.size();
     if (const auto more = extra.find(static_cast<int>(l)); more != extra.end())
       own.insert(own.end(), more->second.begin(), more->second.end());
-    for (const model::CollisionShape& c : own) {
+    for (std::size_t k = 0; k < own.size(); ++k) {
+      const model::CollisionShape& c = own[k];
       if (c.type == Type::kMesh) {
         impl_->ignored.push_back(links[l].name + ": mesh");
         continue;
       }
-      impl_->shapes.push_back(Shape{static_cast<int>(l), c, bounding_radius(c)});
+      impl_->shapes.push_back(Shape{static_cast<int>(l), c, bounding_radius(c), 0.0});
       impl_->exact.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(c, 0.0)));
-      impl_->padded.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(c, padding)));
+      if (k >= model_shapes && c.type == Type::kCylinder) {
+        // A bit: grown sideways and backwards, not beyond its tip (the +z end). The tip's way
+        // to a wall is the task's (a drilling posture puts it a few cm in front of the wall the
+        // camera measured); the padding is room for the odometry's drift across the wall.
+        model::CollisionShape grown = c;
+        grown.size.x() += padding;
+        grown.size.z() += padding;
+        impl_->padded.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(grown, 0.0)));
+        impl_->padded_origin.push_back(c.origin * Eigen::Translation3d(0.0, 0.0, -0.5 * padding));
+        impl_->shapes.back().padded_radius = bounding_radius(grown);
+      } else {
+        impl_->padded.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(c, padding)));
+        impl_->padded_origin.push_back(c.origin);
+        impl_->shapes.back().padded_radius = padded_bounding_radius(c, padding);
+      }
       any = true;
     }
     if (any) impl_->links.push_back(static_cast<int>(l));
@@ -107,7 +135,7 @@ void LinkShapes::place(const std::vector<Eigen::Isometry3d>& link_poses) {
     const fcl::Transform3d t(link_poses.at(static_cast<std::size_t>(s.link)) * s.primitive.origin);
     impl_->exact[i]->setTransform(t);
     impl_->exact[i]->computeAABB();
-    impl_->padded[i]->setTransform(t);
+    impl_->padded[i]->setTransform(fcl::Transform3d(link_poses.at(static_cast<std::size_t>(s.link)) * impl_->padded_origin[i]));
     impl_->padded[i]->computeAABB();
   }
 }

@@ -147,5 +147,37 @@ TEST(LinkShapes, PadsEverySideOfTheClearanceCopy) {
   EXPECT_THROW(LinkShapes(*m, rigid_groups(*m, {}), -0.1), std::invalid_argument);
 }
 
+TEST(LinkShapes, PadsABitSidewaysAndBackwardsButNotBeyondItsTip) {
+  const auto m = drill_robot();
+  const double pad = 0.03;
+  // A bit 0.1 m long on the last link, its tip (+z end) at the link's origin.
+  model::CollisionShape bit;
+  bit.type = model::CollisionShape::Type::kCylinder;
+  bit.size = {0.008, 0.008, 0.1};
+  bit.origin = Eigen::Translation3d(0.0, 0.0, -0.05) * Eigen::Isometry3d::Identity();
+  const int link = static_cast<int>(m->links().size()) - 1;
+  LinkShapes shapes(*m, rigid_groups(*m, m->arm().joints), pad, {{link, {bit}}});
+  shapes.place(std::vector<Eigen::Isometry3d>(m->links().size(), Eigen::Isometry3d::Identity()));
+  const auto found = std::find_if(shapes.shapes().begin(), shapes.shapes().end(), [&](const Shape& s) {
+    return s.link == link && s.primitive.type == model::CollisionShape::Type::kCylinder &&
+           s.primitive.size.isApprox(bit.size);
+  });
+  ASSERT_NE(found, shapes.shapes().end());
+  const std::size_t i = static_cast<std::size_t>(found - shapes.shapes().begin());
+  const auto exact = shapes.exact(i).getAABB();
+  const auto padded = shapes.padded(i).getAABB();
+  EXPECT_NEAR(exact.max_.z(), 0.0, 1e-9);
+  EXPECT_NEAR(exact.min_.z(), -0.1, 1e-9);
+  EXPECT_NEAR(padded.max_.z(), 0.0, 1e-9) << "the tip is not padded";
+  EXPECT_NEAR(padded.min_.z(), -0.1 - pad, 1e-9) << "the back is";
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_NEAR(padded.max_[k] - exact.max_[k], pad, 1e-9) << "sideways, axis " << k;
+    EXPECT_NEAR(exact.min_[k] - padded.min_[k], pad, 1e-9) << "sideways, axis " << k;
+  }
+  // The padded shape's radius about its own centre, half-way along it.
+  EXPECT_NEAR(shapes.padded(i).getTranslation().z(), -0.5 * (0.1 + pad), 1e-9);
+  EXPECT_NEAR(found->padded_radius, std::hypot(0.008 + pad, 0.5 * (0.1 + pad)), 1e-12);
+}
+
 }  // namespace
 }  // namespace concert::collision

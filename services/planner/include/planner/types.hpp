@@ -47,9 +47,8 @@ struct Params {
   double environment_padding = 0.03; ///< robot shapes grown by this against the world [m]
   /// [m] radius of the drill bit's collision cylinder, from each drill's TCP back to where its
   /// module's shapes end (the module database gives the drill's body, not its bit); 0: no bit.
-  /// Off until the drill's blob mission holds with it (system_drill_mission_test: its drilling
-  /// postures then load J2_E past safety's RMS bound).
-  double drill_bit_radius = 0.0;
+  /// Padded by environment_padding sideways and backwards, not beyond its tip.
+  double drill_bit_radius = 0.008;
   /// A start standing up to this far inside the map (odometry drift) is first moved out: the
   /// nearest base pose clear of the map (x, y within this [m], yaw within this [rad] per metre),
   /// the move prepended to the path; 0: such a start is refused.

@@ -140,7 +140,7 @@ Validity StateChecker::check(const Eigen::VectorXd& q, const std::string& contac
     for (std::size_t i = 0; i < shapes.shapes().size(); ++i) {
       const fcl::CollisionObjectd& padded = shapes.padded(i);
       if (!padded.getAABB().overlap(impl_->octree_box)) continue;
-      if (field.distance(padded.getTranslation()) - field_error > shapes.shapes()[i].bounding_radius + padding_) continue;
+      if (field.distance(padded.getTranslation()) - field_error > shapes.shapes()[i].padded_radius) continue;
       fcl::CollisionResultd result;
       fcl::collide(&padded, impl_->octree.get(), request, result);
       if (result.isCollision()) {

@@ -33,6 +33,7 @@ struct Shape {
   int link = -1;                     ///< index in the model's links
   model::CollisionShape primitive;   ///< box, cylinder or sphere, in the link frame
   double bounding_radius = 0.0;      ///< of the exact shape, about its origin [m]
+  double padded_radius = 0.0;        ///< of the padded shape, about the padded object's origin [m]
 };
 
 class LinkShapes {
@@ -41,7 +42,8 @@ class LinkShapes {
   /// self-collision pairs between links whose `groups` differ (one entry per link, e.g.
   /// rigid_groups()) and whose pair the model does not disable. `padding` >= 0 [m]. `extra`:
   /// primitives a link has beyond the model's (by link index; a drill's bit, which the module
-  /// database does not describe).
+  /// database does not describe). An extra cylinder is a bit whose tip is its +z end: padded
+  /// sideways and backwards, not beyond the tip.
   LinkShapes(const model::RobotModel& model, const std::vector<int>& groups, double padding = 0.0,
              const std::map<int, std::vector<model::CollisionShape>>& extra = {});
   ~LinkShapes();
