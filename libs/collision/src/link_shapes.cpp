@@ -10,18 +10,36 @@ namespace {
 
 using Type = model::CollisionShape::Type;
 
-std::shared_ptr<fcl::CollisionGeometryd> geometry(const model::CollisionShape& s, double pad) {
+std::shared_ptr<fcl::CollisionGeometryd> geometry(const model::CollisionShape& s) {
   switch (s.type) {
     case Type::kBox:
-      return std::make_shared<fcl::Boxd>(s.size.x() + 2 * pad, s.size.y() + 2 * pad, s.size.z() + 2 * pad);
+      return std::make_shared<fcl::Boxd>(s.size.x(), s.size.y(), s.size.z());
     case Type::kCylinder:
-      return std::make_shared<fcl::Cylinderd>(s.size.x() + pad, s.size.z() + 2 * pad);
+      return std::make_shared<fcl::Cylinderd>(s.size.x(), s.size.z());
     case Type::kSphere:
-      return std::make_shared<fcl::Sphered>(s.size.x() + pad);
+      return std::make_shared<fcl::Sphered>(s.size.x());
     case Type::kMesh:
       break;
   }
   return nullptr;
+}
+
+// `s` grown by `pad` on every side; a bit (`tip_kept`, a cylinder whose tip is its +z end) grown
+// sideways and backwards only, its origin moved back to stay centred.
+model::CollisionShape grown(const model::CollisionShape& s, double pad, bool tip_kept) {
+  model::CollisionShape g = s;
+  switch (s.type) {
+    case Type::kBox: g.size += Eigen::Vector3d::Constant(2.0 * pad); break;
+    case Type::kCylinder:
+      g.size.x() += pad;
+      g.size.y() += pad;
+      g.size.z() += tip_kept ? pad : 2.0 * pad;
+      if (tip_kept) g.origin = s.origin * Eigen::Translation3d(0.0, 0.0, -0.5 * pad);
+      break;
+    case Type::kSphere: g.size.x() += pad; break;
+    case Type::kMesh: break;
+  }
+  return g;
 }
 
 double bounding_radius(const model::CollisionShape& s) {
@@ -29,17 +47,6 @@ double bounding_radius(const model::CollisionShape& s) {
     case Type::kBox: return 0.5 * s.size.norm();
     case Type::kCylinder: return std::hypot(s.size.x(), 0.5 * s.size.z());
     case Type::kSphere: return s.size.x();
-    case Type::kMesh: break;
-  }
-  return 0.0;
-}
-
-// Of geometry(s, pad), about its origin [m].
-double padded_bounding_radius(const model::CollisionShape& s, double pad) {
-  switch (s.type) {
-    case Type::kBox: return 0.5 * (s.size + Eigen::Vector3d::Constant(2.0 * pad)).norm();
-    case Type::kCylinder: return std::hypot(s.size.x() + pad, 0.5 * s.size.z() + pad);
-    case Type::kSphere: return s.size.x() + pad;
     case Type::kMesh: break;
   }
   return 0.0;
@@ -92,23 +99,14 @@ LinkShapes::LinkShapes(const model::RobotModel& model, const std::vector<int>& g
         impl_->ignored.push_back(links[l].name + ": mesh");
         continue;
       }
-      impl_->shapes.push_back(Shape{static_cast<int>(l), c, bounding_radius(c), 0.0});
-      impl_->exact.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(c, 0.0)));
-      if (k >= model_shapes && c.type == Type::kCylinder) {
-        // A bit: grown sideways and backwards, not beyond its tip (the +z end). The tip's way
-        // to a wall is the task's (a drilling posture puts it a few cm in front of the wall the
-        // camera measured); the padding is room for the odometry's drift across the wall.
-        model::CollisionShape grown = c;
-        grown.size.x() += padding;
-        grown.size.z() += padding;
-        impl_->padded.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(grown, 0.0)));
-        impl_->padded_origin.push_back(c.origin * Eigen::Translation3d(0.0, 0.0, -0.5 * padding));
-        impl_->shapes.back().padded_radius = bounding_radius(grown);
-      } else {
-        impl_->padded.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(c, padding)));
-        impl_->padded_origin.push_back(c.origin);
-        impl_->shapes.back().padded_radius = padded_bounding_radius(c, padding);
-      }
+      // An extra cylinder is a bit: not padded beyond its tip. The tip's way to a wall is the
+      // task's (a drilling posture puts it a few cm in front of the wall the camera measured);
+      // the padding is room for the odometry's drift across the wall.
+      const model::CollisionShape padded = grown(c, padding, k >= model_shapes);
+      impl_->shapes.push_back(Shape{static_cast<int>(l), c, bounding_radius(c), bounding_radius(padded)});
+      impl_->exact.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(c)));
+      impl_->padded.push_back(std::make_unique<fcl::CollisionObjectd>(geometry(padded)));
+      impl_->padded_origin.push_back(padded.origin);
       any = true;
     }
     if (any) impl_->links.push_back(static_cast<int>(l));
