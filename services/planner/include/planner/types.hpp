@@ -31,6 +31,11 @@ using EndEffectorInfo = model::EndEffectorInfo;
 struct Params {
   // Task (paper section 5.4.2).
   double camera_distance = 0.6;      ///< d: camera frame to wall along the normal [m]
+  /// per request (PlanRequest::view_slant > 0): a look from any side, the camera's axis through
+  /// each area's centre from view_near to camera_distance [m] away, at most view_slant [rad]
+  /// off the area's normal
+  double view_slant = 0.0;
+  double view_near = 0.0;             ///< [m] see view_slant
   double contact_force = 200.0;      ///< expected drilling force along the tool axis [N]
   double torque_margin = 1.0;        ///< allowed fraction of the continuous torque [-]
   /// A goal posture (NSPG) keeps each arm joint this far inside its position limits [rad or m],
@@ -196,6 +201,14 @@ struct PlanRequest {
   /// Camera frame to each area along its normal [m]; 0: Params::camera_distance. The drill
   /// service asks for the camera close to the wall to put the bit at a hole.
   double camera_distance = 0.0;
+  /// > 0: a look at each area's centre from any side: the camera's optical axis through the
+  /// centre, the camera between view_near and camera_distance (0: Params::camera_distance) from
+  /// it and at most this far [rad] off the area's normal, rolled any way. The drill's look at a
+  /// mark from where its base stands for a low hole: on morphology A no posture holds the camera
+  /// on a low mark's normal from there, many see it from beside it, 0.8-1.1 m away.
+  /// Not with tip_distance.
+  double view_slant = 0.0;
+  double view_near = 0.0;  ///< [m] the camera at least this far from the area's centre (view_slant)
   /// > 0: the tool's tip (its TCP frame), not its camera, goes this far [m] in front of each
   /// area on its normal, z along -normal; camera_distance is then unused. The drill service's
   /// hole postures: the posture the planner checks (torques with the drilling force, clearance)

@@ -135,8 +135,10 @@ std::pair<double, double> task_error(const PlanningModel& model, const Params& p
                                      const Eigen::Isometry3d& area) {
   const Task task = make_task(params, area);
   const Eigen::Isometry3d pose = model.link_pose(q_full, model.task_frame(tool, params.tip_task));
-  const double angle = std::acos(std::clamp(pose.linear().col(2).dot(task.axis), -1.0, 1.0));
-  return {(pose.translation() - task.position).norm(), angle};
+  const Eigen::Matrix<double, 6, 1> r = detail::task_residual(task, pose);
+  // The axis residual is a chord of the unit sphere: 2 asin(chord / 2) is its angle.
+  const double angle = 2.0 * std::asin(std::clamp(0.5 * r.tail<3>().norm(), 0.0, 1.0));
+  return {r.head<3>().norm(), angle};
 }
 
 PostureResult generate_posture(const PlanningModel& model, StateChecker& checker,

@@ -16,6 +16,7 @@
 #include <variant>
 
 #include "path_search.hpp"
+#include "posture_problem.hpp"
 #include "planner/trajectory.hpp"
 
 namespace concert::planner {
@@ -509,6 +510,22 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
   if (std::isnan(request.tip_distance) || std::isinf(request.tip_distance)) {
     return fail(Status::kInvalidRequest, "tip_distance must be a finite number of metres");
   }
+  // Past about 80 deg the camera would look along the surface, not at it.
+  constexpr double kMaxSlant = 1.4;
+  if (!(request.view_slant >= 0.0 && request.view_slant <= kMaxSlant)) {
+    return fail(Status::kInvalidRequest, "view_slant must be within [0, 1.4] rad");
+  }
+  if (request.view_slant > 0.0) {
+    const double far = request.camera_distance > 0.0 ? request.camera_distance : params_.camera_distance;
+    if (request.tip_distance > 0.0) {
+      return fail(Status::kInvalidRequest,
+                  "view_slant is a look with the camera; tip_distance puts the tool on the area's normal");
+    }
+    if (!(request.view_near >= 0.0 && request.view_near < far)) {
+      return fail(Status::kInvalidRequest, "view_near must be at least 0 m and below camera_distance (" +
+                                               std::to_string(far) + " m)");
+    }
+  }
   if (!(request.tip_reach >= 0.0 && request.tip_reach <= 1.0)) {
     return fail(Status::kInvalidRequest, "tip_reach must be within [0, 1] m");
   }
@@ -703,7 +720,12 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     const double distance = tip                            ? request.tip_distance
                             : request.camera_distance > 0.0 ? request.camera_distance
                                                             : params_.camera_distance;
-    const double height = (request.goals[g].area * Eigen::Vector3d(0.0, 0.0, distance)).z();
+    Params task_params = request_params;
+    task_params.camera_distance = distance;
+    task_params.view_slant = tip ? 0.0 : request.view_slant;
+    task_params.view_near = request.view_near;
+    task_params.tip_task = tip;
+    const double height = detail::make_task(task_params, request.goals[g].area).position.z();
     const std::vector<Eigen::VectorXd> hints = hints_for(*model, height);
     int next_seed = 0;
     // The arm shapes no path reached: the posture search's next seeds are often the same
@@ -720,6 +742,8 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       const auto t_posture = Clock::now();
       Params attempt_params = request_params;
       attempt_params.camera_distance = distance;
+      attempt_params.view_slant = task_params.view_slant;
+      attempt_params.view_near = task_params.view_near;
       attempt_params.fixed_base = request.fixed_base;
       attempt_params.base_travel = request.base_travel;
       attempt_params.tip_task = tip;
@@ -738,10 +762,16 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
       if (!posture.found) {
         if (attempt > 0) break;  // keep the previous attempt's "no path"
         r.status = Status::kUnreachable;
-        r.reason = std::string("no feasible posture puts ") + (tip ? "tip '" : "camera '") +
-                   model->task_frame(*tool, tip) + "' " +
-                   std::to_string(distance) + " m in front of the drilling area (" +
-                   std::to_string(posture.candidates) + " seeds solved; " + posture.reason + ")";
+        std::ostringstream what;
+        if (task_params.view_slant > 0.0) {
+          what << "no feasible posture lets camera '" << model->task_frame(*tool, false) << "' see the area's centre from "
+               << task_params.view_near << "-" << distance << " m within " << task_params.view_slant
+               << " rad of its normal";
+        } else {
+          what << "no feasible posture puts " << (tip ? "tip '" : "camera '") << model->task_frame(*tool, tip) << "' "
+               << std::to_string(distance) << " m in front of the drilling area";
+        }
+        r.reason = what.str() + " (" + std::to_string(posture.candidates) + " seeds solved; " + posture.reason + ")";
         break;
       }
       const double remaining = params_.planning_time - cpu_seconds_since(t0);

@@ -225,11 +225,7 @@ void PostureProblem::evaluate(const Eigen::VectorXd& q, Eigen::VectorXd& r) {
   model_.link_poses(model_.to_full(q, template_), poses_);
   if (task_) {
     const Eigen::Isometry3d& cam = poses_[static_cast<std::size_t>(camera_)];
-    r.segment<3>(0) = kTaskWeight * (cam.translation() - task_->position);
-    // The axis as a difference, not a cross product: a cross product is zero for the camera
-    // looking away from the wall too, and the solver can converge there (a hole posture on the
-    // demo robot would pass every check with the camera turned 180 deg from the hole).
-    r.segment<3>(3) = kTaskWeight * (cam.linear().col(2) - task_->axis);
+    r.head<6>() = kTaskWeight * task_residual(*task_, cam);
   } else {
     r.head<6>().setZero();
   }

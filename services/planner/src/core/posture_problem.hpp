@@ -14,6 +14,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,15 +30,53 @@ namespace concert::planner::detail {
 constexpr double kTaskWeight = 10.0;
 
 struct Task {
-  Eigen::Vector3d position;  // camera target [m]
+  Eigen::Vector3d position;  // camera target [m] (a view: where seeds place the camera)
   Eigen::Vector3d axis;      // camera z target (unit)
   Eigen::Vector3d surface;   // a point of the drilled surface [m]
   Eigen::Vector3d normal;    // its outward normal (unit)
+  // A view (Params::view_slant): the camera's axis through `surface` from `near` to `far` away,
+  // within the slant whose cosine is `cos_slant`; position and axis then only seed the solver.
+  bool view = false;
+  double near = 0.0;
+  double far = 0.0;
+  double cos_slant = 1.0;
 };
 
 inline Task make_task(const Params& params, const Eigen::Isometry3d& area) {
   const Eigen::Vector3d n = area.linear().col(2).normalized();
-  return {area.translation() + params.camera_distance * n, -n, area.translation(), n};
+  Task task{area.translation() + params.camera_distance * n, -n, area.translation(), n};
+  if (params.view_slant > 0.0 && !params.tip_task) {
+    task.view = true;
+    task.near = params.view_near;
+    task.far = params.camera_distance;
+    task.cos_slant = std::cos(params.view_slant);
+    task.position = area.translation() + 0.5 * (task.near + task.far) * n;
+  }
+  return task;
+}
+
+// The task's residuals (6, unweighted) of a camera pose: position and axis, or for a view the
+// distance below near and beyond far, the cosine short of the slant's, and the axis off the
+// line to the centre.
+inline Eigen::Matrix<double, 6, 1> task_residual(const Task& task, const Eigen::Isometry3d& camera) {
+  Eigen::Matrix<double, 6, 1> r;
+  const Eigen::Vector3d a = camera.linear().col(2);
+  if (!task.view) {
+    r.head<3>() = camera.translation() - task.position;
+    // The axis as a difference, not a cross product: a cross product is zero for the camera
+    // looking away from the wall too, and the solver can converge there (a hole posture on the
+    // demo robot would pass every check with the camera turned 180 deg from the hole).
+    r.tail<3>() = a - task.axis;
+    return r;
+  }
+  const Eigen::Vector3d to = task.surface - camera.translation();
+  const double d = to.norm();
+  const Eigen::Vector3d u = d > 1e-9 ? Eigen::Vector3d(to / d) : task.axis;
+  r[0] = std::max(0.0, task.near - d);
+  r[1] = std::max(0.0, d - task.far);
+  r[2] = std::max(0.0, task.cos_slant - (-u).dot(task.normal));
+  r.tail<3>() = a - u;
+  return r;
 }
 
 // A sphere of a link's smooth stand-in for its collision primitives (self collision and

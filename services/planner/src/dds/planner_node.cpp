@@ -317,6 +317,8 @@ ClientRequest to_client_request(const msg::PlanRequest& request) {
   core.model_version = request.model_version();
   core.end_effector = request.end_effector();
   core.camera_distance = request.camera_distance();
+  core.view_slant = request.view_slant();
+  core.view_near = request.view_near();
   core.tip_distance = request.tip_distance();
   core.tip_reach = request.tip_reach();
   core.contact_force = request.contact_force();
