@@ -936,6 +936,7 @@ struct UnseenMarkerTest : RigEngineTest {
   DrillEngine me{EngineParams{std::string(CONCERT_SOURCE_DIR) + "/services/drill/config/patterns.yaml", {}, tuning},
                  inputs, map_frame, ms};
   std::vector<std::uint32_t> answered;
+  bool views_only = false;  // a look is found only from beside the marker (view_slant)
 
   void SetUp() override {
     RigEngineTest::SetUp();
@@ -951,7 +952,8 @@ struct UnseenMarkerTest : RigEngineTest {
       answered.push_back(r.request_id);
       const bool look = r.camera_distance > 0.0;
       const bool standing = r.fixed_base && r.tip_distance > 0.0 && r.start_position.empty() && !r.execute;
-      const bool found = look ? looks : !(standing || (r.fixed_base && r.execute && r.start_position.empty()));
+      const bool found = look ? (views_only ? r.view_slant > 0.0 : looks)
+                              : !(standing || (r.fixed_base && r.execute && r.start_position.empty()));
       PlanReply p = reply(r.request_id, found ? PlanState::kSucceeded : PlanState::kFailed);
       if (found) {
         p.path.names = {"base_x", "base_y", "base_yaw"};
@@ -1018,6 +1020,35 @@ TEST_F(UnseenMarkerTest, WithoutAPlacementWithALookTheLastPostureDrawnIsTaken) {
   EXPECT_EQ(ms.logged("no placement reaches it with a look at marker 0 either; the last whole-body posture drawn taken"),
             1u)
       << ms.log_text;
+  EXPECT_EQ(me.alignment().progress, Progress::kRunning);
+}
+
+// No look on the marker's normal from the whole body's posture, one from beside it (a low row on
+// morphology A): the posture is taken with that look, nothing placed for the hole alone; the
+// look asked last is the view from any side within looks.attempts' slant, as near as frames the
+// marker and out to its `further` beyond the posture's distance.
+TEST_F(UnseenMarkerTest, AWholeBodyPostureWhenceTheCameraSeesTheMarkerOnlyFromBesideIsTaken) {
+  views_only = true;
+  const LookAttempt& view = tuning.looks.attempts.back();
+  ASSERT_GT(view.slant, 0.0);
+  until_trajectory(false);
+  ASSERT_EQ(ms.trajectories.size(), 1u) << ms.log_text;
+  EXPECT_EQ(ms.logged("placed for this hole alone"), 0u) << ms.log_text;
+  EXPECT_EQ(ms.logged("the last whole-body posture drawn taken"), 0u) << ms.log_text;
+  const auto views = std::count_if(ms.plans.begin(), ms.plans.end(), [](const PlanAsk& r) { return r.view_slant > 0.0; });
+  EXPECT_EQ(views, 1) << ms.log_text;
+  const auto asked = std::find_if(ms.plans.begin(), ms.plans.end(), [](const PlanAsk& r) { return r.view_slant > 0.0; });
+  ASSERT_NE(asked, ms.plans.end());
+  EXPECT_DOUBLE_EQ(asked->view_slant, view.slant);
+  EXPECT_GT(asked->view_near, 0.0);
+  EXPECT_GE(asked->camera_distance, asked->view_near + view.further - 1e-9);
+  EXPECT_TRUE(asked->fixed_base);
+  EXPECT_EQ(asked->tip_distance, 0.0);
+  EXPECT_FALSE(asked->start_position.empty()) << "the look is checked from the end of the posture drawn";
+  // The posture ran: the camera is turned onto the marker along the look checked.
+  inputs.on_trajectory(ms.trajectories.back(), {Progress::kSucceeded, "", ""});
+  me.step_motion(now += 0.005);
+  EXPECT_EQ(ms.trajectories.size(), 2u) << ms.log_text;
   EXPECT_EQ(me.alignment().progress, Progress::kRunning);
 }
 

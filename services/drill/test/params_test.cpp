@@ -134,8 +134,8 @@ TEST(DrillParamsFile, TheShippedFileHoldsEveryDefault) {
   EXPECT_TRUE(doc.differences_from_defaults().empty())
       << ::testing::PrintToString(doc.differences_from_defaults());
   // Every key read: 65 single values (look_further one of them), the 4 tables' lengths, and
-  // their rows' keys: 27 attempts x 5, 5 looks x 2, 3 draws x 2, 3 survey attempts x 5.
-  EXPECT_EQ(doc.keys().size(), 65u + 4u + 27u * 5u + 5u * 2u + 3u * 2u + 3u * 5u);
+  // their rows' keys: 27 attempts x 5, 6 looks x 3, 3 draws x 2, 3 survey attempts x 5.
+  EXPECT_EQ(doc.keys().size(), 65u + 4u + 27u * 5u + 6u * 3u + 3u * 2u + 3u * 5u);
   expect_same(p, Params{});
   expect_same(load_params(kShipped), Params{});
 }
@@ -172,6 +172,10 @@ TEST(DrillParamsFile, ABadValueNamesFileKeyAndLine) {
             "drill.yaml: placement.draws[0].toward: expected a number in [0, 1], got '2' (line 3)");
   EXPECT_EQ(error_of("looks:\n  attempts:\n    - {between: maybe}\n"),
             "drill.yaml: looks.attempts[0].between: expected true or false, got 'maybe' (line 3)");
+  EXPECT_THAT(error_of("looks:\n  attempts:\n    - {between: true, further: 0.2, slant: 0.8}\n"),
+              ::testing::HasSubstr("drill.yaml: looks.attempts[0].slant: a look centred between hole and marker"));
+  EXPECT_THAT(error_of("looks:\n  attempts:\n    - {further: 0.8, slant: 2}\n"),
+              ::testing::HasSubstr("drill.yaml: looks.attempts[0].slant: expected a number in [0, 1.4], got '2'"));
   EXPECT_EQ(error_of("hole:\n  attempts: 3\n"),
             "drill.yaml: hole.attempts: expected a list of maps, got '3' (line 2)");
   EXPECT_EQ(error_of("buffers:\n  frames: 0\n"),
@@ -208,7 +212,7 @@ TEST(DrillParamsFile, AnUnknownKeyIsRefusedNamingIt) {
             "replan_shift");
   EXPECT_EQ(error_of("looks:\n  attempts:\n    - {between: false, furthr: 0.1}\n"),
             "drill.yaml: looks.attempts[0].furthr: unknown key (line 3); known keys of "
-            "looks.attempts[0]: between, further");
+            "looks.attempts[0]: between, further, slant");
   EXPECT_EQ(error_of("cameras: {}\n"),
             "drill.yaml: cameras: unknown key (line 1); known keys: approach, bim, blobs, buffers, "
             "camera, hole, liveness, looks, motion, paths, placement, plan_requests, rest, survey, thermal");

@@ -40,8 +40,12 @@ struct HoleAttempt {
 struct LookAttempt {
   /// The camera centred between the hole and its marker (both in view), not on the mark.
   bool between{false};
-  /// [m] the camera this much beyond its distance at the hole's posture.
+  /// [m] the camera this much beyond its distance at the hole's posture (with slant: at most).
   double further{0.0};
+  /// [rad] > 0: the camera sees the mark from any side within this of the wall's normal, as
+  /// near as frames the mark and at most `further` beyond the hole's distance
+  /// (PlanRequest.view_slant); a marker hole's look only, not with `between`.
+  double slant{0.0};
 
   bool operator==(const LookAttempt&) const = default;
 };
@@ -170,9 +174,10 @@ struct Params {
     double marker_drift{0.05};
     /// [N] the force a placement's look is checked with: none is drilled (the planner's least).
     double look_force{1.0};
-    /// Looks in order: on the mark, further out, then centred between hole and marker.
+    /// Looks in order: on the mark, further out, then centred between hole and marker, then
+    /// at the marker from any side.
     std::vector<LookAttempt> attempts{
-        {false, 0.0}, {false, 0.1}, {false, 0.2}, {true, 0.2}, {true, 0.3}};
+        {false, 0.0, 0.0}, {false, 0.1, 0.0}, {false, 0.2, 0.0}, {true, 0.2, 0.0}, {true, 0.3, 0.0}, {false, 0.85, 0.8}};
   };
 
   /// An area's base placement (placement.hpp).

@@ -29,6 +29,8 @@ struct PlanAsk {
   std::vector<std::string> start_names;  ///< empty: from the robot's current state
   std::vector<double> start_position;
   double camera_distance{0.0};      ///< [m]; <= 0: the planner's
+  double view_slant{0.0};           ///< [rad] > 0: a look from any side within this of the normal
+  double view_near{0.0};            ///< [m] with view_slant: the camera at least this far
   bool fixed_base{false};
   double environment_padding{0.0};  ///< [m]; <= 0: the planner's
   double base_travel{0.0};          ///< [m and rad]; <= 0: unbounded

@@ -1835,6 +1835,16 @@ PlanAsk DrillEngine::look_plan(std::size_t attempt) const {
                          (patterns_ ? marker_look_radius(patterns_->marker_size(), 0.0) : 0.0);
     distance = std::max(distance, any_roll_distance(reach, fov));
   }
+  const LookAttempt& attempt_row = tuning_.looks.attempts[attempt];
+  r.view_slant = 0.0;
+  r.view_near = 0.0;
+  if (attempt_row.slant > 0.0 && !attempt_row.between) {
+    // From any side: as near as frames the mark whichever way the camera rolls, out to
+    // `further` beyond the posture's distance; the planner takes the axis through the mark.
+    r.view_slant = attempt_row.slant;
+    r.view_near = look_reach_ > 0.0 ? any_roll_distance(look_reach_, fov) : 0.0;
+    distance = std::max(hole_reached_, r.view_near) + attempt_row.further;
+  }
   r.goals.push_back(goal);
   r.tip_distance = 0.0;
   r.tip_reach = 0.0;
@@ -2309,7 +2319,8 @@ void DrillEngine::look_at_hole_step() {
     start_reanchor(Motion::kLookReanchor);
   } else if (r->state == PlanState::kFailed &&
              look_attempt_ + 1 < tuning_.looks.attempts.size() &&
-             (point_.marker >= 0 || !tuning_.looks.attempts[look_attempt_ + 1].between)) {
+             (point_.marker >= 0 || (!tuning_.looks.attempts[look_attempt_ + 1].between &&
+                                     tuning_.looks.attempts[look_attempt_ + 1].slant <= 0.0))) {
     request_look(look_attempt_ + 1);
   } else if (r->state == PlanState::kFailed) {
     log_line("drill: " + point_.label + ": the camera cannot be turned onto " +

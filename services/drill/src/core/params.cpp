@@ -121,6 +121,9 @@ void read_looks(Map m, Params::Looks& l) {
   m.sequence("attempts", l.attempts, [](Map& item, LookAttempt& a) {
     item.boolean("between", a.between);
     item.number("further", a.further, Range::non_negative());
+    item.number("slant", a.slant, Range::between(0.0, 1.4));
+    if (a.between && a.slant > 0.0)
+      item.fail("slant", "a look centred between hole and marker is on the wall's normal: slant must be 0 with between");
   });
 }
 

@@ -120,6 +120,8 @@ msg::PlanRequest to_msg(const PlanAsk& a) {
   r.start_names(a.start_names);
   r.start_position(a.start_position);
   r.camera_distance(a.camera_distance);
+  r.view_slant(a.view_slant);
+  r.view_near(a.view_near);
   r.fixed_base(a.fixed_base);
   r.environment_padding(a.environment_padding);
   r.base_travel(a.base_travel);
