@@ -740,13 +740,9 @@ PlanResult Planner::plan(const PlanRequest& request, const Eigen::VectorXd& q_st
     };
     for (int attempt = 0;; ++attempt) {
       const auto t_posture = Clock::now();
-      Params attempt_params = request_params;
-      attempt_params.camera_distance = distance;
-      attempt_params.view_slant = task_params.view_slant;
-      attempt_params.view_near = task_params.view_near;
+      Params attempt_params = task_params;
       attempt_params.fixed_base = request.fixed_base;
       attempt_params.base_travel = request.base_travel;
-      attempt_params.tip_task = tip;
       attempt_params.tip_reach = tip ? request.tip_reach : 0.0;
       PostureResult posture;
       do {
