@@ -6,18 +6,25 @@
 # tools/mcap_check: Foxglove's MCAP reader, run by the bag tests; services/gui/app: the operator GUI's
 # three.js, urdf-loader, esbuild and playwright-core) are installed from their committed lockfiles with `npm ci`, when node_modules is missing or
 # older than the lockfile; nothing is fetched at run time.
-# Usage: deploy/install-deps.sh [--check]   (--check: only report what is missing; exit 1 if any)
+# Usage: deploy/install-deps.sh [--check | --runtime]
+#   --check: only report what is missing; exit 1 if any
+#   --runtime: only what the stack needs to run (packages/runtime.txt), no npm step and no
+#              kernel settings: the runtime image (deploy/image/Containerfile, deploy/Dockerfile)
 set -euo pipefail
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 check_only=0
+runtime_only=0
 case "${1:-}" in
   --check) check_only=1 ;;
+  --runtime) runtime_only=1 ;;
   "") ;;
-  *) echo "install-deps.sh: unknown argument '$1' (expected --check or nothing)" >&2; exit 2 ;;
+  *) echo "install-deps.sh: unknown argument '$1' (expected --check, --runtime or nothing)" >&2; exit 2 ;;
 esac
 
-mapfile -t wanted < <(cat "$here"/packages/*.txt | sed 's/#.*//' | tr -s ' \t' '\n' | sed '/^$/d' | sort -u)
+lists=("$here"/packages/*.txt)
+[ "$runtime_only" -eq 1 ] && lists=("$here/packages/runtime.txt")
+mapfile -t wanted < <(cat "${lists[@]}" | sed 's/#.*//' | tr -s ' \t' '\n' | sed '/^$/d' | sort -u)
 
 missing=()
 for pkg in "${wanted[@]}"; do
@@ -43,6 +50,9 @@ else
   $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
   echo "install-deps: done"
 fi
+# The runtime image gets its npm packages and kernel settings from elsewhere (the staged tree;
+# the host's sysctl: a container shares its host's network namespace).
+[ "$runtime_only" -eq 1 ] && exit 0
 
 # npm packages, one folder per Node.js step, from its committed package-lock.json. Quiet when
 # node_modules is already newer than the lockfile.
