@@ -16,12 +16,13 @@ FUZZ_CMAKE_ARGS ?=
 export CCACHE_BASEDIR ?= $(CURDIR)
 export CCACHE_NOHASHDIR ?= 1
 
-.PHONY: all deps configure build test demo bench chaos shift fuzz fuzz-configure fuzz-smoke idl-lock clean help
+.PHONY: all deps configure build image test demo bench chaos shift fuzz fuzz-configure fuzz-smoke idl-lock clean help
 
 all: build
 
 help:
 	@echo "make demo   install what is missing, build, run the stack in simulation"
+	@echo "make image  the deployment's container image from this build (deploy/README.md)"
 	@echo "make test   install what is missing, build, run every test with ctest"
 	@echo "make bench  build and run the benchmarks (BENCHES=\"bench_x ...\": some); figures go to docs/benchmarks.md"
 	@echo "make chaos  the chaos test: SIGKILL every service of concert up under a task"
@@ -40,8 +41,14 @@ configure: deps
 build: configure
 	cmake --build $(BUILD_DIR) -j$(JOBS)
 
-test: build
-	cd $(BUILD_DIR) && ctest --output-on-failure -j$(JOBS) --timeout 300
+# The runtime image of the deployment from this build tree (deploy/README.md); the compose
+# test of `make test` runs it. IMAGE: its name.
+IMAGE ?= concert/stack:latest
+image: build
+	CONCERT_IMAGE=$(IMAGE) ./deploy/image/build.sh $(BUILD_DIR)
+
+test: build image
+	cd $(BUILD_DIR) && CONCERT_IMAGE=$(IMAGE) ctest --output-on-failure -j$(JOBS) --timeout 300
 
 demo: build
 	./deploy/demo.sh $(BUILD_DIR)
