@@ -1,4 +1,5 @@
 #include "concert/simbus/assembly.hpp"
+#include "concert/simbus/bus.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -231,25 +232,6 @@ int32_t robot_id_of(const MountedModule& m, std::size_t esc) {
   return esc < m.robot_ids.size() ? m.robot_ids[esc] : -1;
 }
 
-constexpr int32_t kNone = -1;
-constexpr int32_t kMaster = -2;
-
-struct BusEsc {
-  EscIdentity identity;
-  int32_t esc_type = 0;
-  int32_t robot_id = -1;
-  std::optional<int32_t> reported_topology;                      // a wrong_topology fault
-  std::array<int32_t, 4> peer{kNone, kNone, kNone, kNone};       // ESC index or kMaster
-  std::array<int32_t, 4> peer_port{kNone, kNone, kNone, kNone};
-};
-
-void connect(std::vector<BusEsc>& escs, int32_t a, int32_t port_a, int32_t b, int32_t port_b) {
-  escs[static_cast<std::size_t>(a)].peer[static_cast<std::size_t>(port_a)] = b;
-  escs[static_cast<std::size_t>(a)].peer_port[static_cast<std::size_t>(port_a)] = port_b;
-  escs[static_cast<std::size_t>(b)].peer[static_cast<std::size_t>(port_b)] = a;
-  escs[static_cast<std::size_t>(b)].peer_port[static_cast<std::size_t>(port_b)] = port_a;
-}
-
 }  // namespace
 
 Assembly parse_assembly(std::string_view yaml_text, const std::string& source) {
@@ -363,18 +345,41 @@ void validate(const Assembly& assembly, const EscCatalog& catalog, PortOrder ord
   (void)resolve(assembly, catalog, order);
 }
 
-EscScan simulate_scan(const Assembly& assembly, const EscCatalog& catalog, PortOrder order) {
+uint8_t BusEsc::open_ports() const {
+  uint8_t mask = 0;
+  for (std::size_t p = 0; p < 4; ++p) {
+    if (peer[p] != kNoPeer) mask = static_cast<uint8_t>(mask | (1U << p));
+  }
+  return mask;
+}
+
+namespace {
+
+void connect(std::vector<BusEsc>& escs, int32_t a, int32_t port_a, int32_t b, int32_t port_b) {
+  escs[static_cast<std::size_t>(a)].peer[static_cast<std::size_t>(port_a)] = b;
+  escs[static_cast<std::size_t>(a)].peer_port[static_cast<std::size_t>(port_a)] = port_b;
+  escs[static_cast<std::size_t>(b)].peer[static_cast<std::size_t>(port_b)] = a;
+  escs[static_cast<std::size_t>(b)].peer_port[static_cast<std::size_t>(port_b)] = port_a;
+}
+
+}  // namespace
+
+Bus wire_bus(const Assembly& assembly, const EscCatalog& catalog, PortOrder order) {
   const Resolved r = resolve(assembly, catalog, order);
   const std::size_t n = assembly.modules.size();
 
   // Wire every ESC: inside modules (secondary ESCs), between modules (connectors), master.
-  std::vector<BusEsc> escs;
+  Bus bus;
+  std::vector<BusEsc>& escs = bus.escs;
   std::vector<int32_t> first_esc(n, 0);
   for (std::size_t m = 0; m < n; ++m) {
     first_esc[m] = static_cast<int32_t>(escs.size());
     const ModuleLayout& layout = r.layouts[m];
     for (std::size_t e = 0; e < layout.escs.size(); ++e) {
       BusEsc esc;
+      esc.module = assembly.modules[m].name;
+      esc.module_esc = static_cast<int32_t>(e);
+      esc.board = layout.escs[e].board;
       esc.identity = layout.escs[e].identity;
       esc.esc_type = layout.escs[e].esc_type;
       esc.robot_id = robot_id_of(assembly.modules[m], e);
@@ -396,10 +401,11 @@ EscScan simulate_scan(const Assembly& assembly, const EscCatalog& catalog, PortO
       connect(escs, first_esc[m] + placement->esc, placement->port, first_esc[child], 0);
     }
   }
-  if (broken[r.root]) return EscScan{};
+  if (broken[r.root]) return bus;
+  bus.root = first_esc[r.root];
   {
-    auto& root = escs[static_cast<std::size_t>(first_esc[r.root])];
-    root.peer[0] = kMaster;
+    auto& root = escs[static_cast<std::size_t>(bus.root)];
+    root.peer[0] = kMasterPeer;
     root.peer_port[0] = 0;
   }
   for (const Fault& f : assembly.faults) {
@@ -424,8 +430,8 @@ EscScan simulate_scan(const Assembly& assembly, const EscCatalog& catalog, PortO
       const std::array<int32_t, 2> peer_ports{esc.peer_port[0],
                                               esc.peer_port[static_cast<std::size_t>(port)]};
       const std::array<int32_t, 2> new_ports{static_cast<int32_t>(port), 0};
-      esc.peer[0] = kNone;
-      esc.peer[static_cast<std::size_t>(port)] = kNone;
+      esc.peer[0] = kNoPeer;
+      esc.peer[static_cast<std::size_t>(port)] = kNoPeer;
       for (std::size_t k = 0; k < 2; ++k) {
         const int32_t p = new_ports[k];
         esc.peer[static_cast<std::size_t>(p)] = peers[k];
@@ -437,53 +443,78 @@ EscScan simulate_scan(const Assembly& assembly, const EscCatalog& catalog, PortO
       }
     }
   }
+  return bus;
+}
 
-  // Follow the frame: an ESC receiving on port L[j] forwards to L[j+1] (closed ports loop
-  // back at once); the EPU sits between receiving on port 0 and forwarding to L[1].
+std::vector<FrameStep> follow_frame(const Bus& bus, PortOrder order) {
+  std::vector<FrameStep> steps;
+  if (bus.root < 0) return steps;
+  // An ESC receiving on port L[j] forwards to L[j+1] (closed ports loop back at once); the EPU
+  // sits between receiving on port 0 and forwarding to L[1].
   const auto loop = topology::frame_order(order);
   std::array<int32_t, 4> loop_index{};
   for (std::size_t k = 0; k < 4; ++k) loop_index[static_cast<std::size_t>(loop[k])] = static_cast<int32_t>(k);
-  const auto root = static_cast<std::size_t>(first_esc[r.root]);
+  const auto& escs = bus.escs;
   int32_t entry = 0;
   for (std::size_t p = 0; p < 4; ++p) {
-    if (escs[root].peer[p] == kMaster) entry = static_cast<int32_t>(p);
+    if (escs[static_cast<std::size_t>(bus.root)].peer[p] == kMasterPeer) entry = static_cast<int32_t>(p);
   }
+  using Kind = FrameStep::Kind;
   struct Visit {
     int32_t esc;
     int32_t entry_index;
     int32_t step;
   };
-  std::vector<Visit> stack{{static_cast<int32_t>(root), loop_index[static_cast<std::size_t>(entry)], 0}};
-  EscScan scan;
+  std::vector<Visit> stack{{bus.root, loop_index[static_cast<std::size_t>(entry)], 0}};
+  steps.push_back({Kind::kReceive, bus.root, entry});
   while (!stack.empty()) {
     Visit& v = stack.back();
     if (v.step == 4) {
+      // Back out through the entry port, to the parent's port the frame left by.
+      const int32_t port = loop[static_cast<std::size_t>(v.entry_index)];
+      steps.push_back({Kind::kSend, v.esc, port});
       stack.pop_back();
+      if (!stack.empty()) {
+        const Visit& parent = stack.back();
+        const auto at = static_cast<std::size_t>((parent.entry_index + parent.step) % 4);
+        steps.push_back({Kind::kReceive, parent.esc, loop[at]});
+      }
       continue;
     }
     ++v.step;
     const auto index = static_cast<std::size_t>((v.entry_index + v.step) % 4);
     const BusEsc& esc = escs[static_cast<std::size_t>(v.esc)];
-    if (index == 1) {
-      EscSlave s;
-      s.position = static_cast<int32_t>(scan.slaves.size()) + 1;
-      for (std::size_t p = 0; p < 4; ++p) {
-        if (esc.peer[p] != kNone) s.active_ports = static_cast<uint8_t>(s.active_ports | (1U << p));
-      }
-      s.topology =
-          esc.reported_topology.value_or(std::popcount(static_cast<unsigned>(s.active_ports)));
-      s.esc_type = esc.esc_type;
-      s.identity = esc.identity;
-      s.robot_id = esc.robot_id;
-      scan.slaves.push_back(s);
-    }
-    if (v.step == 4) continue;  // back out through the entry port
+    if (index == 1) steps.push_back({Kind::kProcess, v.esc, 0});
+    if (v.step == 4) continue;
     const auto port = static_cast<std::size_t>(loop[index]);
     if (esc.peer[port] >= 0) {
       const int32_t next = esc.peer[port];
-      const int32_t next_entry = loop_index[static_cast<std::size_t>(esc.peer_port[port])];
-      stack.push_back(Visit{next, next_entry, 0});
+      const int32_t next_port = esc.peer_port[port];
+      steps.push_back({Kind::kSend, v.esc, static_cast<int32_t>(port)});
+      steps.push_back({Kind::kReceive, next, next_port});
+      stack.push_back(Visit{next, loop_index[static_cast<std::size_t>(next_port)], 0});
+    } else {
+      steps.push_back({Kind::kLoopback, v.esc, static_cast<int32_t>(port)});
     }
+  }
+  return steps;
+}
+
+EscScan simulate_scan(const Assembly& assembly, const EscCatalog& catalog, PortOrder order) {
+  const Bus bus = wire_bus(assembly, catalog, order);
+  EscScan scan;
+  for (const FrameStep& step : follow_frame(bus, order)) {
+    if (step.kind != FrameStep::Kind::kProcess) continue;
+    const BusEsc& esc = bus.escs[static_cast<std::size_t>(step.esc)];
+    EscSlave s;
+    s.position = static_cast<int32_t>(scan.slaves.size()) + 1;
+    s.active_ports = esc.open_ports();
+    s.topology =
+        esc.reported_topology.value_or(std::popcount(static_cast<unsigned>(s.active_ports)));
+    s.esc_type = esc.esc_type;
+    s.identity = esc.identity;
+    s.robot_id = esc.robot_id;
+    scan.slaves.push_back(s);
   }
   return scan;
 }
