@@ -1,0 +1,116 @@
+#pragma once
+// A small user-space EtherCAT master: frames of datagrams over a Link, working counters checked,
+// and the bring-up a master does before anything else (ETG.1000.4; SOEM's ecx_config_init does the
+// same steps): count the slaves (BRD), reset them to INIT, give each a station address (APWR
+// 0x0010), read each one's ESC information, DL status (its ports' link and loop state), DC port
+// receive times and SII EEPROM. The result is the scan discovery rebuilds the robot from.
+// Written here because Debian 12 packages no EtherCAT master library.
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "concert/ethercat/frame.hpp"
+#include "concert/ethercat/link.hpp"
+#include "concert/ethercat/sii.hpp"
+#include "concert/topology/types.hpp"
+
+namespace concert::ethercat {
+
+/// Tuning of the master (concert scan read takes these as options).
+struct MasterParams {
+  /// How long to wait for a frame to come back before sending it again.
+  std::chrono::microseconds frame_timeout{20000};
+  /// Sends of one frame before the exchange fails (1 = no retry).
+  int tries = 3;
+  /// Station address of the slave at position 1; the next positions count up from it.
+  uint16_t first_station_address = 0x1001;
+  /// More slaves than this on one ring is an error (a loop or a fault, not a robot).
+  int max_slaves = 256;
+  /// EEPROM status reads per EEPROM read before the slave counts as not answering.
+  int eeprom_polls = 100;
+  /// Words of SII EEPROM read per slave at most (the category list must end before).
+  int max_sii_words = 4096;
+};
+
+/// A ring that does not answer as an EtherCAT ring must; what() names the slave (position and
+/// station address), the command and the register, the working counter got and expected.
+class MasterError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Everything bring-up read from one slave.
+struct SlaveReport {
+  int32_t position = 0;           ///< 1..n, ring order (the order the frame meets the EPUs)
+  uint16_t station_address = 0;   ///< as assigned
+  uint8_t chip_type = 0;          ///< register 0x0000
+  uint8_t chip_revision = 0;
+  uint16_t chip_build = 0;
+  uint8_t fmmus = 0;
+  uint8_t sync_managers = 0;
+  uint8_t ram_kib = 0;
+  uint8_t port_descriptor = 0;    ///< register 0x0007
+  uint16_t dl_status = 0;         ///< register 0x0110
+  uint16_t al_status = 0;         ///< register 0x0130
+  uint16_t al_status_code = 0;    ///< register 0x0134
+  /// DC receive times of ports 0..3 (local clock, ns), latched by one broadcast frame.
+  std::array<uint32_t, 4> receive_time{};
+  SiiIdentity sii;
+  topology::EscSlave slave;       ///< the scan's row for this slave
+};
+
+/// The result of a bring-up.
+struct ScanReport {
+  std::string link;                  ///< interface name
+  std::vector<SlaveReport> slaves;   ///< ring order
+  int frames_sent = 0;
+  int frames_lost = 0;               ///< frames that did not come back in time (and were resent)
+
+  /// The scan in discovery's format (libs/topology).
+  topology::EscScan scan() const;
+};
+
+class Master {
+ public:
+  explicit Master(Link& link, MasterParams params = {});
+
+  /// Brings the ring up as far as INIT and reads it. An empty ring (the frame comes back with
+  /// working counter 0) is an empty scan. Throws MasterError (nothing comes back, a slave does
+  /// not answer, an EEPROM that cannot be read, more than max_slaves) and LinkError.
+  ScanReport scan();
+
+  /// Sends `datagrams` in one frame (all with one index) and returns them as they came back.
+  /// Resends up to `tries` times. Throws MasterError when nothing comes back, LinkError.
+  std::vector<Datagram> exchange(std::vector<Datagram> datagrams);
+
+  /// Sends per-slave datagrams in as few frames as fit, in order; returns the answers in order.
+  std::vector<Datagram> exchange_all(std::vector<Datagram> datagrams);
+
+  int frames_sent() const { return frames_sent_; }
+  int frames_lost() const { return frames_lost_; }
+
+ private:
+  Link& link_;
+  MasterParams params_;
+  Frame frame_;
+  std::vector<uint8_t> bytes_;
+  uint8_t next_index_ = 0;
+  int frames_sent_ = 0;
+  int frames_lost_ = 0;
+};
+
+/// A datagram for `command` at station/position `adp`, register `ado`, with `size` zero bytes of
+/// data (reads) or `data` (writes).
+Datagram make_datagram(Command command, uint16_t adp, uint16_t ado, std::size_t size);
+Datagram make_datagram(Command command, uint16_t adp, uint16_t ado, std::vector<uint8_t> data);
+
+/// Little-endian helpers for datagram data.
+uint16_t read16(const std::vector<uint8_t>& data, std::size_t at = 0);
+uint32_t read32(const std::vector<uint8_t>& data, std::size_t at = 0);
+std::vector<uint8_t> bytes16(uint16_t value);
+
+}  // namespace concert::ethercat

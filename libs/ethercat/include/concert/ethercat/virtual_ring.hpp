@@ -1,0 +1,85 @@
+#pragma once
+// A virtual EtherCAT ring: the ESCs of an assembly (libs/simbus) answering frames as the real
+// ones do. Each ESC has its register space, an SII EEPROM holding its board's identity
+// (sii.hpp), its ports wired as the modules are bolted together; a frame runs through the ESCs
+// in the real port order (0 -> EPU -> 3 -> 1 -> 2, closed ports looping back), each ESC's EPU
+// executing every datagram in turn: auto-increment addresses counted down, station addresses
+// matched, broadcast reads OR-ed, working counters incremented, DC receive times latched per
+// port. concert_ecat_ring serves one over a network interface; tests call process() directly.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "concert/ethercat/esc.hpp"
+#include "concert/ethercat/frame.hpp"
+#include "concert/simbus/assembly.hpp"
+#include "concert/simbus/bus.hpp"
+#include "concert/topology/esc_catalog.hpp"
+
+namespace concert::ethercat {
+
+/// Tuning of the virtual ring (concert_ecat_ring options).
+struct RingParams {
+  uint32_t vendor_id = 0;           ///< SII vendor id of every board (the real one is not on record here)
+  uint32_t esc_delay_ns = 140;      ///< a frame's time through one ESC step (port to EPU, loopback)
+  uint32_t cable_delay_ns = 10;     ///< a frame's time on one cable
+  uint64_t clock_seed = 1;          ///< seeds each ESC's local clock offset
+  bool eeprom_8_byte_reads = false; ///< ESCs that read 8 bytes per EEPROM command (ET1100 does 4 or 8)
+};
+
+/// Counters of what the ring saw.
+struct RingCounters {
+  uint64_t frames = 0;      ///< EtherCAT frames answered
+  uint64_t malformed = 0;   ///< frames dropped as unreadable
+  uint64_t datagrams = 0;
+  std::string last_error;   ///< why the last malformed frame was dropped
+};
+
+class VirtualRing {
+ public:
+  /// The ring of `assembly` (faults applied as simbus applies them). Throws
+  /// simbus::AssemblyError.
+  VirtualRing(const simbus::Assembly& assembly, const topology::EscCatalog& catalog,
+              RingParams params = {});
+
+  /// The frame as it comes back to the master after passing every ESC, or nothing when it does
+  /// not come back (no ESC on the master's port, or bytes that are not an EtherCAT frame:
+  /// counted, the reason in counters().last_error). `now_ns` is the time the frame leaves the
+  /// master (the ESCs' clocks run from it).
+  std::optional<std::vector<uint8_t>> process(std::span<const uint8_t> frame, uint64_t now_ns);
+
+  /// Number of ESCs answering.
+  std::size_t slave_count() const { return order_.size(); }
+  const RingCounters& counters() const { return counters_; }
+
+  /// The register bytes of the ESC at ring position `position` (1-based), for tests.
+  std::span<const uint8_t> registers(int position) const;
+
+ private:
+  struct Esc {
+    simbus::BusEsc bus;
+    std::vector<uint8_t> memory;      // registers and process RAM
+    std::vector<uint16_t> sii;        // EEPROM words
+    uint64_t clock_offset_ns = 0;     // local clock = master time + offset
+    bool latch = false;               // a write to 0x0900 in the frame being processed
+  };
+
+  void execute(Esc& esc, Datagram& d);
+  void after_write(Esc& esc, uint16_t from, uint16_t to);
+  void eeprom_command(Esc& esc);
+  void al_control(Esc& esc);
+  uint16_t get16(const Esc& esc, uint16_t at) const;
+  void put16(Esc& esc, uint16_t at, uint16_t value);
+
+  RingParams params_;
+  std::vector<Esc> escs_;                 // bus order
+  std::vector<int32_t> order_;            // EPU order: ESC index per ring position
+  std::vector<simbus::FrameStep> path_;
+  std::vector<uint64_t> step_time_ns_;    // time of each step after the frame leaves the master
+  RingCounters counters_;
+};
+
+}  // namespace concert::ethercat

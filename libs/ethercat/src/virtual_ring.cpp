@@ -1,0 +1,282 @@
+#include "concert/ethercat/virtual_ring.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <random>
+
+#include "concert/ethercat/sii.hpp"
+
+namespace concert::ethercat {
+namespace {
+
+// Register space and process RAM of an ET1100 (8 KiB of process RAM from 0x1000).
+constexpr std::size_t kMemoryBytes = 0x3000;
+
+// Chip types of register 0x0000 (ET1100 and ET1200 datasheets).
+constexpr uint8_t kChipEt1100 = 0x11;
+constexpr uint8_t kChipEt1200 = 0x12;
+
+/// Registers the EtherCAT side may write (the rest are read-only or PDI-owned, and a write there
+/// changes nothing, as on an ESC). Ranges are inclusive.
+constexpr std::array<std::pair<uint16_t, uint16_t>, 12> kWritable{{
+    {0x0010, 0x0011},  // configured station address
+    {0x0100, 0x0103},  // DL control
+    {0x0120, 0x0121},  // AL control
+    {0x0200, 0x0201},  // ECAT event mask
+    {0x0300, 0x0313},  // error counters (a write clears them)
+    {0x0400, 0x0401},  // watchdog divider
+    {0x0410, 0x0411},  // PDI watchdog time
+    {0x0420, 0x0421},  // process data watchdog time
+    {0x0500, 0x0500},  // EEPROM configuration (offer to PDI)
+    {0x0502, 0x050F},  // EEPROM control, address, data
+    {0x0600, 0x09FF},  // FMMUs, sync managers, distributed clocks
+    {0x1000, 0x2FFF},  // process RAM
+}};
+
+bool writable(std::size_t address) {
+  for (const auto& [from, to] : kWritable) {
+    if (address >= from && address <= to) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+VirtualRing::VirtualRing(const simbus::Assembly& assembly, const topology::EscCatalog& catalog,
+                         RingParams params)
+    : params_(params) {
+  const simbus::Bus bus = simbus::wire_bus(assembly, catalog);
+  path_ = simbus::follow_frame(bus);
+  std::mt19937_64 clocks(params_.clock_seed);
+  std::uniform_int_distribution<uint64_t> offset(0, 1'000'000'000ULL);
+  for (std::size_t i = 0; i < bus.escs.size(); ++i) {
+    const simbus::BusEsc& b = bus.escs[i];
+    Esc e;
+    e.bus = b;
+    e.memory.assign(kMemoryBytes, 0);
+    e.clock_offset_ns = offset(clocks);
+    const bool four = b.board == topology::EscBoard::kFourPort;
+    e.memory[esc::kType] = four ? kChipEt1100 : kChipEt1200;
+    e.memory[esc::kFmmusSupported] = four ? 8 : 3;
+    e.memory[esc::kSyncManagersSupported] = four ? 8 : 4;
+    e.memory[esc::kRamSize] = four ? 8 : 1;
+    e.memory[esc::kPortDescriptor] = four ? 0xAA : 0x0A;  // EBUS on each port the board has
+    // DL status: ports with a peer are linked, open and communicating; the others closed. A
+    // wrong_topology fault is a physical link without communication (a cable to a module that
+    // does not answer) or a link the PHY misses: the linked-port count disagrees with the open
+    // ports, as masters that count links then report.
+    uint16_t dl = esc::kDlPdiOperational;
+    uint8_t linked = b.open_ports();
+    for (int p = 0; p < 4; ++p) {
+      if (linked & (1U << p)) {
+        dl |= esc::dl_communication(p);
+      } else {
+        dl |= esc::dl_loop_closed(p);
+      }
+    }
+    if (b.reported_topology) {
+      const int want = *b.reported_topology;
+      for (int p = 0; p < 4 && std::popcount(static_cast<unsigned>(linked)) < want; ++p) {
+        linked = static_cast<uint8_t>(linked | (1U << p));
+      }
+      for (int p = 3; p >= 0 && std::popcount(static_cast<unsigned>(linked)) > want; --p) {
+        linked = static_cast<uint8_t>(linked & ~(1U << p));
+      }
+    }
+    for (int p = 0; p < 4; ++p) {
+      if (linked & (1U << p)) dl |= esc::dl_link(p);
+    }
+    put16(e, esc::kDlStatus, dl);
+    put16(e, esc::kAlStatus, static_cast<uint16_t>(esc::AlState::kInit));
+    if (params_.eeprom_8_byte_reads) put16(e, esc::kEepromControl, esc::kEeprom8ByteRead);
+    SiiIdentity sii;
+    sii.vendor_id = params_.vendor_id;
+    sii.product_code = static_cast<uint32_t>(b.esc_type);
+    sii.serial = static_cast<uint32_t>(i + 1);
+    sii.module = b.identity;
+    sii.robot_id = b.robot_id;
+    e.sii = make_sii_image(sii);
+    escs_.push_back(std::move(e));
+  }
+  uint64_t t = 0;
+  for (const simbus::FrameStep& step : path_) {
+    t += step.kind == simbus::FrameStep::Kind::kSend ? params_.cable_delay_ns : params_.esc_delay_ns;
+    step_time_ns_.push_back(t);
+    if (step.kind == simbus::FrameStep::Kind::kProcess) order_.push_back(step.esc);
+  }
+}
+
+uint16_t VirtualRing::get16(const Esc& esc, uint16_t at) const {
+  return static_cast<uint16_t>(esc.memory[at] | (esc.memory[at + 1u] << 8));
+}
+
+void VirtualRing::put16(Esc& esc, uint16_t at, uint16_t value) {
+  esc.memory[at] = static_cast<uint8_t>(value & 0xFF);
+  esc.memory[at + 1u] = static_cast<uint8_t>(value >> 8);
+}
+
+std::span<const uint8_t> VirtualRing::registers(int position) const {
+  return escs_.at(static_cast<std::size_t>(order_.at(static_cast<std::size_t>(position - 1)))).memory;
+}
+
+void VirtualRing::eeprom_command(Esc& esc) {
+  uint16_t control = get16(esc, esc::kEepromControl);
+  const uint16_t command = control & esc::kEepromCommandMask;
+  control = static_cast<uint16_t>(control & ~(esc::kEepromCommandMask | esc::kEepromErrorMask | esc::kEepromBusy));
+  if (params_.eeprom_8_byte_reads) control |= esc::kEeprom8ByteRead;
+  if (command == esc::kEepromCommandRead) {
+    const uint32_t word = static_cast<uint32_t>(esc.memory[esc::kEepromAddress]) |
+                          (static_cast<uint32_t>(esc.memory[esc::kEepromAddress + 1]) << 8) |
+                          (static_cast<uint32_t>(esc.memory[esc::kEepromAddress + 2]) << 16) |
+                          (static_cast<uint32_t>(esc.memory[esc::kEepromAddress + 3]) << 24);
+    const int words = params_.eeprom_8_byte_reads ? 4 : 2;
+    for (int k = 0; k < words; ++k) {
+      // An erased EEPROM reads 0xFFFF beyond the image.
+      const uint16_t value = word + k < esc.sii.size() ? esc.sii[word + k] : 0xFFFF;
+      put16(esc, static_cast<uint16_t>(esc::kEepromData + 2 * k), value);
+    }
+  } else if (command != 0) {
+    // Writes and reloads are not offered: the boards' identity is not rewritten from the bus.
+    control |= esc::kEepromAcknowledgeError;
+  }
+  put16(esc, esc::kEepromControl, control);
+}
+
+void VirtualRing::al_control(Esc& esc) {
+  const uint16_t control = get16(esc, esc::kAlControl);
+  const uint16_t status = get16(esc, esc::kAlStatus);
+  const auto current = esc::al_state_from(status).value_or(esc::AlState::kInit);
+  const auto requested = esc::al_state_from(control);
+  const bool error = (status & esc::kAlErrorBit) != 0;
+  const bool acknowledge = (control & esc::kAlErrorBit) != 0;
+  if (error && !acknowledge && requested != esc::AlState::kInit) return;  // error stays until acknowledged
+  const auto set = [&](esc::AlState state, uint16_t code) {
+    put16(esc, esc::kAlStatus, static_cast<uint16_t>(static_cast<uint16_t>(state) | (code ? esc::kAlErrorBit : 0)));
+    put16(esc, esc::kAlStatusCode, code);
+  };
+  if (!requested) {
+    set(current, 0x0012);  // unknown requested state
+    return;
+  }
+  using S = esc::AlState;
+  const S to = *requested;
+  const bool allowed = to == S::kInit || to == current ||
+                       (current == S::kInit && (to == S::kPreOp || to == S::kBoot)) ||
+                       (current == S::kPreOp && to == S::kSafeOp) ||
+                       (current == S::kSafeOp && (to == S::kOp || to == S::kPreOp)) ||
+                       (current == S::kOp && (to == S::kSafeOp || to == S::kPreOp));
+  if (to == S::kBoot) {
+    set(current, 0x0013);  // bootstrap not supported
+  } else if (!allowed) {
+    set(current, 0x0011);  // invalid requested state change
+  } else {
+    set(to, 0);
+  }
+}
+
+void VirtualRing::after_write(Esc& esc, uint16_t from, uint16_t to) {
+  const auto touches = [&](uint16_t a, uint16_t b) { return from <= b && to >= a; };
+  if (touches(esc::kAlControl, esc::kAlControl + 1)) al_control(esc);
+  if (touches(esc::kEepromControl, esc::kEepromControl + 1)) eeprom_command(esc);
+  if (touches(esc::kDcReceiveTimePort0, esc::kDcReceiveTimePort0 + 3)) esc.latch = true;
+}
+
+void VirtualRing::execute(Esc& esc, Datagram& d) {
+  using C = Command;
+  bool addressed = false;
+  switch (d.command) {
+    case C::kArmw: case C::kFrmw: {
+      // Read multiple write (DC time distribution): the addressed slave reads, every other
+      // slave writes what the frame carries.
+      const bool reader = d.command == C::kArmw ? d.adp == 0 : d.adp == get16(esc, esc::kStationAddress);
+      if (d.command == C::kArmw) ++d.adp;
+      for (std::size_t k = 0; k < d.data.size(); ++k) {
+        const std::size_t a = static_cast<std::size_t>(d.ado) + k;
+        if (a >= esc.memory.size()) continue;
+        if (reader) {
+          d.data[k] = esc.memory[a];
+        } else if (writable(a)) {
+          esc.memory[a] = d.data[k];
+        }
+      }
+      ++d.wkc;
+      return;
+    }
+    case C::kAprd: case C::kApwr: case C::kAprw:
+      addressed = d.adp == 0;
+      ++d.adp;  // every ESC counts the position up as the frame passes
+      break;
+    case C::kFprd: case C::kFpwr: case C::kFprw:
+      addressed = d.adp == get16(esc, esc::kStationAddress);
+      break;
+    case C::kBrd: case C::kBwr: case C::kBrw:
+      addressed = true;
+      ++d.adp;
+      break;
+    default:
+      return;  // NOP; logical commands address no FMMU here yet
+  }
+  if (!addressed) return;
+  const bool broadcast = d.command == C::kBrd || d.command == C::kBrw;
+  const std::size_t n = d.data.size();
+  // Read-write commands: the frame takes the old contents, the memory the frame's as sent.
+  const std::vector<uint8_t> sent = writes(d.command) ? d.data : std::vector<uint8_t>{};
+  uint16_t wkc = 0;
+  if (reads(d.command)) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t a = static_cast<std::size_t>(d.ado) + k;
+      const uint8_t value = a < esc.memory.size() ? esc.memory[a] : 0;
+      d.data[k] = broadcast ? static_cast<uint8_t>(d.data[k] | value) : value;
+    }
+    wkc += 1;
+  }
+  if (writes(d.command)) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t a = static_cast<std::size_t>(d.ado) + k;
+      if (a < esc.memory.size() && writable(a)) esc.memory[a] = sent[k];
+    }
+    if (n > 0) after_write(esc, d.ado, static_cast<uint16_t>(d.ado + n - 1));
+    // ETG.1000.4: a write adds 1, a read-write 3 (1 read + 2 write).
+    wkc = static_cast<uint16_t>(wkc + (reads(d.command) ? 2 : 1));
+  }
+  d.wkc = static_cast<uint16_t>(d.wkc + wkc);
+}
+
+std::optional<std::vector<uint8_t>> VirtualRing::process(std::span<const uint8_t> bytes, uint64_t now_ns) {
+  if (order_.empty()) return std::nullopt;
+  Frame frame;
+  try {
+    frame = decode(bytes);
+  } catch (const FrameError& e) {
+    ++counters_.malformed;
+    counters_.last_error = e.what();
+    return std::nullopt;
+  }
+  ++counters_.frames;
+  counters_.datagrams += frame.datagrams.size();
+  for (const int32_t index : order_) {
+    Esc& esc = escs_[static_cast<std::size_t>(index)];
+    esc.latch = false;
+    for (Datagram& d : frame.datagrams) execute(esc, d);
+  }
+  // DC: the ESCs a write to 0x0900 reached latch the local time the frame's first bit passed
+  // each of their ports on its way (ports it did not pass keep their old value).
+  for (std::size_t s = 0; s < path_.size(); ++s) {
+    const simbus::FrameStep& step = path_[s];
+    Esc& esc = escs_[static_cast<std::size_t>(step.esc)];
+    if (!esc.latch) continue;
+    const uint64_t local = now_ns + step_time_ns_[s] + esc.clock_offset_ns;
+    if (step.kind == simbus::FrameStep::Kind::kReceive) {
+      const auto at = static_cast<uint16_t>(esc::kDcReceiveTimePort0 + 4 * step.port);
+      for (int b = 0; b < 4; ++b) esc.memory[at + b] = static_cast<uint8_t>(local >> (8 * b));
+    } else if (step.kind == simbus::FrameStep::Kind::kProcess) {
+      for (int b = 0; b < 8; ++b) esc.memory[esc::kDcReceiveTimeEpu + b] = static_cast<uint8_t>(local >> (8 * b));
+    }
+  }
+  // The ESC on the master's port marks the frame as having passed a slave: bit 1 of the source
+  // address's first byte (locally administered).
+  frame.source[0] = static_cast<uint8_t>(frame.source[0] | 0x02);
+  return encode(frame);
+}
+
+}  // namespace concert::ethercat

@@ -1,0 +1,153 @@
+#!/usr/bin/env bash
+# The EtherCAT master on a wire. concert_ecat_ring serves an assembly's ring on one end of a veth
+# pair; `concert scan read` reads it from the other end; each end is in a network namespace this
+# test makes and removes. Every example assembly of libs/simbus must read, field for field, as
+# `concert scan show --assembly` computes it (for concert_robot_18slaves.yaml: the real scan).
+# One bring-up (the paper's 19-ESC robot) is captured with tshark and decoded by Wireshark's
+# EtherCAT dissector: no malformed frame but the one the test sends on purpose, and the commands
+# a bring-up must send are there with the working counters the ring must return.
+# Usage: ring_wire_test.sh BUILD_DIR. Exit 77 (skipped) when not root.
+set -euo pipefail
+
+build=$(cd "$1" && pwd)
+src=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+db="$src/../shared/data/concert_resources"
+examples="$src/libs/simbus/examples"
+ring_bin="$build/tools/ecat_ring/concert_ecat_ring"
+concert="$build/tools/concert/concert"
+
+if [ "$(id -u)" -ne 0 ]; then
+  echo "skipped: needs root (network namespaces and raw sockets)"
+  exit 77
+fi
+for tool in ip tshark python3; do
+  command -v "$tool" >/dev/null || { echo "FAIL: $tool is missing (deploy/install-deps.sh installs it)"; exit 1; }
+done
+
+tag=$$
+ns_master="concert-ecm-$tag"
+ns_ring="concert-ecr-$tag"
+work=$(mktemp -d)
+ring_pid=""
+tshark_pid=""
+cleanup() {
+  [ -n "$ring_pid" ] && kill "$ring_pid" 2>/dev/null || true
+  [ -n "$tshark_pid" ] && kill "$tshark_pid" 2>/dev/null || true
+  wait 2>/dev/null || true
+  ip netns del "$ns_master" 2>/dev/null || true
+  ip netns del "$ns_ring" 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+fail() { echo "FAIL: $*"; [ -f "$work/ring.log" ] && sed 's/^/  ring: /' "$work/ring.log"; exit 1; }
+
+ip netns add "$ns_master"
+ip netns add "$ns_ring"
+ip link add "ecm$tag" type veth peer name "ecr$tag"
+ip link set "ecm$tag" netns "$ns_master"
+ip link set "ecr$tag" netns "$ns_ring"
+ip -n "$ns_master" link set "ecm$tag" up
+ip -n "$ns_ring" link set "ecr$tag" up
+
+# Waits (bounded: 10 s) until FILE has a line matching PATTERN.
+wait_for_line() {
+  local file=$1 pattern=$2
+  for _ in $(seq 100); do
+    grep -q "$pattern" "$file" 2>/dev/null && return 0
+    sleep 0.1
+  done
+  return 1
+}
+
+start_ring() {
+  ip netns exec "$ns_ring" "$ring_bin" --assembly "$1" --ifname "ecr$tag" --module-db "$db" \
+    > "$work/ring.log" 2>&1 &
+  ring_pid=$!
+  wait_for_line "$work/ring.log" "concert_ecat_ring: serving" || fail "the ring did not start on $1"
+}
+
+stop_ring() {
+  kill -INT "$ring_pid"
+  local rc=0
+  wait "$ring_pid" || rc=$?
+  ring_pid=""
+  [ "$rc" -eq 0 ] || fail "concert_ecat_ring exited $rc after SIGINT"
+  grep -q "concert_ecat_ring: stopped after [1-9][0-9]* frames" "$work/ring.log" ||
+    fail "concert_ecat_ring did not report its frames on stopping"
+}
+
+# 1. Every example assembly: the master's scan is the simulated bus's.
+for file in "$examples"/*.yaml; do
+  name=$(basename "$file")
+  start_ring "$file"
+  ip netns exec "$ns_master" "$concert" scan read --ifname "ecm$tag" --json \
+    > "$work/read.json" 2> "$work/read.err" || { cat "$work/read.err"; fail "scan read failed on $name"; }
+  "$concert" scan show --assembly "$file" --module-db "$db" --json > "$work/show.json"
+  cmp -s "$work/read.json" "$work/show.json" ||
+    { diff "$work/show.json" "$work/read.json" | head -20; fail "$name: scan read differs from scan show"; }
+  stop_ring
+  echo "ok: $name: $(sed 's/concert scan read: //' "$work/read.err")"
+done
+# The 18-slave example is the real robot's: its scan read on the wire is the real scan.
+real="$src/../shared/data/ethercat/concert_robot_18slaves.yaml"
+start_ring "$examples/concert_robot_18slaves.yaml"
+ip netns exec "$ns_master" "$concert" scan read --ifname "ecm$tag" --json > "$work/read.json" 2>/dev/null
+stop_ring
+"$concert" scan show --scan "$real" --json > "$work/real.json"
+cmp -s "$work/read.json" "$work/real.json" ||
+  { diff "$work/real.json" "$work/read.json" | head -20; fail "the 18-slave ring does not read as the real scan"; }
+echo "ok: the 18-slave ring reads as ../shared/data/ethercat/concert_robot_18slaves.yaml"
+
+# 2. A captured bring-up, decoded by Wireshark.
+start_ring "$examples/concert_paper_robot.yaml"
+ip netns exec "$ns_ring" tshark -i "ecr$tag" -w "$work/bringup.pcapng" > "$work/tshark.log" 2>&1 &
+tshark_pid=$!
+wait_for_line "$work/tshark.log" "Capturing on" || fail "tshark did not start capturing"
+ip netns exec "$ns_master" "$concert" scan read --ifname "ecm$tag" > /dev/null 2> "$work/read.err" ||
+  { cat "$work/read.err"; fail "scan read failed during the capture"; }
+# One frame that is not a valid EtherCAT frame (an FPRD whose 2047 bytes of data run past the
+# frame): the ring must drop it and keep answering, and Wireshark must call it malformed (so the
+# check below can fail).
+ip netns exec "$ns_master" python3 - "ecm$tag" <<'PY'
+import socket, sys
+s = socket.socket(socket.AF_PACKET, socket.SOCK_RAW)
+s.bind((sys.argv[1], 0))
+header = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x09" + b"\x88\xa4" + b"\x20\x10"
+fprd = b"\x04\x00\x01\x10\x10\x01\xff\x07"
+s.send(header + fprd + b"\x00" * 36)
+PY
+wait_for_line "$work/ring.log" "dropped frame 1 that is not EtherCAT" || fail "the ring did not report the malformed frame"
+ip netns exec "$ns_master" "$concert" scan read --ifname "ecm$tag" > /dev/null 2>&1 ||
+  fail "the ring stopped answering after a malformed frame"
+kill -INT "$tshark_pid"
+wait "$tshark_pid" || true
+tshark_pid=""
+stop_ring
+malformed=$(tshark -r "$work/bringup.pcapng" -Y "_ws.malformed" 2>/dev/null | wc -l)
+[ "$malformed" -eq 1 ] || fail "Wireshark finds $malformed malformed frames in the capture (expected the 1 sent on purpose)"
+tshark -r "$work/bringup.pcapng" -Y "ecat && !_ws.malformed" -T fields -E separator=';' \
+  -e ecat.cmd -e ecat.adp -e ecat.ado -e ecat.cnt 2>/dev/null > "$work/datagrams.txt"
+python3 - "$work/datagrams.txt" 19 <<'PY' || fail "the capture lacks a command of the bring-up"
+import sys
+n = int(sys.argv[2])
+datagrams = []
+for line in open(sys.argv[1]):
+    cmd, adp, ado, cnt = (field.split(",") for field in line.strip().split(";"))
+    datagrams += [(int(c, 16), int(p, 16), int(o, 16), int(w)) for c, p, o, w in zip(cmd, adp, ado, cnt)]
+BRD, APWR, FPRD = 7, 2, 4
+checks = {
+    "BRD 0x0000 counting %d slaves" % n: any(c == BRD and o == 0 and w == n for c, p, o, w in datagrams),
+    "APWR 0x0010 to every position": {p for c, p, o, w in datagrams if c == APWR and o == 0x10 and w == 0}
+        == {(-i) & 0xFFFF for i in range(n)},
+    "APWR 0x0010 taken by every slave": sum(1 for c, p, o, w in datagrams if c == APWR and o == 0x10 and w == 1) >= n,
+    "FPRD 0x0110 answered by every station": {p for c, p, o, w in datagrams if c == FPRD and o == 0x110 and w == 1}
+        == {0x1001 + i for i in range(n)},
+    "SII reads (FPRD 0x0508)": any(c == FPRD and o == 0x508 and w == 1 for c, p, o, w in datagrams),
+}
+for what, ok in checks.items():
+    print(("ok: " if ok else "MISSING: ") + what)
+sys.exit(0 if all(checks.values()) else 1)
+PY
+echo "ok: $(tshark -r "$work/bringup.pcapng" 2>/dev/null | wc -l) frames captured, 1 malformed (sent on purpose)"
+echo "PASS"
