@@ -7,6 +7,8 @@
 
 #include "concert/common/clock.hpp"
 #include "concert/dds/endpoint.hpp"
+#include "concert/ethercat/esc.hpp"
+#include "concert/ethercat/master.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/dds/conversions.hpp"
 #include "concert/topology/scan_io.hpp"
@@ -89,11 +91,67 @@ int publish(const PublishOptions& o, std::ostream& out, std::ostream& err) {
   return 0;
 }
 
+struct ReadOptions {
+  std::string ifname;
+  bool json = false;
+  bool details = false;
+  double frame_timeout_ms = 20;
+  int tries = 3;
+};
+
+std::string hex(uint32_t value, int digits) {
+  char text[16];
+  std::snprintf(text, sizeof text, "0x%0*X", digits, value);
+  return text;
+}
+
+/// `concert scan read`: the scan the master reads on a network interface, in the format of
+/// `concert scan show`; a summary (and with --details every register read) on stderr.
+int read_scan(const ReadOptions& o, std::ostream& out, std::ostream& err) {
+  ethercat::RawSocketLink link(o.ifname);
+  ethercat::MasterParams params;
+  params.frame_timeout =
+      std::chrono::microseconds(static_cast<int64_t>(o.frame_timeout_ms * 1000.0));
+  params.tries = o.tries;
+  ethercat::Master master(link, params);
+  const auto start = std::chrono::steady_clock::now();
+  const ethercat::ScanReport report = master.scan();
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const topology::EscScan scan = report.scan();
+  if (o.json) {
+    out << topology::scan_to_json(scan).dump(2) << "\n";
+  } else {
+    out << topology::scan_to_yaml(scan);
+  }
+  char timing[64];
+  std::snprintf(timing, sizeof timing, "%.1f ms", ms);
+  err << "concert scan read: " << report.slaves.size() << " slaves on " << o.ifname << " in "
+      << timing << " (" << report.frames_sent << " frames, " << report.frames_lost << " lost)\n";
+  if (o.details) {
+    for (const auto& s : report.slaves) {
+      err << "  slave " << s.position << ": station " << hex(s.station_address, 4) << ", chip "
+          << hex(s.chip_type, 2) << " rev " << int(s.chip_revision) << ", ports "
+          << hex(s.port_descriptor, 2) << ", DL status " << hex(s.dl_status, 4) << ", AL "
+          << ethercat::esc::to_string(static_cast<ethercat::esc::AlState>(s.al_status & 0x0F))
+          << ((s.al_status & ethercat::esc::kAlErrorBit)
+                  ? " error " + hex(s.al_status_code, 4) + " (" +
+                        ethercat::esc::al_status_code_name(s.al_status_code) + ")"
+                  : std::string())
+          << ", vendor " << hex(s.sii.vendor_id, 8) << ", product " << s.sii.product_code
+          << ", serial " << s.sii.serial << ", DC receive times";
+      for (const uint32_t t : s.receive_time) err << " " << t;
+      err << "\n";
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 void register_scan_verbs(cli::Cli& concert) {
   CLI::App& scan = concert.group(concert.app(), "scan",
-                                 "EtherCAT scans: show one, or publish one as a master would");
+                                 "EtherCAT scans: show one, read one off a ring, or publish one as a master would");
 
   struct ShowOptions {
     ScanSource source;
@@ -113,6 +171,29 @@ void register_scan_verbs(cli::Cli& concert) {
                    });
   add_source_options(show, show_options->source);
   show.add_flag("--json", show_options->json, "JSON instead of YAML");
+
+  auto r = std::make_shared<ReadOptions>();
+  CLI::App& read = concert.verb(
+      scan, "read",
+      "bring an EtherCAT ring up to INIT on a network interface and print its scan (as show "
+      "does; needs root or CAP_NET_RAW)",
+      [&concert, r] { return read_scan(*r, concert.out(), concert.err()); });
+  read.add_option("--ifname", r->ifname, "network interface of the EtherCAT ring")
+      ->type_name("IF")
+      ->required();
+  read.add_flag("--json", r->json, "JSON instead of YAML");
+  read.add_flag("--details", r->details,
+                "also print every slave's station address, ESC, DL and AL status, SII identity "
+                "and DC receive times (stderr)");
+  read.add_option("--frame-timeout", r->frame_timeout_ms,
+                  "milliseconds to wait for a frame to come back before resending it")
+      ->type_name("MS")
+      ->check(cli::number(0, 10000, false, true))
+      ->capture_default_str();
+  read.add_option("--tries", r->tries, "sends of a frame before the read fails")
+      ->type_name("N")
+      ->check(cli::number(1, 100, true))
+      ->capture_default_str();
 
   auto o = std::make_shared<PublishOptions>();
   CLI::App& pub =

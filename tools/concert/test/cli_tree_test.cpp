@@ -62,7 +62,7 @@ TEST(ConcertCli, TheTreeHasTheVerbsOfTheBuiltServices) {
   for (const auto& path : all_commands(false, true)) names.insert(join(path, " "));
   for (const char* verb :
        {"up", "status", "sim swap", "sim world", "topic list", "topic info", "topic echo",
-        "topic hz", "topic pub", "bag record", "bag info", "bag play", "scan show", "scan publish", "help"}) {
+        "topic hz", "topic pub", "bag record", "bag info", "bag play", "scan show", "scan read", "scan publish", "help"}) {
     EXPECT_TRUE(names.count(verb)) << verb << " missing from " << join(names);
   }
   EXPECT_GE(names.size(), 12u);
