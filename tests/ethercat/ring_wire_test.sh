@@ -3,7 +3,7 @@
 # pair; `concert scan read` reads it from the other end; each end is in a network namespace this
 # test makes and removes. Every example assembly of libs/simbus must read, field for field, as
 # `concert scan show --assembly` computes it (for concert_robot_18slaves.yaml: the real scan).
-# One bring-up (the paper's 19-ESC robot) is captured with tshark and decoded by Wireshark's
+# One bring-up (the paper's 19-ESC robot) and one second of its cyclic process data are captured with tshark and decoded by Wireshark's
 # EtherCAT dissector: no malformed frame but the one the test sends on purpose, and the commands
 # a bring-up must send are there with the working counters the ring must return.
 # Usage: ring_wire_test.sh BUILD_DIR. Exit 77 (skipped) when not root.
@@ -101,7 +101,7 @@ echo "ok: the 18-slave ring reads as ../shared/data/ethercat/concert_robot_18sla
 
 # 2. A captured bring-up, decoded by Wireshark.
 start_ring "$examples/concert_paper_robot.yaml"
-ip netns exec "$ns_ring" tshark -i "ecr$tag" -w "$work/bringup.pcapng" > "$work/tshark.log" 2>&1 &
+ip netns exec "$ns_ring" tshark -i "ecr$tag" -B 32 -w "$work/bringup.pcapng" > "$work/tshark.log" 2>&1 &
 tshark_pid=$!
 wait_for_line "$work/tshark.log" "Capturing on" || fail "tshark did not start capturing"
 ip netns exec "$ns_master" "$concert" scan read --ifname "ecm$tag" > /dev/null 2> "$work/read.err" ||
@@ -118,8 +118,9 @@ fprd = b"\x04\x00\x01\x10\x10\x01\xff\x07"
 s.send(header + fprd + b"\x00" * 36)
 PY
 wait_for_line "$work/ring.log" "dropped frame 1 that is not EtherCAT" || fail "the ring did not report the malformed frame"
-ip netns exec "$ns_master" "$concert" scan read --ifname "ecm$tag" > /dev/null 2>&1 ||
-  fail "the ring stopped answering after a malformed frame"
+# The ring to OP and one second of cyclic process data (one LRW a millisecond).
+ip netns exec "$ns_master" "$concert" ethercat cycle --ifname "ecm$tag" --seconds 1 --json \
+  > "$work/cycle.json" 2> "$work/cycle.err" || { cat "$work/cycle.err"; fail "the ring stopped answering after a malformed frame"; }
 kill -INT "$tshark_pid"
 wait "$tshark_pid" || true
 tshark_pid=""
@@ -128,14 +129,20 @@ malformed=$(tshark -r "$work/bringup.pcapng" -Y "_ws.malformed" 2>/dev/null | wc
 [ "$malformed" -eq 1 ] || fail "Wireshark finds $malformed malformed frames in the capture (expected the 1 sent on purpose)"
 tshark -r "$work/bringup.pcapng" -Y "ecat && !_ws.malformed" -T fields -E separator=';' \
   -e ecat.cmd -e ecat.adp -e ecat.ado -e ecat.cnt 2>/dev/null > "$work/datagrams.txt"
-python3 - "$work/datagrams.txt" 19 <<'PY' || fail "the capture lacks a command of the bring-up"
-import sys
+python3 - "$work/datagrams.txt" 19 "$work/cycle.json" <<'PY' || fail "the capture lacks a command of the bring-up or the cycle"
+import json, sys
 n = int(sys.argv[2])
+cycle = json.load(open(sys.argv[3]))
+print("cycle: %d cycles, %d lost, %d short, expected working counter %d" % (
+    cycle["cycles"], cycle["lost"], cycle["short_wkc"], cycle["expected_wkc"]))
 datagrams = []
 for line in open(sys.argv[1]):
-    cmd, adp, ado, cnt = (field.split(",") for field in line.strip().split(";"))
+    cmd, adp, ado, cnt = (field.split(",") for field in line.rstrip("\n").split(";"))
+    # Logical commands (LRW) have a logical address instead of ADP/ADO: those fields are empty.
+    if adp == [""]:
+        adp = ado = ["-1"] * len(cmd)
     datagrams += [(int(c, 16), int(p, 16), int(o, 16), int(w)) for c, p, o, w in zip(cmd, adp, ado, cnt)]
-BRD, APWR, FPRD = 7, 2, 4
+BRD, APWR, FPRD, LRW = 7, 2, 4, 12
 checks = {
     "BRD 0x0000 counting %d slaves" % n: any(c == BRD and o == 0 and w == n for c, p, o, w in datagrams),
     "APWR 0x0010 to every position": {p for c, p, o, w in datagrams if c == APWR and o == 0x10 and w == 0}
@@ -144,9 +151,22 @@ checks = {
     "FPRD 0x0110 answered by every station": {p for c, p, o, w in datagrams if c == FPRD and o == 0x110 and w == 1}
         == {0x1001 + i for i in range(n)},
     "SII reads (FPRD 0x0508)": any(c == FPRD and o == 0x508 and w == 1 for c, p, o, w in datagrams),
+    "1000 cycles run": cycle["cycles"] == 1000,
+    # The master saw the full working counter (2 per board with outputs, 1 per board with
+    # inputs) on every cycle that came back; in the capture (which may miss frames when the
+    # machine is busy) every LRW is one sent (0), one of the few answered in SAFE-OP before OP
+    # (1 per board: inputs only) or one answered in OP with the full counter.
+    "every LRW back with the full working counter": cycle["expected_wkc"] > 0 and
+        cycle["short_wkc"] == 0 and
+        0 < sum(1 for c, p, o, w in datagrams if c == LRW and w == cycle["expected_wkc"]) <= cycle["cycles"] and
+        all(w in (0, cycle["process_data_slaves"], cycle["expected_wkc"])
+            for c, p, o, w in datagrams if c == LRW),
 }
 for what, ok in checks.items():
     print(("ok: " if ok else "MISSING: ") + what)
+if not all(checks.values()):
+    from collections import Counter
+    print("LRW working counters in the capture:", dict(Counter(w for c, p, o, w in datagrams if c == LRW)))
 sys.exit(0 if all(checks.values()) else 1)
 PY
 echo "ok: $(tshark -r "$work/bringup.pcapng" 2>/dev/null | wc -l) frames captured, 1 malformed (sent on purpose)"

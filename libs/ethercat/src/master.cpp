@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <bit>
 #include <cstdio>
+#include <cstring>
+#include <thread>
 
 #include "concert/ethercat/esc.hpp"
 
@@ -350,6 +352,170 @@ ScanReport Master::scan() {
   report.frames_sent = frames_sent_ - sent_before;
   report.frames_lost = frames_lost_ - lost_before;
   return report;
+}
+
+const ProcessImageSlave* ProcessImage::slave(int32_t position) const {
+  for (const ProcessImageSlave& s : slaves) {
+    if (s.position == position) return &s;
+  }
+  return nullptr;
+}
+
+ProcessImage Master::map_process_data(const ScanReport& report) {
+  ProcessImage image;
+  std::size_t outputs = 0;
+  std::size_t inputs = 0;
+  for (const SlaveReport& s : report.slaves) {
+    const std::size_t out = s.sii.sync_manager_of(SiiSyncManager::kOutputs) >= 0 ? s.sii.output_bytes() : 0;
+    const std::size_t in = s.sii.sync_manager_of(SiiSyncManager::kInputs) >= 0 ? s.sii.input_bytes() : 0;
+    if (out == 0 && in == 0) continue;
+    image.slaves.push_back({s.position, s.station_address, outputs, out, inputs, in});
+    outputs += out;
+    inputs += in;
+    image.expected_wkc = static_cast<uint16_t>(image.expected_wkc + (out ? 2 : 0) + (in ? 1 : 0));
+  }
+  if (outputs + inputs > kMaxDatagramData) {
+    throw MasterError("process data of " + std::to_string(outputs + inputs) + " bytes does not fit one " +
+                      "frame (" + std::to_string(kMaxDatagramData) + ")");
+  }
+  image.outputs.assign(outputs, 0);
+  image.inputs.assign(inputs, 0);
+  // Sync managers 2 and 3 as the SII describes them, FMMU 0 (outputs, write) and 1 (inputs,
+  // read) onto them: one frame per kind of register, every slave in it.
+  std::vector<Datagram> config;
+  for (const ProcessImageSlave& m : image.slaves) {
+    const SlaveReport& s = report.slaves[static_cast<std::size_t>(m.position - 1)];
+    const auto sm = [&](uint8_t type, std::size_t bytes) {
+      const int n = s.sii.sync_manager_of(type);
+      const SiiSyncManager& d = s.sii.sync_managers[static_cast<std::size_t>(n)];
+      std::vector<uint8_t> r(8, 0);
+      r[0] = static_cast<uint8_t>(d.start & 0xFF);
+      r[1] = static_cast<uint8_t>(d.start >> 8);
+      r[2] = static_cast<uint8_t>(bytes & 0xFF);
+      r[3] = static_cast<uint8_t>(bytes >> 8);
+      r[4] = d.control;
+      r[6] = 1;  // activate
+      config.push_back(make_datagram(Command::kFpwr, s.station_address,
+                                     static_cast<uint16_t>(esc::kSyncManager + 8 * n), std::move(r)));
+      return d.start;
+    };
+    const auto fmmu = [&](int n, uint32_t logical, std::size_t bytes, uint16_t physical, uint8_t type) {
+      std::vector<uint8_t> r(16, 0);
+      for (int b = 0; b < 4; ++b) r[static_cast<std::size_t>(b)] = static_cast<uint8_t>(logical >> (8 * b));
+      r[4] = static_cast<uint8_t>(bytes & 0xFF);
+      r[5] = static_cast<uint8_t>(bytes >> 8);
+      r[6] = 0;  // logical start bit
+      r[7] = 7;  // logical stop bit
+      r[8] = static_cast<uint8_t>(physical & 0xFF);
+      r[9] = static_cast<uint8_t>(physical >> 8);
+      r[10] = 0;
+      r[11] = type;
+      r[12] = 1;  // activate
+      config.push_back(make_datagram(Command::kFpwr, s.station_address,
+                                     static_cast<uint16_t>(esc::kFmmu + 16 * n), std::move(r)));
+    };
+    if (m.output_bytes) {
+      const uint16_t at = sm(SiiSyncManager::kOutputs, m.output_bytes);
+      fmmu(0, static_cast<uint32_t>(m.output_offset), m.output_bytes, at, 2);
+    }
+    if (m.input_bytes) {
+      const uint16_t at = sm(SiiSyncManager::kInputs, m.input_bytes);
+      fmmu(1, static_cast<uint32_t>(outputs + m.input_offset), m.input_bytes, at, 1);
+    }
+  }
+  const auto answers = exchange_all(std::move(config));
+  for (const Datagram& d : answers) {
+    if (d.wkc != 1) {
+      throw MasterError("station " + hex4(d.adp) + " did not take its process data configuration (" +
+                        describe(d) + ", working counter " + std::to_string(d.wkc) + ")");
+    }
+  }
+  // The cyclic frame, encoded once: an LRW over [0, outputs + inputs).
+  Frame f;
+  f.source = frame_.source;
+  Datagram lrw = make_datagram(Command::kLrw, 0, 0, outputs + inputs);
+  lrw.set_logical_address(0);
+  f.datagrams = {lrw};
+  cycle_frame_ = encode(f);
+  cycle_data_at_ = kEthernetHeaderBytes + kEthercatHeaderBytes + kDatagramHeaderBytes;
+  return image;
+}
+
+void Master::request_state(const ScanReport& report, esc::AlState state) {
+  std::vector<Datagram> requests;
+  for (const SlaveReport& s : report.slaves) {
+    requests.push_back(make_datagram(Command::kFpwr, s.station_address, esc::kAlControl,
+                                     bytes16(static_cast<uint16_t>(state))));
+  }
+  exchange_all(std::move(requests));
+  std::vector<uint16_t> status(report.slaves.size(), 0);
+  std::vector<uint16_t> code(report.slaves.size(), 0);
+  for (int poll = 0; poll < params_.state_polls; ++poll) {
+    std::vector<Datagram> reads;
+    for (const SlaveReport& s : report.slaves) {
+      reads.push_back(make_datagram(Command::kFprd, s.station_address, esc::kAlStatus, 6));
+    }
+    const auto answers = exchange_all(std::move(reads));
+    bool all = true;
+    bool refused = false;
+    for (std::size_t i = 0; i < answers.size(); ++i) {
+      if (answers[i].wkc != 1) {
+        all = false;
+        continue;
+      }
+      status[i] = read16(answers[i].data);
+      code[i] = read16(answers[i].data, 4);
+      if (status[i] & esc::kAlErrorBit) refused = true;
+      if ((status[i] & esc::kAlStateMask) != static_cast<uint16_t>(state)) all = false;
+    }
+    if (all) return;
+    if (refused) break;
+    std::this_thread::sleep_for(params_.state_poll_interval);
+  }
+  std::string why;
+  for (std::size_t i = 0; i < report.slaves.size(); ++i) {
+    if ((status[i] & esc::kAlStateMask) == static_cast<uint16_t>(state) && !(status[i] & esc::kAlErrorBit)) continue;
+    if (!why.empty()) why += "; ";
+    const auto now = esc::al_state_from(status[i]);
+    why += slave_name(report.slaves[i]) + " is in " + (now ? esc::to_string(*now) : hex4(status[i]));
+    if (status[i] & esc::kAlErrorBit) {
+      why += ", AL status code " + hex4(code[i]) + " (" + esc::al_status_code_name(code[i]) + ")";
+    }
+  }
+  throw MasterError("the ring did not reach " + esc::to_string(state) + ": " + why);
+}
+
+CycleResult Master::cycle(ProcessImage& image) {
+  CycleResult result;
+  if (cycle_frame_.empty()) throw MasterError("cycle() before map_process_data()");
+  const uint8_t index = next_index_++;
+  uint8_t* frame = cycle_frame_.data();
+  frame[kEthernetHeaderBytes + kEthercatHeaderBytes + 1] = index;
+  std::memcpy(frame + cycle_data_at_, image.outputs.data(), image.outputs.size());
+  const std::size_t wkc_at = cycle_data_at_ + image.outputs.size() + image.inputs.size();
+  frame[wkc_at] = 0;
+  frame[wkc_at + 1] = 0;
+  link_.send(cycle_frame_);
+  ++frames_sent_;
+  const auto deadline = std::chrono::steady_clock::now() + params_.frame_timeout;
+  while (true) {
+    const auto left = std::chrono::duration_cast<std::chrono::microseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) break;
+    const auto received = link_.receive(left);
+    if (!received) break;
+    const std::span<const uint8_t> r = *received;
+    // Ours: the same LRW (command, index) of the same length; anything else is not this cycle's.
+    if (r.size() < wkc_at + 2 || r[12] != 0x88 || r[13] != 0xA4) continue;
+    const std::size_t head = kEthernetHeaderBytes + kEthercatHeaderBytes;
+    if (r[head] != static_cast<uint8_t>(Command::kLrw) || r[head + 1] != index) continue;
+    std::memcpy(image.inputs.data(), r.data() + cycle_data_at_ + image.outputs.size(), image.inputs.size());
+    result.returned = true;
+    result.wkc = static_cast<uint16_t>(r[wkc_at] | (r[wkc_at + 1] << 8));
+    return result;
+  }
+  ++frames_lost_;
+  return result;
 }
 
 }  // namespace concert::ethercat

@@ -33,7 +33,7 @@ uint8_t sii_checksum(std::span<const uint16_t> words) {
   return crc;
 }
 
-std::vector<uint16_t> make_sii_image(const SiiIdentity& identity) {
+std::vector<uint16_t> make_sii_image(const SiiInfo& identity) {
   std::vector<uint16_t> w(esc::kSiiFirstCategory, 0);
   w[7] = sii_checksum(w);
   put32(w, esc::kSiiVendorId, identity.vendor_id);
@@ -53,8 +53,61 @@ std::vector<uint16_t> make_sii_image(const SiiIdentity& identity) {
     put32(w, at + 6, static_cast<uint32_t>(identity.module->mod_rev));
     put32(w, at + 8, static_cast<uint32_t>(identity.robot_id));
   }
+  if (!identity.sync_managers.empty()) {
+    w.push_back(kSiiCategorySyncManagers);
+    w.push_back(static_cast<uint16_t>(4 * identity.sync_managers.size()));
+    for (const SiiSyncManager& sm : identity.sync_managers) {
+      w.push_back(sm.start);
+      w.push_back(sm.length);
+      w.push_back(static_cast<uint16_t>(sm.control | (0 << 8)));  // control, status (0)
+      w.push_back(static_cast<uint16_t>(sm.enable | (sm.type << 8)));
+    }
+  }
+  const auto pdos = [&w](uint16_t category, const std::vector<SiiPdo>& list) {
+    for (const SiiPdo& pdo : list) {
+      w.push_back(category);
+      w.push_back(static_cast<uint16_t>(4 + 4 * pdo.entries.size()));
+      w.push_back(pdo.index);
+      w.push_back(static_cast<uint16_t>(pdo.entries.size() | (pdo.sync_manager << 8)));
+      w.push_back(0);  // synchronization, name index
+      w.push_back(0);  // flags
+      for (const SiiPdoEntry& e : pdo.entries) {
+        w.push_back(e.index);
+        w.push_back(e.subindex);  // subindex, name index 0
+        w.push_back(static_cast<uint16_t>(e.data_type | (e.bits << 8)));
+        w.push_back(0);  // flags
+      }
+    }
+  };
+  pdos(kSiiCategoryTxPdo, identity.tx_pdos);
+  pdos(kSiiCategoryRxPdo, identity.rx_pdos);
   w.push_back(esc::kSiiCategoryEnd);
   return w;
+}
+
+uint32_t SiiPdo::bits() const {
+  uint32_t sum = 0;
+  for (const SiiPdoEntry& e : entries) sum += e.bits;
+  return sum;
+}
+
+std::size_t SiiInfo::output_bytes() const {
+  uint32_t bits = 0;
+  for (const SiiPdo& p : rx_pdos) bits += p.bits();
+  return (bits + 7) / 8;
+}
+
+std::size_t SiiInfo::input_bytes() const {
+  uint32_t bits = 0;
+  for (const SiiPdo& p : tx_pdos) bits += p.bits();
+  return (bits + 7) / 8;
+}
+
+int SiiInfo::sync_manager_of(uint8_t type) const {
+  for (std::size_t i = 0; i < sync_managers.size(); ++i) {
+    if (sync_managers[i].type == type && (sync_managers[i].enable & 1)) return static_cast<int>(i);
+  }
+  return -1;
 }
 
 bool sii_image_complete(std::span<const uint16_t> words) {
@@ -68,12 +121,12 @@ bool sii_image_complete(std::span<const uint16_t> words) {
   return false;
 }
 
-SiiIdentity parse_sii_image(std::span<const uint16_t> words) {
+SiiInfo parse_sii_image(std::span<const uint16_t> words) {
   if (words.size() <= esc::kSiiFirstCategory) {
     throw SiiError("SII image of " + std::to_string(words.size()) +
                    " words ends before the category list (word 0x0040)");
   }
-  SiiIdentity id;
+  SiiInfo id;
   id.vendor_id = get32(words, esc::kSiiVendorId);
   id.product_code = get32(words, esc::kSiiProductCode);
   id.revision = get32(words, esc::kSiiRevision);
@@ -107,6 +160,39 @@ SiiIdentity parse_sii_image(std::span<const uint16_t> words) {
       module.mod_rev = static_cast<int32_t>(get32(words, d + 6));
       id.module = module;
       id.robot_id = static_cast<int32_t>(get32(words, d + 8));
+    } else if (type == kSiiCategorySyncManagers) {
+      if (size % 4 != 0) {
+        throw SiiError("SII SyncM category at word " + hex(at) + " has " + std::to_string(size) +
+                       " words, not a multiple of 4");
+      }
+      for (std::size_t k = at + 2; k < at + 2 + size; k += 4) {
+        SiiSyncManager sm;
+        sm.start = words[k];
+        sm.length = words[k + 1];
+        sm.control = static_cast<uint8_t>(words[k + 2] & 0xFF);
+        sm.enable = static_cast<uint8_t>(words[k + 3] & 0xFF);
+        sm.type = static_cast<uint8_t>(words[k + 3] >> 8);
+        id.sync_managers.push_back(sm);
+      }
+    } else if (type == kSiiCategoryTxPdo || type == kSiiCategoryRxPdo) {
+      if (size < 4) throw SiiError("SII PDO category at word " + hex(at) + " is shorter than its header");
+      SiiPdo pdo;
+      pdo.index = words[at + 2];
+      const std::size_t count = words[at + 3] & 0xFF;
+      pdo.sync_manager = static_cast<uint8_t>(words[at + 3] >> 8);
+      if (size != 4 + 4 * count) {
+        throw SiiError("SII PDO " + hex(pdo.index) + " at word " + hex(at) + " has " +
+                       std::to_string(size) + " words for " + std::to_string(count) + " entries");
+      }
+      for (std::size_t k = at + 6; k < at + 2 + size; k += 4) {
+        SiiPdoEntry e;
+        e.index = words[k];
+        e.subindex = static_cast<uint8_t>(words[k + 1] & 0xFF);
+        e.data_type = static_cast<uint8_t>(words[k + 2] & 0xFF);
+        e.bits = static_cast<uint8_t>(words[k + 2] >> 8);
+        pdo.entries.push_back(e);
+      }
+      (type == kSiiCategoryTxPdo ? id.tx_pdos : id.rx_pdos).push_back(std::move(pdo));
     }
     at += 2 + size;
   }

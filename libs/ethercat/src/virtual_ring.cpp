@@ -43,7 +43,7 @@ bool writable(std::size_t address) {
 }  // namespace
 
 VirtualRing::VirtualRing(const simbus::Assembly& assembly, const topology::EscCatalog& catalog,
-                         RingParams params)
+                         RingParams params, const ProcessDataCatalog* process_data)
     : params_(params) {
   const simbus::Bus bus = simbus::wire_bus(assembly, catalog);
   path_ = simbus::follow_frame(bus);
@@ -89,12 +89,15 @@ VirtualRing::VirtualRing(const simbus::Assembly& assembly, const topology::EscCa
     put16(e, esc::kDlStatus, dl);
     put16(e, esc::kAlStatus, static_cast<uint16_t>(esc::AlState::kInit));
     if (params_.eeprom_8_byte_reads) put16(e, esc::kEepromControl, esc::kEeprom8ByteRead);
-    SiiIdentity sii;
+    SiiInfo sii;
     sii.vendor_id = params_.vendor_id;
     sii.product_code = static_cast<uint32_t>(b.esc_type);
     sii.serial = static_cast<uint32_t>(i + 1);
     sii.module = b.identity;
     sii.robot_id = b.robot_id;
+    if (process_data) e.process_data = process_data->find(b.esc_type);
+    if (e.process_data) add_process_data(sii, *e.process_data);
+    e.info = sii;
     e.sii = make_sii_image(sii);
     escs_.push_back(std::move(e));
   }
@@ -169,9 +172,71 @@ void VirtualRing::al_control(Esc& esc) {
     set(current, 0x0013);  // bootstrap not supported
   } else if (!allowed) {
     set(current, 0x0011);  // invalid requested state change
+  } else if (current == S::kPreOp && to == S::kSafeOp) {
+    // An ESC's firmware takes SAFE-OP only with its process data sync managers set as its SII
+    // describes them.
+    const uint16_t code = check_sync_managers(esc);
+    set(code ? current : to, code);
   } else {
     set(to, 0);
   }
+}
+
+uint16_t VirtualRing::check_sync_managers(const Esc& esc) const {
+  for (const uint8_t type : {SiiSyncManager::kOutputs, SiiSyncManager::kInputs}) {
+    const int n = esc.info.sync_manager_of(type);
+    if (n < 0) continue;
+    const std::size_t bytes = type == SiiSyncManager::kOutputs ? esc.info.output_bytes() : esc.info.input_bytes();
+    const auto at = static_cast<uint16_t>(esc::kSyncManager + 8 * n);
+    const uint16_t start = get16(esc, at);
+    const uint16_t length = get16(esc, static_cast<uint16_t>(at + 2));
+    const bool enabled = (esc.memory[at + 6u] & 1) != 0;
+    const auto& sm = esc.info.sync_managers[static_cast<std::size_t>(n)];
+    if (!enabled || start != sm.start || length != bytes) {
+      return type == SiiSyncManager::kOutputs ? 0x001D : 0x001E;  // invalid output / input configuration
+    }
+  }
+  return 0;
+}
+
+void VirtualRing::execute_logical(Esc& esc, Datagram& d) {
+  const uint32_t first = d.logical_address();
+  const uint64_t last = static_cast<uint64_t>(first) + d.data.size();  // exclusive
+  bool read = false;
+  bool wrote = false;
+  for (int f = 0; f < esc.memory[esc::kFmmusSupported]; ++f) {
+    const auto at = static_cast<std::size_t>(esc::kFmmu + 16 * f);
+    if ((esc.memory[at + 12] & 1) == 0) continue;  // not activated
+    const uint32_t start = static_cast<uint32_t>(esc.memory[at]) | (static_cast<uint32_t>(esc.memory[at + 1]) << 8) |
+                           (static_cast<uint32_t>(esc.memory[at + 2]) << 16) |
+                           (static_cast<uint32_t>(esc.memory[at + 3]) << 24);
+    const uint16_t length = get16(esc, static_cast<uint16_t>(at + 4));
+    const uint16_t physical = get16(esc, static_cast<uint16_t>(at + 8));
+    const uint8_t type = esc.memory[at + 11];  // bit 0 read, bit 1 write
+    const uint64_t from = std::max<uint64_t>(first, start);
+    const uint64_t to = std::min<uint64_t>(last, static_cast<uint64_t>(start) + length);
+    if (from >= to) continue;
+    for (uint64_t l = from; l < to; ++l) {
+      const std::size_t frame_at = static_cast<std::size_t>(l - first);
+      const std::size_t memory_at = physical + static_cast<std::size_t>(l - start);
+      if (memory_at >= esc.memory.size()) continue;
+      if ((type & 1) && reads(d.command)) {
+        d.data[frame_at] = esc.memory[memory_at];
+        read = true;
+      }
+      if ((type & 2) && writes(d.command)) {
+        esc.memory[memory_at] = d.data[frame_at];
+        wrote = true;
+      }
+    }
+  }
+  // Process data only passes in SAFE-OP (inputs) and OP (both); a board in INIT or PRE-OP does
+  // not count the datagram, which is how the master sees it is not exchanging.
+  const auto state = esc::al_state_from(get16(esc, esc::kAlStatus));
+  if (state != esc::AlState::kOp) wrote = false;
+  if (state != esc::AlState::kOp && state != esc::AlState::kSafeOp) read = false;
+  if (read || wrote) esc.touched = true;
+  d.wkc = static_cast<uint16_t>(d.wkc + (read ? 1 : 0) + (wrote ? 2 : 0));
 }
 
 void VirtualRing::after_write(Esc& esc, uint16_t from, uint16_t to) {
@@ -213,8 +278,11 @@ void VirtualRing::execute(Esc& esc, Datagram& d) {
       addressed = true;
       ++d.adp;
       break;
+    case C::kLrd: case C::kLwr: case C::kLrw:
+      execute_logical(esc, d);
+      return;
     default:
-      return;  // NOP; logical commands address no FMMU here yet
+      return;  // NOP
   }
   if (!addressed) return;
   const bool broadcast = d.command == C::kBrd || d.command == C::kBrw;
@@ -257,7 +325,30 @@ std::optional<std::vector<uint8_t>> VirtualRing::process(std::span<const uint8_t
   for (const int32_t index : order_) {
     Esc& esc = escs_[static_cast<std::size_t>(index)];
     esc.latch = false;
+    esc.touched = false;
     for (Datagram& d : frame.datagrams) execute(esc, d);
+  }
+  // The boards behind the ESCs take their outputs and put their inputs for the next frame.
+  if (application_) {
+    for (std::size_t position = 0; position < order_.size(); ++position) {
+      Esc& esc = escs_[static_cast<std::size_t>(order_[position])];
+      if (!esc.process_data || !esc.touched) continue;
+      const auto state = esc::al_state_from(get16(esc, esc::kAlStatus));
+      if (state != esc::AlState::kOp && state != esc::AlState::kSafeOp) continue;
+      const int out_sm = esc.info.sync_manager_of(SiiSyncManager::kOutputs);
+      const int in_sm = esc.info.sync_manager_of(SiiSyncManager::kInputs);
+      std::span<const uint8_t> outputs;
+      std::span<uint8_t> inputs;
+      if (out_sm >= 0) {
+        outputs = std::span<const uint8_t>(esc.memory).subspan(
+            esc.info.sync_managers[static_cast<std::size_t>(out_sm)].start, esc.info.output_bytes());
+      }
+      if (in_sm >= 0) {
+        inputs = std::span<uint8_t>(esc.memory).subspan(
+            esc.info.sync_managers[static_cast<std::size_t>(in_sm)].start, esc.info.input_bytes());
+      }
+      application_(static_cast<int>(position) + 1, *esc.process_data, *state, outputs, inputs, now_ns);
+    }
   }
   // DC: the ESCs a write to 0x0900 reached latch the local time the frame's first bit passed
   // each of their ports on its way (ports it did not pass keep their old value).

@@ -136,7 +136,7 @@ TEST(Esc, NamesAlStates) {
 }
 
 TEST(Sii, ImageRoundTrips) {
-  SiiIdentity id;
+  SiiInfo id;
   id.vendor_id = 0x12345678;
   id.product_code = 21;
   id.revision = 3;
@@ -148,13 +148,13 @@ TEST(Sii, ImageRoundTrips) {
   EXPECT_FALSE(sii_image_complete(std::span<const uint16_t>(image.data(), image.size() - 1)));
   EXPECT_EQ(parse_sii_image(image), id);
   EXPECT_EQ(image[7], sii_checksum(image));
-  SiiIdentity other;
+  SiiInfo other;
   other.product_code = 1280;
   EXPECT_EQ(parse_sii_image(make_sii_image(other)), other);  // no module category
 }
 
 TEST(Sii, NamesWhatIsWrong) {
-  SiiIdentity id;
+  SiiInfo id;
   id.module = topology::EscIdentity{1, 6, 4, 0};
   auto image = make_sii_image(id);
   image[0x41] = 4;  // the CONCERT category claims 4 words

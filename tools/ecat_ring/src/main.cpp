@@ -1,6 +1,7 @@
 // concert_ecat_ring: the EtherCAT ring of an assembly file, answering frames on a network
 // interface until SIGINT/SIGTERM (libs/ethercat VirtualRing over a raw socket).
-//   concert_ecat_ring --assembly FILE --ifname IF [--module-db DIR ...] [--eeprom-8-byte]
+//   concert_ecat_ring --assembly FILE --ifname IF [--module-db DIR ...] [--process-data FILE]
+//                     [--eeprom-8-byte]
 // The assembly's faults (libs/simbus README: upside_down, broken_link, unknown_identity,
 // wrong_topology) are on the ring as a master meets them. Needs root or CAP_NET_RAW.
 #include <chrono>
@@ -20,6 +21,7 @@ struct Options {
   std::string assembly;
   std::string ifname;
   std::vector<std::string> module_dbs;
+  std::string process_data = CONCERT_DEFAULT_PROCESS_DATA;
   bool eeprom_8_byte = false;
 };
 
@@ -30,12 +32,15 @@ int run(const Options& o) {
   topology::EscCatalog catalog = topology::EscCatalog::load(dbs.front());
   for (std::size_t i = 1; i < dbs.size(); ++i) catalog.merge(topology::EscCatalog::load(dbs[i]));
   const simbus::Assembly assembly = simbus::load_assembly(o.assembly);
+  const ethercat::ProcessDataCatalog process_data = ethercat::ProcessDataCatalog::load(o.process_data);
   ethercat::VirtualRing ring(assembly, catalog,
-                             ethercat::RingParams{.eeprom_8_byte_reads = o.eeprom_8_byte});
+                             ethercat::RingParams{.eeprom_8_byte_reads = o.eeprom_8_byte}, &process_data);
   ethercat::RawSocketLink link(o.ifname);
   const std::atomic<bool>& stop = cli::stop_on_signals();
   std::cerr << "concert_ecat_ring: serving " << ring.slave_count() << " ESCs of " << o.assembly
-            << " on " << o.ifname << " (" << ethercat::to_string(link.mac()) << ")" << std::endl;
+            << " on " << o.ifname << " (" << ethercat::to_string(link.mac()) << "); process data of "
+            << o.process_data << " (no drive model behind the boards: their inputs stay zero)"
+            << std::endl;
   const auto start = std::chrono::steady_clock::now();
   uint64_t reported_malformed = 0;
   while (!stop) {
@@ -79,6 +84,9 @@ int main(int argc, char** argv) {
   app.add_option("--module-db", o.module_dbs,
                  "module database folder (repeat to merge; default: the project's)")
       ->type_name("DIR");
+  app.add_option("--process-data", o.process_data, "process data of each board type")
+      ->type_name("FILE")
+      ->capture_default_str();
   app.add_flag("--eeprom-8-byte", o.eeprom_8_byte,
                "ESCs read 8 bytes of EEPROM per command (default 4)");
   cli.on_run(app, [&o] { return run(o); });

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "concert/ethercat/esc.hpp"
 #include "concert/ethercat/frame.hpp"
 #include "concert/ethercat/link.hpp"
 #include "concert/ethercat/sii.hpp"
@@ -34,6 +35,9 @@ struct MasterParams {
   int eeprom_polls = 100;
   /// Words of SII EEPROM read per slave at most (the category list must end before).
   int max_sii_words = 4096;
+  /// AL status reads while waiting for a state, and the time between them.
+  int state_polls = 200;
+  std::chrono::microseconds state_poll_interval{1000};
 };
 
 /// A ring that does not answer as an EtherCAT ring must; what() names the slave (position and
@@ -59,7 +63,7 @@ struct SlaveReport {
   uint16_t al_status_code = 0;    ///< register 0x0134
   /// DC receive times of ports 0..3 (local clock, ns), latched by one broadcast frame.
   std::array<uint32_t, 4> receive_time{};
-  SiiIdentity sii;
+  SiiInfo sii;
   topology::EscSlave slave;       ///< the scan's row for this slave
 };
 
@@ -72,6 +76,34 @@ struct ScanReport {
 
   /// The scan in discovery's format (libs/topology).
   topology::EscScan scan() const;
+};
+
+/// Where each slave's process data sits in the master's image: outputs (written by the master)
+/// at logical addresses [0, outputs), inputs at [outputs, outputs + inputs), one LRW for all.
+struct ProcessImageSlave {
+  int32_t position = 0;
+  uint16_t station_address = 0;
+  std::size_t output_offset = 0;  ///< into ProcessImage::outputs
+  std::size_t output_bytes = 0;
+  std::size_t input_offset = 0;   ///< into ProcessImage::inputs
+  std::size_t input_bytes = 0;
+};
+
+struct ProcessImage {
+  std::vector<uint8_t> outputs;
+  std::vector<uint8_t> inputs;
+  std::vector<ProcessImageSlave> slaves;  ///< only slaves with process data, ring order
+  /// Working counter of a cycle in which every slave exchanged: 2 per slave with outputs (in
+  /// OP), 1 per slave with inputs.
+  uint16_t expected_wkc = 0;
+  /// The slave at ring position `position`, or nullptr (no process data).
+  const ProcessImageSlave* slave(int32_t position) const;
+};
+
+/// One cyclic exchange.
+struct CycleResult {
+  bool returned = false;  ///< the frame came back in time
+  uint16_t wkc = 0;
 };
 
 class Master {
@@ -90,6 +122,21 @@ class Master {
   /// Sends per-slave datagrams in as few frames as fit, in order; returns the answers in order.
   std::vector<Datagram> exchange_all(std::vector<Datagram> datagrams);
 
+  /// Maps every slave's process data (sizes and sync managers from its SII): writes its sync
+  /// managers 2 and 3 and two FMMUs (outputs, inputs), and prepares the cyclic frame. Throws
+  /// MasterError (a slave that does not take the configuration, an image larger than one frame).
+  ProcessImage map_process_data(const ScanReport& report);
+
+  /// Requests `state` of every slave of the report and waits (bounded: `state_polls` reads of
+  /// the AL status, `state_poll_interval` apart) until all are in it. Throws MasterError naming
+  /// each slave that refused, with its AL status code by name, or that did not get there.
+  void request_state(const ScanReport& report, esc::AlState state);
+
+  /// One cycle: sends the outputs and the slaves' inputs space in one LRW, waits for it up to
+  /// the frame timeout (no resend: a late frame is a lost cycle), copies the inputs back.
+  /// Allocates nothing once the image is mapped (on a RawSocketLink). Throws LinkError.
+  CycleResult cycle(ProcessImage& image);
+
   int frames_sent() const { return frames_sent_; }
   int frames_lost() const { return frames_lost_; }
 
@@ -99,6 +146,8 @@ class Master {
   Frame frame_;
   std::vector<uint8_t> bytes_;
   uint8_t next_index_ = 0;
+  std::vector<uint8_t> cycle_frame_;  // the LRW frame, encoded once by map_process_data
+  std::size_t cycle_data_at_ = 0;     // where the datagram's data starts in it
   int frames_sent_ = 0;
   int frames_lost_ = 0;
 };

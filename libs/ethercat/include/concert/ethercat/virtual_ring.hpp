@@ -8,6 +8,7 @@
 // port. concert_ecat_ring serves one over a network interface; tests call process() directly.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -15,6 +16,7 @@
 
 #include "concert/ethercat/esc.hpp"
 #include "concert/ethercat/frame.hpp"
+#include "concert/ethercat/process_data.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/simbus/bus.hpp"
 #include "concert/topology/esc_catalog.hpp"
@@ -38,12 +40,22 @@ struct RingCounters {
   std::string last_error;   ///< why the last malformed frame was dropped
 };
 
+/// What runs on a board behind its ESC (a drive, ...): called after every frame that reached
+/// the board while in SAFE-OP or OP, with the outputs the master wrote into its sync manager 2
+/// and the inputs to fill in sync manager 3 (read by the next frame).
+using BoardApplication =
+    std::function<void(int position, const BoardProcessData& board, esc::AlState state,
+                       std::span<const uint8_t> outputs, std::span<uint8_t> inputs, uint64_t now_ns)>;
+
 class VirtualRing {
  public:
-  /// The ring of `assembly` (faults applied as simbus applies them). Throws
-  /// simbus::AssemblyError.
+  /// The ring of `assembly` (faults applied as simbus applies them); boards whose ESC type has
+  /// a row in `process_data` exchange that process data. Throws simbus::AssemblyError.
   VirtualRing(const simbus::Assembly& assembly, const topology::EscCatalog& catalog,
-              RingParams params = {});
+              RingParams params = {}, const ProcessDataCatalog* process_data = nullptr);
+
+  /// Sets what runs behind every board with process data (none: inputs stay as they are).
+  void set_application(BoardApplication application) { application_ = std::move(application); }
 
   /// The frame as it comes back to the master after passing every ESC, or nothing when it does
   /// not come back (no ESC on the master's port, or bytes that are not an EtherCAT frame:
@@ -65,9 +77,14 @@ class VirtualRing {
     std::vector<uint16_t> sii;        // EEPROM words
     uint64_t clock_offset_ns = 0;     // local clock = master time + offset
     bool latch = false;               // a write to 0x0900 in the frame being processed
+    bool touched = false;             // a logical datagram reached its process data
+    const BoardProcessData* process_data = nullptr;
+    SiiInfo info;
   };
 
   void execute(Esc& esc, Datagram& d);
+  void execute_logical(Esc& esc, Datagram& d);
+  uint16_t check_sync_managers(const Esc& esc) const;
   void after_write(Esc& esc, uint16_t from, uint16_t to);
   void eeprom_command(Esc& esc);
   void al_control(Esc& esc);
@@ -80,6 +97,7 @@ class VirtualRing {
   std::vector<simbus::FrameStep> path_;
   std::vector<uint64_t> step_time_ns_;    // time of each step after the frame leaves the master
   RingCounters counters_;
+  BoardApplication application_;
 };
 
 }  // namespace concert::ethercat
