@@ -61,7 +61,9 @@ wait_for_line() {
 }
 
 start_ring() {
-  ip netns exec "$ns_ring" "$ring_bin" --assembly "$1" --ifname "ecr$tag" --module-db "$db" \
+  local file=$1
+  shift
+  ip netns exec "$ns_ring" "$ring_bin" --assembly "$file" --ifname "ecr$tag" --module-db "$db" "$@" \
     > "$work/ring.log" 2>&1 &
   ring_pid=$!
   wait_for_line "$work/ring.log" "concert_ecat_ring: serving" || fail "the ring did not start on $1"
@@ -170,4 +172,39 @@ if not all(checks.values()):
 sys.exit(0 if all(checks.values()) else 1)
 PY
 echo "ok: $(tshark -r "$work/bringup.pcapng" 2>/dev/null | wc -l) frames captured, 1 malformed (sent on purpose)"
+
+# 3. Run-time faults. A cable pulled while cycling: the cycle watchdog stops at the first short
+#    working counter and the master names where the ring was cut.
+start_ring "$examples/concert_paper_robot.yaml" --fault pull:elbow_2@0.3
+rc=0
+ip netns exec "$ns_master" "$concert" ethercat cycle --ifname "ecm$tag" --seconds 30 \
+  > "$work/cycle.out" 2> "$work/cycle.err" || rc=$?
+stop_ring
+[ "$rc" -eq 1 ] || { cat "$work/cycle.err"; fail "cycling on a ring with a pulled cable exited $rc, not 1"; }
+grep -q "working counter [0-9]* of 45: slaves 1[0-9]-19 do not answer (slave [0-9]* lost the link on port 1)" "$work/cycle.err" ||
+  { cat "$work/cycle.err"; fail "the pulled cable was not named"; }
+echo "ok: pulled cable: $(grep -o 'cycle [0-9]*: working.*' "$work/cycle.err")"
+# A board refusing OP: named with its AL status code.
+start_ring "$examples/concert_paper_robot.yaml" --fault refuse-op:yaw_2
+rc=0
+ip netns exec "$ns_master" "$concert" ethercat cycle --ifname "ecm$tag" --seconds 1 \
+  > /dev/null 2> "$work/cycle.err" || rc=$?
+stop_ring
+[ "$rc" -eq 1 ] && grep -q "is in SAFE-OP, AL status code 0x001A (synchronization error)" "$work/cycle.err" ||
+  { cat "$work/cycle.err"; fail "a board refusing OP was not named (exit $rc)"; }
+echo "ok: refused OP named: $(grep -o 'slave [0-9]* (station 0x[0-9A-F]*) is in SAFE-OP, AL status code 0x001A' "$work/cycle.err")"
+# A module added while the ring runs (SIGHUP re-reads the assembly): the next scan has it.
+cp "$examples/concert_paper_robot.yaml" "$work/assembly.yaml"
+start_ring "$work/assembly.yaml"
+ip netns exec "$ns_master" "$concert" scan read --ifname "ecm$tag" --json > "$work/before.json" 2>/dev/null
+sed -i 's/{name: drill, key: module_drill_concert, parent: yaw_3,/{name: extra_link, key: module_link_straight_400_concert, parent: yaw_3, connector: 1}\n  - {name: drill, key: module_drill_concert, parent: extra_link,/' "$work/assembly.yaml"
+grep -q extra_link "$work/assembly.yaml" || fail "could not add a module to the assembly file"
+kill -HUP "$ring_pid"
+wait_for_line "$work/ring.log" "re-read .*: 19 -> 20 ESCs" || fail "the ring did not take the added module"
+ip netns exec "$ns_master" "$concert" scan read --ifname "ecm$tag" --json > "$work/after.json" 2>/dev/null
+stop_ring
+"$concert" scan show --assembly "$work/assembly.yaml" --module-db "$db" --json > "$work/show.json"
+cmp -s "$work/after.json" "$work/show.json" || fail "the scan after the module was added is not the new assembly's"
+cmp -s "$work/before.json" "$work/after.json" && fail "the scan did not change when a module was added"
+echo "ok: a module added at run time is in the next scan (19 -> 20 ESCs)"
 echo "PASS"

@@ -76,7 +76,7 @@ CycleStats run_cycles(Master& master, ProcessImage& image, const CycleParams& pa
     } else if (r.wkc < image.expected_wkc) {
       ++stats.short_wkc;
     }
-    if (body) body(image, r);
+    if (body && !body(image, r)) break;
     // Behind by more than a period (the machine was busy): start again from now rather than
     // sending a burst of late frames.
     timespec after{};

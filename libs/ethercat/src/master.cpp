@@ -518,4 +518,64 @@ CycleResult Master::cycle(ProcessImage& image) {
   return result;
 }
 
+std::string RingDiagnosis::text() const {
+  if (healthy()) return "the ring answers as scanned";
+  std::string t;
+  // Runs of consecutive positions: "slaves 12-15", "slave 3".
+  for (std::size_t i = 0; i < missing.size();) {
+    std::size_t j = i;
+    while (j + 1 < missing.size() && missing[j + 1] == missing[j] + 1) ++j;
+    if (!t.empty()) t += ", ";
+    t += i == j ? "slave " + std::to_string(missing[i])
+                : "slaves " + std::to_string(missing[i]) + "-" + std::to_string(missing[j]);
+    i = j + 1;
+  }
+  if (!missing.empty()) t += missing.size() == 1 ? " does not answer" : " do not answer";
+  std::string links;
+  for (const auto& [position, port] : links_lost) {
+    if (!links.empty()) links += ", ";
+    links += "slave " + std::to_string(position) + " lost the link on port " + std::to_string(port);
+  }
+  if (!links.empty()) t += t.empty() ? links : " (" + links + ")";
+  for (const auto& [position, code] : al_errors) {
+    if (!t.empty()) t += "; ";
+    t += "slave " + std::to_string(position) + ": AL status code " + hex4(code) + " (" +
+         esc::al_status_code_name(code) + ")";
+  }
+  return t;
+}
+
+RingDiagnosis Master::diagnose(const ScanReport& report) {
+  RingDiagnosis d;
+  try {
+    d.answering = exchange({make_datagram(Command::kBrd, 0, esc::kType, 2)}).front().wkc;
+    std::vector<Datagram> reads;
+    for (const SlaveReport& s : report.slaves) {
+      reads.push_back(make_datagram(Command::kFprd, s.station_address, esc::kDlStatus, 2));
+      reads.push_back(make_datagram(Command::kFprd, s.station_address, esc::kAlStatus, 6));
+    }
+    const auto answers = exchange_all(std::move(reads));
+    for (std::size_t i = 0; i < report.slaves.size(); ++i) {
+      const SlaveReport& s = report.slaves[i];
+      const Datagram& dl = answers[2 * i];
+      const Datagram& al = answers[2 * i + 1];
+      if (dl.wkc != 1 || al.wkc != 1) {
+        d.missing.push_back(s.position);
+        continue;
+      }
+      const uint8_t was = esc::open_ports(s.dl_status);
+      const uint8_t now = esc::open_ports(read16(dl.data));
+      for (int p = 0; p < 4; ++p) {
+        if ((was & (1U << p)) && !(now & (1U << p))) d.links_lost.emplace_back(s.position, p);
+      }
+      if (read16(al.data) & esc::kAlErrorBit) d.al_errors.emplace_back(s.position, read16(al.data, 4));
+    }
+  } catch (const MasterError&) {
+    d.answering = 0;
+    d.missing.clear();
+    for (const SlaveReport& s : report.slaves) d.missing.push_back(s.position);
+  }
+  return d;
+}
+
 }  // namespace concert::ethercat

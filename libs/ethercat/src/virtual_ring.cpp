@@ -44,68 +44,147 @@ bool writable(std::size_t address) {
 
 VirtualRing::VirtualRing(const simbus::Assembly& assembly, const topology::EscCatalog& catalog,
                          RingParams params, const ProcessDataCatalog* process_data)
-    : params_(params) {
-  const simbus::Bus bus = simbus::wire_bus(assembly, catalog);
-  path_ = simbus::follow_frame(bus);
-  std::mt19937_64 clocks(params_.clock_seed);
-  std::uniform_int_distribution<uint64_t> offset(0, 1'000'000'000ULL);
+    : params_(params), catalog_(catalog), process_data_(process_data), assembly_(assembly) {
+  rebuild(assembly_);
+}
+
+void VirtualRing::set_dl_status(Esc& e) {
+  // DL status: ports with a peer are linked, open and communicating; the others closed. A
+  // wrong_topology fault is a physical link without communication (a cable to a module that
+  // does not answer) or a link the PHY misses: the linked-port count disagrees with the open
+  // ports, as masters that count links then report.
+  const simbus::BusEsc& b = e.bus;
+  uint16_t dl = esc::kDlPdiOperational;
+  uint8_t linked = b.open_ports();
+  for (int p = 0; p < 4; ++p) {
+    if (linked & (1U << p)) {
+      dl |= esc::dl_communication(p);
+    } else {
+      dl |= esc::dl_loop_closed(p);
+    }
+  }
+  if (b.reported_topology) {
+    const int want = *b.reported_topology;
+    for (int p = 0; p < 4 && std::popcount(static_cast<unsigned>(linked)) < want; ++p) {
+      linked = static_cast<uint8_t>(linked | (1U << p));
+    }
+    for (int p = 3; p >= 0 && std::popcount(static_cast<unsigned>(linked)) > want; --p) {
+      linked = static_cast<uint8_t>(linked & ~(1U << p));
+    }
+  }
+  for (int p = 0; p < 4; ++p) {
+    if (linked & (1U << p)) dl |= esc::dl_link(p);
+  }
+  put16(e, esc::kDlStatus, dl);
+}
+
+VirtualRing::Esc VirtualRing::fresh_esc(const simbus::BusEsc& b, std::size_t index) {
+  std::mt19937_64 clock(params_.clock_seed * 1'000'003ULL + index);
+  Esc e;
+  e.bus = b;
+  e.memory.assign(kMemoryBytes, 0);
+  e.clock_offset_ns = std::uniform_int_distribution<uint64_t>(0, 1'000'000'000ULL)(clock);
+  const bool four = b.board == topology::EscBoard::kFourPort;
+  e.memory[esc::kType] = four ? kChipEt1100 : kChipEt1200;
+  e.memory[esc::kFmmusSupported] = four ? 8 : 3;
+  e.memory[esc::kSyncManagersSupported] = four ? 8 : 4;
+  e.memory[esc::kRamSize] = four ? 8 : 1;
+  e.memory[esc::kPortDescriptor] = four ? 0xAA : 0x0A;  // EBUS on each port the board has
+  put16(e, esc::kAlStatus, static_cast<uint16_t>(esc::AlState::kInit));
+  if (params_.eeprom_8_byte_reads) put16(e, esc::kEepromControl, esc::kEeprom8ByteRead);
+  SiiInfo sii;
+  sii.vendor_id = params_.vendor_id;
+  sii.product_code = static_cast<uint32_t>(b.esc_type);
+  sii.serial = static_cast<uint32_t>(index + 1);
+  sii.module = b.identity;
+  sii.robot_id = b.robot_id;
+  if (process_data_) e.process_data = process_data_->find(b.esc_type);
+  if (e.process_data) add_process_data(sii, *e.process_data);
+  e.info = sii;
+  e.sii = make_sii_image(sii);
+  return e;
+}
+
+void VirtualRing::rebuild(const simbus::Assembly& as_built) {
+  simbus::Assembly assembly = as_built;
+  for (const std::string& m : pulled_) {
+    assembly.faults.push_back({.type = simbus::FaultType::kBrokenLink, .module = m});
+  }
+  const simbus::Bus bus = simbus::wire_bus(assembly, catalog_);  // throws before any change
+  std::map<std::pair<std::string, int32_t>, Esc> old;
+  for (Esc& e : escs_) old.emplace(std::pair{e.bus.module, e.bus.module_esc}, std::move(e));
+  escs_.clear();
   for (std::size_t i = 0; i < bus.escs.size(); ++i) {
     const simbus::BusEsc& b = bus.escs[i];
-    Esc e;
-    e.bus = b;
-    e.memory.assign(kMemoryBytes, 0);
-    e.clock_offset_ns = offset(clocks);
-    const bool four = b.board == topology::EscBoard::kFourPort;
-    e.memory[esc::kType] = four ? kChipEt1100 : kChipEt1200;
-    e.memory[esc::kFmmusSupported] = four ? 8 : 3;
-    e.memory[esc::kSyncManagersSupported] = four ? 8 : 4;
-    e.memory[esc::kRamSize] = four ? 8 : 1;
-    e.memory[esc::kPortDescriptor] = four ? 0xAA : 0x0A;  // EBUS on each port the board has
-    // DL status: ports with a peer are linked, open and communicating; the others closed. A
-    // wrong_topology fault is a physical link without communication (a cable to a module that
-    // does not answer) or a link the PHY misses: the linked-port count disagrees with the open
-    // ports, as masters that count links then report.
-    uint16_t dl = esc::kDlPdiOperational;
-    uint8_t linked = b.open_ports();
-    for (int p = 0; p < 4; ++p) {
-      if (linked & (1U << p)) {
-        dl |= esc::dl_communication(p);
-      } else {
-        dl |= esc::dl_loop_closed(p);
+    const auto it = old.find({b.module, b.module_esc});
+    if (it != old.end() && it->second.bus.identity == b.identity && it->second.bus.esc_type == b.esc_type) {
+      Esc e = std::move(it->second);
+      for (int p = 0; p < 4; ++p) {
+        // A port that had a peer and has none now: the ESC counts a lost link.
+        if (e.bus.peer[static_cast<std::size_t>(p)] != simbus::kNoPeer &&
+            b.peer[static_cast<std::size_t>(p)] == simbus::kNoPeer) {
+          ++e.memory[esc::kLostLinkCounters + static_cast<std::size_t>(p)];
+        }
       }
+      e.bus = b;
+      escs_.push_back(std::move(e));
+    } else {
+      escs_.push_back(fresh_esc(b, i));
     }
-    if (b.reported_topology) {
-      const int want = *b.reported_topology;
-      for (int p = 0; p < 4 && std::popcount(static_cast<unsigned>(linked)) < want; ++p) {
-        linked = static_cast<uint8_t>(linked | (1U << p));
-      }
-      for (int p = 3; p >= 0 && std::popcount(static_cast<unsigned>(linked)) > want; --p) {
-        linked = static_cast<uint8_t>(linked & ~(1U << p));
-      }
-    }
-    for (int p = 0; p < 4; ++p) {
-      if (linked & (1U << p)) dl |= esc::dl_link(p);
-    }
-    put16(e, esc::kDlStatus, dl);
-    put16(e, esc::kAlStatus, static_cast<uint16_t>(esc::AlState::kInit));
-    if (params_.eeprom_8_byte_reads) put16(e, esc::kEepromControl, esc::kEeprom8ByteRead);
-    SiiInfo sii;
-    sii.vendor_id = params_.vendor_id;
-    sii.product_code = static_cast<uint32_t>(b.esc_type);
-    sii.serial = static_cast<uint32_t>(i + 1);
-    sii.module = b.identity;
-    sii.robot_id = b.robot_id;
-    if (process_data) e.process_data = process_data->find(b.esc_type);
-    if (e.process_data) add_process_data(sii, *e.process_data);
-    e.info = sii;
-    e.sii = make_sii_image(sii);
-    escs_.push_back(std::move(e));
+    Esc& e = escs_.back();
+    set_dl_status(e);
+    const auto refusing = refusing_.find(b.module);
+    e.refuse_op = refusing == refusing_.end() ? 0 : refusing->second;
   }
+  path_ = simbus::follow_frame(bus);
+  order_.clear();
+  step_time_ns_.clear();
   uint64_t t = 0;
   for (const simbus::FrameStep& step : path_) {
     t += step.kind == simbus::FrameStep::Kind::kSend ? params_.cable_delay_ns : params_.esc_delay_ns;
     step_time_ns_.push_back(t);
     if (step.kind == simbus::FrameStep::Kind::kProcess) order_.push_back(step.esc);
+  }
+}
+
+void VirtualRing::set_assembly(const simbus::Assembly& assembly) {
+  rebuild(assembly);
+  assembly_ = assembly;
+  // A pulled cable of a module that is no longer there is plugged back with it.
+  std::erase_if(pulled_, [&](const std::string& m) {
+    return std::none_of(assembly_.modules.begin(), assembly_.modules.end(),
+                        [&](const simbus::MountedModule& x) { return x.name == m; });
+  });
+}
+
+void VirtualRing::pull_cable(const std::string& module) {
+  if (std::find(pulled_.begin(), pulled_.end(), module) != pulled_.end()) return;
+  pulled_.push_back(module);
+  try {
+    rebuild(assembly_);
+  } catch (...) {
+    pulled_.pop_back();
+    throw;
+  }
+}
+
+void VirtualRing::plug_cable(const std::string& module) {
+  std::erase(pulled_, module);
+  rebuild(assembly_);
+}
+
+void VirtualRing::refuse_op(const std::string& module, uint16_t code) {
+  if (std::none_of(assembly_.modules.begin(), assembly_.modules.end(),
+                   [&](const simbus::MountedModule& x) { return x.name == module; })) {
+    throw simbus::AssemblyError(assembly_.source + ": module '" + module + "' is not in the assembly");
+  }
+  if (code) {
+    refusing_[module] = code;
+  } else {
+    refusing_.erase(module);
+  }
+  for (Esc& e : escs_) {
+    if (e.bus.module == module) e.refuse_op = code;
   }
 }
 
@@ -172,6 +251,8 @@ void VirtualRing::al_control(Esc& esc) {
     set(current, 0x0013);  // bootstrap not supported
   } else if (!allowed) {
     set(current, 0x0011);  // invalid requested state change
+  } else if (to == S::kOp && current != S::kOp && esc.refuse_op) {
+    set(current, esc.refuse_op);
   } else if (current == S::kPreOp && to == S::kSafeOp) {
     // An ESC's firmware takes SAFE-OP only with its process data sync managers set as its SII
     // describes them.
@@ -312,6 +393,11 @@ void VirtualRing::execute(Esc& esc, Datagram& d) {
 
 std::optional<std::vector<uint8_t>> VirtualRing::process(std::span<const uint8_t> bytes, uint64_t now_ns) {
   if (order_.empty()) return std::nullopt;
+  ++seen_;
+  if (lose_one_in_ && seen_ % lose_one_in_ == 0) {
+    ++counters_.lost;
+    return std::nullopt;
+  }
   Frame frame;
   try {
     frame = decode(bytes);

@@ -166,3 +166,97 @@ TEST(ProcessData, ALostCycleIsCountedNotResent) {
 
 }  // namespace
 }  // namespace concert::ethercat
+
+namespace concert::ethercat {
+namespace {
+
+struct InOp : Ring {
+  ScanReport report;
+  ProcessImage image;
+  InOp() {
+    report = master.scan();
+    image = master.map_process_data(report);
+    for (const auto state : {esc::AlState::kPreOp, esc::AlState::kSafeOp, esc::AlState::kOp}) {
+      master.request_state(report, state);
+    }
+  }
+};
+
+TEST(RingFaults, APulledCableShortensTheWorkingCounterAndIsNamed) {
+  InOp r;
+  ASSERT_EQ(r.master.cycle(r.image).wkc, r.image.expected_wkc);
+  EXPECT_TRUE(r.master.diagnose(r.report).healthy());
+  // The paper robot's arm from its second elbow on: elbow, yaw, link, elbow, yaw, drill.
+  r.ring.pull_cable("elbow_2");
+  const CycleResult cut = r.master.cycle(r.image);
+  EXPECT_TRUE(cut.returned);
+  EXPECT_LT(cut.wkc, r.image.expected_wkc);
+  const RingDiagnosis d = r.master.diagnose(r.report);
+  EXPECT_EQ(d.answering, static_cast<int>(r.report.slaves.size() - d.missing.size()));
+  ASSERT_FALSE(d.missing.empty());
+  ASSERT_EQ(d.links_lost.size(), 1u);
+  EXPECT_EQ(d.links_lost.front().second, 1);  // the link's output port
+  EXPECT_EQ(d.links_lost.front().first, d.missing.front() - 1);
+  EXPECT_NE(d.text().find("do not answer (slave " + std::to_string(d.missing.front() - 1) +
+                          " lost the link on port 1)"),
+            std::string::npos)
+      << d.text();
+  // Plugged back: the boards kept their configuration and answer in OP again.
+  r.ring.plug_cable("elbow_2");
+  EXPECT_EQ(r.master.cycle(r.image).wkc, r.image.expected_wkc);
+  EXPECT_TRUE(r.master.diagnose(r.report).missing.empty());
+}
+
+TEST(RingFaults, ASlaveRefusingOpIsNamedWithItsCode) {
+  Ring r;
+  const ScanReport report = r.master.scan();
+  r.master.map_process_data(report);
+  r.ring.refuse_op("yaw_2", 0x001A);
+  for (const auto state : {esc::AlState::kPreOp, esc::AlState::kSafeOp}) r.master.request_state(report, state);
+  try {
+    r.master.request_state(report, esc::AlState::kOp);
+    FAIL() << "no error";
+  } catch (const MasterError& e) {
+    EXPECT_NE(std::string(e.what()).find("is in SAFE-OP, AL status code 0x001A (synchronization error)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(r.master.diagnose(report).al_errors.size(), 1u);
+  EXPECT_THROW(r.ring.refuse_op("no_such_module", 0x001A), simbus::AssemblyError);
+}
+
+TEST(RingFaults, LostFramesAreLost) {
+  InOp r;
+  r.ring.lose_one_in(4);
+  int lost = 0;
+  for (int i = 0; i < 40; ++i) lost += r.master.cycle(r.image).returned ? 0 : 1;
+  EXPECT_EQ(lost, 10);
+  EXPECT_EQ(r.ring.counters().lost, 10u);
+}
+
+TEST(RingFaults, AModuleAddedAtRunTimeAppearsInANewScan) {
+  InOp r;
+  const std::size_t before = r.report.slaves.size();
+  simbus::Assembly grown = r.ring.assembly();
+  // A 0.4 m link between the arm's last yaw and the drill.
+  for (auto& m : grown.modules) {
+    if (m.name == "drill") m.parent = "extra_link";
+  }
+  grown.modules.push_back({.name = "extra_link", .key = "module_link_straight_400_concert",
+                           .parent = "yaw_3", .connector = 1});
+  r.ring.set_assembly(grown);
+  // The boards behind the new one moved one position on: the station addresses still reach
+  // them, but the new board has none, so a broadcast counts one more slave than was scanned.
+  EXPECT_EQ(r.master.diagnose(r.report).answering, static_cast<int>(before + 1));
+  Master again(r.link, MasterParams{.frame_timeout = std::chrono::microseconds(1000)});
+  const ScanReport rescanned = again.scan();
+  EXPECT_EQ(rescanned.scan(), simbus::simulate_scan(grown, r.catalog));
+  // A bad assembly leaves the ring as it was.
+  simbus::Assembly bad = grown;
+  bad.modules.back().key = "no_such_key";
+  EXPECT_THROW(r.ring.set_assembly(bad), simbus::AssemblyError);
+  EXPECT_EQ(r.ring.slave_count(), before + 1);
+}
+
+}  // namespace
+}  // namespace concert::ethercat

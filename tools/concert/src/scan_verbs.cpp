@@ -193,7 +193,33 @@ int cycle_ring(const CycleOptions& o, std::ostream& out, std::ostream& err) {
   ethercat::CycleParams params;
   params.period = std::chrono::microseconds(o.period_us);
   params.duration = std::chrono::nanoseconds(static_cast<int64_t>(o.seconds * 1e9));
-  const ethercat::CycleStats stats = ethercat::run_cycles(master, image, params, stop);
+  // The cycle watchdog: a frame back with a working counter short of the expected one, or three
+  // frames lost in a row, ends the run; the master then says what changed on the ring.
+  std::string fault;
+  uint64_t cycle_number = 0;
+  int lost_in_a_row = 0;
+  const ethercat::CycleBody watch = [&](ethercat::ProcessImage&, const ethercat::CycleResult& r) {
+    ++cycle_number;
+    lost_in_a_row = r.returned ? 0 : lost_in_a_row + 1;
+    if (r.returned && r.wkc < image.expected_wkc) {
+      fault = "cycle " + std::to_string(cycle_number) + ": working counter " + std::to_string(r.wkc) +
+              " of " + std::to_string(image.expected_wkc);
+    } else if (lost_in_a_row == 3) {
+      fault = "cycle " + std::to_string(cycle_number) + ": 3 frames lost in a row";
+    }
+    return fault.empty();
+  };
+  const ethercat::CycleStats stats = ethercat::run_cycles(master, image, params, stop, watch);
+  if (!fault.empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const ethercat::RingDiagnosis d = master.diagnose(report);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    char took[32];
+    std::snprintf(took, sizeof took, "%.1f ms", ms);
+    err << "concert ethercat cycle: " << fault << ": " << d.text() << " (diagnosed in " << took << ")\n";
+    out << stats.summary() << "\n";
+    throw cli::Failure("the ring stopped exchanging as mapped: " + d.text());
+  }
   master.request_state(report, ethercat::esc::AlState::kInit);
   if (o.json) {
     nlohmann::json j = {{"slaves", report.slaves.size()},

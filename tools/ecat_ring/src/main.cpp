@@ -2,10 +2,18 @@
 // interface until SIGINT/SIGTERM (libs/ethercat VirtualRing over a raw socket).
 //   concert_ecat_ring --assembly FILE --ifname IF [--module-db DIR ...] [--process-data FILE]
 //                     [--eeprom-8-byte]
+//                     [--fault pull:MODULE@S | refuse-op:MODULE[:CODE] | lose:N ...]
 // The assembly's faults (libs/simbus README: upside_down, broken_link, unknown_identity,
-// wrong_topology) are on the ring as a master meets them. Needs root or CAP_NET_RAW.
+// wrong_topology) are on the ring as a master meets them; --fault adds run-time ones (README of
+// libs/ethercat). SIGHUP re-reads the assembly file: a module added or removed while running.
+// Needs root or CAP_NET_RAW.
+#include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <csignal>
+#include <cstdlib>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,12 +25,63 @@
 
 namespace {
 
+std::atomic<bool> g_reload{false};
+void on_hangup(int) { g_reload = true; }
+
+/// A run-time fault of --fault.
+struct RingFault {
+  enum Kind { kPull, kRefuseOp, kLose } kind = kPull;
+  std::string module;
+  double after_s = 0;   // pull: seconds after the first process data frame
+  uint16_t code = 0x001A;
+  uint64_t one_in = 0;
+  bool done = false;
+};
+
+RingFault parse_fault(const std::string& spec) {
+  RingFault f;
+  const auto colon = spec.find(':');
+  if (colon == std::string::npos) throw concert::cli::UsageError("--fault " + spec + ": expected KIND:ARGUMENT");
+  const std::string kind = spec.substr(0, colon);
+  const std::string arg = spec.substr(colon + 1);
+  const auto number = [&](const std::string& text, const char* what) {
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || v < 0) {
+      throw concert::cli::UsageError("--fault " + spec + ": " + what + " '" + text + "' is not a number >= 0");
+    }
+    return v;
+  };
+  if (kind == "pull") {
+    f.kind = RingFault::kPull;
+    const auto at = arg.find('@');
+    f.module = arg.substr(0, at);
+    if (at != std::string::npos) f.after_s = number(arg.substr(at + 1), "seconds");
+  } else if (kind == "refuse-op") {
+    f.kind = RingFault::kRefuseOp;
+    const auto c = arg.find(':');
+    f.module = arg.substr(0, c);
+    if (c != std::string::npos) f.code = static_cast<uint16_t>(std::stoul(arg.substr(c + 1), nullptr, 0));
+  } else if (kind == "lose") {
+    f.kind = RingFault::kLose;
+    f.one_in = static_cast<uint64_t>(number(arg, "N"));
+    if (f.one_in < 2) throw concert::cli::UsageError("--fault " + spec + ": lose:N needs N >= 2");
+  } else {
+    throw concert::cli::UsageError("--fault " + spec + ": kind '" + kind + "' is not pull, refuse-op or lose");
+  }
+  if (f.kind != RingFault::kLose && f.module.empty()) {
+    throw concert::cli::UsageError("--fault " + spec + ": no module named");
+  }
+  return f;
+}
+
 struct Options {
   std::string assembly;
   std::string ifname;
   std::vector<std::string> module_dbs;
   std::string process_data = CONCERT_DEFAULT_PROCESS_DATA;
   bool eeprom_8_byte = false;
+  std::vector<std::string> faults;
 };
 
 int run(const Options& o) {
@@ -35,8 +94,23 @@ int run(const Options& o) {
   const ethercat::ProcessDataCatalog process_data = ethercat::ProcessDataCatalog::load(o.process_data);
   ethercat::VirtualRing ring(assembly, catalog,
                              ethercat::RingParams{.eeprom_8_byte_reads = o.eeprom_8_byte}, &process_data);
+  std::vector<RingFault> faults;
+  for (const std::string& spec : o.faults) faults.push_back(parse_fault(spec));
+  for (RingFault& f : faults) {
+    if (f.kind == RingFault::kRefuseOp) ring.refuse_op(f.module, f.code);
+    if (f.kind == RingFault::kLose) ring.lose_one_in(f.one_in);
+    if (f.kind == RingFault::kPull) {
+      // Checked now, so a misspelt module fails at start, not minutes later.
+      if (std::none_of(assembly.modules.begin(), assembly.modules.end(),
+                       [&](const simbus::MountedModule& m) { return m.name == f.module; })) {
+        throw cli::UsageError("--fault pull:" + f.module + ": no module '" + f.module + "' in " + o.assembly);
+      }
+    }
+  }
   ethercat::RawSocketLink link(o.ifname);
   const std::atomic<bool>& stop = cli::stop_on_signals();
+  std::signal(SIGHUP, on_hangup);
+  std::optional<std::chrono::steady_clock::time_point> first_process_data;
   std::cerr << "concert_ecat_ring: serving " << ring.slave_count() << " ESCs of " << o.assembly
             << " on " << o.ifname << " (" << ethercat::to_string(link.mac()) << "); process data of "
             << o.process_data << " (no drive model behind the boards: their inputs stay zero)"
@@ -45,7 +119,33 @@ int run(const Options& o) {
   uint64_t reported_malformed = 0;
   while (!stop) {
     const auto frame = link.receive(std::chrono::milliseconds(100));
+    if (g_reload.exchange(false)) {
+      try {
+        const std::size_t before = ring.slave_count();
+        ring.set_assembly(simbus::load_assembly(o.assembly));
+        std::cerr << "concert_ecat_ring: re-read " << o.assembly << ": " << before << " -> "
+                  << ring.slave_count() << " ESCs" << std::endl;
+      } catch (const std::exception& e) {
+        std::cerr << "concert_ecat_ring: re-reading " << o.assembly << " failed, the ring stays as it was: "
+                  << e.what() << std::endl;
+      }
+    }
+    if (first_process_data) {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - *first_process_data).count();
+      for (RingFault& f : faults) {
+        if (f.kind == RingFault::kPull && !f.done && s >= f.after_s) {
+          ring.pull_cable(f.module);
+          f.done = true;
+          std::cerr << "concert_ecat_ring: pulled the cable of '" << f.module << "' after " << s
+                    << " s of process data: " << ring.slave_count() << " ESCs answer" << std::endl;
+        }
+      }
+    }
     if (!frame) continue;
+    // The first logical datagram starts the clock of the timed faults.
+    if (!first_process_data && frame->size() > 16 && (*frame)[16] >= 10 && (*frame)[16] <= 12) {
+      first_process_data = std::chrono::steady_clock::now();
+    }
     const auto now = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                                std::chrono::steady_clock::now() - start)
                                                .count());
@@ -62,7 +162,8 @@ int run(const Options& o) {
   }
   const auto& c = ring.counters();
   std::cerr << "concert_ecat_ring: stopped after " << c.frames << " frames (" << c.datagrams
-            << " datagrams), " << c.malformed << " dropped as malformed" << std::endl;
+            << " datagrams), " << c.malformed << " dropped as malformed, " << c.lost
+            << " lost on purpose" << std::endl;
   return 0;
 }
 
@@ -87,6 +188,12 @@ int main(int argc, char** argv) {
   app.add_option("--process-data", o.process_data, "process data of each board type")
       ->type_name("FILE")
       ->capture_default_str();
+  app.add_option("--fault", o.faults,
+                 "a run-time fault (repeatable): pull:MODULE@S (the cable from MODULE to its parent "
+                 "pulled S s after the first process data frame), refuse-op:MODULE[:CODE] (its "
+                 "boards stay in SAFE-OP with AL status CODE, default 0x001A), lose:N (one frame "
+                 "in N lost)")
+      ->type_name("SPEC");
   app.add_flag("--eeprom-8-byte", o.eeprom_8_byte,
                "ESCs read 8 bytes of EEPROM per command (default 4)");
   cli.on_run(app, [&o] { return run(o); });

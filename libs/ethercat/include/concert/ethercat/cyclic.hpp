@@ -34,9 +34,9 @@ struct CycleStats {
   std::string summary() const;
 };
 
-/// Called every cycle after the inputs came back, before the next outputs go: fill outputs,
-/// read inputs. Its result is ignored; a throw ends the run.
-using CycleBody = std::function<void(ProcessImage& image, const CycleResult& result)>;
+/// Called every cycle after the inputs came back (or did not), before the next outputs go: fill
+/// outputs, read inputs, watch the result. Returns false to end the run.
+using CycleBody = std::function<bool(ProcessImage& image, const CycleResult& result)>;
 
 /// Runs cycles on `image` (mapped, the ring in OP) every `params.period` for `params.duration`
 /// or until `stop`. Allocates nothing per cycle besides what `body` does.

@@ -106,6 +106,19 @@ struct CycleResult {
   uint16_t wkc = 0;
 };
 
+/// What the master finds when the ring no longer answers as scanned (a working counter short):
+/// which slaves are gone, where a link went down, which slaves flag an AL error.
+struct RingDiagnosis {
+  int answering = 0;                                  ///< slaves a broadcast read counts now
+  std::vector<int32_t> missing;                       ///< scanned positions that do not answer
+  std::vector<std::pair<int32_t, int32_t>> links_lost;  ///< (position, port): open at the scan, closed now
+  std::vector<std::pair<int32_t, uint16_t>> al_errors;  ///< (position, AL status code)
+  /// "slaves 12-15 do not answer (slave 11 lost the link on port 1); slave 3: AL status code
+  /// 0x001B (sync manager watchdog)", or "the ring answers as scanned".
+  std::string text() const;
+  bool healthy() const { return missing.empty() && links_lost.empty() && al_errors.empty(); }
+};
+
 class Master {
  public:
   explicit Master(Link& link, MasterParams params = {});
@@ -131,6 +144,10 @@ class Master {
   /// the AL status, `state_poll_interval` apart) until all are in it. Throws MasterError naming
   /// each slave that refused, with its AL status code by name, or that did not get there.
   void request_state(const ScanReport& report, esc::AlState state);
+
+  /// Reads every slave of `report` again (AL status, DL status) and says what changed since.
+  /// Never throws for a ring that does not answer: then every slave is missing.
+  RingDiagnosis diagnose(const ScanReport& report);
 
   /// One cycle: sends the outputs and the slaves' inputs space in one LRW, waits for it up to
   /// the frame timeout (no resend: a late frame is a lost cycle), copies the inputs back.

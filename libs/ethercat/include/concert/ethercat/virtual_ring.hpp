@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
@@ -37,6 +38,7 @@ struct RingCounters {
   uint64_t frames = 0;      ///< EtherCAT frames answered
   uint64_t malformed = 0;   ///< frames dropped as unreadable
   uint64_t datagrams = 0;
+  uint64_t lost = 0;        ///< frames lost on purpose (lose_one_in)
   std::string last_error;   ///< why the last malformed frame was dropped
 };
 
@@ -56,6 +58,24 @@ class VirtualRing {
 
   /// Sets what runs behind every board with process data (none: inputs stay as they are).
   void set_application(BoardApplication application) { application_ = std::move(application); }
+
+  /// The robot as assembled now (a module added or removed at run time, a cable pulled or
+  /// plugged back): ESCs still there keep their state (station address, AL state, sync
+  /// managers, FMMUs, process data); new ones start in INIT without a station address; a port
+  /// that loses its peer counts a lost link (0x0310 + port). Throws simbus::AssemblyError and
+  /// then keeps the ring as it was.
+  void set_assembly(const simbus::Assembly& assembly);
+  const simbus::Assembly& assembly() const { return assembly_; }
+
+  /// Run-time faults, as a crew or a worn cable causes them:
+  /// the cable from `module` to its parent pulled out (module and subtree gone) or plugged back.
+  /// Throws simbus::AssemblyError for a module not in the assembly.
+  void pull_cable(const std::string& module);
+  void plug_cable(const std::string& module);
+  /// The boards of `module` refuse OP (stay in SAFE-OP) with `code` (0: accept OP again).
+  void refuse_op(const std::string& module, uint16_t code);
+  /// Every `n`-th frame is lost (0: none).
+  void lose_one_in(uint64_t n) { lose_one_in_ = n; }
 
   /// The frame as it comes back to the master after passing every ESC, or nothing when it does
   /// not come back (no ESC on the master's port, or bytes that are not an EtherCAT frame:
@@ -80,8 +100,12 @@ class VirtualRing {
     bool touched = false;             // a logical datagram reached its process data
     const BoardProcessData* process_data = nullptr;
     SiiInfo info;
+    uint16_t refuse_op = 0;           // AL status code for OP requests; 0: OP accepted
   };
 
+  void rebuild(const simbus::Assembly& assembly);
+  Esc fresh_esc(const simbus::BusEsc& b, std::size_t index);
+  void set_dl_status(Esc& e);
   void execute(Esc& esc, Datagram& d);
   void execute_logical(Esc& esc, Datagram& d);
   uint16_t check_sync_managers(const Esc& esc) const;
@@ -92,6 +116,13 @@ class VirtualRing {
   void put16(Esc& esc, uint16_t at, uint16_t value);
 
   RingParams params_;
+  topology::EscCatalog catalog_;
+  const ProcessDataCatalog* process_data_ = nullptr;
+  simbus::Assembly assembly_;             // as assembled, without the pulled cables
+  std::vector<std::string> pulled_;       // modules whose cable to the parent is out
+  std::map<std::string, uint16_t> refusing_;  // module -> AL status code
+  uint64_t lose_one_in_ = 0;
+  uint64_t seen_ = 0;
   std::vector<Esc> escs_;                 // bus order
   std::vector<int32_t> order_;            // EPU order: ESC index per ring position
   std::vector<simbus::FrameStep> path_;
