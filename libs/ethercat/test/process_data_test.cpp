@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "concert/ethercat/drive_pdo.hpp"
 #include "concert/ethercat/master.hpp"
 #include "concert/ethercat/process_data.hpp"
 #include "concert/ethercat/virtual_ring.hpp"
@@ -256,6 +257,64 @@ TEST(RingFaults, AModuleAddedAtRunTimeAppearsInANewScan) {
   bad.modules.back().key = "no_such_key";
   EXPECT_THROW(r.ring.set_assembly(bad), simbus::AssemblyError);
   EXPECT_EQ(r.ring.slave_count(), before + 1);
+}
+
+}  // namespace
+}  // namespace concert::ethercat
+
+namespace concert::ethercat {
+namespace {
+
+TEST(DriveCodec, CarriesACommandAndFeedbackThroughTheDriveBoardsBytes) {
+  const ProcessDataCatalog c = ProcessDataCatalog::load(kProcessData);
+  const DriveCodec codec(*c.find(21));
+  hardware::DriveCommand cmd;
+  cmd.mode = hardware::DriveMode::kImpedance;
+  cmd.position = 1.25;
+  cmd.velocity = -0.5;
+  cmd.effort = 12.0;
+  cmd.stiffness = 800;
+  cmd.damping = 20;
+  cmd.max_effort = 140;
+  std::vector<uint8_t> out(codec.output_bytes());
+  codec.encode(cmd, true, out);
+  EXPECT_EQ(out[0] | (out[1] << 8), kControlEnableOperation);
+  EXPECT_EQ(out[2], 4);  // impedance
+  bool enabled = false;
+  const hardware::DriveCommand back = codec.decode_command(out, enabled);
+  EXPECT_TRUE(enabled);
+  EXPECT_EQ(back.mode, hardware::DriveMode::kImpedance);
+  EXPECT_FLOAT_EQ(static_cast<float>(back.position), 1.25F);
+  EXPECT_FLOAT_EQ(static_cast<float>(back.max_effort), 140.0F);
+  codec.encode(cmd, false, out);
+  codec.decode_command(out, enabled);
+  EXPECT_FALSE(enabled);
+
+  DriveFeedback f;
+  f.status_word = kStatusOperationEnabled;
+  f.link_position = -0.75;
+  f.torque = 33.5;
+  f.motor_temperature = 61;
+  std::vector<uint8_t> in(codec.input_bytes());
+  codec.encode(f, in);
+  const DriveFeedback g = codec.decode_feedback(in);
+  EXPECT_EQ(g.status_word, kStatusOperationEnabled);
+  EXPECT_FLOAT_EQ(static_cast<float>(g.link_position), -0.75F);
+  EXPECT_FLOAT_EQ(static_cast<float>(g.torque), 33.5F);
+  EXPECT_FLOAT_EQ(static_cast<float>(g.motor_temperature), 61.0F);
+}
+
+TEST(DriveCodec, RefusesABoardThatIsNoDrive) {
+  const ProcessDataCatalog c = ProcessDataCatalog::parse(
+      "boards:\n  - {esc_type: 7, name: io, outputs: [{name: control_word, type: uint16}], "
+      "inputs: [{name: status_word, type: uint16}]}\n",
+      "pd.yaml");
+  try {
+    DriveCodec codec(*c.find(7));
+    FAIL() << "no error";
+  } catch (const ProcessDataError& e) {
+    EXPECT_EQ(std::string(e.what()), "board 'io' (ESC type 7) has no output entry 'mode' a drive needs");
+  }
 }
 
 }  // namespace
