@@ -207,4 +207,20 @@ stop_ring
 cmp -s "$work/after.json" "$work/show.json" || fail "the scan after the module was added is not the new assembly's"
 cmp -s "$work/before.json" "$work/after.json" && fail "the scan did not change when a module was added"
 echo "ok: a module added at run time is in the next scan (19 -> 20 ESCs)"
+
+# 4. The demo robot's MuJoCo model behind the drive boards (--robot): every joint found its
+#    board, and every drive board reports in OP.
+ip netns exec "$ns_ring" "$ring_bin" --assembly "$src/deploy/demo/drill_robot.yaml" --ifname "ecr$tag" --robot \
+  > "$work/ring.log" 2>&1 &
+ring_pid=$!
+wait_for_line "$work/ring.log" "concert_ecat_ring: serving" || fail "the ring with the robot did not start"
+grep -q "the MuJoCo robot of .*drill_robot.yaml (14 joints) behind the drive boards" "$work/ring.log" ||
+  fail "the ring did not put the demo robot's 14 joints behind its boards"
+ip netns exec "$ns_master" "$concert" ethercat cycle --ifname "ecm$tag" --seconds 1 --feedback \
+  > /dev/null 2> "$work/cycle.err" || { cat "$work/cycle.err"; fail "cycling the robot's ring failed"; }
+stop_ring
+grep -q "joints found no drive board" "$work/ring.log" && fail "a joint of the robot found no drive board"
+boards=$(grep -c "robot_id [0-9]*: status" "$work/cycle.err")
+[ "$boards" -eq 15 ] || { cat "$work/cycle.err"; fail "$boards drive boards reported, expected 15"; }
+echo "ok: the demo robot behind the ring: 15 drive boards report, every joint found its board"
 echo "PASS"

@@ -416,25 +416,30 @@ std::optional<std::vector<uint8_t>> VirtualRing::process(std::span<const uint8_t
   }
   // The boards behind the ESCs take their outputs and put their inputs for the next frame.
   if (application_) {
+    boards_.clear();
     for (std::size_t position = 0; position < order_.size(); ++position) {
       Esc& esc = escs_[static_cast<std::size_t>(order_[position])];
       if (!esc.process_data || !esc.touched) continue;
       const auto state = esc::al_state_from(get16(esc, esc::kAlStatus));
       if (state != esc::AlState::kOp && state != esc::AlState::kSafeOp) continue;
+      BoardIo io;
+      io.position = static_cast<int>(position) + 1;
+      io.esc = &esc.bus;
+      io.board = esc.process_data;
+      io.state = *state;
       const int out_sm = esc.info.sync_manager_of(SiiSyncManager::kOutputs);
       const int in_sm = esc.info.sync_manager_of(SiiSyncManager::kInputs);
-      std::span<const uint8_t> outputs;
-      std::span<uint8_t> inputs;
       if (out_sm >= 0) {
-        outputs = std::span<const uint8_t>(esc.memory).subspan(
+        io.outputs = std::span<const uint8_t>(esc.memory).subspan(
             esc.info.sync_managers[static_cast<std::size_t>(out_sm)].start, esc.info.output_bytes());
       }
       if (in_sm >= 0) {
-        inputs = std::span<uint8_t>(esc.memory).subspan(
+        io.inputs = std::span<uint8_t>(esc.memory).subspan(
             esc.info.sync_managers[static_cast<std::size_t>(in_sm)].start, esc.info.input_bytes());
       }
-      application_(static_cast<int>(position) + 1, *esc.process_data, *state, outputs, inputs, now_ns);
+      boards_.push_back(io);
     }
+    if (!boards_.empty()) application_(boards_, now_ns);
   }
   // DC: the ESCs a write to 0x0900 reached latch the local time the frame's first bit passed
   // each of their ports on its way (ports it did not pass keep their old value).

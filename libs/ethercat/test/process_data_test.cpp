@@ -39,13 +39,16 @@ struct Ring {
   Ring() {
     // A test drive: the link follows the position reference at once, the torque is the
     // feed-forward, and the board reports which position it is at in the ring as temperature.
-    ring.set_application([](int position, const BoardProcessData& board, esc::AlState state,
-                            std::span<const uint8_t> out, std::span<uint8_t> in, uint64_t) {
-      if (state == esc::AlState::kOp) {
-        put_float(in, board.input("link_position")->offset, get_float(out, board.output("position_ref")->offset));
-        put_float(in, board.input("torque")->offset, get_float(out, board.output("torque_ff")->offset));
+    ring.set_application([](std::span<BoardIo> boards, uint64_t) {
+      for (const BoardIo& b : boards) {
+        if (b.state == esc::AlState::kOp) {
+          put_float(b.inputs, b.board->input("link_position")->offset,
+                    get_float(b.outputs, b.board->output("position_ref")->offset));
+          put_float(b.inputs, b.board->input("torque")->offset,
+                    get_float(b.outputs, b.board->output("torque_ff")->offset));
+        }
+        put_float(b.inputs, b.board->input("board_temperature")->offset, static_cast<float>(b.position));
       }
-      put_float(in, board.input("board_temperature")->offset, static_cast<float>(position));
     });
   }
 };

@@ -166,6 +166,7 @@ SimulatedRobot AssemblyBuilder::build_from_text(const std::string& yaml, const s
         const int n = joints_of_module[j.module]++;
         out.joint_modules[j.name] =
             module_identity(out.tree, j.module) + (n > 0 ? " joint " + std::to_string(n + 1) : std::string());
+        out.joint_robot_ids[j.name] = out.tree.modules.at(static_cast<std::size_t>(j.module)).robot_id;
       }
       out.joint_homes[j.name] = j.home;
     }

@@ -9,6 +9,7 @@
 #include "concert/dds/endpoint.hpp"
 #include "concert/ethercat/esc.hpp"
 #include "concert/ethercat/cyclic.hpp"
+#include "concert/ethercat/drive_pdo.hpp"
 #include "concert/ethercat/master.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include <pthread.h>
@@ -154,6 +155,8 @@ int read_scan(const ReadOptions& o, std::ostream& out, std::ostream& err) {
 
 struct CycleOptions {
   std::string ifname;
+  bool feedback = false;
+  std::string process_data = CONCERT_DEFAULT_PROCESS_DATA;
   double seconds = 1.0;
   int period_us = 1000;
   int fifo = 0;
@@ -219,6 +222,22 @@ int cycle_ring(const CycleOptions& o, std::ostream& out, std::ostream& err) {
     err << "concert ethercat cycle: " << fault << ": " << d.text() << " (diagnosed in " << took << ")\n";
     out << stats.summary() << "\n";
     throw cli::Failure("the ring stopped exchanging as mapped: " + d.text());
+  }
+  if (o.feedback) {
+    // Each drive board's last inputs, decoded with the process data file.
+    const auto catalog = ethercat::ProcessDataCatalog::load(o.process_data);
+    for (const auto& m : image.slaves) {
+      const auto& s = report.slaves[static_cast<std::size_t>(m.position - 1)];
+      const ethercat::BoardProcessData* board = catalog.find(s.slave.esc_type);
+      if (!board || !board->input("link_position")) continue;
+      const ethercat::DriveFeedback f = ethercat::DriveCodec(*board).decode_feedback(
+          std::span<const uint8_t>(image.inputs).subspan(m.input_offset, m.input_bytes));
+      char line[200];
+      std::snprintf(line, sizeof line,
+                    "  slave %d robot_id %d: status 0x%04X fault 0x%04X position %+.4f rad velocity %+.4f rad/s torque %+.3f N m\n",
+                    m.position, s.sii.robot_id, f.status_word, f.fault, f.link_position, f.velocity, f.torque);
+      err << line;
+    }
   }
   master.request_state(report, ethercat::esc::AlState::kInit);
   if (o.json) {
@@ -314,6 +333,10 @@ void register_scan_verbs(cli::Cli& concert) {
       ->type_name("PRIO")
       ->check(cli::number(0, 99, true));
   cyc.add_flag("--json", c->json, "the figures as JSON");
+  cyc.add_flag("--feedback", c->feedback, "print every drive board's last feedback (stderr)");
+  cyc.add_option("--process-data", c->process_data, "process data of each board type (for --feedback)")
+      ->type_name("FILE")
+      ->capture_default_str();
 
   auto o = std::make_shared<PublishOptions>();
   CLI::App& pub =

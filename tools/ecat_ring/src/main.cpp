@@ -1,7 +1,7 @@
 // concert_ecat_ring: the EtherCAT ring of an assembly file, answering frames on a network
 // interface until SIGINT/SIGTERM (libs/ethercat VirtualRing over a raw socket).
 //   concert_ecat_ring --assembly FILE --ifname IF [--module-db DIR ...] [--process-data FILE]
-//                     [--eeprom-8-byte]
+//                     [--robot [--world FILE]] [--eeprom-8-byte]
 //                     [--fault pull:MODULE@S | refuse-op:MODULE[:CODE] | lose:N ...]
 // The assembly's faults (libs/simbus README: upside_down, broken_link, unknown_identity,
 // wrong_topology) are on the ring as a master meets them; --fault adds run-time ones (README of
@@ -20,6 +20,10 @@
 #include "concert/cli/cli.hpp"
 #include "concert/cli/stop_signals.hpp"
 #include "concert/ethercat/link.hpp"
+#include "concert/ethercat/robot_on_ring.hpp"
+#include "concert/sim/sim_hardware.hpp"
+#include "concert/world/world.hpp"
+#include <filesystem>
 #include "concert/ethercat/virtual_ring.hpp"
 #include "concert/simbus/assembly.hpp"
 
@@ -82,6 +86,8 @@ struct Options {
   std::string process_data = CONCERT_DEFAULT_PROCESS_DATA;
   bool eeprom_8_byte = false;
   std::vector<std::string> faults;
+  bool robot = false;
+  std::string world;
 };
 
 int run(const Options& o) {
@@ -94,6 +100,23 @@ int run(const Options& o) {
   const ethercat::ProcessDataCatalog process_data = ethercat::ProcessDataCatalog::load(o.process_data);
   ethercat::VirtualRing ring(assembly, catalog,
                              ethercat::RingParams{.eeprom_8_byte_reads = o.eeprom_8_byte}, &process_data);
+  // --robot: the MuJoCo robot of the assembly behind the drive boards.
+  std::optional<sim::SimHardware> simulated;
+  std::optional<ethercat::RobotOnRing> robot;
+  if (o.robot) {
+    const sim::AssemblyBuilder builder(std::vector<std::filesystem::path>(dbs.begin(), dbs.end()));
+    sim::SimulatedRobot mounted = builder.build(o.assembly);
+    const ethercat::BoardProcessData* drive = process_data.find(21);
+    if (!drive) throw cli::Failure(o.process_data + ": no drive board (ESC type 21) to put the robot behind");
+    sim::SimParams params;
+    params.sensors.enabled = false;  // the ring carries the drives only
+    const world::World world = o.world.empty() ? world::World{} : world::load_world_file(o.world);
+    simulated.emplace(mounted, world, params);
+    robot.emplace(*simulated, mounted, *drive);
+    ring.set_application([&robot](std::span<ethercat::BoardIo> boards, uint64_t now) { robot->exchange(boards, now); });
+    std::cerr << "concert_ecat_ring: the MuJoCo robot of " << o.assembly << " (" << simulated->joint_names().size()
+              << " joints) behind the drive boards" << (o.world.empty() ? "" : ", in " + o.world) << std::endl;
+  }
   std::vector<RingFault> faults;
   for (const std::string& spec : o.faults) faults.push_back(parse_fault(spec));
   for (RingFault& f : faults) {
@@ -113,10 +136,11 @@ int run(const Options& o) {
   std::optional<std::chrono::steady_clock::time_point> first_process_data;
   std::cerr << "concert_ecat_ring: serving " << ring.slave_count() << " ESCs of " << o.assembly
             << " on " << o.ifname << " (" << ethercat::to_string(link.mac()) << "); process data of "
-            << o.process_data << " (no drive model behind the boards: their inputs stay zero)"
+            << o.process_data << (o.robot ? "" : " (no robot behind the boards: their inputs stay zero; --robot)")
             << std::endl;
   const auto start = std::chrono::steady_clock::now();
   uint64_t reported_malformed = 0;
+  bool warned_unmatched = false;
   while (!stop) {
     const auto frame = link.receive(std::chrono::milliseconds(100));
     if (g_reload.exchange(false)) {
@@ -150,6 +174,11 @@ int run(const Options& o) {
                                                std::chrono::steady_clock::now() - start)
                                                .count());
     if (auto answer = ring.process(*frame, now)) link.send(*answer);
+    if (robot && !robot->unmatched().empty() && !warned_unmatched) {
+      warned_unmatched = true;
+      std::cerr << "concert_ecat_ring: " << robot->unmatched().size()
+                << " joints found no drive board in OP (first: " << robot->unmatched().front() << ")" << std::endl;
+    }
     const auto& c = ring.counters();
     if (c.malformed > reported_malformed) {
       reported_malformed = c.malformed;
@@ -194,6 +223,10 @@ int main(int argc, char** argv) {
                  "boards stay in SAFE-OP with AL status CODE, default 0x001A), lose:N (one frame "
                  "in N lost)")
       ->type_name("SPEC");
+  app.add_flag("--robot", o.robot,
+               "the assembly's MuJoCo robot (libs/sim) behind the drive boards: their outputs drive "
+               "it, one millisecond of physics per process data frame, their inputs report it");
+  app.add_option("--world", o.world, "the robot's world (with --robot)")->type_name("FILE");
   app.add_flag("--eeprom-8-byte", o.eeprom_8_byte,
                "ESCs read 8 bytes of EEPROM per command (default 4)");
   cli.on_run(app, [&o] { return run(o); });

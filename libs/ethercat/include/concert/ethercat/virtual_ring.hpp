@@ -42,12 +42,19 @@ struct RingCounters {
   std::string last_error;   ///< why the last malformed frame was dropped
 };
 
-/// What runs on a board behind its ESC (a drive, ...): called after every frame that reached
-/// the board while in SAFE-OP or OP, with the outputs the master wrote into its sync manager 2
-/// and the inputs to fill in sync manager 3 (read by the next frame).
-using BoardApplication =
-    std::function<void(int position, const BoardProcessData& board, esc::AlState state,
-                       std::span<const uint8_t> outputs, std::span<uint8_t> inputs, uint64_t now_ns)>;
+/// One board with process data, as a frame left it.
+struct BoardIo {
+  int position = 0;                        ///< ring position, 1-based
+  const simbus::BusEsc* esc = nullptr;     ///< its module, robot_id, identity
+  const BoardProcessData* board = nullptr;
+  esc::AlState state = esc::AlState::kInit;
+  std::span<const uint8_t> outputs;        ///< what the master wrote into sync manager 2
+  std::span<uint8_t> inputs;               ///< sync manager 3: read by the next frame
+};
+
+/// What runs behind the boards (drives, ...): called after every frame whose logical datagram
+/// reached boards in SAFE-OP or OP, with those boards, in ring order.
+using RingApplication = std::function<void(std::span<BoardIo> boards, uint64_t now_ns)>;
 
 class VirtualRing {
  public:
@@ -56,8 +63,8 @@ class VirtualRing {
   VirtualRing(const simbus::Assembly& assembly, const topology::EscCatalog& catalog,
               RingParams params = {}, const ProcessDataCatalog* process_data = nullptr);
 
-  /// Sets what runs behind every board with process data (none: inputs stay as they are).
-  void set_application(BoardApplication application) { application_ = std::move(application); }
+  /// Sets what runs behind the boards with process data (none: inputs stay as they are).
+  void set_application(RingApplication application) { application_ = std::move(application); }
 
   /// The robot as assembled now (a module added or removed at run time, a cable pulled or
   /// plugged back): ESCs still there keep their state (station address, AL state, sync
@@ -128,7 +135,8 @@ class VirtualRing {
   std::vector<simbus::FrameStep> path_;
   std::vector<uint64_t> step_time_ns_;    // time of each step after the frame leaves the master
   RingCounters counters_;
-  BoardApplication application_;
+  RingApplication application_;
+  std::vector<BoardIo> boards_;           // scratch for the application, sized once
 };
 
 }  // namespace concert::ethercat

@@ -43,6 +43,10 @@ struct SimulatedRobot {
   /// swap carries a joint's state by this, never by the joint's name, which another morphology
   /// may give to another module's joint. Empty for a bare URDF.
   std::map<std::string, std::string> joint_modules;
+  /// Moving joint -> the robot_id of its module's ESC (-1: its module has none): how a drive
+  /// board on the EtherCAT ring is told apart from the others (libs/ethercat's robot on the
+  /// virtual ring). Empty for a bare URDF.
+  std::map<std::string, int32_t> joint_robot_ids;
   /// Moving joint -> its homing position, within its limits: where a joint whose module is new
   /// in a hot swap starts.
   std::map<std::string, double> joint_homes;
