@@ -4,6 +4,7 @@
 
 #include "concert/ethercat/esc.hpp"
 #include "concert/ethercat/frame.hpp"
+#include "concert/ethercat/ring_server.hpp"
 #include "concert/ethercat/sii.hpp"
 
 namespace concert::ethercat {
@@ -167,6 +168,36 @@ TEST(Sii, NamesWhatIsWrong) {
   image.pop_back();
   image[0x41] = 10;
   EXPECT_THROW(parse_sii_image(image), SiiError);
+}
+
+}  // namespace
+}  // namespace concert::ethercat
+
+namespace concert::ethercat {
+namespace {
+
+TEST(RingFaultSpec, ReadsEveryKindAndNamesWhatIsWrong) {
+  const RingFault pull = parse_ring_fault("pull:elbow_2@0.5");
+  EXPECT_EQ(pull.kind, RingFault::Kind::kPull);
+  EXPECT_EQ(pull.module, "elbow_2");
+  EXPECT_DOUBLE_EQ(pull.after_s, 0.5);
+  EXPECT_EQ(parse_ring_fault("refuse-op:yaw_2:0x001B").code, 0x001B);
+  EXPECT_EQ(parse_ring_fault("refuse-op:yaw_2").code, 0x001A);
+  EXPECT_EQ(parse_ring_fault("lose:100").one_in, 100u);
+  const auto error_of = [](const std::string& spec) {
+    try {
+      parse_ring_fault(spec);
+    } catch (const RingFaultError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of("cut:x"), "--fault cut:x: kind 'cut' is not pull, refuse-op or lose");
+  EXPECT_EQ(error_of("pull:x@soon"), "--fault pull:x@soon: seconds 'soon' is not a number >= 0");
+  EXPECT_EQ(error_of("lose:1"), "--fault lose:1: lose:N needs N >= 2");
+  EXPECT_EQ(error_of("pull:"), "--fault pull:: no module named");
+  EXPECT_EQ(error_of("refuse-op:m:0x10000"), "--fault refuse-op:m:0x10000: AL status code '0x10000' is not 1..0xFFFF");
+  EXPECT_EQ(error_of("pull"), "--fault pull: expected KIND:ARGUMENT");
 }
 
 }  // namespace

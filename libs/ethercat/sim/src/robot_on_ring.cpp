@@ -1,5 +1,11 @@
 #include "concert/ethercat/robot_on_ring.hpp"
 
+#include <filesystem>
+#include <optional>
+
+#include "concert/sim/sim_hardware.hpp"
+#include "concert/world/world.hpp"
+
 namespace concert::ethercat {
 
 RobotOnRing::RobotOnRing(hardware::Hardware& hardware, const sim::SimulatedRobot& robot,
@@ -66,5 +72,31 @@ void RobotOnRing::exchange(std::span<BoardIo> boards, uint64_t) {
     codec_.encode(f, io.inputs);
   }
 }
+
+struct RobotBehindRing::Impl {
+  std::optional<sim::SimHardware> hardware;
+  std::optional<RobotOnRing> robot;
+};
+
+RobotBehindRing::RobotBehindRing(VirtualRing& ring, const std::vector<std::string>& module_dbs,
+                                 const std::string& assembly_file, const std::string& world_file,
+                                 const ProcessDataCatalog& process_data)
+    : impl_(std::make_unique<Impl>()) {
+  const sim::AssemblyBuilder builder(std::vector<std::filesystem::path>(module_dbs.begin(), module_dbs.end()));
+  const sim::SimulatedRobot mounted = builder.build(assembly_file);
+  const BoardProcessData* drive = process_data.find(21);
+  if (!drive) throw std::runtime_error("the process data has no drive board (ESC type 21) to put the robot behind");
+  sim::SimParams params;
+  params.sensors.enabled = false;  // the ring carries the drives only
+  const world::World world = world_file.empty() ? world::World{} : world::load_world_file(world_file);
+  impl_->hardware.emplace(mounted, world, params);
+  impl_->robot.emplace(*impl_->hardware, mounted, *drive);
+  RobotOnRing* robot = &*impl_->robot;
+  ring.set_application([robot](std::span<BoardIo> boards, uint64_t now) { robot->exchange(boards, now); });
+}
+
+RobotBehindRing::~RobotBehindRing() = default;
+std::size_t RobotBehindRing::joints() const { return impl_->hardware->joint_names().size(); }
+const RobotOnRing& RobotBehindRing::robot() const { return *impl_->robot; }
 
 }  // namespace concert::ethercat

@@ -5,6 +5,7 @@
 // A board is found by its module's robot_id, as the real drives are told apart.
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -53,6 +54,25 @@ class RobotOnRing {
   std::vector<int> board_of_;               // per joint: index into the frame's boards, -1
   std::vector<std::string> unmatched_;
   uint64_t steps_ = 0;
+};
+
+/// The assembly's MuJoCo robot behind a ring's drive boards, owning what it needs.
+class RobotBehindRing {
+ public:
+  /// Builds the robot of `assembly_file` from `module_dbs` (as the sim backend does; no
+  /// sensors), in `world_file` (empty: an empty world), and sets it as `ring`'s application.
+  /// Throws std::runtime_error naming what is wrong (no drive board in `process_data`, a
+  /// joint without robot_id, a module the databases lack).
+  RobotBehindRing(VirtualRing& ring, const std::vector<std::string>& module_dbs,
+                  const std::string& assembly_file, const std::string& world_file,
+                  const ProcessDataCatalog& process_data);
+  ~RobotBehindRing();
+  std::size_t joints() const;
+  const RobotOnRing& robot() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace concert::ethercat
