@@ -155,6 +155,7 @@ int read_scan(const ReadOptions& o, std::ostream& out, std::ostream& err) {
 
 struct CycleOptions {
   std::string ifname;
+  int lost_in_a_row = 3;
   bool feedback = false;
   std::string process_data = CONCERT_DEFAULT_PROCESS_DATA;
   double seconds = 1.0;
@@ -196,8 +197,8 @@ int cycle_ring(const CycleOptions& o, std::ostream& out, std::ostream& err) {
   ethercat::CycleParams params;
   params.period = std::chrono::microseconds(o.period_us);
   params.duration = std::chrono::nanoseconds(static_cast<int64_t>(o.seconds * 1e9));
-  // The cycle watchdog: a frame back with a working counter short of the expected one, or three
-  // frames lost in a row, ends the run; the master then says what changed on the ring.
+  // The cycle watchdog: a frame back with a working counter short of the expected one, or
+  // --lost-in-a-row frames lost in a row, ends the run; the master then says what changed.
   std::string fault;
   uint64_t cycle_number = 0;
   int lost_in_a_row = 0;
@@ -207,8 +208,8 @@ int cycle_ring(const CycleOptions& o, std::ostream& out, std::ostream& err) {
     if (r.returned && r.wkc < image.expected_wkc) {
       fault = "cycle " + std::to_string(cycle_number) + ": working counter " + std::to_string(r.wkc) +
               " of " + std::to_string(image.expected_wkc);
-    } else if (lost_in_a_row == 3) {
-      fault = "cycle " + std::to_string(cycle_number) + ": 3 frames lost in a row";
+    } else if (o.lost_in_a_row > 0 && lost_in_a_row == o.lost_in_a_row) {
+      fault = "cycle " + std::to_string(cycle_number) + ": " + std::to_string(lost_in_a_row) + " frames lost in a row";
     }
     return fault.empty();
   };
@@ -333,6 +334,11 @@ void register_scan_verbs(cli::Cli& concert) {
       ->type_name("PRIO")
       ->check(cli::number(0, 99, true));
   cyc.add_flag("--json", c->json, "the figures as JSON");
+  cyc.add_option("--lost-in-a-row", c->lost_in_a_row,
+                 "frames lost in a row that end the run (0: count them, never stop)")
+      ->type_name("N")
+      ->check(cli::number(0, 1e6, true))
+      ->capture_default_str();
   cyc.add_flag("--feedback", c->feedback, "print every drive board's last feedback (stderr)");
   cyc.add_option("--process-data", c->process_data, "process data of each board type (for --feedback)")
       ->type_name("FILE")
