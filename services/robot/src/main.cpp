@@ -160,8 +160,8 @@ void add_options(CLI::App& app, Options& o) {
 void check(Options& o) {
   if (o.backend == "ethercat") {
     throw concert::cli::UsageError(
-        "backend 'ethercat' is not part of this build (no EtherCAT master here); "
-        "see services/robot/README.md for what it must provide");
+        "backend 'ethercat' is not written yet: the master is (libs/ethercat; `concert scan read`, "
+        "`concert ethercat cycle`), the robot cannot run on it yet; see services/robot/README.md");
   }
   if (o.backend != "sim") {
     throw concert::cli::UsageError("unknown backend '" + o.backend + "' (sim or ethercat)");
