@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "concert/ethercat/ethercat_hardware.hpp"
 #include "concert/ethercat/master.hpp"
 #include "concert/ethercat/robot_on_ring.hpp"
 #include "concert/sim/sim_hardware.hpp"
@@ -106,6 +107,85 @@ TEST(RobotOnRing, MovesTheSimulatedRobotAsTheSimBackendDoes) {
   EXPECT_EQ(f.status_word, kStatusOperationEnabled);
   EXPECT_NEAR(f.link_position, before_last.position[elbow], 1e-6);
   EXPECT_NEAR(f.torque, before_last.effort[elbow], 1e-3 * std::max(1.0, std::abs(before_last.effort[elbow])));
+}
+
+}  // namespace
+}  // namespace concert::ethercat
+
+namespace concert::ethercat {
+namespace {
+
+TEST(EthercatHardware, DrivesTheRobotBehindTheRingByRobotId) {
+  const sim::AssemblyBuilder builder({test_data::kProjectDb});
+  const sim::SimulatedRobot robot = builder.build(kAssembly);
+  sim::SimHardware ringed(robot, world::World{}, quiet());
+  const ProcessDataCatalog pd = ProcessDataCatalog::load(kProcessData);
+  VirtualRing ring(simbus::load_assembly(kAssembly), topology::EscCatalog::load(test_data::kProjectDb), RingParams{}, &pd);
+  RobotOnRing app(ringed, robot, *pd.find(21));
+  ring.set_application([&app](std::span<BoardIo> boards, uint64_t now) { app.exchange(boards, now); });
+  uint64_t now = 0;
+  LoopbackLink link([&](std::span<const uint8_t> f) { return ring.process(f, now += 1'000'000); });
+  EthercatHardware hw(link, pd, MasterParams{.frame_timeout = std::chrono::microseconds(1000),
+                                             .state_poll_interval = std::chrono::microseconds(0)});
+  EXPECT_EQ(hw.scan().scan(), simbus::simulate_scan(simbus::load_assembly(kAssembly),
+                                                     topology::EscCatalog::load(test_data::kProjectDb)));
+  // The robot's joints in reverse order: the hardware order is the caller's.
+  std::vector<std::pair<std::string, int32_t>> joints;
+  for (auto it = ringed.joint_names().rbegin(); it != ringed.joint_names().rend(); ++it) {
+    joints.emplace_back(*it, robot.joint_robot_ids.at(*it));
+  }
+  hw.bind_joints(joints);
+  EXPECT_EQ(hw.generation(), 1u);
+  ASSERT_EQ(hw.joint_names().size(), joints.size());
+  hardware::HardwareState s;
+  hw.step(0.001);  // one exchange so the inputs are the robot's
+  hw.step(0.001);
+  hw.read(s);
+  std::size_t elbow = joints.size();
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    if (joints[j].second == 52) elbow = j;
+  }
+  ASSERT_LT(elbow, joints.size());
+  const double from = s.position[elbow];
+  std::vector<hardware::DriveCommand> cmd(joints.size());
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    cmd[j].mode = hardware::DriveMode::kPosition;
+    cmd[j].position = s.position[j];
+  }
+  cmd[elbow].position = from + 0.3;
+  for (int i = 0; i < 1500; ++i) {
+    hw.write(cmd);
+    hw.step(0.001);
+  }
+  hw.read(s);
+  EXPECT_GT(s.position[elbow] - from, 0.15);
+  EXPECT_EQ(hw.cycle_faults(), 0u);
+  EXPECT_NEAR(s.time, 1.502, 1e-9);
+
+  // Mismatches are refused by name, and nothing changes.
+  const auto error_of = [&hw](std::vector<std::pair<std::string, int32_t>> j) {
+    try {
+      hw.bind_joints(j);
+    } catch (const hardware::HardwareError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of({{"J_x", 99}}).find("joint 'J_x': no board with robot_id 99 on the ring (robot_ids there: 100, 101, 11"),
+            std::string::npos);
+  EXPECT_NE(error_of({{"J_base", 100}}).find("joint 'J_base': robot_id 100 is slave 1 (ESC type 50), which is no drive"),
+            std::string::npos)
+      << error_of({{"J_base", 100}});
+  EXPECT_NE(error_of({{"a", 52}, {"b", 52}}).find("joint 'b': robot_id 52 is slave"), std::string::npos);
+  EXPECT_EQ(hw.generation(), 1u);
+  EXPECT_EQ(hw.joint_names().size(), joints.size());
+
+  // A cable pulled: the cycles that miss boards are counted, and the master says where.
+  ring.pull_cable("elbow_2");
+  hw.write(cmd);
+  hw.step(0.001);
+  EXPECT_EQ(hw.cycle_faults(), 1u);
+  EXPECT_NE(hw.diagnose().text().find("lost the link on port 1"), std::string::npos) << hw.diagnose().text();
 }
 
 }  // namespace

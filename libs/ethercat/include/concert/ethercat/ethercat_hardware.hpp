@@ -1,0 +1,70 @@
+#pragma once
+// The robot's hardware on an EtherCAT ring (hardware::Hardware over the master): bring-up to OP,
+// each joint bound to the drive board of its module's robot_id, one LRW per step(). What the
+// robot service's `ethercat` backend stands on (services/robot/README.md).
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "concert/ethercat/drive_pdo.hpp"
+#include "concert/ethercat/master.hpp"
+#include "concert/ethercat/process_data.hpp"
+#include "concert/hardware/hardware.hpp"
+
+namespace concert::ethercat {
+
+class EthercatHardware final : public hardware::Hardware {
+ public:
+  /// Scans the ring on `link`, maps the process data of every board `process_data` describes
+  /// and brings the ring to OP with every drive disabled (holding). Throws MasterError naming
+  /// the slave that refuses, ProcessDataError for a drive board type the codec cannot read.
+  EthercatHardware(Link& link, const ProcessDataCatalog& process_data, MasterParams params = {});
+
+  /// The ring as scanned (for concert/ethercat/scan).
+  const ScanReport& scan() const { return report_; }
+
+  /// Binds joints to drive boards by robot_id (joint name, robot_id of its module), in the
+  /// order given (the hardware order from now on); generation() increases. Throws
+  /// hardware::HardwareError naming the joint and the slave: no board with that robot_id, a
+  /// board that is no drive, two joints on one board. Nothing changes then.
+  void bind_joints(const std::vector<std::pair<std::string, int32_t>>& joints);
+
+  [[nodiscard]] std::string backend() const override { return "ethercat"; }
+  [[nodiscard]] const std::vector<std::string>& joint_names() const override { return names_; }
+  [[nodiscard]] std::uint64_t generation() const override { return generation_; }
+  /// The joints' last feedback; `time` counts the cycles' periods (DC time is still to come).
+  void read(hardware::HardwareState& state) override;
+  /// Commands for the next step(); every bound drive is enabled from its first command on.
+  void write(const std::vector<hardware::DriveCommand>& commands) override;
+  /// One cycle: outputs out, inputs in. A frame not back or a working counter short of the
+  /// expected one is counted (cycle_faults()) and the last feedback kept.
+  void step(double dt) override;
+
+  /// Cycles that did not exchange every board's process data, since the start.
+  uint64_t cycle_faults() const { return cycle_faults_; }
+  const CycleResult& last_cycle() const { return last_; }
+  /// What changed on the ring since the scan (after cycle faults).
+  RingDiagnosis diagnose() { return master_.diagnose(report_); }
+
+ private:
+  struct Joint {
+    std::string name;
+    const ProcessImageSlave* slave = nullptr;
+    DriveCodec codec;
+  };
+  Master master_;
+  const ProcessDataCatalog& process_data_;
+  ScanReport report_;
+  ProcessImage image_;
+  std::vector<Joint> joints_;
+  std::vector<std::string> names_;
+  std::vector<bool> enabled_;
+  uint64_t generation_ = 0;
+  uint64_t cycle_faults_ = 0;
+  double time_ = 0;
+  CycleResult last_;
+};
+
+}  // namespace concert::ethercat

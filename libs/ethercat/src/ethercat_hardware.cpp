@@ -1,0 +1,92 @@
+#include "concert/ethercat/ethercat_hardware.hpp"
+
+#include <set>
+
+namespace concert::ethercat {
+
+EthercatHardware::EthercatHardware(Link& link, const ProcessDataCatalog& process_data, MasterParams params)
+    : master_(link, params), process_data_(process_data) {
+  report_ = master_.scan();
+  image_ = master_.map_process_data(report_);
+  for (const auto state : {esc::AlState::kPreOp, esc::AlState::kSafeOp}) master_.request_state(report_, state);
+  // Drives expect outputs flowing (all disabled here) before OP.
+  for (int i = 0; i < 10; ++i) master_.cycle(image_);
+  master_.request_state(report_, esc::AlState::kOp);
+}
+
+void EthercatHardware::bind_joints(const std::vector<std::pair<std::string, int32_t>>& joints) {
+  std::vector<Joint> bound;
+  std::set<int32_t> boards;
+  for (const auto& [name, robot_id] : joints) {
+    const SlaveReport* found = nullptr;
+    for (const SlaveReport& s : report_.slaves) {
+      if (s.sii.module && s.sii.robot_id == robot_id && robot_id >= 0) found = &s;
+    }
+    if (!found) {
+      std::string ids;
+      for (const SlaveReport& s : report_.slaves) {
+        if (s.sii.robot_id >= 0) ids += (ids.empty() ? "" : ", ") + std::to_string(s.sii.robot_id);
+      }
+      throw hardware::HardwareError("joint '" + name + "': no board with robot_id " + std::to_string(robot_id) +
+                                    " on the ring (robot_ids there: " + ids + ")");
+    }
+    const std::string where = "joint '" + name + "': robot_id " + std::to_string(robot_id) + " is slave " +
+                              std::to_string(found->position);
+    const BoardProcessData* board = process_data_.find(found->slave.esc_type);
+    const ProcessImageSlave* slave = image_.slave(found->position);
+    if (!board || !slave || !board->output("position_ref")) {
+      throw hardware::HardwareError(where + " (ESC type " + std::to_string(found->slave.esc_type) +
+                                    "), which is no drive");
+    }
+    if (!boards.insert(found->position).second) {
+      throw hardware::HardwareError(where + ", already bound to another joint");
+    }
+    try {
+      bound.push_back(Joint{name, slave, DriveCodec(*board)});
+    } catch (const ProcessDataError& e) {
+      throw hardware::HardwareError(where + ": " + e.what());
+    }
+  }
+  joints_ = std::move(bound);
+  names_.clear();
+  for (const Joint& j : joints_) names_.push_back(j.name);
+  enabled_.assign(joints_.size(), false);
+  ++generation_;
+}
+
+void EthercatHardware::read(hardware::HardwareState& state) {
+  const std::size_t n = joints_.size();
+  state.time = time_;
+  state.position.resize(n);
+  state.velocity.resize(n);
+  state.effort.resize(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    const ProcessImageSlave& s = *joints_[j].slave;
+    const DriveFeedback f = joints_[j].codec.decode_feedback(
+        std::span<const uint8_t>(image_.inputs).subspan(s.input_offset, s.input_bytes));
+    state.position[j] = f.link_position;
+    state.velocity[j] = f.velocity;
+    state.effort[j] = f.torque;
+  }
+}
+
+void EthercatHardware::write(const std::vector<hardware::DriveCommand>& commands) {
+  if (commands.size() != joints_.size()) {
+    throw hardware::HardwareError("ethercat: " + std::to_string(commands.size()) + " commands for " +
+                                  std::to_string(joints_.size()) + " joints");
+  }
+  for (std::size_t j = 0; j < joints_.size(); ++j) {
+    const ProcessImageSlave& s = *joints_[j].slave;
+    enabled_[j] = true;
+    joints_[j].codec.encode(commands[j], true,
+                            std::span<uint8_t>(image_.outputs).subspan(s.output_offset, s.output_bytes));
+  }
+}
+
+void EthercatHardware::step(double dt) {
+  last_ = master_.cycle(image_);
+  if (!last_.returned || last_.wkc < image_.expected_wkc) ++cycle_faults_;
+  time_ += dt;
+}
+
+}  // namespace concert::ethercat
