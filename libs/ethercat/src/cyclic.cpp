@@ -73,7 +73,7 @@ CycleStats run_cycles(Master& master, ProcessImage& image, const CycleParams& pa
     ++stats.cycles;
     if (!r.returned) {
       ++stats.lost;
-    } else if (r.wkc < image.expected_wkc) {
+    } else if (r.wkc != image.expected_wkc) {
       ++stats.short_wkc;
     }
     if (body && !body(image, r)) break;

@@ -4,8 +4,8 @@
 
 namespace concert::ethercat {
 
-EthercatHardware::EthercatHardware(Link& link, const ProcessDataCatalog& process_data, MasterParams params)
-    : master_(link, params), process_data_(process_data) {
+EthercatHardware::EthercatHardware(Link& link, ProcessDataCatalog process_data, MasterParams params)
+    : master_(link, params), process_data_(std::move(process_data)) {
   report_ = master_.scan();
   image_ = master_.map_process_data(report_);
   for (const auto state : {esc::AlState::kPreOp, esc::AlState::kSafeOp}) master_.request_state(report_, state);
@@ -20,7 +20,13 @@ void EthercatHardware::bind_joints(const std::vector<std::pair<std::string, int3
   for (const auto& [name, robot_id] : joints) {
     const SlaveReport* found = nullptr;
     for (const SlaveReport& s : report_.slaves) {
-      if (s.sii.module && s.sii.robot_id == robot_id && robot_id >= 0) found = &s;
+      if (!s.sii.module || s.sii.robot_id != robot_id || robot_id < 0) continue;
+      if (found) {
+        throw hardware::HardwareError("joint '" + name + "': robot_id " + std::to_string(robot_id) +
+                                      " is on two slaves, " + std::to_string(found->position) + " and " +
+                                      std::to_string(s.position) + ": a board programmed twice");
+      }
+      found = &s;
     }
     if (!found) {
       std::string ids;
@@ -42,7 +48,15 @@ void EthercatHardware::bind_joints(const std::vector<std::pair<std::string, int3
       throw hardware::HardwareError(where + ", already bound to another joint");
     }
     try {
-      bound.push_back(Joint{name, slave, DriveCodec(*board)});
+      DriveCodec codec(*board);
+      // The codec's offsets come from the process data file, the slave's bytes from its SII:
+      // a board whose process data is smaller would be written past.
+      if (codec.output_bytes() > slave->output_bytes || codec.input_bytes() > slave->input_bytes) {
+        throw hardware::HardwareError(where + ": its SII gives " + std::to_string(slave->output_bytes) +
+                                      " bytes out and " + std::to_string(slave->input_bytes) + " in, a drive needs " +
+                                      std::to_string(codec.output_bytes()) + " and " + std::to_string(codec.input_bytes()));
+      }
+      bound.push_back(Joint{name, static_cast<std::size_t>(slave - image_.slaves.data()), codec});
     } catch (const ProcessDataError& e) {
       throw hardware::HardwareError(where + ": " + e.what());
     }
@@ -61,7 +75,7 @@ void EthercatHardware::read(hardware::HardwareState& state) {
   state.velocity.resize(n);
   state.effort.resize(n);
   for (std::size_t j = 0; j < n; ++j) {
-    const ProcessImageSlave& s = *joints_[j].slave;
+    const ProcessImageSlave& s = image_.slaves[joints_[j].slave];
     const DriveFeedback f = joints_[j].codec.decode_feedback(
         std::span<const uint8_t>(image_.inputs).subspan(s.input_offset, s.input_bytes));
     state.position[j] = f.link_position;
@@ -76,7 +90,7 @@ void EthercatHardware::write(const std::vector<hardware::DriveCommand>& commands
                                   std::to_string(joints_.size()) + " joints");
   }
   for (std::size_t j = 0; j < joints_.size(); ++j) {
-    const ProcessImageSlave& s = *joints_[j].slave;
+    const ProcessImageSlave& s = image_.slaves[joints_[j].slave];
     enabled_[j] = true;
     joints_[j].codec.encode(commands[j], true,
                             std::span<uint8_t>(image_.outputs).subspan(s.output_offset, s.output_bytes));
@@ -85,7 +99,7 @@ void EthercatHardware::write(const std::vector<hardware::DriveCommand>& commands
 
 void EthercatHardware::step(double dt) {
   last_ = master_.cycle(image_);
-  if (!last_.returned || last_.wkc < image_.expected_wkc) ++cycle_faults_;
+  if (!last_.returned || last_.wkc != image_.expected_wkc) ++cycle_faults_;
   time_ += dt;
 }
 

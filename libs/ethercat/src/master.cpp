@@ -82,10 +82,14 @@ std::vector<Datagram> Master::exchange(std::vector<Datagram> datagrams) {
     link_.send(std::span<const uint8_t>(bytes_.data(), size));
     ++frames_sent_;
     const auto deadline = std::chrono::steady_clock::now() + params_.frame_timeout;
-    while (true) {
-      const auto left = std::chrono::duration_cast<std::chrono::microseconds>(
-          deadline - std::chrono::steady_clock::now());
-      if (left.count() <= 0) break;
+    // Past the deadline the link is still polled (without waiting) for what is already queued:
+    // a frame that came back while this thread was not running is not lost. Bounded.
+    for (int late = 0; late < 64;) {
+      auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0) {
+        left = std::chrono::microseconds(0);
+        ++late;
+      }
       const auto received = link_.receive(left);
       if (!received) break;
       Frame answer;
@@ -366,9 +370,20 @@ ProcessImage Master::map_process_data(const ScanReport& report) {
   std::size_t outputs = 0;
   std::size_t inputs = 0;
   for (const SlaveReport& s : report.slaves) {
-    const std::size_t out = s.sii.sync_manager_of(SiiSyncManager::kOutputs) >= 0 ? s.sii.output_bytes() : 0;
-    const std::size_t in = s.sii.sync_manager_of(SiiSyncManager::kInputs) >= 0 ? s.sii.input_bytes() : 0;
+    const int out_sm = s.sii.sync_manager_of(SiiSyncManager::kOutputs);
+    const int in_sm = s.sii.sync_manager_of(SiiSyncManager::kInputs);
+    const std::size_t out = out_sm >= 0 ? s.sii.output_bytes() : 0;
+    const std::size_t in = in_sm >= 0 ? s.sii.input_bytes() : 0;
     if (out == 0 && in == 0) continue;
+    // What the SII says must fit the ESC: sync managers it has, two FMMUs.
+    const int sms = std::min<int>(s.sync_managers ? s.sync_managers : 16, 16);
+    if (std::max(out_sm, in_sm) >= sms) {
+      throw MasterError(slave_name(s) + ": its SII puts process data in sync manager " +
+                        std::to_string(std::max(out_sm, in_sm)) + ", the ESC has " + std::to_string(sms));
+    }
+    if (s.fmmus < 2) {
+      throw MasterError(slave_name(s) + ": process data needs 2 FMMUs, the ESC has " + std::to_string(s.fmmus));
+    }
     image.slaves.push_back({s.position, s.station_address, outputs, out, inputs, in});
     outputs += out;
     inputs += in;
@@ -384,7 +399,7 @@ ProcessImage Master::map_process_data(const ScanReport& report) {
   // read) onto them: one frame per kind of register, every slave in it.
   std::vector<Datagram> config;
   for (const ProcessImageSlave& m : image.slaves) {
-    const SlaveReport& s = report.slaves[static_cast<std::size_t>(m.position - 1)];
+    const SlaveReport& s = report.slaves.at(static_cast<std::size_t>(m.position - 1));
     const auto sm = [&](uint8_t type, std::size_t bytes) {
       const int n = s.sii.sync_manager_of(type);
       const SiiSyncManager& d = s.sii.sync_managers[static_cast<std::size_t>(n)];
@@ -438,14 +453,25 @@ ProcessImage Master::map_process_data(const ScanReport& report) {
   f.datagrams = {lrw};
   cycle_frame_ = encode(f);
   cycle_data_at_ = kEthernetHeaderBytes + kEthercatHeaderBytes + kDatagramHeaderBytes;
+  cycle_outputs_ = outputs;
+  cycle_inputs_ = inputs;
   return image;
 }
 
 void Master::request_state(const ScanReport& report, esc::AlState state) {
-  std::vector<Datagram> requests;
+  // A slave showing an AL error takes no request until the error is acknowledged: read first,
+  // and acknowledge where an error shows.
+  std::vector<Datagram> before;
   for (const SlaveReport& s : report.slaves) {
-    requests.push_back(make_datagram(Command::kFpwr, s.station_address, esc::kAlControl,
-                                     bytes16(static_cast<uint16_t>(state))));
+    before.push_back(make_datagram(Command::kFprd, s.station_address, esc::kAlStatus, 2));
+  }
+  const auto shown = exchange_all(std::move(before));
+  std::vector<Datagram> requests;
+  for (std::size_t i = 0; i < report.slaves.size(); ++i) {
+    const bool error = shown[i].wkc == 1 && (read16(shown[i].data) & esc::kAlErrorBit);
+    requests.push_back(make_datagram(Command::kFpwr, report.slaves[i].station_address, esc::kAlControl,
+                                     bytes16(static_cast<uint16_t>(static_cast<uint16_t>(state) |
+                                                                   (error ? esc::kAlErrorBit : 0)))));
   }
   exchange_all(std::move(requests));
   std::vector<uint16_t> status(report.slaves.size(), 0);
@@ -465,7 +491,10 @@ void Master::request_state(const ScanReport& report, esc::AlState state) {
       }
       status[i] = read16(answers[i].data);
       code[i] = read16(answers[i].data, 4);
-      if (status[i] & esc::kAlErrorBit) refused = true;
+      if (status[i] & esc::kAlErrorBit) {
+        refused = true;
+        all = false;
+      }
       if ((status[i] & esc::kAlStateMask) != static_cast<uint16_t>(state)) all = false;
     }
     if (all) return;
@@ -488,30 +517,40 @@ void Master::request_state(const ScanReport& report, esc::AlState state) {
 CycleResult Master::cycle(ProcessImage& image) {
   CycleResult result;
   if (cycle_frame_.empty()) throw MasterError("cycle() before map_process_data()");
+  if (image.outputs.size() != cycle_outputs_ || image.inputs.size() != cycle_inputs_) {
+    throw MasterError("cycle() with an image of " + std::to_string(image.outputs.size()) + " + " +
+                      std::to_string(image.inputs.size()) + " bytes; the one mapped has " +
+                      std::to_string(cycle_outputs_) + " + " + std::to_string(cycle_inputs_));
+  }
   const uint8_t index = next_index_++;
   uint8_t* frame = cycle_frame_.data();
-  frame[kEthernetHeaderBytes + kEthercatHeaderBytes + 1] = index;
+  const std::size_t head = kEthernetHeaderBytes + kEthercatHeaderBytes;
+  frame[head + 1] = index;
   std::memcpy(frame + cycle_data_at_, image.outputs.data(), image.outputs.size());
   const std::size_t wkc_at = cycle_data_at_ + image.outputs.size() + image.inputs.size();
   frame[wkc_at] = 0;
   frame[wkc_at + 1] = 0;
   link_.send(cycle_frame_);
   ++frames_sent_;
-  const auto deadline = std::chrono::steady_clock::now() + params_.frame_timeout;
-  while (true) {
-    const auto left = std::chrono::duration_cast<std::chrono::microseconds>(
-        deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0) break;
+  const auto deadline = std::chrono::steady_clock::now() + params_.cycle_timeout;
+  for (int late = 0; late < 64;) {
+    auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) {
+      left = std::chrono::microseconds(0);  // what is already queued still counts
+      ++late;
+    }
     const auto received = link_.receive(left);
     if (!received) break;
     const std::span<const uint8_t> r = *received;
     // Ours: the same LRW (command, index) of the same length; anything else is not this cycle's.
     if (r.size() < wkc_at + 2 || r[12] != 0x88 || r[13] != 0xA4) continue;
-    const std::size_t head = kEthernetHeaderBytes + kEthercatHeaderBytes;
     if (r[head] != static_cast<uint8_t>(Command::kLrw) || r[head + 1] != index) continue;
-    std::memcpy(image.inputs.data(), r.data() + cycle_data_at_ + image.outputs.size(), image.inputs.size());
     result.returned = true;
     result.wkc = static_cast<uint16_t>(r[wkc_at] | (r[wkc_at + 1] << 8));
+    // A board that did not exchange left the zeros the frame carried: keep the last inputs.
+    if (result.wkc == image.expected_wkc) {
+      std::memcpy(image.inputs.data(), r.data() + cycle_data_at_ + image.outputs.size(), image.inputs.size());
+    }
     return result;
   }
   ++frames_lost_;

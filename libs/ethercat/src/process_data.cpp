@@ -112,12 +112,22 @@ ProcessDataCatalog ProcessDataCatalog::load(const std::filesystem::path& file) {
 }
 
 ProcessDataCatalog ProcessDataCatalog::parse(std::string_view yaml, const std::string& source) {
+  try {
+    return parse_checked(yaml, source);
+  } catch (const YAML::Exception& e) {
+    // Whatever the checks below did not foresee still names the file.
+    throw ProcessDataError(source + ": " + e.what());
+  }
+}
+
+ProcessDataCatalog ProcessDataCatalog::parse_checked(std::string_view yaml, const std::string& source) {
   YAML::Node root;
   try {
     root = YAML::Load(std::string(yaml));
   } catch (const YAML::Exception& e) {
     throw ProcessDataError(source + ": not YAML: " + e.what());
   }
+  if (!root.IsMap()) throw ProcessDataError(source + ": expected a list 'boards:'");
   const YAML::Node boards = root["boards"];
   if (!boards || !boards.IsSequence()) throw ProcessDataError(source + ": expected a list 'boards:'");
   ProcessDataCatalog catalog;
@@ -140,6 +150,17 @@ ProcessDataCatalog ProcessDataCatalog::parse(std::string_view yaml, const std::s
       board.inputs = parse_entries(b["inputs"], where + ".inputs");
     } catch (const YAML::Exception& e) {
       throw ProcessDataError(where + ": " + e.what());
+    }
+    // One PDO per direction: at most 255 entries (the SII's count byte), and the three buffers
+    // of the outputs and the inputs within the ESC's 8 KiB of process RAM.
+    for (const auto* list : {&board.outputs, &board.inputs}) {
+      if (list->size() > 255) {
+        throw ProcessDataError(where + ": " + std::to_string(list->size()) + " entries, more than 255" + at_line(b));
+      }
+    }
+    if (3 * (board.output_bytes() + board.input_bytes()) > 0x1C00) {
+      throw ProcessDataError(where + ": " + std::to_string(board.output_bytes()) + " bytes out and " +
+                             std::to_string(board.input_bytes()) + " in do not fit an ESC's process RAM" + at_line(b));
     }
     catalog.boards_.push_back(std::move(board));
   }
@@ -166,9 +187,9 @@ void add_process_data(SiiInfo& sii, const BoardProcessData& board) {
     SiiPdo p;
     p.index = index;
     p.sync_manager = sm;
-    uint8_t sub = 1;
     for (const PdoEntry& e : entries) {
-      p.entries.push_back({.index = e.index, .subindex = e.index ? sub++ : uint8_t{0},
+      // Each entry is a single-value CoE object (or padding, index 0): subindex 0.
+      p.entries.push_back({.index = e.index, .subindex = 0,
                            .data_type = static_cast<uint8_t>(e.type),
                            .bits = static_cast<uint8_t>(8 * size_of(e.type))});
     }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cstdlib>
 #include <optional>
 
@@ -45,7 +46,13 @@ RingFault parse_ring_fault(const std::string& spec) {
     }
   } else if (kind == "lose") {
     f.kind = RingFault::Kind::kLose;
-    f.one_in = static_cast<uint64_t>(non_negative(spec, arg, "N"));
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long n = std::strtoull(arg.c_str(), &end, 10);
+    if (arg.empty() || *end != '\0' || errno == ERANGE || arg[0] == '-') {
+      throw RingFaultError("--fault " + spec + ": N '" + arg + "' is not a whole number");
+    }
+    f.one_in = n;
     if (f.one_in < 2) throw RingFaultError("--fault " + spec + ": lose:N needs N >= 2");
   } else {
     throw RingFaultError("--fault " + spec + ": kind '" + kind + "' is not pull, refuse-op or lose");
@@ -100,17 +107,29 @@ void RingServer::serve(const std::atomic<bool>& stop, std::atomic<bool>& reload,
       const double s = std::chrono::duration<double>(Clock::now() - *first_process_data).count();
       for (RingFault& f : faults_) {
         if (f.kind != RingFault::Kind::kPull || f.done || s < f.after_s) continue;
-        ring_.pull_cable(f.module);
         f.done = true;
-        log_ << "concert_ecat_ring: pulled the cable of '" << f.module << "' after " << s
-             << " s of process data: " << ring_.slave_count() << " ESCs answer" << std::endl;
+        try {
+          ring_.pull_cable(f.module);
+          log_ << "concert_ecat_ring: pulled the cable of '" << f.module << "' after " << s
+               << " s of process data: " << ring_.slave_count() << " ESCs answer" << std::endl;
+        } catch (const std::exception& e) {
+          // The module went with a re-read assembly: nothing to pull.
+          log_ << "concert_ecat_ring: could not pull the cable of '" << f.module << "': " << e.what() << std::endl;
+        }
       }
     }
     if (!frame) continue;
     if (!first_process_data && is_process_data_frame(*frame)) first_process_data = Clock::now();
     const auto now = static_cast<uint64_t>(
         std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
-    if (auto answer = ring_.process(*frame, now)) link_.send(*answer);
+    if (auto answer = ring_.process(*frame, now)) {
+      try {
+        link_.send(*answer);
+      } catch (const LinkError& e) {
+        // The interface went down or is busy: the master sees a lost frame, the ring goes on.
+        log_ << "concert_ecat_ring: " << e.what() << std::endl;
+      }
+    }
     const RingCounters& c = ring_.counters();
     if (c.malformed > reported_malformed) {
       reported_malformed = c.malformed;

@@ -40,7 +40,6 @@ std::vector<uint16_t> make_sii_image(const SiiInfo& identity) {
   put32(w, esc::kSiiProductCode, identity.product_code);
   put32(w, esc::kSiiRevision, identity.revision);
   put32(w, esc::kSiiSerial, identity.serial);
-  w[0x003E] = 0x0000;  // EEPROM size: (0 + 1) KiBit, as the smallest parts report
   w[0x003F] = 0x0001;  // version 1
   if (identity.module) {
     w.push_back(kSiiCategoryConcertModule);
@@ -63,10 +62,14 @@ std::vector<uint16_t> make_sii_image(const SiiInfo& identity) {
       w.push_back(static_cast<uint16_t>(sm.enable | (sm.type << 8)));
     }
   }
+  // One category per direction holding all its PDOs (as SOEM's ec_siiPDO reads them).
   const auto pdos = [&w](uint16_t category, const std::vector<SiiPdo>& list) {
+    if (list.empty()) return;
+    std::size_t size = 0;
+    for (const SiiPdo& pdo : list) size += 4 + 4 * pdo.entries.size();
+    w.push_back(category);
+    w.push_back(static_cast<uint16_t>(size));
     for (const SiiPdo& pdo : list) {
-      w.push_back(category);
-      w.push_back(static_cast<uint16_t>(4 + 4 * pdo.entries.size()));
       w.push_back(pdo.index);
       w.push_back(static_cast<uint16_t>(pdo.entries.size() | (pdo.sync_manager << 8)));
       w.push_back(0);  // synchronization, name index
@@ -82,6 +85,9 @@ std::vector<uint16_t> make_sii_image(const SiiInfo& identity) {
   pdos(kSiiCategoryTxPdo, identity.tx_pdos);
   pdos(kSiiCategoryRxPdo, identity.rx_pdos);
   w.push_back(esc::kSiiCategoryEnd);
+  // EEPROM size (word 0x003E): KiBit - 1 of the smallest part holding the image.
+  const std::size_t kibit = (w.size() * 16 + 1023) / 1024;
+  w[0x003E] = static_cast<uint16_t>(kibit - 1);
   return w;
 }
 
@@ -175,24 +181,31 @@ SiiInfo parse_sii_image(std::span<const uint16_t> words) {
         id.sync_managers.push_back(sm);
       }
     } else if (type == kSiiCategoryTxPdo || type == kSiiCategoryRxPdo) {
-      if (size < 4) throw SiiError("SII PDO category at word " + hex(at) + " is shorter than its header");
-      SiiPdo pdo;
-      pdo.index = words[at + 2];
-      const std::size_t count = words[at + 3] & 0xFF;
-      pdo.sync_manager = static_cast<uint8_t>(words[at + 3] >> 8);
-      if (size != 4 + 4 * count) {
-        throw SiiError("SII PDO " + hex(pdo.index) + " at word " + hex(at) + " has " +
-                       std::to_string(size) + " words for " + std::to_string(count) + " entries");
+      // One or more PDOs, each a 4-word header and 4 words per entry.
+      for (std::size_t k = at + 2; k < at + 2 + size;) {
+        if (k + 4 > at + 2 + size) {
+          throw SiiError("SII PDO category at word " + hex(at) + ": a PDO header at word " + hex(k) +
+                         " runs past the category's " + std::to_string(size) + " words");
+        }
+        SiiPdo pdo;
+        pdo.index = words[k];
+        const std::size_t count = words[k + 1] & 0xFF;
+        pdo.sync_manager = static_cast<uint8_t>(words[k + 1] >> 8);
+        if (k + 4 + 4 * count > at + 2 + size) {
+          throw SiiError("SII PDO " + hex(pdo.index) + " at word " + hex(k) + ": " + std::to_string(count) +
+                         " entries run past the category's " + std::to_string(size) + " words");
+        }
+        for (std::size_t e = k + 4; e < k + 4 + 4 * count; e += 4) {
+          SiiPdoEntry entry;
+          entry.index = words[e];
+          entry.subindex = static_cast<uint8_t>(words[e + 1] & 0xFF);
+          entry.data_type = static_cast<uint8_t>(words[e + 2] & 0xFF);
+          entry.bits = static_cast<uint8_t>(words[e + 2] >> 8);
+          pdo.entries.push_back(entry);
+        }
+        k += 4 + 4 * count;
+        (type == kSiiCategoryTxPdo ? id.tx_pdos : id.rx_pdos).push_back(std::move(pdo));
       }
-      for (std::size_t k = at + 6; k < at + 2 + size; k += 4) {
-        SiiPdoEntry e;
-        e.index = words[k];
-        e.subindex = static_cast<uint8_t>(words[k + 1] & 0xFF);
-        e.data_type = static_cast<uint8_t>(words[k + 2] & 0xFF);
-        e.bits = static_cast<uint8_t>(words[k + 2] >> 8);
-        pdo.entries.push_back(e);
-      }
-      (type == kSiiCategoryTxPdo ? id.tx_pdos : id.rx_pdos).push_back(std::move(pdo));
     }
     at += 2 + size;
   }

@@ -148,13 +148,20 @@ void VirtualRing::rebuild(const simbus::Assembly& as_built) {
 }
 
 void VirtualRing::set_assembly(const simbus::Assembly& assembly) {
-  rebuild(assembly);
-  assembly_ = assembly;
-  // A pulled cable of a module that is no longer there is plugged back with it.
-  std::erase_if(pulled_, [&](const std::string& m) {
-    return std::none_of(assembly_.modules.begin(), assembly_.modules.end(),
+  // A pulled cable of a module that is no longer there goes with the module.
+  std::vector<std::string> pulled = pulled_;
+  std::erase_if(pulled, [&](const std::string& m) {
+    return std::none_of(assembly.modules.begin(), assembly.modules.end(),
                         [&](const simbus::MountedModule& x) { return x.name == m; });
   });
+  std::swap(pulled, pulled_);
+  try {
+    rebuild(assembly);
+  } catch (...) {
+    std::swap(pulled, pulled_);
+    throw;
+  }
+  assembly_ = assembly;
 }
 
 void VirtualRing::pull_cable(const std::string& module) {
@@ -281,11 +288,21 @@ uint16_t VirtualRing::check_sync_managers(const Esc& esc) const {
 }
 
 void VirtualRing::execute_logical(Esc& esc, Datagram& d) {
+  // Process data only passes in SAFE-OP (inputs) and OP (both): a board in INIT or PRE-OP
+  // neither reads nor writes it and does not count the datagram, which is how the master sees
+  // it is not exchanging.
+  const auto state = esc::al_state_from(get16(esc, esc::kAlStatus));
+  const bool may_write = state == esc::AlState::kOp;
+  const bool may_read = may_write || state == esc::AlState::kSafeOp;
+  if (!may_read) return;
   const uint32_t first = d.logical_address();
   const uint64_t last = static_cast<uint64_t>(first) + d.data.size();  // exclusive
+  // The ESC writes the data as it received it, whatever a read FMMU puts into the frame.
+  const std::vector<uint8_t> received = writes(d.command) && may_write ? d.data : std::vector<uint8_t>{};
   bool read = false;
   bool wrote = false;
-  for (int f = 0; f < esc.memory[esc::kFmmusSupported]; ++f) {
+  const int fmmus = std::min<int>(esc.memory[esc::kFmmusSupported], 16);
+  for (int f = 0; f < fmmus; ++f) {
     const auto at = static_cast<std::size_t>(esc::kFmmu + 16 * f);
     if ((esc.memory[at + 12] & 1) == 0) continue;  // not activated
     const uint32_t start = static_cast<uint32_t>(esc.memory[at]) | (static_cast<uint32_t>(esc.memory[at + 1]) << 8) |
@@ -305,17 +322,12 @@ void VirtualRing::execute_logical(Esc& esc, Datagram& d) {
         d.data[frame_at] = esc.memory[memory_at];
         read = true;
       }
-      if ((type & 2) && writes(d.command)) {
-        esc.memory[memory_at] = d.data[frame_at];
+      if ((type & 2) && writes(d.command) && may_write) {
+        esc.memory[memory_at] = received[frame_at];
         wrote = true;
       }
     }
   }
-  // Process data only passes in SAFE-OP (inputs) and OP (both); a board in INIT or PRE-OP does
-  // not count the datagram, which is how the master sees it is not exchanging.
-  const auto state = esc::al_state_from(get16(esc, esc::kAlStatus));
-  if (state != esc::AlState::kOp) wrote = false;
-  if (state != esc::AlState::kOp && state != esc::AlState::kSafeOp) read = false;
   if (read || wrote) esc.touched = true;
   d.wkc = static_cast<uint16_t>(d.wkc + (read ? 1 : 0) + (wrote ? 2 : 0));
 }
@@ -458,7 +470,14 @@ std::optional<std::vector<uint8_t>> VirtualRing::process(std::span<const uint8_t
   // The ESC on the master's port marks the frame as having passed a slave: bit 1 of the source
   // address's first byte (locally administered).
   frame.source[0] = static_cast<uint8_t>(frame.source[0] | 0x02);
-  return encode(frame);
+  try {
+    return encode(frame);
+  } catch (const FrameError& e) {
+    // Decodable but not sendable (longer than an Ethernet frame): dropped, as the wire would.
+    ++counters_.malformed;
+    counters_.last_error = e.what();
+    return std::nullopt;
+  }
 }
 
 }  // namespace concert::ethercat

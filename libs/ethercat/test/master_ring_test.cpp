@@ -147,14 +147,23 @@ TEST(MasterRing, TheRingDropsNoiseAndKeepsAnswering) {
   const Assembly a = simbus::load_assembly(test_data::kExamples + "/concert_paper_robot.yaml");
   Bench bench(a, catalog);
   std::mt19937 rng(5);
-  std::uniform_int_distribution<int> byte(0, 255);
+  std::uniform_int_distribution<int> byte(0, 255), size(14, 1600);
+  uint64_t answered = 0;
   for (int i = 0; i < 2000; ++i) {
-    std::vector<uint8_t> noise(60);
+    std::vector<uint8_t> noise(static_cast<std::size_t>(size(rng)));
     for (auto& x : noise) x = static_cast<uint8_t>(byte(rng));
     noise[12] = 0x88;
     noise[13] = 0xA4;
-    (void)bench.ring.process(noise, 0);
+    if (i % 4 == 0 && noise.size() > 16) {
+      // A header that claims the whole frame: decodes more often, some past 1514 bytes.
+      const auto length = static_cast<uint16_t>(std::min<std::size_t>(noise.size() - 16, 0x7FF));
+      noise[14] = static_cast<uint8_t>(length & 0xFF);
+      noise[15] = static_cast<uint8_t>(0x10 | (length >> 8));
+    }
+    if (bench.ring.process(noise, 0)) ++answered;
   }
+  // Every frame is answered or dropped as malformed, never anything else (no throw, no crash).
+  EXPECT_EQ(bench.ring.counters().malformed + answered, 2000u);
   EXPECT_GT(bench.ring.counters().malformed, 0u);
   Master master(bench.link, quick());
   EXPECT_EQ(master.scan().scan(), simbus::simulate_scan(a, catalog));

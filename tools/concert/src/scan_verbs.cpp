@@ -156,6 +156,9 @@ int read_scan(const ReadOptions& o, std::ostream& out, std::ostream& err) {
 struct CycleOptions {
   std::string ifname;
   int lost_in_a_row = 3;
+  double frame_timeout_ms = 20;
+  int tries = 3;
+  double cycle_timeout_us = 0;  // 0: one period
   bool feedback = false;
   std::string process_data = CONCERT_DEFAULT_PROCESS_DATA;
   double seconds = 1.0;
@@ -166,10 +169,28 @@ struct CycleOptions {
 
 /// `concert ethercat cycle`: the ring to OP, cyclic process data for a while, back to INIT.
 int cycle_ring(const CycleOptions& o, std::ostream& out, std::ostream& err) {
+  const std::atomic<bool>& stop = cli::stop_on_signals();
   ethercat::RawSocketLink link(o.ifname);
-  ethercat::Master master(link);
+  ethercat::MasterParams mp;
+  mp.frame_timeout = std::chrono::microseconds(static_cast<int64_t>(o.frame_timeout_ms * 1000.0));
+  mp.tries = o.tries;
+  mp.cycle_timeout = std::chrono::microseconds(
+      static_cast<int64_t>(o.cycle_timeout_us > 0 ? o.cycle_timeout_us : o.period_us));
+  ethercat::Master master(link, mp);
   const ethercat::ScanReport report = master.scan();
   if (report.slaves.empty()) throw cli::Failure("no slave answers on " + o.ifname);
+  // However this ends (a watchdog fault, an error, Ctrl-C), the ring is asked back to INIT.
+  struct BackToInit {
+    ethercat::Master& master;
+    const ethercat::ScanReport& report;
+    ~BackToInit() {
+      try {
+        master.request_state(report, ethercat::esc::AlState::kInit);
+      } catch (const std::exception&) {
+        // The ring may be gone (a pulled cable): nothing more to ask.
+      }
+    }
+  } back_to_init{master, report};
   ethercat::ProcessImage image = master.map_process_data(report);
   for (const auto state : {ethercat::esc::AlState::kPreOp, ethercat::esc::AlState::kSafeOp}) {
     master.request_state(report, state);
@@ -193,7 +214,6 @@ int cycle_ring(const CycleOptions& o, std::ostream& out, std::ostream& err) {
       << ", " << image.slaves.size() << " with process data (" << image.outputs.size()
       << " bytes out, " << image.inputs.size() << " in), " << o.period_us << " us period, "
       << scheduling << ", " << o.seconds << " s\n";
-  const std::atomic<bool>& stop = cli::stop_on_signals();
   ethercat::CycleParams params;
   params.period = std::chrono::microseconds(o.period_us);
   params.duration = std::chrono::nanoseconds(static_cast<int64_t>(o.seconds * 1e9));
@@ -205,7 +225,7 @@ int cycle_ring(const CycleOptions& o, std::ostream& out, std::ostream& err) {
   const ethercat::CycleBody watch = [&](ethercat::ProcessImage&, const ethercat::CycleResult& r) {
     ++cycle_number;
     lost_in_a_row = r.returned ? 0 : lost_in_a_row + 1;
-    if (r.returned && r.wkc < image.expected_wkc) {
+    if (r.returned && r.wkc != image.expected_wkc) {
       fault = "cycle " + std::to_string(cycle_number) + ": working counter " + std::to_string(r.wkc) +
               " of " + std::to_string(image.expected_wkc);
     } else if (o.lost_in_a_row > 0 && lost_in_a_row == o.lost_in_a_row) {
@@ -231,6 +251,11 @@ int cycle_ring(const CycleOptions& o, std::ostream& out, std::ostream& err) {
       const auto& s = report.slaves[static_cast<std::size_t>(m.position - 1)];
       const ethercat::BoardProcessData* board = catalog.find(s.slave.esc_type);
       if (!board || !board->input("link_position")) continue;
+      if (board->input_bytes() > m.input_bytes) {
+        err << "  slave " << m.position << ": its SII gives " << m.input_bytes << " bytes of inputs, "
+            << o.process_data << " a drive " << board->input_bytes() << "\n";
+        continue;
+      }
       const ethercat::DriveFeedback f = ethercat::DriveCodec(*board).decode_feedback(
           std::span<const uint8_t>(image.inputs).subspan(m.input_offset, m.input_bytes));
       char line[200];
@@ -240,7 +265,6 @@ int cycle_ring(const CycleOptions& o, std::ostream& out, std::ostream& err) {
       err << line;
     }
   }
-  master.request_state(report, ethercat::esc::AlState::kInit);
   if (o.json) {
     nlohmann::json j = {{"slaves", report.slaves.size()},
                         {"process_data_slaves", image.slaves.size()},
@@ -334,6 +358,19 @@ void register_scan_verbs(cli::Cli& concert) {
       ->type_name("PRIO")
       ->check(cli::number(0, 99, true));
   cyc.add_flag("--json", c->json, "the figures as JSON");
+  cyc.add_option("--frame-timeout", c->frame_timeout_ms,
+                 "bring-up: milliseconds to wait for a frame before resending it")
+      ->type_name("MS")
+      ->check(cli::number(0, 10000, false, true))
+      ->capture_default_str();
+  cyc.add_option("--tries", c->tries, "bring-up: sends of a frame before it fails")
+      ->type_name("N")
+      ->check(cli::number(1, 100, true))
+      ->capture_default_str();
+  cyc.add_option("--cycle-timeout", c->cycle_timeout_us,
+                 "microseconds a cycle's frame may take before the cycle counts as lost (default: one period)")
+      ->type_name("US")
+      ->check(cli::number(0, 1e6, false));
   cyc.add_option("--lost-in-a-row", c->lost_in_a_row,
                  "frames lost in a row that end the run (0: count them, never stop)")
       ->type_name("N")

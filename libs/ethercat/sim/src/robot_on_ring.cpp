@@ -74,6 +74,7 @@ void RobotOnRing::exchange(std::span<BoardIo> boards, uint64_t) {
 }
 
 struct RobotBehindRing::Impl {
+  VirtualRing* ring = nullptr;
   std::optional<sim::SimHardware> hardware;
   std::optional<RobotOnRing> robot;
 };
@@ -92,10 +93,14 @@ RobotBehindRing::RobotBehindRing(VirtualRing& ring, const std::vector<std::strin
   impl_->hardware.emplace(mounted, world, params);
   impl_->robot.emplace(*impl_->hardware, mounted, *drive);
   RobotOnRing* robot = &*impl_->robot;
+  impl_->ring = &ring;
   ring.set_application([robot](std::span<BoardIo> boards, uint64_t now) { robot->exchange(boards, now); });
 }
 
-RobotBehindRing::~RobotBehindRing() = default;
+RobotBehindRing::~RobotBehindRing() {
+  // The ring may outlive the robot: it must not call into it then.
+  if (impl_ && impl_->ring) impl_->ring->set_application({});
+}
 std::size_t RobotBehindRing::joints() const { return impl_->hardware->joint_names().size(); }
 const RobotOnRing& RobotBehindRing::robot() const { return *impl_->robot; }
 

@@ -22,7 +22,7 @@ struct CycleParams {
 struct CycleStats {
   uint64_t cycles = 0;
   uint64_t lost = 0;         ///< frames that did not come back within the frame timeout
-  uint64_t short_wkc = 0;    ///< came back with a working counter below the expected one
+  uint64_t short_wkc = 0;    ///< came back with a working counter other than the expected one
   uint16_t expected_wkc = 0;
   double period_mean_us = 0;
   double period_p50_us = 0;

@@ -20,7 +20,9 @@ class EthercatHardware final : public hardware::Hardware {
   /// Scans the ring on `link`, maps the process data of every board `process_data` describes
   /// and brings the ring to OP with every drive disabled (holding). Throws MasterError naming
   /// the slave that refuses, ProcessDataError for a drive board type the codec cannot read.
-  EthercatHardware(Link& link, const ProcessDataCatalog& process_data, MasterParams params = {});
+  EthercatHardware(Link& link, ProcessDataCatalog process_data, MasterParams params = {});
+  EthercatHardware(const EthercatHardware&) = delete;
+  EthercatHardware& operator=(const EthercatHardware&) = delete;
 
   /// The ring as scanned (for concert/ethercat/scan).
   const ScanReport& scan() const { return report_; }
@@ -28,7 +30,8 @@ class EthercatHardware final : public hardware::Hardware {
   /// Binds joints to drive boards by robot_id (joint name, robot_id of its module), in the
   /// order given (the hardware order from now on); generation() increases. Throws
   /// hardware::HardwareError naming the joint and the slave: no board with that robot_id, a
-  /// board that is no drive, two joints on one board. Nothing changes then.
+  /// board that is no drive (or whose process data is smaller than a drive's), two boards with
+  /// the robot_id, two joints on one board. Nothing changes then.
   void bind_joints(const std::vector<std::pair<std::string, int32_t>>& joints);
 
   [[nodiscard]] std::string backend() const override { return "ethercat"; }
@@ -51,11 +54,11 @@ class EthercatHardware final : public hardware::Hardware {
  private:
   struct Joint {
     std::string name;
-    const ProcessImageSlave* slave = nullptr;
+    std::size_t slave = 0;  // index into image_.slaves
     DriveCodec codec;
   };
   Master master_;
-  const ProcessDataCatalog& process_data_;
+  ProcessDataCatalog process_data_;
   ScanReport report_;
   ProcessImage image_;
   std::vector<Joint> joints_;

@@ -25,6 +25,9 @@ namespace concert::ethercat {
 struct MasterParams {
   /// How long to wait for a frame to come back before sending it again.
   std::chrono::microseconds frame_timeout{20000};
+  /// How long cycle() waits for its frame: a frame later than this is a lost cycle (one period
+  /// at 1 kHz, so a late frame never delays the next cycle).
+  std::chrono::microseconds cycle_timeout{1000};
   /// Sends of one frame before the exchange fails (1 = no retry).
   int tries = 3;
   /// Station address of the slave at position 1; the next positions count up from it.
@@ -140,9 +143,10 @@ class Master {
   /// MasterError (a slave that does not take the configuration, an image larger than one frame).
   ProcessImage map_process_data(const ScanReport& report);
 
-  /// Requests `state` of every slave of the report and waits (bounded: `state_polls` reads of
-  /// the AL status, `state_poll_interval` apart) until all are in it. Throws MasterError naming
-  /// each slave that refused, with its AL status code by name, or that did not get there.
+  /// Requests `state` of every slave of the report (acknowledging an AL error a slave shows)
+  /// and waits (bounded: `state_polls` reads of the AL status, `state_poll_interval` apart)
+  /// until all are in it without an error. Throws MasterError naming each slave that refused,
+  /// with its AL status code by name, or that did not get there.
   void request_state(const ScanReport& report, esc::AlState state);
 
   /// Reads every slave of `report` again (AL status, DL status) and says what changed since.
@@ -150,8 +154,10 @@ class Master {
   RingDiagnosis diagnose(const ScanReport& report);
 
   /// One cycle: sends the outputs and the slaves' inputs space in one LRW, waits for it up to
-  /// the frame timeout (no resend: a late frame is a lost cycle), copies the inputs back.
-  /// Allocates nothing once the image is mapped (on a RawSocketLink). Throws LinkError.
+  /// the cycle timeout (no resend: a late frame is a lost cycle), and copies the inputs back
+  /// only when every board exchanged (working counter as expected): otherwise the last inputs
+  /// stay. Allocates nothing once the image is mapped (on a RawSocketLink). Throws MasterError
+  /// for an image that is not the one mapped, LinkError.
   CycleResult cycle(ProcessImage& image);
 
   int frames_sent() const { return frames_sent_; }
@@ -165,6 +171,8 @@ class Master {
   uint8_t next_index_ = 0;
   std::vector<uint8_t> cycle_frame_;  // the LRW frame, encoded once by map_process_data
   std::size_t cycle_data_at_ = 0;     // where the datagram's data starts in it
+  std::size_t cycle_outputs_ = 0;     // the mapped image's sizes
+  std::size_t cycle_inputs_ = 0;
   int frames_sent_ = 0;
   int frames_lost_ = 0;
 };

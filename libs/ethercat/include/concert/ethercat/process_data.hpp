@@ -66,6 +66,7 @@ class ProcessDataCatalog {
   const std::vector<BoardProcessData>& boards() const { return boards_; }
 
  private:
+  static ProcessDataCatalog parse_checked(std::string_view yaml, const std::string& source);
   std::vector<BoardProcessData> boards_;
 };
 

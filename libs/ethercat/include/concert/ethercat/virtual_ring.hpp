@@ -94,7 +94,8 @@ class VirtualRing {
   std::size_t slave_count() const { return order_.size(); }
   const RingCounters& counters() const { return counters_; }
 
-  /// The register bytes of the ESC at ring position `position` (1-based), for tests.
+  /// The register bytes of the ESC at ring position `position` (1-based), for tests; valid
+  /// until the ring changes (set_assembly, pull_cable, plug_cable).
   std::span<const uint8_t> registers(int position) const;
 
  private:
