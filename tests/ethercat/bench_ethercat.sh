@@ -10,11 +10,20 @@ build=$(cd "$here/../.." && pwd)
 src=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$build/CMakeCache.txt")
 seconds=60
 fifo=0
+usage="Usage: bench_ethercat [--seconds S] [--fifo PRIO]
+  --seconds S   how long the 1 kHz cycle runs (default 60)
+  --fifo PRIO   run the master's cycle thread SCHED_FIFO at PRIO (default: SCHED_OTHER)
+Needs root: two network namespaces and a veth pair are made and removed."
 while [ $# -gt 0 ]; do
   case "$1" in
-    --seconds) seconds=$2; shift 2 ;;
-    --fifo) fifo=$2; shift 2 ;;
-    *) echo "bench_ethercat: unknown argument '$1' (--seconds S, --fifo PRIO)" >&2; exit 2 ;;
+    -h|--help) echo "$usage"; exit 0 ;;
+    --seconds|--fifo)
+      [ $# -ge 2 ] || { echo "bench_ethercat: $1 needs a value" >&2; exit 2; }
+      [[ "$2" =~ ^[0-9]+$ ]] && [ "$2" -ge 1 ] ||
+        { echo "bench_ethercat: $1: '$2' is not a whole number >= 1" >&2; exit 2; }
+      if [ "$1" = --seconds ]; then seconds=$2; else fifo=$2; fi
+      shift 2 ;;
+    *) echo "bench_ethercat: unknown argument '$1'" >&2; echo "$usage" >&2; exit 2 ;;
   esac
 done
 [ "$(id -u)" -eq 0 ] || { echo "bench_ethercat: needs root (network namespaces, raw sockets)" >&2; exit 1; }
