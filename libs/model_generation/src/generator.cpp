@@ -645,6 +645,7 @@ GeneratedModel ModelGenerator::generate(const topology::ModuleTree& input_tree, 
     info.chain = j.chain;
     info.module = j.module;
     info.module_key = b.desc_[static_cast<size_t>(j.module)]->key;
+    info.robot_id = tree.modules[static_cast<size_t>(j.module)].robot_id;
     info.type = jd.type;
     const double inf = std::numeric_limits<double>::infinity();
     info.lower = jd.type == JointType::kContinuous ? -inf : jd.limits.lower;

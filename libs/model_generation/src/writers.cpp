@@ -143,7 +143,7 @@ std::string write_config_yaml(const GeneratedModel& model, const std::string& ro
   o << "]\njoints:\n";
   for (const JointInfo& j : model.joints) {
     o << "  - name: " << j.name << "\n    chain: " << j.chain << "\n    module: " << j.module << "\n    module_key: " << j.module_key
-      << "\n    type: " << to_string(j.type) << "\n    position_limits: [" << yaml_num(j.lower) << ", " << yaml_num(j.upper)
+      << "\n    robot_id: " << j.robot_id << "\n    type: " << to_string(j.type) << "\n    position_limits: [" << yaml_num(j.lower) << ", " << yaml_num(j.upper)
       << "]\n    velocity_limit: " << num(j.velocity) << "\n    peak_torque: " << num(j.peak_torque)
       << "\n    continuous_torque: " << num(j.continuous_torque) << "\n    gear_ratio: " << num(j.gear_ratio)
       << "\n    control_mode: " << j.control_mode << "\n    gains: {stiffness: " << num(j.gains.stiffness)

@@ -67,6 +67,9 @@ struct JointInfo {
   std::string chain;
   int module = -1;
   std::string module_key;
+  /// The module's robot_id (its drive board's, from the scan): the EtherCAT master binds the
+  /// joint to the board by it. -1: the tree gave none (hand-made trees).
+  int32_t robot_id = -1;
   module_db::JointType type = module_db::JointType::kRevolute;
   double lower = 0.0;              ///< rad (m)
   double upper = 0.0;              ///< rad (m)
