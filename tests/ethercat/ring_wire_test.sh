@@ -5,7 +5,9 @@
 # `concert scan show --assembly` computes it (for concert_robot_18slaves.yaml: the real scan).
 # One bring-up (the paper's 19-ESC robot) and one second of its cyclic process data are captured with tshark and decoded by Wireshark's
 # EtherCAT dissector: no malformed frame but the one the test sends on purpose, and the commands
-# a bring-up must send are there with the working counters the ring must return.
+# a bring-up must send are there with the working counters the ring must return. Faults (a cable
+# pulled, a board refusing OP, a module added) are named. Last, the robot service runs on the
+# ring (--backend ethercat) and is ready at the model discovery and modelgen made from its scan.
 # Usage: ring_wire_test.sh BUILD_DIR. Exit 77 (skipped) when not root.
 set -euo pipefail
 
@@ -36,8 +38,10 @@ ns_ring="concert-ecr-$tag"
 work=$(mktemp -d)
 ring_pid=""
 tshark_pid=""
+service_pids=()
 cleanup() {
   [ -n "$ring_pid" ] && kill "$ring_pid" 2>/dev/null || true
+  for pid in "${service_pids[@]}"; do kill "$pid" 2>/dev/null || true; done
   [ -n "$tshark_pid" ] && kill "$tshark_pid" 2>/dev/null || true
   wait 2>/dev/null || true
   ip netns del "$ns_master" 2>/dev/null || true
@@ -235,4 +239,38 @@ grep -q "joints found no drive board" "$work/ring.log" && fail "a joint of the r
 boards=$(grep -c "robot_id [0-9]*: status" "$work/cycle.err")
 [ "$boards" -eq 15 ] || { cat "$work/cycle.err"; fail "$boards drive boards reported, expected 15"; }
 echo "ok: the demo robot behind the ring: 15 drive boards report, every joint found its board"
+
+# 5. The robot service on the ring: concert_robot --backend ethercat brings the ring to OP and
+#    publishes the scan its master read; discovery and modelgen make the model from that scan;
+#    the robot binds every joint to its drive board by the robot_id of the model and is ready at
+#    model version 1. DDS on the master namespace's loopback, on CONCERT_DOMAIN_ID (ctest gives
+#    this test a domain of its own; 80 when run by hand).
+ip -n "$ns_master" link set lo up
+: > "$work/ring.log"
+ip netns exec "$ns_ring" "$ring_bin" --assembly "$src/deploy/demo/drill_robot.yaml" --ifname "ecr$tag" --robot \
+  > "$work/ring.log" 2>&1 &
+ring_pid=$!
+wait_for_line "$work/ring.log" "concert_ecat_ring: serving" || fail "the ring with the robot did not start"
+domain=${CONCERT_DOMAIN_ID:-80}
+for service in discovery modelgen; do
+  ip netns exec "$ns_master" env CONCERT_DOMAIN_ID=$domain "$build/services/$service/concert_$service" \
+    > "$work/$service.log" 2>&1 &
+  service_pids+=($!)
+done
+ip netns exec "$ns_master" env CONCERT_DOMAIN_ID=$domain "$build/services/robot/concert_robot" \
+  --backend ethercat --ifname "ecm$tag" > "$work/robot.log" 2>&1 &
+service_pids+=($!)
+rc=0
+ip netns exec "$ns_master" env CONCERT_DOMAIN_ID=$domain timeout 120 "$concert" status --until-version 1 --timeout 60 \
+  --services robot > "$work/status.out" 2> "$work/status.err" || rc=$?
+for pid in "${service_pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
+for pid in "${service_pids[@]}"; do wait "$pid" 2>/dev/null || true; done
+service_pids=()
+stop_ring
+robot_log() { for f in robot discovery modelgen; do sed "s/^/  $f: /" "$work/$f.log" | tail -20; done; }
+[ "$rc" -eq 0 ] || { cat "$work/status.err"; robot_log; fail "the robot on the ring was not ready at model version 1"; }
+grep -q "concert_robot: ethercat on ecm$tag: 19 slaves, in OP" "$work/robot.log" ||
+  { robot_log; fail "the robot service did not bring the ring's 19 slaves to OP"; }
+grep -q "refused" "$work/robot.log" && { robot_log; fail "the robot service refused something"; }
+echo "ok: concert_robot --backend ethercat: $(grep -o 'robot@[^ ]* ready at model version [0-9]*' "$work/status.out")"
 echo "PASS"

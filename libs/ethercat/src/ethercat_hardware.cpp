@@ -1,5 +1,7 @@
 #include "concert/ethercat/ethercat_hardware.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <set>
 
 namespace concert::ethercat {
@@ -14,7 +16,13 @@ EthercatHardware::EthercatHardware(Link& link, ProcessDataCatalog process_data, 
   master_.request_state(report_, esc::AlState::kOp);
 }
 
-void EthercatHardware::bind_joints(const std::vector<std::pair<std::string, int32_t>>& joints) {
+void EthercatHardware::prepare_joints(const std::vector<std::pair<std::string, int32_t>>& joints) {
+  {
+    std::lock_guard lock(binding_mutex_);
+    if (prepared_generation_ > 0 && joints == prepared_) return;
+  }
+  // report_, image_'s layout and process_data_ are fixed from the constructor on: read here
+  // from any thread.
   std::vector<Joint> bound;
   std::set<int32_t> boards;
   for (const auto& [name, robot_id] : joints) {
@@ -61,11 +69,39 @@ void EthercatHardware::bind_joints(const std::vector<std::pair<std::string, int3
       throw hardware::HardwareError(where + ": " + e.what());
     }
   }
-  joints_ = std::move(bound);
-  names_.clear();
-  for (const Joint& j : joints_) names_.push_back(j.name);
-  enabled_.assign(joints_.size(), false);
-  ++generation_;
+  Binding b;
+  b.joints = std::move(bound);
+  for (const Joint& j : b.joints) b.names.push_back(j.name);
+  b.enabled.assign(b.joints.size(), false);
+  std::optional<Binding> freed;
+  std::lock_guard lock(binding_mutex_);
+  freed.swap(retired_);
+  b.generation = ++prepared_generation_;
+  prepared_ = joints;
+  pending_ = std::move(b);
+}
+
+void EthercatHardware::bind_joints(const std::vector<std::pair<std::string, int32_t>>& joints) {
+  prepare_joints(joints);
+  switch_prepared();
+}
+
+hardware::MountedHardware EthercatHardware::mounted() const {
+  std::lock_guard lock(binding_mutex_);
+  if (pending_) return {pending_->generation, pending_->names};
+  return {generation_, names_};
+}
+
+bool EthercatHardware::switch_prepared() {
+  std::lock_guard lock(binding_mutex_);
+  if (!pending_) return false;
+  joints_.swap(pending_->joints);
+  names_.swap(pending_->names);
+  enabled_.swap(pending_->enabled);
+  generation_ = pending_->generation;
+  retired_.swap(pending_);  // retired_ was emptied by prepare_joints(): nothing freed here
+  pending_.reset();         // an empty optional after the swap above
+  return true;
 }
 
 void EthercatHardware::read(hardware::HardwareState& state) {
@@ -95,6 +131,40 @@ void EthercatHardware::write(const std::vector<hardware::DriveCommand>& commands
     joints_[j].codec.encode(commands[j], true,
                             std::span<uint8_t>(image_.outputs).subspan(s.output_offset, s.output_bytes));
   }
+}
+
+std::vector<std::pair<std::string, int32_t>> joint_robot_ids(const std::string& config_yaml) {
+  std::vector<std::pair<std::string, int32_t>> out;
+  YAML::Node root;
+  try {
+    root = YAML::Load(config_yaml);
+  } catch (const YAML::Exception& e) {
+    throw hardware::HardwareError("the model's controller configuration: " + std::string(e.what()));
+  }
+  const YAML::Node joints = root.IsMap() ? root["joints"] : YAML::Node();
+  if (!joints || !joints.IsSequence()) {
+    throw hardware::HardwareError("the model's controller configuration has no `joints` list");
+  }
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const YAML::Node j = joints[i];
+    const std::string where = "the model's controller configuration, joints[" + std::to_string(i) + "]";
+    if (!j.IsMap() || !j["name"] || !j["name"].IsScalar()) throw hardware::HardwareError(where + ": no name");
+    const std::string name = j["name"].as<std::string>();
+    int32_t id = -1;
+    try {
+      if (j["robot_id"]) id = j["robot_id"].as<int32_t>();
+    } catch (const YAML::Exception&) {
+      throw hardware::HardwareError(where + " '" + name + "': robot_id '" + j["robot_id"].as<std::string>() +
+                                    "' is no integer");
+    }
+    if (id < 0) {
+      throw hardware::HardwareError(where + " '" + name +
+                                    "': no robot_id (the module tree the model was generated from gave none, "
+                                    "so no drive board can be found for the joint)");
+    }
+    out.emplace_back(name, id);
+  }
+  return out;
 }
 
 void EthercatHardware::step(double dt) {

@@ -1,8 +1,10 @@
 // concert_robot: the robot service (XBot2's role). Simulated hardware by default.
 //   concert_robot (--assembly FILE | --urdf FILE) [--module-db DIR ...] [--world FILE]
-//                 [--backend sim|ethercat] [--fast] [--duration S] [--ee-frame LINK]
+//                 [--backend sim] [--fast] [--duration S] [--ee-frame LINK]
 //                 [--standalone] [--fifo PRIORITY] [--package NAME=DIR ...] [--safety-timeout S] [--params FILE]
 //                 [--keep-swaps]
+//   concert_robot --backend ethercat --ifname IF [--process-data FILE] [--duration S] [--ee-frame LINK]
+//                 [--fifo PRIORITY] [--safety-timeout S] [--params FILE]
 // --params: YAML with sections robot, sim, loop, node (config/robot.yaml); flags override it.
 // --assembly and --world are the initial robot and world; later ones come as SimCommands over
 // DDS (`concert sim swap FILE`, `concert sim world FILE`, from any host), and the world it
@@ -25,6 +27,8 @@
 #include "concert/cli/stop_signals.hpp"
 #include "concert/common/text.hpp"
 #include "concert/dds/participant.hpp"
+#include "concert/ethercat/ethercat_hardware.hpp"
+#include "concert/ethercat/link.hpp"
 #include "concert/sim/sim_assembly.hpp"
 #include "concert/sim/sim_hardware.hpp"
 #include "robot/loop.hpp"
@@ -38,6 +42,8 @@ namespace {
 
 struct Options {
   std::string backend{"sim"};
+  std::string ifname;        // ethercat: the ring's network interface
+  std::string process_data;  // ethercat: process data of each board type
   std::string assembly;
   std::string urdf;
   std::vector<std::filesystem::path> module_dbs;
@@ -122,6 +128,12 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--backend", o.backend, "hardware backend")
       ->type_name("sim|ethercat")
       ->default_str("sim");
+  app.add_option("--ifname", o.ifname, "ethercat: the network interface of the ring")
+      ->type_name("IF");
+  app.add_option("--process-data", o.process_data,
+                 "ethercat: process data of each board type (default: the project's "
+                 "data/module_db/process_data.yaml)")
+      ->type_name("FILE");
   app.add_flag("--fast", o.fast, "run as fast as possible (simulated time only)");
   app.add_option("--duration", o.duration,
                  "stop after S seconds of loop time (0: run until stopped)")
@@ -158,13 +170,22 @@ void add_options(CLI::App& app, Options& o) {
 
 /// Checks of the parsed options that involve several of them.
 void check(Options& o) {
-  if (o.backend == "ethercat") {
-    throw concert::cli::UsageError(
-        "backend 'ethercat' is not written yet: the master is (libs/ethercat; `concert scan read`, "
-        "`concert ethercat cycle`), the robot cannot run on it yet; see services/robot/README.md");
-  }
-  if (o.backend != "sim") {
+  if (o.backend != "sim" && o.backend != "ethercat") {
     throw concert::cli::UsageError("unknown backend '" + o.backend + "' (sim or ethercat)");
+  }
+  if (o.backend == "ethercat") {
+    // The ring is the robot: no simulated robot, world or model of its own.
+    if (o.ifname.empty()) throw concert::cli::UsageError("--backend ethercat needs --ifname IF (the ring's interface)");
+    for (const auto& [given, flag] : {std::pair{!o.assembly.empty(), "--assembly"}, {!o.urdf.empty(), "--urdf"},
+                                      {!o.world.empty(), "--world"}, {o.standalone, "--standalone"},
+                                      {o.keep_swaps, "--keep-swaps"}, {o.fast, "--fast"}}) {
+      if (given) throw concert::cli::UsageError(std::string(flag) + " is the simulator's: not with --backend ethercat");
+    }
+    if (o.process_data.empty()) o.process_data = CONCERT_DEFAULT_PROCESS_DATA;
+    return;
+  }
+  if (!o.ifname.empty() || !o.process_data.empty()) {
+    throw concert::cli::UsageError("--ifname and --process-data are the ethercat backend's (--backend ethercat)");
   }
   if (o.assembly.empty() == o.urdf.empty()) {
     throw concert::cli::UsageError("give exactly one of --assembly FILE or --urdf FILE");
@@ -218,7 +239,76 @@ std::thread timing_reporter(const concert::robot::Loop& loop, double period, con
   });
 }
 
+/// The loop until stopped (signal, --duration), with the publisher that hands its state to DDS
+/// and the timing reporter; `sensors` (none without sensors) follows the model version.
+void run_loop(concert::robot::RobotCore& core, concert::robot::dds::RobotNode& node,
+              concert::robot::dds::SensorPublisher* sensors, const concert::robot::dds::ServiceParams& service,
+              const Options& options) {
+  using namespace concert;
+  const robot::RobotParams& params = service.robot;
+  // Off the loop thread: the publisher hands the loop's state to DDS.
+  std::atomic<bool> stopping{false};
+  std::thread publisher([&] {
+    std::uint64_t last = 0;
+    auto next = std::chrono::steady_clock::now();
+    while (!stopping.load()) {
+      const robot::RobotState state = core.state();
+      if (state.cycle != last) {
+        last = state.cycle;
+        node.publish(state);
+        if (sensors != nullptr) sensors->set_model_version(static_cast<std::uint32_t>(state.model_version));
+      }
+      next += std::chrono::microseconds(static_cast<long>(1e6 * params.period));
+      std::this_thread::sleep_until(next);
+    }
+  });
+  robot::Loop loop(service.loop, [&] { core.cycle(); });
+  g_loop = &loop;
+  concert::cli::on_stop_signals(on_signal);
+  const auto cycles = options.duration > 0.0 ? static_cast<std::uint64_t>(options.duration / params.period)
+                                              : std::numeric_limits<std::uint64_t>::max();
+  std::thread timing = timing_reporter(loop, params.period, stopping);
+  robot::LoopStats stats;
+  try {
+    stats = loop.run(cycles);
+  } catch (...) {
+    g_loop = nullptr;
+    stopping = true;
+    publisher.join();
+    timing.join();
+    throw;
+  }
+  g_loop = nullptr;
+  stopping = true;
+  publisher.join();
+  timing.join();
+  std::cerr << "concert_robot: stopped: "
+            << robot::simulated_time_line({}, {stats.cycles, stats.overruns}, stats.wall_time, params.period) << "\n";
+}
+
+/// The robot on an EtherCAT ring: the master scans it and brings it to OP (every drive
+/// disabled), publishes the scan, and binds the joints of each model modelgen sends to the drive
+/// boards by their modules' robot_ids (a joint with no board refuses the model, naming it).
+int run_ethercat(const Options& options) {
+  using namespace concert;
+  ethercat::RawSocketLink link(options.ifname);
+  ethercat::EthercatHardware hw(link, ethercat::ProcessDataCatalog::load(options.process_data));
+  const ethercat::ScanReport& report = hw.scan();
+  std::cerr << "concert_robot: ethercat on " << options.ifname << ": " << report.slaves.size()
+            << " slaves, in OP, every drive disabled until a model binds its joints" << std::endl;
+  robot::dds::ServiceParams service = service_params(options);
+  robot::RobotCore core(hw, service.robot);
+  concert::dds::Participant participant({.name = "robot"});
+  robot::dds::RobotNode node(participant, core, service.node, [&hw](const model::ModelDescription& d) {
+    hw.prepare_joints(ethercat::joint_robot_ids(d.config_yaml));
+  });
+  node.publish_scan(report.scan(), "ethercat " + options.ifname);
+  run_loop(core, node, nullptr, service, options);
+  return 0;
+}
+
 int run(const Options& options) {
+  if (options.backend == "ethercat") return run_ethercat(options);
   using namespace concert;
   {
     std::optional<sim::AssemblyBuilder> builder;
@@ -250,23 +340,6 @@ int run(const Options& options) {
       node.apply_model(simulated.urdf, 1, options.ee_frame);
     }
 
-    const robot::LoopParams& loop_params = service.loop;
-    // Off the loop thread: the publisher hands the loop's state to DDS.
-    std::atomic<bool> stopping{false};
-    std::thread publisher([&] {
-      std::uint64_t last = 0;
-      auto next = std::chrono::steady_clock::now();
-      while (!stopping.load()) {
-        const robot::RobotState state = core.state();
-        if (state.cycle != last) {
-          last = state.cycle;
-          node.publish(state);
-          sensors.set_model_version(static_cast<std::uint32_t>(state.model_version));
-        }
-        next += std::chrono::microseconds(static_cast<long>(1e6 * params.period));
-        std::this_thread::sleep_until(next);
-      }
-    });
     // Hot swaps and world changes come as SimCommands over DDS (`concert sim swap/world`):
     // prepared on the sim node's worker thread, switched in by the loop at a cycle boundary.
     robot::dds::SimNode sim_node(
@@ -278,19 +351,7 @@ int run(const Options& options) {
         },
         options.keep_swaps ? robot::dds::SimNode::Keep{options.assembly, options.world}
                            : robot::dds::SimNode::Keep{});
-    robot::Loop loop(loop_params, [&] { core.cycle(); });
-    g_loop = &loop;
-    concert::cli::on_stop_signals(on_signal);
-    const auto cycles = options.duration > 0.0 ? static_cast<std::uint64_t>(options.duration / params.period)
-                                                : std::numeric_limits<std::uint64_t>::max();
-    std::thread timing = timing_reporter(loop, params.period, stopping);
-    const robot::LoopStats stats = loop.run(cycles);
-    g_loop = nullptr;
-    stopping = true;
-    publisher.join();
-    timing.join();
-    std::cerr << "concert_robot: stopped: "
-              << robot::simulated_time_line({}, {stats.cycles, stats.overruns}, stats.wall_time, params.period) << "\n";
+    run_loop(core, node, &sensors, service, options);
   }
   return 0;
 }

@@ -1,6 +1,6 @@
 // concert_robot as a process: it publishes the simulated bus scan and the world, and
 // SimCommands over DDS (what `concert sim swap/world` send) hot-swap the assembly or change
-// the world, or are refused with the reason.
+// the world, or are refused with the reason. The ethercat backend's command-line errors are named.
 #include <gtest/gtest.h>
 
 #include <signal.h>
@@ -8,6 +8,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
+#include <tuple>
+#include <utility>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -220,6 +223,39 @@ TEST(RobotMain, SimCommandsSwapTheAssemblyAndChangeTheWorld) {
   EXPECT_NE(reply->message().find("walk.yaml: route: expected x, y pairs [m], at least one (got 1 numbers) (line 2)"),
             std::string::npos)
       << reply->message();
+}
+
+}  // namespace
+
+namespace {
+
+// The command's exit code and what it printed (stdout and stderr).
+std::pair<int, std::string> run_robot(const std::string& args) {
+  const std::string command = std::string(ROBOT_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return {-1, "popen failed"};
+  std::string out;
+  char buffer[512];
+  while (fgets(buffer, sizeof buffer, pipe) != nullptr) out += buffer;
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+// The ethercat backend's command line: the interface required, the simulator's flags refused,
+// an interface that is not there named.
+TEST(RobotMain, TheEthercatBackendNamesWhatIsWrongWithItsArguments) {
+  auto [code, out] = run_robot("--backend ethercat");
+  EXPECT_EQ(code, 2) << out;
+  EXPECT_NE(out.find("--backend ethercat needs --ifname IF"), std::string::npos) << out;
+  std::tie(code, out) = run_robot("--backend ethercat --ifname lo --assembly " + kPaperRobot.string());
+  EXPECT_EQ(code, 2) << out;
+  EXPECT_NE(out.find("--assembly is the simulator's: not with --backend ethercat"), std::string::npos) << out;
+  std::tie(code, out) = run_robot("--assembly " + kPaperRobot.string() + " --ifname lo");
+  EXPECT_EQ(code, 2) << out;
+  EXPECT_NE(out.find("--ifname and --process-data are the ethercat backend's"), std::string::npos) << out;
+  std::tie(code, out) = run_robot("--backend ethercat --ifname ecnosuch0");
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_NE(out.find("ecnosuch0"), std::string::npos) << out;
 }
 
 }  // namespace

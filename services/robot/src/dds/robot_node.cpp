@@ -15,10 +15,11 @@ namespace concert::robot::dds {
 
 namespace cdds = concert::dds;
 
-RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams params)
+RobotNode::RobotNode(cdds::Participant& participant, RobotCore& core, NodeParams params, ModelHook before_model)
     : participant_(participant),
       core_(core),
       params_(std::move(params)),
+      before_model_(std::move(before_model)),
       status_(participant, params_.service_name),
       joint_state_(participant, cdds::topics::joint_state),
       odometry_(participant, cdds::topics::odometry),
@@ -157,11 +158,13 @@ void RobotNode::on_model(const msg::RobotModel& m) {
       built = model::RobotModel::build(model::dds::to_description(m));
     } catch (const std::exception& e) {
       if (m.chains().empty()) {
+        if (before_model_) before_model_(model::dds::to_description(m));
         core_.set_model(m.urdf(), m.version());
         return model::LimitsTable{};
       }
       throw ModelMismatchError(e.what());
     }
+    if (before_model_) before_model_(built->description());
     core_.set_model(built);
     return built->limits();
   });

@@ -3,12 +3,14 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
 
 #include "concert/dds/endpoint.hpp"
 #include "concert/dds/status_reporter.hpp"
+#include "concert/model/description.hpp"
 #include "concert/topology/types.hpp"
 #include "robot/robot_core.hpp"
 #include "robot/safety_watchdog.hpp"
@@ -41,7 +43,12 @@ std::string tool_end_effector(const msg::RobotModel& model);
 /// status topic with the core's message; the last good model stays.
 class RobotNode {
  public:
-  RobotNode(concert::dds::Participant& participant, RobotCore& core, NodeParams params = {});
+  /// Called with each model from the model topic before the core takes it (the ethercat backend
+  /// binds its joints to drive boards there); what it throws refuses the model.
+  using ModelHook = std::function<void(const model::ModelDescription&)>;
+
+  RobotNode(concert::dds::Participant& participant, RobotCore& core, NodeParams params = {},
+            ModelHook before_model = {});
   ~RobotNode();
   RobotNode(const RobotNode&) = delete;
   RobotNode& operator=(const RobotNode&) = delete;
@@ -73,6 +80,7 @@ class RobotNode {
   concert::dds::Participant& participant_;
   RobotCore& core_;
   NodeParams params_;
+  ModelHook before_model_;
   concert::dds::StatusReporter status_;
   concert::dds::Writer<msg::JointState> joint_state_;
   concert::dds::Writer<msg::Odometry> odometry_;

@@ -4,6 +4,8 @@
 // robot service's `ethercat` backend stands on (services/robot/README.md).
 
 #include <cstdint>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,12 +29,22 @@ class EthercatHardware final : public hardware::Hardware {
   /// The ring as scanned (for concert/ethercat/scan).
   const ScanReport& scan() const { return report_; }
 
-  /// Binds joints to drive boards by robot_id (joint name, robot_id of its module), in the
-  /// order given (the hardware order from now on); generation() increases. Throws
-  /// hardware::HardwareError naming the joint and the slave: no board with that robot_id, a
-  /// board that is no drive (or whose process data is smaller than a drive's), two boards with
-  /// the robot_id, two joints on one board. Nothing changes then.
+  /// Any thread: prepares the binding of joints to drive boards by robot_id (joint name,
+  /// robot_id of its module), in the order given (the hardware order once switched);
+  /// mounted() reports it from now on and the control thread's switch_prepared() runs it.
+  /// Throws hardware::HardwareError naming the joint and the slave: no board with that robot_id,
+  /// a board that is no drive (or whose process data is smaller than a drive's), two boards
+  /// with the robot_id, two joints on one board. Nothing changes then. The binding prepared
+  /// last again (a new version of the same robot's model) changes nothing either.
+  void prepare_joints(const std::vector<std::pair<std::string, int32_t>>& joints);
+  /// prepare_joints() and switch_prepared() at once (the control thread, or before it runs).
   void bind_joints(const std::vector<std::pair<std::string, int32_t>>& joints);
+
+  /// Any thread: the binding prepared last (else the running one).
+  [[nodiscard]] hardware::MountedHardware mounted() const override;
+  /// Control thread, at a cycle boundary: runs the binding prepared last; every drive of it
+  /// starts disabled until its first command. Swaps buffers, allocates nothing.
+  bool switch_prepared() override;
 
   [[nodiscard]] std::string backend() const override { return "ethercat"; }
   [[nodiscard]] const std::vector<std::string>& joint_names() const override { return names_; }
@@ -57,6 +69,12 @@ class EthercatHardware final : public hardware::Hardware {
     std::size_t slave = 0;  // index into image_.slaves
     DriveCodec codec;
   };
+  struct Binding {
+    std::vector<Joint> joints;
+    std::vector<std::string> names;
+    std::vector<bool> enabled;
+    uint64_t generation = 0;
+  };
   Master master_;
   ProcessDataCatalog process_data_;
   ScanReport report_;
@@ -65,9 +83,22 @@ class EthercatHardware final : public hardware::Hardware {
   std::vector<std::string> names_;
   std::vector<bool> enabled_;
   uint64_t generation_ = 0;
+  // The binding other threads prepared, not yet switched to; the one switched away from waits
+  // in retired_ to be freed off the control thread (by the next prepare_joints()).
+  mutable std::mutex binding_mutex_;
+  std::optional<Binding> pending_;
+  std::optional<Binding> retired_;
+  uint64_t prepared_generation_ = 0;
+  std::vector<std::pair<std::string, int32_t>> prepared_;  // what the binding prepared last was made from
   uint64_t cycle_faults_ = 0;
   double time_ = 0;
   CycleResult last_;
 };
+
+/// The joints of a model's controller configuration (modelgen's controller.yaml: `joints`, each
+/// with `name` and `robot_id`) with their modules' robot_ids, in file order: what
+/// bind_joints() takes. Throws hardware::HardwareError naming the joint without a robot_id (a
+/// model generated from a tree the scan gave no robot_ids) or the YAML's fault.
+std::vector<std::pair<std::string, int32_t>> joint_robot_ids(const std::string& config_yaml);
 
 }  // namespace concert::ethercat
