@@ -341,13 +341,50 @@ TEST(MissionTree, APlacementsOrderCountsOnlyTheHolesStillToDrill) {
   EXPECT_THAT(fake.calls_of("drill"), ElementsAre("drill 0 blob 3 0.050", "drill 0 blob 2 0.050"));
 }
 
+// What the sensors showed at the first survey may stand in the way only then: a hole judged
+// unreachable is asked once more after the area's other holes were drilled (the robot stands
+// elsewhere), and drilled if reachable then.
+TEST(MissionTree, AnUnreachableHoleIsAskedAgainAfterTheOthersWereDrilled) {
+  FakePorts fake(1);
+  fake.verdicts["0 blob 2"] = {Reach::kUnreachable, "no posture: obstacles kept the camera off the task"};
+  fake.on_call = [&fake](const std::string& call) {
+    if (call == "drill 0 blob 1 0.050") fake.verdicts.clear();
+  };
+  MissionTree tree(mission_of(1), fake);
+  ASSERT_EQ(run(tree, fake), MissionState::kSucceeded) << tree.report().reason;
+  EXPECT_THAT(fake.calls_of("survey"), ElementsAre("survey 0 2", "survey 0 1"));
+  EXPECT_THAT(fake.calls_of("place"), ElementsAre("place 0 1", "place 0 1"));
+  EXPECT_THAT(fake.calls_of("drill"), ElementsAre("drill 0 blob 1 0.050", "drill 0 blob 2 0.050"));
+  const MissionReport& r = tree.report();
+  EXPECT_EQ(r.areas[0].state, AreaState::kDone);
+  EXPECT_EQ(r.areas[0].holes[1].state, HoleState::kDrilled);
+  EXPECT_EQ(r.areas[0].holes[1].reach.reach, Reach::kReachable);
+  EXPECT_EQ(r.holes_drilled(), 2);
+}
+
+// Asked again only once, and only when a hole of the area was drilled: with none drilled the
+// robot has not moved.
+TEST(MissionTree, NoHoleDrilledNoSecondSurvey) {
+  FakePorts fake(1);
+  fake.verdicts["0 blob 1"] = {Reach::kUnreachable, "no posture"};
+  fake.verdicts["0 blob 2"] = {Reach::kUnreachable, "no posture"};
+  MissionTree tree(mission_of(1), fake);
+  ASSERT_EQ(run(tree, fake), MissionState::kFailed);
+  EXPECT_THAT(fake.calls_of("survey"), ElementsAre("survey 0 2"));
+  EXPECT_THAT(fake.calls_of("place"), IsEmpty());
+  EXPECT_THAT(fake.calls_of("drill"), IsEmpty());
+  EXPECT_EQ(tree.report().areas[0].reason, "2 of 2 holes unreachable (hole 'blob 1': no posture)");
+}
+
 TEST(MissionTree, HolesTheSurveyFindsUnreachableAreReportedNotAttempted) {
   FakePorts fake(2);
   fake.verdicts["0 blob 2"] = {Reach::kUnreachable, "no posture: J3_E 163.9 N m over 160 continuous"};
   fake.verdicts["1 blob 1"] = {Reach::kUnknown, "the planner refused: another model"};
   MissionTree tree(mission_of(2), fake);
   ASSERT_EQ(run(tree, fake), MissionState::kFailed);
-  EXPECT_THAT(fake.calls_of("survey"), ElementsAre("survey 0 2", "survey 1 2"));
+  // Area 0's unreachable hole is asked once more after its other hole was drilled; still
+  // unreachable, nothing is placed for it.
+  EXPECT_THAT(fake.calls_of("survey"), ElementsAre("survey 0 2", "survey 0 1", "survey 1 2"));
   EXPECT_THAT(fake.calls_of("place"), ElementsAre("place 0 1", "place 1 2")) << "placed for the reachable only";
   EXPECT_THAT(fake.calls_of("drill"),
               ElementsAre("drill 0 blob 1 0.050", "drill 1 blob 1 0.050", "drill 1 blob 2 0.050"));
@@ -731,14 +768,32 @@ TEST(MissionTree, DescribesItsShape) {
             "      execute (action)\n"
             "      plan the next area (action)\n"
             "      detect (action)\n"
-            "      survey (action)\n"
-            "      place (action)\n"
-            "      holes (for each)\n"
-            "        hole (finally)\n"
-            "          align and drill (sequence)\n"
-            "            align (action)\n"
-            "            drill (action)\n"
-            "          retract (action)\n"
+            "      survey and drill (sequence)\n"
+            "        survey (action)\n"
+            "        drill the reachable holes (fallback)\n"
+            "          no hole reachable (condition)\n"
+            "          place and drill (sequence)\n"
+            "            place (action)\n"
+            "            holes (for each)\n"
+            "              hole (finally)\n"
+            "                align and drill (sequence)\n"
+            "                  align (action)\n"
+            "                  drill (action)\n"
+            "                retract (action)\n"
+            "      survey again (fallback)\n"
+            "        nothing to ask again (condition)\n"
+            "        survey and drill again (sequence)\n"
+            "          survey again (action)\n"
+            "          drill the reachable holes (fallback)\n"
+            "            no hole reachable (condition)\n"
+            "            place and drill (sequence)\n"
+            "              place (action)\n"
+            "              holes (for each)\n"
+            "                hole (finally)\n"
+            "                  align and drill (sequence)\n"
+            "                    align (action)\n"
+            "                    drill (action)\n"
+            "                  retract (action)\n"
             "  stow the arm if anything moved (fallback)\n"
             "    nothing moved (condition)\n"
             "    stow the arm (action)\n");

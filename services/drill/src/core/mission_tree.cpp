@@ -99,6 +99,7 @@ struct MissionTree::Impl {
     for (const auto& spec : mission.areas) report.areas.push_back({.name = spec.name});
     drilled_before.resize(mission.areas.size());
     plan_started.resize(mission.areas.size(), false);
+    asked_again.resize(mission.areas.size(), false);
     root = build();
   }
 
@@ -108,6 +109,7 @@ struct MissionTree::Impl {
   std::unique_ptr<bt::Node> root;
   std::vector<std::vector<Eigen::Vector3d>> drilled_before;  // per area: hole origins [m]
   std::vector<bool> plan_started;                            // per area
+  std::vector<bool> asked_again;  // per area: its unreachable holes were surveyed a second time
   std::vector<DrillPoint> detected;
   std::vector<std::size_t> surveying;   // the area's holes surveyed (report indices)
   std::vector<std::size_t> placing;     // the area's holes placed for (report indices)
@@ -223,60 +225,71 @@ struct MissionTree::Impl {
         [this] { ports.detect(current_area, mission.areas[current_area], area().located); },
         [this] { return detection(); }, Step::kDetect);
 
-    // Which holes the robot can reach at all, before anything moves for them: the others are
-    // reported with the planner's reason and not attempted.
-    auto survey = action(
-        "survey", Work::kPlan,
-        [this] {
-          surveying = pending_holes();
-          ports.classify(current_area, pending_points());
-        },
-        [this] { return surveyed(); }, Step::kSurvey);
-
-    // One base placement for the area's holes (drill/placement.hpp), before the first.
-    auto place = action(
-        "place", Work::kDrill,
-        [this] {
-          moved = true;
-          placing = pending_holes();
-          hole_order.clear();
-          ports.place(current_area, pending_points());
-        },
-        [this] { return placed(); }, Step::kPlace);
-
-    auto align = action(
-        "align", Work::kDrill,
-        [this] {
-          moved = true;
-          ports.align(hole().point);
-        },
-        [this] { return ports.alignment(); }, Step::kAlign);
-    auto drill = action(
-        "drill", Work::kDrill, [this] { ports.drill(hole().point, mission.depth); },
-        [this] { return ports.drilling(); }, Step::kDrill);
-    auto retract = action(
-        "retract", Work::kDrill, [this] { ports.retract(); }, [this] { return retraction(); },
-        Step::kRetract);
-    auto hole_body = std::make_unique<bt::Finally>(
-        "hole", hidden(sequence("align and drill", std::move(align), std::move(drill))),
-        std::move(retract));
-    bt::ForEach::Hooks hole_hooks{
-        .items = [this] { return ordered_holes(); },
-        .label = [this](std::size_t i) { return quoted("hole", area().holes[i].point.label); },
-        .begin =
-            [this](std::size_t i) {
-              current_hole = i;
-              hole_active = true;
-            },
-        .end = [this](std::size_t, bt::Status status,
-                      const std::string& why) { return hole_done(status, why); }};
-    auto holes =
-        std::make_unique<bt::ForEach>("holes", std::move(hole_hooks), hidden(std::move(hole_body)));
+    // Which holes the robot can reach at all, before anything moves for them (the others are
+    // reported with the planner's reason and not attempted), one base placement for the
+    // reachable ones (drill/placement.hpp), and each of those aligned, drilled and retracted.
+    const auto survey_and_drill = [&](const std::string& pass) {
+      auto survey = action(
+          "survey" + pass, Work::kPlan,
+          [this] {
+            surveying = pending_holes();
+            ports.classify(current_area, pending_points());
+          },
+          [this] { return surveyed(); }, Step::kSurvey);
+      auto place = action(
+          "place", Work::kDrill,
+          [this] {
+            moved = true;
+            placing = pending_holes();
+            hole_order.clear();
+            ports.place(current_area, pending_points());
+          },
+          [this] { return placed(); }, Step::kPlace);
+      auto align = action(
+          "align", Work::kDrill,
+          [this] {
+            moved = true;
+            ports.align(hole().point);
+          },
+          [this] { return ports.alignment(); }, Step::kAlign);
+      auto drill = action(
+          "drill", Work::kDrill, [this] { ports.drill(hole().point, mission.depth); },
+          [this] { return ports.drilling(); }, Step::kDrill);
+      auto retract = action(
+          "retract", Work::kDrill, [this] { ports.retract(); }, [this] { return retraction(); },
+          Step::kRetract);
+      auto hole_body = std::make_unique<bt::Finally>(
+          "hole", hidden(sequence("align and drill", std::move(align), std::move(drill))),
+          std::move(retract));
+      bt::ForEach::Hooks hole_hooks{
+          .items = [this] { return ordered_holes(); },
+          .label = [this](std::size_t i) { return quoted("hole", area().holes[i].point.label); },
+          .begin =
+              [this](std::size_t i) {
+                current_hole = i;
+                hole_active = true;
+              },
+          .end = [this](std::size_t, bt::Status status,
+                        const std::string& why) { return hole_done(status, why); }};
+      auto holes =
+          std::make_unique<bt::ForEach>("holes", std::move(hole_hooks), hidden(std::move(hole_body)));
+      auto drill_reachable = bt::fallback(
+          "drill the reachable holes", std::make_unique<bt::Condition>("no hole reachable", [this] { return pending_holes().empty(); }),
+          hidden(sequence("place and drill", std::move(place), std::move(holes))));
+      return hidden(sequence("survey and drill" + pass, std::move(survey), hidden(std::move(drill_reachable))));
+    };
+    // The holes the first survey judged unreachable, asked once more after the area's other
+    // holes were drilled: the robot then stands elsewhere, and the planner's map of what is
+    // around it is new (what the sensors saw at the first survey may have been in the way only
+    // then).
+    auto again = bt::fallback(
+        "survey again",
+        std::make_unique<bt::Condition>("nothing to ask again", [this] { return !reopen_unreachable(); }),
+        survey_and_drill(" again"));
 
     auto area_body =
         sequence("area", hidden(std::move(navigate)), std::move(plan), std::move(execute),
-                 std::move(plan_next), std::move(detect), std::move(survey), std::move(place),
-                 std::move(holes));
+                 std::move(plan_next), std::move(detect), survey_and_drill(""), hidden(std::move(again)));
     auto areas = for_each_area(
         "areas", true,
         [this](std::size_t, bt::Status status, const std::string& why) {
@@ -406,6 +419,27 @@ struct MissionTree::Impl {
       }
     }
     return Outcome::succeeded();
+  }
+
+  // The area's holes the survey skipped as unreachable back to pending, once per area and only
+  // when one of its holes was drilled since (the robot moved); true if there were any.
+  bool reopen_unreachable() {
+    if (!fatal.empty() || asked_again[current_area]) return false;
+    auto& holes = area().holes;
+    const bool drilled = std::any_of(holes.begin(), holes.end(),
+                                     [](const HoleReport& h) { return h.state == HoleState::kDrilled; });
+    if (!drilled) return false;
+    bool any = false;
+    for (HoleReport& h : holes) {
+      if (h.state == HoleState::kSkipped && h.reach.reach == Reach::kUnreachable) {
+        h.state = HoleState::kPending;
+        h.reason.clear();
+        h.reach = HoleReach{};
+        any = true;
+      }
+    }
+    asked_again[current_area] = any;
+    return any;
   }
 
   // A placement that failed left the whole body somewhere along its move: held there, and the
