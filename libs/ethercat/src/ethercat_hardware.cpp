@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <set>
 
 namespace concert::ethercat {
@@ -20,6 +21,10 @@ void EthercatHardware::prepare_joints(const std::vector<std::pair<std::string, i
   {
     std::lock_guard lock(binding_mutex_);
     if (prepared_generation_ > 0 && joints == prepared_) return;
+  }
+  std::set<std::string> names;
+  for (const auto& [name, robot_id] : joints) {
+    if (!names.insert(name).second) throw hardware::HardwareError("joint '" + name + "' is listed twice");
   }
   // report_, image_'s layout and process_data_ are fixed from the constructor on: read here
   // from any thread.
@@ -75,10 +80,14 @@ void EthercatHardware::prepare_joints(const std::vector<std::pair<std::string, i
   b.enabled.assign(b.joints.size(), false);
   std::optional<Binding> freed;
   std::lock_guard lock(binding_mutex_);
+  // Another thread may have prepared the same binding meanwhile.
+  if (prepared_generation_ > 0 && joints == prepared_) return;
   freed.swap(retired_);
   b.generation = ++prepared_generation_;
   prepared_ = joints;
   pending_ = std::move(b);
+  mounted_generation_.store(pending_->generation, std::memory_order_release);
+  has_pending_.store(true, std::memory_order_release);
 }
 
 void EthercatHardware::bind_joints(const std::vector<std::pair<std::string, int32_t>>& joints) {
@@ -93,14 +102,27 @@ hardware::MountedHardware EthercatHardware::mounted() const {
 }
 
 bool EthercatHardware::switch_prepared() {
+  // Locks only when a binding waits: the other threads' work under the lock (copies, frees)
+  // does not delay the cycles in between.
+  if (!has_pending_.load(std::memory_order_acquire)) return false;
   std::lock_guard lock(binding_mutex_);
   if (!pending_) return false;
   joints_.swap(pending_->joints);
   names_.swap(pending_->names);
   enabled_.swap(pending_->enabled);
   generation_ = pending_->generation;
+  // A board of the old binding that the new one leaves out is told to stop: its last command
+  // (maybe a torque) would otherwise stay in the outputs.
+  for (const Joint& old : pending_->joints) {
+    const bool kept = std::any_of(joints_.begin(), joints_.end(), [&](const Joint& j) { return j.slave == old.slave; });
+    if (kept) continue;
+    const ProcessImageSlave& s = image_.slaves[old.slave];
+    old.codec.encode(hardware::DriveCommand{}, false,
+                     std::span<uint8_t>(image_.outputs).subspan(s.output_offset, s.output_bytes));
+  }
   retired_.swap(pending_);  // retired_ was emptied by prepare_joints(): nothing freed here
   pending_.reset();         // an empty optional after the swap above
+  has_pending_.store(false, std::memory_order_release);
   return true;
 }
 
@@ -154,7 +176,7 @@ std::vector<std::pair<std::string, int32_t>> joint_robot_ids(const std::string& 
     try {
       if (j["robot_id"]) id = j["robot_id"].as<int32_t>();
     } catch (const YAML::Exception&) {
-      throw hardware::HardwareError(where + " '" + name + "': robot_id '" + j["robot_id"].as<std::string>() +
+      throw hardware::HardwareError(where + " '" + name + "': robot_id '" + YAML::Dump(j["robot_id"]) +
                                     "' is no integer");
     }
     if (id < 0) {

@@ -362,6 +362,21 @@ TEST(MissionTree, AnUnreachableHoleIsAskedAgainAfterTheOthersWereDrilled) {
   EXPECT_EQ(r.holes_drilled(), 2);
 }
 
+// A second survey that fails leaves the hole as the first judged it: not drilled blind.
+TEST(MissionTree, ASecondSurveyThatFailsKeepsTheFirstVerdict) {
+  FakePorts fake(1);
+  fake.verdicts["0 blob 2"] = {Reach::kUnreachable, "no posture"};
+  fake.scripts["survey 0 1"] = {1.0, "the planner is gone"};
+  MissionTree tree(mission_of(1), fake);
+  ASSERT_EQ(run(tree, fake), MissionState::kFailed);
+  EXPECT_THAT(fake.calls_of("survey"), ElementsAre("survey 0 2", "survey 0 1"));
+  EXPECT_THAT(fake.calls_of("drill"), ElementsAre("drill 0 blob 1 0.050"));
+  const HoleReport& h = tree.report().areas[0].holes[1];
+  EXPECT_EQ(h.state, HoleState::kSkipped);
+  EXPECT_EQ(h.reach.reach, Reach::kUnreachable);
+  EXPECT_EQ(h.reason, "unreachable: no posture");
+}
+
 // Asked again only once, and only when a hole of the area was drilled: with none drilled the
 // robot has not moved.
 TEST(MissionTree, NoHoleDrilledNoSecondSurvey) {

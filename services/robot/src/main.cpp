@@ -18,6 +18,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -246,6 +247,7 @@ void run_loop(concert::robot::RobotCore& core, concert::robot::dds::RobotNode& n
               const Options& options) {
   using namespace concert;
   const robot::RobotParams& params = service.robot;
+  robot::Loop loop(service.loop, [&] { core.cycle(); });
   // Off the loop thread: the publisher hands the loop's state to DDS.
   std::atomic<bool> stopping{false};
   std::thread publisher([&] {
@@ -262,20 +264,20 @@ void run_loop(concert::robot::RobotCore& core, concert::robot::dds::RobotNode& n
       std::this_thread::sleep_until(next);
     }
   });
-  robot::Loop loop(service.loop, [&] { core.cycle(); });
   g_loop = &loop;
   concert::cli::on_stop_signals(on_signal);
   const auto cycles = options.duration > 0.0 ? static_cast<std::uint64_t>(options.duration / params.period)
                                               : std::numeric_limits<std::uint64_t>::max();
-  std::thread timing = timing_reporter(loop, params.period, stopping);
+  std::thread timing;
   robot::LoopStats stats;
   try {
+    timing = timing_reporter(loop, params.period, stopping);
     stats = loop.run(cycles);
   } catch (...) {
     g_loop = nullptr;
     stopping = true;
     publisher.join();
-    timing.join();
+    if (timing.joinable()) timing.join();
     throw;
   }
   g_loop = nullptr;
@@ -300,7 +302,18 @@ int run_ethercat(const Options& options) {
   robot::RobotCore core(hw, service.robot);
   concert::dds::Participant participant({.name = "robot"});
   robot::dds::RobotNode node(participant, core, service.node, [&hw](const model::ModelDescription& d) {
-    hw.prepare_joints(ethercat::joint_robot_ids(d.config_yaml));
+    const auto ids = ethercat::joint_robot_ids(d.config_yaml);
+    // The core refuses a model whose joints are not the mounted ones: checked here, before the
+    // binding changes.
+    std::set<std::string> configured, modelled;
+    for (const auto& [name, id] : ids) configured.insert(name);
+    for (const model::JointLimits& j : d.joints) modelled.insert(j.name);
+    if (configured != modelled) {
+      throw hardware::HardwareError("the model's controller configuration names " + std::to_string(configured.size()) +
+                                    " joints, its limits table " + std::to_string(modelled.size()) +
+                                    ": not the same joints");
+    }
+    hw.prepare_joints(ids);
   });
   node.publish_scan(report.scan(), "ethercat " + options.ifname);
   run_loop(core, node, nullptr, service, options);

@@ -110,6 +110,7 @@ struct MissionTree::Impl {
   std::vector<std::vector<Eigen::Vector3d>> drilled_before;  // per area: hole origins [m]
   std::vector<bool> plan_started;                            // per area
   std::vector<bool> asked_again;  // per area: its unreachable holes were surveyed a second time
+  std::vector<std::pair<std::size_t, HoleReport>> reopened;  // those holes as the first survey left them
   std::vector<DrillPoint> detected;
   std::vector<std::size_t> surveying;   // the area's holes surveyed (report indices)
   std::vector<std::size_t> placing;     // the area's holes placed for (report indices)
@@ -417,7 +418,12 @@ struct MissionTree::Impl {
           h.reason = "unreachable: " + reach[k].why;
         }
       }
+    } else {
+      // A second survey that gave no verdicts leaves its holes as the first one judged them
+      // (not attempted blind).
+      for (const auto& [i, before] : reopened) area().holes[i] = before;
     }
+    reopened.clear();
     return Outcome::succeeded();
   }
 
@@ -430,8 +436,11 @@ struct MissionTree::Impl {
                                      [](const HoleReport& h) { return h.state == HoleState::kDrilled; });
     if (!drilled) return false;
     bool any = false;
-    for (HoleReport& h : holes) {
+    reopened.clear();
+    for (std::size_t i = 0; i < holes.size(); ++i) {
+      HoleReport& h = holes[i];
       if (h.state == HoleState::kSkipped && h.reach.reach == Reach::kUnreachable) {
+        reopened.emplace_back(i, h);
         h.state = HoleState::kPending;
         h.reason.clear();
         h.reach = HoleReach{};

@@ -283,13 +283,15 @@ class RobotCore {
   /// Human-readable reason of an aborted trajectory (names the joint for tracking errors).
   [[nodiscard]] std::string describe(const TrajectoryProgress& progress) const;
 
+  /// Throws ModelMismatchError (`what` first) when `version` is older than the accepted one
+  /// (what set_model() refuses first; checked before anything is prepared for the model).
+  void check_newer(std::uint64_t version, const std::string& what) const;
+
   struct Slot;
   struct Loop;
 
  private:
   struct Shared;
-  // Throws ModelMismatchError (`what` first) when `version` is older than the accepted one.
-  void check_newer(std::uint64_t version, const std::string& what) const;
   // The model installed with its end-effector frame (checked a link of it), legs and limits.
   void install(std::shared_ptr<const kinematics::Model> model, std::uint64_t version, const std::string& ee,
                std::vector<Leg> legs, const model::LimitsTable& limits);

@@ -158,12 +158,15 @@ void RobotNode::on_model(const msg::RobotModel& m) {
       built = model::RobotModel::build(model::dds::to_description(m));
     } catch (const std::exception& e) {
       if (m.chains().empty()) {
+        core_.check_newer(m.version(), "model version " + std::to_string(m.version()));
         if (before_model_) before_model_(model::dds::to_description(m));
         core_.set_model(m.urdf(), m.version());
         return model::LimitsTable{};
       }
       throw ModelMismatchError(e.what());
     }
+    // What the core would refuse first is checked before the hook prepares anything for it.
+    core_.check_newer(m.version(), "model version " + std::to_string(m.version()));
     if (before_model_) before_model_(built->description());
     core_.set_model(built);
     return built->limits();

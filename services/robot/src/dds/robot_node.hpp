@@ -44,7 +44,10 @@ std::string tool_end_effector(const msg::RobotModel& model);
 class RobotNode {
  public:
   /// Called with each model from the model topic before the core takes it (the ethercat backend
-  /// binds its joints to drive boards there); what it throws refuses the model.
+  /// binds its joints to drive boards there); what it throws refuses the model. A model older
+  /// than the running one is refused before it is called; one the core refuses after it (a
+  /// model whose tool frame or legs it cannot use) leaves the hardware as the hook prepared it,
+  /// and the drives hold until a model that matches arrives.
   using ModelHook = std::function<void(const model::ModelDescription&)>;
 
   RobotNode(concert::dds::Participant& participant, RobotCore& core, NodeParams params = {},

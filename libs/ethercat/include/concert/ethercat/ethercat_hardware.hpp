@@ -3,6 +3,7 @@
 // each joint bound to the drive board of its module's robot_id, one LRW per step(). What the
 // robot service's `ethercat` backend stands on (services/robot/README.md).
 
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 #include <optional>
@@ -34,7 +35,7 @@ class EthercatHardware final : public hardware::Hardware {
   /// mounted() reports it from now on and the control thread's switch_prepared() runs it.
   /// Throws hardware::HardwareError naming the joint and the slave: no board with that robot_id,
   /// a board that is no drive (or whose process data is smaller than a drive's), two boards
-  /// with the robot_id, two joints on one board. Nothing changes then. The binding prepared
+  /// with the robot_id, two joints on one board, a joint listed twice. Nothing changes then. The binding prepared
   /// last again (a new version of the same robot's model) changes nothing either.
   void prepare_joints(const std::vector<std::pair<std::string, int32_t>>& joints);
   /// prepare_joints() and switch_prepared() at once (the control thread, or before it runs).
@@ -42,8 +43,13 @@ class EthercatHardware final : public hardware::Hardware {
 
   /// Any thread: the binding prepared last (else the running one).
   [[nodiscard]] hardware::MountedHardware mounted() const override;
+  /// Any thread, without locking: mounted().generation.
+  [[nodiscard]] std::uint64_t mounted_generation() const override {
+    return mounted_generation_.load(std::memory_order_acquire);
+  }
   /// Control thread, at a cycle boundary: runs the binding prepared last; every drive of it
-  /// starts disabled until its first command. Swaps buffers, allocates nothing.
+  /// starts disabled until its first command, and a board the new binding leaves out is
+  /// disabled. Swaps buffers, allocates nothing.
   bool switch_prepared() override;
 
   [[nodiscard]] std::string backend() const override { return "ethercat"; }
@@ -90,6 +96,8 @@ class EthercatHardware final : public hardware::Hardware {
   std::optional<Binding> retired_;
   uint64_t prepared_generation_ = 0;
   std::vector<std::pair<std::string, int32_t>> prepared_;  // what the binding prepared last was made from
+  std::atomic<bool> has_pending_{false};
+  std::atomic<uint64_t> mounted_generation_{0};
   uint64_t cycle_faults_ = 0;
   double time_ = 0;
   CycleResult last_;
