@@ -189,6 +189,25 @@ std::vector<std::pair<std::string, int32_t>> joint_robot_ids(const std::string& 
   return out;
 }
 
+std::vector<std::pair<std::string, int32_t>> model_binding(const std::string& config_yaml,
+                                                           const std::vector<std::string>& modelled) {
+  std::vector<std::pair<std::string, int32_t>> ids = joint_robot_ids(config_yaml);
+  std::set<std::string> configured;
+  for (const auto& [name, id] : ids) configured.insert(name);
+  const std::set<std::string> model(modelled.begin(), modelled.end());
+  for (const std::string& name : model) {
+    if (!configured.count(name)) {
+      throw hardware::HardwareError("joint '" + name + "' of the model is not in its controller configuration");
+    }
+  }
+  for (const std::string& name : configured) {
+    if (!model.count(name)) {
+      throw hardware::HardwareError("joint '" + name + "' of the controller configuration is not in the model");
+    }
+  }
+  return ids;
+}
+
 void EthercatHardware::step(double dt) {
   last_ = master_.cycle(image_);
   if (!last_.returned || last_.wkc != image_.expected_wkc) ++cycle_faults_;

@@ -18,7 +18,6 @@
 #include <limits>
 #include <map>
 #include <optional>
-#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -269,21 +268,21 @@ void run_loop(concert::robot::RobotCore& core, concert::robot::dds::RobotNode& n
   const auto cycles = options.duration > 0.0 ? static_cast<std::uint64_t>(options.duration / params.period)
                                               : std::numeric_limits<std::uint64_t>::max();
   std::thread timing;
+  const auto stop = [&] {
+    g_loop = nullptr;
+    stopping = true;
+    publisher.join();
+    if (timing.joinable()) timing.join();
+  };
   robot::LoopStats stats;
   try {
     timing = timing_reporter(loop, params.period, stopping);
     stats = loop.run(cycles);
   } catch (...) {
-    g_loop = nullptr;
-    stopping = true;
-    publisher.join();
-    if (timing.joinable()) timing.join();
+    stop();
     throw;
   }
-  g_loop = nullptr;
-  stopping = true;
-  publisher.join();
-  timing.join();
+  stop();
   std::cerr << "concert_robot: stopped: "
             << robot::simulated_time_line({}, {stats.cycles, stats.overruns}, stats.wall_time, params.period) << "\n";
 }
@@ -302,18 +301,9 @@ int run_ethercat(const Options& options) {
   robot::RobotCore core(hw, service.robot);
   concert::dds::Participant participant({.name = "robot"});
   robot::dds::RobotNode node(participant, core, service.node, [&hw](const model::ModelDescription& d) {
-    const auto ids = ethercat::joint_robot_ids(d.config_yaml);
-    // The core refuses a model whose joints are not the mounted ones: checked here, before the
-    // binding changes.
-    std::set<std::string> configured, modelled;
-    for (const auto& [name, id] : ids) configured.insert(name);
-    for (const model::JointLimits& j : d.joints) modelled.insert(j.name);
-    if (configured != modelled) {
-      throw hardware::HardwareError("the model's controller configuration names " + std::to_string(configured.size()) +
-                                    " joints, its limits table " + std::to_string(modelled.size()) +
-                                    ": not the same joints");
-    }
-    hw.prepare_joints(ids);
+    std::vector<std::string> joints;
+    for (const model::JointLimits& j : d.joints) joints.push_back(j.name);
+    hw.prepare_joints(ethercat::model_binding(d.config_yaml, joints));
   });
   node.publish_scan(report.scan(), "ethercat " + options.ifname);
   run_loop(core, node, nullptr, service, options);

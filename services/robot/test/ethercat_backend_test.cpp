@@ -128,6 +128,27 @@ TEST(EthercatBackend, RunsTheModelGeneratedFromTheRingsScan) {
   }
   EXPECT_EQ(hw.mounted().generation, 1u);
 
+  // The configuration and the model must name the same joints.
+  std::vector<std::string> modelled;
+  for (const model::JointLimits& j : model->description().joints) modelled.push_back(j.name);
+  EXPECT_EQ(ethercat::model_binding(model->description().config_yaml, modelled), ids);
+  modelled.pop_back();
+  try {
+    (void)ethercat::model_binding(model->description().config_yaml, modelled);
+    ADD_FAILURE() << "a configuration with a joint the model has not was taken";
+  } catch (const hardware::HardwareError& e) {
+    EXPECT_NE(std::string(e.what()).find("of the controller configuration is not in the model"), std::string::npos)
+        << e.what();
+  }
+  modelled.push_back("J_extra");
+  modelled.push_back(model->description().joints.back().name);
+  try {
+    (void)ethercat::model_binding(model->description().config_yaml, modelled);
+    ADD_FAILURE() << "a model with a joint the configuration has not was taken";
+  } catch (const hardware::HardwareError& e) {
+    EXPECT_EQ(std::string(e.what()), "joint 'J_extra' of the model is not in its controller configuration");
+  }
+
   // A configuration without robot_ids (a hand-made tree) names the joint.
   EXPECT_THROW(ethercat::joint_robot_ids("joints:\n  - {name: J1_A}\n"), hardware::HardwareError);
   try {

@@ -109,4 +109,11 @@ class EthercatHardware final : public hardware::Hardware {
 /// model generated from a tree the scan gave no robot_ids) or the YAML's fault.
 std::vector<std::pair<std::string, int32_t>> joint_robot_ids(const std::string& config_yaml);
 
+/// What prepare_joints() takes for a model: joint_robot_ids(config_yaml), checked to name
+/// exactly `modelled` (the model's moving joints, any order), since the robot refuses a model
+/// whose joints are not the mounted ones. Throws hardware::HardwareError naming a joint one
+/// side has and the other not.
+std::vector<std::pair<std::string, int32_t>> model_binding(const std::string& config_yaml,
+                                                           const std::vector<std::string>& modelled);
+
 }  // namespace concert::ethercat
