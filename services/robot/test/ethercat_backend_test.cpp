@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -21,6 +22,7 @@
 #include "concert/sim/sim_hardware.hpp"
 #include "concert/simbus/assembly.hpp"
 #include "concert/topology/reconstruction.hpp"
+#include "concert/topology/scan_io.hpp"
 #include "robot/robot_core.hpp"
 #include "test_data.hpp"
 
@@ -156,6 +158,29 @@ TEST(EthercatBackend, RunsTheModelGeneratedFromTheRingsScan) {
   } catch (const hardware::HardwareError& e) {
     EXPECT_NE(std::string(e.what()).find("joints[0] 'J1_A': no robot_id"), std::string::npos) << e.what();
   }
+}
+
+// The real CONCERT robot's scan (18 ESCs, ../shared/data): the model made from it binds its 14
+// joints to the 14 drive boards (ESC type 21) of that scan, one board each.
+TEST(EthercatBackend, TheRealScansModelBindsEveryJointToOneOfItsDriveBoards) {
+  const std::string db = std::string(CONCERT_SHARED_DATA) + "/concert_resources";
+  const topology::EscScan scan = topology::load_scan(std::string(CONCERT_SHARED_DATA) +
+                                                     "/ethercat/concert_robot_18slaves.yaml");
+  const topology::ModuleTree tree = topology::discover(scan, topology::EscCatalog::load(db));
+  const auto generated = model_generation::ModelGenerator(module_db::load_module_database(db)).generate(tree);
+  std::set<int32_t> drive_boards;
+  for (const topology::EscSlave& s : scan.slaves) {
+    if (s.esc_type == 21) drive_boards.insert(s.robot_id);
+  }
+  ASSERT_EQ(drive_boards.size(), 14u);
+  const auto ids = ethercat::joint_robot_ids(generated.config_yaml);
+  EXPECT_EQ(ids.size(), generated.joints.size());
+  std::set<int32_t> bound;
+  for (const auto& [joint, id] : ids) {
+    EXPECT_TRUE(drive_boards.count(id)) << joint << " has robot_id " << id << ", no drive board of the scan";
+    EXPECT_TRUE(bound.insert(id).second) << "two joints on robot_id " << id;
+  }
+  EXPECT_EQ(bound, drive_boards);
 }
 
 }  // namespace
